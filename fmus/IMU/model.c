@@ -1,0 +1,120 @@
+/* IMU: accelerometer, gyrometer and magnetometer sampled at sample_rate and held (SPEC 3.3).
+ *
+ *   acc = f_B + b_a + n_a
+ *   gyro = omega + b_g + n_g
+ *   magneto = A R^T m_I + b_s + b_d + n_m         (seed 000, eq. 1)
+ *   R_reel = R(q)
+ *
+ * The sample at t_k = k / sample_rate uses the inputs at t_k: it is taken when the outputs
+ * are read after the inputs for t_k were set, or at the latest when a step leaves t_k.
+ * Noise sample k of channel c is a pure function of (seed, k, c), so streams do not depend
+ * on the co-simulation step; its standard deviation is density * sqrt(sample_rate).
+ */
+#include <math.h>
+#include <stdint.h>
+
+#include "variables.h"
+
+#define R(name) (m->real[VR_##name])
+
+enum { CH_ACC = 0, CH_GYRO = 3, CH_MAG = 6, CH_WALK_GYRO = 9, CH_WALK_ACC = 12, N_CHANNELS = 15 };
+
+typedef struct {
+    int64_t next_sample;
+    double gyro_bias[3], acc_bias[3];
+} Data;
+
+const size_t MODEL_DATA_SIZE = sizeof(Data);
+
+static uint64_t splitmix64(uint64_t z) {
+    z += 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* Standard normal draw number `channel` of sample `k` (Box-Muller on two hashed uniforms). */
+static double gaussian(int seed, int64_t k, int channel) {
+    uint64_t key = splitmix64((uint64_t)(uint32_t)seed) ^ ((uint64_t)k * 64u + 2u * (uint64_t)channel);
+    double u1 = ((double)(splitmix64(key) >> 11) + 1.0) * 0x1.0p-53; /* (0, 1] */
+    double u2 = (double)(splitmix64(key ^ 0xD1B54A32D192ED03ull) >> 11) * 0x1.0p-53;
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+static void take_sample(ModelInstance *m, Data *d, int64_t k) {
+    const double *q = &R(q0), *w = &R(omega_x), *f = &R(f_x), *bd = &R(b_d_x);
+    const double *a = &R(A_11), *bs = &R(b_s_x), *mi = &R(m_I_x);
+    double r[9], body[3], sd_acc = 0.0, sd_gyro = 0.0, sd_mag = 0.0, noise[N_CHANNELS];
+    int noisy = m->boolean[VB_noise_enabled], biased = m->boolean[VB_bias_enabled], i, c;
+    double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3];
+    r[0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
+    r[1] = 2.0 * (q1 * q2 - q0 * q3);
+    r[2] = 2.0 * (q1 * q3 + q0 * q2);
+    r[3] = 2.0 * (q1 * q2 + q0 * q3);
+    r[4] = 1.0 - 2.0 * (q1 * q1 + q3 * q3);
+    r[5] = 2.0 * (q2 * q3 - q0 * q1);
+    r[6] = 2.0 * (q1 * q3 - q0 * q2);
+    r[7] = 2.0 * (q2 * q3 + q0 * q1);
+    r[8] = 1.0 - 2.0 * (q1 * q1 + q2 * q2);
+    if (noisy) {
+        double root_rate = sqrt(R(sample_rate));
+        sd_acc = R(acc_noise_density) * root_rate;
+        sd_gyro = R(gyro_noise_density) * root_rate;
+        sd_mag = R(mag_noise_density) * root_rate;
+    }
+    for (c = 0; c < N_CHANNELS; c++) noise[c] = noisy || c >= CH_WALK_GYRO ? gaussian(m->integer[VI_seed], k, c) : 0.0;
+    for (i = 0; i < 3; i++) body[i] = r[i] * mi[0] + r[3 + i] * mi[1] + r[6 + i] * mi[2]; /* R^T m_I */
+    for (i = 0; i < 3; i++) {
+        (&R(acc_x))[i] = f[i] + (biased ? d->acc_bias[i] : 0.0) + sd_acc * noise[CH_ACC + i];
+        (&R(gyro_x))[i] = w[i] + (biased ? d->gyro_bias[i] : 0.0) + sd_gyro * noise[CH_GYRO + i];
+        (&R(magneto_x))[i] = a[3 * i] * body[0] + a[3 * i + 1] * body[1] + a[3 * i + 2] * body[2] + bs[i] +
+                             bd[i] + sd_mag * noise[CH_MAG + i];
+        (&R(gyro_bias_x))[i] = biased ? d->gyro_bias[i] : 0.0;
+        (&R(acc_bias_x))[i] = biased ? d->acc_bias[i] : 0.0;
+    }
+    for (i = 0; i < 9; i++) (&R(R_reel_11))[i] = r[i];
+    /* bias random walk to the next sample */
+    for (i = 0; i < 3; i++) {
+        double root_dt = sqrt(1.0 / R(sample_rate));
+        d->gyro_bias[i] += R(gyro_bias_walk) * root_dt * noise[CH_WALK_GYRO + i];
+        d->acc_bias[i] += R(acc_bias_walk) * root_dt * noise[CH_WALK_ACC + i];
+    }
+}
+
+/* Index of the last sample instant at or before t. */
+static int64_t last_instant(ModelInstance *m, double t) { return (int64_t)floor(t * R(sample_rate) + 1e-6); }
+
+fmi2Status model_initialize(ModelInstance *m) {
+    Data *d = (Data *)m->data;
+    int i;
+    if (!(R(sample_rate) > 0.0) || !isfinite(R(sample_rate))) {
+        log_error(m, "parameter sample_rate = %g Hz must be positive and finite", R(sample_rate));
+        return fmi2Error;
+    }
+    if (!(R(gyro_noise_density) >= 0.0) || !(R(acc_noise_density) >= 0.0) ||
+        !(R(mag_noise_density) >= 0.0) || !(R(gyro_bias_walk) >= 0.0) || !(R(acc_bias_walk) >= 0.0)) {
+        log_error(m, "noise densities and bias walks must be non-negative");
+        return fmi2Error;
+    }
+    for (i = 0; i < 3; i++) {
+        d->gyro_bias[i] = (&R(b_g_x))[i];
+        d->acc_bias[i] = (&R(b_a_x))[i];
+    }
+    d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - 1e-6);
+    return fmi2OK;
+}
+
+fmi2Status model_do_step(ModelInstance *m, double t, double h) {
+    Data *d = (Data *)m->data;
+    /* instants in [t, t + h) are taken now, with the inputs held over the step */
+    int64_t end = (int64_t)ceil((t + h) * R(sample_rate) - 1e-6);
+    while (d->next_sample < end) take_sample(m, d, d->next_sample++);
+    return fmi2OK;
+}
+
+void model_outputs(ModelInstance *m) {
+    Data *d = (Data *)m->data;
+    int64_t due = last_instant(m, m->time);
+    if (!m->inputs_fresh) return;
+    while (d->next_sample <= due) take_sample(m, d, d->next_sample++);
+}

@@ -1,0 +1,72 @@
+"""Variable table of the IMU FMU: accelerometer, gyrometer, magnetometer, and R_reel.
+
+Noise defaults come from datasheets:
+- gyrometer and accelerometer: InvenSense MPU-9250 product specification (PS-MPU-9250A-01
+  rev. 1.1): rate noise spectral density 0.01 deg/s/sqrt(Hz), accelerometer noise power
+  spectral density 300 ug/sqrt(Hz);
+- magnetometer: ST LIS3MDL datasheet (DocID024204 rev. 5), RMS noise 3.2 mgauss on x and y
+  in ultra-high-performance mode at 80 Hz, i.e. 0.32 uT / sqrt(80 Hz) = 3.6e-8 T/sqrt(Hz).
+The gyro bias is the lab's case (seed 002): (0.02, -0.01, 0.015) rad/s.
+"""
+
+import math
+
+from fmus import vehicle as V
+from fmus.variables import Boolean, Integer, Real, Table
+
+_Q = ("q0", "q1", "q2", "q3")
+_W = ("omega_x", "omega_y", "omega_z")
+_F = ("f_x", "f_y", "f_z")
+_B = ("b_d_x", "b_d_y", "b_d_z")
+_AXES = "xyz"
+
+GYRO_NOISE_DENSITY = math.radians(0.01)  # rad/s/sqrt(Hz)
+ACC_NOISE_DENSITY = 300e-6 * 9.80665  # m/s^2/sqrt(Hz)
+MAG_NOISE_DENSITY = 0.32e-6 / math.sqrt(80.0)  # T/sqrt(Hz)
+LAB_GYRO_BIAS = (0.02, -0.01, 0.015)  # rad/s
+
+TABLE = Table(
+    "IMU",
+    "Sampled accelerometer, gyrometer and magnetometer with seeded white noise, biases, soft and "
+    "hard iron and the field of the motor currents; exposes the true rotation R_reel",
+    variables=[
+        Real("q0", "input", 1.0, "1", "true attitude quaternion, scalar part"),
+        Real("q1", "input", 0.0, "1", "true attitude quaternion, x"),
+        Real("q2", "input", 0.0, "1", "true attitude quaternion, y"),
+        Real("q3", "input", 0.0, "1", "true attitude quaternion, z"),
+        *[Real(f"omega_{a}", "input", 0.0, "rad/s", f"true body rate about {a}_B") for a in _AXES],
+        Real("f_x", "input", 0.0, "m/s2", "true specific force along x_B"),
+        Real("f_y", "input", 0.0, "m/s2", "true specific force along y_B"),
+        Real("f_z", "input", -V.GRAVITY, "m/s2", "true specific force along z_B"),
+        *[Real(f"b_d_{a}", "input", 0.0, "T", f"field of the motor currents, {a}_B") for a in _AXES],
+        # parameters
+        Real("sample_rate", "parameter", 1000.0, "Hz", "sampling rate of all three sensors"),
+        Boolean("noise_enabled", "parameter", True, "white measurement noise on"),
+        Boolean("bias_enabled", "parameter", False, "accelerometer and gyrometer biases on"),
+        Integer("seed", "parameter", 1, "seed of the noise generator"),
+        Real("gyro_noise_density", "parameter", GYRO_NOISE_DENSITY, "rad/s/Hz0.5", "gyro white noise density"),
+        Real("acc_noise_density", "parameter", ACC_NOISE_DENSITY, "m/s2/Hz0.5", "accelerometer noise density"),
+        Real("mag_noise_density", "parameter", MAG_NOISE_DENSITY, "T/Hz0.5", "magnetometer noise density"),
+        Real("gyro_bias_walk", "parameter", 0.0, "rad/s2/Hz0.5", "gyro bias random walk density"),
+        Real("acc_bias_walk", "parameter", 0.0, "m/s3/Hz0.5", "accelerometer bias random walk density"),
+        *[Real(f"b_g_{a}", "parameter", LAB_GYRO_BIAS[k], "rad/s", f"initial gyro bias, {a}_B")
+          for k, a in enumerate(_AXES)],
+        *[Real(f"b_a_{a}", "parameter", 0.0, "m/s2", f"initial accelerometer bias, {a}_B") for a in _AXES],
+        *[Real(f"A_{i}{j}", "parameter", 1.0 if i == j else 0.0, "1", f"soft-iron matrix, row {i} column {j}")
+          for i in range(1, 4) for j in range(1, 4)],
+        *[Real(f"b_s_{a}", "parameter", 0.0, "T", f"hard-iron bias, {a}_B") for a in _AXES],
+        *[Real(f"m_I_{a}", "parameter", V.EARTH_FIELD[k], "T", f"Earth field in NED, {'NED'[k]}")
+          for k, a in enumerate(_AXES)],
+        # outputs
+        *[Real(f"acc_{a}", "output", unit="m/s2", description=f"accelerometer, {a}_B", depends=_F) for a in _AXES],
+        *[Real(f"gyro_{a}", "output", unit="rad/s", description=f"gyrometer, {a}_B", depends=_W) for a in _AXES],
+        *[Real(f"magneto_{a}", "output", unit="T", description=f"magnetometer, {a}_B", depends=_Q + _B)
+          for a in _AXES],
+        *[Real(f"R_reel_{i}{j}", "output", unit="1", description=f"true rotation body to NED, ({i},{j})",
+               depends=_Q)
+          for i in range(1, 4) for j in range(1, 4)],
+        *[Real(f"gyro_bias_{a}", "output", unit="rad/s", description=f"true gyro bias, {a}_B") for a in _AXES],
+        *[Real(f"acc_bias_{a}", "output", unit="m/s2", description=f"true accelerometer bias, {a}_B")
+          for a in _AXES],
+    ],
+)

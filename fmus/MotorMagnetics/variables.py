@@ -1,0 +1,44 @@
+"""Variable table of the MotorMagnetics FMU (motors, ESCs, battery, field of the currents)."""
+
+from fmus import vehicle as V
+from fmus.variables import Real, Table
+
+_N = range(1, 5)
+
+TABLE = Table(
+    "MotorMagnetics",
+    "Four DC-approximated brushless motors with ESCs and a LiPo battery; magnetic field of the "
+    "motor currents at the magnetometer",
+    states=9,
+    variables=[
+        *[Real(f"c{n}", "input", 0.0, "1", f"ESC command of motor {n}, saturated to [0, 1]") for n in _N],
+        Real("R_m", "parameter", V.MOTOR_RESISTANCE, "Ohm", "winding resistance"),
+        Real("L_m", "parameter", V.MOTOR_INDUCTANCE, "H", "winding inductance"),
+        Real("k_e", "parameter", V.MOTOR_KE, "V.s/rad", "back-EMF and torque constant"),
+        Real("J_r", "parameter", V.ROTOR_INERTIA, "kg.m2", "rotor and propeller inertia"),
+        Real("k_m", "parameter", V.DRAG_TORQUE_COEFF, "N.m.s2", "propeller drag torque coefficient"),
+        Real("n_cells", "parameter", float(V.BATTERY_CELLS), "1", "LiPo cells in series"),
+        Real("capacity", "parameter", V.BATTERY_CAPACITY, "A.s", "battery capacity"),
+        Real("R_b", "parameter", V.BATTERY_RESISTANCE, "Ohm", "battery internal resistance"),
+        Real("soc0", "parameter", V.BATTERY_SOC0, "1", "initial state of charge"),
+        *[Real(f"ocv{k}", "parameter", c, "V", f"cell open-circuit voltage, coefficient of soc^{k}")
+          for k, c in enumerate(V.CELL_OCV_COEFFS)],
+        *[Real(f"kappa{n}", "parameter", V.MOTOR_FIELD_GAIN[n - 1], "T/A", f"field per ampere of motor {n}")
+          for n in _N],
+        *[Real(f"v{n}_{a}", "parameter", V.MOTOR_FIELD_DIRECTION[n - 1][k], "1",
+               f"direction of the field of motor {n}, {a} component (normalised)")
+          for n in _N for k, a in enumerate("xyz")],
+        Real("sub_step", "parameter", 1e-3, "s", "largest internal step of the exponential integrator"),
+        # outputs
+        *[Real(f"omega_r{n}", "output", unit="rad/s", description=f"speed of rotor {n}") for n in _N],
+        Real("b_d_x", "output", unit="T", description="field of the motor currents at the magnetometer, x_B"),
+        Real("b_d_y", "output", unit="T", description="field of the motor currents at the magnetometer, y_B"),
+        Real("b_d_z", "output", unit="T", description="field of the motor currents at the magnetometer, z_B"),
+        Real("u_batt", "output", unit="V", description="battery terminal voltage"),
+        *[Real(f"i{n}", "output", unit="A", description=f"current of motor {n}") for n in _N],
+        Real("i_batt", "output", unit="A", description="battery current"),
+        Real("soc", "output", unit="1", description="battery state of charge"),
+        *[Real(f"b_d{n}_{a}", "output", unit="T", description=f"field of motor {n} alone, {a}_B")
+          for n in _N for a in "xyz"],
+    ],
+)

@@ -1,0 +1,94 @@
+within QuadCoSim;
+model MotorMagnetics "Four DC-approximated brushless motors, ESCs, LiPo battery, field of the currents"
+  input Real c1 = 0 "ESC command of motor 1, saturated to [0, 1]";
+  input Real c2 = 0 "ESC command of motor 2";
+  input Real c3 = 0 "ESC command of motor 3";
+  input Real c4 = 0 "ESC command of motor 4";
+
+  parameter Real R_m(unit = "Ohm") = 0.10 "winding resistance";
+  parameter Real L_m(unit = "H") = 4.0e-5 "winding inductance";
+  parameter Real k_e(unit = "V.s/rad") = 60/(2*3.141592653589793*920) "back-EMF constant (920 KV)";
+  parameter Real J_r(unit = "kg.m2") = 3.0e-5 "rotor and propeller inertia";
+  parameter Real k_m(unit = "N.m.s2") = 1.6e-7 "propeller drag torque coefficient";
+  parameter Real n_cells = 3 "LiPo cells in series";
+  parameter Real capacity(unit = "A.s") = 7920 "battery capacity (2200 mAh)";
+  parameter Real R_b(unit = "Ohm") = 0.02 "battery internal resistance";
+  parameter Real soc0 = 0.9 "initial state of charge";
+  parameter Real ocv0(unit = "V") = 3.27 "cell open-circuit voltage, constant term";
+  parameter Real ocv1(unit = "V") = 1.53 "cell open-circuit voltage, soc term";
+  parameter Real ocv2(unit = "V") = -2.03 "cell open-circuit voltage, soc^2 term";
+  parameter Real ocv3(unit = "V") = 1.43 "cell open-circuit voltage, soc^3 term";
+  parameter Real kappa1(unit = "T/A") = 1.10e-6 "field per ampere of motor 1";
+  parameter Real kappa2(unit = "T/A") = 0.95e-6 "field per ampere of motor 2";
+  parameter Real kappa3(unit = "T/A") = 1.25e-6 "field per ampere of motor 3";
+  parameter Real kappa4(unit = "T/A") = 1.05e-6 "field per ampere of motor 4";
+  parameter Real v1_x = 0.30;
+  parameter Real v1_y = 0.80;
+  parameter Real v1_z = -0.52;
+  parameter Real v2_x = -0.55;
+  parameter Real v2_y = -0.35;
+  parameter Real v2_z = 0.76;
+  parameter Real v3_x = 0.70;
+  parameter Real v3_y = -0.50;
+  parameter Real v3_z = 0.51;
+  parameter Real v4_x = -0.40;
+  parameter Real v4_y = 0.75;
+  parameter Real v4_z = 0.53;
+
+  output Real omega_r1(unit = "rad/s", start = 0, fixed = true);
+  output Real omega_r2(unit = "rad/s", start = 0, fixed = true);
+  output Real omega_r3(unit = "rad/s", start = 0, fixed = true);
+  output Real omega_r4(unit = "rad/s", start = 0, fixed = true);
+  output Real b_d_x(unit = "T");
+  output Real b_d_y(unit = "T");
+  output Real b_d_z(unit = "T");
+  output Real u_batt(unit = "V") "battery terminal voltage";
+  output Real i1(unit = "A", start = 0, fixed = true);
+  output Real i2(unit = "A", start = 0, fixed = true);
+  output Real i3(unit = "A", start = 0, fixed = true);
+  output Real i4(unit = "A", start = 0, fixed = true);
+  output Real i_batt(unit = "A") "battery current";
+  output Real soc(start = soc0, fixed = true) "state of charge";
+  output Real b_d1_x, b_d1_y, b_d1_z, b_d2_x, b_d2_y, b_d2_z;
+  output Real b_d3_x, b_d3_y, b_d3_z, b_d4_x, b_d4_y, b_d4_z;
+protected
+  Real c1s, c2s, c3s, c4s "saturated commands";
+  parameter Real n1 = sqrt(v1_x^2 + v1_y^2 + v1_z^2);
+  parameter Real n2 = sqrt(v2_x^2 + v2_y^2 + v2_z^2);
+  parameter Real n3 = sqrt(v3_x^2 + v3_y^2 + v3_z^2);
+  parameter Real n4 = sqrt(v4_x^2 + v4_y^2 + v4_z^2);
+equation
+  c1s = min(max(c1, 0), 1);
+  c2s = min(max(c2, 0), 1);
+  c3s = min(max(c3, 0), 1);
+  c4s = min(max(c4, 0), 1);
+  // the ESC draws c_n i_n from the battery and never pushes current back into it
+  i_batt = c1s*max(i1, 0) + c2s*max(i2, 0) + c3s*max(i3, 0) + c4s*max(i4, 0);
+  u_batt = n_cells*(ocv0 + soc*(ocv1 + soc*(ocv2 + soc*ocv3))) - R_b*i_batt;
+  der(soc) = -i_batt/capacity;
+
+  L_m*der(i1) = c1s*u_batt - R_m*i1 - k_e*omega_r1;
+  L_m*der(i2) = c2s*u_batt - R_m*i2 - k_e*omega_r2;
+  L_m*der(i3) = c3s*u_batt - R_m*i3 - k_e*omega_r3;
+  L_m*der(i4) = c4s*u_batt - R_m*i4 - k_e*omega_r4;
+  J_r*der(omega_r1) = k_e*i1 - k_m*omega_r1*abs(omega_r1);
+  J_r*der(omega_r2) = k_e*i2 - k_m*omega_r2*abs(omega_r2);
+  J_r*der(omega_r3) = k_e*i3 - k_m*omega_r3*abs(omega_r3);
+  J_r*der(omega_r4) = k_e*i4 - k_m*omega_r4*abs(omega_r4);
+
+  b_d1_x = kappa1*i1*v1_x/n1;
+  b_d1_y = kappa1*i1*v1_y/n1;
+  b_d1_z = kappa1*i1*v1_z/n1;
+  b_d2_x = kappa2*i2*v2_x/n2;
+  b_d2_y = kappa2*i2*v2_y/n2;
+  b_d2_z = kappa2*i2*v2_z/n2;
+  b_d3_x = kappa3*i3*v3_x/n3;
+  b_d3_y = kappa3*i3*v3_y/n3;
+  b_d3_z = kappa3*i3*v3_z/n3;
+  b_d4_x = kappa4*i4*v4_x/n4;
+  b_d4_y = kappa4*i4*v4_y/n4;
+  b_d4_z = kappa4*i4*v4_z/n4;
+  b_d_x = b_d1_x + b_d2_x + b_d3_x + b_d4_x;
+  b_d_y = b_d1_y + b_d2_y + b_d3_y + b_d4_y;
+  b_d_z = b_d1_z + b_d2_z + b_d3_z + b_d4_z;
+end MotorMagnetics;

@@ -1,0 +1,171 @@
+/* Quadrotor: rigid body of a quad-X multirotor (SPEC 3.1). NED inertial frame, FRD body frame.
+ *
+ *   dp = v
+ *   m dv = m g e3 - R (T e3) - D v            thrust along -z_B
+ *   dq = 0.5 q (x) (0, omega) + k_norm (1 - |q|^2) q
+ *   J domega = -omega x J omega + tau
+ *
+ * State x = (p[3], v[3], q[4], omega[3]); RK4 with sub-steps of at most sub_step.
+ */
+#include <math.h>
+
+#include "airframe.h"
+#include "variables.h"
+
+#define R(name) (m->real[VR_##name])
+
+typedef struct {
+    double x[N_STATES];
+} Data;
+
+const size_t MODEL_DATA_SIZE = sizeof(Data);
+
+/* Thrust and torques of the rotors at the present inputs. */
+static void rotor_forces(ModelInstance *m, double *thrust, double tau[3]) {
+    const double *w = &R(omega_r1);
+    int n;
+    *thrust = 0.0;
+    tau[0] = tau[1] = tau[2] = 0.0;
+    for (n = 0; n < N_MOTORS; n++) {
+        double w2 = w[n] * w[n];
+        double t = R(k_f) * w2;
+        *thrust += t;
+        tau[0] -= R(arm) * ARM_Y[n] * t; /* r x (-t e3) = (-y t, x t, 0) */
+        tau[1] += R(arm) * ARM_X[n] * t;
+        tau[2] += R(k_m) * SPIN[n] * w2;
+    }
+}
+
+/* Body-to-NED rotation R(q) = I + 2 q0 S(qv) + 2 S(qv)^2, row-major. */
+static void rotation(const double *q, double r[9]) {
+    double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3];
+    r[0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
+    r[1] = 2.0 * (q1 * q2 - q0 * q3);
+    r[2] = 2.0 * (q1 * q3 + q0 * q2);
+    r[3] = 2.0 * (q1 * q2 + q0 * q3);
+    r[4] = 1.0 - 2.0 * (q1 * q1 + q3 * q3);
+    r[5] = 2.0 * (q2 * q3 - q0 * q1);
+    r[6] = 2.0 * (q1 * q3 - q0 * q2);
+    r[7] = 2.0 * (q2 * q3 + q0 * q1);
+    r[8] = 1.0 - 2.0 * (q1 * q1 + q2 * q2);
+}
+
+static void derivatives(ModelInstance *m, double t, const double *x, double *dx) {
+    const double *v = x + 3, *q = x + 6, *w = x + 10;
+    double thrust, tau[3], r[9], norm_error;
+    (void)t;
+    if (m->boolean[VB_clamped]) {
+        int i;
+        for (i = 0; i < N_STATES; i++) dx[i] = 0.0;
+        return;
+    }
+    rotor_forces(m, &thrust, tau);
+    rotation(q, r);
+    dx[0] = v[0];
+    dx[1] = v[1];
+    dx[2] = v[2];
+    dx[3] = -thrust / R(m) * r[2] - R(drag) / R(m) * v[0];
+    dx[4] = -thrust / R(m) * r[5] - R(drag) / R(m) * v[1];
+    dx[5] = R(g) - thrust / R(m) * r[8] - R(drag) / R(m) * v[2];
+    norm_error = R(k_norm) * (1.0 - (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]));
+    dx[6] = 0.5 * (-q[1] * w[0] - q[2] * w[1] - q[3] * w[2]) + norm_error * q[0];
+    dx[7] = 0.5 * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1]) + norm_error * q[1];
+    dx[8] = 0.5 * (q[0] * w[1] + q[3] * w[0] - q[1] * w[2]) + norm_error * q[2];
+    dx[9] = 0.5 * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0]) + norm_error * q[3];
+    dx[10] = (tau[0] - (R(Jzz) - R(Jyy)) * w[1] * w[2]) / R(Jxx);
+    dx[11] = (tau[1] - (R(Jxx) - R(Jzz)) * w[2] * w[0]) / R(Jyy);
+    dx[12] = (tau[2] - (R(Jyy) - R(Jxx)) * w[0] * w[1]) / R(Jzz);
+}
+
+fmi2Status model_initialize(ModelInstance *m) {
+    Data *d = (Data *)m->data;
+    double c1, s1, c2, s2, c3, s3;
+    const char *positive[] = {"m", "Jxx", "Jyy", "Jzz", "arm", "k_f", "g", "sub_step"};
+    const double values[] = {R(m), R(Jxx), R(Jyy), R(Jzz), R(arm), R(k_f), R(g), R(sub_step)};
+    unsigned i;
+    for (i = 0; i < sizeof values / sizeof values[0]; i++) {
+        if (!(values[i] > 0.0) || !isfinite(values[i])) {
+            log_error(m, "parameter %s = %g must be positive and finite", positive[i], values[i]);
+            return fmi2Error;
+        }
+    }
+    if (!(R(k_m) >= 0.0) || !(R(drag) >= 0.0) || !(R(k_norm) >= 0.0)) {
+        log_error(m, "parameters k_m = %g, drag = %g and k_norm = %g must be non-negative", R(k_m),
+                  R(drag), R(k_norm));
+        return fmi2Error;
+    }
+    if (R(Jxx) + R(Jyy) < R(Jzz) || R(Jyy) + R(Jzz) < R(Jxx) || R(Jzz) + R(Jxx) < R(Jyy)) {
+        log_error(m, "inertia (%g, %g, %g) violates the triangle inequality of a rigid body",
+                  R(Jxx), R(Jyy), R(Jzz));
+        return fmi2Error;
+    }
+    d->x[0] = R(p_x0);
+    d->x[1] = R(p_y0);
+    d->x[2] = R(p_z0);
+    d->x[3] = R(v_x0);
+    d->x[4] = R(v_y0);
+    d->x[5] = R(v_z0);
+    /* Z-Y-X Euler angles to quaternion */
+    c1 = cos(0.5 * R(theta1_0));
+    s1 = sin(0.5 * R(theta1_0));
+    c2 = cos(0.5 * R(theta2_0));
+    s2 = sin(0.5 * R(theta2_0));
+    c3 = cos(0.5 * R(theta3_0));
+    s3 = sin(0.5 * R(theta3_0));
+    d->x[6] = c3 * c2 * c1 + s3 * s2 * s1;
+    d->x[7] = c3 * c2 * s1 - s3 * s2 * c1;
+    d->x[8] = c3 * s2 * c1 + s3 * c2 * s1;
+    d->x[9] = s3 * c2 * c1 - c3 * s2 * s1;
+    d->x[10] = R(omega_x0);
+    d->x[11] = R(omega_y0);
+    d->x[12] = R(omega_z0);
+    if (m->boolean[VB_clamped]) {
+        for (i = 3; i < 6; i++) d->x[i] = 0.0;
+        for (i = 10; i < 13; i++) d->x[i] = 0.0;
+    }
+    return fmi2OK;
+}
+
+fmi2Status model_do_step(ModelInstance *m, double t, double h) {
+    Data *d = (Data *)m->data;
+    int n = (int)ceil(h / R(sub_step) - 1e-9), k;
+    double hh;
+    if (n < 1) n = 1;
+    hh = h / n;
+    for (k = 0; k < n; k++) rk4_step(m, derivatives, t + k * hh, hh, d->x, N_STATES);
+    return fmi2OK;
+}
+
+void model_outputs(ModelInstance *m) {
+    Data *d = (Data *)m->data;
+    const double *x = d->x;
+    double dx[N_STATES], r[9], thrust, tau[3];
+    int i;
+    derivatives(m, m->time, x, dx);
+    rotor_forces(m, &thrust, tau);
+    rotation(x + 6, r);
+    R(p_x) = x[0];
+    R(p_y) = x[1];
+    R(p_z) = x[2];
+    R(v_x) = x[3];
+    R(v_y) = x[4];
+    R(v_z) = x[5];
+    R(q0) = x[6];
+    R(q1) = x[7];
+    R(q2) = x[8];
+    R(q3) = x[9];
+    R(omega_x) = x[10];
+    R(omega_y) = x[11];
+    R(omega_z) = x[12];
+    /* f_B = R^T (dv - g e3) */
+    for (i = 0; i < 3; i++)
+        (&R(f_x))[i] = r[i] * dx[3] + r[3 + i] * dx[4] + r[6 + i] * (dx[5] - R(g));
+    for (i = 0; i < 9; i++) (&R(R11))[i] = r[i];
+    R(theta1) = atan2(r[7], r[8]);
+    R(theta2) = -asin(fmax(-1.0, fmin(1.0, r[6])));
+    R(theta3) = atan2(r[3], r[0]);
+    R(thrust) = thrust;
+    R(tau_x) = tau[0];
+    R(tau_y) = tau[1];
+    R(tau_z) = tau[2];
+}

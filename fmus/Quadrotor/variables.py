@@ -1,0 +1,70 @@
+"""Variable table of the Quadrotor FMU (rigid body of a quad-X, SPEC section 3.1)."""
+
+from fmus import vehicle as V
+from fmus.variables import Boolean, Real, Table
+
+_F = ("omega_r1", "omega_r2", "omega_r3", "omega_r4")
+
+TABLE = Table(
+    "Quadrotor",
+    "Rigid-body dynamics of a quad-X multirotor, NED/FRD, quaternion attitude",
+    states=13,
+    variables=[
+        # inputs
+        *[Real(f"omega_r{n}", "input", 0.0, "rad/s", f"speed of rotor {n}") for n in range(1, 5)],
+        # parameters
+        Real("m", "parameter", V.MASS, "kg", "mass"),
+        Real("Jxx", "parameter", V.INERTIA[0], "kg.m2", "inertia about x_B"),
+        Real("Jyy", "parameter", V.INERTIA[1], "kg.m2", "inertia about y_B"),
+        Real("Jzz", "parameter", V.INERTIA[2], "kg.m2", "inertia about z_B"),
+        Real("arm", "parameter", V.ARM, "m", "distance from the centre to a rotor axis"),
+        Real("k_f", "parameter", V.THRUST_COEFF, "N.s2", "thrust coefficient, T_n = k_f omega_n^2"),
+        Real("k_m", "parameter", V.DRAG_TORQUE_COEFF, "N.m.s2", "drag torque coefficient"),
+        Real("drag", "parameter", V.LINEAR_DRAG, "N.s/m", "linear translational drag D"),
+        Real("g", "parameter", V.GRAVITY, "m/s2", "gravity along +z of {I}"),
+        Real("k_norm", "parameter", V.QUATERNION_NORM_GAIN, "1/s", "quaternion norm-keeping gain"),
+        Real("sub_step", "parameter", 2e-3, "s", "largest internal RK4 step"),
+        Boolean("clamped", "parameter", False, "body held at its initial pose (rig on the ground)"),
+        Real("p_x0", "parameter", 0.0, "m", "initial north position"),
+        Real("p_y0", "parameter", 0.0, "m", "initial east position"),
+        Real("p_z0", "parameter", 0.0, "m", "initial down position"),
+        Real("v_x0", "parameter", 0.0, "m/s", "initial north velocity"),
+        Real("v_y0", "parameter", 0.0, "m/s", "initial east velocity"),
+        Real("v_z0", "parameter", 0.0, "m/s", "initial down velocity"),
+        Real("theta1_0", "parameter", 0.0, "rad", "initial roll"),
+        Real("theta2_0", "parameter", 0.0, "rad", "initial pitch"),
+        Real("theta3_0", "parameter", 0.0, "rad", "initial yaw"),
+        Real("omega_x0", "parameter", 0.0, "rad/s", "initial body rate about x_B"),
+        Real("omega_y0", "parameter", 0.0, "rad/s", "initial body rate about y_B"),
+        Real("omega_z0", "parameter", 0.0, "rad/s", "initial body rate about z_B"),
+        # outputs; q, omega and f are contiguous, in the order the IMU takes them
+        Real("q0", "output", unit="1", description="attitude quaternion, scalar part"),
+        Real("q1", "output", unit="1", description="attitude quaternion, x"),
+        Real("q2", "output", unit="1", description="attitude quaternion, y"),
+        Real("q3", "output", unit="1", description="attitude quaternion, z"),
+        Real("omega_x", "output", unit="rad/s", description="body rate about x_B"),
+        Real("omega_y", "output", unit="rad/s", description="body rate about y_B"),
+        Real("omega_z", "output", unit="rad/s", description="body rate about z_B"),
+        Real("f_x", "output", unit="m/s2", description="specific force along x_B", depends=_F),
+        Real("f_y", "output", unit="m/s2", description="specific force along y_B", depends=_F),
+        Real("f_z", "output", unit="m/s2", description="specific force along z_B", depends=_F),
+        Real("p_x", "output", unit="m", description="north position"),
+        Real("p_y", "output", unit="m", description="east position"),
+        Real("p_z", "output", unit="m", description="down position"),
+        Real("v_x", "output", unit="m/s", description="north velocity"),
+        Real("v_y", "output", unit="m/s", description="east velocity"),
+        Real("v_z", "output", unit="m/s", description="down velocity"),
+        Real("theta1", "output", unit="rad", description="roll (Z-Y-X Euler)"),
+        Real("theta2", "output", unit="rad", description="pitch (Z-Y-X Euler)"),
+        Real("theta3", "output", unit="rad", description="yaw (Z-Y-X Euler)"),
+        *[
+            Real(f"R{i}{j}", "output", unit="1", description=f"rotation body to NED, row {i} column {j}")
+            for i in range(1, 4)
+            for j in range(1, 4)
+        ],
+        Real("thrust", "output", unit="N", description="total rotor thrust", depends=_F),
+        Real("tau_x", "output", unit="N.m", description="rotor torque about x_B", depends=_F),
+        Real("tau_y", "output", unit="N.m", description="rotor torque about y_B", depends=_F),
+        Real("tau_z", "output", unit="N.m", description="rotor torque about z_B", depends=_F),
+    ],
+)

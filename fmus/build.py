@@ -1,0 +1,99 @@
+"""Build the plant FMUs from source with the system C compiler.
+
+For each model the build stages a source FMU: ``modelDescription.xml`` and ``variables.h``
+generated from the model's variable table, ``airframe.h`` from :mod:`fmus.airframe`, the shared
+shell, the model's equations and the FMI 2.0 headers (taken from the installed fmpy). The
+shared library is then compiled from those staged sources alone, warnings as errors, so
+that the sources shipped in the FMU are known to build.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+from fmus import MODELS, default_fmu_dir
+from fmus.airframe import c_header as airframe_header
+
+HERE = Path(__file__).resolve().parent
+CFLAGS = ["-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden"]
+FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+SOURCE_FILES = ("shell.c", "model.c")
+
+
+class BuildError(RuntimeError):
+    """The C compiler refused a model."""
+
+
+def table(model: str):
+    """The variable table of ``model``."""
+    return importlib.import_module(f"fmus.{model}.variables").TABLE
+
+
+def _fmi_header_dir() -> Path:
+    import fmpy
+
+    path = Path(fmpy.__file__).parent / "c-code"
+    if not (path / FMI_HEADERS[0]).exists():
+        raise BuildError(f"the FMI 2.0 headers are missing from fmpy ({path}); reinstall fmpy")
+    return path
+
+
+def build_fmu(model: str, out_dir: Path, compiler: str | None = None) -> Path:
+    """Build ``out_dir/<model>.fmu`` and return its path."""
+    compiler = compiler or os.environ.get("CC", "cc")
+    stage = out_dir / model
+    if stage.exists():
+        shutil.rmtree(stage)
+    sources = stage / "sources"
+    binaries = stage / "binaries" / "linux64"
+    sources.mkdir(parents=True)
+    binaries.mkdir(parents=True)
+
+    tab = table(model)
+    for name in FMI_HEADERS:
+        shutil.copy(_fmi_header_dir() / name, sources / name)
+    shutil.copy(HERE / "c" / "shell.c", sources / "shell.c")
+    shutil.copy(HERE / "c" / "shell.h", sources / "shell.h")
+    shutil.copy(HERE / model / "model.c", sources / "model.c")
+    (sources / "variables.h").write_text(tab.c_header())
+    (sources / "airframe.h").write_text(airframe_header())
+    (stage / "modelDescription.xml").write_text(tab.model_description(list(SOURCE_FILES)))
+
+    library = binaries / f"{model}.so"
+    command = [compiler, *CFLAGS, "-shared", "-I", str(sources), "-o", str(library)]
+    command += [str(sources / s) for s in SOURCE_FILES] + ["-lm"]
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise BuildError(f"{model}: {' '.join(command)}\n{done.stderr}")
+
+    fmu = out_dir / f"{model}.fmu"
+    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
+        for path in sorted(stage.rglob("*")):
+            if path.is_file():
+                archive.write(path, path.relative_to(stage).as_posix())
+    return fmu
+
+
+def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) -> list[Path]:
+    """Build every plant FMU into ``out_dir`` (default ``build/fmus``)."""
+    out_dir = Path(out_dir or default_fmu_dir())
+    out_dir.mkdir(parents=True, exist_ok=True)
+    built = []
+    for model in models:
+        built.append(build_fmu(model, out_dir))
+        if verbose:
+            print(f"built {built[-1]}")
+    return built
+
+
+if __name__ == "__main__":
+    try:
+        build_all(sys.argv[1] if len(sys.argv) > 1 else None)
+    except BuildError as error:
+        sys.exit(str(error))

@@ -1,0 +1,459 @@
+/* FMI 2.0 Co-Simulation shell: state machine, get/set by value reference, logging, status.
+ * No model-specific code lives here; see shell.h for what a model provides. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "variables.h"
+
+#define UNUSED(x) (void)(x)
+
+static void vlog(ModelInstance *m, fmi2Status status, const char *category, const char *format,
+                 va_list args) {
+    char message[1024];
+    if (!m || !m->callbacks || !m->callbacks->logger) return;
+    if (status == fmi2OK && !m->logging_on) return;
+    vsnprintf(message, sizeof message, format, args);
+    m->callbacks->logger(m->callbacks->componentEnvironment, m->instance_name, status, category,
+                         "%s", message);
+}
+
+void log_error(ModelInstance *m, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    vlog(m, fmi2Error, "logStatusError", format, args);
+    va_end(args);
+}
+
+void log_warning(ModelInstance *m, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    vlog(m, fmi2Warning, "logStatusWarning", format, args);
+    va_end(args);
+}
+
+void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, int n) {
+    double k1[64], k2[64], k3[64], k4[64], tmp[64];
+    int i;
+    f(m, t, x, k1);
+    for (i = 0; i < n; i++) tmp[i] = x[i] + 0.5 * h * k1[i];
+    f(m, t + 0.5 * h, tmp, k2);
+    for (i = 0; i < n; i++) tmp[i] = x[i] + 0.5 * h * k2[i];
+    f(m, t + 0.5 * h, tmp, k3);
+    for (i = 0; i < n; i++) tmp[i] = x[i] + h * k3[i];
+    f(m, t + h, tmp, k4);
+    for (i = 0; i < n; i++) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+}
+
+static fmi2Status fail(ModelInstance *m, const char *function, const char *format, ...) {
+    char message[900];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    log_error(m, "%s: %s", function, message);
+    return fmi2Error;
+}
+
+static int allowed(ModelInstance *m, const char *function, unsigned modes) {
+    if (!m) return 0;
+    if ((1u << m->mode) & modes) return 1;
+    fail(m, function, "not allowed in the present state (mode %d)", (int)m->mode);
+    return 0;
+}
+
+#define ANY_MODE 0x1Fu
+#define BEFORE_STEPPING ((1u << MODE_INSTANTIATED) | (1u << MODE_INITIALIZATION))
+#define INITIALIZED ((1u << MODE_STEPPING) | (1u << MODE_TERMINATED))
+
+/* Index of the first non-finite Real variable, or -1. */
+static int first_non_finite(ModelInstance *m) {
+    int i;
+    for (i = 0; i < N_REAL; i++)
+        if (!isfinite(m->real[i])) return i;
+    return -1;
+}
+
+static void reset_values(ModelInstance *m) {
+    int i;
+    for (i = 0; i < N_REAL; i++) m->real[i] = REAL_INFO[i].start;
+    for (i = 0; i < N_INTEGER; i++) m->integer[i] = (int)INTEGER_INFO[i].start;
+    for (i = 0; i < N_BOOLEAN; i++) m->boolean[i] = BOOLEAN_INFO[i].start != 0.0;
+    memset(m->data, 0, MODEL_DATA_SIZE);
+    m->time = 0.0;
+    m->outputs_stale = 1;
+    m->inputs_fresh = 1;
+}
+
+/* ---------------------------------------------------------------- common functions */
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    UNUSED(nCategories);
+    UNUSED(categories);
+    if (!m) return fmi2Error;
+    m->logging_on = loggingOn;
+    return fmi2OK;
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation,
+                              const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                              fmi2Boolean loggingOn) {
+    ModelInstance *m;
+    UNUSED(fmuResourceLocation);
+    UNUSED(visible);
+    if (!functions || !functions->logger) return NULL;
+    if (!instanceName || !*instanceName) instanceName = MODEL_NAME;
+    if (fmuType != fmi2CoSimulation) {
+        functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: %s supports Co-Simulation only", MODEL_NAME);
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, MODEL_GUID) != 0) {
+        functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: GUID %s does not match %s; rebuild the FMU",
+                          fmuGUID ? fmuGUID : "(null)", MODEL_GUID);
+        return NULL;
+    }
+    m = (ModelInstance *)calloc(1, sizeof(ModelInstance));
+    if (!m) return NULL;
+    m->instance_name = (char *)malloc(strlen(instanceName) + 1);
+    if (m->instance_name) strcpy((char *)m->instance_name, instanceName);
+    m->callbacks = functions;
+    m->logging_on = loggingOn;
+    m->real = (double *)calloc(N_REAL > 0 ? N_REAL : 1, sizeof(double));
+    m->integer = (int *)calloc(N_INTEGER > 0 ? N_INTEGER : 1, sizeof(int));
+    m->boolean = (fmi2Boolean *)calloc(N_BOOLEAN > 0 ? N_BOOLEAN : 1, sizeof(fmi2Boolean));
+    m->data = calloc(1, MODEL_DATA_SIZE > 0 ? MODEL_DATA_SIZE : 1);
+    if (!m->instance_name || !m->real || !m->integer || !m->boolean || !m->data) {
+        fmi2FreeInstance(m);
+        return NULL;
+    }
+    reset_values(m);
+    m->mode = MODE_INSTANTIATED;
+    return m;
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    ModelInstance *m = (ModelInstance *)c;
+    if (!m) return;
+    free((void *)m->instance_name);
+    free(m->real);
+    free(m->integer);
+    free(m->boolean);
+    free(m->data);
+    free(m);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    ModelInstance *m = (ModelInstance *)c;
+    UNUSED(toleranceDefined);
+    UNUSED(tolerance);
+    UNUSED(stopTimeDefined);
+    UNUSED(stopTime);
+    if (!allowed(m, "fmi2SetupExperiment", 1u << MODE_INSTANTIATED)) return fmi2Error;
+    m->time = startTime;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    ModelInstance *m = (ModelInstance *)c;
+    if (!allowed(m, "fmi2EnterInitializationMode", 1u << MODE_INSTANTIATED)) return fmi2Error;
+    m->mode = MODE_INITIALIZATION;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    ModelInstance *m = (ModelInstance *)c;
+    fmi2Status status;
+    int bad;
+    if (!allowed(m, "fmi2ExitInitializationMode", 1u << MODE_INITIALIZATION)) return fmi2Error;
+    status = model_initialize(m);
+    if (status > fmi2Warning) {
+        m->mode = MODE_ERROR;
+        return status;
+    }
+    model_outputs(m);
+    m->outputs_stale = 0;
+    bad = first_non_finite(m);
+    if (bad >= 0) {
+        m->mode = MODE_ERROR;
+        return fail(m, "fmi2ExitInitializationMode", "%s is not finite after initialization",
+                    REAL_INFO[bad].name);
+    }
+    m->mode = MODE_STEPPING;
+    return status;
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) {
+    ModelInstance *m = (ModelInstance *)c;
+    if (!allowed(m, "fmi2Terminate", 1u << MODE_STEPPING | 1u << MODE_ERROR)) return fmi2Error;
+    m->mode = MODE_TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c) {
+    ModelInstance *m = (ModelInstance *)c;
+    if (!m) return fmi2Error;
+    reset_values(m);
+    m->mode = MODE_INSTANTIATED;
+    return fmi2OK;
+}
+
+/* ---------------------------------------------------------------- get and set */
+static fmi2Status check_refs(ModelInstance *m, const char *function, const fmi2ValueReference vr[],
+                             size_t nvr, int count) {
+    size_t i;
+    if (nvr > 0 && !vr) return fail(m, function, "null value reference array");
+    for (i = 0; i < nvr; i++) {
+        if ((int)vr[i] >= count) return fail(m, function, "unknown value reference %u", vr[i]);
+    }
+    return fmi2OK;
+}
+
+static fmi2Status check_settable(ModelInstance *m, const char *function, const VariableInfo *info) {
+    if (info->causality == CAUSALITY_PARAMETER && m->mode != MODE_INSTANTIATED &&
+        m->mode != MODE_INITIALIZATION)
+        return fail(m, function, "parameter %s can only be set before initialization ends",
+                    info->name);
+    if (info->causality == CAUSALITY_OUTPUT || info->causality == CAUSALITY_LOCAL)
+        return fail(m, function, "%s is an output and cannot be set", info->name);
+    return fmi2OK;
+}
+
+static void refresh_outputs(ModelInstance *m) {
+    if (m->outputs_stale && m->mode == MODE_STEPPING) {
+        model_outputs(m);
+        m->outputs_stale = 0;
+    }
+}
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    size_t i;
+    if (!allowed(m, "fmi2GetReal", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
+    if (check_refs(m, "fmi2GetReal", vr, nvr, N_REAL) != fmi2OK) return fmi2Error;
+    refresh_outputs(m);
+    for (i = 0; i < nvr; i++) value[i] = m->real[vr[i]];
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Integer value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    size_t i;
+    if (!allowed(m, "fmi2GetInteger", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
+    if (check_refs(m, "fmi2GetInteger", vr, nvr, N_INTEGER) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++) value[i] = m->integer[vr[i]];
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Boolean value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    size_t i;
+    if (!allowed(m, "fmi2GetBoolean", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
+    if (check_refs(m, "fmi2GetBoolean", vr, nvr, N_BOOLEAN) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++) value[i] = m->boolean[vr[i]];
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         fmi2String value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    UNUSED(vr);
+    UNUSED(value);
+    if (nvr == 0) return fmi2OK;
+    return fail(m, "fmi2GetString", "this model has no String variables");
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                       const fmi2Real value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    size_t i;
+    if (!allowed(m, "fmi2SetReal", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
+    if (check_refs(m, "fmi2SetReal", vr, nvr, N_REAL) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++) {
+        const VariableInfo *info = &REAL_INFO[vr[i]];
+        if (check_settable(m, "fmi2SetReal", info) != fmi2OK) return fmi2Error;
+        if (!isfinite(value[i])) {
+            m->mode = MODE_ERROR;
+            return fail(m, "fmi2SetReal", "%s = %g at t = %g is not a finite number", info->name,
+                        value[i], m->time);
+        }
+    }
+    for (i = 0; i < nvr; i++) m->real[vr[i]] = value[i];
+    m->outputs_stale = 1;
+    m->inputs_fresh = 1;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Integer value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    size_t i;
+    if (!allowed(m, "fmi2SetInteger", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
+    if (check_refs(m, "fmi2SetInteger", vr, nvr, N_INTEGER) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++)
+        if (check_settable(m, "fmi2SetInteger", &INTEGER_INFO[vr[i]]) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++) m->integer[vr[i]] = value[i];
+    m->outputs_stale = 1;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          const fmi2Boolean value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    size_t i;
+    if (!allowed(m, "fmi2SetBoolean", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
+    if (check_refs(m, "fmi2SetBoolean", vr, nvr, N_BOOLEAN) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++)
+        if (check_settable(m, "fmi2SetBoolean", &BOOLEAN_INFO[vr[i]]) != fmi2OK) return fmi2Error;
+    for (i = 0; i < nvr; i++) m->boolean[vr[i]] = value[i] ? fmi2True : fmi2False;
+    m->outputs_stale = 1;
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         const fmi2String value[]) {
+    ModelInstance *m = (ModelInstance *)c;
+    UNUSED(vr);
+    UNUSED(value);
+    if (nvr == 0) return fmi2OK;
+    return fail(m, "fmi2SetString", "this model has no String variables");
+}
+
+/* ---------------------------------------------------------------- unsupported capabilities */
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s) {
+    UNUSED(s);
+    return fail((ModelInstance *)c, "fmi2GetFMUstate", "not supported");
+}
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) {
+    UNUSED(s);
+    return fail((ModelInstance *)c, "fmi2SetFMUstate", "not supported");
+}
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s) {
+    UNUSED(s);
+    return fail((ModelInstance *)c, "fmi2FreeFMUstate", "not supported");
+}
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *size) {
+    UNUSED(s);
+    UNUSED(size);
+    return fail((ModelInstance *)c, "fmi2SerializedFMUstateSize", "not supported");
+}
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte bytes[], size_t size) {
+    UNUSED(s);
+    UNUSED(bytes);
+    UNUSED(size);
+    return fail((ModelInstance *)c, "fmi2SerializeFMUstate", "not supported");
+}
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
+                                   fmi2FMUstate *s) {
+    UNUSED(bytes);
+    UNUSED(size);
+    UNUSED(s);
+    return fail((ModelInstance *)c, "fmi2DeSerializeFMUstate", "not supported");
+}
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                        const fmi2ValueReference z[], size_t nz,
+                                        const fmi2Real dv[], fmi2Real dz[]) {
+    UNUSED(u);
+    UNUSED(nu);
+    UNUSED(z);
+    UNUSED(nz);
+    UNUSED(dv);
+    UNUSED(dz);
+    return fail((ModelInstance *)c, "fmi2GetDirectionalDerivative", "not supported");
+}
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[]) {
+    UNUSED(vr);
+    UNUSED(nvr);
+    UNUSED(order);
+    UNUSED(value);
+    return fail((ModelInstance *)c, "fmi2SetRealInputDerivatives", "not supported");
+}
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[]) {
+    UNUSED(vr);
+    UNUSED(nvr);
+    UNUSED(order);
+    UNUSED(value);
+    return fail((ModelInstance *)c, "fmi2GetRealOutputDerivatives", "not supported");
+}
+fmi2Status fmi2CancelStep(fmi2Component c) {
+    return fail((ModelInstance *)c, "fmi2CancelStep", "doStep is synchronous; nothing to cancel");
+}
+
+/* ---------------------------------------------------------------- stepping */
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                      fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    ModelInstance *m = (ModelInstance *)c;
+    fmi2Status status;
+    int bad;
+    UNUSED(noSetFMUStatePriorToCurrentPoint);
+    if (!allowed(m, "fmi2DoStep", 1u << MODE_STEPPING)) return fmi2Error;
+    if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
+        return fail(m, "fmi2DoStep", "step size %g must be positive and finite", communicationStepSize);
+    if (fabs(currentCommunicationPoint - m->time) > 1e-9 * (1.0 + fabs(m->time)))
+        return fail(m, "fmi2DoStep", "communication point %.12g differs from the model time %.12g",
+                    currentCommunicationPoint, m->time);
+    status = model_do_step(m, currentCommunicationPoint, communicationStepSize);
+    m->time = currentCommunicationPoint + communicationStepSize;
+    m->inputs_fresh = 0;
+    if (status > fmi2Warning) {
+        m->mode = MODE_ERROR;
+        return status;
+    }
+    model_outputs(m);
+    m->outputs_stale = 0;
+    bad = first_non_finite(m);
+    if (bad >= 0) {
+        m->mode = MODE_ERROR;
+        return fail(m, "fmi2DoStep", "%s became %g at t = %g", REAL_INFO[bad].name, m->real[bad],
+                    m->time);
+    }
+    return status;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
+    UNUSED(s);
+    if (!c) return fmi2Error;
+    *value = ((ModelInstance *)c)->mode == MODE_ERROR ? fmi2Error : fmi2OK;
+    return fmi2OK;
+}
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
+    ModelInstance *m = (ModelInstance *)c;
+    if (!m) return fmi2Error;
+    if (s == fmi2LastSuccessfulTime) {
+        *value = m->time;
+        return fmi2OK;
+    }
+    return fail(m, "fmi2GetRealStatus", "status kind %d not supported", (int)s);
+}
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
+    UNUSED(s);
+    UNUSED(value);
+    return fail((ModelInstance *)c, "fmi2GetIntegerStatus", "not supported");
+}
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
+    ModelInstance *m = (ModelInstance *)c;
+    if (!m) return fmi2Error;
+    if (s == fmi2Terminated) {
+        *value = fmi2False;
+        return fmi2OK;
+    }
+    return fail(m, "fmi2GetBooleanStatus", "status kind %d not supported", (int)s);
+}
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
+    UNUSED(s);
+    UNUSED(value);
+    return fail((ModelInstance *)c, "fmi2GetStringStatus", "not supported");
+}

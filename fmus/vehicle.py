@@ -1,0 +1,81 @@
+"""The default vehicle: every physical constant of the plant, in one place, with its unit.
+
+The FMU variable tables take their start values from here, the controller and the mixer
+read the same numbers, and the README quotes them.
+
+Sources
+-------
+- Airframe: a 450 mm quad-X of about 1 kg on 10x4.5 inch propellers and 2212-class
+  920 KV motors (the DJI F450 class). Inertia and thrust/drag coefficients are the values
+  of ../shared/SPEC.md section 3.1, which match published identifications of this class
+  (e.g. Bouabdallah, "Design and control of quadrotors", EPFL thesis 2007, for the
+  order of J; k_f and k_m from static thrust-stand data of 10-inch propellers).
+- Motor: 920 rpm/V gives k_e = 60 / (2 pi 920) V s/rad. Winding resistance and inductance
+  are representative of 2212-class outrunners (0.1 ohm, 40 uH); rotor plus propeller
+  inertia is that of a 10-inch propeller and bell (3e-5 kg m^2).
+- Battery: 3S 2200 mAh LiPo, internal resistance 5 mohm per cell plus wiring.
+- Magnetic perturbation: kappa and directions chosen so that, drone clamped and one motor
+  swept over its range, the uncompensated mean angular error of the measured field is of
+  the order of Table 1 of Metge et al. (seed 000: 10.6 to 11.1 degrees).
+"""
+
+from __future__ import annotations
+
+import math
+
+GRAVITY = 9.81  # m/s^2, along +z of the NED frame {I}
+
+# Earth magnetic field in Paris, as in the lab report (seed 002), NED frame.
+EARTH_FIELD_NORM = 4.7e-5  # T
+EARTH_FIELD_INCLINATION = math.radians(65.0)  # rad, below the horizon
+EARTH_FIELD = (
+    EARTH_FIELD_NORM * math.cos(EARTH_FIELD_INCLINATION),  # T, north
+    0.0,  # T, east
+    EARTH_FIELD_NORM * math.sin(EARTH_FIELD_INCLINATION),  # T, down
+)
+
+# Rigid body
+MASS = 1.0  # kg
+INERTIA = (0.010, 0.010, 0.018)  # kg m^2, diagonal in {B} (Jxx, Jyy, Jzz)
+ARM = 0.225  # m, centre to rotor axis
+THRUST_COEFF = 1.0e-5  # N/(rad/s)^2, k_f: thrust of one rotor = k_f omega^2
+DRAG_TORQUE_COEFF = 1.6e-7  # N m/(rad/s)^2, k_m: reaction torque of one rotor = k_m omega^2
+LINEAR_DRAG = 0.0  # N s/m, optional translational drag D
+QUATERNION_NORM_GAIN = 1.0  # 1/s, gain of the norm-keeping term of dq
+
+# Motors and ESCs (DC-motor approximation of a brushless motor)
+MOTOR_KV = 920.0  # rpm/V
+MOTOR_KE = 60.0 / (2.0 * math.pi * MOTOR_KV)  # V s/rad (= N m/A)
+MOTOR_RESISTANCE = 0.10  # ohm
+MOTOR_INDUCTANCE = 4.0e-5  # H
+ROTOR_INERTIA = 3.0e-5  # kg m^2, rotor bell plus propeller
+
+# Battery
+BATTERY_CELLS = 3  # in series
+BATTERY_CAPACITY = 2.2 * 3600.0  # A s (2200 mAh)
+BATTERY_RESISTANCE = 0.02  # ohm, internal plus wiring
+BATTERY_SOC0 = 0.9  # 1, initial state of charge
+# Open-circuit voltage of one cell against state of charge s in [0, 1]:
+# E_cell(s) = c0 + c1 s + c2 s^2 + c3 s^3, monotone, 4.20 V full, 3.71 V at half, 3.27 V empty.
+CELL_OCV_COEFFS = (3.27, 1.53, -2.03, 1.43)  # V, V, V, V
+
+# Magnetic field of the motor currents at the magnetometer, sensor frame {B}.
+# kappa_n in T/A; v_n unit vectors (normalised by the FMU).
+MOTOR_FIELD_GAIN = (1.10e-6, 0.95e-6, 1.25e-6, 1.05e-6)  # T/A
+MOTOR_FIELD_DIRECTION = (
+    (0.30, 0.80, -0.52),  # 1, unit-less
+    (-0.55, -0.35, 0.76),  # 2, unit-less
+    (0.70, -0.50, 0.51),  # 3, unit-less
+    (-0.40, 0.75, 0.53),  # 4, unit-less
+)
+
+
+def cell_voltage(soc: float) -> float:
+    """Open-circuit voltage of one cell (V) at state of charge ``soc`` (1)."""
+    c0, c1, c2, c3 = CELL_OCV_COEFFS
+    return c0 + soc * (c1 + soc * (c2 + soc * c3))
+
+
+def hover_rotor_speed(mass: float = MASS, thrust_coeff: float = THRUST_COEFF) -> float:
+    """Rotor speed (rad/s) at which four rotors carry ``mass`` (kg)."""
+    return math.sqrt(mass * GRAVITY / (4.0 * thrust_coeff))

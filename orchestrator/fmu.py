@@ -1,0 +1,220 @@
+"""Loading and stepping one FMI 2.0 Co-Simulation FMU through fmpy.
+
+:class:`FMUInstance` does the set-up once (extraction, instantiation, parameters,
+initialization) with clear errors, and then exposes the raw ctypes FMI functions and the
+value references, so that a hot loop can call them with preallocated buffers.
+"""
+
+from __future__ import annotations
+
+import atexit
+import ctypes
+import difflib
+import math
+import shutil
+from collections import deque
+from pathlib import Path
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+
+from fmus import fmu_path
+
+STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
+_extracted: dict[tuple[str, float], str] = {}
+
+
+class FMUError(RuntimeError):
+    """An FMU refused a call: the block, the time, the status and what the FMU logged."""
+
+    def __init__(self, block: str, function: str, status: int, time: float | None, log: list[str]):
+        self.block, self.function, self.status, self.time, self.log = block, function, status, time, log
+        when = "" if time is None else f" at t = {time:.6g} s"
+        logged = "\n  ".join(log[-10:]) if log else "(the FMU logged nothing)"
+        super().__init__(
+            f"{block}: {function} returned {STATUS[status] if 0 <= status < 6 else status}{when}.\n"
+            f"  FMU log:\n  {logged}"
+        )
+
+
+def _unzip(path: Path) -> str:
+    key = (str(path), path.stat().st_mtime)
+    if key not in _extracted:
+        _extracted[key] = extract(str(path))
+    return _extracted[key]
+
+
+@atexit.register
+def _cleanup():
+    for directory in _extracted.values():
+        shutil.rmtree(directory, ignore_errors=True)
+
+
+def nearest(name: str, candidates, n: int = 3) -> str:
+    """``"did you mean a, b?"`` for the candidates closest to ``name``."""
+    close = difflib.get_close_matches(name, list(candidates), n=n, cutoff=0.5)
+    return f" Did you mean {', '.join(close)}?" if close else ""
+
+
+class FMUInstance:
+    """One instantiated and initialized FMU.
+
+    Parameters
+    ----------
+    model : str
+        Name of a built FMU (``"Quadrotor"``, ``"MotorMagnetics"``, ``"IMU"``), found by
+        :func:`fmus.fmu_path`, or a path to an ``.fmu`` file.
+    parameters : dict, optional
+        Overrides of parameter start values, by variable name.
+    name : str, optional
+        Instance (block) name used in messages; defaults to the model name.
+    start_time : float
+        Start time (s).
+    """
+
+    def __init__(self, model: str, parameters: dict | None = None, name: str | None = None,
+                 start_time: float = 0.0):
+        path = Path(model) if str(model).endswith(".fmu") else fmu_path(model)
+        self.name = name or path.stem
+        self.time = start_time
+        self.log: deque[str] = deque(maxlen=200)
+        description = read_model_description(str(path))
+        self.description = description
+        self.variables = {v.name: v for v in description.modelVariables}
+        self.parameters = [v.name for v in description.modelVariables if v.causality == "parameter"]
+        self.inputs = [v.name for v in description.modelVariables if v.causality == "input"]
+        self.outputs = [v.name for v in description.modelVariables if v.causality == "output"]
+        overrides = self._check_parameters(parameters or {})
+
+        self._callbacks = fmi2CallbackFunctions()
+        self._logger = fmi2CallbackLoggerTYPE(self._on_log)
+        self._callbacks.logger = self._logger
+        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(ctypes.CDLL(None).calloc)
+        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(ctypes.CDLL(None).free)
+        from fmpy.logging import addLoggerProxy
+
+        addLoggerProxy(ctypes.byref(self._callbacks))
+
+        self._slave = FMU2Slave(
+            guid=description.guid,
+            unzipDirectory=_unzip(path),
+            modelIdentifier=description.coSimulation.modelIdentifier,
+            instanceName=self.name,
+        )
+        functions = self._slave._functions
+        self.fmi2SetReal = functions["fmi2SetReal"]
+        self.fmi2GetReal = functions["fmi2GetReal"]
+        self.fmi2DoStep = functions["fmi2DoStep"]
+        self._call(lambda: self._slave.instantiate(callbacks=self._callbacks), "fmi2Instantiate")
+        self.component = self._slave.component
+        self._call(lambda: self._slave.setupExperiment(startTime=start_time), "fmi2SetupExperiment")
+        self._call(self._slave.enterInitializationMode, "fmi2EnterInitializationMode")
+        for name, value in overrides.items():
+            self._set_any(name, value)
+        self._call(self._slave.exitInitializationMode, "fmi2ExitInitializationMode")
+        self.closed = False
+
+    # ------------------------------------------------------------------ set-up helpers
+    def _on_log(self, env, instance, status, category, message):
+        label = STATUS[status] if 0 <= status < 6 else status
+        self.log.append(f"[{label}] {message.decode(errors='replace')}")
+
+    def _call(self, function, label: str):
+        from fmpy.fmi1 import FMICallException
+
+        try:
+            function()
+        except FMICallException as error:
+            raise FMUError(self.name, label, error.status, self.time, list(self.log)) from None
+        except Exception as error:
+            if "Failed to instantiate" in str(error):
+                raise FMUError(self.name, label, 3, self.time, list(self.log)) from None
+            raise
+
+    def _check_parameters(self, parameters: dict) -> dict:
+        checked = {}
+        for name, value in parameters.items():
+            variable = self.variables.get(name)
+            if variable is None or variable.causality != "parameter":
+                raise ValueError(
+                    f"{self.name} has no parameter {name!r}.{nearest(name, self.parameters)} "
+                    f"Its parameters are listed by `quadcosim list --parameters {self.name}`."
+                )
+            if variable.type == "Real":
+                value = float(value)
+                if not math.isfinite(value):
+                    raise ValueError(f"{self.name}.{name} = {value} is not a finite number")
+            elif variable.type == "Integer":
+                if int(value) != value:
+                    raise ValueError(f"{self.name}.{name} = {value!r} must be an integer")
+                value = int(value)
+            elif variable.type == "Boolean":
+                if value not in (True, False, 0, 1):
+                    raise ValueError(f"{self.name}.{name} = {value!r} must be true or false")
+                value = bool(value)
+            checked[name] = value
+        return checked
+
+    def _set_any(self, name: str, value):
+        variable = self.variables[name]
+        setter = {"Real": self._slave.setReal, "Integer": self._slave.setInteger,
+                  "Boolean": self._slave.setBoolean}[variable.type]
+        self._call(lambda: setter([variable.valueReference], [value]), f"fmi2Set{variable.type}({name})")
+
+    def vr(self, names) -> np.ndarray:
+        """Value references of Real variables ``names``, as a ctypes-ready uint32 array."""
+        refs = []
+        for name in names:
+            variable = self.variables.get(name)
+            if variable is None:
+                raise KeyError(f"{self.name} has no variable {name!r}.{nearest(name, self.variables)}")
+            if variable.type != "Real":
+                raise TypeError(f"{self.name}.{name} is {variable.type}; only Real signals are wired")
+            refs.append(variable.valueReference)
+        return np.array(refs, dtype=np.uint32)
+
+    # ------------------------------------------------------------------ slow path (by name)
+    def set(self, names, values):
+        refs = self.vr(names)
+        buffer = np.ascontiguousarray(values, dtype=np.float64)
+        status = self.fmi2SetReal(self.component, refs.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
+                                  len(refs), buffer.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        if status > 1:
+            raise FMUError(self.name, "fmi2SetReal", status, self.time, list(self.log))
+
+    def get(self, names) -> np.ndarray:
+        refs = self.vr(names)
+        buffer = np.empty(len(refs))
+        status = self.fmi2GetReal(self.component, refs.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
+                                  len(refs), buffer.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        if status > 1:
+            raise FMUError(self.name, "fmi2GetReal", status, self.time, list(self.log))
+        return buffer
+
+    def step(self, t: float, h: float):
+        status = self.fmi2DoStep(self.component, t, h, 1)
+        if status > 1:
+            raise FMUError(self.name, "fmi2DoStep", status, t, list(self.log))
+        self.time = t + h
+
+    def close(self):
+        if not getattr(self, "closed", True):
+            try:
+                self._slave.terminate()
+            except Exception:  # an FMU in error state may refuse terminate; free it anyway
+                pass
+            self._slave.fmi2FreeInstance(self.component)
+            self.closed = True
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
