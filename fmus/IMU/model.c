@@ -5,8 +5,9 @@
  *   magneto = A R^T m_I + b_s + b_d + n_m         (seed 000, eq. 1)
  *   R_reel = R(q)
  *
- * The sample at t_k = k / sample_rate uses the inputs at t_k: it is taken when the outputs
- * are read after the inputs for t_k were set, or at the latest when a step leaves t_k.
+ * The sample at t_k = k / sample_rate uses the inputs at t_k: while the time is t_k it follows
+ * the inputs as they are set, and it is final once a step leaves t_k. Instants inside a step
+ * see the inputs held over the step.
  * Noise sample k of channel c is a pure function of (seed, k, c), so streams do not depend
  * on the co-simulation step; its standard deviation is density * sqrt(sample_rate).
  */
@@ -17,7 +18,7 @@
 
 #define R(name) (m->real[VR_##name])
 
-enum { CH_ACC = 0, CH_GYRO = 3, CH_MAG = 6, CH_WALK_GYRO = 9, CH_WALK_ACC = 12, N_CHANNELS = 15 };
+enum { CH_ACC = 0, CH_GYRO = 3, CH_MAG = 6, CH_WALK_GYRO = 9, CH_WALK_ACC = 12 };
 
 typedef struct {
     int64_t next_sample;
@@ -44,7 +45,7 @@ static double gaussian(int seed, int64_t k, int channel) {
 static void take_sample(ModelInstance *m, Data *d, int64_t k) {
     const double *q = &R(q0), *w = &R(omega_x), *f = &R(f_x), *bd = &R(b_d_x);
     const double *a = &R(A_11), *bs = &R(b_s_x), *mi = &R(m_I_x);
-    double r[9], body[3], sd_acc = 0.0, sd_gyro = 0.0, sd_mag = 0.0, noise[N_CHANNELS];
+    double r[9], body[3], sd_acc = 0.0, sd_gyro = 0.0, sd_mag = 0.0, noise[CH_WALK_GYRO];
     int noisy = m->boolean[VB_noise_enabled], biased = m->boolean[VB_bias_enabled], i, c;
     double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3];
     r[0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
@@ -62,7 +63,7 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k) {
         sd_gyro = R(gyro_noise_density) * root_rate;
         sd_mag = R(mag_noise_density) * root_rate;
     }
-    for (c = 0; c < N_CHANNELS; c++) noise[c] = noisy || c >= CH_WALK_GYRO ? gaussian(m->integer[VI_seed], k, c) : 0.0;
+    for (c = 0; c < CH_WALK_GYRO; c++) noise[c] = noisy ? gaussian(m->integer[VI_seed], k, c) : 0.0;
     for (i = 0; i < 3; i++) body[i] = r[i] * mi[0] + r[3 + i] * mi[1] + r[6 + i] * mi[2]; /* R^T m_I */
     for (i = 0; i < 3; i++) {
         (&R(acc_x))[i] = f[i] + (biased ? d->acc_bias[i] : 0.0) + sd_acc * noise[CH_ACC + i];
@@ -73,16 +74,18 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k) {
         (&R(acc_bias_x))[i] = biased ? d->acc_bias[i] : 0.0;
     }
     for (i = 0; i < 9; i++) (&R(R_reel_11))[i] = r[i];
-    /* bias random walk to the next sample */
+}
+
+/* Sample k is final: the biases walk on to sample k + 1. */
+static void commit_sample(ModelInstance *m, Data *d, int64_t k) {
+    double root_dt = sqrt(1.0 / R(sample_rate));
+    int seed = m->integer[VI_seed], i;
     for (i = 0; i < 3; i++) {
-        double root_dt = sqrt(1.0 / R(sample_rate));
-        d->gyro_bias[i] += R(gyro_bias_walk) * root_dt * noise[CH_WALK_GYRO + i];
-        d->acc_bias[i] += R(acc_bias_walk) * root_dt * noise[CH_WALK_ACC + i];
+        d->gyro_bias[i] += R(gyro_bias_walk) * root_dt * gaussian(seed, k, CH_WALK_GYRO + i);
+        d->acc_bias[i] += R(acc_bias_walk) * root_dt * gaussian(seed, k, CH_WALK_ACC + i);
     }
 }
 
-/* Index of the last sample instant at or before t. */
-static int64_t last_instant(ModelInstance *m, double t) { return (int64_t)floor(t * R(sample_rate) + 1e-6); }
 
 fmi2Status model_initialize(ModelInstance *m) {
     Data *d = (Data *)m->data;
@@ -106,15 +109,19 @@ fmi2Status model_initialize(ModelInstance *m) {
 
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
-    /* instants in [t, t + h) are taken now, with the inputs held over the step */
+    /* instants in [t, t + h) become final, with the inputs held over the step */
     int64_t end = (int64_t)ceil((t + h) * R(sample_rate) - 1e-6);
-    while (d->next_sample < end) take_sample(m, d, d->next_sample++);
+    for (; d->next_sample < end; d->next_sample++) {
+        take_sample(m, d, d->next_sample);
+        commit_sample(m, d, d->next_sample);
+    }
     return fmi2OK;
 }
 
 void model_outputs(ModelInstance *m) {
     Data *d = (Data *)m->data;
-    int64_t due = last_instant(m, m->time);
-    if (!m->inputs_fresh) return;
-    while (d->next_sample <= due) take_sample(m, d, d->next_sample++);
+    double position = m->time * R(sample_rate);
+    int64_t k = (int64_t)floor(position + 1e-6);
+    /* at a sample instant not yet final, the sample follows the present inputs */
+    if (k == d->next_sample && fabs(position - (double)k) < 1e-6) take_sample(m, d, k);
 }

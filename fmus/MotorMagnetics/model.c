@@ -11,10 +11,15 @@
  * never pushes current back into the battery, hence max(i_n, 0).
  *
  * The electrical time constant L/R (0.4 ms) is far below the mechanical one (about 25 ms), so
- * the currents are stiff. They are integrated by the exponential time-differencing RK4 of
- * Cox and Matthews (J. Comput. Phys. 176, 2002): the linear decay -R/L i is solved exactly
- * and the rest with RK4 weights, which reduces to classical RK4 on the other states.
+ * the currents are stiff. Each motor's linear part, y = (omega, i) with
+ *   dy = A y + N(y),  A = [0, k_e/J_r; -k_e/L, -R/L],  N = (-k_m omega|omega|/J_r, c u/L),
+ * is integrated by the exponential time-differencing RK4 of Cox and Matthews (J. Comput. Phys.
+ * 176, 2002): exp(hA) and the phi-functions of hA are exact (2x2, by Lagrange interpolation
+ * on the eigenvalues of A), and the slow remainder N gets RK4-like weights. Putting the
+ * back-EMF and torque coupling in A keeps the fast current transient out of N, which would
+ * otherwise reduce the order of the method. The state of charge uses classical RK4.
  */
+#include <complex.h>
 #include <math.h>
 
 #include "airframe.h"
@@ -22,13 +27,15 @@
 
 #define R(name) (m->real[VR_##name])
 
-enum { W = 0, I = N_MOTORS, SOC = 2 * N_MOTORS };
+enum { OMEGA = 0, CURRENT = N_MOTORS, SOC = 2 * N_MOTORS };
 
 typedef struct {
     double x[N_STATES];
     double v[N_MOTORS][3]; /* unit field directions */
-    double step;           /* sub-step the coefficients below were computed for */
-    double e, e2, q, f1, f2, f3;
+    double step;           /* sub-step the matrices below were computed for */
+    /* 2x2 row-major functions of h A: exp(hA), exp(hA/2), (h/2) phi1(hA/2), and the
+     * ETDRK4 weights h(phi1 - 3 phi2 + 4 phi3), h(phi2 - 2 phi3), h(-phi2 + 4 phi3) */
+    double e[4], e2[4], q[4], f1[4], f2[4], f3[4];
     int saturated[N_MOTORS];
 } Data;
 
@@ -40,7 +47,7 @@ static double battery_current(ModelInstance *m, const double *x) {
     double total = 0.0;
     int n;
     for (n = 0; n < N_MOTORS; n++)
-        if (x[I + n] > 0.0) total += clamp01((&R(c1))[n]) * x[I + n];
+        if (x[CURRENT + n] > 0.0) total += clamp01((&R(c1))[n]) * x[CURRENT + n];
     return total;
 }
 
@@ -50,76 +57,125 @@ static double battery_voltage(ModelInstance *m, const double *x) {
     return R(n_cells) * cell - R(R_b) * battery_current(m, x);
 }
 
-/* The non-stiff remainder N(x) = f(x) - lambda x, with lambda = -R/L on the currents. */
+/* The slow remainder N(x): drag and the command voltage for each motor, and dsoc. */
 static void nonstiff(ModelInstance *m, const double *x, double *nx) {
     double u = battery_voltage(m, x);
     int n;
     for (n = 0; n < N_MOTORS; n++) {
-        double w = x[W + n];
-        nx[W + n] = (R(k_e) * x[I + n] - R(k_m) * w * fabs(w)) / R(J_r);
-        nx[I + n] = (clamp01((&R(c1))[n]) * u - R(k_e) * w) / R(L_m);
+        double w = x[OMEGA + n];
+        nx[OMEGA + n] = -R(k_m) * w * fabs(w) / R(J_r);
+        nx[CURRENT + n] = clamp01((&R(c1))[n]) * u / R(L_m);
     }
     nx[SOC] = -battery_current(m, x) / R(capacity);
 }
 
 /* phi_k(z) = sum_j z^j / (j + k)!; phi_k = 1/k! + z phi_(k+1). phi3 by its series near 0,
- * where the closed form cancels, and in closed form elsewhere. */
-static void phi123(double z, double *p1, double *p2, double *p3) {
-    if (fabs(z) < 0.5) {
-        double term = 1.0 / 6.0, sum = 0.0;
+ * where the closed form cancels, and in closed form elsewhere. Index 0 is exp. */
+static void phi0123(double complex z, double complex p[4]) {
+    if (cabs(z) < 0.5) {
+        double complex term = 1.0 / 6.0, sum = 0.0;
         int j;
         for (j = 0; j < 20; j++) {
             sum += term;
             term *= z / (j + 4);
         }
-        *p3 = sum;
+        p[3] = sum;
     } else {
-        *p3 = (exp(z) - 1.0 - z - 0.5 * z * z) / (z * z * z);
+        p[3] = (cexp(z) - 1.0 - z - 0.5 * z * z) / (z * z * z);
     }
-    *p2 = 0.5 + z * *p3;
-    *p1 = 1.0 + z * *p2;
+    p[2] = 0.5 + z * p[3];
+    p[1] = 1.0 + z * p[2];
+    p[0] = 1.0 + z * p[1];
+}
+
+/* F(hA) = alpha I + beta A for a 2x2 A with eigenvalues l1 != l2, given F(h l1), F(h l2). */
+static void interpolate(const double a[4], double complex l1, double complex l2, double complex f1,
+                        double complex f2, double scale, double out[4]) {
+    double complex beta = (f1 - f2) / (l1 - l2), alpha = (l1 * f2 - l2 * f1) / (l1 - l2);
+    out[0] = scale * creal(alpha + beta * a[0]);
+    out[1] = scale * creal(beta * a[1]);
+    out[2] = scale * creal(beta * a[2]);
+    out[3] = scale * creal(alpha + beta * a[3]);
 }
 
 static void etd_coefficients(ModelInstance *m, Data *d, double h) {
-    double z = -R(R_m) / R(L_m) * h, p1, p2, p3, h1, dummy2, dummy3;
-    phi123(z, &p1, &p2, &p3);
-    phi123(0.5 * z, &h1, &dummy2, &dummy3);
-    d->e = exp(z);
-    d->e2 = exp(0.5 * z);
-    d->q = 0.5 * h * h1;
-    d->f1 = h * (p1 - 3.0 * p2 + 4.0 * p3);
-    d->f2 = h * (p2 - 2.0 * p3);
-    d->f3 = h * (-p2 + 4.0 * p3);
+    const double a[4] = {0.0, R(k_e) / R(J_r), -R(k_e) / R(L_m), -R(R_m) / R(L_m)};
+    double trace = a[0] + a[3], det = a[0] * a[3] - a[1] * a[2];
+    double complex root = csqrt((double complex)(trace * trace - 4.0 * det));
+    double complex l1 = 0.5 * (trace + root), l2 = 0.5 * (trace - root);
+    double complex p1[4], p2[4], h1[4], h2[4], w1[3], w2[3];
+    if (cabs(l1 - l2) < 1e-6 * cabs(l1)) { /* confluent: split by a negligible amount */
+        l1 += 1e-5 * cabs(l1);
+        l2 -= 1e-5 * cabs(l2);
+    }
+    phi0123(h * l1, p1);
+    phi0123(h * l2, p2);
+    phi0123(0.5 * h * l1, h1);
+    phi0123(0.5 * h * l2, h2);
+    interpolate(a, l1, l2, p1[0], p2[0], 1.0, d->e);
+    interpolate(a, l1, l2, h1[0], h2[0], 1.0, d->e2);
+    interpolate(a, l1, l2, h1[1], h2[1], 0.5 * h, d->q);
+    w1[0] = p1[1] - 3.0 * p1[2] + 4.0 * p1[3];
+    w2[0] = p2[1] - 3.0 * p2[2] + 4.0 * p2[3];
+    w1[1] = p1[2] - 2.0 * p1[3];
+    w2[1] = p2[2] - 2.0 * p2[3];
+    w1[2] = -p1[2] + 4.0 * p1[3];
+    w2[2] = -p2[2] + 4.0 * p2[3];
+    interpolate(a, l1, l2, w1[0], w2[0], h, d->f1);
+    interpolate(a, l1, l2, w1[1], w2[1], h, d->f2);
+    interpolate(a, l1, l2, w1[2], w2[2], h, d->f3);
     d->step = h;
 }
 
+/* out = M (x_w, x_i) for motor n, M 2x2 row-major */
+#define APPLY(M, y, n, out_w, out_i)                                \
+    do {                                                           \
+        out_w = (M)[0] * (y)[OMEGA + (n)] + (M)[1] * (y)[CURRENT + (n)];     \
+        out_i = (M)[2] * (y)[OMEGA + (n)] + (M)[3] * (y)[CURRENT + (n)];     \
+    } while (0)
+
 static void etdrk4_step(ModelInstance *m, Data *d, double h) {
-    double *x = d->x, na[N_STATES], nb[N_STATES], nc[N_STATES], nu[N_STATES];
-    double a[N_STATES], b[N_STATES], c[N_STATES];
-    int k;
+    double *x = d->x, nu[N_STATES], na[N_STATES], nb[N_STATES], nc[N_STATES];
+    double a[N_STATES], b[N_STATES], c[N_STATES], tmp[N_STATES], p, r;
+    int n, k;
     if (h != d->step) etd_coefficients(m, d, h);
     nonstiff(m, x, nu);
-    for (k = 0; k < N_STATES; k++) {
-        int stiff = k >= I && k < SOC;
-        a[k] = x[k] * (stiff ? d->e2 : 1.0) + (stiff ? d->q : 0.5 * h) * nu[k];
+    for (n = 0; n < N_MOTORS; n++) {
+        APPLY(d->e2, x, n, a[OMEGA + n], a[CURRENT + n]);
+        APPLY(d->q, nu, n, p, r);
+        a[OMEGA + n] += p;
+        a[CURRENT + n] += r;
     }
+    a[SOC] = x[SOC] + 0.5 * h * nu[SOC];
     nonstiff(m, a, na);
-    for (k = 0; k < N_STATES; k++) {
-        int stiff = k >= I && k < SOC;
-        b[k] = x[k] * (stiff ? d->e2 : 1.0) + (stiff ? d->q : 0.5 * h) * na[k];
+    for (n = 0; n < N_MOTORS; n++) {
+        APPLY(d->e2, x, n, b[OMEGA + n], b[CURRENT + n]);
+        APPLY(d->q, na, n, p, r);
+        b[OMEGA + n] += p;
+        b[CURRENT + n] += r;
     }
+    b[SOC] = x[SOC] + 0.5 * h * na[SOC];
     nonstiff(m, b, nb);
-    for (k = 0; k < N_STATES; k++) {
-        int stiff = k >= I && k < SOC;
-        c[k] = a[k] * (stiff ? d->e2 : 1.0) + (stiff ? d->q : 0.5 * h) * (2.0 * nb[k] - nu[k]);
+    for (k = 0; k < N_STATES; k++) tmp[k] = 2.0 * nb[k] - nu[k];
+    for (n = 0; n < N_MOTORS; n++) {
+        APPLY(d->e2, a, n, c[OMEGA + n], c[CURRENT + n]);
+        APPLY(d->q, tmp, n, p, r);
+        c[OMEGA + n] += p;
+        c[CURRENT + n] += r;
     }
+    c[SOC] = a[SOC] + 0.5 * h * tmp[SOC];
     nonstiff(m, c, nc);
-    for (k = 0; k < N_STATES; k++) {
-        if (k >= I && k < SOC)
-            x[k] = d->e * x[k] + d->f1 * nu[k] + 2.0 * d->f2 * (na[k] + nb[k]) + d->f3 * nc[k];
-        else
-            x[k] += h / 6.0 * (nu[k] + 2.0 * (na[k] + nb[k]) + nc[k]);
+    for (k = 0; k < N_STATES; k++) tmp[k] = na[k] + nb[k];
+    for (n = 0; n < N_MOTORS; n++) {
+        double w, i, w1, i1, w2, i2, w3, i3;
+        APPLY(d->e, x, n, w, i);
+        APPLY(d->f1, nu, n, w1, i1);
+        APPLY(d->f2, tmp, n, w2, i2);
+        APPLY(d->f3, nc, n, w3, i3);
+        x[OMEGA + n] = w + w1 + 2.0 * w2 + w3;
+        x[CURRENT + n] = i + i1 + 2.0 * i2 + i3;
     }
+    x[SOC] += h / 6.0 * (nu[SOC] + 2.0 * tmp[SOC] + nc[SOC]);
 }
 
 fmi2Status model_initialize(ModelInstance *m) {
@@ -148,8 +204,8 @@ fmi2Status model_initialize(ModelInstance *m) {
             return fmi2Error;
         }
         for (i = 0; i < 3; i++) d->v[n][i] = v[i] / norm;
-        d->x[W + n] = 0.0;
-        d->x[I + n] = 0.0;
+        d->x[OMEGA + n] = 0.0;
+        d->x[CURRENT + n] = 0.0;
     }
     d->x[SOC] = R(soc0);
     d->step = -1.0;
@@ -178,9 +234,9 @@ void model_outputs(ModelInstance *m) {
     int n, a;
     for (a = 0; a < 3; a++) (&R(b_d_x))[a] = 0.0;
     for (n = 0; n < N_MOTORS; n++) {
-        double field = (&R(kappa1))[n] * x[I + n];
-        (&R(omega_r1))[n] = x[W + n];
-        (&R(i1))[n] = x[I + n];
+        double field = (&R(kappa1))[n] * x[CURRENT + n];
+        (&R(omega_r1))[n] = x[OMEGA + n];
+        (&R(i1))[n] = x[CURRENT + n];
         for (a = 0; a < 3; a++) {
             (&R(b_d1_x))[3 * n + a] = field * d->v[n][a];
             (&R(b_d_x))[a] += field * d->v[n][a];

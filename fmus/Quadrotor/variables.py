@@ -23,7 +23,7 @@ TABLE = Table(
         Real("drag", "parameter", V.LINEAR_DRAG, "N.s/m", "linear translational drag D"),
         Real("g", "parameter", V.GRAVITY, "m/s2", "gravity along +z of {I}"),
         Real("k_norm", "parameter", V.QUATERNION_NORM_GAIN, "1/s", "quaternion norm-keeping gain"),
-        Real("sub_step", "parameter", 2e-3, "s", "largest internal RK4 step"),
+        Real("sub_step", "parameter", 1e-2, "s", "largest internal RK4 step"),
         Boolean("clamped", "parameter", False, "body held at its initial pose (rig on the ground)"),
         Real("p_x0", "parameter", 0.0, "m", "initial north position"),
         Real("p_y0", "parameter", 0.0, "m", "initial east position"),

@@ -84,7 +84,6 @@ static void reset_values(ModelInstance *m) {
     memset(m->data, 0, MODEL_DATA_SIZE);
     m->time = 0.0;
     m->outputs_stale = 1;
-    m->inputs_fresh = 1;
 }
 
 /* ---------------------------------------------------------------- common functions */
@@ -291,7 +290,6 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     }
     for (i = 0; i < nvr; i++) m->real[vr[i]] = value[i];
     m->outputs_stale = 1;
-    m->inputs_fresh = 1;
     return fmi2OK;
 }
 
@@ -407,7 +405,6 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                     currentCommunicationPoint, m->time);
     status = model_do_step(m, currentCommunicationPoint, communicationStepSize);
     m->time = currentCommunicationPoint + communicationStepSize;
-    m->inputs_fresh = 0;
     if (status > fmi2Warning) {
         m->mode = MODE_ERROR;
         return status;

@@ -41,7 +41,6 @@ typedef struct ModelInstance {
     int *integer;
     fmi2Boolean *boolean;
     int outputs_stale; /* inputs changed since the outputs were last computed */
-    int inputs_fresh;  /* inputs were set at the present time (since the last doStep) */
     void *data;        /* the model's own state, MODEL_DATA_SIZE bytes */
 } ModelInstance;
 

@@ -1,0 +1,29 @@
+"""Small helpers shared by the tests."""
+
+import numpy as np
+
+from orchestrator.fmu import FMUInstance
+
+
+def run_fmu(model, parameters, inputs, steps, h=1e-3, outputs=()):
+    """Step ``model`` ``steps`` times with constant ``inputs``; outputs after each step."""
+    fmu = FMUInstance(model, parameters)
+    names = list(inputs)
+    if names:
+        fmu.set(names, [inputs[n] for n in names])
+    values = np.empty((steps + 1, len(outputs)))
+    values[0] = fmu.get(outputs)
+    for k in range(steps):
+        fmu.step(k * h, h)
+        if names:
+            fmu.set(names, [inputs[n] for n in names])
+        values[k + 1] = fmu.get(outputs)
+    fmu.close()
+    return {name: values[:, j] for j, name in enumerate(outputs)}
+
+
+def rotation(q):
+    """R(q) = I + 2 q0 S(qv) + 2 S(qv)^2 (body to NED)."""
+    q0, qv = q[0], np.asarray(q[1:])
+    s = np.array([[0, -qv[2], qv[1]], [qv[2], 0, -qv[0]], [-qv[1], qv[0], 0]])
+    return np.eye(3) + 2 * q0 * s + 2 * s @ s
