@@ -114,6 +114,14 @@ class FMUInstance:
         self.fmi2DoStep = functions["fmi2DoStep"]
         self._call(lambda: self._slave.instantiate(callbacks=self._callbacks), "fmi2Instantiate")
         self.component = self._slave.component
+        # Hot-path handles: fresh function objects without argtypes, called with prebuilt
+        # ctypes arguments, skip ctypes' per-call conversions (0.66 against 2.2 us here).
+        dll = self._slave.dll
+        self.raw_set_real, self.raw_get_real, self.raw_do_step = (
+            dll["fmi2SetReal"], dll["fmi2GetReal"], dll["fmi2DoStep"])
+        for function in (self.raw_set_real, self.raw_get_real, self.raw_do_step):
+            function.restype = ctypes.c_int
+        self.component_arg = ctypes.c_void_p(self.component)
         self._call(lambda: self._slave.setupExperiment(startTime=start_time), "fmi2SetupExperiment")
         self._call(self._slave.enterInitializationMode, "fmi2EnterInitializationMode")
         for name, value in overrides.items():

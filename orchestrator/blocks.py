@@ -1,0 +1,151 @@
+"""Block contracts: Python blocks and FMU blocks.
+
+A block has named scalar inputs and outputs. At each of its steps (every ``period`` macro
+steps) the master gives a Python block its inputs ``u`` and a view ``y`` of its outputs, both
+float64 arrays in declaration order; the block writes ``y`` in place. An FMU block sets its
+inputs, reads its outputs, and advances its state by one communication step.
+
+Blocks are stepped in dependency order (Gauss-Seidel): a block whose outputs depend on its
+present inputs (direct feedthrough) runs after the blocks that feed it. A Python block that
+declares no feedthrough sees, from blocks ordered after it, the values of the previous macro
+step: a unit delay.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class Block:
+    """Base class of Python blocks.
+
+    Subclasses set ``inputs`` and ``outputs`` (tuples of names), may set ``feedthrough``
+    (``True``: every output depends on the present inputs; ``False``: none does) and
+    implement :meth:`step`. ``parameters`` documents the tunable values with their units.
+    """
+
+    inputs: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ()
+    feedthrough: bool = True
+
+    def __init__(self, name: str, period: int = 1):
+        if int(period) != period or period < 1:
+            raise ValueError(f"{name}: period must be a positive integer number of macro steps, not {period}")
+        self.name = name
+        self.period = int(period)
+
+    @property
+    def feedthrough_inputs(self) -> set[str]:
+        return set(self.inputs) if self.feedthrough else set()
+
+    def start(self, t0: float, dt: float) -> None:
+        """Reset the state before a run; ``dt`` is this block's own step (s)."""
+
+    def step(self, t: float, u: np.ndarray, y: np.ndarray) -> None:
+        """Compute the outputs at time ``t`` (s) from the inputs ``u``, writing ``y`` in place."""
+        raise NotImplementedError(f"{type(self).__name__} must implement step(t, u, y)")
+
+    def close(self) -> None:
+        """Release resources after a run."""
+
+
+class Table(Block):
+    """Outputs read from a table sampled at the block's own rate (for scripted signals).
+
+    Parameters
+    ----------
+    name : str
+        Block name.
+    outputs : sequence of str
+        Output names.
+    values : (n, len(outputs)) array
+        Row ``k`` is output at the block's ``k``-th step; the last row is held after the end.
+    """
+
+    feedthrough = False
+
+    def __init__(self, name: str, outputs, values, period: int = 1):
+        super().__init__(name, period)
+        self.outputs = tuple(outputs)
+        self.values = np.ascontiguousarray(values, dtype=float)
+        if self.values.ndim != 2 or self.values.shape[1] != len(self.outputs):
+            raise ValueError(f"{name}: values must have shape (n, {len(self.outputs)}), not {self.values.shape}")
+        if not np.isfinite(self.values).all():
+            raise ValueError(f"{name}: the table holds NaN or Inf")
+
+    def start(self, t0, dt):
+        self._k = 0
+
+    def step(self, t, u, y):
+        k = self._k
+        y[:] = self.values[k if k < len(self.values) else -1]
+        self._k = k + 1
+
+
+class Constant(Block):
+    """Constant outputs."""
+
+    feedthrough = False
+
+    def __init__(self, name: str, values: dict[str, float]):
+        super().__init__(name)
+        self.outputs = tuple(values)
+        self.values = np.array([float(v) for v in values.values()])
+
+    def step(self, t, u, y):
+        y[:] = self.values
+
+
+class FMUBlock:
+    """A block backed by a built FMU.
+
+    Parameters
+    ----------
+    name : str
+        Block name (the lab's diagram names: ``Quadrotor``, ``MotorMagnetics``, ``IMU``).
+    model : str, optional
+        FMU model name; defaults to ``name``.
+    parameters : dict, optional
+        Parameter overrides, by FMU variable name.
+    period : int
+        Runs every ``period`` macro steps, with a communication step of ``period * dt``.
+    """
+
+    def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
+        from fmpy import read_model_description
+
+        from fmus import fmu_path
+
+        if int(period) != period or period < 1:
+            raise ValueError(f"{name}: period must be a positive integer number of macro steps, not {period}")
+        self.name = name
+        self.model = model or name
+        self.parameters = dict(parameters or {})
+        self.period = int(period)
+        description = read_model_description(str(fmu_path(self.model)))
+        variables = description.modelVariables
+        self.inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
+        self.outputs = tuple(v.name for v in variables if v.causality == "output" and v.type == "Real")
+        self.parameter_names = tuple(v.name for v in variables if v.causality == "parameter")
+        unknown = set(self.parameters) - set(self.parameter_names)
+        if unknown:
+            from orchestrator.fmu import nearest
+
+            name0 = sorted(unknown)[0]
+            raise ValueError(f"{name} ({self.model}) has no parameter {name0!r}.{nearest(name0, self.parameter_names)}")
+        fed = set()
+        for output in description.outputs:
+            fed |= {d.name for d in (output.dependencies or [])}
+        self.feedthrough_inputs = fed & set(self.inputs)
+        self.instance = None
+
+    def instantiate(self, t0: float):
+        from orchestrator.fmu import FMUInstance
+
+        self.instance = FMUInstance(self.model, self.parameters, name=self.name, start_time=t0)
+        return self.instance
+
+    def close(self):
+        if self.instance is not None:
+            self.instance.close()
+            self.instance = None

@@ -1,0 +1,512 @@
+"""A system of blocks and connections, and the fixed-step co-simulation master that runs it.
+
+Signals live in one float64 vector, the bus. Each block's outputs occupy a contiguous
+slice of it. Before a run everything is resolved once: value references, the slices each
+FMU reads its inputs from (one ``fmi2SetReal`` per contiguous run, straight from the bus,
+no copy), the views each Python block reads and writes, faults, recording. The loop then
+makes only the FMI calls and the Python block steps, with no name look-up and no
+allocation per step.
+
+Per macro step ``n`` (time ``t_n``), in dependency order:
+1. every block due at ``n`` produces its outputs at ``t_n`` (FMU: set inputs, get outputs;
+   Python block: ``step``);
+2. the bus is recorded (every ``decimation`` steps) and checked for NaN and Inf;
+3. every FMU due at ``n`` takes its inputs from blocks later in the order (a non-feedthrough
+   input, so the loop is not algebraic) and steps to ``t_n + period * dt``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from orchestrator.blocks import Block, Constant, FMUBlock
+from orchestrator.fmu import FMUError, nearest
+from orchestrator.result import Result, expand
+
+_VOID_P, _SIZE = ctypes.c_void_p, ctypes.c_size_t
+
+
+class SimulationError(RuntimeError):
+    """A run failed. ``result`` holds what was recorded up to the failure."""
+
+    def __init__(self, message: str, result: Result | None = None):
+        super().__init__(message)
+        self.result = result
+
+
+class AlgebraicLoopError(ValueError):
+    """Blocks with direct feedthrough form a cycle."""
+
+    def __init__(self, cycle: list[str]):
+        self.cycle = cycle
+        super().__init__(
+            "algebraic loop: " + " -> ".join(cycle + cycle[:1]) + ". Every block in it passes its inputs "
+            "straight to its outputs. Break it with a block without direct feedthrough (a delay, a "
+            "filter state) or connect one of these signals from elsewhere."
+        )
+
+
+FAULT_KINDS = ("offset", "scale", "stuck", "noise", "dropout")
+
+
+@dataclass
+class Fault:
+    """A fault on the connection into ``target`` (``"Block.input"``), active for
+    ``start <= t < stop`` (s).
+
+    kind:
+    - ``offset``: adds ``value``;
+    - ``scale``: multiplies by ``value``;
+    - ``stuck``: holds ``value``, or the value at ``start`` when ``value`` is None;
+    - ``noise``: adds white Gaussian noise of standard deviation ``value`` (seeded by ``seed``);
+    - ``dropout``: the signal is lost and reads 0.
+    """
+
+    target: str
+    kind: str
+    start: float
+    stop: float
+    value: float | None = None
+    seed: int = 0
+    _held: float | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if self.kind not in FAULT_KINDS:
+            raise ValueError(f"unknown fault kind {self.kind!r}; use one of {', '.join(FAULT_KINDS)}")
+        if not self.stop > self.start:
+            raise ValueError(f"fault on {self.target}: stop ({self.stop}) must come after start ({self.start})")
+        if self.kind in ("offset", "scale", "noise") and self.value is None:
+            raise ValueError(f"a {self.kind} fault needs a value")
+        if self.kind == "noise" and self.value < 0:
+            raise ValueError(f"noise fault on {self.target}: standard deviation {self.value} is negative")
+
+    def reset(self):
+        self._held = None
+        self._rng = np.random.default_rng(self.seed)
+
+    def apply(self, t: float, x: float) -> float:
+        if not self.start <= t < self.stop:
+            self._held = None
+            return x
+        kind = self.kind
+        if kind == "offset":
+            return x + self.value
+        if kind == "scale":
+            return x * self.value
+        if kind == "stuck":
+            if self._held is None:
+                self._held = x if self.value is None else self.value
+            return self._held
+        if kind == "noise":
+            return x + self.value * self._rng.standard_normal()
+        return 0.0
+
+
+class System:
+    """Blocks plus connections, declared by name, run by a fixed-step master.
+
+    Parameters
+    ----------
+    dt : float
+        Macro step (s), default 1 ms.
+
+    Examples
+    --------
+    >>> sys = System(dt=1e-3)
+    >>> sys.add(FMUBlock("MotorMagnetics"))
+    >>> sys.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], [[0.5] * 4]))
+    >>> sys.connect("Setpoint.c", "MotorMagnetics.c")
+    >>> result = sys.run(1.0)
+    """
+
+    def __init__(self, dt: float = 1e-3):
+        if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+            raise ValueError(f"macro step dt = {dt!r} s must be a positive number of seconds")
+        self.dt = float(dt)
+        self.blocks: dict[str, Block | FMUBlock] = {}
+        self.connections: dict[str, str] = {}  # destination "B.u" -> source "A.y"
+        self.faults: list[Fault] = []
+
+    # ------------------------------------------------------------------ declaration
+    def add(self, block):
+        if block.name in self.blocks:
+            raise ValueError(f"a block named {block.name!r} is already in the system")
+        if "." in block.name:
+            raise ValueError(f"block name {block.name!r} must not contain a dot")
+        self.blocks[block.name] = block
+        return block
+
+    def _resolve(self, signal: str, direction: str) -> list[str]:
+        block_name, dot, name = signal.partition(".")
+        if not dot:
+            raise ValueError(f"signal {signal!r} must be written Block.signal")
+        block = self.blocks.get(block_name)
+        if block is None:
+            raise KeyError(f"unknown block {block_name!r} in {signal!r}.{nearest(block_name, self.blocks)} "
+                           f"Blocks: {', '.join(self.blocks)}.")
+        names = block.outputs if direction == "output" else block.inputs
+        members = expand(name, names)
+        if not members:
+            raise KeyError(f"{block_name} has no {direction} {name!r}.{nearest(name, names)} "
+                           f"Its {direction}s: {', '.join(names)}.")
+        return [f"{block_name}.{m}" for m in members]
+
+    def connect(self, source: str, destination: str):
+        """Connect output ``source`` to input ``destination`` (``"Block.signal"``; a vector
+        name such as ``"IMU.acc"`` connects its components in order)."""
+        sources = self._resolve(source, "output")
+        destinations = self._resolve(destination, "input")
+        if len(sources) != len(destinations):
+            raise ValueError(f"{source} has {len(sources)} components and {destination} has {len(destinations)}")
+        for s, d in zip(sources, destinations, strict=True):
+            if d in self.connections:
+                raise ValueError(f"{d} is already connected to {self.connections[d]}")
+            self.connections[d] = s
+
+    def set_input(self, destination: str, value: float):
+        """Tie input ``destination`` (or each component of it) to a constant ``value``."""
+        targets = self._resolve(destination, "input")
+        name = "Const_" + destination.replace(".", "_")
+        block = self.add(Constant(name, {t.split(".", 1)[1]: value for t in targets}))
+        for target in targets:
+            self.connections[target] = f"{block.name}.{target.split('.', 1)[1]}"
+
+    def inject(self, fault: Fault) -> Fault:
+        """Add a fault on the connection into ``fault.target``."""
+        targets = self._resolve(fault.target, "input")
+        if len(targets) != 1:
+            raise ValueError(f"a fault applies to one signal; {fault.target} has {len(targets)}")
+        fault.target = targets[0]
+        self.faults.append(fault)
+        return fault
+
+    # ------------------------------------------------------------------ structure
+    def unconnected(self) -> list[str]:
+        return [f"{b.name}.{u}" for b in self.blocks.values() for u in b.inputs
+                if f"{b.name}.{u}" not in self.connections]
+
+    def order(self) -> list:
+        """Blocks in dependency order; raises :class:`AlgebraicLoopError` on a cycle of
+        direct-feedthrough connections."""
+        names = list(self.blocks)
+        after: dict[str, set[str]] = {n: set() for n in names}  # n must run after these
+        for dst, src in self.connections.items():
+            dst_block, dst_input = dst.split(".", 1)
+            src_block = src.split(".", 1)[0]
+            if dst_input in self.blocks[dst_block].feedthrough_inputs and src_block != dst_block:
+                after[dst_block].add(src_block)
+            elif dst_input in self.blocks[dst_block].feedthrough_inputs:
+                raise AlgebraicLoopError([dst_block])
+        ordered, placed = [], set()
+        while len(ordered) < len(names):
+            ready = [n for n in names if n not in placed and after[n] <= placed]
+            if not ready:
+                raise AlgebraicLoopError(_cycle({n: after[n] - placed for n in names if n not in placed}))
+            ordered.append(ready[0])
+            placed.add(ready[0])
+        return [self.blocks[n] for n in ordered]
+
+    def signals(self) -> list[str]:
+        return [f"{b.name}.{y}" for b in self.blocks.values() for y in b.outputs]
+
+    # ------------------------------------------------------------------ running
+    def run(self, duration: float, decimation: int = 1, progress: bool = False, start_time: float = 0.0) -> Result:
+        """Run for ``duration`` seconds and return the recorded :class:`Result`.
+
+        Every output of every block is recorded, every ``decimation`` macro steps. On a
+        failure a :class:`SimulationError` is raised whose ``result`` holds what was
+        recorded up to it.
+        """
+        if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
+            raise ValueError(f"duration = {duration!r} s must be a positive number of seconds")
+        if int(decimation) != decimation or decimation < 1:
+            raise ValueError(f"decimation = {decimation!r} must be a positive integer")
+        missing = self.unconnected()
+        if missing:
+            raise ValueError(f"unconnected input{'s' * (len(missing) > 1)}: {', '.join(missing)}. Connect each "
+                             "with system.connect(source, destination) or tie it with system.set_input(name, value).")
+        plan = _Plan(self, duration, int(decimation), start_time)
+        try:
+            plan.run(progress)
+        finally:
+            plan.close()
+        return plan.result()
+
+
+def _cycle(after: dict[str, set[str]]) -> list[str]:
+    """One cycle in the 'runs after' graph restricted to blocks that could not be placed."""
+    node = next(iter(after))
+    seen: list[str] = []
+    while node not in seen:
+        seen.append(node)
+        node = next(iter(after[node]))
+    cycle = seen[seen.index(node):]
+    return list(reversed(cycle))
+
+
+class _Failure(Exception):
+    def __init__(self, message: str):
+        super().__init__(message)
+
+
+class _Plan:
+    """Everything resolved once for one run."""
+
+    def __init__(self, system: System, duration: float, decimation: int, t0: float):
+        self.system, self.dt, self.t0, self.decimation = system, system.dt, t0, decimation
+        self.steps = int(round(duration / system.dt))
+        if self.steps < 1:
+            raise ValueError(f"duration {duration} s is shorter than one macro step ({system.dt} s)")
+        self.order = system.order()
+        position = {b.name: i for i, b in enumerate(self.order)}
+        # bus layout: outputs block by block, then one slot per fault
+        self.slot: dict[str, int] = {}
+        for block in self.order:
+            for y in block.outputs:
+                self.slot[f"{block.name}.{y}"] = len(self.slot)
+        self.names = list(self.slot)
+        self.fault_slot = {f.target: len(self.slot) + k for k, f in enumerate(system.faults)}
+        self.bus = np.zeros(len(self.slot) + len(system.faults))
+        self.rows = self.steps // decimation + 1
+        self.record = np.empty((self.rows, len(self.slot)))
+        self.recorded = 0
+        self.time_now = t0
+        self.fmus = []
+        for fault in system.faults:
+            fault.reset()
+        try:
+            self._prepare(position)
+        except BaseException:
+            self.close()
+            raise
+
+    def _source(self, block_name: str, u: str) -> tuple[int, bool]:
+        """Bus slot an input reads, and whether its source runs earlier in the order."""
+        destination = f"{block_name}.{u}"
+        source = self.system.connections[destination]
+        early = self.position[source.split(".", 1)[0]] < self.position[block_name]
+        return self.fault_slot.get(destination, self.slot[source]), early
+
+    def _prepare(self, position):
+        self.position = position
+        bus_address = self.bus.ctypes.data
+        self.phase_a, self.phase_b = [], []
+        for block in self.order:
+            first = self.slot[f"{block.name}.{block.outputs[0]}"] if block.outputs else 0
+            faults = [(f, self.slot[self.system.connections[f.target]], self.fault_slot[f.target])
+                      for f in self.system.faults if f.target.startswith(block.name + ".")]
+            if isinstance(block, FMUBlock):
+                instance = block.instantiate(self.t0)
+                self.fmus.append(block)
+                early, late = [], []
+                for u in block.inputs:
+                    slot, is_early = self._source(block.name, u)
+                    (early if is_early else late).append((instance.variables[u].valueReference, slot))
+                out_vr = instance.vr(block.outputs)
+                self.bus[first:first + len(block.outputs)] = instance.get(block.outputs)
+                a = _fmu_phase_a(block, instance, _runs(early, bus_address), out_vr,
+                                 _VOID_P(bus_address + 8 * first), faults, self.bus)
+                b = _fmu_phase_b(block, instance, _runs(late, bus_address), block.period * self.dt)
+                self.phase_a.append((block.period, a))
+                self.phase_b.append((block.period, b))
+            else:
+                block.start(self.t0, block.period * self.dt)
+                y = self.bus[first:first + len(block.outputs)]
+                slots = [self._source(block.name, u)[0] for u in block.inputs]
+                self.phase_a.append((block.period, _python_phase(block, slots, y, faults, self.bus)))
+
+    def run(self, progress: bool):
+        bus, record, dt, t0, dec = self.bus, self.record, self.dt, self.t0, self.decimation
+        phase_a, phase_b = self.phase_a, self.phase_b
+        reduce, isfinite = np.add.reduce, math.isfinite
+        bar = _progress(self.steps * dt) if progress else None
+        chunk = max(1, self.steps // 200)
+        n = 0
+        started = time.perf_counter()
+        try:
+            for n in range(self.steps + 1):
+                t = t0 + n * dt
+                self.time_now = t
+                for period, fn in phase_a:
+                    if period == 1 or n % period == 0:
+                        fn(t)
+                if n % dec == 0:
+                    record[n // dec] = bus[:record.shape[1]]
+                    self.recorded = n // dec + 1
+                    if not isfinite(reduce(bus)):
+                        raise _Failure(self._non_finite(t))
+                if n == self.steps:
+                    break
+                for period, fn in phase_b:
+                    if period == 1 or n % period == 0:
+                        fn(t)
+                if bar is not None and n % chunk == 0:
+                    bar.update(chunk * dt)
+        except _Failure as failure:
+            raise SimulationError(str(failure), self.result(error=str(failure))) from None
+        except FMUError as error:
+            message = str(error)
+            if "not a finite number" in message:
+                message = self._non_finite(self.time_now) + "\n" + message
+            raise SimulationError(message, self.result(error=message)) from None
+        except Exception as error:  # a Python block failed: keep what was recorded
+            message = f"at t = {self.time_now:.6g} s: {type(error).__name__}: {error}"
+            raise SimulationError(message, self.result(error=message)) from error
+        finally:
+            self.loop_seconds = time.perf_counter() - started
+            if bar is not None:
+                bar.close()
+
+    def _non_finite(self, t: float) -> str:
+        for block in self.order:  # the first in the order is where it appeared
+            for y in block.outputs:
+                name = f"{block.name}.{y}"
+                value = self.bus[self.slot[name]]
+                if not math.isfinite(value):
+                    return (f"{name} became {value} at t = {t:.6g} s (the first non-finite signal in the block "
+                            f"order). Check the block {block.name} and its inputs.")
+        return f"a fault or input became non-finite at t = {t:.6g} s"
+
+    def result(self, error: str | None = None) -> Result:
+        rows = self.recorded
+        time = self.t0 + np.arange(rows) * self.decimation * self.dt
+        meta = {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
+                "order": [b.name for b in self.order],
+                "connections": dict(self.system.connections)}
+        return Result(time, self.names, self.record[:rows].copy(), meta, error)
+
+    def close(self):
+        for block in self.fmus:
+            block.close()
+        for block in self.system.blocks.values():
+            if isinstance(block, Block):
+                block.close()
+
+
+def _runs(refs: list[tuple[int, int]], bus_address: int):
+    """Split (value reference, bus slot) pairs into runs of consecutive slots: one
+    fmi2SetReal each, reading straight from the bus."""
+    refs = sorted(refs, key=lambda r: r[1])
+    runs, current = [], []
+    for vr, slot in refs:
+        if current and slot != current[-1][1] + 1:
+            runs.append(current)
+            current = []
+        current.append((vr, slot))
+    if current:
+        runs.append(current)
+    out = []
+    for run in runs:
+        vrs = np.array([vr for vr, _ in run], dtype=np.uint32)
+        out.append((vrs, _VOID_P(vrs.ctypes.data), _SIZE(len(run)), _VOID_P(bus_address + 8 * run[0][1])))
+    return out
+
+
+def _status_error(block, function, status, t):
+    return FMUError(block.name, function, status, t, list(block.instance.log))
+
+
+def _apply_faults(faults, bus, t):
+    for fault, source, slot in faults:
+        bus[slot] = fault.apply(t, bus[source])
+
+
+def _fmu_phase_a(block, instance, runs, out_vr, out_ptr, faults, bus):
+    set_real, get_real, component = instance.raw_set_real, instance.raw_get_real, instance.component_arg
+    out_vr_ptr, n_out = _VOID_P(out_vr.ctypes.data), _SIZE(len(out_vr))
+    keep = (runs, out_vr)  # the ctypes pointers refer into these arrays
+    calls = [(vr_ptr, n, ptr) for _, vr_ptr, n, ptr in runs]
+
+    if len(calls) == 1 and not faults:
+        vr_ptr, n_in, in_ptr = calls[0]
+
+        def phase(t, keep=keep):
+            status = set_real(component, vr_ptr, n_in, in_ptr)
+            if status > 1:
+                raise _status_error(block, "fmi2SetReal", status, t)
+            status = get_real(component, out_vr_ptr, n_out, out_ptr)
+            if status > 1:
+                raise _status_error(block, "fmi2GetReal", status, t)
+        return phase
+
+    def phase(t, keep=keep):
+        if faults:
+            _apply_faults(faults, bus, t)
+        for vr_ptr, n_in, in_ptr in calls:
+            status = set_real(component, vr_ptr, n_in, in_ptr)
+            if status > 1:
+                raise _status_error(block, "fmi2SetReal", status, t)
+        status = get_real(component, out_vr_ptr, n_out, out_ptr)
+        if status > 1:
+            raise _status_error(block, "fmi2GetReal", status, t)
+    return phase
+
+
+def _fmu_phase_b(block, instance, runs, h):
+    set_real, do_step, component = instance.raw_set_real, instance.raw_do_step, instance.component_arg
+    calls = [(vr_ptr, n, ptr) for _, vr_ptr, n, ptr in runs]
+    keep = runs
+    now, step, no_rollback = ctypes.c_double(0.0), ctypes.c_double(h), ctypes.c_int(1)
+
+    if not calls:
+        def phase(t, keep=keep):
+            now.value = t
+            status = do_step(component, now, step, no_rollback)
+            if status > 1:
+                raise _status_error(block, "fmi2DoStep", status, t)
+        return phase
+
+    def phase(t, keep=keep):
+        for vr_ptr, n_in, in_ptr in calls:
+            status = set_real(component, vr_ptr, n_in, in_ptr)
+            if status > 1:
+                raise _status_error(block, "fmi2SetReal", status, t)
+        now.value = t
+        status = do_step(component, now, step, no_rollback)
+        if status > 1:
+            raise _status_error(block, "fmi2DoStep", status, t)
+    return phase
+
+
+def _python_phase(block, slots, y, faults, bus):
+    step = block.step
+    n = len(slots)
+    if n and slots == list(range(slots[0], slots[0] + n)):
+        u = bus[slots[0]:slots[0] + n]  # a view: no copy at all
+        copies = ()
+    else:
+        u = np.zeros(n)
+        copies, k = [], 0
+        while k < n:  # contiguous runs of source slots, copied slice by slice
+            j = k
+            while j + 1 < n and slots[j + 1] == slots[j] + 1:
+                j += 1
+            copies.append((k, j + 1, slots[k], slots[j] + 1))
+            k = j + 1
+        copies = tuple(copies)
+
+    if not copies and not faults:
+        def phase(t):
+            step(t, u, y)
+        return phase
+
+    def phase(t):
+        if faults:
+            _apply_faults(faults, bus, t)
+        for a, b, c, d in copies:
+            u[a:b] = bus[c:d]
+        step(t, u, y)
+    return phase
+
+
+def _progress(total_seconds: float):
+    from tqdm import tqdm
+
+    return tqdm(total=total_seconds, unit="s sim",
+                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]")
+
