@@ -74,12 +74,11 @@ class Table(Block):
             raise ValueError(f"{name}: the table holds NaN or Inf")
 
     def start(self, t0, dt):
-        self._k = 0
+        self._rows = iter(self.values)
+        self._last = self.values[-1]
 
     def step(self, t, u, y):
-        k = self._k
-        y[:] = self.values[k if k < len(self.values) else -1]
-        self._k = k + 1
+        y[:] = next(self._rows, self._last)
 
 
 class Constant(Block):

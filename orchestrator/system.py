@@ -28,8 +28,6 @@ from orchestrator.blocks import Block, Constant, FMUBlock
 from orchestrator.fmu import FMUError, nearest
 from orchestrator.result import Result, expand
 
-_VOID_P, _SIZE = ctypes.c_void_p, ctypes.c_size_t
-
 
 class SimulationError(RuntimeError):
     """A run failed. ``result`` holds what was recorded up to the failure."""
@@ -296,6 +294,8 @@ class _Plan:
         self.position = position
         bus_address = self.bus.ctypes.data
         self.phase_a, self.phase_b = [], []
+        pending: list = []  # FMU blocks of the phase-A batch being gathered
+        late_calls: dict[int, list] = {}  # period -> phase-B calls
         for block in self.order:
             first = self.slot[f"{block.name}.{block.outputs[0]}"] if block.outputs else 0
             faults = [(f, self.slot[self.system.connections[f.target]], self.fault_slot[f.target])
@@ -307,18 +307,36 @@ class _Plan:
                 for u in block.inputs:
                     slot, is_early = self._source(block.name, u)
                     (early if is_early else late).append((instance.variables[u].valueReference, slot))
-                out_vr = instance.vr(block.outputs)
                 self.bus[first:first + len(block.outputs)] = instance.get(block.outputs)
-                a = _fmu_phase_a(block, instance, _runs(early, bus_address), out_vr,
-                                 _VOID_P(bus_address + 8 * first), faults, self.bus)
-                b = _fmu_phase_b(block, instance, _runs(late, bus_address), block.period * self.dt)
-                self.phase_a.append((block.period, a))
-                self.phase_b.append((block.period, b))
+                out_vr = instance.vr(block.outputs)
+                calls_a = [_call(_SET, block, instance, vrs, bus_address + 8 * slot) for vrs, slot in _runs(early)]
+                calls_a.append(_call(_GET, block, instance, out_vr, bus_address + 8 * first))
+                calls_b = [_call(_SET, block, instance, vrs, bus_address + 8 * slot) for vrs, slot in _runs(late)]
+                calls_b.append(_call(_STEP, block, instance, None, 0, h=block.period * self.dt))
+                if pending and (faults or pending[0][0] != block.period):
+                    self.phase_a.append(self._batch(pending))
+                    pending = []
+                pending.append((block.period, calls_a, faults))
+                late_calls.setdefault(block.period, []).extend(calls_b)
             else:
+                if pending:
+                    self.phase_a.append(self._batch(pending))
+                    pending = []
                 block.start(self.t0, block.period * self.dt)
                 y = self.bus[first:first + len(block.outputs)]
                 slots = [self._source(block.name, u)[0] for u in block.inputs]
                 self.phase_a.append((block.period, _python_phase(block, slots, y, faults, self.bus)))
+        if pending:
+            self.phase_a.append(self._batch(pending))
+        for period, calls in late_calls.items():
+            self.phase_b.append(self._batch([(period, calls, [])]))
+
+    def _batch(self, parts):
+        """One phase entry running the FMI calls of ``parts`` in a single call into C."""
+        period = parts[0][0]
+        calls = [c for _, cs, _ in parts for c in cs]
+        faults = [f for _, _, fs in parts for f in fs]
+        return period, _batch_phase(calls, faults, self.bus)
 
     def run(self, progress: bool):
         bus, record, dt, t0, dec = self.bus, self.record, self.dt, self.t0, self.decimation
@@ -388,9 +406,9 @@ class _Plan:
                 block.close()
 
 
-def _runs(refs: list[tuple[int, int]], bus_address: int):
+def _runs(refs: list[tuple[int, int]]):
     """Split (value reference, bus slot) pairs into runs of consecutive slots: one
-    fmi2SetReal each, reading straight from the bus."""
+    fmi2SetReal each, reading straight from the bus. Yields (value references, first slot)."""
     refs = sorted(refs, key=lambda r: r[1])
     runs, current = [], []
     for vr, slot in refs:
@@ -400,77 +418,64 @@ def _runs(refs: list[tuple[int, int]], bus_address: int):
         current.append((vr, slot))
     if current:
         runs.append(current)
-    out = []
-    for run in runs:
-        vrs = np.array([vr for vr, _ in run], dtype=np.uint32)
-        out.append((vrs, _VOID_P(vrs.ctypes.data), _SIZE(len(run)), _VOID_P(bus_address + 8 * run[0][1])))
-    return out
+    return [(np.array([vr for vr, _ in run], dtype=np.uint32), run[0][1]) for run in runs]
 
 
-def _status_error(block, function, status, t):
-    return FMUError(block.name, function, status, t, list(block.instance.log))
+class _Call(ctypes.Structure):
+    """One FMI call, as orchestrator/c/calls.c reads it."""
+
+    _fields_ = [("kind", ctypes.c_int), ("block", ctypes.c_int), ("function", ctypes.c_void_p),
+                ("component", ctypes.c_void_p), ("vr", ctypes.c_void_p), ("n", ctypes.c_size_t),
+                ("values", ctypes.c_void_p), ("h", ctypes.c_double)]
+
+
+_SET, _GET, _STEP = 0, 1, 2
+_FUNCTION_NAMES = ("fmi2SetReal", "fmi2GetReal", "fmi2DoStep")
+
+
+def _call(kind, block, instance, vrs, address, h=0.0):
+    function = (instance.raw_set_real, instance.raw_get_real, instance.raw_do_step)[kind]
+    call = _Call(kind, 0, ctypes.cast(function, ctypes.c_void_p).value, instance.component,
+                 None if vrs is None else vrs.ctypes.data, 0 if vrs is None else len(vrs), address, h)
+    return call, block, vrs
+
+
+_runner = None
+
+
+def _call_runner():
+    global _runner
+    if _runner is None:
+        from fmus import call_runner_path
+
+        library = ctypes.CDLL(str(call_runner_path()))
+        _runner = library.run_calls
+        _runner.restype = ctypes.c_int
+    return _runner
+
+
+def _batch_phase(calls, faults, bus):
+    run = _call_runner()
+    array = (_Call * len(calls))(*[c for c, _, _ in calls])
+    blocks = [b for _, b, _ in calls]
+    keep = [v for _, _, v in calls]  # the value reference arrays the calls point into
+    count, failed, now = ctypes.c_int(len(calls)), ctypes.c_int(-1), ctypes.c_double(0.0)
+    failed_ref = ctypes.byref(failed)
+
+    def phase(t, keep=keep):
+        if faults:
+            _apply_faults(faults, bus, t)
+        now.value = t
+        status = run(array, count, now, failed_ref)
+        if status > 1:
+            block = blocks[failed.value]
+            raise FMUError(block.name, _FUNCTION_NAMES[array[failed.value].kind], status, t, list(block.instance.log))
+    return phase
 
 
 def _apply_faults(faults, bus, t):
     for fault, source, slot in faults:
         bus[slot] = fault.apply(t, bus[source])
-
-
-def _fmu_phase_a(block, instance, runs, out_vr, out_ptr, faults, bus):
-    set_real, get_real, component = instance.raw_set_real, instance.raw_get_real, instance.component_arg
-    out_vr_ptr, n_out = _VOID_P(out_vr.ctypes.data), _SIZE(len(out_vr))
-    keep = (runs, out_vr)  # the ctypes pointers refer into these arrays
-    calls = [(vr_ptr, n, ptr) for _, vr_ptr, n, ptr in runs]
-
-    if len(calls) == 1 and not faults:
-        vr_ptr, n_in, in_ptr = calls[0]
-
-        def phase(t, keep=keep):
-            status = set_real(component, vr_ptr, n_in, in_ptr)
-            if status > 1:
-                raise _status_error(block, "fmi2SetReal", status, t)
-            status = get_real(component, out_vr_ptr, n_out, out_ptr)
-            if status > 1:
-                raise _status_error(block, "fmi2GetReal", status, t)
-        return phase
-
-    def phase(t, keep=keep):
-        if faults:
-            _apply_faults(faults, bus, t)
-        for vr_ptr, n_in, in_ptr in calls:
-            status = set_real(component, vr_ptr, n_in, in_ptr)
-            if status > 1:
-                raise _status_error(block, "fmi2SetReal", status, t)
-        status = get_real(component, out_vr_ptr, n_out, out_ptr)
-        if status > 1:
-            raise _status_error(block, "fmi2GetReal", status, t)
-    return phase
-
-
-def _fmu_phase_b(block, instance, runs, h):
-    set_real, do_step, component = instance.raw_set_real, instance.raw_do_step, instance.component_arg
-    calls = [(vr_ptr, n, ptr) for _, vr_ptr, n, ptr in runs]
-    keep = runs
-    now, step, no_rollback = ctypes.c_double(0.0), ctypes.c_double(h), ctypes.c_int(1)
-
-    if not calls:
-        def phase(t, keep=keep):
-            now.value = t
-            status = do_step(component, now, step, no_rollback)
-            if status > 1:
-                raise _status_error(block, "fmi2DoStep", status, t)
-        return phase
-
-    def phase(t, keep=keep):
-        for vr_ptr, n_in, in_ptr in calls:
-            status = set_real(component, vr_ptr, n_in, in_ptr)
-            if status > 1:
-                raise _status_error(block, "fmi2SetReal", status, t)
-        now.value = t
-        status = do_step(component, now, step, no_rollback)
-        if status > 1:
-            raise _status_error(block, "fmi2DoStep", status, t)
-    return phase
 
 
 def _python_phase(block, slots, y, faults, bus):

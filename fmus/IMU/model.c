@@ -21,7 +21,8 @@
 enum { CH_ACC = 0, CH_GYRO = 3, CH_MAG = 6, CH_WALK_GYRO = 9, CH_WALK_ACC = 12 };
 
 typedef struct {
-    int64_t next_sample;
+    int64_t next_sample; /* first instant not yet final */
+    int64_t current;     /* instant of the sample the outputs hold */
     double gyro_bias[3], acc_bias[3];
 } Data;
 
@@ -43,6 +44,7 @@ static double gaussian(int seed, int64_t k, int channel) {
 }
 
 static void take_sample(ModelInstance *m, Data *d, int64_t k) {
+    d->current = k;
     const double *q = &R(q0), *w = &R(omega_x), *f = &R(f_x), *bd = &R(b_d_x);
     const double *a = &R(A_11), *bs = &R(b_s_x), *mi = &R(m_I_x);
     double r[9], body[3], sd_acc = 0.0, sd_gyro = 0.0, sd_mag = 0.0, noise[CH_WALK_GYRO];
@@ -80,6 +82,7 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k) {
 static void commit_sample(ModelInstance *m, Data *d, int64_t k) {
     double root_dt = sqrt(1.0 / R(sample_rate));
     int seed = m->integer[VI_seed], i;
+    if (R(gyro_bias_walk) == 0.0 && R(acc_bias_walk) == 0.0) return;
     for (i = 0; i < 3; i++) {
         d->gyro_bias[i] += R(gyro_bias_walk) * root_dt * gaussian(seed, k, CH_WALK_GYRO + i);
         d->acc_bias[i] += R(acc_bias_walk) * root_dt * gaussian(seed, k, CH_WALK_ACC + i);
@@ -104,6 +107,7 @@ fmi2Status model_initialize(ModelInstance *m) {
         d->acc_bias[i] = (&R(b_a_x))[i];
     }
     d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - 1e-6);
+    d->current = -1;
     return fmi2OK;
 }
 
@@ -112,7 +116,8 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     /* instants in [t, t + h) become final, with the inputs held over the step */
     int64_t end = (int64_t)ceil((t + h) * R(sample_rate) - 1e-6);
     for (; d->next_sample < end; d->next_sample++) {
-        take_sample(m, d, d->next_sample);
+        /* the sample at t is already current unless inputs changed since it was read */
+        if (!(d->current == d->next_sample && !m->outputs_stale)) take_sample(m, d, d->next_sample);
         commit_sample(m, d, d->next_sample);
     }
     return fmi2OK;

@@ -227,11 +227,18 @@ static fmi2Status check_settable(ModelInstance *m, const char *function, const V
     return fmi2OK;
 }
 
-static void refresh_outputs(ModelInstance *m) {
-    if (m->outputs_stale && m->mode == MODE_STEPPING) {
-        model_outputs(m);
-        m->outputs_stale = 0;
+/* Outputs are computed when read, once per change of state or inputs. */
+static fmi2Status refresh_outputs(ModelInstance *m, const char *function) {
+    int bad;
+    if (!m->outputs_stale || m->mode != MODE_STEPPING) return fmi2OK;
+    model_outputs(m);
+    m->outputs_stale = 0;
+    bad = first_non_finite(m);
+    if (bad >= 0) {
+        m->mode = MODE_ERROR;
+        return fail(m, function, "%s became %g at t = %g", REAL_INFO[bad].name, m->real[bad], m->time);
     }
+    return fmi2OK;
 }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
@@ -239,7 +246,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     size_t i;
     if (!allowed(m, "fmi2GetReal", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
     if (check_refs(m, "fmi2GetReal", vr, nvr, N_REAL) != fmi2OK) return fmi2Error;
-    refresh_outputs(m);
+    if (refresh_outputs(m, "fmi2GetReal") != fmi2OK) return fmi2Error;
     for (i = 0; i < nvr; i++) value[i] = m->real[vr[i]];
     return fmi2OK;
 }
@@ -395,7 +402,6 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     ModelInstance *m = (ModelInstance *)c;
     fmi2Status status;
-    int bad;
     UNUSED(noSetFMUStatePriorToCurrentPoint);
     if (!allowed(m, "fmi2DoStep", 1u << MODE_STEPPING)) return fmi2Error;
     if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
@@ -409,14 +415,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
         m->mode = MODE_ERROR;
         return status;
     }
-    model_outputs(m);
-    m->outputs_stale = 0;
-    bad = first_non_finite(m);
-    if (bad >= 0) {
-        m->mode = MODE_ERROR;
-        return fail(m, "fmi2DoStep", "%s became %g at t = %g", REAL_INFO[bad].name, m->real[bad],
-                    m->time);
-    }
+    m->outputs_stale = 1;
     return status;
 }
 

@@ -56,7 +56,8 @@ void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, in
 extern const size_t MODEL_DATA_SIZE;
 /* Check parameters, set the initial state and outputs. */
 fmi2Status model_initialize(ModelInstance *m);
-/* Advance the state from t to t + h with the inputs held; outputs are refreshed after. */
+/* Advance the state from t to t + h with the inputs held. A model whose state can become
+ * non-finite reports it here; outputs are refreshed lazily, when next read. */
 fmi2Status model_do_step(ModelInstance *m, double t, double h);
 /* Outputs from the state and the present inputs (direct feedthrough). */
 void model_outputs(ModelInstance *m);
