@@ -61,7 +61,7 @@ CELL_OCV_COEFFS = (3.27, 1.53, -2.03, 1.43)  # V, V, V, V
 
 # Magnetic field of the motor currents at the magnetometer, sensor frame {B}.
 # kappa_n in T/A; v_n unit vectors (normalised by the FMU).
-MOTOR_FIELD_GAIN = (1.10e-6, 0.95e-6, 1.25e-6, 1.05e-6)  # T/A
+MOTOR_FIELD_GAIN = (1.85e-6, 1.60e-6, 2.10e-6, 1.75e-6)  # T/A
 MOTOR_FIELD_DIRECTION = (
     (0.30, 0.80, -0.52),  # 1, unit-less
     (-0.55, -0.35, 0.76),  # 2, unit-less
@@ -95,3 +95,17 @@ def steady_command(omega, u_batt, resistance: float = MOTOR_RESISTANCE, ke: floa
     """
     current = drag_torque_coeff * omega * abs(omega) / ke
     return (resistance * current + ke * omega) / u_batt
+
+
+def hover_command(soc: float = BATTERY_SOC0) -> float:
+    """ESC command (1) that holds hover speed at state of charge ``soc``, under hover load.
+
+    The load sags the battery voltage, which raises the command: solved as a fixed point.
+    """
+    w = hover_rotor_speed()
+    open_circuit = BATTERY_CELLS * cell_voltage(soc)
+    u = open_circuit
+    for _ in range(30):
+        c = steady_command(w, u)
+        u = open_circuit - BATTERY_RESISTANCE * 4 * c * steady_current(w)
+    return c

@@ -1,9 +1,17 @@
-"""The ``quadcosim`` command line."""
+"""quadcosim: run the quadrotor co-simulation scenarios, build the FMUs, benchmark the master.
+
+  quadcosim build                          build the plant FMUs from source
+  quadcosim list [--parameters MODEL]      scenarios and their options (or an FMU's parameters)
+  quadcosim run SCENARIO [--set k=v]... [--out DIR] [--fault ...]
+  quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
+  quadcosim bench [--json]                 speed of the master
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 
 def _build(args) -> int:
@@ -17,12 +25,108 @@ def _build(args) -> int:
     return 0
 
 
+def _list(args) -> int:
+    if args.parameters:
+        from fmus import MODELS
+        from fmus.build import table
+
+        if args.parameters not in MODELS:
+            print(f"unknown model {args.parameters!r}; models: {', '.join(MODELS)}", file=sys.stderr)
+            return 2
+        for v in table(args.parameters).of("parameter"):
+            unit = f" [{v.unit}]" if v.unit else ""
+            print(f"  {v.name:22s} = {v.start!r:24}{unit:12s} {v.description}")
+        return 0
+    import scenarios
+
+    for name, scenario in scenarios.registry().items():
+        print(f"{name}: {scenario.description}")
+        for key, option in scenario.options.items():
+            choices = f" ({'|'.join(map(str, option.choices))})" if option.choices else ""
+            print(f"    {key:16s} = {option.default!s:10s}{choices}  {option.help}")
+    return 0
+
+
+def _parse_fault(text: str):
+    from orchestrator import Fault
+
+    parts = text.split(":")
+    if len(parts) not in (4, 5):
+        raise ValueError(f"--fault {text!r}: write TARGET:KIND:START:STOP[:VALUE], e.g. IMU.gyro_x:offset:2:3:0.1")
+    value = float(parts[4]) if len(parts) == 5 else None
+    return Fault(parts[0], parts[1], float(parts[2]), float(parts[3]), value)
+
+
+def _run(args) -> int:
+    import scenarios
+    from orchestrator import SimulationError
+
+    try:
+        faults = [_parse_fault(f) for f in args.fault or []]
+        out = Path(args.out) if args.out else Path("results") / args.scenario
+        _, metrics = scenarios.run(args.scenario, args.set, out, progress=True, faults=faults)
+    except SimulationError as error:
+        print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)
+        if error.result is not None:
+            print(f"what was recorded up to the failure ({len(error.result)} samples) is in {out}/", file=sys.stderr)
+        return 1
+    except (KeyError, ValueError) as error:
+        print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
+        return 2
+    shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario")}
+    for key, value in shown.items():
+        print(f"  {key}: {value}")
+    print(f"results, metrics.json and figures in {out}/")
+    return 0
+
+
+def _diagram(args) -> int:
+    import scenarios
+    from orchestrator.diagram import draw
+
+    try:
+        scenario = scenarios.get(args.scenario)
+        system = scenario.build(scenario.parse(args.set))
+    except (KeyError, ValueError) as error:
+        print(error.args[0] if error.args else error, file=sys.stderr)
+        return 2
+    path = draw(system, args.out or f"results/{args.scenario}/diagram.png")
+    print(path)
+    return 0
+
+
+def _bench(args) -> int:
+    from orchestrator import bench
+
+    return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
+
+
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__)
+    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     build = sub.add_parser("build", help="build the plant FMUs from source into build/fmus")
     build.add_argument("--out", default=None, help="output folder (default build/fmus)")
     build.set_defaults(func=_build)
+    listing = sub.add_parser("list", help="the scenarios and their options")
+    listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
+    listing.set_defaults(func=_list)
+    run = sub.add_parser("run", help="run a scenario")
+    run.add_argument("scenario")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario option")
+    run.add_argument("--out", help="output folder (default results/SCENARIO)")
+    run.add_argument("--fault", action="append", metavar="TARGET:KIND:START:STOP[:VALUE]",
+                     help="fault on the connection into TARGET; KIND is offset, scale, stuck, noise or dropout")
+    run.set_defaults(func=_run)
+    diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
+    diagram.add_argument("scenario")
+    diagram.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
+    diagram.set_defaults(func=_diagram)
+    bench = sub.add_parser("bench", help="benchmark the co-simulation master")
+    bench.add_argument("--json", action="store_true")
+    bench.add_argument("--seconds", type=float, default=5.0)
+    bench.set_defaults(func=_bench)
     return p
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import atexit
 import ctypes
 import difflib
+import itertools
 import math
 import shutil
 from collections import deque
@@ -24,11 +25,31 @@ from fmpy.fmi2 import (
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
 )
+from fmpy.logging import addLoggerProxy
 
 from fmus import fmu_path
 
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 _extracted: dict[tuple[str, float], str] = {}
+_logs: dict[bytes, deque] = {}  # instance name -> its log
+_instances = itertools.count(1)
+
+
+def _on_log(env, instance, status, category, message):
+    log = _logs.get(instance)
+    if log is not None:
+        label = STATUS[status] if 0 <= status < 6 else status
+        log.append(f"[{label}] {message.decode(errors='replace')}")
+
+
+# fmpy's native proxy formats the FMU's variadic messages; it keeps one Python logger for the
+# whole process, so there is one callback structure and messages are routed by instance name.
+_CALLBACKS = fmi2CallbackFunctions()
+_LOGGER = fmi2CallbackLoggerTYPE(_on_log)
+_CALLBACKS.logger = _LOGGER
+_CALLBACKS.allocateMemory = fmi2CallbackAllocateMemoryTYPE(ctypes.CDLL(None).calloc)
+_CALLBACKS.freeMemory = fmi2CallbackFreeMemoryTYPE(ctypes.CDLL(None).free)
+addLoggerProxy(ctypes.byref(_CALLBACKS))
 
 
 class FMUError(RuntimeError):
@@ -92,27 +113,20 @@ class FMUInstance:
         self.inputs = [v.name for v in description.modelVariables if v.causality == "input"]
         self.outputs = [v.name for v in description.modelVariables if v.causality == "output"]
         overrides = self._check_parameters(parameters or {})
-
-        self._callbacks = fmi2CallbackFunctions()
-        self._logger = fmi2CallbackLoggerTYPE(self._on_log)
-        self._callbacks.logger = self._logger
-        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(ctypes.CDLL(None).calloc)
-        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(ctypes.CDLL(None).free)
-        from fmpy.logging import addLoggerProxy
-
-        addLoggerProxy(ctypes.byref(self._callbacks))
+        self._instance_name = f"{self.name}#{next(_instances)}"
+        _logs[self._instance_name.encode()] = self.log
 
         self._slave = FMU2Slave(
             guid=description.guid,
             unzipDirectory=_unzip(path),
             modelIdentifier=description.coSimulation.modelIdentifier,
-            instanceName=self.name,
+            instanceName=self._instance_name,
         )
         functions = self._slave._functions
         self.fmi2SetReal = functions["fmi2SetReal"]
         self.fmi2GetReal = functions["fmi2GetReal"]
         self.fmi2DoStep = functions["fmi2DoStep"]
-        self._call(lambda: self._slave.instantiate(callbacks=self._callbacks), "fmi2Instantiate")
+        self._call(lambda: self._slave.instantiate(callbacks=_CALLBACKS), "fmi2Instantiate")
         self.component = self._slave.component
         # Hot-path handles: fresh function objects without argtypes, called with prebuilt
         # ctypes arguments, skip ctypes' per-call conversions (0.66 against 2.2 us here).
@@ -130,10 +144,6 @@ class FMUInstance:
         self.closed = False
 
     # ------------------------------------------------------------------ set-up helpers
-    def _on_log(self, env, instance, status, category, message):
-        label = STATUS[status] if 0 <= status < 6 else status
-        self.log.append(f"[{label}] {message.decode(errors='replace')}")
-
     def _call(self, function, label: str):
         from fmpy.fmi1 import FMICallException
 
@@ -219,6 +229,7 @@ class FMUInstance:
             except Exception:  # an FMU in error state may refuse terminate; free it anyway
                 pass
             self._slave.fmi2FreeInstance(self.component)
+            _logs.pop(self._instance_name.encode(), None)
             self.closed = True
 
     def __del__(self):

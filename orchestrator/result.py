@@ -102,11 +102,14 @@ class Result:
             data = np.column_stack([archive[n] for n in names]) if names else np.empty((len(archive["time"]), 0))
             return cls(archive["time"], names, data, meta, meta.pop("error", None))
 
-    def save(self, out_dir) -> list[Path]:
-        """Write ``results.npz``, ``results.mat`` and ``results.csv`` into ``out_dir``."""
+    def save(self, out_dir, csv: bool = False) -> list[Path]:
+        """Write ``results.npz`` and ``results.mat`` (and ``results.csv``) into ``out_dir``."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        return [self.to_npz(out / "results.npz"), self.to_mat(out / "results.mat"), self.to_csv(out / "results.csv")]
+        written = [self.to_npz(out / "results.npz"), self.to_mat(out / "results.mat")]
+        if csv:
+            written.append(self.to_csv(out / "results.csv"))
+        return written
 
     # ------------------------------------------------------------------ plots
     def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = ""):

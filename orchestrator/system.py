@@ -388,7 +388,11 @@ class _Plan:
                 if not math.isfinite(value):
                     return (f"{name} became {value} at t = {t:.6g} s (the first non-finite signal in the block "
                             f"order). Check the block {block.name} and its inputs.")
-        return f"a fault or input became non-finite at t = {t:.6g} s"
+        for fault in self.system.faults:
+            value = self.bus[self.fault_slot[fault.target]]
+            if not math.isfinite(value):
+                return f"the {fault.kind} fault on {fault.target} made it {value} at t = {t:.6g} s"
+        return f"a signal became non-finite at t = {t:.6g} s"
 
     def result(self, error: str | None = None) -> Result:
         rows = self.recorded

@@ -21,19 +21,8 @@ def run(commands, seconds, h=1e-3, fmu=None):
     return fmu, {name: values[:, j] for j, name in enumerate(OUT)}
 
 
-def hover_command():
-    """Command that holds hover speed at the voltage reached under hover load (fixed point)."""
-    w = vehicle.hover_rotor_speed()
-    u = vehicle.BATTERY_CELLS * vehicle.cell_voltage(vehicle.BATTERY_SOC0)
-    for _ in range(20):
-        c = vehicle.steady_command(w, u)
-        u = vehicle.BATTERY_CELLS * vehicle.cell_voltage(vehicle.BATTERY_SOC0) - \
-            vehicle.BATTERY_RESISTANCE * 4 * c * vehicle.steady_current(w)
-    return c
-
-
 def test_hover_current_and_time_constant(capsys):
-    c = hover_command()
+    c = vehicle.hover_command()
     fmu, out = run([c] * 4, 1.0)
     assert out["omega_r1"][-1] == pytest.approx(vehicle.hover_rotor_speed(), rel=2e-3)
     assert 3.0 <= out["i1"][-1] <= 5.0

@@ -18,10 +18,10 @@ model MotorMagnetics "Four DC-approximated brushless motors, ESCs, LiPo battery,
   parameter Real ocv1(unit = "V") = 1.53 "cell open-circuit voltage, soc term";
   parameter Real ocv2(unit = "V") = -2.03 "cell open-circuit voltage, soc^2 term";
   parameter Real ocv3(unit = "V") = 1.43 "cell open-circuit voltage, soc^3 term";
-  parameter Real kappa1(unit = "T/A") = 1.10e-6 "field per ampere of motor 1";
-  parameter Real kappa2(unit = "T/A") = 0.95e-6 "field per ampere of motor 2";
-  parameter Real kappa3(unit = "T/A") = 1.25e-6 "field per ampere of motor 3";
-  parameter Real kappa4(unit = "T/A") = 1.05e-6 "field per ampere of motor 4";
+  parameter Real kappa1(unit = "T/A") = 1.85e-6 "field per ampere of motor 1";
+  parameter Real kappa2(unit = "T/A") = 1.60e-6 "field per ampere of motor 2";
+  parameter Real kappa3(unit = "T/A") = 2.10e-6 "field per ampere of motor 3";
+  parameter Real kappa4(unit = "T/A") = 1.75e-6 "field per ampere of motor 4";
   parameter Real v1_x = 0.30;
   parameter Real v1_y = 0.80;
   parameter Real v1_z = -0.52;

@@ -1,0 +1,80 @@
+"""``open-loop``: scripted ESC commands into MotorMagnetics, then Quadrotor, then IMU.
+
+The motors spin up to the hover command, the vehicle hovers, then a short differential
+pulse on each pair of motors rolls, pitches and yaws it. No controller: the attitude is
+left free after each pulse.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fmus import vehicle
+from orchestrator import System, Table
+from scenarios import Option, Scenario
+from scenarios.plant import add_plant, imu_parameters, save_figure
+
+OPTIONS = {
+    "duration": Option(2.0, "simulated time (s)", minimum=1e-3),
+    "dt": Option(1e-3, "macro step (s)", minimum=1e-6),
+    "noise": Option(True, "IMU white noise"),
+    "bias": Option(False, "IMU accelerometer and gyro biases"),
+    "magnetic": Option(True, "field of the motor currents at the magnetometer"),
+    "seed": Option(1, "IMU noise seed"),
+    "pulse": Option(0.01, "height of the differential command pulses (1)", minimum=0.0),
+}
+
+
+def commands(duration: float, dt: float, pulse: float) -> np.ndarray:
+    """(n, 4) ESC commands: spin-up, hover, then roll, pitch and yaw pulses of 50 ms."""
+    t = np.arange(int(round(duration / dt)) + 1) * dt
+    c = np.full((len(t), 4), vehicle.hover_command())
+    c *= np.clip(t / 0.3, 0.0, 1.0)[:, None]
+    # columns are motors 1..4: 1 front-right, 2 rear-left, 3 front-left, 4 rear-right
+    for start, pattern in ((0.8, (-1, 1, 1, -1)), (1.2, (1, -1, 1, -1)), (1.6, (1, 1, -1, -1))):
+        window = (t >= start) & (t < start + 0.05)
+        c[window] += pulse * np.array(pattern)
+    return c
+
+
+def build(o: dict) -> System:
+    system = System(dt=o["dt"])
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], commands(o["duration"], o["dt"], o["pulse"])))
+    add_plant(system, imu=imu_parameters(o["noise"], o["bias"], o["seed"]), magnetic=o["magnetic"])
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    return system
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    figures = []
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    result.plot("Setpoint.c", ax=axes[0])
+    axes[0].set_ylabel("ESC command (1)")
+    result.plot("MotorMagnetics.omega_r", ax=axes[1])
+    axes[1].set_ylabel("rotor speed (rad/s)")
+    result.plot("Quadrotor.theta1", "Quadrotor.theta2", "Quadrotor.theta3", ax=axes[2], scale=180 / np.pi)
+    axes[2].set_ylabel("attitude (deg)")
+    figures.append(save_figure(fig, out, "open_loop.png"))
+    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    result.plot("IMU.acc", ax=axes[0])
+    axes[0].set_ylabel("accelerometer (m/s²)")
+    result.plot("IMU.gyro", ax=axes[1])
+    axes[1].set_ylabel("gyrometer (rad/s)")
+    result.plot("IMU.magneto", ax=axes[2], scale=1e6)
+    axes[2].set_ylabel("magnetometer (µT)")
+    figures.append(save_figure(fig, out, "imu.png"))
+    loop = result.meta.get("loop_seconds")
+    return {
+        "final_position_m": result["Quadrotor.p"][-1].tolist(),
+        "max_abs_attitude_deg": np.degrees(np.abs(np.column_stack(
+            [result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])).max(axis=0)).tolist(),
+        "hover_current_A": float(result["MotorMagnetics.i1"][int(0.7 / o["dt"])]),
+        "us_per_step": None if loop is None else loop / (len(result) - 1) * 1e6,
+        "real_time_factor": None if loop is None else o["duration"] / loop,
+        "figures": [f for f in figures if f],
+    }
+
+
+SCENARIO = Scenario("open-loop", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report)

@@ -1,0 +1,122 @@
+"""``rig``: the drone clamped to the ground, each motor swept in turn, then all four together.
+
+The test rig of Metge et al. (seed 000): with the body fixed, the Earth field in the sensor
+frame is constant, so whatever moves the measured field comes from the motor currents.
+Phases: motors off (the reference field m0), then each motor alone with its command ramped
+from 0 to 1 and back to 0, then a free set where all four commands vary fast and together.
+The metrics are the uncompensated mean angular errors between the measured field and m0
+(seed 000, Table 1, row "no dynamic calibration").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from orchestrator import System, Table
+from scenarios import Option, Scenario
+from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
+
+OPTIONS = {
+    "reference": Option(1.0, "motors-off time at the start (s)", minimum=0.1),
+    "sweep": Option(4.0, "time of one motor's ramp up and down (s)", minimum=0.1),
+    "rest": Option(0.5, "motors-off time between sweeps (s)", minimum=0.0),
+    "free": Option(6.0, "time of the free set, all motors varied together (s)", minimum=0.0),
+    "dt": Option(1e-3, "macro step (s)", minimum=1e-6),
+    "noise": Option(True, "IMU white noise"),
+    "seed": Option(1, "seed of the IMU noise and of the free-set commands"),
+    "roll": Option(0.0, "roll of the rig (rad)"),
+    "pitch": Option(0.0, "pitch of the rig (rad)"),
+    "yaw": Option(0.0, "yaw of the rig (rad)"),
+}
+
+
+def phases(o: dict) -> list[tuple[str, float, float]]:
+    """(name, start, stop) of each phase (s)."""
+    out, t = [("reference", 0.0, o["reference"])], o["reference"]
+    for n in range(1, 5):
+        out.append((f"motor{n}", t, t + o["sweep"]))
+        t += o["sweep"] + o["rest"]
+    if o["free"] > 0:
+        out.append(("free", t, t + o["free"]))
+        t += o["free"]
+    return out
+
+
+def duration(o: dict) -> float:
+    return phases(o)[-1][2]
+
+
+def commands(o: dict) -> np.ndarray:
+    dt = o["dt"]
+    t = np.arange(int(round(duration(o) / dt)) + 1) * dt
+    c = np.zeros((len(t), 4))
+    for name, start, stop in phases(o):
+        inside = (t >= start) & (t < stop)
+        s = (t[inside] - start) / (stop - start)
+        if name.startswith("motor"):
+            c[inside, int(name[-1]) - 1] = 1.0 - np.abs(2.0 * s - 1.0)  # triangle 0 -> 1 -> 0
+        elif name == "free":
+            rng = np.random.default_rng(o["seed"])
+            # sums of random sinusoids up to 3 Hz: fast, simultaneous changes of all four
+            for motor in range(4):
+                f = rng.uniform(0.3, 3.0, 4)
+                phase = rng.uniform(0, 2 * np.pi, 4)
+                wave = np.sin(2 * np.pi * f[:, None] * t[inside][None, :] + phase[:, None]).sum(axis=0)
+                c[inside, motor] = np.clip(0.5 + 0.15 * wave, 0.0, 1.0)
+    return c
+
+
+def build(o: dict) -> System:
+    system = System(dt=o["dt"])
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], commands(o)))
+    add_plant(system, quadrotor={"clamped": True, "theta1_0": o["roll"], "theta2_0": o["pitch"],
+                                 "theta3_0": o["yaw"]},
+              imu=imu_parameters(o["noise"], False, o["seed"]))
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    return system
+
+
+def mean_errors(result, o) -> tuple[np.ndarray, dict[str, float]]:
+    """Angular error (deg) of the measured field against the motors-off reference, and its
+    mean over each phase."""
+    field = result["IMU.magneto"]
+    t = result.time
+    spans = phases(o)
+    _, start, stop = spans[0]
+    reference = field[(t >= start) & (t < stop)].mean(axis=0)
+    error = np.degrees(angle_between(field, reference))
+    means = {name: float(error[(t >= a) & (t < b)].mean()) for name, a, b in spans[1:]}
+    return error, means
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    error, means = mean_errors(result, o)
+    t = result.time
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    for axis in "xyz":
+        axes[0].plot(t, result[f"IMU.magneto_{axis}"] * 1e6, label=f"m_{axis}")
+    axes[0].set_ylabel("measured field (µT)")
+    axes[0].legend(fontsize=8)
+    axes[0].set_title("Clamped drone: measured field as the motor commands rise (cf. seed 000, Fig. 1)")
+    result.plot("Setpoint.c", ax=axes[1])
+    axes[1].set_ylabel("ESC command (1)")
+    axes[2].plot(t, error)
+    axes[2].set_ylabel("angle to m0 (deg)")
+    for name, a, b in phases(o)[1:]:
+        axes[2].axvspan(a, b, alpha=0.08)
+        axes[2].text(0.5 * (a + b), error.max() * 0.95, f"{name}\n{means[name]:.1f}°", ha="center", va="top",
+                     fontsize=7)
+    axes[2].grid(True, alpha=0.3)
+    figure = save_figure(fig, out, "rig_field.png")
+    single = [means[f"motor{n}"] for n in range(1, 5)]
+    return {
+        "mean_angular_error_deg": means,
+        "mean_angular_error_single_motor_deg": float(np.mean(single)),
+        "reference_field_uT": (result["IMU.magneto"][t < o["reference"]].mean(axis=0) * 1e6).tolist(),
+        "figures": [figure] if figure else [],
+    }
+
+
+SCENARIO = Scenario("rig", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report, duration=duration)
