@@ -95,6 +95,7 @@ def draw(system, path) -> Path:
     ax.set_title(f"{len(order)} blocks, {len(system.connections)} connections, macro step {system.dt * 1e3:g} ms")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=130, bbox_inches="tight")
+    with matplotlib.rc_context({"svg.fonttype": "none"}):  # SVG text stays text
+        fig.savefig(path, dpi=130, bbox_inches="tight")
     plt.close(fig)
     return path

@@ -363,8 +363,9 @@ class _Plan:
                 for period, fn in phase_b:
                     if period == 1 or n % period == 0:
                         fn(t)
-                if bar is not None and n % chunk == 0:
-                    bar.update(chunk * dt)
+                if bar is not None and n % chunk == 0 and n:
+                    bar.n = n * dt
+                    bar.refresh()
         except _Failure as failure:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:

@@ -70,7 +70,8 @@ def report(result, o, out) -> dict:
         "final_position_m": result["Quadrotor.p"][-1].tolist(),
         "max_abs_attitude_deg": np.degrees(np.abs(np.column_stack(
             [result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])).max(axis=0)).tolist(),
-        "hover_current_A": float(result["MotorMagnetics.i1"][int(0.7 / o["dt"])]),
+        "hover_current_A": float(result["MotorMagnetics.i1"][np.searchsorted(result.time, min(0.7, o["duration"]))]
+                                 if result.time[-1] >= 0.7 else np.nan),
         "us_per_step": None if loop is None else loop / (len(result) - 1) * 1e6,
         "real_time_factor": None if loop is None else o["duration"] / loop,
         "figures": [f for f in figures if f],

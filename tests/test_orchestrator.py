@@ -1,0 +1,178 @@
+"""The co-simulation master: wiring, multi-rate, faults, recording, exports and failures."""
+
+import tracemalloc
+
+import numpy as np
+import pytest
+import scipy.io
+
+import scenarios
+from orchestrator import AlgebraicLoopError, Block, Fault, FMUBlock, Result, System, Table
+
+
+class Ramp(Block):
+    """y = t: a known signal."""
+
+    outputs = ("y",)
+    feedthrough = False
+
+    def step(self, t, u, y):
+        y[0] = t
+
+
+class Probe(Block):
+    """Copies its input to its output, and counts its steps."""
+
+    inputs = ("u",)
+    outputs = ("y",)
+
+    def start(self, t0, dt):
+        self.times = []
+
+    def step(self, t, u, y):
+        self.times.append(t)
+        y[0] = u[0]
+
+
+class Gain(Block):
+    inputs = ("u",)
+    outputs = ("y",)
+
+    def step(self, t, u, y):
+        y[0] = 2.0 * u[0]
+
+
+def probe_system(dt=1e-3, period=1):
+    system = System(dt)
+    system.add(Ramp("Source"))
+    probe = system.add(Probe("Probe", period=period))
+    system.connect("Source.y", "Probe.u")
+    return system, probe
+
+
+# ---------------------------------------------------------------- faults
+@pytest.mark.parametrize("kind, value, expected", [
+    ("offset", 0.5, lambda t: t + 0.5),
+    ("scale", -2.0, lambda t: -2.0 * t),
+    ("stuck", None, lambda t: np.full_like(t, 0.3)),  # the value at the fault's start
+    ("stuck", 7.0, lambda t: np.full_like(t, 7.0)),
+    ("dropout", None, lambda t: np.zeros_like(t)),
+])
+def test_each_fault_acts_inside_its_window_only(kind, value, expected):
+    system, _ = probe_system()
+    system.inject(Fault("Probe.u", kind, 0.3, 0.6, value))
+    result = system.run(1.0)
+    t, y = result.time, result["Probe.y"]
+    inside = (t >= 0.3 - 1e-12) & (t < 0.6 - 1e-12)
+    assert np.allclose(y[inside], expected(t[inside]), atol=1e-12)
+    assert np.allclose(y[~inside], t[~inside], atol=1e-12)
+
+
+def test_noise_fault_statistics_and_window():
+    system, _ = probe_system()
+    system.inject(Fault("Probe.u", "noise", 1.0, 3.0, 0.2, seed=3))
+    result = system.run(4.0)
+    t, y = result.time, result["Probe.y"]
+    inside = (t >= 1.0 - 1e-12) & (t < 3.0 - 1e-12)
+    deviation = y[inside] - t[inside]
+    assert abs(deviation.std() / 0.2 - 1) < 0.05 and abs(deviation.mean()) < 0.02
+    assert np.array_equal(y[~inside], t[~inside])
+
+
+def test_fault_on_an_fmu_input():
+    system = System()
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], np.full((1, 4), 0.5)))
+    system.add(FMUBlock("MotorMagnetics"))
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    system.inject(Fault("MotorMagnetics.c2", "dropout", 0.0, 10.0))
+    result = system.run(0.3)
+    assert result["MotorMagnetics.omega_r2"][-1] == 0.0 and result["MotorMagnetics.omega_r1"][-1] > 300
+
+
+# ---------------------------------------------------------------- multi-rate and order
+@pytest.mark.parametrize("period", [1, 2, 5])
+def test_block_at_one_kth_rate_steps_every_kth_macro_step(period):
+    system, probe = probe_system(period=period)
+    result = system.run(0.1)
+    steps = np.round(np.array(probe.times) / 1e-3).astype(int)
+    assert np.array_equal(steps, np.arange(0, 101, period))
+    # between its steps the output holds
+    y = result["Probe.y"]
+    assert np.allclose(y, (np.arange(101) // period) * period * 1e-3)
+
+
+def test_fmu_at_a_multiple_of_the_macro_step():
+    system = System()
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], np.full((1, 4), 0.5)))
+    system.add(FMUBlock("MotorMagnetics", period=4))
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    w = system.run(0.2)["MotorMagnetics.omega_r1"]
+    changes = np.flatnonzero(np.diff(w)) + 1
+    assert np.all(changes % 4 == 0) and len(changes) == 50
+
+
+def test_algebraic_loop_is_reported_with_its_blocks():
+    system = System()
+    system.add(Gain("A"))
+    system.add(Gain("B"))
+    system.connect("A.y", "B.u")
+    system.connect("B.y", "A.u")
+    with pytest.raises(AlgebraicLoopError) as error:
+        system.run(0.01)
+    assert "A -> B -> A" in str(error.value) or "B -> A -> B" in str(error.value)
+
+
+def test_loop_through_a_block_without_feedthrough_is_not_algebraic():
+    system = System()
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], np.full((1, 4), 0.4)))
+    system.add(FMUBlock("MotorMagnetics"))
+    system.add(Probe("Probe"))
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    system.connect("MotorMagnetics.omega_r1", "Probe.u")
+    assert [b.name for b in system.order()] == ["Setpoint", "MotorMagnetics", "Probe"]
+
+
+# ---------------------------------------------------------------- hot path
+def test_no_allocation_grows_with_the_number_of_steps():
+    def peak(seconds):
+        scenario = scenarios.get("open-loop")
+        system = scenario.build(scenario.parse({"duration": seconds}))
+        tracemalloc.start()
+        result = system.run(seconds)
+        _, top = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        return top - result.data.nbytes * 2  # the record and the result's copy of it
+
+    short, long = peak(0.5), peak(2.5)
+    assert long - short < 64 * 1024  # 2000 more steps, no growth beyond noise
+
+
+# ---------------------------------------------------------------- results
+def test_exports_load_back_equal(tmp_path):
+    _, metrics = scenarios.run("open-loop", {"duration": 0.2})
+    result, _ = scenarios.run("open-loop", {"duration": 0.2})
+    result.save(tmp_path, csv=True)
+    back = Result.from_npz(tmp_path / "results.npz")
+    assert back.names == result.names and np.array_equal(back.data, result.data)
+    assert np.array_equal(back.time, result.time)
+    mat = scipy.io.loadmat(tmp_path / "results.mat", squeeze_me=True)
+    assert np.array_equal(mat["time"], result.time)
+    assert np.array_equal(mat["IMU"]["acc_x"].item(), result["IMU.acc_x"])
+    csv = np.genfromtxt(tmp_path / "results.csv", delimiter=",", names=True)
+    assert np.array_equal(csv["IMUacc_x"], result["IMU.acc_x"])  # numpy drops the dot in names
+    assert np.array_equal(csv["time"], result.time)
+
+
+def test_same_scenario_and_seed_give_identical_results():
+    a, _ = scenarios.run("open-loop", {"duration": 0.3, "seed": 4})
+    b, _ = scenarios.run("open-loop", {"duration": 0.3, "seed": 4})
+    c, _ = scenarios.run("open-loop", {"duration": 0.3, "seed": 5})
+    assert np.array_equal(a.data, b.data)
+    assert not np.array_equal(a["IMU.gyro"], c["IMU.gyro"])
+
+
+def test_vector_signals_connect_and_index():
+    result, _ = scenarios.run("open-loop", {"duration": 0.05})
+    assert result["IMU.acc"].shape == (51, 3)
+    assert result["MotorMagnetics.omega_r"].shape == (51, 4)
+    assert result["IMU.R_reel"].shape == (51, 9)
