@@ -204,8 +204,8 @@ fmi2Status model_initialize(ModelInstance *m) {
             return fmi2Error;
         }
         for (i = 0; i < 3; i++) d->v[n][i] = v[i] / norm;
-        d->x[OMEGA + n] = 0.0;
-        d->x[CURRENT + n] = 0.0;
+        d->x[OMEGA + n] = R(omega0);
+        d->x[CURRENT + n] = R(k_m) * R(omega0) * fabs(R(omega0)) / R(k_e);
     }
     d->x[SOC] = R(soc0);
     d->step = -1.0;

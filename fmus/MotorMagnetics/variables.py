@@ -28,6 +28,7 @@ TABLE = Table(
         *[Real(f"v{n}_{a}", "parameter", V.MOTOR_FIELD_DIRECTION[n - 1][k], "1",
                f"direction of the field of motor {n}, {a} component (normalised)")
           for n in _N for k, a in enumerate("xyz")],
+        Real("omega0", "parameter", 0.0, "rad/s", "initial speed of every rotor, at its steady current"),
         Real("sub_step", "parameter", 2.5e-4, "s", "largest internal step of the exponential integrator"),
         # outputs
         *[Real(f"omega_r{n}", "output", unit="rad/s", description=f"speed of rotor {n}") for n in _N],

@@ -34,19 +34,20 @@ model MotorMagnetics "Four DC-approximated brushless motors, ESCs, LiPo battery,
   parameter Real v4_x = -0.40;
   parameter Real v4_y = 0.75;
   parameter Real v4_z = 0.53;
+  parameter Real omega0(unit = "rad/s") = 0 "initial speed of every rotor, at its steady current";
 
-  output Real omega_r1(unit = "rad/s", start = 0, fixed = true);
-  output Real omega_r2(unit = "rad/s", start = 0, fixed = true);
-  output Real omega_r3(unit = "rad/s", start = 0, fixed = true);
-  output Real omega_r4(unit = "rad/s", start = 0, fixed = true);
+  output Real omega_r1(unit = "rad/s", start = omega0, fixed = true);
+  output Real omega_r2(unit = "rad/s", start = omega0, fixed = true);
+  output Real omega_r3(unit = "rad/s", start = omega0, fixed = true);
+  output Real omega_r4(unit = "rad/s", start = omega0, fixed = true);
   output Real b_d_x(unit = "T");
   output Real b_d_y(unit = "T");
   output Real b_d_z(unit = "T");
   output Real u_batt(unit = "V") "battery terminal voltage";
-  output Real i1(unit = "A", start = 0, fixed = true);
-  output Real i2(unit = "A", start = 0, fixed = true);
-  output Real i3(unit = "A", start = 0, fixed = true);
-  output Real i4(unit = "A", start = 0, fixed = true);
+  output Real i1(unit = "A", start = k_m*omega0*abs(omega0)/k_e, fixed = true);
+  output Real i2(unit = "A", start = k_m*omega0*abs(omega0)/k_e, fixed = true);
+  output Real i3(unit = "A", start = k_m*omega0*abs(omega0)/k_e, fixed = true);
+  output Real i4(unit = "A", start = k_m*omega0*abs(omega0)/k_e, fixed = true);
   output Real i_batt(unit = "A") "battery current";
   output Real soc(start = soc0, fixed = true) "state of charge";
   output Real b_d1_x, b_d1_y, b_d1_z, b_d2_x, b_d2_y, b_d2_z;

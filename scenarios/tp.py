@@ -1,0 +1,165 @@
+"""``tp``: the lab's closed loop: Setpoint -> Controller -> MotorMagnetics -> Quadrotor -> IMU -> Quaternion_estim.
+
+One case of the lab's matrix (seed 002) per run: estimator x flight profile x feedback (the
+controller fed by the ground truth, "gt", or by the estimate) x noise x gyro bias, with or
+without the field of the motor currents at the magnetometer (the lab had none).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from estimators import DEFAULT_GAINS, QuaternionEstim
+from fmus import vehicle
+from fmus.IMU.variables import LAB_GYRO_BIAS
+from orchestrator import System, Table
+from scenarios import Option, Scenario
+from scenarios.control import SETPOINT, Controller, profile
+from scenarios.plant import add_plant, imu_parameters, save_figure
+
+OPTIONS = {
+    "estimator": Option("linear", "attitude estimator", choices=("linear", "explicit", "passive")),
+    "flight": Option("quasi", "flight profile", choices=("quasi", "nonstationary")),
+    "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
+    "noise": Option(False, "IMU white noise"),
+    "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s"),
+    "magnetic": Option(False, "field of the motor currents at the magnetometer"),
+    "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
+    "discretisation": Option("exp", "quaternion update", choices=("exp", "euler")),
+    "k": Option(0.05, "linear filter gain, all three axes (1/s)", minimum=0.0),
+    "k1": Option(0.2, "explicit filter: accelerometer gain (1/s)", minimum=0.0),
+    "k2": Option(0.2, "explicit filter: magnetometer gain (1/s)", minimum=0.0),
+    "kP": Option(1.0, "explicit: overall gain (1); passive: proportional gain (1/s)", minimum=0.0),
+    "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)"),
+    "duration": Option(20.0, "simulated time (s)", minimum=0.01),
+    "settle": Option(2.0, "time excluded from the error metrics (s)", minimum=0.0),
+    "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
+    "imu_rate": Option(1000.0, "IMU and estimator rate (Hz)", minimum=1.0),
+    "seed": Option(1, "IMU noise seed"),
+}
+
+
+def estimator_gains(o: dict) -> dict:
+    kind = o["estimator"]
+    if kind == "linear":
+        return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
+    ki = o["kI"] if o["kI"] >= 0 else DEFAULT_GAINS[kind]["kI"]
+    if kind == "explicit":
+        return {"k1": o["k1"], "k2": o["k2"], "kP": o["kP"], "kI": ki}
+    return {"kP": o["kP"], "kI": ki}
+
+
+def build(o: dict) -> System:
+    if o["kI"] < 0 and o["kI"] != -1.0:
+        raise ValueError(f"option kI={o['kI']} must be non-negative (or -1 for the default)")
+    period = round(1.0 / (o["imu_rate"] * o["dt"]))
+    if period < 1 or abs(period * o["dt"] * o["imu_rate"] - 1.0) > 1e-9:
+        raise ValueError(f"imu_rate = {o['imu_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
+    system = System(dt=o["dt"])
+    system.add(Table("Setpoint", SETPOINT, profile(o["flight"], o["duration"], o["dt"])))
+    add_plant(system, motors={"omega0": vehicle.hover_rotor_speed()},
+              imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
+              magnetic=o["magnetic"], imu_period=period)
+    estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
+                                           discretisation=o["discretisation"], ry=o["ry"]))
+    for name in estimator.inputs:
+        system.connect(f"IMU.{name}", f"Quaternion_estim.{name}")
+    system.add(Controller())
+    for name in SETPOINT:
+        system.connect(f"Setpoint.{name}", f"Controller.{name}")
+    if o["feedback"] == "gt":
+        system.connect("Quadrotor.q", "Controller.q")
+        system.connect("Quadrotor.omega", "Controller.omega")
+    else:
+        system.connect("Quaternion_estim.q_est", "Controller.q")
+        system.connect("Quaternion_estim.omega_est", "Controller.omega")
+    system.connect("Quadrotor.p", "Controller.p")
+    system.connect("Quadrotor.v", "Controller.v")
+    system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
+    system.connect("Controller.c", "MotorMagnetics.c")
+    return system
+
+
+def wrapped(angle: np.ndarray) -> np.ndarray:
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def errors(result) -> tuple[np.ndarray, np.ndarray]:
+    """Estimation and tracking errors (rad), columns roll, pitch, yaw. Tracking compares the
+    attitude with the controller's setpoint (the position hold's roll and pitch when holding)."""
+    truth = np.column_stack([result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])
+    estimate = result["Quaternion_estim.theta_est"]
+    setpoint = np.column_stack([result["Controller.theta_d1"], result["Controller.theta_d2"],
+                                result["Setpoint.theta_d3"]])
+    return wrapped(estimate - truth), wrapped(setpoint - truth)
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    estimation, tracking = errors(result)
+    after = result.time >= o["settle"]
+    truth = np.column_stack([result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])
+    estimate = result["Quaternion_estim.theta_est"]
+    t = result.time
+    label = f"{o['estimator']}, {o['flight']}, {o['feedback']}, noise {o['noise']}, bias {o['bias']}"
+    figures = []
+    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    for k, name in enumerate(("roll", "pitch")):
+        axes[k].plot(t, np.degrees(truth[:, k]), label=f"{name} (truth)")
+        axes[k].plot(t, np.degrees(estimate[:, k]), "--", label=f"{name} (estimate)")
+        axes[k].set_ylabel(f"{name} (deg)")
+        axes[k].legend(fontsize=8)
+        axes[k].grid(True, alpha=0.3)
+    axes[1].set_xlabel("time (s)")
+    axes[0].set_title(label)
+    figures.append(save_figure(fig, out, "roll_pitch.png"))
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    ax.plot(t, np.degrees(truth[:, 2]), label="yaw (truth)")
+    ax.plot(t, np.degrees(estimate[:, 2]), "--", label="yaw (estimate)")
+    ax.set_ylabel("yaw (deg)")
+    ax.set_xlabel("time (s)")
+    ax.legend(fontsize=8)
+    ax.grid(True, alpha=0.3)
+    ax.set_title(label)
+    figures.append(save_figure(fig, out, "yaw.png"))
+    true_bias = result["IMU.gyro_bias"]
+    estimated_bias = result["Quaternion_estim.b_est"]
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    for k, axis in enumerate("xyz"):
+        line = ax.plot(t, estimated_bias[:, k], label=f"b_est_{axis}")[0]
+        ax.plot(t, true_bias[:, k], ":", color=line.get_color(), label=f"b_{axis} (true)")
+    ax.set_ylabel("gyro bias (rad/s)")
+    ax.set_xlabel("time (s)")
+    ax.legend(fontsize=7, ncol=3)
+    ax.grid(True, alpha=0.3)
+    figures.append(save_figure(fig, out, "bias.png"))
+    metrics = {
+        "settle_s": o["settle"],
+        "rms_error_deg": np.degrees(np.sqrt((estimation[after] ** 2).mean(axis=0))).tolist(),
+        "max_error_deg": np.degrees(np.abs(estimation[after]).max(axis=0)).tolist(),
+        "tracking_rms_deg": np.degrees(np.sqrt((tracking[after] ** 2).mean(axis=0))).tolist(),
+        "bias_error_final": None,
+        "figures": [f for f in figures if f],
+    }
+    if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
+        metrics["bias_error_final"] = (estimated_bias[-1] - true_bias[-1]).tolist()
+        metrics["bias_convergence_s"] = bias_convergence_time(t, estimated_bias - true_bias, 1e-3)
+    loop = result.meta.get("loop_seconds")
+    if loop:
+        metrics["real_time_factor"] = o["duration"] / loop
+    return metrics
+
+
+def bias_convergence_time(t, error, tolerance) -> float | None:
+    """First time after which every component of ``error`` stays within ``tolerance``."""
+    outside = np.flatnonzero(np.abs(error).max(axis=1) > tolerance)
+    if len(outside) == 0:
+        return float(t[0])
+    if outside[-1] == len(t) - 1:
+        return None
+    return float(t[outside[-1] + 1])
+
+
+SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report)
+LAB_BIAS = LAB_GYRO_BIAS
