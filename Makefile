@@ -19,7 +19,7 @@ fmus: $(STAMP)
 	$(BIN)/quadcosim build
 
 demo: fmus
-	$(BIN)/quadcosim run rig --out results/rig
+	$(BIN)/quadcosim run tp --out results/tp
 
 test: fmus
 	$(BIN)/ruff check .

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 LINEAR, EXPLICIT, PASSIVE = 0, 1, 2
 KINDS = {"linear": LINEAR, "explicit": EXPLICIT, "passive": PASSIVE}
@@ -46,7 +46,7 @@ GAINS = {
 }
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def quaternion_multiply(p, q, out):
     """out = p (x) q (Hamilton)."""
     a0, a1, a2, a3 = p[0], p[1], p[2], p[3]
@@ -57,7 +57,7 @@ def quaternion_multiply(p, q, out):
     out[3] = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rotation(q, r):
     """r = R(q) = I + 2 q0 S(qv) + 2 S(qv)^2, row-major 3x3."""
     q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
@@ -72,7 +72,7 @@ def rotation(q, r):
     r[2, 2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def euler_from_quaternion(q, theta):
     """Z-Y-X Euler angles (roll, pitch, yaw) of q, rad."""
     q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
@@ -82,7 +82,7 @@ def euler_from_quaternion(q, theta):
     theta[2] = math.atan2(2.0 * (q1 * q2 + q0 * q3), 1.0 - 2.0 * (q2 * q2 + q3 * q3))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def quaternion_from_euler(theta, q):
     c1, s1 = math.cos(0.5 * theta[0]), math.sin(0.5 * theta[0])
     c2, s2 = math.cos(0.5 * theta[1]), math.sin(0.5 * theta[1])
@@ -93,20 +93,20 @@ def quaternion_from_euler(theta, q):
     q[3] = s3 * c2 * c1 - c3 * s2 * s1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def wrap(angle):
     """Angle wrapped to [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _normalise(q):
     n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     for i in range(4):
         q[i] /= n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _integrate(q, wx, wy, wz, dt, discretisation):
     """Advance q by the body rate (wx, wy, wz) over dt."""
     if discretisation == EULER:
@@ -134,7 +134,7 @@ def _integrate(q, wx, wy, wz, dt, discretisation):
     _normalise(q)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _cross_with_reference(r, v, vx, vy, vz, norm_v, gain, w):
     """w += gain (v/|v|) x (R^T ref/|ref|), the correction of one reference direction."""
     bx = r[0, 0] * vx + r[1, 0] * vy + r[2, 0] * vz
@@ -146,7 +146,7 @@ def _cross_with_reference(r, v, vx, vy, vz, norm_v, gain, w):
     w[2] += scale * (v[0] * by - v[1] * bx)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def triad(acc, mag, config, r):
     """Rotation body -> NED from the accelerometer (primary: gravity) and the magnetometer.
 
@@ -182,7 +182,7 @@ def triad(acc, mag, config, r):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def update(kind, x, u, gains, config, dt, y, work):
     """One estimator step with the sample ``u``; writes the outputs ``y``.
 
@@ -253,7 +253,7 @@ def update(kind, x, u, gains, config, dt, y, work):
         y[10 + i] = gyro[i] - b[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def initial_state(q0, b0, x):
     for i in range(4):
         x[i] = q0[i]
@@ -262,15 +262,15 @@ def initial_state(q0, b0, x):
     euler_from_quaternion(x[0:4], x[7:10])
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def run_batch(kind, inputs, gains, config, dt, q0, b0, outputs):
-    """Run ``len(gains)`` filters over the samples ``inputs`` (N, n_u).
+    """Run ``len(gains)`` filters over the samples ``inputs`` (N, n_u), gain sets in parallel.
 
     ``gains`` (G, n_gains); ``outputs`` (G, N, OUTPUT_SIZE) is filled in place.
     """
-    x = np.empty(STATE_SIZE)
-    work = np.empty(WORK_SIZE)
-    for g in range(gains.shape[0]):
+    for g in prange(gains.shape[0]):
+        x = np.empty(STATE_SIZE)
+        work = np.empty(WORK_SIZE)
         initial_state(q0, b0, x)
         for n in range(inputs.shape[0]):
             update(kind, x, inputs[n], gains[g], config, dt, outputs[g, n], work)

@@ -213,12 +213,13 @@ class System:
         return [f"{b.name}.{y}" for b in self.blocks.values() for y in b.outputs]
 
     # ------------------------------------------------------------------ running
-    def run(self, duration: float, decimation: int = 1, progress: bool = False, start_time: float = 0.0) -> Result:
+    def run(self, duration: float, decimation: int = 1, progress: bool = False, start_time: float = 0.0,
+            record=None) -> Result:
         """Run for ``duration`` seconds and return the recorded :class:`Result`.
 
-        Every output of every block is recorded, every ``decimation`` macro steps. On a
-        failure a :class:`SimulationError` is raised whose ``result`` holds what was
-        recorded up to it.
+        ``record`` lists the signals to keep (vector names allowed); by default every output
+        of every block. They are recorded every ``decimation`` macro steps. On a failure a
+        :class:`SimulationError` is raised whose ``result`` holds what was recorded up to it.
         """
         if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
             raise ValueError(f"duration = {duration!r} s must be a positive number of seconds")
@@ -228,7 +229,7 @@ class System:
         if missing:
             raise ValueError(f"unconnected input{'s' * (len(missing) > 1)}: {', '.join(missing)}. Connect each "
                              "with system.connect(source, destination) or tie it with system.set_input(name, value).")
-        plan = _Plan(self, duration, int(decimation), start_time)
+        plan = _Plan(self, duration, int(decimation), start_time, record)
         try:
             plan.run(progress)
         finally:
@@ -255,7 +256,7 @@ class _Failure(Exception):
 class _Plan:
     """Everything resolved once for one run."""
 
-    def __init__(self, system: System, duration: float, decimation: int, t0: float):
+    def __init__(self, system: System, duration: float, decimation: int, t0: float, record=None):
         self.system, self.dt, self.t0, self.decimation = system, system.dt, t0, decimation
         self.steps = int(round(duration / system.dt))
         if self.steps < 1:
@@ -267,11 +268,24 @@ class _Plan:
         for block in self.order:
             for y in block.outputs:
                 self.slot[f"{block.name}.{y}"] = len(self.slot)
-        self.names = list(self.slot)
         self.fault_slot = {f.target: len(self.slot) + k for k, f in enumerate(system.faults)}
         self.bus = np.zeros(len(self.slot) + len(system.faults))
+        if record is None:
+            slots = list(range(len(self.slot)))
+        else:
+            slots = sorted({self.slot[name] for signal in record for name in system._resolve(signal, "output")})
+        by_slot = {v: k for k, v in self.slot.items()}
+        self.names = [by_slot[s] for s in slots]
+        # recorded slots as runs of consecutive bus slots: (row from, row to, bus from, bus to)
+        self.record_runs, k = [], 0
+        while k < len(slots):
+            j = k
+            while j + 1 < len(slots) and slots[j + 1] == slots[j] + 1:
+                j += 1
+            self.record_runs.append((k, j + 1, slots[k], slots[j] + 1))
+            k = j + 1
         self.rows = self.steps // decimation + 1
-        self.record = np.empty((self.rows, len(self.slot)))
+        self.record = np.empty((self.rows, len(slots)))
         self.recorded = 0
         self.time_now = t0
         self.fmus = []
@@ -340,7 +354,7 @@ class _Plan:
 
     def run(self, progress: bool):
         bus, record, dt, t0, dec = self.bus, self.record, self.dt, self.t0, self.decimation
-        phase_a, phase_b = self.phase_a, self.phase_b
+        phase_a, phase_b, runs = self.phase_a, self.phase_b, self.record_runs
         reduce, isfinite = np.add.reduce, math.isfinite
         bar = _progress(self.steps * dt) if progress else None
         chunk = max(1, self.steps // 200)
@@ -354,7 +368,9 @@ class _Plan:
                     if period == 1 or n % period == 0:
                         fn(t)
                 if n % dec == 0:
-                    record[n // dec] = bus[:record.shape[1]]
+                    row = record[n // dec]
+                    for a, b, c, d in runs:
+                        row[a:b] = bus[c:d]
                     self.recorded = n // dec + 1
                     if not isfinite(reduce(bus)):
                         raise _Failure(self._non_finite(t))

@@ -118,7 +118,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     duration = scenario.duration(options) if scenario.duration else options["duration"]
     out = Path(out_dir) if out_dir else None
     try:
-        result = system.run(duration, progress=progress)
+        result = system.run(duration, progress=progress, record=scenario.extra.get("record"))
     except SimulationError as error:
         if out is not None and error.result is not None:
             error.result.meta["scenario"] = {"name": name, "options": options}

@@ -77,7 +77,7 @@ def parameters(gains: dict | None = None) -> np.ndarray:
     return p
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def control_law(u, p, y):
     """u: setpoint[7], q[4], omega[3], p[3], v[3], u_batt; y: c[4], T, tau[3], theta_d[2]."""
     roll_d, pitch_d, yaw = u[0], u[1], u[2]
@@ -151,6 +151,9 @@ def profile(flight: str, duration: float, dt: float) -> np.ndarray:
     ramp = np.clip(t / 2.0, 0.0, 1.0)  # ease in over the first 2 s
     zero = np.zeros_like(t)
     d = np.radians
+    if flight == "hover":
+        # hold the position, the yaw and the altitude
+        return np.column_stack([zero, zero, zero, zero, zero, zero, np.ones_like(t)])
     if flight == "quasi":
         # hover on the spot: slow changes of yaw and altitude, roll and pitch from the position hold
         yaw = d(20.0) * np.sin(2 * np.pi * 0.02 * t)
@@ -158,9 +161,9 @@ def profile(flight: str, duration: float, dt: float) -> np.ndarray:
         return np.column_stack([zero, zero, yaw * ramp, zero, zero, z * ramp, np.ones_like(t)])
     if flight == "nonstationary":
         # large, fast attitude changes and accelerations
-        roll = d(30.0) * np.sin(2 * np.pi * 0.5 * t)
-        pitch = d(25.0) * np.sin(2 * np.pi * 0.4 * t + 0.5)
-        yaw = d(60.0) * np.sin(2 * np.pi * 0.2 * t)
-        z = -1.0 * np.sin(2 * np.pi * 0.25 * t)
+        roll = d(20.0) * np.sin(2 * np.pi * 0.4 * t)
+        pitch = d(20.0) * np.sin(2 * np.pi * 0.3 * t + 0.5)
+        yaw = d(30.0) * np.sin(2 * np.pi * 0.1 * t)
+        z = -1.0 * np.sin(2 * np.pi * 0.2 * t)
         return np.column_stack([roll * ramp, pitch * ramp, yaw * ramp, zero, zero, z * ramp, zero])
-    raise ValueError(f"flight {flight!r} must be 'quasi' or 'nonstationary'")
+    raise ValueError(f"flight {flight!r} must be 'hover', 'quasi' or 'nonstationary'")

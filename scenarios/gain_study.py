@@ -1,0 +1,160 @@
+"""``gain-study``: the linear filter's gain swept, python-control predictions against simulated errors.
+
+1. GT mode: the closed loop hovers, fed by the ground truth, with IMU noise on; the sensor
+   stream is recorded once and the linear filter is run on it by the batch path for every
+   gain of a log grid at once. Its roll and pitch error variances are set against the
+   variance python-control predicts from the IMU's noise densities
+   (estimators/analysis.py), and the two optimal gains are compared.
+2. Estimate-fed mode: one closed-loop run per gain, the controller fed by the estimate, in
+   parallel on the available cores; their roll and pitch error variances go on the same
+   figure.
+
+The statistical uncertainty of each simulated variance is measured by batch means: the
+stream is cut into 20 blocks, each far longer than the filter's time constant 1/k, and the
+standard error of the mean of the block variances is reported, relative to the variance.
+The AR(1) formula sqrt(2 / (k T)) per axis gives the same order and fixes the duration
+needed: T >= 800 / k_min seconds for 5 % on one axis, half that for roll and pitch pooled.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+from estimators import analysis, estimate
+from scenarios import Option, Scenario
+from scenarios.plant import save_figure
+
+OPTIONS = {
+    "k_min": Option(0.05, "smallest gain (1/s)", minimum=1e-4),
+    "k_max": Option(5.0, "largest gain (1/s)", minimum=1e-4),
+    "count": Option(16, "gains on the log grid", minimum=3),
+    "duration": Option(10200.0, "length of the recorded GT stream (s)", minimum=1.0),
+    "burn_in": Option(200.0, "stream time discarded at the start of every filter (s)", minimum=0.0),
+    "imu_rate": Option(100.0, "IMU and estimator rate (Hz); also the macro step rate", minimum=1.0),
+    "seed": Option(1, "IMU noise seed"),
+    "closed_loop": Option(True, "also run the estimate-fed closed loop for each gain, in parallel"),
+    "closed_duration": Option(120.0, "length of each estimate-fed run (s)", minimum=1.0),
+    "closed_flight": Option("hover", "flight of the estimate-fed runs", choices=("hover", "quasi")),
+}
+
+
+def grid(o: dict) -> np.ndarray:
+    if not o["k_max"] > o["k_min"]:
+        raise ValueError(f"k_max = {o['k_max']} must exceed k_min = {o['k_min']}")
+    return np.geomspace(o["k_min"], o["k_max"], o["count"])
+
+
+def build(o: dict):
+    import scenarios
+
+    grid(o)
+    tp = scenarios.get("tp")
+    return tp.build(tp.parse({"estimator": "linear", "flight": "hover", "feedback": "gt", "noise": True,
+                              "duration": o["duration"], "dt": 1.0 / o["imu_rate"], "imu_rate": o["imu_rate"],
+                              "seed": o["seed"], "settle": 0.0}))
+
+
+RECORD = ["IMU.acc", "IMU.gyro", "IMU.magneto", "Quadrotor.theta1", "Quadrotor.theta2", "Quadrotor.theta3"]
+
+
+def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
+    """Roll and pitch error variances (rad^2, pooled) and their relative standard errors."""
+    dt = 1.0 / o["imu_rate"]
+    truth = np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])
+    start = int(round(o["burn_in"] / dt))
+    variances, errors = [], []
+    for chunk in np.array_split(gains, max(1, len(gains) // 2)):
+        out = estimate("linear", result["IMU.acc"], result["IMU.gyro"], result["IMU.magneto"], dt,
+                       {"k1": chunk, "k2": chunk, "k3": chunk})
+        for g in range(len(chunk)):
+            error = out["theta"][g, start:, :2] - truth[start:]
+            blocks = np.array_split(error, 20)
+            block_vars = np.array([(b**2).mean() for b in blocks])
+            variances.append(block_vars.mean())
+            errors.append(block_vars.std(ddof=1) / np.sqrt(len(blocks)) / block_vars.mean())
+    return np.array(variances), np.array(errors)
+
+
+def _closed_loop(args):
+    import scenarios
+
+    k, o = args
+    result, metrics = scenarios.run("tp", {"estimator": "linear", "k": k, "flight": o["closed_flight"],
+                                           "feedback": "estimate", "noise": True, "duration": o["closed_duration"],
+                                           "settle": min(20.0, o["closed_duration"] / 4), "seed": o["seed"]})
+    rms = np.radians(metrics["rms_error_deg"][:2])
+    return float((rms**2).mean()), metrics["tracking_rms_deg"]
+
+
+def closed_loop_variances(gains, o) -> tuple[np.ndarray, list]:
+    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+        results = list(pool.map(_closed_loop, [(float(k), o) for k in gains]))
+    return np.array([r[0] for r in results]), [r[1] for r in results]
+
+
+def optimum_of(gains, values) -> float:
+    """Minimum of a sampled curve: parabola through the three points around the smallest sample
+    (in log gain, log value)."""
+    i = int(np.clip(np.argmin(values), 1, len(values) - 2))
+    x, y = np.log(gains[i - 1:i + 2]), np.log(values[i - 1:i + 2])
+    a, b, _ = np.polyfit(x, y, 2)
+    return float(np.exp(-b / (2 * a))) if a > 0 else float(gains[np.argmin(values)])
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    gains = grid(o)
+    dt = 1.0 / o["imu_rate"]
+    sigma_gyro, sigma_angle = analysis.imu_noise_per_sample(o["imu_rate"])
+    predicted = analysis.linear_error_variance(gains, dt, sigma_gyro, sigma_angle)
+    simulated, relative_se = simulated_variances(result, gains, o)
+    k_predicted = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle)
+    k_simulated = optimum_of(gains, simulated)
+    closed, tracking = (closed_loop_variances(gains, o) if o["closed_loop"] else (None, None))
+
+    fig, ax = plt.subplots(figsize=(8, 5))
+    fine = np.geomspace(gains[0], gains[-1], 200)
+    ax.loglog(fine, np.degrees(np.sqrt(analysis.linear_error_variance(fine, dt, sigma_gyro, sigma_angle))),
+              label="python-control prediction")
+    ax.errorbar(gains, np.degrees(np.sqrt(simulated)), yerr=np.degrees(np.sqrt(simulated)) * relative_se / 2,
+                fmt="o", label="simulated, GT mode (batch path)")
+    if closed is not None:
+        ax.loglog(gains, np.degrees(np.sqrt(closed)), "s", mfc="none", label="simulated, estimate-fed closed loop")
+    ax.axvline(0.05, color="grey", ls=":", label="lab gain 0.05")
+    ax.axvline(k_predicted, color="C0", ls="--", lw=0.8, label=f"predicted optimum {k_predicted:.2f}")
+    ax.axvline(k_simulated, color="C1", ls="--", lw=0.8, label=f"simulated optimum {k_simulated:.2f}")
+    ax.set_xlabel("gain k (1/s)")
+    ax.set_ylabel("roll/pitch error, standard deviation (deg)")
+    ax.set_title(f"Linear filter: error against gain ({o['imu_rate']:g} Hz IMU, {o['duration']:g} s stream)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    figure = save_figure(fig, out, "gain_study.png")
+    ratio = simulated / predicted - 1.0
+    return {
+        "gains": gains.tolist(),
+        "predicted_variance_rad2": predicted.tolist(),
+        "simulated_variance_rad2": simulated.tolist(),
+        "relative_difference": ratio.tolist(),
+        "max_abs_relative_difference": float(np.abs(ratio).max()),
+        "simulated_relative_standard_error": relative_se.tolist(),
+        "max_relative_standard_error": float(relative_se.max()),
+        "predicted_optimal_gain": k_predicted,
+        "simulated_optimal_gain": k_simulated,
+        "optimum_ratio": max(k_predicted, k_simulated) / min(k_predicted, k_simulated),
+        "bandwidth_at_lab_gain_rad_s": analysis.linear_bandwidth(0.05),
+        "closed_loop_variance_rad2": None if closed is None else closed.tolist(),
+        "closed_loop_tracking_rms_deg": tracking,
+        "figures": [figure] if figure else [],
+    }
+
+
+def duration(o: dict) -> float:
+    return o["duration"]
+
+
+SCENARIO = Scenario("gain-study", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
+                    duration=duration, extra={"record": RECORD})

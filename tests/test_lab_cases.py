@@ -1,0 +1,71 @@
+"""The lab's cases (seed 002), checked with numbers on the tp scenario."""
+
+import numpy as np
+import pytest
+
+import scenarios
+from estimators import analysis
+from scenarios.tp import LAB_BIAS, bias_convergence_time
+
+
+def run(**options):
+    return scenarios.run("tp", options)
+
+
+def test_linear_gt_quasi_stationary_without_noise():
+    _, m = run(estimator="linear", k=0.05)
+    roll, pitch, yaw = m["rms_error_deg"]
+    assert roll < 0.5 and pitch < 0.5 and yaw < 1.0
+
+
+def test_non_stationary_flight_degrades_linear_not_explicit():
+    _, quasi = run(estimator="linear")
+    _, linear = run(estimator="linear", flight="nonstationary")
+    _, explicit = run(estimator="explicit", flight="nonstationary")
+    grown = np.array(linear["rms_error_deg"]) / np.maximum(quasi["rms_error_deg"], 1e-3)
+    assert np.all(grown > 10) and min(linear["rms_error_deg"]) > 1.0  # the linear error grows
+    assert max(explicit["rms_error_deg"]) < 2.0
+
+
+def test_explicit_without_bias_estimate_has_the_predicted_steady_error():
+    result, _ = run(estimator="explicit", flight="hover", bias=True, k1=2.0, k2=2.0, kI=0.0, duration=30.0)
+    late = result.time > 20.0
+    simulated = np.column_stack([result[f"Quaternion_estim.theta_est{i}"] - result[f"Quadrotor.theta{i}"]
+                                 for i in (1, 2, 3)])[late].mean(axis=0)
+    predicted = analysis.explicit_bias_steady_error(2.0, 2.0, 1.0, LAB_BIAS)
+    assert np.allclose(simulated, predicted, rtol=0.1, atol=np.radians(0.05))
+
+
+@pytest.mark.parametrize("ry", ["reel", "triad"])
+@pytest.mark.parametrize("gain", [0.1, 1.0, 10.0, 100.0])
+def test_passive_recovers_the_lab_bias_in_the_predicted_time(ry, gain):
+    predicted = analysis.passive_bias_convergence_time(gain, gain, max(np.abs(LAB_BIAS)), 1e-3)
+    result, m = run(estimator="passive", flight="hover", bias=True, kP=gain, kI=gain, ry=ry,
+                    duration=max(10.0, 1.5 * predicted))
+    error = result["Quaternion_estim.b_est"] - result["IMU.gyro_bias"]
+    assert np.abs(error[-1]).max() < 1e-3
+    simulated = bias_convergence_time(result.time, error, 1e-3)
+    assert simulated == pytest.approx(predicted, rel=0.2)
+
+
+@pytest.mark.parametrize("flight", ["quasi", "nonstationary"])
+@pytest.mark.parametrize("estimator", ["linear", "explicit", "passive"])
+def test_estimate_fed_control_flies_with_noise_and_bias(estimator, flight):
+    result, m = run(estimator=estimator, flight=flight, feedback="estimate", noise=True, bias=True,
+                    kI=0.3 if estimator == "explicit" else -1.0, duration=15.0)
+    tilt = np.degrees(np.abs(np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])))
+    assert tilt.max() < 60.0  # never tumbles
+    assert max(m["tracking_rms_deg"]) < 20.0 and max(m["rms_error_deg"]) < 20.0
+    if flight == "quasi":  # the position hold holds, on the true position
+        assert np.abs(result["Quadrotor.p"][:, :2]).max() < 5.0
+
+
+def test_linear_gain_prediction_matches_simulation():
+    """python-control's predicted roll/pitch error variance against the batch path on a
+    recorded GT stream (a shortened gain-study: gains around the optimum)."""
+    _, m = scenarios.run("gain-study", {"k_min": 0.25, "k_max": 2.0, "count": 5, "duration": 1200.0,
+                                        "closed_loop": False})
+    se = np.array(m["simulated_relative_standard_error"])
+    assert se.max() < 0.06
+    assert np.all(np.abs(m["relative_difference"]) < 0.15)
+    assert m["optimum_ratio"] < 1.5
