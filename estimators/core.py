@@ -83,14 +83,18 @@ def euler_from_quaternion(q, theta):
 
 
 @njit(cache=True, error_model="numpy")
+def euler_to_quaternion(roll, pitch, yaw):
+    """Quaternion (q0, q1, q2, q3) of Z-Y-X Euler angles (rad)."""
+    c1, s1 = math.cos(0.5 * roll), math.sin(0.5 * roll)
+    c2, s2 = math.cos(0.5 * pitch), math.sin(0.5 * pitch)
+    c3, s3 = math.cos(0.5 * yaw), math.sin(0.5 * yaw)
+    return (c3 * c2 * c1 + s3 * s2 * s1, c3 * c2 * s1 - s3 * s2 * c1,
+            c3 * s2 * c1 + s3 * c2 * s1, s3 * c2 * c1 - c3 * s2 * s1)
+
+
+@njit(cache=True, error_model="numpy")
 def quaternion_from_euler(theta, q):
-    c1, s1 = math.cos(0.5 * theta[0]), math.sin(0.5 * theta[0])
-    c2, s2 = math.cos(0.5 * theta[1]), math.sin(0.5 * theta[1])
-    c3, s3 = math.cos(0.5 * theta[2]), math.sin(0.5 * theta[2])
-    q[0] = c3 * c2 * c1 + s3 * s2 * s1
-    q[1] = c3 * c2 * s1 - s3 * s2 * c1
-    q[2] = c3 * s2 * c1 + s3 * c2 * s1
-    q[3] = s3 * c2 * c1 - c3 * s2 * s1
+    q[0], q[1], q[2], q[3] = euler_to_quaternion(theta[0], theta[1], theta[2])
 
 
 @njit(cache=True, error_model="numpy")

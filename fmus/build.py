@@ -60,6 +60,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None) -> Path:
         shutil.copy(_fmi_header_dir() / name, sources / name)
     shutil.copy(HERE / "c" / "shell.c", sources / "shell.c")
     shutil.copy(HERE / "c" / "shell.h", sources / "shell.h")
+    shutil.copy(HERE / "c" / "quaternion.h", sources / "quaternion.h")
     shutil.copy(HERE / model / "model.c", sources / "model.c")
     (sources / "variables.h").write_text(tab.c_header())
     (sources / "airframe.h").write_text(airframe_header())

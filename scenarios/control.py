@@ -32,6 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
+from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from fmus.airframe import MOTORS
 from orchestrator.blocks import Block
@@ -88,12 +89,7 @@ def control_law(u, p, y):
         right = -math.sin(yaw) * ax + math.cos(yaw) * ay
         roll_d = min(max(right / p[P_G], -p[P_TILT]), p[P_TILT])
         pitch_d = min(max(-forward / p[P_G], -p[P_TILT]), p[P_TILT])
-    h1, h2, h3 = 0.5 * roll_d, 0.5 * pitch_d, 0.5 * yaw
-    c1, s1, c2, s2, c3, s3 = math.cos(h1), math.sin(h1), math.cos(h2), math.sin(h2), math.cos(h3), math.sin(h3)
-    d0 = c3 * c2 * c1 + s3 * s2 * s1
-    d1 = c3 * c2 * s1 - s3 * s2 * c1
-    d2 = c3 * s2 * c1 + s3 * c2 * s1
-    d3 = s3 * c2 * c1 - c3 * s2 * s1
+    d0, d1, d2, d3 = euler_to_quaternion(roll_d, pitch_d, yaw)
     q0, q1, q2, q3 = u[7], u[8], u[9], u[10]
     # q_e = conj(q_d) (x) q
     e0 = d0 * q0 + d1 * q1 + d2 * q2 + d3 * q3

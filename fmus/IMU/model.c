@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "quaternion.h"
 #include "variables.h"
 
 #define R(name) (m->real[VR_##name])
@@ -49,16 +50,7 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k) {
     const double *a = &R(A_11), *bs = &R(b_s_x), *mi = &R(m_I_x);
     double r[9], body[3], sd_acc = 0.0, sd_gyro = 0.0, sd_mag = 0.0, noise[CH_WALK_GYRO];
     int noisy = m->boolean[VB_noise_enabled], biased = m->boolean[VB_bias_enabled], i, c;
-    double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3];
-    r[0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
-    r[1] = 2.0 * (q1 * q2 - q0 * q3);
-    r[2] = 2.0 * (q1 * q3 + q0 * q2);
-    r[3] = 2.0 * (q1 * q2 + q0 * q3);
-    r[4] = 1.0 - 2.0 * (q1 * q1 + q3 * q3);
-    r[5] = 2.0 * (q2 * q3 - q0 * q1);
-    r[6] = 2.0 * (q1 * q3 - q0 * q2);
-    r[7] = 2.0 * (q2 * q3 + q0 * q1);
-    r[8] = 1.0 - 2.0 * (q1 * q1 + q2 * q2);
+    rotation_from_quaternion(q, r);
     if (noisy) {
         double root_rate = sqrt(R(sample_rate));
         sd_acc = R(acc_noise_density) * root_rate;

@@ -127,53 +127,41 @@ static void etd_coefficients(ModelInstance *m, Data *d, double h) {
     d->step = h;
 }
 
-/* out = M (x_w, x_i) for motor n, M 2x2 row-major */
-#define APPLY(M, y, n, out_w, out_i)                                \
-    do {                                                           \
-        out_w = (M)[0] * (y)[OMEGA + (n)] + (M)[1] * (y)[CURRENT + (n)];     \
-        out_i = (M)[2] * (y)[OMEGA + (n)] + (M)[3] * (y)[CURRENT + (n)];     \
-    } while (0)
+/* out = e y + q n on each motor's (omega, i) pair, with the 2x2 matrices e and q;
+ * the state of charge gets e = 1 and q = h/2. */
+static void stage(const double e[4], const double q[4], double h, const double *y, const double *n, double *out) {
+    int k;
+    for (k = 0; k < N_MOTORS; k++) {
+        double w = y[OMEGA + k], i = y[CURRENT + k], nw = n[OMEGA + k], ni = n[CURRENT + k];
+        out[OMEGA + k] = e[0] * w + e[1] * i + q[0] * nw + q[1] * ni;
+        out[CURRENT + k] = e[2] * w + e[3] * i + q[2] * nw + q[3] * ni;
+    }
+    out[SOC] = y[SOC] + 0.5 * h * n[SOC];
+}
 
 static void etdrk4_step(ModelInstance *m, Data *d, double h) {
     double *x = d->x, nu[N_STATES], na[N_STATES], nb[N_STATES], nc[N_STATES];
-    double a[N_STATES], b[N_STATES], c[N_STATES], tmp[N_STATES], p, r;
+    double a[N_STATES], b[N_STATES], c[N_STATES], tmp[N_STATES];
     int n, k;
     if (h != d->step) etd_coefficients(m, d, h);
     nonstiff(m, x, nu);
-    for (n = 0; n < N_MOTORS; n++) {
-        APPLY(d->e2, x, n, a[OMEGA + n], a[CURRENT + n]);
-        APPLY(d->q, nu, n, p, r);
-        a[OMEGA + n] += p;
-        a[CURRENT + n] += r;
-    }
-    a[SOC] = x[SOC] + 0.5 * h * nu[SOC];
+    stage(d->e2, d->q, h, x, nu, a);
     nonstiff(m, a, na);
-    for (n = 0; n < N_MOTORS; n++) {
-        APPLY(d->e2, x, n, b[OMEGA + n], b[CURRENT + n]);
-        APPLY(d->q, na, n, p, r);
-        b[OMEGA + n] += p;
-        b[CURRENT + n] += r;
-    }
-    b[SOC] = x[SOC] + 0.5 * h * na[SOC];
+    stage(d->e2, d->q, h, x, na, b);
     nonstiff(m, b, nb);
     for (k = 0; k < N_STATES; k++) tmp[k] = 2.0 * nb[k] - nu[k];
-    for (n = 0; n < N_MOTORS; n++) {
-        APPLY(d->e2, a, n, c[OMEGA + n], c[CURRENT + n]);
-        APPLY(d->q, tmp, n, p, r);
-        c[OMEGA + n] += p;
-        c[CURRENT + n] += r;
-    }
-    c[SOC] = a[SOC] + 0.5 * h * tmp[SOC];
+    stage(d->e2, d->q, h, a, tmp, c);
     nonstiff(m, c, nc);
     for (k = 0; k < N_STATES; k++) tmp[k] = na[k] + nb[k];
     for (n = 0; n < N_MOTORS; n++) {
-        double w, i, w1, i1, w2, i2, w3, i3;
-        APPLY(d->e, x, n, w, i);
-        APPLY(d->f1, nu, n, w1, i1);
-        APPLY(d->f2, tmp, n, w2, i2);
-        APPLY(d->f3, nc, n, w3, i3);
-        x[OMEGA + n] = w + w1 + 2.0 * w2 + w3;
-        x[CURRENT + n] = i + i1 + 2.0 * i2 + i3;
+        const double *e = d->e, *f1 = d->f1, *f2 = d->f2, *f3 = d->f3;
+        double w = x[OMEGA + n], i = x[CURRENT + n];
+        x[OMEGA + n] = e[0] * w + e[1] * i + f1[0] * nu[OMEGA + n] + f1[1] * nu[CURRENT + n] +
+                       2.0 * (f2[0] * tmp[OMEGA + n] + f2[1] * tmp[CURRENT + n]) + f3[0] * nc[OMEGA + n] +
+                       f3[1] * nc[CURRENT + n];
+        x[CURRENT + n] = e[2] * w + e[3] * i + f1[2] * nu[OMEGA + n] + f1[3] * nu[CURRENT + n] +
+                         2.0 * (f2[2] * tmp[OMEGA + n] + f2[3] * tmp[CURRENT + n]) + f3[2] * nc[OMEGA + n] +
+                         f3[3] * nc[CURRENT + n];
     }
     x[SOC] += h / 6.0 * (nu[SOC] + 2.0 * tmp[SOC] + nc[SOC]);
 }

@@ -10,6 +10,7 @@
 #include <math.h>
 
 #include "airframe.h"
+#include "quaternion.h"
 #include "variables.h"
 
 #define R(name) (m->real[VR_##name])
@@ -36,20 +37,6 @@ static void rotor_forces(ModelInstance *m, double *thrust, double tau[3]) {
     }
 }
 
-/* Body-to-NED rotation R(q) = I + 2 q0 S(qv) + 2 S(qv)^2, row-major. */
-static void rotation(const double *q, double r[9]) {
-    double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3];
-    r[0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
-    r[1] = 2.0 * (q1 * q2 - q0 * q3);
-    r[2] = 2.0 * (q1 * q3 + q0 * q2);
-    r[3] = 2.0 * (q1 * q2 + q0 * q3);
-    r[4] = 1.0 - 2.0 * (q1 * q1 + q3 * q3);
-    r[5] = 2.0 * (q2 * q3 - q0 * q1);
-    r[6] = 2.0 * (q1 * q3 - q0 * q2);
-    r[7] = 2.0 * (q2 * q3 + q0 * q1);
-    r[8] = 1.0 - 2.0 * (q1 * q1 + q2 * q2);
-}
-
 static void derivatives(ModelInstance *m, double t, const double *x, double *dx) {
     const double *v = x + 3, *q = x + 6, *w = x + 10;
     double thrust, tau[3], r[9], norm_error;
@@ -60,7 +47,7 @@ static void derivatives(ModelInstance *m, double t, const double *x, double *dx)
         return;
     }
     rotor_forces(m, &thrust, tau);
-    rotation(q, r);
+    rotation_from_quaternion(q, r);
     dx[0] = v[0];
     dx[1] = v[1];
     dx[2] = v[2];
@@ -143,7 +130,7 @@ void model_outputs(ModelInstance *m) {
     int i;
     derivatives(m, m->time, x, dx);
     rotor_forces(m, &thrust, tau);
-    rotation(x + 6, r);
+    rotation_from_quaternion(x + 6, r);
     R(p_x) = x[0];
     R(p_y) = x[1];
     R(p_z) = x[2];
