@@ -533,6 +533,7 @@ def _python_phase(block, slots, y, faults, bus):
 def _progress(total_seconds: float):
     from tqdm import tqdm
 
-    return tqdm(total=total_seconds, unit="s sim",
+    # shown only when a run lasts more than a few seconds of wall time
+    return tqdm(total=total_seconds, unit="s sim", delay=3.0,
                 bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]")
 
