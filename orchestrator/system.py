@@ -262,7 +262,7 @@ class _Plan:
         if self.steps < 1:
             raise ValueError(f"duration {duration} s is shorter than one macro step ({system.dt} s)")
         self.order = system.order()
-        position = {b.name: i for i, b in enumerate(self.order)}
+        self.position = {b.name: i for i, b in enumerate(self.order)}
         # bus layout: outputs block by block, then one slot per fault
         self.slot: dict[str, int] = {}
         for block in self.order:
@@ -276,14 +276,7 @@ class _Plan:
             slots = sorted({self.slot[name] for signal in record for name in system._resolve(signal, "output")})
         by_slot = {v: k for k, v in self.slot.items()}
         self.names = [by_slot[s] for s in slots]
-        # recorded slots as runs of consecutive bus slots: (row from, row to, bus from, bus to)
-        self.record_runs, k = [], 0
-        while k < len(slots):
-            j = k
-            while j + 1 < len(slots) and slots[j + 1] == slots[j] + 1:
-                j += 1
-            self.record_runs.append((k, j + 1, slots[k], slots[j] + 1))
-            k = j + 1
+        self.record_runs = _copies(slots)
         self.rows = self.steps // decimation + 1
         self.record = np.empty((self.rows, len(slots)))
         self.recorded = 0
@@ -292,7 +285,7 @@ class _Plan:
         for fault in system.faults:
             fault.reset()
         try:
-            self._prepare(position)
+            self._prepare()
         except BaseException:
             self.close()
             raise
@@ -304,8 +297,7 @@ class _Plan:
         early = self.position[source.split(".", 1)[0]] < self.position[block_name]
         return self.fault_slot.get(destination, self.slot[source]), early
 
-    def _prepare(self, position):
-        self.position = position
+    def _prepare(self):
         bus_address = self.bus.ctypes.data
         self.phase_a, self.phase_b = [], []
         pending: list = []  # FMU blocks of the phase-A batch being gathered
@@ -427,19 +419,29 @@ class _Plan:
                 block.close()
 
 
+def _consecutive(slots: list[int]) -> list[tuple[int, int]]:
+    """Index ranges [i, j) of ``slots`` over which each slot is the previous one plus one."""
+    ranges, i = [], 0
+    while i < len(slots):
+        j = i + 1
+        while j < len(slots) and slots[j] == slots[j - 1] + 1:
+            j += 1
+        ranges.append((i, j))
+        i = j
+    return ranges
+
+
+def _copies(slots: list[int]) -> tuple:
+    """Slice copies gathering bus ``slots`` into a vector: (to from, to end, bus from, bus end)."""
+    return tuple((i, j, slots[i], slots[j - 1] + 1) for i, j in _consecutive(slots))
+
+
 def _runs(refs: list[tuple[int, int]]):
     """Split (value reference, bus slot) pairs into runs of consecutive slots: one
     fmi2SetReal each, reading straight from the bus. Yields (value references, first slot)."""
     refs = sorted(refs, key=lambda r: r[1])
-    runs, current = [], []
-    for vr, slot in refs:
-        if current and slot != current[-1][1] + 1:
-            runs.append(current)
-            current = []
-        current.append((vr, slot))
-    if current:
-        runs.append(current)
-    return [(np.array([vr for vr, _ in run], dtype=np.uint32), run[0][1]) for run in runs]
+    slots = [slot for _, slot in refs]
+    return [(np.array([vr for vr, _ in refs[i:j]], dtype=np.uint32), slots[i]) for i, j in _consecutive(slots)]
 
 
 class _Call(ctypes.Structure):
@@ -507,14 +509,7 @@ def _python_phase(block, slots, y, faults, bus):
         copies = ()
     else:
         u = np.zeros(n)
-        copies, k = [], 0
-        while k < n:  # contiguous runs of source slots, copied slice by slice
-            j = k
-            while j + 1 < n and slots[j + 1] == slots[j] + 1:
-                j += 1
-            copies.append((k, j + 1, slots[k], slots[j] + 1))
-            k = j + 1
-        copies = tuple(copies)
+        copies = _copies(slots)
 
     if not copies and not faults:
         def phase(t):
