@@ -11,7 +11,6 @@ import numpy as np
 
 from estimators import DEFAULT_GAINS, QuaternionEstim
 from fmus import vehicle
-from fmus.IMU.variables import LAB_GYRO_BIAS
 from orchestrator import System, Table
 from scenarios import Option, Scenario
 from scenarios.control import SETPOINT, Controller, profile
@@ -164,4 +163,3 @@ def bias_convergence_time(t, error, tolerance) -> float | None:
 
 
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report)
-LAB_BIAS = LAB_GYRO_BIAS

@@ -5,7 +5,8 @@ import pytest
 
 import scenarios
 from estimators import analysis
-from scenarios.tp import LAB_BIAS, bias_convergence_time
+from fmus.IMU.variables import LAB_GYRO_BIAS as LAB_BIAS
+from scenarios.tp import bias_convergence_time
 
 
 def run(**options):
