@@ -24,7 +24,7 @@ TOLERANCE = 1e-6  # of the peak of each signal
 STOP = 2.0
 
 
-def compare(model, inputs, parameters, fmu_step, every, tolerance=TOLERANCE):
+def compare(model, inputs, parameters, fmu_step, every, tolerance=TOLERANCE, report=print):
     outputs = [v.name for v in table(model).of("output")]
     times, fmu = simulate_fmu(model, inputs, parameters, STOP, fmu_step, outputs)
     grid = times[::every]
@@ -35,6 +35,8 @@ def compare(model, inputs, parameters, fmu_step, every, tolerance=TOLERANCE):
         scale = max(np.abs(reference).max(), 1e-300)
         worst[name] = np.abs(twin[name] - reference).max() / scale
     bad = {k: v for k, v in worst.items() if not v <= tolerance}
+    name = max(worst, key=worst.get)
+    report(f"\n{model} twin against FMU over {STOP:g} s: largest difference {worst[name]:.2g} of the peak ({name})")
     assert not bad, bad
     return twin
 

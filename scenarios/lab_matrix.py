@@ -1,0 +1,135 @@
+"""The lab's matrix in one go: every ``tp`` case of the report, and the checks against analysis.
+
+    python -m scenarios.lab_matrix --out results/lab-matrix
+
+Runs the cases in parallel on the available cores; each case leaves its own folder (figures,
+metrics.json, results) under the output folder, and ``summary.md`` gathers the numbers:
+- estimation RMS error (roll, pitch, yaw) and tracking RMS for each case;
+- the explicit filter without bias estimate: simulated steady error against the linearised
+  prediction (estimators.analysis.explicit_bias_steady_error);
+- the passive filter: bias-convergence time against the linearised prediction for
+  kP = kI in {0.1, 1, 10, 100}, with R_reel and with TRIAD.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from estimators import analysis
+from fmus.IMU.variables import LAB_GYRO_BIAS
+
+CASES = {
+    "linear-quasi-gt": {"estimator": "linear"},
+    "linear-quasi-gt-noise": {"estimator": "linear", "noise": True},
+    "linear-quasi-estimate-noise": {"estimator": "linear", "noise": True, "feedback": "estimate"},
+    "linear-nonstationary-gt": {"estimator": "linear", "flight": "nonstationary"},
+    "linear-nonstationary-gt-noise": {"estimator": "linear", "flight": "nonstationary", "noise": True},
+    "linear-nonstationary-estimate-noise": {"estimator": "linear", "flight": "nonstationary", "noise": True,
+                                            "feedback": "estimate"},
+    "explicit-0.002-quasi-gt": {"estimator": "explicit", "k1": 0.002, "k2": 0.002},
+    "explicit-0.002-nonstationary-gt": {"estimator": "explicit", "k1": 0.002, "k2": 0.002, "flight": "nonstationary"},
+    "explicit-0.002-quasi-estimate": {"estimator": "explicit", "k1": 0.002, "k2": 0.002, "feedback": "estimate"},
+    "explicit-0.2-nonstationary-estimate": {"estimator": "explicit", "flight": "nonstationary",
+                                            "feedback": "estimate"},
+    "explicit-nonstationary-estimate-noise": {"estimator": "explicit", "flight": "nonstationary",
+                                              "feedback": "estimate", "noise": True},
+    "explicit-nonstationary-estimate-noise-bias": {"estimator": "explicit", "flight": "nonstationary",
+                                                   "feedback": "estimate", "noise": True, "bias": True},
+    **{f"passive-reel-{g:g}-quasi-estimate-noise-bias": {"estimator": "passive", "kP": g, "kI": g, "bias": True,
+                                                          "noise": True, "feedback": "estimate"}
+       for g in (0.1, 1.0, 10.0, 100.0)},
+    "passive-triad-quasi-estimate-noise-bias": {"estimator": "passive", "ry": "triad", "bias": True, "noise": True,
+                                                "feedback": "estimate"},
+}
+EXPLICIT_GAINS = (0.2, 1.0, 2.0)
+PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
+
+
+def _case(args):
+    import scenarios
+
+    name, options, out = args
+    _, metrics = scenarios.run("tp", options, out / name if out else None)
+    return name, metrics
+
+
+def _explicit(k):
+    import scenarios
+
+    result, _ = scenarios.run("tp", {"estimator": "explicit", "flight": "hover", "bias": True, "k1": k, "k2": k,
+                                     "kI": 0.0, "duration": 60.0})
+    late = result.time > 45.0
+    error = np.column_stack([result[f"Quaternion_estim.theta_est{i}"] - result[f"Quadrotor.theta{i}"]
+                             for i in (1, 2, 3)])[late].mean(axis=0)
+    return k, np.degrees(error).tolist()
+
+
+def _passive(args):
+    import scenarios
+
+    ry, gain = args
+    predicted = analysis.passive_bias_convergence_time(gain, gain, max(np.abs(LAB_GYRO_BIAS)), 1e-3)
+    _, metrics = scenarios.run("tp", {"estimator": "passive", "flight": "hover", "bias": True, "kP": gain, "kI": gain,
+                                      "ry": ry, "duration": max(10.0, 1.5 * predicted)})
+    return ry, gain, metrics["bias_convergence_s"], predicted
+
+
+def run(out: Path | None) -> dict:
+    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+        cases = dict(pool.map(_case, [(name, options, out) for name, options in CASES.items()]))
+        explicit = list(pool.map(_explicit, EXPLICIT_GAINS))
+        passive = list(pool.map(_passive, [(ry, g) for ry in ("reel", "triad") for g in PASSIVE_GAINS]))
+    summary = {
+        "cases": {name: {k: m[k] for k in ("rms_error_deg", "tracking_rms_deg", "bias_error_final")}
+                  for name, m in cases.items()},
+        "explicit_steady_bias_error_deg": [
+            {"k1=k2": k, "simulated": sim,
+             "predicted": np.degrees(analysis.explicit_bias_steady_error(k, k, 1.0, LAB_GYRO_BIAS)).tolist()}
+            for k, sim in explicit],
+        "passive_bias_convergence_s": [{"ry": ry, "kP=kI": g, "simulated": s, "predicted": p}
+                                       for ry, g, s, p in passive],
+    }
+    if out:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        (out / "summary.md").write_text(markdown(summary))
+    return summary
+
+
+def markdown(summary: dict) -> str:
+    def deg(values):
+        return " / ".join(f"{v:.3f}" for v in values)
+
+    lines = ["| case | estimation RMS (deg, roll/pitch/yaw) | tracking RMS (deg) |", "|---|---|---|"]
+    for name, m in summary["cases"].items():
+        lines.append(f"| {name} | {deg(m['rms_error_deg'])} | {deg(m['tracking_rms_deg'])} |")
+    lines += ["", "| explicit, no bias estimate, k1 = k2 | simulated steady error (deg) | predicted (deg) |",
+              "|---|---|---|"]
+    for row in summary["explicit_steady_bias_error_deg"]:
+        lines.append(f"| {row['k1=k2']:g} | {deg(row['simulated'])} | {deg(row['predicted'])} |")
+    lines += ["", "| passive, R_y | kP = kI | bias within 1e-3 rad/s after (s), simulated | predicted |",
+              "|---|---|---|---|"]
+    for row in summary["passive_bias_convergence_s"]:
+        simulated = "not reached" if row["simulated"] is None else f"{row['simulated']:.2f}"
+        lines.append(f"| {row['ry']} | {row['kP=kI']:g} | {simulated} | {row['predicted']:.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m scenarios.lab_matrix", description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="results/lab-matrix", help="output folder")
+    args = parser.parse_args(argv)
+    summary = run(Path(args.out))
+    print(markdown(summary))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
