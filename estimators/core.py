@@ -38,12 +38,6 @@ CONFIG_SIZE = 6
 STATE_SIZE = 10
 OUTPUT_SIZE = 13
 WORK_SIZE = 21
-# gains per kind, in order
-GAINS = {
-    "linear": ("k1", "k2", "k3"),
-    "explicit": ("k1", "k2", "kP", "kI"),
-    "passive": ("kP", "kI"),
-}
 
 
 @njit(cache=True, error_model="numpy")
@@ -190,7 +184,8 @@ def triad(acc, mag, config, r):
 def update(kind, x, u, gains, config, dt, y, work):
     """One estimator step with the sample ``u``; writes the outputs ``y``.
 
-    ``kind`` is LINEAR, EXPLICIT or PASSIVE; ``gains`` follows :data:`GAINS`; ``work`` is a
+    ``kind`` is LINEAR, EXPLICIT or PASSIVE; ``gains`` in the order of
+    :data:`estimators.filters.DEFAULT_GAINS`; ``work`` is a
     scratch array of WORK_SIZE floats owned by the caller, so that nothing is allocated.
     """
     acc, gyro, mag = u[0:3], u[3:6], u[6:9]

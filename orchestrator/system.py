@@ -280,7 +280,6 @@ class _Plan:
         self.rows = self.steps // decimation + 1
         self.record = np.empty((self.rows, len(slots)))
         self.recorded = 0
-        self.time_now = t0
         self.fmus = []
         for fault in system.faults:
             fault.reset()
@@ -355,7 +354,6 @@ class _Plan:
         try:
             for n in range(self.steps + 1):
                 t = t0 + n * dt
-                self.time_now = t
                 for period, fn in phase_a:
                     if period == 1 or n % period == 0:
                         fn(t)
@@ -379,10 +377,10 @@ class _Plan:
         except FMUError as error:
             message = str(error)
             if "not a finite number" in message:
-                message = self._non_finite(self.time_now) + "\n" + message
+                message = self._non_finite(t0 + n * dt) + "\n" + message
             raise SimulationError(message, self.result(error=message)) from None
         except Exception as error:  # a Python block failed: keep what was recorded
-            message = f"at t = {self.time_now:.6g} s: {type(error).__name__}: {error}"
+            message = f"at t = {t0 + n * dt:.6g} s: {type(error).__name__}: {error}"
             raise SimulationError(message, self.result(error=message)) from error
         finally:
             self.loop_seconds = time.perf_counter() - started

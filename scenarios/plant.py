@@ -10,8 +10,6 @@ import numpy as np
 
 from orchestrator import FMUBlock, System
 
-GAUSS_PER_TESLA = 1e4
-
 
 def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: bool = True,
               imu_period: int = 1) -> System:

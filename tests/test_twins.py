@@ -16,7 +16,6 @@ import pytest
 
 pytest.importorskip("modelica")
 
-from fmus import vehicle  # noqa: E402
 from fmus.build import table  # noqa: E402
 from fmus.twins import simulate_fmu, simulate_twin  # noqa: E402
 
@@ -79,4 +78,3 @@ def test_twin_parameters_equal_fmu_start_values(model):
     twin = simulate_twin(model, inputs, {}, 0.01, np.array([0.0, 0.01]))
     for v in parameters:
         assert twin[v.name][0] == pytest.approx(float(v.start), rel=1e-12, abs=0), v.name
-    assert vehicle.MASS == twin.get("m", [vehicle.MASS])[0]
