@@ -26,14 +26,6 @@ def default_fmu_dir() -> Path:
     return Path(env) if env else Path(__file__).resolve().parent.parent / "build" / "fmus"
 
 
-def call_runner_path() -> Path:
-    """Path of the orchestrator's compiled FMI call runner, built with the FMUs."""
-    path = default_fmu_dir() / "libquadcosim_calls.so"
-    if not path.is_file():
-        raise FMUNotFoundError(f"{path} not found. Build it, with the FMUs, by `quadcosim build` (or `make fmus`).")
-    return path
-
-
 def fmu_path(name: str) -> Path:
     """Path of the built FMU called ``name``; says how to build it when it is missing."""
     path = default_fmu_dir() / f"{name}.fmu"

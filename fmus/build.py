@@ -81,21 +81,8 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None) -> Path:
     return fmu
 
 
-def build_call_runner(out_dir: Path, compiler: str | None = None) -> Path:
-    """Build the orchestrator's FMI call runner (orchestrator/c/calls.c) beside the FMUs."""
-    compiler = compiler or os.environ.get("CC", "cc")
-    source = HERE.parent / "orchestrator" / "c" / "calls.c"
-    library = out_dir / "libquadcosim_calls.so"
-    command = [compiler, *CFLAGS, "-shared", "-o", str(library), str(source)]
-    done = subprocess.run(command, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise BuildError(f"call runner: {' '.join(command)}\n{done.stderr}")
-    return library
-
-
 def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) -> list[Path]:
-    """Build every plant FMU, and the orchestrator's call runner, into ``out_dir``
-    (default ``build/fmus``)."""
+    """Build every plant FMU into ``out_dir`` (default :func:`fmus.default_fmu_dir`)."""
     out_dir = Path(out_dir or default_fmu_dir())
     out_dir.mkdir(parents=True, exist_ok=True)
     built = []
@@ -103,9 +90,6 @@ def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) 
         built.append(build_fmu(model, out_dir))
         if verbose:
             print(f"built {built[-1]}")
-    built.append(build_call_runner(out_dir))
-    if verbose:
-        print(f"built {built[-1]}")
     return built
 
 

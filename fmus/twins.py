@@ -81,17 +81,59 @@ def simulate_fmu(model: str, inputs: dict[str, str], parameters: dict, stop: flo
 
     Outputs are read with the inputs set to their value at the communication point; the step
     is then taken with the inputs at mid-step, which the FMU holds constant over the step, so
-    that a continuous input is integrated to second order in ``step``.
+    that a continuous input is integrated to second order in ``step``. The FMU is driven
+    through fmpy directly, so that the plant needs no co-simulation master to be checked.
 
-    Returns the communication times and the outputs there.
+    Parameters
+    ----------
+    model : str
+        Name of a built FMU (found by :func:`fmus.fmu_path`).
+    inputs : dict of str to str
+        Input name to expression of ``time`` (s), as for :func:`simulate_twin`.
+    parameters : dict
+        Parameter overrides by variable name, in the FMU's units (SI).
+    stop : float
+        End time (s).
+    step : float
+        Communication step (s).
+    outputs : list of str
+        Output names to return.
+
+    Returns
+    -------
+    times : ndarray
+        Communication times (s), ``0, step, ..., stop``.
+    values : dict of str to ndarray
+        Each output at ``times``, in the FMU's units.
     """
-    from orchestrator.fmu import FMUInstance
+    import shutil
 
-    fmu = FMUInstance(model, parameters)
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    from fmus import fmu_path
+
+    path = str(fmu_path(model))
+    description = read_model_description(path)
+    variables = {v.name: v for v in description.modelVariables}
+    unzipped = extract(path)
+    slave = FMU2Slave(guid=description.guid, unzipDirectory=unzipped,
+                      modelIdentifier=description.coSimulation.modelIdentifier, instanceName=model)
+    slave.instantiate()
     try:
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        for name, value in parameters.items():
+            variable = variables[name]
+            setter = {"Real": (slave.setReal, float), "Integer": (slave.setInteger, int),
+                      "Boolean": (slave.setBoolean, bool)}[variable.type]
+            setter[0]([variable.valueReference], [setter[1](value)])
+        slave.exitInitializationMode()
         n = int(round(stop / step))
         times = np.arange(n + 1) * step
         names = list(inputs)
+        input_refs = [variables[name].valueReference for name in names]
+        output_refs = [variables[name].valueReference for name in outputs]
         at = input_values(inputs, times)
         mid = input_values(inputs, times + 0.5 * step)
         u = np.column_stack([at[name] for name in names]) if names else None
@@ -99,12 +141,14 @@ def simulate_fmu(model: str, inputs: dict[str, str], parameters: dict, stop: flo
         values = np.empty((n + 1, len(outputs)))
         for k, t in enumerate(times):
             if names:
-                fmu.set(names, u[k])
-            values[k] = fmu.get(outputs)
+                slave.setReal(input_refs, list(u[k]))
+            values[k] = slave.getReal(output_refs)
             if k < n:
                 if names:
-                    fmu.set(names, u_mid[k])
-                fmu.step(t, step)
+                    slave.setReal(input_refs, list(u_mid[k]))
+                slave.doStep(float(t), step)
         return times, {name: values[:, j] for j, name in enumerate(outputs)}
     finally:
-        fmu.close()
+        slave.terminate()
+        slave.freeInstance()
+        shutil.rmtree(unzipped, ignore_errors=True)

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from orchestrator.blocks import Block, Constant, FMUBlock
+from orchestrator.calls import run_calls
 from orchestrator.fmu import FMUError, nearest
 from orchestrator.result import Result, expand
 
@@ -461,22 +462,8 @@ def _call(kind, block, instance, vrs, address, h=0.0):
     return call, block, vrs
 
 
-_runner = None
-
-
-def _call_runner():
-    global _runner
-    if _runner is None:
-        from fmus import call_runner_path
-
-        library = ctypes.CDLL(str(call_runner_path()))
-        _runner = library.run_calls
-        _runner.restype = ctypes.c_int
-    return _runner
-
-
 def _batch_phase(calls, faults, bus):
-    run = _call_runner()
+    run = run_calls()
     array = (_Call * len(calls))(*[c for c, _, _ in calls])
     blocks = [b for _, b, _ in calls]
     keep = [v for _, _, v in calls]  # the value reference arrays the calls point into

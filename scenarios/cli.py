@@ -1,6 +1,6 @@
 """quadcosim: run the quadrotor co-simulation scenarios, build the FMUs, benchmark the master.
 
-  quadcosim build                          build the plant FMUs from source
+  quadcosim build                          build the plant FMUs and the master's call runner
   quadcosim list [--parameters MODEL]      scenarios and their options (or an FMU's parameters)
   quadcosim run SCENARIO [--set k=v]... [--out DIR] [--fault ...]
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
@@ -16,10 +16,12 @@ from pathlib import Path
 
 def _build(args) -> int:
     from fmus.build import BuildError, build_all
+    from orchestrator.calls import RunnerBuildError, build_runner
 
     try:
         build_all(args.out)
-    except BuildError as error:
+        print(f"built {build_runner()}")
+    except (BuildError, RunnerBuildError) as error:
         print(error, file=sys.stderr)
         return 1
     return 0
@@ -96,7 +98,7 @@ def _diagram(args) -> int:
 
 
 def _bench(args) -> int:
-    from orchestrator import bench
+    from benchmarks import master as bench
 
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
 
@@ -105,7 +107,7 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs from source into build/fmus")
+    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus) and the master's C call runner")
     build.add_argument("--out", default=None, help="output folder (default build/fmus)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")

@@ -19,6 +19,8 @@ import time
 
 import numpy as np
 
+from benchmarks import estimators
+
 
 def orchestrator_us_per_step(seconds: float, repeats: int) -> float:
     import scenarios
@@ -104,11 +106,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
         "overhead_ratio": orchestrator / raw,
         "rtf_open_loop": 1e3 / orchestrator,
     }
-    try:
-        from estimators import bench as estimator_bench
-    except ImportError:
-        return figures
-    return figures | estimator_bench.measure(seconds, repeats)
+    return figures | estimators.measure(seconds, repeats)
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,98 @@
+"""The call runner: a small C library that runs a prepared list of FMI calls in one go.
+
+A co-simulation step then costs one crossing from Python into C per group of FMU calls
+instead of one per call. The runner's source is ``orchestrator/c/calls.c``; it is compiled
+with the system C compiler into the runner folder, a setting: ``$QUADCOSIM_RUNNER_DIR`` or
+``build/orchestrator`` beside the package. :func:`runner_path` compiles it on first use when it
+is missing or older than its source; ``quadcosim build`` compiles it with the FMUs.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+SOURCE = Path(__file__).resolve().parent / "c" / "calls.c"
+LIBRARY_NAME = "libquadcosim_calls.so"
+CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-shared")
+
+
+class RunnerBuildError(RuntimeError):
+    """The C compiler refused the call runner, or no C compiler was found."""
+
+
+def runner_dir() -> Path:
+    """Folder of the compiled call runner.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$QUADCOSIM_RUNNER_DIR`` if set, else ``build/orchestrator`` beside the package.
+    """
+    env = os.environ.get("QUADCOSIM_RUNNER_DIR")
+    return Path(env) if env else SOURCE.parent.parent.parent / "build" / "orchestrator"
+
+
+def build_runner(out_dir: str | Path | None = None, compiler: str | None = None) -> Path:
+    """Compile ``orchestrator/c/calls.c`` into a shared library, warnings as errors.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path, optional
+        Destination folder; :func:`runner_dir` by default.
+    compiler : str, optional
+        C compiler command; ``$CC`` or ``cc`` by default.
+
+    Returns
+    -------
+    pathlib.Path
+        Path of the library. It is written under a temporary name and renamed, so that
+        processes starting together never load a half-written file.
+    """
+    compiler = compiler or os.environ.get("CC", "cc")
+    out = Path(out_dir) if out_dir is not None else runner_dir()
+    out.mkdir(parents=True, exist_ok=True)
+    library = out / LIBRARY_NAME
+    handle, partial = tempfile.mkstemp(prefix=".calls-", suffix=".so", dir=out)
+    os.close(handle)
+    command = [compiler, *CFLAGS, "-o", partial, str(SOURCE)]
+    try:
+        done = subprocess.run(command, capture_output=True, text=True)
+    except FileNotFoundError:
+        os.unlink(partial)
+        raise RunnerBuildError(f"no C compiler {compiler!r}: install one (e.g. gcc) or set $CC") from None
+    if done.returncode != 0:
+        os.unlink(partial)
+        raise RunnerBuildError(f"call runner: {' '.join(command)}\n{done.stderr}")
+    os.replace(partial, library)
+    return library
+
+
+def runner_path() -> Path:
+    """Path of the compiled call runner, compiling it first if it is missing or stale.
+
+    Returns
+    -------
+    pathlib.Path
+        Path of ``libquadcosim_calls.so`` in :func:`runner_dir`.
+    """
+    library = runner_dir() / LIBRARY_NAME
+    if not library.is_file() or library.stat().st_mtime < SOURCE.stat().st_mtime:
+        build_runner()
+    return library
+
+
+_run_calls = None
+
+
+def run_calls():
+    """The runner's ``run_calls(calls, count, t, failed)`` function, loaded once per process."""
+    global _run_calls
+    if _run_calls is None:
+        function = ctypes.CDLL(str(runner_path())).run_calls
+        function.restype = ctypes.c_int
+        _run_calls = function
+    return _run_calls

@@ -1,0 +1,107 @@
+"""Dependencies point one way: fmus <- orchestrator <- estimators/calibration <- scenarios,
+the command line and the benchmarks.
+
+Every import in every module of the package is read from its syntax tree (imports inside
+functions included), so a late import cannot hide a dependency.
+"""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGES = ("fmus", "orchestrator", "estimators", "calibration", "scenarios", "benchmarks")
+
+# What each layer may import from the project, besides itself. A name ending in "." allows
+# the whole package; a bare module name allows that module and nothing below it.
+ALLOWED = {
+    "fmus": (),
+    # to find built FMUs only: the package's locating functions, not its build or its models
+    "orchestrator": ("fmus",),
+    # the block contract, and the plant's constants (vehicle, sensor densities)
+    "estimators": ("orchestrator.blocks", "fmus.", "calibration."),
+    "calibration": ("orchestrator.blocks", "fmus.", "estimators."),
+    "scenarios": tuple(f"{p}." for p in PACKAGES),
+    "benchmarks": tuple(f"{p}." for p in PACKAGES),
+}
+
+
+def _imports(path: Path) -> list[tuple[int, str]]:
+    """(line, absolute module name) of every import of a project package in ``path``."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                raise AssertionError(f"{path.relative_to(ROOT)}:{node.lineno}: relative import; write it absolute")
+            if node.module in PACKAGES:  # `from fmus import vehicle` imports fmus.vehicle
+                found += [(node.lineno, f"{node.module}.{alias.name}") for alias in node.names]
+            else:
+                found.append((node.lineno, node.module))
+    return [(line, name) for line, name in found if name.split(".")[0] in PACKAGES]
+
+
+def _allowed(layer: str, module: str, package_names: set[str]) -> bool:
+    if module.split(".")[0] == layer:
+        return True
+    for rule in ALLOWED[layer]:
+        if rule.endswith(".") and (module + ".").startswith(rule):
+            return True
+        # `from fmus import fmu_path` names an attribute of the package, not a module
+        if module == rule or (module.rsplit(".", 1)[0] == rule and module not in package_names):
+            return True
+    return False
+
+
+def _modules() -> set[str]:
+    names = set()
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            names.add(".".join(parts[:-1] if parts[-1] == "__init__" else parts))
+    return names
+
+
+def _violations() -> list[str]:
+    modules = _modules()
+    bad = []
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            for line, module in _imports(path):
+                if not _allowed(package, module, modules):
+                    bad.append(f"{path.relative_to(ROOT)}:{line} imports {module}")
+    return bad
+
+
+def test_every_import_points_down_the_layers():
+    bad = _violations()
+    assert not bad, "imports against the direction fmus <- orchestrator <- estimators/calibration <- " \
+                    "scenarios/CLI/benchmarks:\n" + "\n".join(bad)
+
+
+def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert project["project"]["scripts"]["quadcosim"] == "scenarios.cli:main"
+    assert "benchmarks*" in project["tool"]["setuptools"]["packages"]["find"]["include"]
+    assert not (ROOT / "orchestrator" / "cli.py").exists()
+    assert not list((ROOT / "orchestrator").glob("bench*.py"))
+    assert not list((ROOT / "estimators").glob("bench*.py"))
+
+
+@pytest.mark.parametrize(("layer", "module", "expected"), [
+    ("orchestrator", "fmus", True),
+    ("orchestrator", "fmus.fmu_path", True),
+    ("orchestrator", "fmus.build", False),
+    ("orchestrator", "scenarios", False),
+    ("fmus", "orchestrator.fmu", False),
+    ("estimators", "orchestrator.blocks", True),
+    ("estimators", "orchestrator.system", False),
+    ("estimators", "scenarios.plant", False),
+    ("scenarios", "benchmarks.master", True),
+])
+def test_the_rule_itself(layer, module, expected):
+    assert _allowed(layer, module, _modules() | {"fmus.build", "orchestrator.system"}) is expected
