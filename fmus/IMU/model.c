@@ -13,6 +13,7 @@
  */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "quaternion.h"
 #include "variables.h"
@@ -106,7 +107,14 @@ fmi2Status model_initialize(ModelInstance *m) {
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     /* instants in [t, t + h) become final, with the inputs held over the step */
-    int64_t end = (int64_t)ceil((t + h) * R(sample_rate) - 1e-6);
+    double last = ceil((t + h) * R(sample_rate) - 1e-6);
+    int64_t end;
+    char what[64];
+    snprintf(what, sizeof what, "samples at sample_rate = %g Hz", R(sample_rate));
+    if (!work_allowed(m, last - (double)d->next_sample, h, what,
+                      "take shorter communication steps or a lower sample_rate"))
+        return fmi2Error;
+    end = (int64_t)last;
     for (; d->next_sample < end; d->next_sample++) {
         /* the sample at t is already current unless inputs changed since it was read */
         if (!(d->current == d->next_sample && !m->outputs_stale)) take_sample(m, d, d->next_sample);

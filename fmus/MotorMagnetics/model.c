@@ -202,8 +202,9 @@ fmi2Status model_initialize(ModelInstance *m) {
 
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
-    int n = (int)ceil(h / R(sub_step) - 1e-9), k;
+    int n = substep_count(m, h, R(sub_step), "sub_step"), k;
     (void)t;
+    if (n == 0) return fmi2Error;
     for (k = 0; k < N_MOTORS; k++) {
         double c = (&R(c1))[k];
         int outside = c < 0.0 || c > 1.0;
@@ -211,7 +212,6 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
             log_warning(m, "c%d = %g at t = %g is outside [0, 1]: saturated", k + 1, c, m->time);
         d->saturated[k] = outside;
     }
-    if (n < 1) n = 1;
     for (k = 0; k < n; k++) etdrk4_step(m, d, h / n);
     return fmi2OK;
 }

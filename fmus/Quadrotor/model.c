@@ -115,9 +115,9 @@ fmi2Status model_initialize(ModelInstance *m) {
 
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
-    int n = (int)ceil(h / R(sub_step) - 1e-9), k;
+    int n = substep_count(m, h, R(sub_step), "sub_step"), k;
     double hh;
-    if (n < 1) n = 1;
+    if (n == 0) return fmi2Error;
     hh = h / n;
     for (k = 0; k < n; k++) rk4_step(m, derivatives, t + k * hh, hh, d->x, N_STATES);
     return fmi2OK;

@@ -47,6 +47,24 @@ void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, in
     for (i = 0; i < n; i++) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
 }
 
+int work_allowed(ModelInstance *m, double count, double h, const char *what, const char *fix) {
+    if (count <= (double)MAX_SUBSTEPS_PER_STEP) return 1; /* false for NaN */
+    log_error(m, "fmi2DoStep: a step of %g s at t = %g would need %.3g %s, more than the %d allowed "
+                 "per step; %s",
+              h, m->time, count, what, MAX_SUBSTEPS_PER_STEP, fix);
+    return 0;
+}
+
+int substep_count(ModelInstance *m, double h, double max_step, const char *parameter) {
+    double count = ceil(h / max_step - 1e-9);
+    char what[128];
+    if (count < 1.0) return 1;
+    snprintf(what, sizeof what, "sub-steps of %s = %g s", parameter, max_step);
+    if (!work_allowed(m, count, h, what, "take shorter communication steps or a larger sub-step"))
+        return 0;
+    return (int)count;
+}
+
 static fmi2Status fail(ModelInstance *m, const char *function, const char *format, ...) {
     char message[900];
     va_list args;
@@ -57,10 +75,21 @@ static fmi2Status fail(ModelInstance *m, const char *function, const char *forma
     return fmi2Error;
 }
 
+static const char *const MODE_NAMES[] = {"instantiated", "in initialization mode", "in step mode",
+                                         "terminated", "in the error state"};
+
 static int allowed(ModelInstance *m, const char *function, unsigned modes) {
+    char list[128] = "";
+    int k;
     if (!m) return 0;
     if ((1u << m->mode) & modes) return 1;
-    fail(m, function, "not allowed in the present state (mode %d)", (int)m->mode);
+    for (k = 0; k <= MODE_ERROR; k++) {
+        if (!((1u << k) & modes)) continue;
+        if (*list) strcat(list, ", ");
+        strcat(list, MODE_NAMES[k]);
+    }
+    fail(m, function, "not allowed: the FMU is %s (allowed only when it is %s)", MODE_NAMES[m->mode],
+         list);
     return 0;
 }
 
@@ -153,11 +182,14 @@ void fmi2FreeInstance(fmi2Component c) {
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     ModelInstance *m = (ModelInstance *)c;
-    UNUSED(toleranceDefined);
-    UNUSED(tolerance);
-    UNUSED(stopTimeDefined);
-    UNUSED(stopTime);
     if (!allowed(m, "fmi2SetupExperiment", 1u << MODE_INSTANTIATED)) return fmi2Error;
+    if (!isfinite(startTime))
+        return fail(m, "fmi2SetupExperiment", "startTime = %g is not a finite number", startTime);
+    if (toleranceDefined && !(tolerance > 0.0 && isfinite(tolerance)))
+        return fail(m, "fmi2SetupExperiment", "tolerance = %g must be positive and finite", tolerance);
+    if (stopTimeDefined && !(stopTime >= startTime && isfinite(stopTime)))
+        return fail(m, "fmi2SetupExperiment", "stopTime = %g must be finite and not before startTime = %g",
+                    stopTime, startTime);
     m->time = startTime;
     return fmi2OK;
 }
@@ -208,11 +240,13 @@ fmi2Status fmi2Reset(fmi2Component c) {
 
 /* ---------------------------------------------------------------- get and set */
 static fmi2Status check_refs(ModelInstance *m, const char *function, const fmi2ValueReference vr[],
-                             size_t nvr, int count) {
+                             size_t nvr, int count, const char *type) {
     size_t i;
     if (nvr > 0 && !vr) return fail(m, function, "null value reference array");
-    for (i = 0; i < nvr; i++) {
-        if ((int)vr[i] >= count) return fail(m, function, "unknown value reference %u", vr[i]);
+    for (i = 0; i < nvr; i++) { /* unsigned: a reference of 2^31 or more is not a negative index */
+        if (vr[i] >= (fmi2ValueReference)count)
+            return fail(m, function, "unknown value reference %u: this model has %d %s variables, 0 to %d",
+                        (unsigned)vr[i], count, type, count - 1);
     }
     return fmi2OK;
 }
@@ -245,7 +279,8 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
     if (!allowed(m, "fmi2GetReal", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
-    if (check_refs(m, "fmi2GetReal", vr, nvr, N_REAL) != fmi2OK) return fmi2Error;
+    if (check_refs(m, "fmi2GetReal", vr, nvr, N_REAL, "Real") != fmi2OK) return fmi2Error;
+    if (nvr > 0 && !value) return fail(m, "fmi2GetReal", "null value array");
     if (refresh_outputs(m, "fmi2GetReal") != fmi2OK) return fmi2Error;
     for (i = 0; i < nvr; i++) value[i] = m->real[vr[i]];
     return fmi2OK;
@@ -256,7 +291,8 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
     if (!allowed(m, "fmi2GetInteger", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
-    if (check_refs(m, "fmi2GetInteger", vr, nvr, N_INTEGER) != fmi2OK) return fmi2Error;
+    if (check_refs(m, "fmi2GetInteger", vr, nvr, N_INTEGER, "Integer") != fmi2OK) return fmi2Error;
+    if (nvr > 0 && !value) return fail(m, "fmi2GetInteger", "null value array");
     for (i = 0; i < nvr; i++) value[i] = m->integer[vr[i]];
     return fmi2OK;
 }
@@ -266,7 +302,8 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
     if (!allowed(m, "fmi2GetBoolean", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
-    if (check_refs(m, "fmi2GetBoolean", vr, nvr, N_BOOLEAN) != fmi2OK) return fmi2Error;
+    if (check_refs(m, "fmi2GetBoolean", vr, nvr, N_BOOLEAN, "Boolean") != fmi2OK) return fmi2Error;
+    if (nvr > 0 && !value) return fail(m, "fmi2GetBoolean", "null value array");
     for (i = 0; i < nvr; i++) value[i] = m->boolean[vr[i]];
     return fmi2OK;
 }
@@ -285,7 +322,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
     if (!allowed(m, "fmi2SetReal", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
-    if (check_refs(m, "fmi2SetReal", vr, nvr, N_REAL) != fmi2OK) return fmi2Error;
+    if (check_refs(m, "fmi2SetReal", vr, nvr, N_REAL, "Real") != fmi2OK) return fmi2Error;
+    if (nvr > 0 && !value) return fail(m, "fmi2SetReal", "null value array");
     for (i = 0; i < nvr; i++) {
         const VariableInfo *info = &REAL_INFO[vr[i]];
         if (check_settable(m, "fmi2SetReal", info) != fmi2OK) return fmi2Error;
@@ -305,7 +343,8 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
     if (!allowed(m, "fmi2SetInteger", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
-    if (check_refs(m, "fmi2SetInteger", vr, nvr, N_INTEGER) != fmi2OK) return fmi2Error;
+    if (check_refs(m, "fmi2SetInteger", vr, nvr, N_INTEGER, "Integer") != fmi2OK) return fmi2Error;
+    if (nvr > 0 && !value) return fail(m, "fmi2SetInteger", "null value array");
     for (i = 0; i < nvr; i++)
         if (check_settable(m, "fmi2SetInteger", &INTEGER_INFO[vr[i]]) != fmi2OK) return fmi2Error;
     for (i = 0; i < nvr; i++) m->integer[vr[i]] = value[i];
@@ -318,7 +357,8 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
     if (!allowed(m, "fmi2SetBoolean", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
-    if (check_refs(m, "fmi2SetBoolean", vr, nvr, N_BOOLEAN) != fmi2OK) return fmi2Error;
+    if (check_refs(m, "fmi2SetBoolean", vr, nvr, N_BOOLEAN, "Boolean") != fmi2OK) return fmi2Error;
+    if (nvr > 0 && !value) return fail(m, "fmi2SetBoolean", "null value array");
     for (i = 0; i < nvr; i++)
         if (check_settable(m, "fmi2SetBoolean", &BOOLEAN_INFO[vr[i]]) != fmi2OK) return fmi2Error;
     for (i = 0; i < nvr; i++) m->boolean[vr[i]] = value[i] ? fmi2True : fmi2False;
@@ -401,33 +441,46 @@ fmi2Status fmi2CancelStep(fmi2Component c) {
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     ModelInstance *m = (ModelInstance *)c;
+    double t = currentCommunicationPoint, h = communicationStepSize;
     fmi2Status status;
+    int bad;
     UNUSED(noSetFMUStatePriorToCurrentPoint);
     if (!allowed(m, "fmi2DoStep", 1u << MODE_STEPPING)) return fmi2Error;
-    if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
-        return fail(m, "fmi2DoStep", "step size %g must be positive and finite", communicationStepSize);
-    if (fabs(currentCommunicationPoint - m->time) > 1e-9 * (1.0 + fabs(m->time)))
-        return fail(m, "fmi2DoStep", "communication point %.12g differs from the model time %.12g",
-                    currentCommunicationPoint, m->time);
-    status = model_do_step(m, currentCommunicationPoint, communicationStepSize);
-    m->time = currentCommunicationPoint + communicationStepSize;
+    if (!(h > 0.0) || !isfinite(h))
+        return fail(m, "fmi2DoStep", "step size %g must be positive and finite", h);
+    if (!isfinite(t) || !isfinite(t + h))
+        return fail(m, "fmi2DoStep", "communication point %g (step %g) is not a finite time", t, h);
+    if (!(fabs(t - m->time) <= 1e-9 * (1.0 + fabs(m->time))))
+        return fail(m, "fmi2DoStep", "communication point %.12g differs from the model time %.12g", t,
+                    m->time);
+    status = model_do_step(m, t, h);
     if (status > fmi2Warning) {
         m->mode = MODE_ERROR;
         return status;
     }
-    m->outputs_stale = 1;
+    m->time = t + h;
+    /* outputs (which include the state) are checked here, so that a state that became
+     * non-finite fails this step rather than the next read */
+    model_outputs(m);
+    m->outputs_stale = 0;
+    bad = first_non_finite(m);
+    if (bad >= 0) {
+        m->mode = MODE_ERROR;
+        return fail(m, "fmi2DoStep", "%s became %g in the step from t = %g to %g", REAL_INFO[bad].name,
+                    m->real[bad], t, t + h);
+    }
     return status;
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
     UNUSED(s);
-    if (!c) return fmi2Error;
+    if (!c || !value) return fmi2Error;
     *value = ((ModelInstance *)c)->mode == MODE_ERROR ? fmi2Error : fmi2OK;
     return fmi2OK;
 }
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
     ModelInstance *m = (ModelInstance *)c;
-    if (!m) return fmi2Error;
+    if (!m || !value) return fmi2Error;
     if (s == fmi2LastSuccessfulTime) {
         *value = m->time;
         return fmi2OK;
@@ -441,7 +494,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 }
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     ModelInstance *m = (ModelInstance *)c;
-    if (!m) return fmi2Error;
+    if (!m || !value) return fmi2Error;
     if (s == fmi2Terminated) {
         *value = fmi2False;
         return fmi2OK;

@@ -48,6 +48,20 @@ typedef struct ModelInstance {
 void log_error(ModelInstance *m, const char *format, ...);
 void log_warning(ModelInstance *m, const char *format, ...);
 
+/* The most sub-steps (or sensor samples) a model may compute in one doStep. A step or
+ * parameters that would need more are refused with a message rather than hanging the caller;
+ * at the limit a plant model's doStep takes 30 to 100 ms (a 50 s step of MotorMagnetics at its
+ * default sub-step, 200 s of the IMU at 1 kHz). */
+#define MAX_SUBSTEPS_PER_STEP 200000
+
+/* Whether `count` sub-steps or samples (a real number: it may be huge or non-finite) fit in one
+ * doStep of h seconds; if not, logs why, naming `what` (e.g. "sub-steps of sub_step = 0.01 s")
+ * and the `fix`, and returns 0. */
+int work_allowed(ModelInstance *m, double count, double h, const char *what, const char *fix);
+/* Number of equal sub-steps of at most max_step (the model's parameter `parameter`) covering a
+ * step h, at least 1; or 0, with the reason logged, beyond MAX_SUBSTEPS_PER_STEP. */
+int substep_count(ModelInstance *m, double h, double max_step, const char *parameter);
+
 /* Fixed-step classical RK4 over a model's state vector, for models that need nothing else. */
 typedef void (*Derivatives)(ModelInstance *m, double t, const double *x, double *dx);
 void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, int n);

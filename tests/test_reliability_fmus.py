@@ -1,0 +1,160 @@
+"""The FMUs under hostile but honest use: each bad call gets an FMI error status and a message
+naming the problem; nothing crashes, hangs or returns OK with garbage. Then a fuzz of every FMU
+and a leak check over many instantiate/step/free cycles."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from raw_fmu import RawFMU
+
+from fmus import MODELS
+
+OK, ERROR = 0, 3
+HERE = Path(__file__).resolve().parent
+
+
+def stepping(model, parameters=None):
+    fmu = RawFMU(model)
+    assert fmu.instantiate()
+    assert fmu.initialize(parameters=parameters) == OK, fmu.messages()
+    return fmu
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_value_references_beyond_the_table_are_refused_not_a_segfault(model):
+    fmu = stepping(model)
+    for reference in (2**31, 2**32 - 1, fmu.count["Real"]):
+        assert fmu.set_real([reference], [1.0]) == ERROR
+        assert f"fmi2SetReal: unknown value reference {reference}" in fmu.messages()
+        assert fmu.get_real([reference])[0] == ERROR
+        assert f"fmi2GetReal: unknown value reference {reference}: this model has {fmu.count['Real']} Real" \
+            in fmu.messages()
+    assert fmu.set_integer([2**31], [1]) == ERROR
+    assert "fmi2SetInteger: unknown value reference 2147483648" in fmu.messages()
+    fmu.free()
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_non_finite_times_are_refused(model):
+    fmu = RawFMU(model)
+    fmu.instantiate()
+    assert fmu.setup(math.nan) == ERROR
+    assert "fmi2SetupExperiment: startTime = nan is not a finite number" in fmu.messages()
+    fmu = stepping(model)
+    for t in (math.nan, math.inf, 1e308):
+        assert fmu.do_step(t, 1e-3 if t != 1e308 else 1e308) == ERROR
+        assert "is not a finite time" in fmu.messages() or "differs from the model time" in fmu.messages()
+    assert "fmi2DoStep: communication point nan (step 0.001) is not a finite time" in fmu.messages()
+    assert fmu.time() == 0.0  # a refused step does not advance the time
+    assert fmu.do_step(0.0, 1e-3) == OK
+    fmu.free()
+
+
+@pytest.mark.parametrize("model, parameter, value, step, words", [
+    ("MotorMagnetics", None, None, 1e12, "step of 1e+12 s at t = 0 would need 4e+15 sub-steps of sub_step = 0.00025 s"),
+    ("IMU", None, None, 1e12, "would need 1e+15 samples at sample_rate = 1000 Hz"),
+    ("IMU", "sample_rate", 1e12, 1e-3, "would need 1e+09 samples at sample_rate = 1e+12 Hz"),
+    ("MotorMagnetics", "sub_step", 1e-11, 1e-3, "would need 1e+08 sub-steps of sub_step = 1e-11 s"),
+    ("Quadrotor", "sub_step", 1e-11, 1e-3, "would need 1e+08 sub-steps of sub_step = 1e-11 s"),
+    ("Quadrotor", "sub_step", 1e-300, 1e-3, "would need 1e+297 sub-steps of sub_step = 1e-300 s"),
+    # more sub-steps than an int holds
+    ("Quadrotor", "sub_step", 1e-4, 1e6, "would need 1e+10 sub-steps"),
+])
+def test_steps_needing_too_much_work_are_refused_at_once(model, parameter, value, step, words):
+    fmu = stepping(model, {parameter: value} if parameter else None)
+    start = time.perf_counter()
+    assert fmu.do_step(0.0, step) == ERROR
+    elapsed = time.perf_counter() - start
+    assert words in fmu.messages()
+    assert "more than the 200000 allowed per step" in fmu.messages()
+    assert elapsed < 0.01
+    fmu.free()
+
+
+def test_the_largest_step_allowed_runs():
+    fmu = stepping("MotorMagnetics")
+    start = time.perf_counter()
+    assert fmu.do_step(0.0, 0.99 * 200000 * 2.5e-4) == OK, fmu.messages()
+    print(f"MotorMagnetics: a step of 200000 sub-steps takes {time.perf_counter() - start:.3f} s")
+    fmu.free()
+
+
+def test_a_state_becoming_non_finite_fails_the_step_itself():
+    fmu = stepping("Quadrotor")
+    refs = [fmu.refs[f"omega_r{n}"] for n in range(1, 5)]
+    assert fmu.set_real(refs, [1e200] * 4) == OK
+    assert fmu.do_step(0.0, 1e-3) == ERROR
+    assert "fmi2DoStep: " in fmu.messages() and "became" in fmu.messages()
+    assert "in the step from t = 0 to 0.001" in fmu.messages()
+    assert fmu.get_real([fmu.refs["p_z"]])[0] == ERROR  # the FMU is in its error state
+    assert "the FMU is in the error state" in fmu.messages()
+    fmu.free()
+
+
+def test_wrong_state_messages_name_the_states():
+    fmu = RawFMU("IMU")
+    fmu.instantiate()
+    assert fmu.do_step(0.0, 1e-3) == ERROR
+    assert "fmi2DoStep: not allowed: the FMU is instantiated (allowed only when it is in step mode)" \
+        in fmu.messages()
+    fmu.initialize()
+    assert fmu.call("fmi2EnterInitializationMode") == ERROR
+    assert "the FMU is in step mode (allowed only when it is instantiated)" in fmu.messages()
+    assert "mode 2" not in fmu.messages()
+    fmu.free()
+
+
+FUZZ_CALLS = 10_000
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_fuzz(model, tmp_path):
+    """Random calls in random order, run in a child process so that a crash is a failure with
+    the call that caused it, not the end of the test session."""
+    log = tmp_path / "calls.log"
+    done = subprocess.run([sys.executable, str(HERE / "fuzz_fmu.py"), model, str(FUZZ_CALLS), str(log)],
+                          capture_output=True, text=True, timeout=300, env=os.environ | {"PYTHONHASHSEED": "0"})
+    last = log.read_text().splitlines()[-1:] if log.exists() else []
+    assert done.returncode == 0, (f"fuzzing {model} ended with code {done.returncode} at call {last}\n"
+                                  f"{done.stderr[-3000:]}")
+    summary = json.loads(done.stdout.splitlines()[-1])
+    print(f"{model}: {summary['calls']} calls in {summary['sessions']} sessions, statuses {summary['statuses']}, "
+          f"slowest {summary['slowest_call_s'] * 1e3:.1f} ms ({summary['slowest_call']})")
+    assert summary["calls"] >= FUZZ_CALLS
+    assert summary["statuses"].get("0", 0) > 0.2 * FUZZ_CALLS  # the fuzz gets past the first error
+    assert summary["slowest_call_s"] < 1.0
+
+
+def resident_bytes() -> int:
+    with open("/proc/self/statm") as statm:
+        return int(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_instantiate_step_free_cycles_do_not_leak(model):
+    fmu = RawFMU(model)
+    inputs = [v.valueReference for v in fmu.description.modelVariables if v.causality == "input"]
+
+    def cycle():
+        assert fmu.instantiate()
+        assert fmu.initialize() == OK
+        fmu.set_real(inputs, [0.5] * len(inputs))
+        for k in range(10):
+            assert fmu.do_step(k * 1e-3, 1e-3) == OK
+        fmu.get_real(fmu.outputs)
+        fmu.free()
+
+    for _ in range(100):  # the allocator and the logger reach their steady state
+        cycle()
+    before = resident_bytes()
+    for _ in range(1000):
+        cycle()
+    growth = resident_bytes() - before
+    print(f"{model}: resident memory grew by {growth / 1024:.0f} KiB over 1000 cycles")
+    assert growth < 2**20
