@@ -1,0 +1,178 @@
+"""A magnetometer calibration and its JSON file.
+
+File format (UTF-8 JSON, SI units; every field is checked on loading)::
+
+    {
+      "format": "quadcosim-magnetometer-calibration",
+      "version": 1,
+      "motors": 4,                                  # N
+      "static": {"A": [[3 x 3]], "b_s": [3],         # m_bar = A m + b_s (b_s in T)
+                 "field_norm": 4.7e-05},             # |A^-1 (m_bar - b_s)| (T)
+      "reference": [3],                             # m0, motors off (T), or null
+      "field": {"orders": {"I": 4, "J": 1},          # eq. 4
+                "v": [[N x 3]],                      # unit directions, sensor frame
+                "theta": [[N x I (J + 1)]]},         # a_10, a_11, a_20, ... a_IJ (T / V^j)
+      "dynamics": {"rate": 1/s, "drag": 1/(V s), "limit": V, "exponent": 0 | 1,
+                   "freewheel": true | false, "gain": [N] (T/V)},
+      "notes": {...}                                # free-form provenance
+    }
+
+``static``, ``reference``, ``field`` and ``dynamics`` may each be ``null``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from dataclasses import field as _default
+from pathlib import Path
+
+import numpy as np
+
+from calibration.dynamic import MotorFieldModel
+from calibration.identify import MotorDynamics
+from calibration.static import CalibrationError, StaticCalibration
+
+FORMAT = "quadcosim-magnetometer-calibration"
+VERSION = 1
+
+
+@dataclass
+class Calibration:
+    """Static calibration, the paper's motor-field model and the identified motor dynamics.
+
+    Attributes
+    ----------
+    motors : int
+        Number of motors N.
+    static : StaticCalibration or None
+        Soft and hard iron; ``None`` is ``A = I``, ``b_s = 0``.
+    field : MotorFieldModel or None
+        Directions ``v_n`` and amplitudes ``theta_n`` (eqs. 3, 4).
+    dynamics : MotorDynamics or None
+        For the dynamics-aware compensation.
+    reference : (3,) array or None
+        ``m0``, motors off, drone clamped (T).
+    notes : dict
+        Provenance, written as is.
+    """
+
+    motors: int = 4
+    static: StaticCalibration | None = None
+    field: MotorFieldModel | None = None
+    dynamics: MotorDynamics | None = None
+    reference: np.ndarray | None = None
+    notes: dict = _default(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        s, f, d = self.static, self.field, self.dynamics
+        return {
+            "format": FORMAT,
+            "version": VERSION,
+            "motors": self.motors,
+            "static": None if s is None else {"A": np.asarray(s.A).tolist(), "b_s": np.asarray(s.b_s).tolist(),
+                                              "field_norm": float(s.field_norm)},
+            "reference": None if self.reference is None else np.asarray(self.reference, dtype=float).tolist(),
+            "field": None if f is None else {"orders": {"I": f.orders[0], "J": f.orders[1]}, "v": f.v.tolist(),
+                                             "theta": f.theta.tolist()},
+            "dynamics": None if d is None else {"rate": d.rate, "drag": d.drag, "limit": d.limit,
+                                                "exponent": d.exponent, "freewheel": d.freewheel,
+                                                "gain": np.asarray(d.gain).tolist()},
+            "notes": self.notes,
+        }
+
+    def save(self, path) -> Path:
+        """Write the calibration to ``path`` (JSON) and return the path."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(self.to_dict(), indent=2) + "\n")
+        return path
+
+    @classmethod
+    def from_dict(cls, data: dict, motors: int | None = None, orders: tuple[int, int] | None = None,
+                  where: str = "calibration") -> Calibration:
+        def fail(message):
+            raise CalibrationError(f"{where}: {message}")
+
+        def array(value, shape, name):
+            try:
+                out = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                fail(f"{name} must be numbers, not {value!r}")
+            if out.shape != shape:
+                fail(f"{name} must have shape {shape}, not {out.shape}")
+            if not np.isfinite(out).all():
+                fail(f"{name} holds NaN or Inf")
+            return out
+
+        if not isinstance(data, dict):
+            fail("the file must hold a JSON object")
+        if data.get("format") != FORMAT:
+            fail(f"not a magnetometer calibration (format {data.get('format')!r}, expected {FORMAT!r})")
+        if data.get("version") != VERSION:
+            fail(f"version {data.get('version')!r} is not supported (this reader knows version {VERSION})")
+        missing = [k for k in ("motors", "static", "reference", "field", "dynamics") if k not in data]
+        if missing:
+            fail(f"missing key(s) {', '.join(missing)}")
+        n = data["motors"]
+        if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+            fail(f"motors = {n!r} must be a positive integer")
+        if motors is not None and n != motors:
+            fail(f"the file calibrates {n} motors; this vehicle has {motors}. Calibrate this vehicle")
+        static = None
+        if data["static"] is not None:
+            s = data["static"]
+            if not isinstance(s, dict) or not {"A", "b_s", "field_norm"} <= set(s):
+                fail("static must hold A, b_s and field_norm")
+            A = array(s["A"], (3, 3), "static.A")
+            if abs(np.linalg.det(A)) < 1e-12 * np.abs(A).max() ** 3:
+                fail("static.A is singular")
+            static = StaticCalibration(A=A, b_s=array(s["b_s"], (3,), "static.b_s"),
+                                       field_norm=float(array(s["field_norm"], (), "static.field_norm")))
+        reference = None if data["reference"] is None else array(data["reference"], (3,), "reference")
+        model = None
+        if data["field"] is not None:
+            f = data["field"]
+            if not isinstance(f, dict) or not {"orders", "v", "theta"} <= set(f):
+                fail("field must hold orders, v and theta")
+            o = f["orders"]
+            if not (isinstance(o, dict) and isinstance(o.get("I"), int) and isinstance(o.get("J"), int)
+                    and o["I"] >= 1 and o["J"] >= 0):
+                fail(f"field.orders = {o!r} must be {{'I': integer >= 1, 'J': integer >= 0}}")
+            I, J = o["I"], o["J"]
+            if orders is not None and (I, J) != tuple(orders):
+                fail(f"the file has orders I = {I}, J = {J}; ({orders[0]}, {orders[1]}) were asked for")
+            v = array(f["v"], (n, 3), "field.v")
+            if np.abs(np.linalg.norm(v, axis=1) - 1.0).max() > 1e-6:
+                fail("field.v must hold unit vectors")
+            model = MotorFieldModel(v, array(f["theta"], (n, I * (J + 1)), f"field.theta (orders I = {I}, J = {J})"),
+                                    (I, J))
+        dynamics = None
+        if data["dynamics"] is not None:
+            d = data["dynamics"]
+            keys = {"rate", "drag", "limit", "exponent", "freewheel", "gain"}
+            if not isinstance(d, dict) or not keys <= set(d):
+                fail(f"dynamics must hold {', '.join(sorted(keys))}")
+            rate, drag, limit = (float(array(d[k], (), f"dynamics.{k}")) for k in ("rate", "drag", "limit"))
+            if not (rate > 0 and drag >= 0 and limit > 0):
+                fail("dynamics.rate and dynamics.limit must be positive and dynamics.drag non-negative")
+            if d["exponent"] not in (0, 1) or not isinstance(d["freewheel"], bool):
+                fail("dynamics.exponent must be 0 or 1 and dynamics.freewheel true or false")
+            dynamics = MotorDynamics(rate, drag, limit, int(d["exponent"]), d["freewheel"],
+                                     array(d["gain"], (n,), "dynamics.gain"))
+        return cls(n, static, model, dynamics, reference, dict(data.get("notes") or {}))
+
+    @classmethod
+    def load(cls, path, motors: int | None = None, orders: tuple[int, int] | None = None) -> Calibration:
+        """Read a calibration file; refuse a malformed one, or one for another number of motors
+        or other orders (when ``motors`` or ``orders`` is given), with a message naming the defect."""
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except OSError as error:
+            raise CalibrationError(f"cannot read calibration file {path}: {error.strerror}") from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as error:
+            raise CalibrationError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+        return cls.from_dict(data, motors, orders, where=str(path))
