@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from orchestrator import Block
+from orchestrator.blocks import Block
 
 STATIC, METGE, DYNAMIC = 0, 1, 2
 MODES = {"static": STATIC, "metge": METGE, "dynamic": DYNAMIC}
