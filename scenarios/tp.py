@@ -13,16 +13,17 @@ from estimators import DEFAULT_GAINS, QuaternionEstim
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
-from scenarios.control import SETPOINT, Controller, profile
+from scenarios.flight import FLIGHTS, SETPOINT, Controller, profile
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 OPTIONS = {
     "estimator": Option("linear", "attitude estimator", choices=("linear", "explicit", "passive")),
-    "flight": Option("quasi", "flight profile: quasi-stationary, non-stationary, or a plain hover",
-                     choices=("quasi", "nonstationary", "hover")),
+    "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py)", choices=FLIGHTS),
+    "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
     "noise": Option(False, "IMU white noise"),
     "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s"),
+    "drag": Option(0.0, "linear translational drag (N s/m)", minimum=0.0),
     "magnetic": Option(False, "field of the motor currents at the magnetometer"),
     "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
     "discretisation": Option("exp", "quaternion update", choices=("exp", "euler")),
@@ -56,8 +57,8 @@ def build(o: dict) -> System:
     if period < 1 or abs(period * o["dt"] * o["imu_rate"] - 1.0) > 1e-9:
         raise ValueError(f"imu_rate = {o['imu_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     system = System(dt=o["dt"])
-    system.add(Table("Setpoint", SETPOINT, profile(o["flight"], o["duration"], o["dt"])))
-    add_plant(system, motors={"omega0": vehicle.hover_rotor_speed()},
+    system.add(Table("Setpoint", SETPOINT, profile(o["flight"], o["duration"], o["dt"], np.radians(o["tilt_deg"]))))
+    add_plant(system, quadrotor={"drag": o["drag"]}, motors={"omega0": vehicle.hover_rotor_speed()},
               imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
               magnetic=o["magnetic"], imu_period=period)
     estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
