@@ -34,7 +34,13 @@ def orchestrator_us_per_step(seconds: float, repeats: int) -> float:
     return best * 1e6
 
 
+def _at(array: np.ndarray, index: int = 0) -> ctypes.c_void_p:
+    """Address of ``array[index]``, as a ctypes argument."""
+    return ctypes.c_void_p(array.ctypes.data + array.itemsize * index)
+
+
 def raw_us_per_step(seconds: float, repeats: int) -> float:
+    """Microseconds per step of the hand-written ctypes loop (best of ``repeats``)."""
     from orchestrator.fmu import FMUInstance
     from scenarios.open_loop import commands
 
@@ -51,9 +57,6 @@ def raw_us_per_step(seconds: float, repeats: int) -> float:
             keep.append(array)
             return void(array.ctypes.data), size(len(array))
 
-        def at(array, index=0):
-            return void(array.ctypes.data + 8 * index)
-
         m_out, q_out, i_out = (np.zeros(len(f.outputs)) for f in (motors, body, imu))
         record = np.empty((steps + 1, len(m_out) + len(q_out) + len(i_out)))
         m_in_vr, m_in_n = refs(motors, ["c1", "c2", "c3", "c4"])
@@ -63,14 +66,14 @@ def raw_us_per_step(seconds: float, repeats: int) -> float:
         i_in_vr, i_in_n = refs(imu, ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z"])
         i_bd_vr, i_bd_n = refs(imu, ["b_d_x", "b_d_y", "b_d_z"])
         i_vr, i_n = refs(imu, imu.outputs)
-        omega_r = at(m_out, motors.outputs.index("omega_r1"))
-        b_d = at(m_out, motors.outputs.index("b_d_x"))
-        q = at(q_out, body.outputs.index("q0"))
-        rows = [at(table, 4 * k) for k in range(len(table))]
+        omega_r = _at(m_out, motors.outputs.index("omega_r1"))
+        b_d = _at(m_out, motors.outputs.index("b_d_x"))
+        q = _at(q_out, body.outputs.index("q0"))
+        rows = [_at(table, 4 * k) for k in range(len(table))]
         ms, mg, md, mc = motors.raw_set_real, motors.raw_get_real, motors.raw_do_step, motors.component_arg
         qs, qg, qd, qc = body.raw_set_real, body.raw_get_real, body.raw_do_step, body.component_arg
         is_, ig, id_, ic = imu.raw_set_real, imu.raw_get_real, imu.raw_do_step, imu.component_arg
-        m_ptr, q_ptr, i_ptr = at(m_out), at(q_out), at(i_out)
+        m_ptr, q_ptr, i_ptr = _at(m_out), _at(q_out), _at(i_out)
         a, b = len(m_out), len(m_out) + len(q_out)
         now, h, one = ctypes.c_double(0.0), ctypes.c_double(1e-3), ctypes.c_int(1)
         started = time.perf_counter()

@@ -16,7 +16,7 @@ angular velocity along -z_B; the drag reaction on the body is then along +z_B, a
 ``tau_z = k_m * sum(spin_n * omega_n^2)``.
 
 The C models include ``airframe.h``, generated from this table by :mod:`fmus.build`; the
-mixer and the README read :data:`MOTORS`.
+mixer reads :data:`MOTORS`.
 """
 
 from __future__ import annotations
@@ -62,10 +62,3 @@ def c_header() -> str:
         f"static const double SPIN[N_MOTORS] = {{{spin}}};\n\n"
         "#endif\n"
     )
-
-
-def markdown_table() -> str:
-    rows = ["| motor | position | arm angle | spin (seen from above) |", "|---|---|---|---|"]
-    for m in MOTORS:
-        rows.append(f"| {m.number} | {m.position} | {m.angle_deg:+.0f}° | {'CCW' if m.spin > 0 else 'CW'} |")
-    return "\n".join(rows)

@@ -14,9 +14,12 @@ from __future__ import annotations
 
 import math
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
+
+from fmus import fmu_path
 
 PACKAGE_DIR = Path(__file__).resolve().parent / "QuadCoSim"
 _FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "pi": math.pi}
@@ -106,29 +109,8 @@ def simulate_fmu(model: str, inputs: dict[str, str], parameters: dict, stop: flo
     values : dict of str to ndarray
         Each output at ``times``, in the FMU's units.
     """
-    import shutil
-
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-
-    from fmus import fmu_path
-
-    path = str(fmu_path(model))
-    description = read_model_description(path)
-    variables = {v.name: v for v in description.modelVariables}
-    unzipped = extract(path)
-    slave = FMU2Slave(guid=description.guid, unzipDirectory=unzipped,
-                      modelIdentifier=description.coSimulation.modelIdentifier, instanceName=model)
-    slave.instantiate()
+    slave, variables, unzipped = _start(model, parameters)
     try:
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        for name, value in parameters.items():
-            variable = variables[name]
-            setter = {"Real": (slave.setReal, float), "Integer": (slave.setInteger, int),
-                      "Boolean": (slave.setBoolean, bool)}[variable.type]
-            setter[0]([variable.valueReference], [setter[1](value)])
-        slave.exitInitializationMode()
         n = int(round(stop / step))
         times = np.arange(n + 1) * step
         names = list(inputs)
@@ -152,3 +134,29 @@ def simulate_fmu(model: str, inputs: dict[str, str], parameters: dict, stop: flo
         slave.terminate()
         slave.freeInstance()
         shutil.rmtree(unzipped, ignore_errors=True)
+
+
+def _start(model: str, parameters: dict):
+    """Instantiate and initialise the built FMU ``model`` with fmpy, parameters set.
+
+    Returns the fmpy slave, its variables by name and the folder it was extracted into.
+    """
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    path = str(fmu_path(model))
+    description = read_model_description(path)
+    variables = {v.name: v for v in description.modelVariables}
+    unzipped = extract(path)
+    slave = FMU2Slave(guid=description.guid, unzipDirectory=unzipped,
+                      modelIdentifier=description.coSimulation.modelIdentifier, instanceName=model)
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    for name, value in parameters.items():
+        variable = variables[name]
+        setter, kind = {"Real": (slave.setReal, float), "Integer": (slave.setInteger, int),
+                        "Boolean": (slave.setBoolean, bool)}[variable.type]
+        setter([variable.valueReference], [kind(value)])
+    slave.exitInitializationMode()
+    return slave, variables, unzipped

@@ -82,14 +82,26 @@ class Table(Block):
 
 
 class Constant(Block):
-    """Constant outputs."""
+    """Constant outputs.
+
+    Parameters
+    ----------
+    name : str
+        Block name.
+    values : dict of str to float
+        Output name to its value (in the unit of whatever it feeds).
+    ties : str, optional
+        The input this block ties off, when :meth:`System.set_input` made it; the diagram
+        draws such a block as a note on that input rather than as a block.
+    """
 
     feedthrough = False
 
-    def __init__(self, name: str, values: dict[str, float]):
+    def __init__(self, name: str, values: dict[str, float], ties: str | None = None):
         super().__init__(name)
         self.outputs = tuple(values)
         self.values = np.array([float(v) for v in values.values()])
+        self.ties = ties
 
     def step(self, t, u, y):
         y[:] = self.values

@@ -13,7 +13,10 @@ import ctypes
 import os
 import subprocess
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 SOURCE = Path(__file__).resolve().parent / "c" / "calls.c"
 LIBRARY_NAME = "libquadcosim_calls.so"
@@ -96,3 +99,82 @@ def run_calls():
         function.restype = ctypes.c_int
         _run_calls = function
     return _run_calls
+
+
+class _CCall(ctypes.Structure):
+    """One FMI call, laid out as ``Call`` in ``orchestrator/c/calls.c``."""
+
+    _fields_ = [("kind", ctypes.c_int), ("function", ctypes.c_void_p), ("component", ctypes.c_void_p),
+                ("vr", ctypes.c_void_p), ("n", ctypes.c_size_t), ("values", ctypes.c_void_p),
+                ("h", ctypes.c_double)]
+
+
+@dataclass(frozen=True)
+class SetInputs:
+    """``fmi2SetReal`` of FMU inputs whose sources sit in consecutive bus slots from ``slot``.
+
+    The FMU reads straight from the bus: no copy.
+    """
+
+    block: object  # an FMUBlock with a live instance
+    refs: np.ndarray  # value references, uint32
+    slot: int
+    kind = 0
+    function = "fmi2SetReal"
+
+
+@dataclass(frozen=True)
+class GetOutputs:
+    """``fmi2GetReal`` of all of an FMU's outputs into its bus slots from ``slot``."""
+
+    block: object
+    refs: np.ndarray
+    slot: int
+    kind = 1
+    function = "fmi2GetReal"
+
+
+@dataclass(frozen=True)
+class DoStep:
+    """``fmi2DoStep`` of one communication step ``h`` (s) from the present time."""
+
+    block: object
+    h: float
+    kind = 2
+    function = "fmi2DoStep"
+
+
+FMICall = SetInputs | GetOutputs | DoStep
+
+
+def _pack(call: FMICall, bus: np.ndarray) -> _CCall:
+    instance = call.block.instance
+    function = {0: instance.raw_set_real, 1: instance.raw_get_real, 2: instance.raw_do_step}[call.kind]
+    address = ctypes.cast(function, ctypes.c_void_p).value
+    if isinstance(call, DoStep):
+        return _CCall(call.kind, address, instance.component, None, 0, None, call.h)
+    values = bus.ctypes.data + bus.itemsize * call.slot
+    return _CCall(call.kind, address, instance.component, call.refs.ctypes.data, len(call.refs), values, 0.0)
+
+
+def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
+    """A function of time ``t`` (s) that applies ``taps`` (faults) and runs ``calls`` in one
+    call into the runner; it raises :class:`orchestrator.fmu.FMUError` naming the block, the
+    FMI function, the time and the FMU's log when a call returns Error or Fatal."""
+    from orchestrator.faults import apply_faults
+    from orchestrator.fmu import FMUError
+
+    run = run_calls()
+    array = (_CCall * len(calls))(*[_pack(c, bus) for c in calls])
+    count, failed, now = ctypes.c_int(len(calls)), ctypes.c_int(-1), ctypes.c_double(0.0)
+    failed_ref = ctypes.byref(failed)
+
+    def phase(t, calls=calls):  # ``calls`` keeps alive the arrays the C calls point into
+        if taps:
+            apply_faults(taps, bus, t)
+        now.value = t
+        status = run(array, count, now, failed_ref)
+        if status > 1:
+            call = calls[failed.value]
+            raise FMUError(call.block.name, call.function, status, t, list(call.block.instance.log))
+    return phase

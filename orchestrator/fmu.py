@@ -122,14 +122,11 @@ class FMUInstance:
             modelIdentifier=description.coSimulation.modelIdentifier,
             instanceName=self._instance_name,
         )
-        functions = self._slave._functions
-        self.fmi2SetReal = functions["fmi2SetReal"]
-        self.fmi2GetReal = functions["fmi2GetReal"]
-        self.fmi2DoStep = functions["fmi2DoStep"]
         self._call(lambda: self._slave.instantiate(callbacks=_CALLBACKS), "fmi2Instantiate")
         self.component = self._slave.component
-        # Hot-path handles: fresh function objects without argtypes, called with prebuilt
-        # ctypes arguments, skip ctypes' per-call conversions (0.66 against 2.2 us here).
+        # One set of handles for every path: fresh function objects without argtypes, called
+        # with prebuilt ctypes arguments, skip ctypes' per-call conversions (0.66 against 2.2 us
+        # here). fmpy's own wrappers serve only the set-up calls above and below.
         dll = self._slave.dll
         self.raw_set_real, self.raw_get_real, self.raw_do_step = (
             dll["fmi2SetReal"], dll["fmi2GetReal"], dll["fmi2DoStep"])
@@ -200,24 +197,54 @@ class FMUInstance:
 
     # ------------------------------------------------------------------ slow path (by name)
     def set(self, names, values):
+        """Set Real inputs (or parameters, before a step) by name.
+
+        Parameters
+        ----------
+        names : sequence of str
+            Variable names.
+        values : array_like
+            Their values, in the units of the model description (SI).
+        """
         refs = self.vr(names)
         buffer = np.ascontiguousarray(values, dtype=np.float64)
-        status = self.fmi2SetReal(self.component, refs.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
-                                  len(refs), buffer.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        status = self.raw_set_real(self.component_arg, ctypes.c_void_p(refs.ctypes.data), ctypes.c_size_t(len(refs)),
+                                   ctypes.c_void_p(buffer.ctypes.data))
         if status > 1:
             raise FMUError(self.name, "fmi2SetReal", status, self.time, list(self.log))
 
     def get(self, names) -> np.ndarray:
+        """Real variables by name, in the units of the model description (SI).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Variable names.
+
+        Returns
+        -------
+        ndarray
+            Their present values.
+        """
         refs = self.vr(names)
         buffer = np.empty(len(refs))
-        status = self.fmi2GetReal(self.component, refs.ctypes.data_as(ctypes.POINTER(ctypes.c_uint32)),
-                                  len(refs), buffer.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        status = self.raw_get_real(self.component_arg, ctypes.c_void_p(refs.ctypes.data), ctypes.c_size_t(len(refs)),
+                                   ctypes.c_void_p(buffer.ctypes.data))
         if status > 1:
             raise FMUError(self.name, "fmi2GetReal", status, self.time, list(self.log))
         return buffer
 
     def step(self, t: float, h: float):
-        status = self.fmi2DoStep(self.component, t, h, 1)
+        """Advance one communication step.
+
+        Parameters
+        ----------
+        t : float
+            Present communication time (s).
+        h : float
+            Step size (s), positive.
+        """
+        status = self.raw_do_step(self.component_arg, ctypes.c_double(t), ctypes.c_double(h), ctypes.c_int(1))
         if status > 1:
             raise FMUError(self.name, "fmi2DoStep", status, t, list(self.log))
         self.time = t + h

@@ -83,14 +83,10 @@ def _split(text: str) -> tuple[str, str]:
 
 
 def registry() -> dict[str, Scenario]:
+    """Every scenario, by name. A module listed here that is missing is an error, not a gap."""
     scenarios = {}
     for module in _MODULES:
-        try:
-            scenario = importlib.import_module(f"scenarios.{module}").SCENARIO
-        except ModuleNotFoundError as error:
-            if error.name != f"scenarios.{module}":
-                raise
-            continue
+        scenario = importlib.import_module(f"scenarios.{module}").SCENARIO
         scenarios[scenario.name] = scenario
     return scenarios
 

@@ -176,3 +176,31 @@ def test_vector_signals_connect_and_index():
     assert result["IMU.acc"].shape == (51, 3)
     assert result["MotorMagnetics.omega_r"].shape == (51, 4)
     assert result["IMU.R_reel"].shape == (51, 9)
+
+
+# ---------------------------------------------------------------- declaration rules
+def test_set_input_refuses_a_connected_input_as_connect_does():
+    system, _ = probe_system()
+    with pytest.raises(ValueError, match="Probe.u is already connected to Source.y"):
+        system.set_input("Probe.u", 1.0)
+    with pytest.raises(ValueError, match="Probe.u is already connected to Source.y"):
+        system.connect("Source.y", "Probe.u")
+    free = System()
+    free.add(Probe("Probe"))
+    free.set_input("Probe.u", 2.5)
+    with pytest.raises(ValueError, match="already connected to Const_Probe_u.u"):
+        free.connect("Const_Probe_u.u", "Probe.u")
+    assert free.run(0.002)["Probe.y"].tolist() == [2.5, 2.5, 2.5]
+
+
+def test_diagram_draws_a_tied_input_with_its_value_and_no_block(tmp_path):
+    from orchestrator.diagram import _wiring
+
+    system = System()
+    system.add(Probe("Probe"))
+    system.set_input("Probe.u", 2.5)
+    system.add(Ramp("Source"))
+    order, links, constants = _wiring(system)
+    assert [b.name for b in order] == ["Probe", "Source"]  # the tie is no block of the picture
+    assert constants == {"Probe": {2.5: ["u"]}}
+    assert not links

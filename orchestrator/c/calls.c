@@ -10,7 +10,6 @@ enum { CALL_SET_REAL = 0, CALL_GET_REAL = 1, CALL_DO_STEP = 2 };
 
 typedef struct {
     int kind;
-    int block; /* the caller's index of the block, for error reports */
     void *function;
     void *component;
     const unsigned int *vr;

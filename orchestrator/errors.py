@@ -1,0 +1,25 @@
+"""The errors of the master."""
+
+from __future__ import annotations
+
+from orchestrator.result import Result
+
+
+class SimulationError(RuntimeError):
+    """A run failed. ``result`` holds what was recorded up to the failure."""
+
+    def __init__(self, message: str, result: Result | None = None):
+        super().__init__(message)
+        self.result = result
+
+
+class AlgebraicLoopError(ValueError):
+    """Blocks with direct feedthrough form a cycle."""
+
+    def __init__(self, cycle: list[str]):
+        self.cycle = cycle
+        super().__init__(
+            "algebraic loop: " + " -> ".join(cycle + cycle[:1]) + ". Every block in it passes its inputs "
+            "straight to its outputs. Break it with a block without direct feedthrough (a delay, a "
+            "filter state) or connect one of these signals from elsewhere."
+        )

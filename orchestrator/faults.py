@@ -1,0 +1,95 @@
+"""Faults injected on connections: offset, scale, stuck-at, noise burst, dropout.
+
+A fault sits on the connection into one block input. While it is active, the master gives
+that input a faulted copy of its source signal, held in a bus slot of its own, so that the
+source signal itself (and every other block reading it) stays intact.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+FAULT_KINDS = ("offset", "scale", "stuck", "noise", "dropout")
+
+
+@dataclass
+class Fault:
+    """A fault on the connection into ``target`` (``"Block.input"``), active for
+    ``start <= t < stop``.
+
+    Parameters
+    ----------
+    target : str
+        The faulted input, ``"Block.input"``.
+    kind : str
+        - ``offset``: adds ``value`` (the signal's unit);
+        - ``scale``: multiplies by ``value`` (dimensionless);
+        - ``stuck``: holds ``value``, or the value at ``start`` when ``value`` is None;
+        - ``noise``: adds white Gaussian noise of standard deviation ``value`` (the signal's
+          unit), drawn once per macro step from a generator seeded by ``seed``;
+        - ``dropout``: the signal is lost and reads 0.
+    start, stop : float
+        Active window (s).
+    value : float, optional
+        See ``kind``.
+    seed : int
+        Seed of the noise generator.
+    """
+
+    target: str
+    kind: str
+    start: float
+    stop: float
+    value: float | None = None
+    seed: int = 0
+    _held: float | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if self.kind not in FAULT_KINDS:
+            raise ValueError(f"unknown fault kind {self.kind!r}; use one of {', '.join(FAULT_KINDS)}")
+        if not self.stop > self.start:
+            raise ValueError(f"fault on {self.target}: stop ({self.stop}) must come after start ({self.start})")
+        if self.kind in ("offset", "scale", "noise") and self.value is None:
+            raise ValueError(f"a {self.kind} fault needs a value")
+        if self.kind == "noise" and self.value < 0:
+            raise ValueError(f"noise fault on {self.target}: standard deviation {self.value} is negative")
+
+    def reset(self) -> None:
+        """Forget the held value and reseed the noise generator, before a run."""
+        self._held = None
+        self._rng = np.random.default_rng(self.seed)
+
+    def apply(self, t: float, x: float) -> float:
+        """The faulted value of signal value ``x`` at time ``t`` (s); ``x`` outside the window."""
+        if not self.start <= t < self.stop:
+            self._held = None
+            return x
+        kind = self.kind
+        if kind == "offset":
+            return x + self.value
+        if kind == "scale":
+            return x * self.value
+        if kind == "stuck":
+            if self._held is None:
+                self._held = x if self.value is None else self.value
+            return self._held
+        if kind == "noise":
+            return x + self.value * self._rng.standard_normal()
+        return 0.0
+
+
+@dataclass(frozen=True)
+class FaultTap:
+    """Where one fault reads its source signal and writes the faulted copy, as bus slots."""
+
+    fault: Fault
+    source: int
+    slot: int
+
+
+def apply_faults(taps: list[FaultTap], bus: np.ndarray, t: float) -> None:
+    """Write each tap's faulted copy of its source into its own bus slot at time ``t`` (s)."""
+    for tap in taps:
+        bus[tap.slot] = tap.fault.apply(t, bus[tap.source])

@@ -1,0 +1,324 @@
+"""The run plan: everything the master resolves once before a run, and the loop that runs it.
+
+The bus
+    One float64 vector holds every signal: each block's outputs in a contiguous run of slots,
+    blocks in dependency order, then one slot per fault for the faulted copy of its signal.
+
+Building a plan (:class:`Plan`), in order:
+
+1. :meth:`Plan._lay_out_bus`: a slot per block output, then a slot per fault;
+2. :meth:`Plan._plan_recording`: the recorded signals, as :class:`Copy` slices from the bus
+   into a row of a preallocated array;
+3. :meth:`Plan._wire_blocks`, block by block in dependency order:
+
+   - an FMU block (:meth:`Plan._wire_fmu`) is instantiated and its first outputs read. Its
+     calls are split in two phases: phase A sets the inputs whose sources ran earlier in this
+     macro step and gets the outputs; phase B sets the inputs whose sources run later (non
+     feedthrough: a unit delay, not an algebraic loop) and steps. Inputs fed from
+     consecutive slots share one :class:`~orchestrator.calls.SetInputs` call that reads straight
+     from the bus;
+   - a Python block (:meth:`Plan._wire_python`) gets a view of its output slots, and its
+     inputs as a view of the bus when their slots are consecutive, or as :class:`Copy` slices;
+   - consecutive FMU blocks with one period and no fault share one batch: one call into the C
+     runner (:func:`orchestrator.calls.batch`) per group per step.
+
+Running (:meth:`Plan.run`), per macro step ``n`` at ``t_n``: the :class:`Phase` entries of
+phase A, due at ``n``, in order; the bus is recorded (every ``decimation`` steps) and checked for
+NaN and Inf; the phase B entries due at ``n``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+
+from orchestrator.blocks import Block, FMUBlock
+from orchestrator.calls import DoStep, FMICall, GetOutputs, SetInputs, batch
+from orchestrator.errors import SimulationError
+from orchestrator.faults import FaultTap, apply_faults
+from orchestrator.fmu import FMUError
+from orchestrator.result import Result
+
+
+class Copy(NamedTuple):
+    """One slice copy ``vector[into] = bus[source]`` (a named tuple: unpacked in the loop)."""
+
+    into: slice
+    source: slice
+
+
+class Phase(NamedTuple):
+    """A function of time (s) run every ``period`` macro steps."""
+
+    period: int
+    run: Callable[[float], None]
+
+
+class _BatchPart(NamedTuple):
+    period: int
+    calls: list[FMICall]
+    taps: list[FaultTap]
+
+
+class _Failure(Exception):
+    """A check in the loop failed (a non-finite signal)."""
+
+
+def consecutive(slots: list[int]) -> list[tuple[int, int]]:
+    """Index ranges ``[i, j)`` of ``slots`` over which each slot is the previous one plus one."""
+    ranges, i = [], 0
+    while i < len(slots):
+        j = i + 1
+        while j < len(slots) and slots[j] == slots[j - 1] + 1:
+            j += 1
+        ranges.append((i, j))
+        i = j
+    return ranges
+
+
+def copies(slots: list[int]) -> tuple[Copy, ...]:
+    """The slice copies that gather bus ``slots`` into a vector, in order."""
+    return tuple(Copy(slice(i, j), slice(slots[i], slots[j - 1] + 1)) for i, j in consecutive(slots))
+
+
+def input_runs(refs: list[tuple[int, int]]) -> list[tuple[np.ndarray, int]]:
+    """Split (value reference, bus slot) pairs into runs of consecutive slots.
+
+    Returns
+    -------
+    list of (ndarray, int)
+        Value references (uint32) of each run and the bus slot of its first member.
+    """
+    refs = sorted(refs, key=lambda r: r[1])
+    slots = [slot for _, slot in refs]
+    return [(np.array([vr for vr, _ in refs[i:j]], dtype=np.uint32), slots[i]) for i, j in consecutive(slots)]
+
+
+class Plan:
+    """Everything resolved once for one run of ``system``: bus, recording, calls, phases.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+        The system, fully connected.
+    duration : float
+        Simulated time (s).
+    decimation : int
+        Record every ``decimation`` macro steps.
+    t0 : float
+        Start time (s).
+    record : list of str, optional
+        Signals to record (vector names allowed); every output by default.
+    """
+
+    def __init__(self, system, duration: float, decimation: int, t0: float, record=None):
+        self.system, self.dt, self.t0, self.decimation = system, system.dt, t0, decimation
+        self.steps = int(round(duration / system.dt))
+        if self.steps < 1:
+            raise ValueError(f"duration {duration} s is shorter than one macro step ({system.dt} s)")
+        self.order = system.order()
+        self.position = {b.name: i for i, b in enumerate(self.order)}
+        self._lay_out_bus()
+        self._plan_recording(record)
+        self.fmus: list[FMUBlock] = []
+        for fault in system.faults:
+            fault.reset()
+        try:
+            self._wire_blocks()
+        except BaseException:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------------ building
+    def _lay_out_bus(self):
+        self.slot: dict[str, int] = {}
+        for block in self.order:
+            for y in block.outputs:
+                self.slot[f"{block.name}.{y}"] = len(self.slot)
+        self.fault_slot = {f.target: len(self.slot) + k for k, f in enumerate(self.system.faults)}
+        self.bus = np.zeros(len(self.slot) + len(self.system.faults))
+
+    def _plan_recording(self, record):
+        if record is None:
+            slots = list(range(len(self.slot)))
+        else:
+            slots = sorted({self.slot[name] for signal in record for name in self.system._resolve(signal, "output")})
+        by_slot = {v: k for k, v in self.slot.items()}
+        self.names = [by_slot[s] for s in slots]
+        self.record_copies = copies(slots)
+        self.record = np.empty((self.steps // self.decimation + 1, len(slots)))
+        self.recorded = 0
+
+    def _source(self, block_name: str, u: str) -> tuple[int, bool]:
+        """Bus slot input ``u`` reads, and whether its source runs earlier in the order."""
+        destination = f"{block_name}.{u}"
+        source = self.system.connections[destination]
+        early = self.position[source.split(".", 1)[0]] < self.position[block_name]
+        return self.fault_slot.get(destination, self.slot[source]), early
+
+    def _outputs(self, block) -> tuple[int, np.ndarray]:
+        """First bus slot of ``block``'s outputs, and the view of them."""
+        first = self.slot[f"{block.name}.{block.outputs[0]}"] if block.outputs else 0
+        return first, self.bus[first:first + len(block.outputs)]
+
+    def _taps(self, block) -> list[FaultTap]:
+        return [FaultTap(f, self.slot[self.system.connections[f.target]], self.fault_slot[f.target])
+                for f in self.system.faults if f.target.startswith(block.name + ".")]
+
+    def _wire_blocks(self):
+        self.phase_a: list[Phase] = []
+        self.phase_b: list[Phase] = []
+        pending: list[_BatchPart] = []  # FMU blocks gathered into the next phase-A batch
+        late: dict[int, list[FMICall]] = {}  # period -> phase-B calls
+        for block in self.order:
+            taps = self._taps(block)
+            if isinstance(block, FMUBlock):
+                calls_a, calls_b = self._wire_fmu(block)
+                if pending and (taps or pending[0].period != block.period):
+                    self.phase_a.append(self._batch(pending))
+                    pending = []
+                pending.append(_BatchPart(block.period, calls_a, taps))
+                late.setdefault(block.period, []).extend(calls_b)
+            else:
+                if pending:
+                    self.phase_a.append(self._batch(pending))
+                    pending = []
+                self.phase_a.append(Phase(block.period, self._wire_python(block, taps)))
+        if pending:
+            self.phase_a.append(self._batch(pending))
+        for period, calls in late.items():
+            self.phase_b.append(self._batch([_BatchPart(period, calls, [])]))
+
+    def _wire_fmu(self, block: FMUBlock) -> tuple[list[FMICall], list[FMICall]]:
+        """Instantiate ``block``, read its first outputs; its phase-A and phase-B calls."""
+        instance = block.instantiate(self.t0)
+        self.fmus.append(block)
+        early, late = [], []
+        for u in block.inputs:
+            slot, is_early = self._source(block.name, u)
+            (early if is_early else late).append((instance.variables[u].valueReference, slot))
+        first, outputs = self._outputs(block)
+        outputs[:] = instance.get(block.outputs)
+        calls_a = [SetInputs(block, refs, slot) for refs, slot in input_runs(early)]
+        calls_a.append(GetOutputs(block, instance.vr(block.outputs), first))
+        calls_b = [SetInputs(block, refs, slot) for refs, slot in input_runs(late)]
+        calls_b.append(DoStep(block, block.period * self.dt))
+        return calls_a, calls_b
+
+    def _batch(self, parts: list[_BatchPart]) -> Phase:
+        calls = [c for part in parts for c in part.calls]
+        taps = [t for part in parts for t in part.taps]
+        return Phase(parts[0].period, batch(calls, taps, self.bus))
+
+    def _wire_python(self, block: Block, taps: list[FaultTap]) -> Callable[[float], None]:
+        """``block.step`` with its inputs gathered from the bus and its outputs written there."""
+        block.start(self.t0, block.period * self.dt)
+        step, bus = block.step, self.bus
+        _, y = self._outputs(block)
+        slots = [self._source(block.name, u)[0] for u in block.inputs]
+        n = len(slots)
+        if n and slots == list(range(slots[0], slots[0] + n)):
+            u, gather = bus[slots[0]:slots[0] + n], ()  # a view: no copy at all
+        else:
+            u, gather = np.zeros(n), copies(slots)
+        if not gather and not taps:
+            def phase(t):
+                step(t, u, y)
+            return phase
+
+        def phase(t):
+            if taps:
+                apply_faults(taps, bus, t)
+            for into, source in gather:
+                u[into] = bus[source]
+            step(t, u, y)
+        return phase
+
+    # ------------------------------------------------------------------ running
+    def run(self, progress: bool = False):
+        """Step from ``t0`` to ``t0 + steps * dt``; raises :class:`SimulationError` on a failure."""
+        bus, record, dt, t0, dec = self.bus, self.record, self.dt, self.t0, self.decimation
+        phase_a, phase_b, gather = self.phase_a, self.phase_b, self.record_copies
+        reduce, isfinite = np.add.reduce, math.isfinite
+        bar = _progress(self.steps * dt) if progress else None
+        chunk = max(1, self.steps // 200)
+        n = 0
+        started = time.perf_counter()
+        try:
+            for n in range(self.steps + 1):
+                t = t0 + n * dt
+                for period, fn in phase_a:
+                    if period == 1 or n % period == 0:
+                        fn(t)
+                if n % dec == 0:
+                    row = record[n // dec]
+                    for into, source in gather:
+                        row[into] = bus[source]
+                    self.recorded = n // dec + 1
+                    if not isfinite(reduce(bus)):
+                        raise _Failure(self._non_finite(t))
+                if n == self.steps:
+                    break
+                for period, fn in phase_b:
+                    if period == 1 or n % period == 0:
+                        fn(t)
+                if bar is not None and n % chunk == 0 and n:
+                    bar.n = n * dt
+                    bar.refresh()
+        except _Failure as failure:
+            raise SimulationError(str(failure), self.result(error=str(failure))) from None
+        except FMUError as error:
+            message = str(error)
+            if "not a finite number" in message:
+                message = self._non_finite(t0 + n * dt) + "\n" + message
+            raise SimulationError(message, self.result(error=message)) from None
+        except Exception as error:  # a Python block failed: keep what was recorded
+            message = f"at t = {t0 + n * dt:.6g} s: {type(error).__name__}: {error}"
+            raise SimulationError(message, self.result(error=message)) from error
+        finally:
+            self.loop_seconds = time.perf_counter() - started
+            if bar is not None:
+                bar.close()
+
+    def _non_finite(self, t: float) -> str:
+        for block in self.order:  # the first in the order is where it appeared
+            for y in block.outputs:
+                name = f"{block.name}.{y}"
+                value = self.bus[self.slot[name]]
+                if not math.isfinite(value):
+                    return (f"{name} became {value} at t = {t:.6g} s (the first non-finite signal in the block "
+                            f"order). Check the block {block.name} and its inputs.")
+        for fault in self.system.faults:
+            value = self.bus[self.fault_slot[fault.target]]
+            if not math.isfinite(value):
+                return f"the {fault.kind} fault on {fault.target} made it {value} at t = {t:.6g} s"
+        return f"a signal became non-finite at t = {t:.6g} s"
+
+    def result(self, error: str | None = None) -> Result:
+        """What was recorded so far, as a :class:`Result` (time in s from ``t0``)."""
+        rows = self.recorded
+        times = self.t0 + np.arange(rows) * self.decimation * self.dt
+        meta = {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
+                "order": [b.name for b in self.order],
+                "connections": dict(self.system.connections)}
+        return Result(times, self.names, self.record[:rows].copy(), meta, error)
+
+    def close(self):
+        """Free the FMU instances and close the Python blocks."""
+        for block in self.fmus:
+            block.close()
+        for block in self.system.blocks.values():
+            if isinstance(block, Block):
+                block.close()
+
+
+def _progress(total_seconds: float):
+    from tqdm import tqdm
+
+    # shown only when a run lasts more than a few seconds of wall time
+    return tqdm(total=total_seconds, unit="s sim", delay=3.0,
+                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]")
