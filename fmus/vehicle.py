@@ -6,17 +6,20 @@ read the same numbers, and the README quotes them.
 Sources
 -------
 - Airframe: a 450 mm quad-X of about 1 kg on 10x4.5 inch propellers and 2212-class
-  920 KV motors (the DJI F450 class). Inertia and thrust/drag coefficients are the values
-  of ../shared/SPEC.md section 3.1, which match published identifications of this class
-  (e.g. Bouabdallah, "Design and control of quadrotors", EPFL thesis 2007, for the
-  order of J; k_f and k_m from static thrust-stand data of 10-inch propellers).
+  920 KV motors (the DJI F450 class). Inertia and thrust/drag coefficients are of the order
+  of published identifications of this class (Bouabdallah, "Design and control of
+  quadrotors with application to autonomous flying", EPFL thesis, 2007, for the order of J;
+  k_f and k_m from static thrust-stand data of 10-inch propellers).
+- Rotor drag and parasitic drag: see the constants below (RotorPy; Luukkonen).
 - Motor: 920 rpm/V gives k_e = 60 / (2 pi 920) V s/rad. Winding resistance and inductance
   are representative of 2212-class outrunners (0.1 ohm, 40 uH); rotor plus propeller
   inertia is that of a 10-inch propeller and bell (3e-5 kg m^2).
 - Battery: 3S 2200 mAh LiPo, internal resistance 5 mohm per cell plus wiring.
 - Magnetic perturbation: kappa and directions chosen so that, drone clamped and one motor
   swept over its range, the uncompensated mean angular error of the measured field is of
-  the order of Table 1 of Metge et al. (seed 000: 10.6 to 11.1 degrees).
+  the order of Table 1 of Metge, Mégret, Giremus, Berthoumieu, Mazel, "Compensation dynamique
+  des perturbations magnétiques pour l'estimation d'attitude d'un micro-drone" (10.6 to 11.1
+  degrees).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ import math
 
 GRAVITY = 9.81  # m/s^2, along +z of the NED frame {I}
 
-# Earth magnetic field in Paris, as in the lab report (seed 002), NED frame.
+# Earth magnetic field in Paris, as in the lab's attitude-estimation report, NED frame.
 EARTH_FIELD_NORM = 4.7e-5  # T
 EARTH_FIELD_INCLINATION = math.radians(65.0)  # rad, below the horizon
 EARTH_FIELD = (
@@ -40,7 +43,15 @@ INERTIA = (0.010, 0.010, 0.018)  # kg m^2, diagonal in {B} (Jxx, Jyy, Jzz)
 ARM = 0.225  # m, centre to rotor axis
 THRUST_COEFF = 1.0e-5  # N/(rad/s)^2, k_f: thrust of one rotor = k_f omega^2
 DRAG_TORQUE_COEFF = 1.6e-7  # N m/(rad/s)^2, k_m: reaction torque of one rotor = k_m omega^2
-LINEAR_DRAG = 0.0  # N s/m, optional translational drag D
+# Rotor drag: the H-force of blade flapping and induced drag, F_B = -k_d (sum |omega_n|) (v_a,x, v_a,y, 0)
+# with v_a the airspeed in {B}. RotorPy's value for the AscTec Hummingbird (Folk, Paulos, Kumar,
+# "RotorPy: a Python-based multirotor simulator with aerodynamics for education and research", 2023).
+# At hover it lumps to 4 k_d omega_h = 0.24 kg/s, the 0.25 kg/s Luukkonen identifies for a 0.5 kg
+# quad ("Modelling and control of quadcopter", Aalto University, 2011): drag time constant m / 0.24 = 4.2 s.
+ROTOR_DRAG_COEFF = 1.19e-4  # kg/rad, k_d (N per rad/s of rotor speed per m/s of airspeed)
+# Parasitic (frame) drag, F_B,i = -c_D,i |v_a| v_a,i, optional, off by default. RotorPy's Hummingbird
+# uses (0.5e-2, 0.5e-2, 1e-2) N/(m/s)^2.
+PARASITIC_DRAG = (0.0, 0.0, 0.0)  # N/(m/s)^2, (c_Dx, c_Dy, c_Dz) in {B}
 QUATERNION_NORM_GAIN = 1.0  # 1/s, gain of the norm-keeping term of dq
 
 # Motors and ESCs (DC-motor approximation of a brushless motor)

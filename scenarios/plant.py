@@ -1,7 +1,8 @@
 """The plant of the lab's diagram, wired once for every scenario.
 
-``MotorMagnetics -> omega_r -> Quadrotor -> (q, omega, f) -> IMU``, and the field of the
-motor currents ``b_d`` into the IMU (or zero when the perturbation is off).
+``MotorMagnetics -> (omega_r, domega_r) -> Quadrotor -> (q, omega, f) -> IMU``, and the field of
+the supply currents ``b_d`` into the IMU (or zero when the perturbation is off). The wind into
+the Quadrotor is a constant NED vector, or left for the caller to connect.
 """
 
 from __future__ import annotations
@@ -12,11 +13,30 @@ from orchestrator import FMUBlock, System
 
 
 def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: bool = True,
-              imu_period: int = 1) -> System:
+              imu_period: int = 1, wind=(0.0, 0.0, 0.0)) -> System:
+    """Add the three plant FMUs to ``system`` and wire them.
+
+    Parameters
+    ----------
+    system : System
+    quadrotor, motors, imu : dict, optional
+        Parameter overrides of the Quadrotor, MotorMagnetics and IMU FMUs.
+    magnetic : bool
+        Feed the field of the supply currents ``b_d`` (T, sensor frame) to the IMU; zero if False.
+    imu_period : int
+        IMU period in macro steps.
+    wind : sequence of 3 floats or None
+        Constant wind velocity (m/s, NED: north, east, down). ``None`` leaves ``Quadrotor.wind``
+        unconnected, for the caller to connect a wind source.
+    """
     system.add(FMUBlock("MotorMagnetics", parameters=motors))
     system.add(FMUBlock("Quadrotor", parameters=quadrotor))
     system.add(FMUBlock("IMU", parameters=imu, period=imu_period))
     system.connect("MotorMagnetics.omega_r", "Quadrotor.omega_r")
+    system.connect("MotorMagnetics.domega_r", "Quadrotor.domega_r")
+    if wind is not None:
+        for axis, value in zip("xyz", wind, strict=True):
+            system.set_input(f"Quadrotor.wind_{axis}", float(value))
     system.connect("Quadrotor.q", "IMU.q")
     system.connect("Quadrotor.omega", "IMU.omega")
     system.connect("Quadrotor.f", "IMU.f")

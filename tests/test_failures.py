@@ -52,6 +52,8 @@ def test_fmu_error_status_names_block_time_and_log_and_keeps_the_record():
     system.add(FMUBlock("Quadrotor"))
     for n in range(1, 5):
         system.connect("Speeds.y", f"Quadrotor.omega_r{n}")
+    system.set_input("Quadrotor.domega_r", 0.0)
+    system.set_input("Quadrotor.wind", 0.0)
     with pytest.raises(SimulationError) as error:
         system.run(1.0)
     message = str(error.value)

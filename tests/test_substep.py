@@ -13,8 +13,10 @@ from fmus.twins import simulate_fmu
 
 CASES = {
     "Quadrotor": (
-        {f"omega_r{n}": f"495 + {15 * n}*sin({3 * n}*time) + 20*cos(5*time)" for n in range(1, 5)},
-        {"drag": 0.2},
+        {**{f"omega_r{n}": f"495 + {15 * n}*sin({3 * n}*time) + 20*cos(5*time)" for n in range(1, 5)},
+         **{f"domega_r{n}": f"{45 * n * n}*cos({3 * n}*time) - 100*sin(5*time)" for n in range(1, 5)},
+         "wind_x": "2 + sin(time)", "wind_y": "-1", "wind_z": "0"},
+        {"c_Dx": 0.01, "c_Dy": 0.01, "c_Dz": 0.02, "v_x0": 2.0, "omega_y0": 0.5},
         ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "p_x", "p_y", "p_z", "v_x", "v_z", "f_x", "f_z"],
     ),
     "MotorMagnetics": (

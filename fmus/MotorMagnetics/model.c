@@ -224,6 +224,7 @@ void model_outputs(ModelInstance *m) {
     for (n = 0; n < N_MOTORS; n++) {
         double field = (&R(kappa1))[n] * x[CURRENT + n];
         (&R(omega_r1))[n] = x[OMEGA + n];
+        (&R(domega_r1))[n] = (R(k_e) * x[CURRENT + n] - R(k_m) * x[OMEGA + n] * fabs(x[OMEGA + n])) / R(J_r);
         (&R(i1))[n] = x[CURRENT + n];
         for (a = 0; a < 3; a++) {
             (&R(b_d1_x))[3 * n + a] = field * d->v[n][a];

@@ -32,6 +32,8 @@ TABLE = Table(
         Real("sub_step", "parameter", 2.5e-4, "s", "largest internal step of the exponential integrator"),
         # outputs
         *[Real(f"omega_r{n}", "output", unit="rad/s", description=f"speed of rotor {n}") for n in _N],
+        *[Real(f"domega_r{n}", "output", unit="rad/s2", description=f"angular acceleration of rotor {n}")
+          for n in _N],
         Real("b_d_x", "output", unit="T", description="field of the motor currents at the magnetometer, x_B"),
         Real("b_d_y", "output", unit="T", description="field of the motor currents at the magnetometer, y_B"),
         Real("b_d_z", "output", unit="T", description="field of the motor currents at the magnetometer, z_B"),

@@ -40,6 +40,10 @@ model MotorMagnetics "Four DC-approximated brushless motors, ESCs, LiPo battery,
   output Real omega_r2(unit = "rad/s", start = omega0, fixed = true);
   output Real omega_r3(unit = "rad/s", start = omega0, fixed = true);
   output Real omega_r4(unit = "rad/s", start = omega0, fixed = true);
+  output Real domega_r1(unit = "rad/s2") "angular acceleration of rotor 1";
+  output Real domega_r2(unit = "rad/s2") "angular acceleration of rotor 2";
+  output Real domega_r3(unit = "rad/s2") "angular acceleration of rotor 3";
+  output Real domega_r4(unit = "rad/s2") "angular acceleration of rotor 4";
   output Real b_d_x(unit = "T");
   output Real b_d_y(unit = "T");
   output Real b_d_z(unit = "T");
@@ -72,10 +76,14 @@ equation
   L_m*der(i2) = c2s*u_batt - R_m*i2 - k_e*omega_r2;
   L_m*der(i3) = c3s*u_batt - R_m*i3 - k_e*omega_r3;
   L_m*der(i4) = c4s*u_batt - R_m*i4 - k_e*omega_r4;
-  J_r*der(omega_r1) = k_e*i1 - k_m*omega_r1*abs(omega_r1);
-  J_r*der(omega_r2) = k_e*i2 - k_m*omega_r2*abs(omega_r2);
-  J_r*der(omega_r3) = k_e*i3 - k_m*omega_r3*abs(omega_r3);
-  J_r*der(omega_r4) = k_e*i4 - k_m*omega_r4*abs(omega_r4);
+  J_r*domega_r1 = k_e*i1 - k_m*omega_r1*abs(omega_r1);
+  J_r*domega_r2 = k_e*i2 - k_m*omega_r2*abs(omega_r2);
+  J_r*domega_r3 = k_e*i3 - k_m*omega_r3*abs(omega_r3);
+  J_r*domega_r4 = k_e*i4 - k_m*omega_r4*abs(omega_r4);
+  der(omega_r1) = domega_r1;
+  der(omega_r2) = domega_r2;
+  der(omega_r3) = domega_r3;
+  der(omega_r4) = domega_r4;
 
   b_d1_x = kappa1*i1*v1_x/n1;
   b_d1_y = kappa1*i1*v1_y/n1;

@@ -1,9 +1,17 @@
-/* Quadrotor: rigid body of a quad-X multirotor (SPEC 3.1). NED inertial frame, FRD body frame.
+/* Quadrotor: rigid body of a quad-X multirotor. NED inertial frame, FRD body frame.
  *
  *   dp = v
- *   m dv = m g e3 - R (T e3) - D v            thrust along -z_B
+ *   m dv = m g e3 + R (-T e3 + F_d)                     thrust along -z_B
+ *   F_d = -k_d sum|omega_n| (v_a,x, v_a,y, 0) - c_D,i |v_a| v_a,i      v_a = R^T (v - wind)
  *   dq = 0.5 q (x) (0, omega) + k_norm (1 - |q|^2) q
- *   J domega = -omega x J omega + tau
+ *   J domega = -omega x J omega + tau - omega x h_r + tau_r
+ *
+ * F_d: the rotor drag (H-force of blade flapping and induced drag, lumped at the centre of
+ * mass as in RotorPy's multirotor) and an optional parasitic drag, both on the airspeed.
+ * Rotor n spins at -s_n omega_n e3 (airframe.h: s_n = +1 counter-clockwise seen from above),
+ * so the rotors carry h_r = -J_r sum(s_n omega_n) e3. Their gyroscopic moment is -omega x h_r,
+ * and spinning them up reacts on the body with -dh_r/dt = J_r sum(s_n domega_n) e3, which adds
+ * to the drag torque k_m sum(s_n omega_n^2) e3 with the same sign.
  *
  * State x = (p[3], v[3], q[4], omega[3]); RK4 with sub-steps of at most sub_step.
  */
@@ -23,7 +31,7 @@ const size_t MODEL_DATA_SIZE = sizeof(Data);
 
 /* Thrust and torques of the rotors at the present inputs. */
 static void rotor_forces(ModelInstance *m, double *thrust, double tau[3]) {
-    const double *w = &R(omega_r1);
+    const double *w = &R(omega_r1), *dw = &R(domega_r1);
     int n;
     *thrust = 0.0;
     tau[0] = tau[1] = tau[2] = 0.0;
@@ -33,13 +41,33 @@ static void rotor_forces(ModelInstance *m, double *thrust, double tau[3]) {
         *thrust += t;
         tau[0] -= R(arm) * ARM_Y[n] * t; /* r x (-t e3) = (-y t, x t, 0) */
         tau[1] += R(arm) * ARM_X[n] * t;
-        tau[2] += R(k_m) * SPIN[n] * w2;
+        tau[2] += SPIN[n] * (R(k_m) * w2 + R(J_r) * dw[n]);
     }
+}
+
+/* Drag force in {B} at velocity v (NED) and rotation r (body to NED, row-major). */
+static void drag_force(ModelInstance *m, const double *v, const double r[9], double f[3]) {
+    const double *w = &R(omega_r1), *c = &R(c_Dx);
+    double air[3], va[3], speed, rotor = 0.0;
+    int i;
+    for (i = 0; i < 3; i++) air[i] = v[i] - (&R(wind_x))[i];
+    for (i = 0; i < 3; i++) va[i] = r[i] * air[0] + r[3 + i] * air[1] + r[6 + i] * air[2];
+    for (i = 0; i < N_MOTORS; i++) rotor += fabs(w[i]);
+    speed = sqrt(va[0] * va[0] + va[1] * va[1] + va[2] * va[2]);
+    for (i = 0; i < 3; i++) f[i] = -c[i] * speed * va[i] - (i < 2 ? R(k_d) * rotor * va[i] : 0.0);
+}
+
+/* Sum of s_n omega_n: the rotors' angular momentum is -J_r times this, along e3. */
+static double spin_sum(ModelInstance *m) {
+    double total = 0.0;
+    int n;
+    for (n = 0; n < N_MOTORS; n++) total += SPIN[n] * (&R(omega_r1))[n];
+    return total;
 }
 
 static void derivatives(ModelInstance *m, double t, const double *x, double *dx) {
     const double *v = x + 3, *q = x + 6, *w = x + 10;
-    double thrust, tau[3], r[9], norm_error;
+    double thrust, tau[3], r[9], f[3], body[3], norm_error, gyro;
     (void)t;
     if (m->boolean[VB_clamped]) {
         int i;
@@ -48,19 +76,24 @@ static void derivatives(ModelInstance *m, double t, const double *x, double *dx)
     }
     rotor_forces(m, &thrust, tau);
     rotation_from_quaternion(q, r);
+    drag_force(m, v, r, f);
+    body[0] = f[0] / R(m);
+    body[1] = f[1] / R(m);
+    body[2] = (f[2] - thrust) / R(m);
     dx[0] = v[0];
     dx[1] = v[1];
     dx[2] = v[2];
-    dx[3] = -thrust / R(m) * r[2] - R(drag) / R(m) * v[0];
-    dx[4] = -thrust / R(m) * r[5] - R(drag) / R(m) * v[1];
-    dx[5] = R(g) - thrust / R(m) * r[8] - R(drag) / R(m) * v[2];
+    dx[3] = r[0] * body[0] + r[1] * body[1] + r[2] * body[2];
+    dx[4] = r[3] * body[0] + r[4] * body[1] + r[5] * body[2];
+    dx[5] = R(g) + r[6] * body[0] + r[7] * body[1] + r[8] * body[2];
     norm_error = R(k_norm) * (1.0 - (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]));
     dx[6] = 0.5 * (-q[1] * w[0] - q[2] * w[1] - q[3] * w[2]) + norm_error * q[0];
     dx[7] = 0.5 * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1]) + norm_error * q[1];
     dx[8] = 0.5 * (q[0] * w[1] + q[3] * w[0] - q[1] * w[2]) + norm_error * q[2];
     dx[9] = 0.5 * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0]) + norm_error * q[3];
-    dx[10] = (tau[0] - (R(Jzz) - R(Jyy)) * w[1] * w[2]) / R(Jxx);
-    dx[11] = (tau[1] - (R(Jxx) - R(Jzz)) * w[2] * w[0]) / R(Jyy);
+    gyro = R(J_r) * spin_sum(m); /* -omega x h_r = gyro (omega_y, -omega_x, 0) */
+    dx[10] = (tau[0] + gyro * w[1] - (R(Jzz) - R(Jyy)) * w[1] * w[2]) / R(Jxx);
+    dx[11] = (tau[1] - gyro * w[0] - (R(Jxx) - R(Jzz)) * w[2] * w[0]) / R(Jyy);
     dx[12] = (tau[2] - (R(Jyy) - R(Jxx)) * w[0] * w[1]) / R(Jzz);
 }
 
@@ -69,6 +102,8 @@ fmi2Status model_initialize(ModelInstance *m) {
     double c1, s1, c2, s2, c3, s3;
     const char *positive[] = {"m", "Jxx", "Jyy", "Jzz", "arm", "k_f", "g", "sub_step"};
     const double values[] = {R(m), R(Jxx), R(Jyy), R(Jzz), R(arm), R(k_f), R(g), R(sub_step)};
+    const char *non_negative[] = {"k_m", "k_d", "c_Dx", "c_Dy", "c_Dz", "J_r", "k_norm"};
+    const double others[] = {R(k_m), R(k_d), R(c_Dx), R(c_Dy), R(c_Dz), R(J_r), R(k_norm)};
     unsigned i;
     for (i = 0; i < sizeof values / sizeof values[0]; i++) {
         if (!(values[i] > 0.0) || !isfinite(values[i])) {
@@ -76,10 +111,11 @@ fmi2Status model_initialize(ModelInstance *m) {
             return fmi2Error;
         }
     }
-    if (!(R(k_m) >= 0.0) || !(R(drag) >= 0.0) || !(R(k_norm) >= 0.0)) {
-        log_error(m, "parameters k_m = %g, drag = %g and k_norm = %g must be non-negative", R(k_m),
-                  R(drag), R(k_norm));
-        return fmi2Error;
+    for (i = 0; i < sizeof others / sizeof others[0]; i++) {
+        if (!(others[i] >= 0.0) || !isfinite(others[i])) {
+            log_error(m, "parameter %s = %g must be non-negative and finite", non_negative[i], others[i]);
+            return fmi2Error;
+        }
     }
     if (R(Jxx) + R(Jyy) < R(Jzz) || R(Jyy) + R(Jzz) < R(Jxx) || R(Jzz) + R(Jxx) < R(Jyy)) {
         log_error(m, "inertia (%g, %g, %g) violates the triangle inequality of a rigid body",
@@ -126,11 +162,12 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
 void model_outputs(ModelInstance *m) {
     Data *d = (Data *)m->data;
     const double *x = d->x;
-    double dx[N_STATES], r[9], thrust, tau[3];
+    double dx[N_STATES], r[9], thrust, tau[3], f[3];
     int i;
     derivatives(m, m->time, x, dx);
     rotor_forces(m, &thrust, tau);
     rotation_from_quaternion(x + 6, r);
+    drag_force(m, x + 3, r, f);
     R(p_x) = x[0];
     R(p_y) = x[1];
     R(p_z) = x[2];
@@ -155,4 +192,5 @@ void model_outputs(ModelInstance *m) {
     R(tau_x) = tau[0];
     R(tau_y) = tau[1];
     R(tau_z) = tau[2];
+    for (i = 0; i < 3; i++) (&R(drag_x))[i] = m->boolean[VB_clamped] ? 0.0 : f[i];
 }

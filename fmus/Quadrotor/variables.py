@@ -1,17 +1,23 @@
-"""Variable table of the Quadrotor FMU (rigid body of a quad-X, SPEC section 3.1)."""
+"""Variable table of the Quadrotor FMU: rigid body of a quad-X with rotor drag, wind and rotor inertia."""
 
 from fmus import vehicle as V
 from fmus.variables import Boolean, Real, Table
 
-_F = ("omega_r1", "omega_r2", "omega_r3", "omega_r4")
+_W = ("omega_r1", "omega_r2", "omega_r3", "omega_r4")
+_DW = ("domega_r1", "domega_r2", "domega_r3", "domega_r4")
+_WIND = ("wind_x", "wind_y", "wind_z")
+_F = _W + _WIND
 
 TABLE = Table(
     "Quadrotor",
-    "Rigid-body dynamics of a quad-X multirotor, NED/FRD, quaternion attitude",
+    "Rigid-body dynamics of a quad-X multirotor with rotor drag, wind and rotor inertia; NED/FRD, quaternion attitude",
     states=13,
     variables=[
         # inputs
         *[Real(f"omega_r{n}", "input", 0.0, "rad/s", f"speed of rotor {n}") for n in range(1, 5)],
+        *[Real(f"domega_r{n}", "input", 0.0, "rad/s2", f"angular acceleration of rotor {n}") for n in range(1, 5)],
+        *[Real(f"wind_{a}", "input", 0.0, "m/s", f"wind velocity, {d} (NED)")
+          for a, d in zip("xyz", ("north", "east", "down"), strict=True)],
         # parameters
         Real("m", "parameter", V.MASS, "kg", "mass"),
         Real("Jxx", "parameter", V.INERTIA[0], "kg.m2", "inertia about x_B"),
@@ -20,7 +26,11 @@ TABLE = Table(
         Real("arm", "parameter", V.ARM, "m", "distance from the centre to a rotor axis"),
         Real("k_f", "parameter", V.THRUST_COEFF, "N.s2", "thrust coefficient, T_n = k_f omega_n^2"),
         Real("k_m", "parameter", V.DRAG_TORQUE_COEFF, "N.m.s2", "drag torque coefficient"),
-        Real("drag", "parameter", V.LINEAR_DRAG, "N.s/m", "linear translational drag D"),
+        Real("k_d", "parameter", V.ROTOR_DRAG_COEFF, "kg/rad",
+             "rotor drag (H-force): F_B = -k_d sum|omega_n| (v_a,x, v_a,y, 0)"),
+        *[Real(f"c_D{a}", "parameter", V.PARASITIC_DRAG[k], "N.s2/m2", f"parasitic drag along {a}_B, -c |v_a| v_a")
+          for k, a in enumerate("xyz")],
+        Real("J_r", "parameter", V.ROTOR_INERTIA, "kg.m2", "inertia of one rotor and propeller about its axis"),
         Real("g", "parameter", V.GRAVITY, "m/s2", "gravity along +z of {I}"),
         Real("k_norm", "parameter", V.QUATERNION_NORM_GAIN, "1/s", "quaternion norm-keeping gain"),
         Real("sub_step", "parameter", 1e-2, "s", "largest internal RK4 step"),
@@ -62,9 +72,12 @@ TABLE = Table(
             for i in range(1, 4)
             for j in range(1, 4)
         ],
-        Real("thrust", "output", unit="N", description="total rotor thrust", depends=_F),
-        Real("tau_x", "output", unit="N.m", description="rotor torque about x_B", depends=_F),
-        Real("tau_y", "output", unit="N.m", description="rotor torque about y_B", depends=_F),
-        Real("tau_z", "output", unit="N.m", description="rotor torque about z_B", depends=_F),
+        Real("thrust", "output", unit="N", description="total rotor thrust", depends=_W),
+        Real("tau_x", "output", unit="N.m", description="rotor torque about x_B", depends=_W),
+        Real("tau_y", "output", unit="N.m", description="rotor torque about y_B", depends=_W),
+        Real("tau_z", "output", unit="N.m", description="rotor torque about z_B, drag and spin-up reaction",
+             depends=_W + _DW),
+        *[Real(f"drag_{a}", "output", unit="N", description=f"aerodynamic drag force along {a}_B", depends=_F)
+          for a in "xyz"],
     ],
 )
