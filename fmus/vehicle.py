@@ -52,6 +52,7 @@ ROTOR_DRAG_COEFF = 1.19e-4  # kg/rad, k_d (N per rad/s of rotor speed per m/s of
 # Parasitic (frame) drag, F_B,i = -c_D,i |v_a| v_a,i, optional, off by default. RotorPy's Hummingbird
 # uses (0.5e-2, 0.5e-2, 1e-2) N/(m/s)^2.
 PARASITIC_DRAG = (0.0, 0.0, 0.0)  # N/(m/s)^2, (c_Dx, c_Dy, c_Dz) in {B}
+LINEAR_DRAG = 0.0  # N s/m, optional isotropic linear drag on the airspeed, F = -D v_a (off by default)
 QUATERNION_NORM_GAIN = 1.0  # 1/s, gain of the norm-keeping term of dq
 
 # Motors and ESCs (DC-motor approximation of a brushless motor)

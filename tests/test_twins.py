@@ -45,7 +45,7 @@ def test_quadrotor_twin():
     inputs |= {f"domega_r{n}": f"{45 * n * n}*cos({3 * n}*time) - 100*sin(5*time)" for n in range(1, 5)}
     inputs |= {"wind_x": "3 + sin(2*time)", "wind_y": "-1.5*cos(time)", "wind_z": "0.5"}
     params = {"theta1_0": 0.1, "theta2_0": -0.2, "theta3_0": 0.4, "omega_x0": 0.3, "omega_y0": -0.5,
-              "v_x0": 1.0, "v_y0": -2.0, "c_Dx": 0.01, "c_Dy": 0.02, "c_Dz": 0.03}
+              "v_x0": 1.0, "v_y0": -2.0, "c_Dx": 0.01, "c_Dy": 0.02, "c_Dz": 0.03, "drag": 0.1}
     compare("Quadrotor", inputs, params, 1e-4, 100)
 
 

@@ -23,6 +23,7 @@ model Quadrotor "Rigid-body dynamics of a quad-X multirotor with rotor drag, win
   parameter Real c_Dx(unit = "N.s2/m2") = 0 "parasitic drag along x_B";
   parameter Real c_Dy(unit = "N.s2/m2") = 0 "parasitic drag along y_B";
   parameter Real c_Dz(unit = "N.s2/m2") = 0 "parasitic drag along z_B";
+  parameter Real drag(unit = "N.s/m") = 0 "optional linear drag on the airspeed";
   parameter Real J_r(unit = "kg.m2") = 3.0e-5 "inertia of one rotor and propeller";
   parameter Real g(unit = "m/s2") = 9.81 "gravity along +z of the NED frame";
   parameter Real k_norm(unit = "1/s") = 1.0 "quaternion norm-keeping gain";
@@ -113,9 +114,9 @@ equation
   va_z = R13*(v_x - wind_x) + R23*(v_y - wind_y) + R33*(v_z - wind_z);
   // skipped when unused: the toolchain differentiates sqrt, infinite at zero airspeed
   airspeed = if clamped or c_Dx + c_Dy + c_Dz <= 0 then 0 else sqrt(va_x^2 + va_y^2 + va_z^2);
-  F_x = -k_d*(abs(omega_r1) + abs(omega_r2) + abs(omega_r3) + abs(omega_r4))*va_x - c_Dx*airspeed*va_x;
-  F_y = -k_d*(abs(omega_r1) + abs(omega_r2) + abs(omega_r3) + abs(omega_r4))*va_y - c_Dy*airspeed*va_y;
-  F_z = -c_Dz*airspeed*va_z;
+  F_x = -k_d*(abs(omega_r1) + abs(omega_r2) + abs(omega_r3) + abs(omega_r4))*va_x - c_Dx*airspeed*va_x - drag*va_x;
+  F_y = -k_d*(abs(omega_r1) + abs(omega_r2) + abs(omega_r3) + abs(omega_r4))*va_y - c_Dy*airspeed*va_y - drag*va_y;
+  F_z = -c_Dz*airspeed*va_z - drag*va_z;
   drag_x = if clamped then 0 else F_x;
   drag_y = if clamped then 0 else F_y;
   drag_z = if clamped then 0 else F_z;

@@ -2,12 +2,13 @@
  *
  *   dp = v
  *   m dv = m g e3 + R (-T e3 + F_d)                     thrust along -z_B
- *   F_d = -k_d sum|omega_n| (v_a,x, v_a,y, 0) - c_D,i |v_a| v_a,i      v_a = R^T (v - wind)
+ *   F_d = -k_d sum|omega_n| (v_a,x, v_a,y, 0) - c_D,i |v_a| v_a,i - D v_a     v_a = R^T (v - wind)
  *   dq = 0.5 q (x) (0, omega) + k_norm (1 - |q|^2) q
  *   J domega = -omega x J omega + tau - omega x h_r + tau_r
  *
  * F_d: the rotor drag (H-force of blade flapping and induced drag, lumped at the centre of
- * mass as in RotorPy's multirotor) and an optional parasitic drag, both on the airspeed.
+ * mass as in RotorPy's multirotor) and optional parasitic drags (quadratic per body axis, and
+ * linear isotropic D = drag), all on the airspeed.
  * Rotor n spins at -s_n omega_n e3 (airframe.h: s_n = +1 counter-clockwise seen from above),
  * so the rotors carry h_r = -J_r sum(s_n omega_n) e3. Their gyroscopic moment is -omega x h_r,
  * and spinning them up reacts on the body with -dh_r/dt = J_r sum(s_n domega_n) e3, which adds
@@ -54,7 +55,7 @@ static void drag_force(ModelInstance *m, const double *v, const double r[9], dou
     for (i = 0; i < 3; i++) va[i] = r[i] * air[0] + r[3 + i] * air[1] + r[6 + i] * air[2];
     for (i = 0; i < N_MOTORS; i++) rotor += fabs(w[i]);
     speed = sqrt(va[0] * va[0] + va[1] * va[1] + va[2] * va[2]);
-    for (i = 0; i < 3; i++) f[i] = -c[i] * speed * va[i] - (i < 2 ? R(k_d) * rotor * va[i] : 0.0);
+    for (i = 0; i < 3; i++) f[i] = -(c[i] * speed + R(drag)) * va[i] - (i < 2 ? R(k_d) * rotor * va[i] : 0.0);
 }
 
 /* Sum of s_n omega_n: the rotors' angular momentum is -J_r times this, along e3. */
@@ -102,8 +103,8 @@ fmi2Status model_initialize(ModelInstance *m) {
     double c1, s1, c2, s2, c3, s3;
     const char *positive[] = {"m", "Jxx", "Jyy", "Jzz", "arm", "k_f", "g", "sub_step"};
     const double values[] = {R(m), R(Jxx), R(Jyy), R(Jzz), R(arm), R(k_f), R(g), R(sub_step)};
-    const char *non_negative[] = {"k_m", "k_d", "c_Dx", "c_Dy", "c_Dz", "J_r", "k_norm"};
-    const double others[] = {R(k_m), R(k_d), R(c_Dx), R(c_Dy), R(c_Dz), R(J_r), R(k_norm)};
+    const char *non_negative[] = {"k_m", "k_d", "c_Dx", "c_Dy", "c_Dz", "drag", "J_r", "k_norm"};
+    const double others[] = {R(k_m), R(k_d), R(c_Dx), R(c_Dy), R(c_Dz), R(drag), R(J_r), R(k_norm)};
     unsigned i;
     for (i = 0; i < sizeof values / sizeof values[0]; i++) {
         if (!(values[i] > 0.0) || !isfinite(values[i])) {

@@ -30,6 +30,7 @@ TABLE = Table(
              "rotor drag (H-force): F_B = -k_d sum|omega_n| (v_a,x, v_a,y, 0)"),
         *[Real(f"c_D{a}", "parameter", V.PARASITIC_DRAG[k], "N.s2/m2", f"parasitic drag along {a}_B, -c |v_a| v_a")
           for k, a in enumerate("xyz")],
+        Real("drag", "parameter", V.LINEAR_DRAG, "N.s/m", "optional linear drag on the airspeed, -drag v_a"),
         Real("J_r", "parameter", V.ROTOR_INERTIA, "kg.m2", "inertia of one rotor and propeller about its axis"),
         Real("g", "parameter", V.GRAVITY, "m/s2", "gravity along +z of {I}"),
         Real("k_norm", "parameter", V.QUATERNION_NORM_GAIN, "1/s", "quaternion norm-keeping gain"),
