@@ -40,11 +40,11 @@ def batch_updates_per_s(gain_sets: int = 256, samples: int = 4000, repeats: int 
 
     acc, gyro, mag = _data(samples)
     gains = {"k1": np.geomspace(0.01, 10, gain_sets), "kI": 0.1}
-    estimate("explicit", acc[:10], gyro[:10], mag[:10], 1e-3, gains)  # compile
+    estimate("explicit", acc=acc[:10], gyro=gyro[:10], mag=mag[:10], dt=1e-3, gains=gains)  # compile
     best = np.inf
     for _ in range(repeats):
         started = time.perf_counter()
-        estimate("explicit", acc, gyro, mag, 1e-3, gains)
+        estimate("explicit", acc=acc, gyro=gyro, mag=mag, dt=1e-3, gains=gains)
         best = min(best, time.perf_counter() - started)
     return gain_sets * samples / best
 

@@ -1,10 +1,24 @@
-"""Attitude estimators: the lab's ``Quaternion_estim`` variants, and their analysis.
+"""Attitude estimators: the lab's ``Quaternion_estim`` variants, published filters, and analysis.
 
-- :class:`QuaternionEstim`: the streaming block (``linear``, ``explicit``, ``passive``);
-- :func:`estimate`: the same filters on recorded arrays, many gain sets at once;
+- :class:`QuaternionEstim`: the streaming block (``linear``, ``explicit``, ``passive``, and the
+  published ``vqf`` and ``madgwick`` for comparison);
+- :func:`estimate`: the same filters on recorded arrays, many gain sets at once
+  (:func:`gain_grid` builds them), with errors against a reference reduced in the loop;
+- :func:`score`: the quaternion-error RMSE (total, inclination, heading);
+- :mod:`estimators.recording`: recorded files (``.npz``, ``.mat``, ``.csv``) in and out;
 - :mod:`estimators.analysis`: python-control analyses of the gains.
 """
 
-from estimators.filters import DEFAULT_GAINS, QuaternionEstim, estimate
+from estimators.filters import (
+    CORRECTIONS,
+    DEFAULT_GAINS,
+    LAB_GAINS,
+    QuaternionEstim,
+    estimate,
+    gain_grid,
+    references,
+    score,
+)
 
-__all__ = ["DEFAULT_GAINS", "QuaternionEstim", "estimate"]
+__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "LAB_GAINS", "QuaternionEstim", "estimate", "gain_grid", "references",
+           "score"]

@@ -4,16 +4,17 @@ Every function here is compiled by numba and used by both the streaming
 ``Quaternion_estim`` block (one call per sample) and the batch path (a compiled loop over
 samples and gain sets), so the two paths run the same arithmetic.
 
-Conventions: NED/FRD, ``q = (q0, q1, q2, q3)`` scalar first and Hamilton, ``R(q)`` body to
-NED. Measurements in the body frame: ``acc`` (m/s^2, specific force), ``gyro`` (rad/s),
-``mag`` (T). The input vector ``u`` of an update is ``acc[3], gyro[3], mag[3]`` followed,
-for the passive filter fed by the true rotation, by ``R_reel`` row-major ``[9]``.
+Conventions: ``q = (q0, q1, q2, q3)`` scalar first and Hamilton, ``R(q)`` body to inertial.
+The inertial frame is set by two reference vectors in the configuration: the acceleration
+of gravity ``g_I`` (m/s^2; NED: ``(0, 0, 9.81)``) and the Earth field ``m_I`` (T, or any unit
+shared with the magnetometer). At rest the accelerometer reads the specific force
+``R^T (-g_I)``. Measurements in the body frame: ``acc`` (m/s^2), ``gyro`` (rad/s), ``mag``.
 
-State ``x``: ``q[0:4]``, gyro bias estimate ``b[4:7]`` (rad/s), Euler angles ``theta[7:10]``
-(rad; the linear filter's own state). Output ``y``: ``q_est[4]``, ``theta_est[3]`` (Z-Y-X),
-``b_est[3]`` (rad/s), ``omega_est[3] = gyro - b_est`` (rad/s).
+Every layout (inputs, state, outputs, gains, configuration) is declared once below as
+``(name, size)`` pairs; the compiled code reads slots by the constants derived from those
+names, never by bare positions.
 
-Discretisation of the nonlinear filters, chosen by ``config[DISCRETE]``:
+Discretisation of the nonlinear filters, chosen by the configuration's ``discretisation``:
 - ``EXP`` (0, default): ``q <- q (x) exp(0.5 Omega dt)``, exact for a rate constant over the
   sample, then normalised against round-off;
 - ``EULER`` (1): ``q <- q + dt 0.5 q (x) (0, Omega)``, then normalised (Mahony's and the
@@ -28,16 +29,62 @@ import math
 import numpy as np
 from numba import njit, prange
 
+
+def _offsets(layout):
+    """{name: (start, stop)} of consecutive slots declared as (name, size) pairs."""
+    slots, start = {}, 0
+    for name, size in layout:
+        slots[name] = (start, start + size)
+        start += size
+    return slots, start
+
+
 LINEAR, EXPLICIT, PASSIVE = 0, 1, 2
 KINDS = {"linear": LINEAR, "explicit": EXPLICIT, "passive": PASSIVE}
 EXP, EULER = 0, 1
 REEL, TRIAD = 0, 1
-# config vector: gravity (m/s^2), Earth field m_I (T, NED, 3), discretisation, R_y source
-G, M_I, DISCRETE, RY = 0, 1, 4, 5
-CONFIG_SIZE = 6
-STATE_SIZE = 10
-OUTPUT_SIZE = 13
-WORK_SIZE = 21
+
+INPUT_LAYOUT = (("acc", 3), ("gyro", 3), ("mag", 3), ("R_reel", 9))
+INPUT_SLOTS, INPUT_SIZE = _offsets(INPUT_LAYOUT)
+ACC, GYRO, MAG, R_Y = (INPUT_SLOTS[n][0] for n in ("acc", "gyro", "mag", "R_reel"))
+
+CONFIG_LAYOUT = (("gravity", 3), ("earth_field", 3), ("discretisation", 1), ("ry", 1))
+CONFIG_SLOTS, CONFIG_SIZE = _offsets(CONFIG_LAYOUT)
+GRAVITY, FIELD, DISCRETE, RY = (CONFIG_SLOTS[n][0] for n in ("gravity", "earth_field", "discretisation", "ry"))
+
+# "pending" is 1 until the first sample has set the attitude from TRIAD (initial="triad")
+STATE_LAYOUT = (("q", 4), ("b", 3), ("theta", 3), ("gyro_lowpass", 3), ("acc_lowpass", 3), ("rest_time", 1),
+                ("pending", 1))
+STATE_SLOTS, STATE_SIZE = _offsets(STATE_LAYOUT)
+Q, B, THETA, GYRO_LP, ACC_LP, REST_TIME, PENDING = (STATE_SLOTS[n][0] for n in (
+    "q", "b", "theta", "gyro_lowpass", "acc_lowpass", "rest_time", "pending"))
+
+# weights: accelerometer weight, magnetometer weight (0..1), at rest (0 or 1)
+OUTPUT_LAYOUT = (("q", 4), ("theta", 3), ("b", 3), ("omega", 3), ("weights", 3))
+OUTPUT_SLOTS, OUTPUT_SIZE = _offsets(OUTPUT_LAYOUT)
+OUT_Q, OUT_THETA, OUT_B, OUT_OMEGA, OUT_WEIGHTS = (OUTPUT_SLOTS[n][0] for n in ("q", "theta", "b", "omega", "weights"))
+
+# Gains and correction settings, one vector per gain set; see estimators.filters for meanings.
+GAIN_NAMES = ("k1", "k2", "k3", "kP", "kI", "heading_only", "acc_tolerance", "mag_norm_tolerance",
+              "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain")
+GAIN_SLOTS = {name: i for i, name in enumerate(GAIN_NAMES)}
+GAIN_SIZE = len(GAIN_NAMES)
+K1, K2, K3, KP, KI = (GAIN_SLOTS[n] for n in ("k1", "k2", "k3", "kP", "kI"))
+HEADING_ONLY, ACC_TOL, MAG_NORM_TOL, MAG_DIP_TOL = (GAIN_SLOTS[n] for n in (
+    "heading_only", "acc_tolerance", "mag_norm_tolerance", "mag_dip_tolerance"))
+REST_GYRO, REST_ACC, REST_MIN_TIME, REST_GAIN = (GAIN_SLOTS[n] for n in ("rest_gyro", "rest_acc", "rest_time",
+                                                                          "rest_gain"))
+
+REST_LOWPASS_TAU = 0.5  # s, time constant of the low-pass filters of the rest detector
+WORK_LAYOUT = (("R", 9), ("omega", 3), ("R_y", 9), ("v_up", 3), ("v_field", 3), ("scratch", 3))
+WORK_SLOTS, WORK_SIZE = _offsets(WORK_LAYOUT)
+W_R, W_OMEGA, W_RY, W_UP, W_FIELD, W_SCRATCH = (WORK_SLOTS[n][0] for n in ("R", "omega", "R_y", "v_up", "v_field",
+                                                                          "scratch"))
+# error sums of the in-loop reduction, per gain set
+ERROR_LAYOUT = (("total2", 1), ("inclination2", 1), ("heading2", 1), ("heading_sin", 1), ("heading_cos", 1),
+                ("count", 1))
+ERROR_SLOTS, ERROR_SIZE = _offsets(ERROR_LAYOUT)
+E_TOTAL, E_INCL, E_HEAD, E_SIN, E_COS, E_COUNT = range(ERROR_SIZE)
 
 
 @njit(cache=True, error_model="numpy")
@@ -67,6 +114,28 @@ def rotation(q, r):
 
 
 @njit(cache=True, error_model="numpy")
+def quaternion_from_rotation(r, q):
+    """Unit quaternion (q0 >= 0) of the rotation matrix ``r`` (Shepperd's method)."""
+    trace = r[0, 0] + r[1, 1] + r[2, 2]
+    if trace >= max(r[0, 0], r[1, 1], r[2, 2]):
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q[0], q[1], q[2], q[3] = 0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s
+    elif r[0, 0] >= r[1, 1] and r[0, 0] >= r[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + r[0, 0] - r[1, 1] - r[2, 2])
+        q[0], q[1], q[2], q[3] = (r[2, 1] - r[1, 2]) / s, 0.25 * s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s
+    elif r[1, 1] >= r[2, 2]:
+        s = 2.0 * math.sqrt(1.0 - r[0, 0] + r[1, 1] - r[2, 2])
+        q[0], q[1], q[2], q[3] = (r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, 0.25 * s, (r[1, 2] + r[2, 1]) / s
+    else:
+        s = 2.0 * math.sqrt(1.0 - r[0, 0] - r[1, 1] + r[2, 2])
+        q[0], q[1], q[2], q[3] = (r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, 0.25 * s
+    if q[0] < 0.0:
+        for i in range(4):
+            q[i] = -q[i]
+    _normalise(q)
+
+
+@njit(cache=True, error_model="numpy")
 def euler_from_quaternion(q, theta):
     """Z-Y-X Euler angles (roll, pitch, yaw) of q, rad."""
     q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
@@ -88,6 +157,7 @@ def euler_to_quaternion(roll, pitch, yaw):
 
 @njit(cache=True, error_model="numpy")
 def quaternion_from_euler(theta, q):
+    """Write into ``q`` the quaternion of the Z-Y-X Euler angles ``theta`` (rad)."""
     q[0], q[1], q[2], q[3] = euler_to_quaternion(theta[0], theta[1], theta[2])
 
 
@@ -102,6 +172,11 @@ def _normalise(q):
     n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     for i in range(4):
         q[i] /= n
+
+
+@njit(cache=True, error_model="numpy")
+def _norm3(v):
+    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 
 
 @njit(cache=True, error_model="numpy")
@@ -133,101 +208,182 @@ def _integrate(q, wx, wy, wz, dt, discretisation):
 
 
 @njit(cache=True, error_model="numpy")
-def _cross_with_reference(r, v, vx, vy, vz, norm_v, gain, w):
-    """w += gain (v/|v|) x (R^T ref/|ref|), the correction of one reference direction."""
-    bx = r[0, 0] * vx + r[1, 0] * vy + r[2, 0] * vz
-    by = r[0, 1] * vx + r[1, 1] * vy + r[2, 1] * vz
-    bz = r[0, 2] * vx + r[1, 2] * vy + r[2, 2] * vz
-    scale = gain / (norm_v * math.sqrt(bx * bx + by * by + bz * bz))
-    w[0] += scale * (v[1] * bz - v[2] * by)
-    w[1] += scale * (v[2] * bx - v[0] * bz)
-    w[2] += scale * (v[0] * by - v[1] * bx)
+def _body(r, vx, vy, vz, out):
+    """out = R^T (vx, vy, vz) / |.|, an inertial direction seen in the body frame."""
+    out[0] = r[0, 0] * vx + r[1, 0] * vy + r[2, 0] * vz
+    out[1] = r[0, 1] * vx + r[1, 1] * vy + r[2, 1] * vz
+    out[2] = r[0, 2] * vx + r[1, 2] * vy + r[2, 2] * vz
+    n = _norm3(out)
+    for i in range(3):
+        out[i] /= n
+
+
+@njit(cache=True, error_model="numpy")
+def _add_cross(v, norm_v, vhat, gain, w):
+    """w += gain (v/|v|) x vhat, the correction of one reference direction (vhat unit)."""
+    scale = gain / norm_v
+    w[0] += scale * (v[1] * vhat[2] - v[2] * vhat[1])
+    w[1] += scale * (v[2] * vhat[0] - v[0] * vhat[2])
+    w[2] += scale * (v[0] * vhat[1] - v[1] * vhat[0])
 
 
 @njit(cache=True, error_model="numpy")
 def triad(acc, mag, config, r):
-    """Rotation body -> NED from the accelerometer (primary: gravity) and the magnetometer.
+    """Rotation body -> inertial from the accelerometer (primary: gravity) and the magnetometer.
 
-    Inertial triad (down, down x m_I, down x (down x m_I)) matched with the body triad built
-    the same way from d = -acc/|acc| and the measured field. False, and ``r`` unset, when
-    the two measurements give no frame (null or parallel).
+    Inertial triad ``(d_I, d_I x m_I, d_I x (d_I x m_I))`` with ``d_I = g_I/|g_I|``, matched with
+    the body triad built the same way from ``d = -acc/|acc|`` and the measured field, so that
+    ``R^T d_I = d`` exactly: the magnetometer sets the heading only. False, and ``r`` unset,
+    when the measurements or the references give no frame (null or parallel).
     """
-    na = math.sqrt(acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2])
-    if na == 0.0:
+    na = _norm3(acc)
+    gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
+    ng = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if na == 0.0 or ng == 0.0:
         return False
     d0, d1, d2 = -acc[0] / na, -acc[1] / na, -acc[2] / na
-    # body: s2 = d x mag / |.|, s3 = d x s2
     s20, s21, s22 = d1 * mag[2] - d2 * mag[1], d2 * mag[0] - d0 * mag[2], d0 * mag[1] - d1 * mag[0]
     n = math.sqrt(s20 * s20 + s21 * s21 + s22 * s22)
     if n == 0.0:
         return False
     s20, s21, s22 = s20 / n, s21 / n, s22 / n
     s30, s31, s32 = d1 * s22 - d2 * s21, d2 * s20 - d0 * s22, d0 * s21 - d1 * s20
-    # inertial: t1 = e3, t2 = e3 x m_I / |.| = (-m_y, m_x, 0)/|.|, t3 = e3 x t2 = (-t2_y, t2_x, 0)
-    mx, my = config[M_I], config[M_I + 1]
-    n = math.sqrt(mx * mx + my * my)
-    t20, t21 = -my / n, mx / n
-    t30, t31 = -t21, t20
-    r[0, 0] = t20 * s20 + t30 * s30
-    r[0, 1] = t20 * s21 + t30 * s31
-    r[0, 2] = t20 * s22 + t30 * s32
-    r[1, 0] = t21 * s20 + t31 * s30
-    r[1, 1] = t21 * s21 + t31 * s31
-    r[1, 2] = t21 * s22 + t31 * s32
-    r[2, 0] = d0
-    r[2, 1] = d1
-    r[2, 2] = d2
+    t10, t11, t12 = gx / ng, gy / ng, gz / ng
+    mx, my, mz = config[FIELD], config[FIELD + 1], config[FIELD + 2]
+    t20, t21, t22 = t11 * mz - t12 * my, t12 * mx - t10 * mz, t10 * my - t11 * mx
+    n = math.sqrt(t20 * t20 + t21 * t21 + t22 * t22)
+    if n == 0.0:
+        return False
+    t20, t21, t22 = t20 / n, t21 / n, t22 / n
+    t30, t31, t32 = t11 * t22 - t12 * t21, t12 * t20 - t10 * t22, t10 * t21 - t11 * t20
+    # R = t1 d^T + t2 s2^T + t3 s3^T
+    r[0, 0] = t10 * d0 + t20 * s20 + t30 * s30
+    r[0, 1] = t10 * d1 + t20 * s21 + t30 * s31
+    r[0, 2] = t10 * d2 + t20 * s22 + t30 * s32
+    r[1, 0] = t11 * d0 + t21 * s20 + t31 * s30
+    r[1, 1] = t11 * d1 + t21 * s21 + t31 * s31
+    r[1, 2] = t11 * d2 + t21 * s22 + t31 * s32
+    r[2, 0] = t12 * d0 + t22 * s20 + t32 * s30
+    r[2, 1] = t12 * d1 + t22 * s21 + t32 * s31
+    r[2, 2] = t12 * d2 + t22 * s22 + t32 * s32
     return True
+
+
+@njit(cache=True, error_model="numpy")
+def _ramp(deviation, tolerance):
+    """Weight 1 at no deviation, falling linearly to 0 at ``tolerance``; 1 when tolerance is 0 (off)."""
+    if tolerance <= 0.0:
+        return 1.0
+    return max(0.0, 1.0 - abs(deviation) / tolerance)
+
+
+@njit(cache=True, error_model="numpy")
+def _linear(x, u, gains, config, dt):
+    g = math.sqrt(config[GRAVITY] ** 2 + config[GRAVITY + 1] ** 2 + config[GRAVITY + 2] ** 2)
+    acc, gyro, mag = u[ACC:ACC + 3], u[GYRO:GYRO + 3], u[MAG:MAG + 3]
+    theta = x[THETA:THETA + 3]
+    # roll and pitch from the accelerometer (small angles), yaw from the tilt-compensated field
+    measured1 = -acc[1] / g
+    measured2 = acc[0] / g
+    c1, s1 = math.cos(theta[0]), math.sin(theta[0])
+    c2, s2 = math.cos(theta[1]), math.sin(theta[1])
+    level_x = c2 * mag[0] + s2 * s1 * mag[1] + s2 * c1 * mag[2]
+    level_y = c1 * mag[1] - s1 * mag[2]
+    measured3 = math.atan2(-level_y, level_x)
+    theta[0] += dt * (gyro[0] - gains[K1] * (theta[0] - measured1))
+    theta[1] += dt * (gyro[1] - gains[K2] * (theta[1] - measured2))
+    theta[2] = wrap(theta[2] + dt * (gyro[2] - gains[K3] * wrap(theta[2] - measured3)))
+    quaternion_from_euler(theta, x[Q:Q + 4])
+
+
+@njit(cache=True, error_model="numpy")
+def _rest(x, acc, gyro, gains, g, dt):
+    """Rest detector on low-passed gyro and accelerometer; True once at rest for ``rest_time``."""
+    alpha = dt / (REST_LOWPASS_TAU + dt)
+    for i in range(3):
+        x[GYRO_LP + i] += alpha * (gyro[i] - x[GYRO_LP + i])
+        x[ACC_LP + i] += alpha * (acc[i] - x[ACC_LP + i])
+    if gains[REST_GYRO] <= 0.0:
+        return False
+    still = (_norm3(x[GYRO_LP:GYRO_LP + 3]) < gains[REST_GYRO]
+             and abs(_norm3(x[ACC_LP:ACC_LP + 3]) - g) < gains[REST_ACC])
+    x[REST_TIME] = x[REST_TIME] + dt if still else 0.0
+    return x[REST_TIME] >= gains[REST_MIN_TIME]
+
+
+@njit(cache=True, error_model="numpy")
+def _split(w, vhat, tilt_weight, heading_weight):
+    """w <- tilt_weight * (part of w normal to vhat) + heading_weight * (part along vhat)."""
+    along = w[0] * vhat[0] + w[1] * vhat[1] + w[2] * vhat[2]
+    for i in range(3):
+        w[i] = tilt_weight * (w[i] - along * vhat[i]) + heading_weight * along * vhat[i]
 
 
 @njit(cache=True, error_model="numpy")
 def update(kind, x, u, gains, config, dt, y, work):
     """One estimator step with the sample ``u``; writes the outputs ``y``.
 
-    ``kind`` is LINEAR, EXPLICIT or PASSIVE; ``gains`` in the order of
-    :data:`estimators.filters.DEFAULT_GAINS`; ``work`` is a
-    scratch array of WORK_SIZE floats owned by the caller, so that nothing is allocated.
+    ``kind`` is LINEAR, EXPLICIT or PASSIVE; ``x`` the state, ``u`` the sample, ``gains`` the
+    gain vector and ``config`` the configuration, each in the layout declared above; ``work``
+    is a scratch array of WORK_SIZE floats owned by the caller, so that nothing is allocated.
     """
-    acc, gyro, mag = u[0:3], u[3:6], u[6:9]
-    q, b, theta = x[0:4], x[4:7], x[7:10]
+    acc, gyro, mag = u[ACC:ACC + 3], u[GYRO:GYRO + 3], u[MAG:MAG + 3]
+    q, b = x[Q:Q + 4], x[B:B + 3]
+    if x[PENDING] > 0.0:
+        x[PENDING] = 0.0
+        if triad(acc, mag, config, work[W_RY:W_RY + 9].reshape((3, 3))):
+            quaternion_from_rotation(work[W_RY:W_RY + 9].reshape((3, 3)), q)
+            euler_from_quaternion(q, x[THETA:THETA + 3])
+    acc_weight, mag_weight, at_rest = 1.0, 1.0, False
     if kind == LINEAR:
-        g = config[G]
-        # roll and pitch from the accelerometer (small angles), yaw from the tilt-compensated field
-        measured1 = -acc[1] / g
-        measured2 = acc[0] / g
-        c1, s1 = math.cos(theta[0]), math.sin(theta[0])
-        c2, s2 = math.cos(theta[1]), math.sin(theta[1])
-        level_x = c2 * mag[0] + s2 * s1 * mag[1] + s2 * c1 * mag[2]
-        level_y = c1 * mag[1] - s1 * mag[2]
-        measured3 = math.atan2(-level_y, level_x)
-        theta[0] += dt * (gyro[0] - gains[0] * (theta[0] - measured1))
-        theta[1] += dt * (gyro[1] - gains[1] * (theta[1] - measured2))
-        theta[2] = wrap(theta[2] + dt * (gyro[2] - gains[2] * wrap(theta[2] - measured3)))
-        quaternion_from_euler(theta, q)
+        _linear(x, u, gains, config, dt)
     else:
-        r = work[0:9].reshape((3, 3))
-        w = work[9:12]
+        r = work[W_R:W_R + 9].reshape((3, 3))
+        w = work[W_OMEGA:W_OMEGA + 3]
+        v_up, v_field = work[W_UP:W_UP + 3], work[W_FIELD:W_FIELD + 3]
         rotation(q, r)
+        gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
+        mx, my, mz = config[FIELD], config[FIELD + 1], config[FIELD + 2]
+        g = math.sqrt(gx * gx + gy * gy + gz * gz)
+        field = math.sqrt(mx * mx + my * my + mz * mz)
+        _body(r, -gx, -gy, -gz, v_up)  # estimated direction of the specific force at rest ("up")
+        _body(r, mx, my, mz, v_field)
+        na, nm = _norm3(acc), _norm3(mag)
+        # a null measurement (free fall, a dropped sensor) carries no direction: weight 0
+        acc_weight = _ramp(na - g, gains[ACC_TOL]) if na > 0.0 else 0.0
+        mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL]) if nm > 0.0 else 0.0
+        if nm > 0.0 and gains[MAG_DIP_TOL] > 0.0:
+            # dip: angle of the field below the horizontal plane, measured against the estimate's vertical
+            sin_dip = -(mag[0] * v_up[0] + mag[1] * v_up[1] + mag[2] * v_up[2]) / nm
+            sin_ref = -(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2])
+            mag_weight *= _ramp(math.asin(min(1.0, max(-1.0, sin_dip))) - math.asin(min(1.0, max(-1.0, sin_ref))),
+                                gains[MAG_DIP_TOL])
         w[:] = 0.0
         if kind == EXPLICIT:
-            # v1 = acc/|acc| against R^T (0, 0, -1); v2 = mag/|mag| against R^T m_I/|m_I|
-            # a null measurement (free fall, a dropped sensor) carries no direction: skipped
-            na = math.sqrt(acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2])
-            nm = math.sqrt(mag[0] * mag[0] + mag[1] * mag[1] + mag[2] * mag[2])
-            if na > 0.0:
-                _cross_with_reference(r, acc, 0.0, 0.0, -1.0, na, gains[0], w)
-            if nm > 0.0:
-                _cross_with_reference(r, mag, config[M_I], config[M_I + 1], config[M_I + 2], nm, gains[1], w)
-            kp, ki = gains[2], gains[3]
+            # v1 = acc/|acc| against R^T(-g_I)/|g|; v2 = mag/|mag| against R^T m_I/|m_I|
+            if acc_weight > 0.0:
+                _add_cross(acc, na, v_up, gains[K1] * acc_weight, w)
+            if mag_weight > 0.0:
+                if gains[HEADING_ONLY] > 0.0:
+                    # the magnetometer's correction kept along the vertical: it turns the heading only
+                    m = work[W_SCRATCH:W_SCRATCH + 3]
+                    m[:] = 0.0
+                    _add_cross(mag, nm, v_field, gains[K2] * mag_weight, m)
+                    _split(m, v_up, 0.0, 1.0)
+                    for i in range(3):
+                        w[i] += m[i]
+                else:
+                    _add_cross(mag, nm, v_field, gains[K2] * mag_weight, w)
         else:
-            ry = work[12:21].reshape((3, 3))
+            ry = work[W_RY:W_RY + 9].reshape((3, 3))
             usable = True
             if config[RY] == TRIAD:
                 usable = triad(acc, mag, config, ry)
             else:
                 for i in range(3):
                     for j in range(3):
-                        ry[i, j] = u[9 + 3 * i + j]
+                        ry[i, j] = u[R_Y + 3 * i + j]
+                acc_weight, mag_weight = 1.0, 1.0  # R_reel carries no sensor disturbance
             # omega = vex(Pa(R^T R_y)): only the antisymmetric part of R^T R_y is needed
             for i, j, k in ((2, 1, 0), (0, 2, 1), (1, 0, 2)):
                 if not usable:
@@ -237,39 +393,125 @@ def update(kind, x, u, gains, config, dt, y, work):
                     upper += r[m, i] * ry[m, j]
                     lower += r[m, j] * ry[m, i]
                 w[k] = 0.5 * (upper - lower)
-            kp, ki = gains[0], gains[1]
-        b[0] -= dt * ki * w[0]
-        b[1] -= dt * ki * w[1]
-        b[2] -= dt * ki * w[2]
+            if usable and gains[HEADING_ONLY] > 0.0:
+                # tilt from R_y's vertical alone (the accelerometer for TRIAD), heading from the rest
+                along = w[0] * v_up[0] + w[1] * v_up[1] + w[2] * v_up[2]
+                v_meas = work[W_SCRATCH:W_SCRATCH + 3]
+                _body(ry, -gx, -gy, -gz, v_meas)
+                w[:] = 0.0
+                _add_cross(v_meas, 1.0, v_up, acc_weight, w)
+                for i in range(3):
+                    w[i] += mag_weight * along * v_up[i]
+            elif usable and (acc_weight < 1.0 or mag_weight < 1.0):
+                _split(w, v_up, acc_weight, mag_weight)
+        kp, ki = (gains[KP], gains[KI])
+        at_rest = _rest(x, acc, gyro, gains, g, dt)
+        for i in range(3):
+            b[i] -= dt * ki * w[i]
+            if at_rest:
+                b[i] += dt * gains[REST_GAIN] * (gyro[i] - b[i])
         _integrate(q, gyro[0] - b[0] + kp * w[0], gyro[1] - b[1] + kp * w[1], gyro[2] - b[2] + kp * w[2], dt,
                    int(config[DISCRETE]))
-        euler_from_quaternion(q, theta)
+        euler_from_quaternion(q, x[THETA:THETA + 3])
     for i in range(4):
-        y[i] = q[i]
+        y[OUT_Q + i] = q[i]
     for i in range(3):
-        y[4 + i] = theta[i]
-        y[7 + i] = b[i]
-        y[10 + i] = gyro[i] - b[i]
+        y[OUT_THETA + i] = x[THETA + i]
+        y[OUT_B + i] = b[i]
+        y[OUT_OMEGA + i] = gyro[i] - b[i]
+    y[OUT_WEIGHTS] = acc_weight
+    y[OUT_WEIGHTS + 1] = mag_weight
+    y[OUT_WEIGHTS + 2] = 1.0 if at_rest else 0.0
 
 
 @njit(cache=True, error_model="numpy")
-def initial_state(q0, b0, x):
+def initial_state(q0, b0, from_triad, x):
+    """State at the start: attitude ``q0`` (or TRIAD of the first sample), bias ``b0`` (rad/s)."""
+    x[:] = 0.0
     for i in range(4):
-        x[i] = q0[i]
+        x[Q + i] = q0[i]
     for i in range(3):
-        x[4 + i] = b0[i]
-    euler_from_quaternion(x[0:4], x[7:10])
+        x[B + i] = b0[i]
+    x[PENDING] = 1.0 if from_triad else 0.0
+    euler_from_quaternion(x[Q:Q + 4], x[THETA:THETA + 3])
+
+
+@njit(cache=True, error_model="numpy")
+def error_angles(q, reference, gravity, heading_offset):
+    """Total, inclination and signed heading errors (rad) of ``q`` against ``reference``.
+
+    The error is the rotation ``q (x) reference^-1`` in the inertial frame, first turned by
+    ``-heading_offset`` about the vertical (``gravity``'s direction) when the two frames differ
+    by a constant heading. Heading is its part about the vertical, inclination the rest
+    (the decomposition of the BROAD benchmark, Laidig et al. 2021).
+    """
+    p0, p1, p2, p3 = reference[0], -reference[1], -reference[2], -reference[3]
+    e0 = q[0] * p0 - q[1] * p1 - q[2] * p2 - q[3] * p3
+    e1 = q[0] * p1 + q[1] * p0 + q[2] * p3 - q[3] * p2
+    e2 = q[0] * p2 - q[1] * p3 + q[2] * p0 + q[3] * p1
+    e3 = q[0] * p3 + q[1] * p2 - q[2] * p1 + q[3] * p0
+    ng = math.sqrt(gravity[0] ** 2 + gravity[1] ** 2 + gravity[2] ** 2)
+    ux, uy, uz = gravity[0] / ng, gravity[1] / ng, gravity[2] / ng
+    if heading_offset != 0.0:
+        c, s = math.cos(0.5 * heading_offset), -math.sin(0.5 * heading_offset)
+        a1, a2, a3 = s * ux, s * uy, s * uz
+        e0, e1, e2, e3 = (c * e0 - a1 * e1 - a2 * e2 - a3 * e3, c * e1 + a1 * e0 + a2 * e3 - a3 * e2,
+                          c * e2 - a1 * e3 + a2 * e0 + a3 * e1, c * e3 + a1 * e2 - a2 * e1 + a3 * e0)
+    if e0 < 0.0:
+        e0, e1, e2, e3 = -e0, -e1, -e2, -e3
+    vector = math.sqrt(e1 * e1 + e2 * e2 + e3 * e3)
+    vertical = e1 * ux + e2 * uy + e3 * uz
+    total = 2.0 * math.atan2(vector, e0)
+    inclination = 2.0 * math.atan2(math.sqrt(max(0.0, vector * vector - vertical * vertical)),
+                                   math.sqrt(e0 * e0 + vertical * vertical))
+    heading = 2.0 * math.atan2(vertical, e0)
+    return total, inclination, heading
+
+
+@njit(cache=True, error_model="numpy")
+def accumulate_error(q, reference, gravity, heading_offset, sums):
+    """Add one sample's squared errors (and heading circular sums) to ``sums`` (ERROR_LAYOUT)."""
+    total, inclination, heading = error_angles(q, reference, gravity, heading_offset)
+    sums[E_TOTAL] += total * total
+    sums[E_INCL] += inclination * inclination
+    sums[E_HEAD] += heading * heading
+    sums[E_SIN] += math.sin(heading)
+    sums[E_COS] += math.cos(heading)
+    sums[E_COUNT] += 1.0
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def run_batch(kind, inputs, gains, config, dt, q0, b0, outputs):
-    """Run ``len(gains)`` filters over the samples ``inputs`` (N, n_u), gain sets in parallel.
+def run_batch(kind, inputs, gains, config, dt, q0, b0, from_triad, columns, outputs, reference, scored,
+              heading_offsets, sums):
+    """Run ``len(gains)`` filters over the samples ``inputs`` (N, INPUT_SIZE), gain sets in parallel.
 
-    ``gains`` (G, n_gains); ``outputs`` (G, N, OUTPUT_SIZE) is filled in place.
+    ``gains`` (G, GAIN_SIZE). The outputs listed by ``columns`` (indices into OUTPUT_LAYOUT) are
+    written into ``outputs`` (G, N, len(columns)), unless ``outputs`` has no sample axis
+    (shape (G, 0, 0)). With a ``reference`` (N, 4), the errors of the samples where
+    ``scored`` is true, after removing ``heading_offsets`` (G,), are summed into ``sums``
+    (G, ERROR_SIZE): a gain study then keeps no time series at all.
     """
+    keep = outputs.shape[1] > 0
+    score = reference.shape[0] > 0
     for g in prange(gains.shape[0]):
         x = np.empty(STATE_SIZE)
         work = np.empty(WORK_SIZE)
-        initial_state(q0, b0, x)
+        y = np.empty(OUTPUT_SIZE)
+        initial_state(q0, b0, from_triad, x)
         for n in range(inputs.shape[0]):
-            update(kind, x, inputs[n], gains[g], config, dt, outputs[g, n], work)
+            update(kind, x, inputs[n], gains[g], config, dt, y, work)
+            if keep:
+                for c in range(columns.shape[0]):
+                    outputs[g, n, c] = y[columns[c]]
+            if score and scored[n]:
+                accumulate_error(y[OUT_Q:OUT_Q + 4], reference[n], config[GRAVITY:GRAVITY + 3], heading_offsets[g],
+                                 sums[g])
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def score_series(q, reference, scored, gravity, heading_offsets, sums):
+    """The reduction of :func:`run_batch` on stored estimates ``q`` (G, N, 4)."""
+    for g in prange(q.shape[0]):
+        for n in range(q.shape[1]):
+            if scored[n]:
+                accumulate_error(q[g, n], reference[n], gravity, heading_offsets[g], sums[g])

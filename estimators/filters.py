@@ -1,31 +1,66 @@
 """Attitude estimators as a streaming block and as a function on recorded arrays.
 
 Both call the compiled update of :mod:`estimators.core`, so the block and the batch path
-compute the same numbers. Three filters:
+compute the same numbers. Three filters of the lab, and two published ones for comparison
+(:mod:`estimators.reference`: ``vqf``, ``madgwick``).
 
 ``linear`` (lab report, section II)
     Per axis, ``dtheta_i = omega_m,i - k_i (theta_i - theta_i,meas)`` with
     ``theta1,meas = -a_m,y / g``, ``theta2,meas = a_m,x / g`` and the yaw of the
     magnetometer after removing the estimated roll and pitch,
     ``theta3,meas = atan2(-m_level,y, m_level,x)`` (the lab's ``-m_y / m_I,1`` for small
-    angles). Gains ``k1, k2, k3`` (1/s), lab value 0.05. Explicit Euler. No bias estimate.
-``explicit`` (Mahony, Hamel, Pflimlin 2008, eqs. 32/48; lab section III.1)
+    angles). Gains ``k1, k2, k3`` (1/s). Explicit Euler. No bias estimate. NED only (gravity
+    along +z).
+``explicit`` (Mahony, Hamel, Pflimlin, "Nonlinear complementary filters on the special
+orthogonal group", 2008, eqs. 32/48; lab section III.1)
     ``dq = 0.5 q (x) (0, omega_m - b + kP omega_mes)``, ``omega_mes = sum k_i v_i x vhat_i``,
-    ``db = -kI omega_mes``. The references are normalised: ``v_1 = a_m/|a_m|`` against
-    ``vhat_1 = R^T (0, 0, -1)``, ``v_2 = m_m/|m_m|`` against ``vhat_2 = R^T m_I/|m_I|``.
-    Gains ``k1, k2`` (1/s, lab: 0.002 and 0.2), ``kP`` (1), ``kI`` (1/s^2; 0 turns the
-    bias estimate off).
+    ``db = -kI omega_mes``. The directions are normalised: ``v_1 = a_m/|a_m|`` against
+    ``vhat_1 = R^T (-g_I)/|g_I|``, ``v_2 = m_m/|m_m|`` against ``vhat_2 = R^T m_I/|m_I|``.
+    Gains ``k1, k2`` (1), ``kP`` (1/s), ``kI`` (1/s^2; 0 turns the bias estimate off).
+    **Gain convention**: ``kP`` multiplies ``k1`` and ``k2``, so Mahony's ``Kp`` (and the
+    ``ahrs`` package's ``k_P``) is ``kP`` with ``k1 = k2 = 1``, and Mahony's ``Ki`` is
+    ``kI`` with ``k1 = k2 = 1``. The lab wrote ``k1 = k2 = 0.2, kP = 1``: an effective
+    ``Kp`` of 0.2 per direction.
 ``passive`` (Mahony 2008, eqs. 13/47; lab section III.2)
     ``dR = R S(omega_m - b + kP omega)``, ``db = -kI omega``, ``omega = vex(Pa(R^T R_y))``,
     with ``R_y`` the true rotation ``R_reel`` of the IMU (``ry="reel"``, as the lab did) or
     the TRIAD rotation of accelerometer and magnetometer (``ry="triad"``). Gains ``kP``
-    (1/s) and ``kI`` (1/s^2), lab: 0.1 to 100.
+    (1/s) and ``kI`` (1/s^2).
 
-Initial state: ``q0`` (default identity) and ``b0`` (default zero, rad/s).
+Disturbance-aware corrections (explicit and passive; the passive filter's only with TRIAD),
+each switched by its own setting, all off when 0. ``corrections=True`` turns all on at
+:data:`CORRECTIONS`; a dict switches or tunes each:
+
+``heading_only`` (0 or 1)
+    The magnetometer's correction is kept along the estimated vertical, so a magnetic error
+    turns the heading and never tilts the estimate. Passive: the tilt correction comes from
+    ``R_y``'s vertical alone (the accelerometer, for TRIAD).
+``acc_tolerance`` (m/s^2)
+    The accelerometer's weight falls linearly from 1 to 0 as ``||a_m| - g|`` grows to this
+    value (linear accelerations, vibration).
+``mag_norm_tolerance`` (1, relative), ``mag_dip_tolerance`` (rad)
+    The magnetometer's weight falls linearly to 0 as ``|m_m|/|m_I| - 1`` or the measured dip
+    (against the estimate's vertical) minus the reference dip grows to these values.
+``rest_gyro`` (rad/s), ``rest_acc`` (m/s^2), ``rest_time`` (s), ``rest_gain`` (1/s)
+    Rest detection: once the low-passed gyro norm stays under ``rest_gyro`` and the low-passed
+    specific force within ``rest_acc`` of g for ``rest_time``, the bias follows the gyro,
+    ``db = rest_gain (omega_m - b)``.
+
+The outputs ``weights`` are the accelerometer and magnetometer weights in use and the rest flag.
+
+References: ``gravity`` (m/s^2, the acceleration of gravity in the inertial frame, NED by
+default, or its magnitude along +z) and the Earth field ``earth_field`` (T, inertial frame),
+or ``dip`` and ``declination`` (rad) with ``field_norm`` (T). Any right-handed inertial frame
+works (ENU: ``gravity=(0, 0, -9.81)``); default: the lab's (Paris, 65 deg dip, no declination).
+
+Initial state: ``q0`` (default identity) or ``initial="triad"`` (the TRIAD attitude of the
+first sample; the batch path also takes a function ``(gyro, acc, mag) -> q0``), and ``b0``
+(rad/s, default zero).
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -34,22 +69,71 @@ from estimators import core
 from fmus import vehicle
 from orchestrator.blocks import Block
 
+FILTERS = tuple(core.KINDS)
+# Defaults for real recordings (tuned on the BROAD benchmark; see the README)
 DEFAULT_GAINS = {
+    "linear": {"k1": 0.05, "k2": 0.05, "k3": 0.05},
+    "explicit": {"k1": 1.0, "k2": 1.0, "kP": 0.5, "kI": 0.002},
+    "passive": {"kP": 0.5, "kI": 0.002},
+}
+# The lab report's values
+LAB_GAINS = {
     "linear": {"k1": 0.05, "k2": 0.05, "k3": 0.05},
     "explicit": {"k1": 0.2, "k2": 0.2, "kP": 1.0, "kI": 0.0},
     "passive": {"kP": 1.0, "kI": 1.0},
 }
+CORRECTIONS = {
+    "heading_only": 1.0,
+    "acc_tolerance": 2.0,  # m/s^2
+    "mag_norm_tolerance": 0.2,  # 1, relative to |m_I|
+    "mag_dip_tolerance": math.radians(10.0),  # rad
+    "rest_gyro": math.radians(2.0),  # rad/s
+    "rest_acc": 0.5,  # m/s^2
+    "rest_time": 1.5,  # s
+    "rest_gain": 1.0,  # 1/s
+}
+CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
+OUTPUT_NAMES = tuple(name for name, _ in core.OUTPUT_LAYOUT)
 OUTPUTS = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "theta_est3",
-           "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z")
+           "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z",
+           "acc_weight", "mag_weight", "at_rest")
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")
 R_REEL = tuple(f"R_reel_{i}{j}" for i in range(1, 4) for j in range(1, 4))
+assert len(OUTPUTS) == core.OUTPUT_SIZE and len(MEASUREMENTS) + len(R_REEL) == core.INPUT_SIZE
 
 
-def check_gains(kind: str, gains: dict | None) -> dict:
-    """Gains of ``kind`` with defaults filled in; refuses unknown names and negative values."""
+def _reference_kinds():
+    from estimators import reference
+
+    return reference.KINDS
+
+
+def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
+    """Gains and correction settings of ``kind`` by name, defaults filled in.
+
+    Parameters
+    ----------
+    kind : {"linear", "explicit", "passive"}
+    gains : dict, optional
+        Gain values by name (see the module docstring); a value may be an array of gain sets.
+        Correction settings may be given here too, to vary them across gain sets.
+    corrections : bool or dict, optional
+        ``None``/``False``: all off; ``True``: all at :data:`CORRECTIONS`; a dict: those
+        given on (``True`` for the default value, or a value), the others off.
+
+    Returns
+    -------
+    dict
+        Every name the filter reads, with its value. Unknown names and negative or
+        non-finite values are refused with a ``ValueError``.
+    """
     if kind not in core.KINDS:
-        raise ValueError(f"unknown estimator {kind!r}; use one of {', '.join(core.KINDS)}")
+        raise ValueError(f"unknown estimator {kind!r}; use one of {', '.join(FILTERS + _reference_kinds())}")
     merged = dict(DEFAULT_GAINS[kind])
+    if kind != "linear":
+        merged |= _corrections(corrections)
+    elif corrections:
+        raise ValueError("the linear filter has no disturbance-aware corrections; use corrections=None")
     for name, value in (gains or {}).items():
         if name not in merged:
             raise ValueError(f"the {kind} estimator has no gain {name!r}; its gains are {', '.join(merged)}")
@@ -61,108 +145,403 @@ def check_gains(kind: str, gains: dict | None) -> dict:
     return merged
 
 
-def config_vector(discretisation: str = "exp", ry: str = "reel", earth_field=vehicle.EARTH_FIELD,
-                  gravity: float = vehicle.GRAVITY) -> np.ndarray:
+def _corrections(corrections) -> dict:
+    if corrections is None or corrections is False:
+        return dict(CORRECTIONS_OFF)
+    if corrections is True:
+        return dict(CORRECTIONS)
+    if not isinstance(corrections, dict):
+        raise ValueError(f"corrections={corrections!r}: give True, False or a dict of {', '.join(CORRECTIONS)}")
+    chosen = dict(CORRECTIONS_OFF)
+    for name, value in corrections.items():
+        if name not in CORRECTIONS:
+            raise ValueError(f"unknown correction {name!r}; the corrections are {', '.join(CORRECTIONS)}")
+        if value is True and name.startswith("rest_"):
+            chosen |= {k: v for k, v in CORRECTIONS.items() if k.startswith("rest_")}
+        else:
+            chosen[name] = CORRECTIONS[name] if value is True else float(value)
+    return chosen
+
+
+def gain_table(kind: str, gains: dict | None = None, corrections=None) -> np.ndarray:
+    """(G, core.GAIN_SIZE) table of gain sets, each column placed by its name."""
+    merged = check_gains(kind, gains, corrections)
+    columns = {name: np.atleast_1d(np.asarray(v, dtype=float)) for name, v in merged.items()}
+    sizes = {len(c) for c in columns.values() if len(c) > 1}
+    if len(sizes) > 1:
+        raise ValueError(f"array-valued gains must share one length, not {sorted(sizes)}; gain_grid() builds "
+                         "a Cartesian product")
+    count = sizes.pop() if sizes else 1
+    table = np.zeros((count, core.GAIN_SIZE))
+    for name, column in columns.items():
+        table[:, core.GAIN_SLOTS[name]] = column
+    return table
+
+
+def gain_grid(**axes) -> dict:
+    """Cartesian product of named gain values, as equal-length arrays for :func:`estimate`.
+
+    ``gain_grid(kP=[0.1, 1], kI=[0, 0.01, 0.1])`` gives six gain sets; the first name varies
+    slowest, so a result over the sets reshapes to ``(2, 3)``, the lengths in the order given.
+    """
+    if not axes:
+        raise ValueError("gain_grid needs at least one named axis, e.g. gain_grid(kP=[0.1, 1])")
+    values = [np.atleast_1d(np.asarray(v, dtype=float)) for v in axes.values()]
+    product = np.array(list(itertools.product(*values)), dtype=float).reshape(-1, len(values))
+    return {name: product[:, k] for k, name in enumerate(axes)}
+
+
+def references(gravity=vehicle.GRAVITY, earth_field=None, dip=None, declination=0.0,
+               field_norm=vehicle.EARTH_FIELD_NORM) -> tuple[np.ndarray, np.ndarray]:
+    """Gravity (m/s^2) and Earth field vectors in the inertial frame.
+
+    Parameters
+    ----------
+    gravity : float or (3,) array
+        Acceleration of gravity, inertial frame (m/s^2); a number is its magnitude along +z
+        (NED's down).
+    earth_field : (3,) array, optional
+        Earth field, inertial frame (T or the magnetometer's unit). Default: from ``dip``, or
+        the lab's field.
+    dip, declination : float, optional
+        Inclination below the horizontal and declination east of north (rad), for a NED
+        frame, with ``field_norm`` (T).
+    """
+    g = np.array([0.0, 0.0, float(gravity)]) if np.ndim(gravity) == 0 else np.asarray(gravity, dtype=float)
+    if g.shape != (3,) or not np.all(np.isfinite(g)) or np.linalg.norm(g) == 0:
+        raise ValueError(f"gravity {gravity!r} must be a non-zero number (m/s^2, along +z) or a 3-vector")
+    if earth_field is not None and dip is not None:
+        raise ValueError("give either earth_field or dip (and declination), not both")
+    if dip is not None:
+        m = field_norm * np.array([math.cos(dip) * math.cos(declination), math.cos(dip) * math.sin(declination),
+                                   math.sin(dip)])
+    else:
+        m = np.asarray(vehicle.EARTH_FIELD if earth_field is None else earth_field, dtype=float)
+    if m.shape != (3,) or not np.all(np.isfinite(m)) or np.linalg.norm(np.cross(m, g)) == 0:
+        raise ValueError(f"earth_field {m} must be a finite 3-vector not parallel to gravity")
+    return g, m
+
+
+def config_vector(discretisation: str = "exp", ry: str = "reel", earth_field=None, gravity=vehicle.GRAVITY,
+                  dip=None, declination=0.0) -> np.ndarray:
+    """The configuration of the compiled filters (layout ``core.CONFIG_LAYOUT``).
+
+    ``discretisation`` ``"exp"`` (exponential map) or ``"euler"`` (Euler step plus
+    renormalisation); ``ry`` ``"reel"`` or ``"triad"`` for the passive filter; references as in
+    :func:`references`.
+    """
     if discretisation not in ("exp", "euler"):
         raise ValueError(f"discretisation {discretisation!r} must be 'exp' or 'euler'")
     if ry not in ("reel", "triad"):
         raise ValueError(f"ry {ry!r} must be 'reel' (the IMU's R_reel) or 'triad' (from acc and mag)")
+    g, m = references(gravity, earth_field, dip, declination)
     config = np.empty(core.CONFIG_SIZE)
-    config[core.G] = gravity
-    config[core.M_I:core.M_I + 3] = earth_field
+    config[core.GRAVITY:core.GRAVITY + 3] = g
+    config[core.FIELD:core.FIELD + 3] = m
     config[core.DISCRETE] = core.EXP if discretisation == "exp" else core.EULER
     config[core.RY] = core.REEL if ry == "reel" else core.TRIAD
     return config
 
 
-class QuaternionEstim(Block):
-    """The lab's ``Quaternion_estim`` block: one of the three filters, streaming.
+def _initial(q0, initial) -> tuple[np.ndarray, bool]:
+    if initial not in (None, "triad") and not callable(initial):
+        raise ValueError(f"initial={initial!r} must be None (use q0), 'triad' or a function (gyro, acc, mag) -> q0")
+    q = np.asarray((1.0, 0.0, 0.0, 0.0) if q0 is None else q0, dtype=float)
+    if q.shape != (4,) or not np.isfinite(q).all() or np.linalg.norm(q) == 0:
+        raise ValueError(f"q0 {q0!r} must be a non-zero quaternion (q0, q1, q2, q3)")
+    return q / np.linalg.norm(q), initial == "triad"
 
+
+class QuaternionEstim(Block):
+    """The lab's ``Quaternion_estim`` block: one of the filters, streaming.
+
+    Parameters
+    ----------
+    kind : {"linear", "explicit", "passive", "vqf", "madgwick"}
+    gains : dict, optional
+        Gains by name (scalars); see the module docstring and :func:`check_gains`.
+    name : str
+    period : int
+        Runs every ``period`` macro steps, normally at the IMU's rate.
+    q0 : (4,) array, optional
+        Initial attitude, body to inertial (default identity).
+    b0 : (3,) array
+        Initial gyro-bias estimate (rad/s).
+    initial : {None, "triad"}
+        ``"triad"``: start from the TRIAD attitude of the first sample instead of ``q0``.
+    corrections : bool or dict, optional
+        Disturbance-aware corrections, see :func:`check_gains`.
+    discretisation : {"exp", "euler"}
+    ry : {"reel", "triad"}
+        Passive filter: ``R_y`` from the IMU's ``R_reel`` or from TRIAD.
+    gravity, earth_field, dip, declination
+        Reference vectors, see :func:`references`.
+
+    Notes
+    -----
     Inputs: ``acc_x/y/z`` (m/s^2), ``gyro_x/y/z`` (rad/s), ``magneto_x/y/z`` (T), and
     ``R_reel_11..33`` for the passive filter fed by the true rotation. Outputs: ``q_est0..3``,
-    ``theta_est1..3`` (rad), ``b_est_x/y/z`` (rad/s), ``omega_est_x/y/z = gyro - b_est``.
-    Runs every ``period`` macro steps, normally at the IMU's rate.
+    ``theta_est1..3`` (rad, Z-Y-X), ``b_est_x/y/z`` (rad/s), ``omega_est_x/y/z = gyro - b_est``
+    (rad/s), ``acc_weight``, ``mag_weight`` (1) and ``at_rest`` (0 or 1).
     """
 
     outputs = OUTPUTS
 
-    def __init__(self, kind: str = "explicit", gains: dict | None = None, name: str = "Quaternion_estim",
-                 period: int = 1, q0=(1.0, 0.0, 0.0, 0.0), b0=(0.0, 0.0, 0.0), discretisation: str = "exp",
-                 ry: str = "reel"):
+    def __init__(self, kind: str = "explicit", gains: dict | None = None, *, name: str = "Quaternion_estim",
+                 period: int = 1, q0=None, b0=(0.0, 0.0, 0.0), initial=None, corrections=None,
+                 discretisation: str = "exp", ry: str = "reel", gravity=vehicle.GRAVITY, earth_field=None, dip=None,
+                 declination=0.0):
         super().__init__(name, period)
         self.kind = kind
-        self.gains = check_gains(kind, gains)
-        self.inputs = MEASUREMENTS + (R_REEL if kind == "passive" and ry == "reel" else ())
-        self.config = config_vector(discretisation, ry)
-        self.q0 = np.asarray(q0, dtype=float) / np.linalg.norm(q0)
+        self.q0, self.from_triad = _initial(q0, initial)
+        if callable(initial):
+            raise ValueError("the streaming block starts from q0 or initial='triad'; a function needs the recording")
         self.b0 = np.asarray(b0, dtype=float)
-        self._gains = np.array(list(self.gains.values()), dtype=float)
+        self.config = config_vector(discretisation, ry, earth_field, gravity, dip, declination)
+        if kind in _reference_kinds():
+            from estimators import reference
+
+            self.gains = reference.check_gains(kind, gains)
+            self.inputs = MEASUREMENTS
+            return
+        self.gains = check_gains(kind, gains, corrections)
+        _check_frame(kind, self.config)
+        self.inputs = MEASUREMENTS + (R_REEL if kind == "passive" and ry == "reel" else ())
+        self._gains = gain_table(kind, self.gains)[0]
         self._code = core.KINDS[kind]
 
     def start(self, t0, dt):
         self.dt = dt
+        if self.kind in _reference_kinds():
+            from estimators import reference
+
+            self.step = reference.streaming_step(self.kind, self.gains, self.config, dt, self.q0, self.b0,
+                                                 self.from_triad)
+            return
         self.state = np.empty(core.STATE_SIZE)
         self.work = np.empty(core.WORK_SIZE)
-        core.initial_state(self.q0, self.b0, self.state)
+        core.initial_state(self.q0, self.b0, self.from_triad, self.state)
         update, code, state, gains, config, work = (core.update, self._code, self.state, self._gains,
                                                     self.config, self.work)
+        sample = np.zeros(core.INPUT_SIZE)  # the block's inputs may omit R_reel: padded once here
+        width = len(self.inputs)
 
         def step(t, u, y):
-            update(code, state, u, gains, config, dt, y, work)
+            sample[:width] = u
+            update(code, state, sample, gains, config, dt, y, work)
 
         self.step = step  # bound once: the hot loop calls the compiled update directly
         _compile(code)
 
 
+def _check_frame(kind, config):
+    gx, gy, gz = config[core.GRAVITY:core.GRAVITY + 3]
+    if kind == "linear" and (gx or gy or gz <= 0):
+        raise ValueError("the linear filter works in NED only: give gravity along +z")
+
+
 def _compile(code: int):
     """Compile the update before a run, so that the first sample is not the one that pays."""
-    u = np.zeros(18)
-    u[2], u[6] = -1.0, 1.0
-    core.update(code, np.array([1.0, 0, 0, 0, 0, 0, 0, 0, 0, 0]), u, np.zeros(4), config_vector(), 1e-3,
-                np.empty(core.OUTPUT_SIZE), np.empty(core.WORK_SIZE))
+    u = np.zeros(core.INPUT_SIZE)
+    u[core.ACC + 2], u[core.MAG] = -1.0, 1.0
+    x = np.zeros(core.STATE_SIZE)
+    x[core.Q] = 1.0
+    core.update(code, x, u, np.zeros(core.GAIN_SIZE), config_vector(), 1e-3, np.empty(core.OUTPUT_SIZE),
+                np.empty(core.WORK_SIZE))
 
 
-def estimate(kind: str, acc, gyro, mag, dt: float, gains: dict | None = None, R_reel=None,
-             q0=(1.0, 0.0, 0.0, 0.0), b0=(0.0, 0.0, 0.0), discretisation: str = "exp", ry: str = "reel") -> dict:
-    """Run a filter on recorded arrays.
+def check_measurements(gyro, acc, mag, gravity_norm: float, check_units: bool = True) -> np.ndarray:
+    """(N, 9) samples ``acc, gyro, mag``, refused with a clear message when malformed.
+
+    With ``check_units``, the median norm of ``acc`` must lie between half and twice the
+    gravity norm (m/s^2): a gyro in rad/s, or an accelerometer in g, does not.
+    """
+    parts = {}
+    for label, value in (("acc", acc), ("gyro", gyro), ("mag", mag)):
+        array = np.asarray(value, dtype=float)
+        if array.ndim != 2 or array.shape[1] != 3:
+            raise ValueError(f"{label} must be an (N, 3) array, not shape {array.shape}")
+        parts[label] = array
+    lengths = {len(p) for p in parts.values()}
+    if len(lengths) != 1 or lengths == {0}:
+        raise ValueError(f"acc, gyro and mag must hold the same number (> 0) of samples, not "
+                         f"{[len(p) for p in parts.values()]}")
+    if check_units:
+        norms = {label: float(np.median(np.linalg.norm(p, axis=1))) for label, p in parts.items()}
+        if not 0.5 * gravity_norm <= norms["acc"] <= 2.0 * gravity_norm:
+            hint = ""
+            if 0.5 * gravity_norm <= norms["gyro"] <= 2.0 * gravity_norm:
+                hint = " The gyro's norm is near g: were acc and gyro swapped?"
+            elif 0.5 <= norms["acc"] <= 2.0:
+                hint = " Is acc in g? Give it in m/s^2."
+            raise ValueError(f"acc has a median norm of {norms['acc']:.3g}, not near |g| = {gravity_norm:.3g} m/s^2."
+                             f"{hint} (check_units=False skips this check.)")
+    inputs = np.ascontiguousarray(np.column_stack([parts["acc"], parts["gyro"], parts["mag"]]))
+    if not np.isfinite(inputs).all():
+        raise ValueError("the recorded measurements hold NaN or Inf")
+    return inputs
+
+
+def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None, corrections=None, R_reel=None,
+             q0=None, b0=(0.0, 0.0, 0.0), initial=None, discretisation: str = "exp", ry: str = "reel",
+             gravity=vehicle.GRAVITY, earth_field=None, dip=None, declination=0.0, outputs=OUTPUT_NAMES,
+             reference=None, scored=None, align_heading: bool = False, check_units: bool = True) -> dict:
+    """Run a filter on recorded arrays, for one or many gain sets at once.
 
     Parameters
     ----------
-    kind : {"linear", "explicit", "passive"}
-    acc, gyro, mag : (N, 3) arrays
-        Body-frame measurements (m/s^2, rad/s, T), sample ``n`` at time ``n * dt``.
+    kind : {"linear", "explicit", "passive", "vqf", "madgwick"}
+        The filter (see the module docstring; ``vqf`` and ``madgwick`` are the published
+        filters of :mod:`estimators.reference`).
+    gyro, acc, mag : (N, 3) arrays, keyword-only
+        Body-frame measurements: rad/s, m/s^2 (specific force: ``-g`` rotated into the body at
+        rest), and T (or the unit of ``earth_field``); sample ``n`` at time ``n * dt``.
     dt : float
         Sample period (s).
-    gains : dict
-        Gain values; a value may be an array of G gain sets, so that one call evaluates G
-        filters (all array-valued gains must have the same length; scalars are shared).
+    gains : dict, optional
+        Gains by name; a value may be an array of G gain sets, so that one call evaluates G
+        filters (array-valued gains share one length; scalars are shared; :func:`gain_grid`
+        builds a Cartesian product). Defaults: :data:`DEFAULT_GAINS`.
+    corrections : bool or dict, optional
+        Disturbance-aware corrections (explicit, passive), see :func:`check_gains`.
     R_reel : (N, 9) array, optional
         True rotation, row-major, for ``kind="passive"`` with ``ry="reel"``.
+    q0 : (4,) array, optional
+        Initial attitude, body to inertial, scalar first (default identity).
+    b0 : (3,) array
+        Initial gyro-bias estimate (rad/s).
+    initial : {None, "triad"} or callable
+        ``"triad"``: start from the TRIAD attitude of the first sample; a function
+        ``(gyro, acc, mag) -> q0`` computes ``q0`` from the recording.
+    discretisation : {"exp", "euler"}
+        Quaternion update: exponential map, or Euler step plus renormalisation (see
+        :mod:`estimators.core`).
+    ry : {"reel", "triad"}
+        Passive filter's measured rotation: the true one (``R_reel``) or TRIAD.
+    gravity, earth_field, dip, declination
+        Reference vectors in the inertial frame, see :func:`references`.
+    outputs : sequence of {"q", "theta", "b", "omega", "weights"}
+        Time series to return; ``("q",)`` keeps memory to 32 bytes per sample and gain set,
+        ``()`` keeps none (with ``reference``, for studies over thousands of gain sets).
+    reference : (N, 4) array, optional
+        True attitude; the errors against it are reduced inside the compiled loop.
+    scored : (N,) bool array, optional
+        Samples that count in the errors (default all), e.g. the movement phases.
+    align_heading : bool
+        Remove each gain set's mean heading offset before scoring (for a reference whose
+        inertial frame differs from the filter's by a constant heading); costs a second pass.
+    check_units : bool
+        Refuse an ``acc`` whose median norm is far from g (see :func:`check_measurements`).
 
     Returns
     -------
-    dict of arrays with a leading gain-set axis (G, N, ...): ``q`` (4), ``theta`` (3, rad),
-    ``b`` (3, rad/s), ``omega`` (3, rad/s).
+    dict
+        For each requested output an array (G, N, size): ``q`` (4), ``theta`` (3, rad, Z-Y-X),
+        ``b`` (3, rad/s), ``omega`` (3, rad/s), ``weights`` (3: accelerometer and
+        magnetometer weights, rest flag). With ``reference``, ``errors``: a dict of (G,)
+        arrays ``total_rmse_deg``, ``inclination_rmse_deg``, ``heading_rmse_deg`` and
+        ``heading_offset_deg`` (the offset removed).
     """
-    merged = check_gains(kind, gains)
-    columns = [np.atleast_1d(np.asarray(v, dtype=float)) for v in merged.values()]
-    sizes = {len(c) for c in columns if len(c) > 1}
-    if len(sizes) > 1:
-        raise ValueError(f"array-valued gains must share one length, not {sorted(sizes)}")
-    count = sizes.pop() if sizes else 1
-    table = np.column_stack([np.broadcast_to(c, count) for c in columns])
-    parts = [np.asarray(acc, float), np.asarray(gyro, float), np.asarray(mag, float)]
+    config = config_vector(discretisation, ry, earth_field, gravity, dip, declination)
+    inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[core.GRAVITY:core.GRAVITY + 3])),
+                                check_units)
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt = {dt} s must be positive")
+    unknown = [name for name in outputs if name not in OUTPUT_NAMES]
+    if unknown:
+        raise ValueError(f"unknown output {unknown[0]!r}; the outputs are {', '.join(OUTPUT_NAMES)}")
+    q_start, from_triad = _initial(q0, initial)
+    if callable(initial):
+        q_start, _ = _initial(initial(inputs[:, core.GYRO:core.GYRO + 3], inputs[:, core.ACC:core.ACC + 3],
+                                      inputs[:, core.MAG:core.MAG + 3]), None)
+    reference, scored = _scoring(reference, scored, len(inputs))
+    if kind in _reference_kinds():
+        from estimators import reference as published
+
+        series = published.estimate(kind, inputs, dt, gains, config, q_start, np.asarray(b0, float), from_triad,
+                                    outputs)
+        return _with_errors(series, reference, scored, config, align_heading)
+    table = gain_table(kind, gains, corrections)
+    _check_frame(kind, config)
     if kind == "passive" and ry == "reel":
         if R_reel is None:
             raise ValueError("the passive filter with ry='reel' needs R_reel (N, 9); or use ry='triad'")
-        parts.append(np.asarray(R_reel, float))
-    inputs = np.ascontiguousarray(np.column_stack(parts))
+        rotations = np.asarray(R_reel, dtype=float).reshape(len(inputs), 9)
+    else:
+        rotations = np.zeros((len(inputs), 9))
+    inputs = np.ascontiguousarray(np.column_stack([inputs, rotations]))
     if not np.isfinite(inputs).all():
-        raise ValueError("the recorded measurements hold NaN or Inf")
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt = {dt} s must be positive")
-    outputs = np.empty((count, len(inputs), core.OUTPUT_SIZE))
-    q0 = np.asarray(q0, dtype=float) / np.linalg.norm(q0)
-    core.run_batch(core.KINDS[kind], inputs, table, config_vector(discretisation, ry), dt, q0,
-                   np.asarray(b0, dtype=float), outputs)
-    return {"q": outputs[..., 0:4], "theta": outputs[..., 4:7], "b": outputs[..., 7:10], "omega": outputs[..., 10:13]}
+        raise ValueError("R_reel holds NaN or Inf")
+    columns = np.concatenate([np.arange(*core.OUTPUT_SLOTS[name]) for name in outputs] or [np.zeros(0, int)])
+    stored = np.empty((len(table), len(inputs) if len(columns) else 0, len(columns)))
+    sums = np.zeros((len(table), core.ERROR_SIZE))
+    offsets = np.zeros(len(table))
+    args = (core.KINDS[kind], inputs, table, config, dt, q_start, np.asarray(b0, dtype=float), from_triad,
+            columns.astype(np.int64))
+    core.run_batch(*args, stored, reference, scored, offsets, sums)
+    result, start = {}, 0
+    for name in outputs:
+        size = core.OUTPUT_SLOTS[name][1] - core.OUTPUT_SLOTS[name][0]
+        result[name] = stored[..., start:start + size]
+        start += size
+    if len(reference):
+        if align_heading:
+            offsets = np.arctan2(sums[:, core.E_SIN], sums[:, core.E_COS])
+            sums[:] = 0.0
+            core.run_batch(*args, np.empty((len(table), 0, 0)), reference, scored, offsets, sums)
+        result["errors"] = _errors(sums, offsets)
+    return result
+
+
+def _scoring(reference, scored, count):
+    if reference is None:
+        return np.zeros((0, 4)), np.zeros(0, dtype=bool)
+    reference = np.ascontiguousarray(reference, dtype=float)
+    if reference.shape != (count, 4) or not np.isfinite(reference).all():
+        raise ValueError(f"reference must be a finite ({count}, 4) array of quaternions, not shape {reference.shape}")
+    reference = reference / np.linalg.norm(reference, axis=1, keepdims=True)
+    scored = np.ones(count, dtype=bool) if scored is None else np.asarray(scored, dtype=bool).reshape(-1)
+    if scored.shape != (count,) or not scored.any():
+        raise ValueError(f"scored must be a ({count},) boolean array with at least one true sample")
+    return reference, scored
+
+
+def _errors(sums, offsets) -> dict:
+    count = sums[:, core.E_COUNT]
+    return {
+        "total_rmse_deg": np.degrees(np.sqrt(sums[:, core.E_TOTAL] / count)),
+        "inclination_rmse_deg": np.degrees(np.sqrt(sums[:, core.E_INCL] / count)),
+        "heading_rmse_deg": np.degrees(np.sqrt(sums[:, core.E_HEAD] / count)),
+        "heading_offset_deg": np.degrees(offsets),
+    }
+
+
+def _with_errors(series, reference, scored, config, align_heading):
+    """Errors of stored estimates (the published filters), by the same compiled reduction."""
+    if len(reference):
+        q = np.ascontiguousarray(series["q_all"])
+        gravity = config[core.GRAVITY:core.GRAVITY + 3].copy()
+        offsets = np.zeros(len(q))
+        sums = np.zeros((len(q), core.ERROR_SIZE))
+        core.score_series(q, reference, scored, gravity, offsets, sums)
+        if align_heading:
+            offsets = np.arctan2(sums[:, core.E_SIN], sums[:, core.E_COS])
+            sums[:] = 0.0
+            core.score_series(q, reference, scored, gravity, offsets, sums)
+        series["errors"] = _errors(sums, offsets)
+    series.pop("q_all")
+    return series
+
+
+def score(q, reference, scored=None, gravity=vehicle.GRAVITY, align_heading: bool = False) -> dict:
+    """Quaternion-error RMSE of estimates ``q`` (N, 4) or (G, N, 4) against ``reference`` (N, 4).
+
+    The same reduction as :func:`estimate`'s ``reference`` (total, inclination and heading
+    RMSE in degrees, over the ``scored`` samples; see :func:`estimators.core.error_angles`).
+    """
+    q = np.asarray(q, dtype=float)
+    q = np.ascontiguousarray(q[None] if q.ndim == 2 else q)
+    reference, scored = _scoring(reference, scored, q.shape[1])
+    g, _ = references(gravity)
+    return {k: (v[0] if q.shape[0] == 1 else v) for k, v in _with_errors(
+        {"q_all": q}, reference, scored, config_vector(gravity=g), align_heading)["errors"].items()}

@@ -67,8 +67,8 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
     start = int(round(o["burn_in"] / dt))
     variances, errors = [], []
     for chunk in np.array_split(gains, max(1, len(gains) // 2)):
-        out = estimate("linear", result["IMU.acc"], result["IMU.gyro"], result["IMU.magneto"], dt,
-                       {"k1": chunk, "k2": chunk, "k3": chunk})
+        out = estimate("linear", acc=result["IMU.acc"], gyro=result["IMU.gyro"], mag=result["IMU.magneto"], dt=dt,
+                       gains={"k1": chunk, "k2": chunk, "k3": chunk}, outputs=("theta",))
         for g in range(len(chunk)):
             error = out["theta"][g, start:, :2] - truth[start:]
             blocks = np.array_split(error, 20)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from estimators import DEFAULT_GAINS, QuaternionEstim
+from estimators import LAB_GAINS, QuaternionEstim
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
@@ -17,7 +17,7 @@ from scenarios.flight import FLIGHTS, SETPOINT, Controller, profile
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 OPTIONS = {
-    "estimator": Option("linear", "attitude estimator", choices=("linear", "explicit", "passive")),
+    "estimator": Option("linear", "attitude estimator", choices=("linear", "explicit", "passive", "vqf", "madgwick")),
     "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py)", choices=FLIGHTS),
     "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
@@ -32,6 +32,7 @@ OPTIONS = {
     "k2": Option(0.2, "explicit filter: magnetometer gain (1/s)", minimum=0.0),
     "kP": Option(1.0, "explicit: overall gain (1); passive: proportional gain (1/s)", minimum=0.0),
     "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)"),
+    "corrections": Option(False, "explicit/passive: disturbance-aware corrections (estimators.CORRECTIONS)"),
     "duration": Option(20.0, "simulated time (s)", minimum=0.01),
     "settle": Option(2.0, "time excluded from the error metrics (s)", minimum=0.0),
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
@@ -44,7 +45,9 @@ def estimator_gains(o: dict) -> dict:
     kind = o["estimator"]
     if kind == "linear":
         return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
-    ki = o["kI"] if o["kI"] >= 0 else DEFAULT_GAINS[kind]["kI"]
+    if kind in ("vqf", "madgwick"):
+        return {}  # the packages' defaults
+    ki = o["kI"] if o["kI"] >= 0 else LAB_GAINS[kind]["kI"]
     if kind == "explicit":
         return {"k1": o["k1"], "k2": o["k2"], "kP": o["kP"], "kI": ki}
     return {"kP": o["kP"], "kI": ki}
@@ -62,7 +65,8 @@ def build(o: dict) -> System:
               imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
               magnetic=o["magnetic"], imu_period=period)
     estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
-                                           discretisation=o["discretisation"], ry=o["ry"]))
+                                           discretisation=o["discretisation"], ry=o["ry"],
+                                           corrections=o["corrections"]))
     for name in estimator.inputs:
         system.connect(f"IMU.{name}", f"Quaternion_estim.{name}")
     system.add(Controller())
