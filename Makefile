@@ -19,7 +19,7 @@ fmus: $(STAMP)
 	$(BIN)/quadcosim build
 
 demo: fmus
-	$(BIN)/quadcosim run tp --out results/tp
+	$(BIN)/quadcosim run tp --out results/tp --overwrite
 
 test: fmus
 	$(BIN)/ruff check .

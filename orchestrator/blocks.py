@@ -58,27 +58,55 @@ class Table(Block):
         Block name.
     outputs : sequence of str
         Output names.
-    values : (n, len(outputs)) array
+    values : (n, len(outputs)) array, or callable
         Row ``k`` is output at the block's ``k``-th step; the last row is held after the end.
+        A callable ``values(t)`` maps an array of times ``t`` (s) to the rows at those times;
+        it is evaluated a chunk of rows at a time as the run goes, so that a long run never
+        holds its whole table in memory.
+    chunk : int
+        Rows evaluated at once from a callable.
     """
 
     feedthrough = False
 
-    def __init__(self, name: str, outputs, values, period: int = 1):
+    def __init__(self, name: str, outputs, values, period: int = 1, chunk: int = 4096):
         super().__init__(name, period)
         self.outputs = tuple(outputs)
-        self.values = np.ascontiguousarray(values, dtype=float)
-        if self.values.ndim != 2 or self.values.shape[1] != len(self.outputs):
-            raise ValueError(f"{name}: values must have shape (n, {len(self.outputs)}), not {self.values.shape}")
-        if not np.isfinite(self.values).all():
-            raise ValueError(f"{name}: the table holds NaN or Inf")
+        self.function = values if callable(values) else None
+        self.chunk = int(chunk)
+        if self.function is None:
+            self.values = self._checked(np.ascontiguousarray(values, dtype=float))
+        else:  # evaluated once here so that a bad function fails before the run
+            self.values = None
+            self._checked(np.ascontiguousarray(self.function(np.zeros(1)), dtype=float))
+
+    def _checked(self, values: np.ndarray) -> np.ndarray:
+        if values.ndim != 2 or values.shape[1] != len(self.outputs):
+            raise ValueError(f"{self.name}: values must have shape (n, {len(self.outputs)}), not {values.shape}")
+        if not np.isfinite(values).all():
+            raise ValueError(f"{self.name}: the table holds NaN or Inf")
+        return values
 
     def start(self, t0, dt):
-        self._rows = iter(self.values)
-        self._last = self.values[-1]
+        if self.function is None:
+            self._rows = iter(self.values)
+            self._last = self.values[-1]
+            return
+        self._t0, self._dt, self._next = t0, dt, 0
+        self._rows = iter(())
 
     def step(self, t, u, y):
-        y[:] = next(self._rows, self._last)
+        if self.function is None:
+            y[:] = next(self._rows, self._last)
+            return
+        row = next(self._rows, None)
+        if row is None:  # the next chunk: times (k0 + i) dt, as an array of the whole run has them
+            k = self._next + np.arange(self.chunk)
+            self._next += self.chunk
+            self._rows = iter(self._checked(np.ascontiguousarray(self.function(self._t0 + k * self._dt),
+                                                                 dtype=float)))
+            row = next(self._rows)
+        y[:] = row
 
 
 class Constant(Block):

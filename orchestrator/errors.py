@@ -13,6 +13,16 @@ class SimulationError(RuntimeError):
         self.result = result
 
 
+class RunInterrupted(SimulationError):
+    """The run was interrupted (Ctrl-C, or SIGTERM turned into
+    :class:`orchestrator.interrupts.Terminated`). ``result`` holds what was recorded;
+    ``signal_number`` is the signal that stopped it."""
+
+    def __init__(self, message: str, result: Result | None, signal_number: int):
+        super().__init__(message, result)
+        self.signal_number = signal_number
+
+
 class AlgebraicLoopError(ValueError):
     """Blocks with direct feedthrough form a cycle."""
 

@@ -31,15 +31,33 @@ from fmus import fmu_path
 
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 _extracted: dict[tuple[str, float], str] = {}
-_logs: dict[bytes, deque] = {}  # instance name -> its log
+_logs: dict[bytes, FMULog] = {}  # instance name -> its log
 _instances = itertools.count(1)
+
+
+class FMULog(deque):
+    """The last messages of one FMU instance, with a count of its warnings and the first few
+    of them (a warning, such as a saturated command, is kept even when later messages push it
+    out of the log)."""
+
+    FIRST = 5
+
+    def __init__(self, maxlen: int = 200):
+        super().__init__(maxlen=maxlen)
+        self.warnings = 0
+        self.first_warnings: list[str] = []
 
 
 def _on_log(env, instance, status, category, message):
     log = _logs.get(instance)
     if log is not None:
         label = STATUS[status] if 0 <= status < 6 else status
-        log.append(f"[{label}] {message.decode(errors='replace')}")
+        text = f"[{label}] {message.decode(errors='replace')}"
+        log.append(text)
+        if status == 1:
+            log.warnings += 1
+            if len(log.first_warnings) < FMULog.FIRST:
+                log.first_warnings.append(text)
 
 
 # fmpy's native proxy formats the FMU's variadic messages; it keeps one Python logger for the
@@ -105,7 +123,7 @@ class FMUInstance:
         path = Path(model) if str(model).endswith(".fmu") else fmu_path(model)
         self.name = name or path.stem
         self.time = start_time
-        self.log: deque[str] = deque(maxlen=200)
+        self.log = FMULog()
         description = read_model_description(str(path))
         self.description = description
         self.variables = {v.name: v for v in description.modelVariables}
@@ -170,6 +188,9 @@ class FMUInstance:
                 if int(value) != value:
                     raise ValueError(f"{self.name}.{name} = {value!r} must be an integer")
                 value = int(value)
+                if not -2**31 <= value < 2**31:  # an FMI Integer is 32 bits: no silent wrap-around
+                    raise ValueError(f"{self.name}.{name} = {value} is outside the range of an FMI Integer, "
+                                     f"{-2**31} to {2**31 - 1}")
             elif variable.type == "Boolean":
                 if value not in (True, False, 0, 1):
                     raise ValueError(f"{self.name}.{name} = {value!r} must be true or false")

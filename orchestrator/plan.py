@@ -38,10 +38,11 @@ import numpy as np
 
 from orchestrator.blocks import Block, FMUBlock
 from orchestrator.calls import DoStep, FMICall, GetOutputs, SetInputs, batch
-from orchestrator.errors import SimulationError
+from orchestrator.errors import RunInterrupted, SimulationError
 from orchestrator.faults import FaultTap, apply_faults
 from orchestrator.fmu import FMUError
-from orchestrator.result import Result
+from orchestrator.interrupts import signal_name, signal_number
+from orchestrator.result import Result, check_record_fits
 
 
 class Copy(NamedTuple):
@@ -125,6 +126,7 @@ class Plan:
         self._lay_out_bus()
         self._plan_recording(record)
         self.fmus: list[FMUBlock] = []
+        self.logs = {}  # block name -> its FMU's log, kept after the FMU is freed
         for fault in system.faults:
             fault.reset()
         try:
@@ -150,7 +152,9 @@ class Plan:
         by_slot = {v: k for k, v in self.slot.items()}
         self.names = [by_slot[s] for s in slots]
         self.record_copies = copies(slots)
-        self.record = np.empty((self.steps // self.decimation + 1, len(slots)))
+        rows = self.steps // self.decimation + 1
+        check_record_fits(rows, len(slots), self.decimation)
+        self.record = np.empty((rows, len(slots)))  # its pages become resident as rows fill
         self.recorded = 0
 
     def _source(self, block_name: str, u: str) -> tuple[int, bool]:
@@ -197,6 +201,7 @@ class Plan:
         """Instantiate ``block``, read its first outputs; its phase-A and phase-B calls."""
         instance = block.instantiate(self.t0)
         self.fmus.append(block)
+        self.logs[block.name] = instance.log
         early, late = [], []
         for u in block.inputs:
             slot, is_early = self._source(block.name, u)
@@ -267,8 +272,7 @@ class Plan:
                     if period == 1 or n % period == 0:
                         fn(t)
                 if bar is not None and n % chunk == 0 and n:
-                    bar.n = n * dt
-                    bar.refresh()
+                    bar.update(n * dt - bar.n)  # respects the bar's delay, unlike refresh()
         except _Failure as failure:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
@@ -279,6 +283,10 @@ class Plan:
         except Exception as error:  # a Python block failed: keep what was recorded
             message = f"at t = {t0 + n * dt:.6g} s: {type(error).__name__}: {error}"
             raise SimulationError(message, self.result(error=message)) from error
+        except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM by way of Terminated
+            number = signal_number(interrupt)
+            message = f"interrupted by {signal_name(number)} at t = {t0 + n * dt:.6g} s"
+            raise RunInterrupted(message, self.result(error=message), number) from None
         finally:
             self.loop_seconds = time.perf_counter() - started
             if bar is not None:
@@ -299,13 +307,19 @@ class Plan:
         return f"a signal became non-finite at t = {t:.6g} s"
 
     def result(self, error: str | None = None) -> Result:
-        """What was recorded so far, as a :class:`Result` (time in s from ``t0``)."""
+        """What was recorded so far, as a :class:`Result` (time in s from ``t0``). The data
+        are a view of the record, not a copy: a run's memory stays that of its record."""
         rows = self.recorded
-        times = self.t0 + np.arange(rows) * self.decimation * self.dt
+        times = np.arange(rows, dtype=np.float64)  # in place, one vector: the values of
+        times *= self.decimation                   # t0 + arange(rows) * decimation * dt
+        times *= self.dt
+        times += self.t0
+        warnings = {name: {"count": log.warnings, "first": list(log.first_warnings)}
+                    for name, log in self.logs.items() if log.warnings}
         meta = {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
                 "order": [b.name for b in self.order],
-                "connections": dict(self.system.connections)}
-        return Result(times, self.names, self.record[:rows].copy(), meta, error)
+                "connections": dict(self.system.connections), "fmu_warnings": warnings}
+        return Result(times, self.names, self.record[:rows], meta, error)
 
     def close(self):
         """Free the FMU instances and close the Python blocks."""

@@ -8,7 +8,46 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.files import atomic_path
 from orchestrator.fmu import nearest
+
+#: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.
+FORMATS = ("npz", "mat", "csv")
+
+
+def available_memory() -> int | None:
+    """Memory the kernel can give without swapping (bytes): ``MemAvailable`` of
+    ``/proc/meminfo``, or None where that is not known."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return None
+
+
+#: Share of the available memory a record may take: the rest is for the scenario's report.
+RECORD_SHARE = 0.8
+
+
+def check_record_fits(rows: int, signals: int, decimation: int = 1) -> int:
+    """Bytes a record of ``rows`` samples of ``signals`` float64 signals will take; raises
+    :class:`MemoryError` naming the figure and the way out if that exceeds
+    :data:`RECORD_SHARE` of the available memory."""
+    need = rows * signals * 8
+    available = available_memory()
+    if available is not None and need > RECORD_SHARE * available:
+        raise RecordTooLarge(
+            f"this run would record {rows} samples of {signals} signals, {need / 1e9:.3g} GB, more than "
+            f"{RECORD_SHARE:.0%} of the {available / 1e9:.3g} GB of memory available. Record less: every N-th "
+            f"step (--decimation N, now {decimation}), fewer signals (--record SIGNAL ...), or a shorter run.")
+    return need
+
+
+class RecordTooLarge(MemoryError, ValueError):
+    """A run's record would not fit in memory (a ``ValueError`` too: it is refused input)."""
 
 
 def expand(name: str, available) -> list[str]:
@@ -68,15 +107,20 @@ class Result:
         return self.data[:, columns[0]] if len(columns) == 1 and members[0] == name else self.data[:, columns]
 
     # ------------------------------------------------------------------ exports
+    # Each export writes a temporary file beside the target and renames it when complete, so
+    # an interrupt while saving never leaves a truncated file over earlier results.
     def to_npz(self, path) -> Path:
+        """NumPy archive: ``time``, one array per signal, and ``_meta`` (JSON)."""
         path = Path(path)
-        np.savez(path, time=self.time, **{n: self.data[:, i] for i, n in enumerate(self.names)},
-                 _meta=json.dumps(self.meta | {"error": self.error}))
+        with atomic_path(path) as temporary:
+            np.savez(temporary, time=self.time, **{n: self.data[:, i] for i, n in enumerate(self.names)},
+                     _meta=json.dumps(self.meta | {"error": self.error}, default=float))
         return path
 
     def to_csv(self, path) -> Path:
+        """One row per sample: ``time`` (s) then every signal, full precision."""
         path = Path(path)
-        with path.open("w", newline="") as handle:
+        with atomic_path(path) as temporary, temporary.open("w", newline="") as handle:
             writer = csv.writer(handle)
             writer.writerow(["time", *self.names])
             for t, row in zip(self.time, self.data, strict=True):
@@ -91,7 +135,8 @@ class Result:
         for i, name in enumerate(self.names):
             block, _, signal = name.partition(".")
             blocks.setdefault(block, {})[signal] = self.data[:, i]
-        savemat(Path(path), {"time": self.time, **blocks}, long_field_names=True)
+        with atomic_path(path) as temporary:
+            savemat(temporary, {"time": self.time, **blocks}, long_field_names=True)
         return Path(path)
 
     @classmethod
@@ -102,14 +147,17 @@ class Result:
             data = np.column_stack([archive[n] for n in names]) if names else np.empty((len(archive["time"]), 0))
             return cls(archive["time"], names, data, meta, meta.pop("error", None))
 
-    def save(self, out_dir, csv: bool = False) -> list[Path]:
-        """Write ``results.npz`` and ``results.mat`` (and ``results.csv``) into ``out_dir``."""
+    def save(self, out_dir, csv: bool = False, formats=("npz", "mat")) -> list[Path]:
+        """Write ``results.<format>`` into ``out_dir`` for each of ``formats`` (a subset of
+        :data:`FORMATS`; ``csv=True`` adds ``"csv"``). Returns the paths written."""
+        formats = list(dict.fromkeys([*formats, *(["csv"] if csv else [])]))
+        unknown = [f for f in formats if f not in FORMATS]
+        if unknown:
+            raise ValueError(f"unknown result format {', '.join(unknown)}; formats: {', '.join(FORMATS)}")
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        written = [self.to_npz(out / "results.npz"), self.to_mat(out / "results.mat")]
-        if csv:
-            written.append(self.to_csv(out / "results.csv"))
-        return written
+        writers = {"npz": self.to_npz, "mat": self.to_mat, "csv": self.to_csv}
+        return [writers[f](out / f"results.{f}") for f in formats]
 
     # ------------------------------------------------------------------ plots
     def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = ""):

@@ -9,7 +9,6 @@ figures and returns its metrics. :func:`run` does the rest: results (``results.n
 from __future__ import annotations
 
 import importlib
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -98,41 +97,76 @@ def get(name: str) -> Scenario:
     return scenarios[name]
 
 
-def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=()):
+def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
+        record=None, formats=("npz", "mat"), overwrite: bool = False):
     """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
 
-    Returns ``(result, metrics)``. On a failure, what was recorded is saved all the same and
-    :class:`orchestrator.SimulationError` is raised.
+    ``decimation`` keeps every N-th macro step; ``record`` lists the signals to keep (default:
+    the scenario's choice, else all); ``formats`` are the result files written (``npz``,
+    ``mat``, ``csv``). ``out_dir`` is checked before the run: a folder holding earlier results
+    is refused unless ``overwrite``.
+
+    Returns ``(result, metrics)``. On a failure or an interrupt, what was recorded is saved all
+    the same, with a ``metrics.json`` saying where the run stopped, and
+    :class:`orchestrator.SimulationError` (:class:`orchestrator.RunInterrupted`) is raised.
     """
     from orchestrator import SimulationError
+    from orchestrator.files import prepare_out_dir
+    from orchestrator.interrupts import signal_name
+    from orchestrator.result import FORMATS
+    from orchestrator import RunInterrupted
 
     scenario = get(name)
     options = scenario.parse(settings)
+    unknown = [f for f in formats if f not in FORMATS]
+    if unknown or not formats:
+        raise ValueError(f"--format {','.join(formats)}: choose among {', '.join(FORMATS)}")
+    out = prepare_out_dir(out_dir, overwrite) if out_dir else None
     system = scenario.build(options)
     for fault in faults:
         system.inject(fault)
     duration = scenario.duration(options) if scenario.duration else options["duration"]
-    out = Path(out_dir) if out_dir else None
+    base = {"scenario": name, "options": options, "duration_s": duration, "decimation": decimation}
     try:
-        result = system.run(duration, progress=progress, record=scenario.extra.get("record"))
+        result = system.run(duration, decimation=decimation, progress=progress,
+                            record=record if record else scenario.extra.get("record"))
     except SimulationError as error:
-        if out is not None and error.result is not None:
-            error.result.meta["scenario"] = {"name": name, "options": options}
-            error.result.save(out)
-            _write_metrics(out, {"scenario": name, "options": options, "error": str(error),
-                                 "recorded_until_s": float(error.result.time[-1]) if len(error.result) else None})
+        partial = error.result
+        if out is not None and partial is not None:
+            partial.meta["scenario"] = {"name": name, "options": options}
+            written = partial.save(out, formats=formats)
+            stopped = {"status": "interrupted" if isinstance(error, RunInterrupted) else "failed",
+                       "error": str(error),
+                       "recorded_until_s": float(partial.time[-1]) if len(partial) else None,
+                       "samples": len(partial),
+                       "fmu_warnings": _warning_counts(partial)}
+            if isinstance(error, RunInterrupted):
+                stopped["interrupted_by"] = signal_name(error.signal_number)
+            _write_metrics(out, base | stopped | {"files": sorted(p.name for p in written)})
         raise
     result.meta["scenario"] = {"name": name, "options": options}
-    metrics = {"scenario": name, "options": options}
+    metrics = base | {"status": "completed", "samples": len(result), "fmu_warnings": _warning_counts(result)}
+    written = result.save(out, formats=formats) if out is not None else []
+    try:
+        metrics |= scenario.report(result, options, out)
+    except KeyError as error:
+        if not record:
+            raise
+        # the report needs a signal the user chose not to record: the results stand alone
+        metrics["report"] = f"report skipped: {error.args[0]} (add it to --record for the report)"
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        result.save(out)
-    metrics |= scenario.report(result, options, out)
-    if out is not None:
-        _write_metrics(out, metrics)
+        figures = sorted(p.name for p in out.iterdir() if p.suffix in (".png", ".svg", ".pdf"))
+        _write_metrics(out, metrics | {"files": sorted([p.name for p in written] + figures)})
     return result, metrics
 
 
+def _warning_counts(result) -> dict:
+    """Per FMU block that warned: ``{"count": n, "first": [the first few messages]}``."""
+    return dict(result.meta.get("fmu_warnings", {}))
+
+
 def _write_metrics(out: Path, metrics: dict):
+    from orchestrator.files import write_json
+
     out.mkdir(parents=True, exist_ok=True)
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float) + "\n")
+    write_json(out / "metrics.json", metrics)

@@ -59,14 +59,32 @@ def _parse_fault(text: str):
     return Fault(parts[0], parts[1], float(parts[2]), float(parts[3]), value)
 
 
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a positive integer")
+    return value
+
+
 def _run(args) -> int:
     import scenarios
     from orchestrator import SimulationError
+    from orchestrator import RunInterrupted
 
+    out = Path(args.out) if args.out else Path("results") / args.scenario
+    formats = [f.strip() for f in args.format.split(",") if f.strip()]
     try:
         faults = [_parse_fault(f) for f in args.fault or []]
-        out = Path(args.out) if args.out else Path("results") / args.scenario
-        _, metrics = scenarios.run(args.scenario, args.set, out, progress=True, faults=faults)
+        _, metrics = scenarios.run(args.scenario, args.set, out, progress=True, faults=faults,
+                                   decimation=args.decimation, record=args.record, formats=formats,
+                                   overwrite=args.overwrite)
+    except RunInterrupted as error:
+        print(f"quadcosim run {args.scenario}: {error}", file=sys.stderr)
+        print(f"what was recorded ({len(error.result)} samples) and metrics.json are in {out}/", file=sys.stderr)
+        return 128 + error.signal_number
     except SimulationError as error:
         print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)
         if error.result is not None:
@@ -75,11 +93,23 @@ def _run(args) -> int:
     except (KeyError, ValueError) as error:
         print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
+    warnings = metrics.pop("fmu_warnings", {})
     shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario")}
     for key, value in shown.items():
         print(f"  {key}: {value}")
-    print(f"results, metrics.json and figures in {out}/")
+    _print_warnings(warnings)
+    print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
     return 0
+
+
+def _print_warnings(warnings: dict, shown: int = 3):
+    """The FMUs' warnings (counted in metrics.json): the count per block and the first few."""
+    if not warnings:
+        return
+    print("  FMU warnings: " + ", ".join(f"{block} {w['count']}" for block, w in warnings.items()), file=sys.stderr)
+    for block, w in warnings.items():
+        for line in w["first"][:shown]:
+            print(f"    {block}: {line}", file=sys.stderr)
 
 
 def _diagram(args) -> int:
@@ -119,6 +149,13 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="output folder (default results/SCENARIO)")
     run.add_argument("--fault", action="append", metavar="TARGET:KIND:START:STOP[:VALUE]",
                      help="fault on the connection into TARGET; KIND is offset, scale, stuck, noise or dropout")
+    run.add_argument("--overwrite", action="store_true", help="replace the results already in the --out folder")
+    run.add_argument("--decimation", type=_positive_int, default=1, metavar="N",
+                     help="record every N-th macro step (default 1)")
+    run.add_argument("--record", nargs="+", metavar="SIGNAL",
+                     help="record only these signals (Block.signal; a vector name such as IMU.acc is allowed)")
+    run.add_argument("--format", default="npz,mat", metavar="npz,mat,csv",
+                     help="result files to write, comma-separated (default npz,mat)")
     run.set_defaults(func=_run)
     diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
     diagram.add_argument("scenario")
@@ -133,8 +170,15 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    args = parser().parse_args(argv)
-    return args.func(args)
+    from orchestrator.interrupts import exit_code, terminate_as_interrupt
+
+    try:
+        with terminate_as_interrupt():  # SIGTERM ends the command as Ctrl-C does: cleanly
+            args = parser().parse_args(argv)
+            return args.func(args)
+    except KeyboardInterrupt as interrupt:  # before or after a run: nothing half-written is left
+        print("quadcosim: interrupted", file=sys.stderr)
+        return exit_code(interrupt)
 
 
 if __name__ == "__main__":

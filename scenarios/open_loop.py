@@ -7,6 +7,8 @@ left free after each pulse.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from fmus import vehicle
@@ -26,8 +28,13 @@ OPTIONS = {
 
 
 def commands(duration: float, dt: float, pulse: float) -> np.ndarray:
-    """(n, 4) ESC commands: spin-up, hover, then roll, pitch and yaw pulses of 50 ms."""
-    t = np.arange(int(round(duration / dt)) + 1) * dt
+    """(n, 4) ESC commands at 0, dt, ..., duration: see :func:`commands_at`."""
+    return commands_at(np.arange(int(round(duration / dt)) + 1) * dt, pulse)
+
+
+def commands_at(t: np.ndarray, pulse: float) -> np.ndarray:
+    """(len(t), 4) ESC commands at times ``t`` (s): spin-up, hover, then roll, pitch and yaw
+    pulses of 50 ms."""
     c = np.full((len(t), 4), vehicle.hover_command())
     c *= np.clip(t / 0.3, 0.0, 1.0)[:, None]
     # columns are motors 1..4: 1 front-right, 2 rear-left, 3 front-left, 4 rear-right
@@ -39,7 +46,7 @@ def commands(duration: float, dt: float, pulse: float) -> np.ndarray:
 
 def build(o: dict) -> System:
     system = System(dt=o["dt"])
-    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], commands(o["duration"], o["dt"], o["pulse"])))
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], partial(commands_at, pulse=o["pulse"])))
     add_plant(system, imu=imu_parameters(o["noise"], o["bias"], o["seed"]), magnetic=o["magnetic"])
     system.connect("Setpoint.c", "MotorMagnetics.c")
     return system

@@ -7,13 +7,15 @@ without the field of the motor currents at the magnetometer (the lab had none).
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from estimators import LAB_GAINS, QuaternionEstim
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
-from scenarios.flight import FLIGHTS, SETPOINT, Controller, profile
+from scenarios.flight import FLIGHTS, SETPOINT, Controller, profile_at
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 OPTIONS = {
@@ -60,7 +62,8 @@ def build(o: dict) -> System:
     if period < 1 or abs(period * o["dt"] * o["imu_rate"] - 1.0) > 1e-9:
         raise ValueError(f"imu_rate = {o['imu_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     system = System(dt=o["dt"])
-    system.add(Table("Setpoint", SETPOINT, profile(o["flight"], o["duration"], o["dt"], np.radians(o["tilt_deg"]))))
+    setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
+    system.add(Table("Setpoint", SETPOINT, setpoint))
     add_plant(system, quadrotor={"drag": o["drag"]}, motors={"omega0": vehicle.hover_rotor_speed()},
               imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
               magnetic=o["magnetic"], imu_period=period)

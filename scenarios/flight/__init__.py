@@ -9,6 +9,6 @@
 
 from scenarios.flight.controller import GAINS, SETPOINT, Controller
 from scenarios.flight.mixer import allocation_matrix, esc_command
-from scenarios.flight.profiles import FLIGHTS, profile
+from scenarios.flight.profiles import FLIGHTS, profile, profile_at
 
-__all__ = ["FLIGHTS", "GAINS", "SETPOINT", "Controller", "allocation_matrix", "esc_command", "profile"]
+__all__ = ["FLIGHTS", "GAINS", "SETPOINT", "Controller", "allocation_matrix", "esc_command", "profile", "profile_at"]

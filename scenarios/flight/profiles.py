@@ -48,25 +48,34 @@ def _sine(amplitude, frequency, t, phase=0.0):
 
 
 def profile(flight: str, duration: float, dt: float, tilt: float = 5.0 * DEG) -> np.ndarray:
-    """Setpoint table of a flight profile.
+    """Setpoint table of a flight profile at 0, dt, ..., duration (s): see :func:`profile_at`.
+
+    Returns
+    -------
+    (n, 7) ndarray
+        Rows of ``SETPOINT``.
+    """
+    return profile_at(flight, np.arange(int(round(duration / dt)) + 1) * dt, tilt)
+
+
+def profile_at(flight: str, t: np.ndarray, tilt: float = 5.0 * DEG) -> np.ndarray:
+    """Setpoints of a flight profile at times ``t`` (s). A ``Table`` evaluates it a chunk of
+    rows at a time, so that a long run never holds its whole profile.
 
     Parameters
     ----------
     flight : str
         One of :data:`FLIGHTS` (see the module docstring).
-    duration : float
-        Length (s).
-    dt : float
-        Row spacing (s), the ``Setpoint`` block's period.
+    t : ndarray
+        Times (s).
     tilt : float
         Pitch of the ``tilt`` profile (rad); ignored by the others.
 
     Returns
     -------
-    (n, 7) ndarray
+    (len(t), 7) ndarray
         Rows of ``SETPOINT``: roll, pitch, yaw (rad), x_d, y_d, z_d (m, NED), hold (1 or 0).
     """
-    t = np.arange(int(round(duration / dt)) + 1) * dt
     ramp = np.clip(t / EASE_IN, 0.0, 1.0)
     zero, one = np.zeros_like(t), np.ones_like(t)
     if flight == "hover":

@@ -1,0 +1,191 @@
+"""Runs and files under hostile but honest use: interrupts, bad output folders, runs too large
+for memory, out-of-range seeds, FMU warnings. Each case checks the message, the exit code and
+what is left on disk."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.io import loadmat
+
+import orchestrator.files
+from orchestrator import FMUBlock, Result, System, Table
+from orchestrator.files import atomic_path
+from scenarios.cli import main as cli
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+# ---------------------------------------------------------------------- interrupts
+@pytest.mark.parametrize("sent, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_an_interrupted_run_saves_what_it_recorded_and_leaves_no_temporary_files(tmp_path, sent, code):
+    temporary, out, errors = tmp_path / "tmp", tmp_path / "run", tmp_path / "stderr"
+    temporary.mkdir()
+    with errors.open("w") as stderr:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", "duration=120", "--out", str(out)],
+            stdout=subprocess.DEVNULL, stderr=stderr, cwd=ROOT, env=os.environ | {"TMPDIR": str(temporary)})
+        deadline = time.monotonic() + 120
+        while "%|" not in errors.read_text() and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.2)  # the progress bar shows once the run is under way
+        assert process.poll() is None, errors.read_text()
+        process.send_signal(sent)
+        assert process.wait(timeout=60) == code, errors.read_text()[-2000:]
+    message = errors.read_text()
+    assert f"interrupted by {sent.name} at t = " in message
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "interrupted" and metrics["interrupted_by"] == sent.name
+    stopped = metrics["recorded_until_s"]
+    assert 0 < stopped < 120
+    saved = Result.from_npz(out / "results.npz")
+    assert len(saved) == metrics["samples"] and saved.time[-1] == pytest.approx(stopped)
+    assert np.isfinite(saved.data).all() and saved["Quadrotor.q0"].shape == (len(saved),)
+    matlab = loadmat(out / "results.mat")
+    assert matlab["time"].size == len(saved)
+    assert sorted(os.listdir(temporary)) == []  # the extracted FMUs are gone
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]  # no half-written file
+    print(f"{sent.name}: exit {code}, stopped at t = {stopped} s, {len(saved)} samples kept")
+
+
+def test_an_interrupt_while_saving_keeps_the_earlier_file(tmp_path, monkeypatch):
+    path = tmp_path / "results.npz"
+    earlier = Result(np.arange(3.0), ["A.x"], np.ones((3, 1)))
+    earlier.to_npz(path)
+    before = path.read_bytes()
+
+    def interrupted_savez(file, **arrays):
+        Path(file).write_bytes(b"PK half an archive")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez", interrupted_savez)
+    with pytest.raises(KeyboardInterrupt):
+        Result(np.arange(5.0), ["A.x"], np.zeros((5, 1))).to_npz(path)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results.npz"]
+
+
+def test_atomic_files_take_the_usual_permissions(tmp_path):
+    with atomic_path(tmp_path / "metrics.json") as temporary:
+        temporary.write_text("{}")
+    assert (tmp_path / "metrics.json").stat().st_mode & 0o777 == 0o666 & ~orchestrator.files._UMASK
+
+
+# ---------------------------------------------------------------------- output folder
+def test_out_is_checked_before_the_run(tmp_path, capsys):
+    existing_file = tmp_path / "results"
+    existing_file.write_text("not a folder")
+    start = time.perf_counter()
+    assert cli(["run", "open-loop", "--out", str(existing_file)]) == 2
+    assert "--out " + str(existing_file) + ": a file of that name exists; give a folder name" in capsys.readouterr().err
+    assert cli(["run", "open-loop", "--out", "/proc/quadcosim-results"]) == 2
+    assert "cannot create the folder" in capsys.readouterr().err
+    assert time.perf_counter() - start < 5  # refused before anything is simulated
+
+
+def test_existing_results_are_refused_unless_overwrite_and_stale_files_go(tmp_path, capsys):
+    out = tmp_path / "run"
+    base = ["run", "open-loop", "--set", "duration=0.05", "--out", str(out)]
+    assert cli([*base, "--format", "npz,csv"]) == 0
+    assert {"results.npz", "results.csv", "metrics.json", "open_loop.png"} <= {p.name for p in out.iterdir()}
+    first = (out / "results.npz").read_bytes()
+    capsys.readouterr()
+    assert cli(base) == 2
+    assert "already holds results (results.npz, results.csv, metrics.json); give another folder or add " \
+        "--overwrite to replace them" in capsys.readouterr().err
+    assert (out / "results.npz").read_bytes() == first
+    assert cli([*base, "--format", "mat", "--overwrite"]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert "results.csv" not in names and "results.npz" not in names and "results.mat" in names
+    assert json.loads((out / "metrics.json").read_text())["files"] == ["imu.png", "open_loop.png", "results.mat"]
+
+
+# ---------------------------------------------------------------------- recording options
+def test_decimation_record_and_format_on_the_command_line(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert cli(["run", "open-loop", "--set", "duration=0.1", "--out", str(out), "--decimation", "10",
+                "--record", "IMU.acc", "Quadrotor.q", "--format", "npz,mat,csv"]) == 0
+    saved = Result.from_npz(out / "results.npz")
+    assert saved.names == ["Quadrotor.q0", "Quadrotor.q1", "Quadrotor.q2", "Quadrotor.q3",
+                           "IMU.acc_x", "IMU.acc_y", "IMU.acc_z"]
+    assert np.allclose(saved.time, np.arange(11) * 0.01)
+    header = (out / "results.csv").read_text().splitlines()[0]
+    assert header == "time," + ",".join(saved.names)
+    assert loadmat(out / "results.mat")["IMU"]["acc_x"][0, 0].size == 11
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["decimation"] == 10 and metrics["samples"] == 11
+    assert "report skipped" in metrics["report"] and "Setpoint.c" in metrics["report"]
+
+
+@pytest.mark.parametrize("arguments, words", [
+    (["--decimation", "0"], "argument --decimation: '0' is not a positive integer"),
+    (["--format", "npz,xls"], "--format npz,xls: choose among npz, mat, csv"),
+    (["--record", "IMU.acc_w"], "IMU has no output 'acc_w'. Did you mean"),
+])
+def test_bad_recording_options_are_refused(arguments, words, tmp_path, capsys):
+    assert run_cli(["run", "open-loop", "--set", "duration=0.05", "--out", str(tmp_path / "run"), *arguments]) == 2
+    assert words in capsys.readouterr().err
+
+
+def run_cli(arguments) -> int:
+    """The command's exit code, argparse's refusals included."""
+    try:
+        return cli(arguments)
+    except SystemExit as exit:
+        return exit.code
+
+
+# ---------------------------------------------------------------------- memory
+def test_a_run_that_would_not_fit_in_memory_is_refused_with_the_figure_and_the_way_out(tmp_path, capsys):
+    start = time.perf_counter()
+    assert cli(["run", "open-loop", "--set", "duration=1e7", "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err
+    assert "this run would record 10000000001 samples of" in err
+    assert "GB of memory available. Record less: every N-th step (--decimation N, now 1)" in err
+    assert time.perf_counter() - start < 20
+
+
+def test_the_record_is_not_copied_at_the_end_of_a_run():
+    """Python-side allocations during a run: the record, its time vector, and little else."""
+    steps = 200_000
+    system = System(dt=1e-3)
+    system.add(Table("Source", ["a", "b", "c", "d"], np.ones((1, 4))))
+    tracemalloc.start()
+    result = system.run(steps * 1e-3)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    recorded = result.data.nbytes + result.time.nbytes
+    print(f"peak Python allocation {peak / 1e6:.2f} MB for {recorded / 1e6:.2f} MB recorded")
+    assert peak < 1.05 * recorded
+
+
+# ---------------------------------------------------------------------- FMU parameters and warnings
+def test_a_seed_beyond_32_bits_is_refused_not_wrapped(tmp_path, capsys):
+    assert cli(["run", "open-loop", "--set", "seed=4294967297", "--out", str(tmp_path / "run")]) == 2
+    assert "IMU.seed = 4294967297 is outside the range of an FMI Integer, -2147483648 to 2147483647" \
+        in capsys.readouterr().err
+
+
+def test_fmu_warnings_are_counted_and_the_first_shown(tmp_path, capsys):
+    system = System()
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], [[1.5, 0.5, -0.2, 0.5]]))
+    system.add(FMUBlock("MotorMagnetics"))
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    result = system.run(0.01)
+    warnings = result.meta["fmu_warnings"]["MotorMagnetics"]
+    assert warnings["count"] == 2
+    assert warnings["first"][0].startswith("[Warning] c1 = 1.5 at t = 0 is outside [0, 1]: saturated")
+    out = tmp_path / "run"
+    assert cli(["run", "open-loop", "--set", "duration=0.3", "--out", str(out),
+                "--fault", "MotorMagnetics.c2:offset:0.1:0.2:1.0"]) == 0
+    err = capsys.readouterr().err
+    assert "FMU warnings: MotorMagnetics 1" in err
+    assert "MotorMagnetics: [Warning] c2 = " in err and "is outside [0, 1]: saturated" in err
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["fmu_warnings"]["MotorMagnetics"]["count"] == 1
