@@ -110,11 +110,10 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     the same, with a ``metrics.json`` saying where the run stopped, and
     :class:`orchestrator.SimulationError` (:class:`orchestrator.RunInterrupted`) is raised.
     """
-    from orchestrator import SimulationError
+    from orchestrator import RunInterrupted, SimulationError
     from orchestrator.files import prepare_out_dir
     from orchestrator.interrupts import signal_name
     from orchestrator.result import FORMATS
-    from orchestrator import RunInterrupted
 
     scenario = get(name)
     options = scenario.parse(settings)

@@ -71,8 +71,7 @@ def _positive_int(text: str) -> int:
 
 def _run(args) -> int:
     import scenarios
-    from orchestrator import SimulationError
-    from orchestrator import RunInterrupted
+    from orchestrator import RunInterrupted, SimulationError
 
     out = Path(args.out) if args.out else Path("results") / args.scenario
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
