@@ -17,7 +17,8 @@ Modes:
   (:class:`calibration.identify.MotorDynamics`): per motor a back-EMF state ``e`` (V) with
   ``de/dt = rate (c u - e) - drag e |e|`` (DC motor, quasi-static current), the winding voltage
   ``w = clip(c u - e, low, limit)`` with ``low = 0`` when the ESC free-wheels, and the amplitude
-  ``gain c^exponent w`` (``exponent = 1``: the supply cable carries the ESC input current
+  ``gain c^exponent w``, with the command and voltage held over the last step (the current at
+  ``t`` answers the voltage applied before ``t``) (``exponent = 1``: the supply cable carries the ESC input current
   ``c i``; ``0``: the motor current ``i``). Integrated by Heun's method on the macro step.
 
 The magnetometer is sampled and held at ``sample_rate`` (instants ``k / sample_rate``); the
@@ -104,11 +105,13 @@ def step(t, dt, mag, c, u, A_inv, b_s, v, theta, I, J, dynamics, mode, sample_ra
             for n in range(n_motors):
                 if mode == METGE:
                     f = _amplitude_polynomial(c_clip[n], u, theta[n], I, J)
-                else:
-                    w = c_clip[n] * u - state[n]
+                else:  # the current at t was driven by the command held over the last step
+                    c_held = state[n_motors + n] if state[started] > 0.0 else c_clip[n]
+                    u_held = state[2 * n_motors] if state[started] > 0.0 else u
+                    w = c_held * u_held - state[n]
                     low = 0.0 if dynamics[FREEWHEEL] > 0.5 else -np.inf
                     w = min(max(w, low), dynamics[LIMIT])
-                    f = dynamics[GAINS + n] * w * (c_clip[n] if dynamics[EXPONENT] > 0.5 else 1.0)
+                    f = dynamics[GAINS + n] * w * (c_held if dynamics[EXPONENT] > 0.5 else 1.0)
                 for a in range(3):
                     state[held + a] += f * v[n, a]
     for n in range(n_motors):

@@ -12,7 +12,7 @@ File format (UTF-8 JSON, SI units; every field is checked on loading)::
       "field": {"orders": {"I": 4, "J": 1},          # eq. 4
                 "v": [[N x 3]],                      # unit directions, sensor frame
                 "theta": [[N x I (J + 1)]]},         # a_10, a_11, a_20, ... a_IJ (T / V^j)
-      "dynamics": {"rate": 1/s, "drag": 1/(V s), "limit": V, "exponent": 0 | 1,
+      "dynamics": {"rate": 1/s, "drag": 1/(V s), "limit": V or null (none), "exponent": 0 | 1,
                    "freewheel": true | false, "gain": [N] (T/V)},
       "notes": {...}                                # free-form provenance
     }
@@ -75,7 +75,8 @@ class Calibration:
             "reference": None if self.reference is None else np.asarray(self.reference, dtype=float).tolist(),
             "field": None if f is None else {"orders": {"I": f.orders[0], "J": f.orders[1]}, "v": f.v.tolist(),
                                              "theta": f.theta.tolist()},
-            "dynamics": None if d is None else {"rate": d.rate, "drag": d.drag, "limit": d.limit,
+            "dynamics": None if d is None else {"rate": d.rate, "drag": d.drag,
+                                                "limit": d.limit if np.isfinite(d.limit) else None,
                                                 "exponent": d.exponent, "freewheel": d.freewheel,
                                                 "gain": np.asarray(d.gain).tolist()},
             "notes": self.notes,
@@ -153,7 +154,8 @@ class Calibration:
             keys = {"rate", "drag", "limit", "exponent", "freewheel", "gain"}
             if not isinstance(d, dict) or not keys <= set(d):
                 fail(f"dynamics must hold {', '.join(sorted(keys))}")
-            rate, drag, limit = (float(array(d[k], (), f"dynamics.{k}")) for k in ("rate", "drag", "limit"))
+            rate, drag = (float(array(d[k], (), f"dynamics.{k}")) for k in ("rate", "drag"))
+            limit = np.inf if d["limit"] is None else float(array(d["limit"], (), "dynamics.limit"))
             if not (rate > 0 and drag >= 0 and limit > 0):
                 fail("dynamics.rate and dynamics.limit must be positive and dynamics.drag non-negative")
             if d["exponent"] not in (0, 1) or not isinstance(d["freewheel"], bool):

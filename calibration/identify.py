@@ -64,7 +64,7 @@ class MotorDynamics:
 
 def _predicted(params, time, c, u, v, exponent, freewheel, sample_rate):
     n = len(v)
-    dynamics = np.r_[np.exp(params[:3]), exponent, freewheel, params[3:3 + n]]
+    dynamics = np.r_[np.exp(np.clip(params[:3], -30.0, 30.0)), exponent, freewheel, params[3:3 + n]]
     out = np.empty((len(time), 3))
     zero = np.zeros(n)
     # Compensating a zero reading with A = I, b_s = 0 returns -b_d: the prediction, negated.
@@ -122,5 +122,8 @@ def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> Motor
             if best is None or cost < best[0]:
                 best = (cost, fit.x, exponent, freewheel)
     cost, x, exponent, freewheel = best
-    return MotorDynamics(rate=float(np.exp(x[0])), drag=float(np.exp(x[1])), limit=float(np.exp(x[2])),
+    limit = float(np.exp(x[2]))
+    if limit > 10 * u_mean:  # never reached in the records: no limit seen
+        limit = np.inf
+    return MotorDynamics(rate=float(np.exp(x[0])), drag=float(np.exp(x[1])), limit=limit,
                          exponent=int(exponent), freewheel=bool(freewheel), gain=np.array(x[3:]), rms=cost)

@@ -155,7 +155,7 @@ def test_dynamic_fit_refusals():
 
 def calibration():
     reference, sweeps = synthetic_set(1)
-    dynamics = MotorDynamics(rate=40.0, drag=0.5, limit=3.0, exponent=1, freewheel=True,
+    dynamics = MotorDynamics(rate=40.0, drag=0.5, limit=np.inf, exponent=1, freewheel=True,
                              gain=np.array([2e-5, 1.8e-5, 2.2e-5, 1.9e-5]))
     return Calibration(4, StaticCalibration(A_TRUE, B_TRUE, NORM), fit_dynamic(reference, sweeps), dynamics,
                        reference, {"origin": "synthetic"})

@@ -1,0 +1,323 @@
+"""``metge``: dynamic calibration and compensation of the motor currents' field, Table 1 and Figure 3 of Metge et al.
+
+Metge, Mégret, Giremus, Berthoumieu, Mazel, "Compensation dynamique des perturbations
+magnétiques pour l'estimation d'attitude d'un micro-drone" (GRETSI 2013). The drone is
+clamped, so the Earth field is constant in the sensor frame.
+
+- Calibration set 1: motors off (``m0``), then each motor alone through a staircase of K
+  command levels, 0 -> 1, motors in order 1..4; the settled part of each level is one of the
+  K measurements (eq. 5). The sweep is made at two battery states (a full and a half-used
+  battery): within one run the voltage barely moves, and the voltage terms of eq. 4 (J >= 1)
+  need it to. After the first run, the free set: all four commands varied together, slowly,
+  then fast, then slowly (as in flight).
+- Calibration set 2: two other battery states, other noise seeds, another sweep order
+  (motors 4..1, levels in a shuffled order).
+- Each set gives a calibration (eqs. 6 to 8, orders I, J), and the rig record of the same set
+  identifies the motor dynamics for the dynamics-aware compensation.
+- Table 1: mean angular error between the compensated field (eq. 9) and the motors-off
+  reference, rows "no dynamic calibration / calibration 1 / calibration 2", columns
+  "set 1 / set 2 / free set"; Figure 3: the error against time on the free set, with the
+  four commands.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
+from fmus import vehicle
+from orchestrator import System, Table
+from scenarios import Option, Scenario
+from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
+
+PAPER_TABLE1 = {"none": {"set1": 11.142, "set2": 10.623, "free": 55.853},
+                "calibration1": {"set1": 0.248, "set2": 0.635, "free": 7.970},
+                "calibration2": {"set1": 0.483, "set2": 0.226, "free": 7.706}}
+
+OPTIONS = {
+    "levels": Option(12, "K: command levels per motor", minimum=2),
+    "hold": Option(0.25, "time at each level (s)", minimum=0.02),
+    "settle": Option(0.15, "start of each level left out of the K measurements (s)", minimum=0.0),
+    "reference": Option(1.0, "motors-off time at the start (s)", minimum=0.1),
+    "rest": Option(0.5, "motors-off time after each motor (s)", minimum=0.0),
+    "free": Option(12.0, "time of the free set: slow, fast, slow thirds (s)", minimum=0.0),
+    "orders": Option("4,1", "I,J of eq. 4, or 'cv' for the orders chosen by cross-validation"),
+    "soc1": Option("0.95,0.6", "battery states of charge of the runs of set 1 (1)"),
+    "soc2": Option("0.8,0.45", "battery states of charge of the runs of set 2 (1)"),
+    "mag_rate": Option(100.0, "magnetometer sample rate (Hz): the IMU runs at it on the clamped rig",
+                       minimum=1.0),
+    "seed1": Option(1, "noise and free-set seed of set 1"),
+    "seed2": Option(2, "noise and sweep-order seed of set 2"),
+    "noise": Option(True, "IMU white noise"),
+    "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
+    "static": Option("", "static calibration file (JSON) for A, b_s; empty: the IMU's identity"),
+}
+RECORD = ["Setpoint.c", "MotorMagnetics.u_batt", "IMU.magneto"]
+
+
+def schedule(o: dict, set_number: int) -> tuple[list[tuple[str, float, float, int, float]], float]:
+    """Phases ``(name, start, stop, motor, command)`` of a calibration set and its end time (s).
+
+    Set 1: motors 1..4, levels rising; set 2: motors 4..1, levels shuffled."""
+    levels = np.arange(1, o["levels"] + 1) / o["levels"]
+    motors = [0, 1, 2, 3]
+    if set_number == 2:
+        motors = motors[::-1]
+        levels = np.random.default_rng(o["seed2"]).permutation(levels)
+    out, t = [("reference", 0.0, o["reference"], -1, 0.0)], o["reference"]
+    for n in motors:
+        for level in levels:
+            out.append((f"motor{n + 1}", t, t + o["hold"], n, float(level)))
+            t += o["hold"]
+        t += o["rest"]
+    return out, t
+
+
+def free_commands(o: dict, t: np.ndarray) -> np.ndarray:
+    """All four commands together: sums of sinusoids, slow (0.1 to 0.6 Hz) in the outer thirds,
+    fast (1 to 4 Hz) in the middle third, around 0.5."""
+    rng = np.random.default_rng(o["seed1"] + 100)
+    third = o["free"] / 3
+    fast = (t >= third) & (t < 2 * third)
+    c = np.empty((len(t), 4))
+    for n in range(4):
+        slow_f, fast_f = rng.uniform(0.1, 0.6, 3), rng.uniform(1.0, 4.0, 3)
+        phase = rng.uniform(0, 2 * np.pi, (2, 3))
+        slow = np.sin(2 * np.pi * slow_f[:, None] * t + phase[0][:, None]).sum(axis=0)
+        quick = np.sin(2 * np.pi * fast_f[:, None] * t + phase[1][:, None]).sum(axis=0)
+        c[:, n] = np.where(fast, 0.5 + 0.13 * quick, 0.5 + 0.13 * slow)
+    return np.clip(c, 0.0, 1.0)
+
+
+def socs(o: dict, set_number: int) -> list[float]:
+    text = o[f"soc{set_number}"]
+    try:
+        values = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise ValueError(f"option soc{set_number} = {text!r} must be comma-separated states of charge") from None
+    if not values or not all(0.0 <= v <= 1.0 for v in values):
+        raise ValueError(f"option soc{set_number} = {text!r}: each state of charge must be within [0, 1]")
+    return values
+
+
+def commands(o: dict, set_number: int, free: bool = False) -> tuple[np.ndarray, float, float]:
+    """Command table (rows every macro step), the end of the sweeps and the end of the run (s)."""
+    phases, end = schedule(o, set_number)
+    stop = end + (o["free"] if free else 0.0)
+    t = np.arange(int(round(stop / o["dt"])) + 1) * o["dt"]
+    c = np.zeros((len(t), 4))
+    for _, a, b, motor, level in phases[1:]:
+        c[(t >= a - 1e-9) & (t < b - 1e-9), motor] = level
+    if free and o["free"] > 0:
+        inside = t >= end - 1e-9
+        c[inside] = free_commands(o, t[inside] - end)
+    return c, end, stop
+
+
+def system_for(o: dict, set_number: int, run: int) -> System:
+    """Run ``run`` of calibration set ``set_number``; the first run of set 1 ends with the free set."""
+    c, _, _ = commands(o, set_number, free=(set_number, run) == (1, 0))
+    system = System(dt=o["dt"])
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], c))
+    seed = o[f"seed{set_number}"] + 10 * run
+    add_plant(system, quadrotor={"clamped": True}, motors={"soc0": socs(o, set_number)[run]},
+              imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"]))
+    system.connect("Setpoint.c", "MotorMagnetics.c")
+    return system
+
+
+def build(o: dict) -> System:
+    if not 0 <= o["settle"] < o["hold"]:
+        raise ValueError(f"settle = {o['settle']} s must be shorter than hold = {o['hold']} s")
+    socs(o, 1), socs(o, 2)
+    parse_orders(o["orders"])
+    if abs(round(1.0 / (o["mag_rate"] * o["dt"])) * o["mag_rate"] * o["dt"] - 1.0) > 1e-9:
+        raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
+    return system_for(o, 1, 0)
+
+
+def parse_orders(text: str):
+    if text == "cv":
+        return None
+    try:
+        I, J = (int(x) for x in text.split(","))
+    except ValueError:
+        raise ValueError(f"option orders = {text!r} must be 'I,J' (for instance 4,1) or 'cv'") from None
+    if I < 1 or J < 0:
+        raise ValueError(f"option orders = {text!r}: I must be >= 1 and J >= 0")
+    return I, J
+
+
+class RigRun:
+    """One recorded run on the clamped rig: arrays, phases, and the rows of its K measurements."""
+
+    def __init__(self, result, o: dict, set_number: int):
+        self.time = result.time
+        self.field = result["IMU.magneto"]
+        self.commands = result["Setpoint.c"]
+        self.voltage = result["MotorMagnetics.u_batt"]
+        self.phases, self.end = schedule(o, set_number)
+        t = self.time
+        _, a, b, _, _ = self.phases[0]
+        self.reference = self.field[(t >= a + 0.1) & (t < b)].mean(axis=0)  # m0, after the start-up
+        self.motor_of = np.full(len(t), -1)
+        for _, a, b, motor, _ in self.phases[1:]:
+            self.motor_of[(t >= a + o["settle"]) & (t < b - 1e-9)] = motor
+        self.settled = self.motor_of >= 0
+        self.sweeping = (t >= self.phases[1][1]) & (t < self.end)
+        self.free = t >= self.end
+
+    def record(self):
+        rows = self.time < self.end
+        return self.time[rows], self.field[rows], self.commands[rows], self.voltage[rows]
+
+
+class RigSet:
+    """A calibration set: runs at several battery states, pooled (each run's readings are taken
+    relative to its own motors-off reference)."""
+
+    def __init__(self, runs: list[RigRun]):
+        self.runs = runs
+        self.reference = np.mean([r.reference for r in runs], axis=0)
+
+    def sweeps(self) -> list[Sweep]:
+        out = []
+        for n in range(4):
+            parts = [(r.field[r.motor_of == n] - r.reference + self.reference, r.commands[r.motor_of == n, n],
+                      r.voltage[r.motor_of == n]) for r in self.runs]
+            out.append(Sweep(*(np.concatenate(x) for x in zip(*parts, strict=True))))
+        return out
+
+
+def load_static(o):
+    return Calibration.load(o["static"]).static if o["static"] else None
+
+
+def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Calibration:
+    model = fit_dynamic(rig.reference, rig.sweeps(), orders)
+    dynamics = fit_motor_dynamics([r.record() for r in rig.runs], [r.reference for r in rig.runs], model.v,
+                                  sample_rate)
+    return Calibration(4, static, model, dynamics, rig.reference, {"made_by": f"quadcosim run metge ({name})"})
+
+
+def errors_deg(cal: Calibration, run: RigRun, mode: str, sample_rate: float) -> np.ndarray:
+    """Angular error (deg) of the compensated field against the statically corrected
+    motors-off reference of the run, at every row."""
+    out = compensate(cal, run.time, run.field, run.commands, run.voltage, mode, sample_rate)
+    m0 = run.reference if cal.static is None else cal.static.correct(run.reference)
+    return np.degrees(angle_between(out, m0))
+
+
+def set_error(cal, rig: RigSet, mode, rate, rows: str) -> float:
+    """Mean error over the chosen rows (``settled`` or ``sweeping``) of every run of a set."""
+    return float(np.concatenate([errors_deg(cal, r, mode, rate)[getattr(r, rows)] for r in rig.runs]).mean())
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    orders = parse_orders(o["orders"])
+    rate = o["mag_rate"]
+    static = load_static(o)
+    runs = {1: [RigRun(result, o, 1)], 2: []}
+    for set_number in (1, 2):
+        for run in range(len(runs[set_number]), len(socs(o, set_number))):
+            recorded = system_for(o, set_number, run).run(commands(o, set_number)[2], record=RECORD)
+            if out is not None:
+                recorded.save(out / f"set{set_number}_run{run}")
+            runs[set_number].append(RigRun(recorded, o, set_number))
+    rig1, rig2 = RigSet(runs[1]), RigSet(runs[2])
+    first = runs[1][0]
+    study = order_study([(rig1.reference, rig1.sweeps()), (rig2.reference, rig2.sweeps())])
+    if orders is None:
+        orders = study["best"]
+    cals = {"calibration1": calibrate(rig1, orders, static, rate, "set 1"),
+            "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
+    none = Calibration(4, static)
+    table, dynamic_free, series, whole = {}, {}, {}, {}
+    for row, cal in [("none", none)] + list(cals.items()):
+        mode = "static" if row == "none" else "metge"
+        series[row] = errors_deg(cal, first, mode, rate)
+        table[row] = {"set1": set_error(cal, rig1, mode, rate, "settled"),
+                      "set2": set_error(cal, rig2, mode, rate, "settled"),
+                      "free": float(series[row][first.free].mean())}
+        whole[row] = {"set1": set_error(cal, rig1, mode, rate, "sweeping"),
+                      "set2": set_error(cal, rig2, mode, rate, "sweeping")}
+        if row != "none":
+            series[row + "_dynamic"] = errors_deg(cal, first, "dynamic", rate)
+            dynamic_free[row] = float(series[row + "_dynamic"][first.free].mean())
+    free_rows = first.free
+    t_free = first.time[free_rows] - first.end
+    third = o["free"] / 3
+    fast = (t_free >= third) & (t_free < 2 * third)
+    e_free = series["calibration1"][free_rows]
+    ed_free = series["calibration1_dynamic"][free_rows]
+    true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
+    true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
+    v_error = {name: np.degrees(np.arccos(np.clip((c.field.v * true_v).sum(axis=1), -1, 1))).tolist()
+               for name, c in cals.items()}
+    figures = []
+    if out is not None:
+        for name, cal in cals.items():
+            cal.save(out / f"{name}.json")
+    # Figure 3 of the paper
+    fig, axes = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+    axes[0].plot(t_free, series["none"][free_rows], lw=0.8,
+                 label=f"no dynamic calibration (mean {table['none']['free']:.1f}°)")
+    axes[0].plot(t_free, e_free, lw=0.8, label=f"eq. 9, calibration 1 (mean {table['calibration1']['free']:.2f}°)")
+    axes[0].plot(t_free, ed_free, lw=0.8,
+                 label=f"motor dynamics, calibration 1 (mean {dynamic_free['calibration1']:.2f}°)")
+    axes[0].axvspan(third, 2 * third, alpha=0.08, color="k")
+    axes[0].set_ylabel("angular error (deg)")
+    axes[0].set_yscale("log")
+    axes[0].legend(fontsize=8)
+    axes[0].grid(True, alpha=0.3, which="both")
+    axes[0].set_title("Free set, drone clamped: field error before and after compensation (cf. Metge et al., Fig. 3)",
+                      fontsize=10)
+    for n in range(4):
+        axes[1].plot(t_free, first.commands[free_rows, n], lw=0.8, label=f"c{n + 1}")
+    axes[1].axvspan(third, 2 * third, alpha=0.08, color="k")
+    axes[1].set_ylabel("ESC command (1)")
+    axes[1].set_xlabel("time in the free set (s); shaded: fast command changes")
+    axes[1].legend(fontsize=8, ncol=4)
+    figures.append(save_figure(fig, out, "figure3_free_set.png"))
+    # Table 1 beside the paper's
+    fig, ax = plt.subplots(figsize=(9, 2.6))
+    ax.axis("off")
+    rows = ["none", "calibration1", "calibration2"]
+    cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")] for r in rows]
+    cells.append(["", "", f"{dynamic_free['calibration1']:.3f} / {dynamic_free['calibration2']:.3f}"])
+    ax.table(cellText=cells, rowLabels=["no dynamic calibration", "calibration 1", "calibration 2",
+                                        "motor dynamics (cal. 1 / 2)"],
+             colLabels=["set 1", "set 2", "free set"], loc="center")
+    ax.set_title(f"Mean angular error (deg), simulated (paper), orders I = {orders[0]}, J = {orders[1]}")
+    figures.append(save_figure(fig, out, "table1.png"))
+    return {
+        "table1_deg": table,
+        "free_set_dynamic_deg": dynamic_free["calibration1"],
+        "free_set_dynamic_calibration2_deg": dynamic_free["calibration2"],
+        "paper_table1_deg": PAPER_TABLE1,
+        "improvement_factor_sets": {f"{r}_{c}": table["none"][c] / table[r][c]
+                                    for r in ("calibration1", "calibration2") for c in ("set1", "set2")},
+        "dynamic_gain_free": table["calibration1"]["free"] / dynamic_free["calibration1"],
+        "sets_with_transients_deg": whole,
+        "free_eq9_slow_fast_deg": {"slow": float(e_free[~fast].mean()), "fast": float(e_free[fast].mean())},
+        "free_dynamic_slow_fast_deg": {"slow": float(ed_free[~fast].mean()), "fast": float(ed_free[fast].mean())},
+        "direction_error_deg": v_error,
+        "orders": list(orders),
+        "order_study_uT": {f"I={i},J={j}": s * 1e6 for (i, j), s in study["scores"].items()},
+        "order_study_best": list(study["best"]),
+        "magnetometer_rate_hz": rate,
+        "battery_voltage_v": {f"set{k}_run{i}": float(r.voltage[r.sweeping].mean())
+                              for k in (1, 2) for i, r in enumerate(runs[k])},
+        "motor_dynamics": {name: c.to_dict()["dynamics"] for name, c in cals.items()},
+        "figures": [f for f in figures if f],
+    }
+
+
+def duration(o: dict) -> float:
+    return commands(o, 1, free=True)[2]
+
+
+SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
+                    duration=duration, extra={"record": RECORD})

@@ -1,0 +1,151 @@
+"""``static-cal``: static magnetometer calibration (soft and hard iron) from a hand-held rotation sweep, motors off.
+
+The IMU is driven by a scripted attitude, as a hand-held calibration turns the vehicle: three
+rotations at incommensurate rates, ``R = Rz(w3 t) Ry(w2 t) Rx(w1 t)``, which carry the sensor
+through every orientation. The magnetometer has a known soft iron ``A`` and hard iron ``b_s``
+(the option values); :func:`calibration.fit_static` recovers them from the readings alone,
+and the metrics compare them with the truth, give the quality figures, and the heading error
+of the corrected field over a level yaw turn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calibration import Calibration, fit_static
+from fmus import vehicle
+from orchestrator import FMUBlock, System, Table
+from scenarios import Option, Scenario
+from scenarios.plant import angle_between, imu_parameters, save_figure
+
+SOFT_IRON = ((1.06, 0.04, -0.03), (0.04, 0.95, 0.05), (-0.03, 0.05, 1.02))  # 1, symmetric
+HARD_IRON = (12e-6, -8e-6, 20e-6)  # T
+
+OPTIONS = {
+    "duration": Option(60.0, "length of the sweep (s)", minimum=1.0),
+    "rates": Option("0.23,0.17,0.41", "turn rates about x, y, z (rev/s)"),
+    "mag_rate": Option(100.0, "magnetometer sample rate (Hz)", minimum=1.0),
+    "dt": Option(1e-2, "macro step (s)", minimum=1e-5),
+    "noise": Option(True, "IMU white noise"),
+    "seed": Option(1, "IMU noise seed"),
+    "iron": Option(True, "soft and hard iron on (the module's SOFT_IRON, HARD_IRON); off: A = I, b_s = 0"),
+}
+
+
+def _rot(axis: int, angle: np.ndarray) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.zeros((len(angle), 3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    R[:, axis, axis] = 1
+    R[:, i, i], R[:, i, j], R[:, j, i], R[:, j, j] = c, -s, s, c
+    return R
+
+
+def attitude(o: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) and rotations body -> NED of the sweep."""
+    try:
+        rates = [float(x) for x in o["rates"].split(",")]
+        assert len(rates) == 3
+    except (ValueError, AssertionError):
+        raise ValueError(f"option rates = {o['rates']!r} must be three comma-separated turn rates (rev/s)") from None
+    t = np.arange(int(round(o["duration"] / o["dt"])) + 1) * o["dt"]
+    R = _rot(2, 2 * np.pi * rates[2] * t) @ _rot(1, 2 * np.pi * rates[1] * t) @ _rot(0, 2 * np.pi * rates[0] * t)
+    return t, R
+
+
+def quaternions(R: np.ndarray) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    xyzw = Rotation.from_matrix(R).as_quat()
+    q = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
+    q[q[:, 0] < 0] *= -1
+    return q
+
+
+def iron(o: dict) -> tuple[np.ndarray, np.ndarray]:
+    if o["iron"]:
+        return np.array(SOFT_IRON), np.array(HARD_IRON)
+    return np.eye(3), np.zeros(3)
+
+
+def build(o: dict) -> System:
+    t, R = attitude(o)
+    q = quaternions(R)
+    force = np.einsum("nji,j->ni", R, [0.0, 0.0, -vehicle.GRAVITY])  # at rest: R^T (0, 0, -g)
+    omega = np.zeros((len(t), 3))
+    omega[:-1] = np.array([[(r1.T @ r2)[2, 1], (r1.T @ r2)[0, 2], (r1.T @ r2)[1, 0]] for r1, r2 in zip(R[:-1], R[1:],
+                                                                                                      strict=True)])
+    omega[:-1] /= o["dt"]
+    A, b = iron(o)
+    period = round(1.0 / (o["mag_rate"] * o["dt"]))
+    if period < 1 or abs(period * o["dt"] * o["mag_rate"] - 1.0) > 1e-9:
+        raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
+    system = System(dt=o["dt"])
+    names = ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z"]
+    system.add(Table("Hand", names, np.column_stack([q, omega, force])))
+    parameters = imu_parameters(o["noise"], False, o["seed"], sample_rate=o["mag_rate"])
+    parameters |= {f"A_{i + 1}{j + 1}": A[i, j] for i in range(3) for j in range(3)}
+    parameters |= {f"b_s_{a}": b[k] for k, a in enumerate("xyz")}
+    system.add(FMUBlock("IMU", parameters=parameters))
+    for name in names:
+        system.connect(f"Hand.{name}", f"IMU.{name}")
+    system.set_input("IMU.b_d", 0.0)  # motors off
+    return system
+
+
+def duration(o: dict) -> float:
+    return o["duration"]
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    A, b = iron(o)
+    samples = result["IMU.magneto"][:: max(1, round(1.0 / (o["mag_rate"] * o["dt"])))]
+    fit = fit_static(samples, field_norm=vehicle.EARTH_FIELD_NORM)
+    earth = np.array(vehicle.EARTH_FIELD)
+    yaw = np.linspace(-np.pi, np.pi, 721)
+    level = np.column_stack([np.cos(yaw) * earth[0], -np.sin(yaw) * earth[0], np.full_like(yaw, earth[2])])
+    corrected = fit.correct(level @ A.T + b)
+    heading = np.degrees(np.angle(np.exp(1j * (np.arctan2(-corrected[:, 1], corrected[:, 0]) - yaw))))
+    raw = level @ A.T + b
+    heading_raw = np.degrees(np.angle(np.exp(1j * (np.arctan2(-raw[:, 1], raw[:, 0]) - yaw))))
+    if out is not None:
+        Calibration(4, fit, notes={"made_by": "quadcosim run static-cal"}).save(out / "static.json")
+    fig = plt.figure(figsize=(10, 4.5))
+    ax = fig.add_subplot(1, 2, 1, projection="3d")
+    ax.scatter(*(samples * 1e6).T, s=2, label="raw")
+    ax.scatter(*(fit.correct(samples) * 1e6).T, s=2, label="corrected")
+    ax.set_xlabel("x (µT)")
+    ax.set_ylabel("y (µT)")
+    ax.set_zlabel("z (µT)")
+    ax.legend(fontsize=8)
+    ax.set_title("readings of the sweep", fontsize=10)
+    ax2 = fig.add_subplot(1, 2, 2)
+    ax2.plot(np.degrees(yaw), heading_raw, label="uncorrected")
+    ax2.plot(np.degrees(yaw), heading, label="corrected")
+    ax2.set_xlabel("true heading (deg)")
+    ax2.set_ylabel("heading error (deg)")
+    ax2.grid(True, alpha=0.3)
+    ax2.legend(fontsize=8)
+    ax2.set_title("level yaw turn, noise-free readings", fontsize=10)
+    figure = save_figure(fig, out, "static_calibration.png")
+    truth = result["IMU.magneto"]  # the angle of every corrected reading to the true body field
+    t, R = attitude(o)
+    body = np.einsum("nji,j->ni", R[: len(truth)], earth)
+    angle = np.degrees(angle_between(fit.correct(truth), body))
+    return {
+        "A": fit.A.tolist(), "b_s_uT": (fit.b_s * 1e6).tolist(),
+        "A_true": A.tolist(), "b_s_true_uT": (b * 1e6).tolist(),
+        "A_error_max": float(np.abs(fit.A - A).max()),
+        "b_s_error_max_uT": float(np.abs(fit.b_s - b).max() * 1e6),
+        "quality": fit.quality(),
+        "heading_error_max_deg": float(np.abs(heading).max()),
+        "heading_error_uncorrected_max_deg": float(np.abs(heading_raw).max()),
+        "field_angle_error_mean_deg": float(angle.mean()),
+        "figures": [figure] if figure else [],
+    }
+
+
+SCENARIO = Scenario("static-cal", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
+                    duration=duration, extra={"record": ["IMU.magneto"]})

@@ -1,0 +1,31 @@
+"""The calibration scenarios on short horizons: static-cal recovers the IMU's soft and hard
+iron; metge reproduces the shape of Metge et al.'s Table 1 and the motor-dynamics gain."""
+
+import numpy as np
+
+import scenarios
+
+
+def test_static_cal_recovers_the_iron_of_the_imu(tmp_path):
+    _, m = scenarios.run("static-cal", {"duration": 40.0}, out_dir=tmp_path)
+    print({k: m[k] for k in ("A_error_max", "b_s_error_max_uT", "quality", "heading_error_max_deg")})
+    assert m["A_error_max"] < 1e-3
+    assert m["b_s_error_max_uT"] < 0.03
+    assert m["heading_error_max_deg"] < 0.15 < 40 < m["heading_error_uncorrected_max_deg"]
+    assert m["quality"]["coverage"] > 0.9
+    assert (tmp_path / "static.json").exists()
+
+
+def test_metge_table1_and_the_motor_dynamics(tmp_path):
+    _, m = scenarios.run("metge", {"levels": 8, "hold": 0.2, "settle": 0.12, "free": 6.0}, out_dir=tmp_path)
+    table = m["table1_deg"]
+    print(table, m["free_set_dynamic_deg"], m["direction_error_deg"], m["free_eq9_slow_fast_deg"])
+    for row in ("calibration1", "calibration2"):
+        for column in ("set1", "set2"):
+            assert table["none"][column] / table[row][column] > 15
+        assert table[row]["free"] < 0.8 * table["none"]["free"]
+    assert np.max(m["direction_error_deg"]["calibration1"]) < 1.0
+    assert m["free_eq9_slow_fast_deg"]["fast"] > 2 * m["free_eq9_slow_fast_deg"]["slow"]
+    assert m["free_set_dynamic_deg"] < table["calibration1"]["free"] / 2
+    assert {"calibration1.json", "calibration2.json", "figure3_free_set.png", "table1.png"} <= {
+        p.name for p in tmp_path.iterdir()}
