@@ -44,8 +44,30 @@ def _fmi_header_dir() -> Path:
     return path
 
 
-def build_fmu(model: str, out_dir: Path, compiler: str | None = None) -> Path:
-    """Build ``out_dir/<model>.fmu`` and return its path."""
+def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=None) -> Path:
+    """Build ``out_dir/<model>.fmu`` from source.
+
+    Parameters
+    ----------
+    model : str
+        Model folder under ``fmus/`` (its ``model.c``; its ``variables.py`` unless ``variables``).
+    out_dir : pathlib.Path
+        Output folder; the staged sources stay in ``out_dir/<model>/``.
+    compiler : str, optional
+        C compiler command; ``$CC`` or ``cc`` by default.
+    variables : fmus.variables.Table, optional
+        A variable table to build with instead of the model's own (tests build variants).
+
+    Returns
+    -------
+    pathlib.Path
+        The ``.fmu`` file.
+
+    Raises
+    ------
+    BuildError
+        The table is inconsistent (a vector's members apart, say) or the compiler refused.
+    """
     compiler = compiler or os.environ.get("CC", "cc")
     stage = out_dir / model
     if stage.exists():
@@ -55,16 +77,20 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None) -> Path:
     sources.mkdir(parents=True)
     binaries.mkdir(parents=True)
 
-    tab = table(model)
+    tab = variables or table(model)
+    try:
+        header, description = tab.c_header(), tab.model_description(list(SOURCE_FILES))
+    except ValueError as error:
+        raise BuildError(str(error)) from None
     for name in FMI_HEADERS:
         shutil.copy(_fmi_header_dir() / name, sources / name)
     shutil.copy(HERE / "c" / "shell.c", sources / "shell.c")
     shutil.copy(HERE / "c" / "shell.h", sources / "shell.h")
     shutil.copy(HERE / "c" / "quaternion.h", sources / "quaternion.h")
     shutil.copy(HERE / model / "model.c", sources / "model.c")
-    (sources / "variables.h").write_text(tab.c_header())
+    (sources / "variables.h").write_text(header)
     (sources / "airframe.h").write_text(airframe_header())
-    (stage / "modelDescription.xml").write_text(tab.model_description(list(SOURCE_FILES)))
+    (stage / "modelDescription.xml").write_text(description)
 
     library = binaries / f"{model}.so"
     command = [compiler, *CFLAGS, "-shared", "-I", str(sources), "-o", str(library)]

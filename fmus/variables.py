@@ -12,6 +12,7 @@ arrays ``real``, ``integer`` and ``boolean``.
 from __future__ import annotations
 
 import math
+import re
 import uuid
 from dataclasses import dataclass, field
 from xml.sax.saxutils import quoteattr
@@ -79,6 +80,9 @@ class Table:
     description: str
     variables: list[Variable]
     states: int = 0
+    # Vectors beyond those the names imply (see :meth:`vectors`): name -> member names in order,
+    # e.g. the field of each motor, ``b_d1_x ... b_d4_z``, as one 12-vector.
+    extra_vectors: dict[str, tuple[str, ...]] = field(default_factory=dict)
     vr: dict[str, int] = field(init=False)
 
     def __post_init__(self):
@@ -96,6 +100,55 @@ class Table:
         for v in self.variables:
             if isinstance(v.depends, tuple) and not set(v.depends) <= inputs:
                 raise ValueError(f"{self.model}.{v.name} depends on unknown inputs {v.depends}")
+
+    def vectors(self) -> dict[str, list[Variable]]:
+        """The table's vectors, by name, members in order.
+
+        Variables whose names differ only by a final component, ``x y z`` or a number, with an
+        optional underscore before it (``acc_x acc_y acc_z``, ``omega_r1 ... omega_r4``,
+        ``q0 ... q3``, ``R_reel_11 ... R_reel_33``), form the vector named by the common stem
+        (``acc``, ``omega_r``, ``q``, ``R_reel``); plus :attr:`extra_vectors`.
+
+        Raises
+        ------
+        ValueError
+            A vector's members are not consecutive rows of one type in component order (the C
+            code addresses them as one array), or a vector's name is also a variable's.
+        """
+        by_name = {v.name: v for v in self.variables}
+        groups: dict[tuple[str, str], list[Variable]] = {}
+        for v in self.variables:
+            match = _MEMBER.fullmatch(v.name)
+            if match and match.group(1):
+                groups.setdefault((match.group(1), v.type), []).append(v)
+        found = {stem: members for (stem, _), members in groups.items() if len(members) > 1}
+        for name, members in self.extra_vectors.items():
+            unknown = [n for n in members if n not in by_name]
+            if unknown:
+                raise ValueError(f"{self.model}: vector {name} names unknown variables {unknown}")
+            found[name] = [by_name[n] for n in members]
+        for name, members in found.items():
+            self._check_vector(name, members, name in self.extra_vectors)
+        return found
+
+    def _check_vector(self, name: str, members: list[Variable], declared: bool):
+        if name in self.vr:
+            raise ValueError(f"{self.model}: vector {name!r} has the name of a variable; rename one of them")
+        names = [v.name for v in members]
+        if len({v.type for v in members}) > 1:
+            raise ValueError(f"{self.model}: vector {name} mixes types: {names}")
+        if not declared:
+            keys = [_component_key(_MEMBER.fullmatch(n).group(3)) for n in names]
+            if keys != sorted(keys):
+                raise ValueError(f"{self.model}: the members of vector {name} are out of order in the table: "
+                                 f"{', '.join(names)}. Write its rows in component order.")
+        refs = [self.vr[n] for n in names]
+        for previous, present, n in zip(refs, refs[1:], names[1:], strict=False):
+            if present != previous + 1:
+                raise ValueError(
+                    f"{self.model}: the members of vector {name} ({', '.join(names)}) must be consecutive "
+                    f"rows of the variable table, since the C code addresses them as one array; {n} has "
+                    f"value reference {present}, not {previous + 1}. Move its rows together.")
 
     def of(self, causality: str, type_: str | None = None) -> list[Variable]:
         return [
@@ -133,34 +186,13 @@ class Table:
         ]
         if units:
             lines.append("  <UnitDefinitions>")
-            lines += [f'    <Unit name="{u}"/>' for u in units]
+            lines += [f"    {_unit_definition(u)}" for u in units]
             lines.append("  </UnitDefinitions>")
         lines.append('  <DefaultExperiment startTime="0" stopTime="2" stepSize="0.001"/>')
         lines.append("  <ModelVariables>")
         for v in self.variables:
-            attrs = [
-                f'name="{v.name}"',
-                f'valueReference="{self.vr[v.name]}"',
-                f'causality="{v.causality}"',
-                f'variability="{v.fmi_variability}"',
-            ]
-            if v.causality == "parameter":
-                attrs.append('initial="exact"')
-            if v.description:
-                attrs.append(f"description={quoteattr(v.description)}")
-            type_attrs = []
-            if v.start is not None:
-                type_attrs.append(f'start="{_xml_value(v.type, v.start)}"')
-            if v.unit:
-                type_attrs.append(f'unit="{v.unit}"')
-            if v.min is not None:
-                type_attrs.append(f'min="{v.min!r}"')
-            if v.max is not None:
-                type_attrs.append(f'max="{v.max!r}"')
             lines.append(f"    <!-- {index[v.name]} -->")
-            lines.append(f"    <ScalarVariable {' '.join(attrs)}>")
-            lines.append(f"      <{v.type} {' '.join(type_attrs)}/>".replace(" />", "/>"))
-            lines.append("    </ScalarVariable>")
+            lines += self._scalar_variable(v)
         lines.append("  </ModelVariables>")
         lines.append("  <ModelStructure>")
         outputs = self.of("output")
@@ -175,6 +207,30 @@ class Table:
         lines.append("  </ModelStructure>")
         lines.append("</fmiModelDescription>")
         return "\n".join(lines) + "\n"
+
+    def _scalar_variable(self, v: Variable) -> list[str]:
+        attrs = [
+            f'name="{v.name}"',
+            f'valueReference="{self.vr[v.name]}"',
+            f'causality="{v.causality}"',
+            f'variability="{v.fmi_variability}"',
+        ]
+        if v.causality == "parameter":
+            attrs.append('initial="exact"')
+        if v.description:
+            attrs.append(f"description={quoteattr(v.description)}")
+        type_attrs = []
+        if v.start is not None:
+            type_attrs.append(f'start="{_xml_value(v.type, v.start)}"')
+        if v.unit:
+            type_attrs.append(f'unit="{v.unit}"')
+        if v.min is not None:
+            type_attrs.append(f'min="{v.min!r}"')
+        if v.max is not None:
+            type_attrs.append(f'max="{v.max!r}"')
+        return [f"    <ScalarVariable {' '.join(attrs)}>",
+                f"      <{v.type} {' '.join(type_attrs)}/>".replace(" />", "/>"),
+                "    </ScalarVariable>"]
 
     @staticmethod
     def _depends(v: Variable, inputs: list[str]) -> list[str]:
@@ -201,12 +257,21 @@ class Table:
             f"#define N_STATES {self.states}",
             "",
         ]
-        for type_, prefix in (("Real", "VR_"), ("Integer", "VI_"), ("Boolean", "VB_")):
+        prefixes = {"Real": "VR_", "Integer": "VI_", "Boolean": "VB_"}
+        for type_, prefix in prefixes.items():
             members = [v for v in self.variables if v.type == type_]
             if members:
                 lines.append("enum {")
                 lines += [f"    {prefix}{v.name} = {self.vr[v.name]}," for v in members]
                 lines.append("};")
+        vectors = self.vectors()
+        if vectors:
+            lines += ["", "/* Vectors: consecutive variables of one type, checked by the build; a model reads",
+                      " * the k-th member of vector v as (&R(v))[k] and its length as LEN_v. */", "enum {"]
+            for name, members in vectors.items():
+                prefix = prefixes[members[0].type]
+                lines.append(f"    {prefix}{name} = {prefix}{members[0].name}, LEN_{name} = {len(members)},")
+            lines.append("};")
         lines.append("")
         for type_, array in (("Real", "REAL_INFO"), ("Integer", "INTEGER_INFO"), ("Boolean", "BOOLEAN_INFO")):
             members = [v for v in self.variables if v.type == type_]
@@ -220,6 +285,14 @@ class Table:
         lines.append("")
         lines.append("#endif")
         return "\n".join(lines) + "\n"
+
+
+# A vector member's name: a stem, an optional underscore, a component (x, y, z or a number).
+_MEMBER = re.compile(r"(.*?)(_?)([xyz]|\d+)")
+
+
+def _component_key(component: str) -> tuple[int, int]:
+    return (0, "xyz".index(component)) if component in "xyz" else (1, int(component))
 
 
 def _c_causality(causality: str) -> str:
@@ -240,3 +313,59 @@ def _unknown(index: int, depends: list[str], indices: dict[str, int]) -> str:
     deps = " ".join(str(indices[name]) for name in depends)
     kinds = " ".join("dependent" for _ in depends)
     return f'<Unknown index="{index}" dependencies="{deps}" dependenciesKind="{kinds}"/>'
+
+
+# SI base units of the symbols the tables use (FMI 2.0 BaseUnit exponents: kg, m, s, A, K, mol,
+# cd, rad). A unit is written as symbols with optional exponents joined by "." and "/", e.g.
+# "N.m.s2", "m/s2", "T/A"; each "/" divides by the factor that follows it.
+BASE_SYMBOLS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+SYMBOLS: dict[str, dict[str, int]] = {
+    "1": {}, "kg": {"kg": 1}, "m": {"m": 1}, "s": {"s": 1}, "A": {"A": 1}, "K": {"K": 1},
+    "rad": {"rad": 1}, "Hz": {"s": -1},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
+    "Ohm": {"kg": 1, "m": 2, "s": -3, "A": -2},
+    "H": {"kg": 1, "m": 2, "s": -2, "A": -2},
+    "T": {"kg": 1, "s": -2, "A": -1},
+}
+
+
+def base_unit(unit: str) -> dict[str, int] | None:
+    """Exponents of the SI base units of ``unit`` (``"T"`` -> ``{"kg": 1, "s": -2, "A": -1}``).
+
+    Parameters
+    ----------
+    unit : str
+        A unit as the variable tables write it.
+
+    Returns
+    -------
+    dict of str to int, or None
+        Non-zero exponents by base symbol; None when an exponent is not an integer (the noise
+        densities per square root of hertz), which FMI 2.0's ``BaseUnit`` cannot express.
+
+    Raises
+    ------
+    ValueError
+        A symbol that is not in :data:`SYMBOLS`.
+    """
+    exponents: dict[str, float] = {}
+    for k, part in enumerate(unit.split("/")):
+        for factor in re.split(r"\.(?=[A-Za-z])", part):  # "Hz0.5": the dot of a number stays
+            match = re.fullmatch(r"([A-Za-z]+|1)(\d+(?:\.\d+)?)?", factor)
+            if not match or match.group(1) not in SYMBOLS:
+                raise ValueError(f"unit {unit!r}: unknown symbol {factor!r}; known: {', '.join(SYMBOLS)}")
+            power = float(match.group(2) or 1) * (-1 if k else 1)
+            for base, exponent in SYMBOLS[match.group(1)].items():
+                exponents[base] = exponents.get(base, 0) + exponent * power
+    if any(e != int(e) for e in exponents.values()):
+        return None
+    return {b: int(exponents[b]) for b in BASE_SYMBOLS if exponents.get(b)}
+
+
+def _unit_definition(unit: str) -> str:
+    base = base_unit(unit)
+    if base is None:  # a fractional power of a second: the unit is named, not converted
+        return f'<Unit name="{unit}"/>'
+    attrs = "".join(f' {b}="{e}"' for b, e in base.items())
+    return f'<Unit name="{unit}"><BaseUnit{attrs}/></Unit>'

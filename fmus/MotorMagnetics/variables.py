@@ -10,6 +10,9 @@ TABLE = Table(
     "Four DC-approximated brushless motors with ESCs and a LiPo battery; magnetic field of the "
     "motor currents at the magnetometer",
     states=9,
+    # each motor's field direction and field contribution, read as 4 x 3 arrays by the C model
+    extra_vectors={"v": tuple(f"v{n}_{a}" for n in _N for a in "xyz"),
+                   "b_d_motor": tuple(f"b_d{n}_{a}" for n in _N for a in "xyz")},
     variables=[
         *[Real(f"c{n}", "input", 0.0, "1", f"ESC command of motor {n}, saturated to [0, 1]") for n in _N],
         Real("R_m", "parameter", V.MOTOR_RESISTANCE, "Ohm", "winding resistance"),

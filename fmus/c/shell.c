@@ -10,9 +10,23 @@
 
 #define UNUSED(x) (void)(x)
 
+/* Room for one log message and for the pieces it is assembled from (characters). */
+#define LOG_MESSAGE_SIZE 1024
+#define FAIL_MESSAGE_SIZE 900
+#define SHORT_TEXT_SIZE 128
+
+/* A communication point matches the model time within this relative tolerance: a master that
+ * computes t = n * dt accumulates rounding, never a real gap. */
+#define TIME_MATCH_TOLERANCE 1e-9
+/* h / max_step that exceeds an integer by no more than this is rounding: no extra sub-step. */
+#define SUBSTEP_ROUNDING 1e-9
+
+/* RK4 scratch: one vector per stage, sized by the model's state count. */
+#define RK4_CAPACITY (N_STATES > 0 ? N_STATES : 1)
+
 static void vlog(ModelInstance *m, fmi2Status status, const char *category, const char *format,
                  va_list args) {
-    char message[1024];
+    char message[LOG_MESSAGE_SIZE];
     if (!m || !m->callbacks || !m->callbacks->logger) return;
     if (status == fmi2OK && !m->logging_on) return;
     vsnprintf(message, sizeof message, format, args);
@@ -35,8 +49,13 @@ void log_warning(ModelInstance *m, const char *format, ...) {
 }
 
 void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, int n) {
-    double k1[64], k2[64], k3[64], k4[64], tmp[64];
+    double k1[RK4_CAPACITY], k2[RK4_CAPACITY], k3[RK4_CAPACITY], k4[RK4_CAPACITY], tmp[RK4_CAPACITY];
     int i;
+    if (n < 0 || n > N_STATES) {
+        log_error(m, "rk4_step: %d states, but the variable table declares %d (states=...)", n, N_STATES);
+        m->step_failed = 1;
+        return;
+    }
     f(m, t, x, k1);
     for (i = 0; i < n; i++) tmp[i] = x[i] + 0.5 * h * k1[i];
     f(m, t + 0.5 * h, tmp, k2);
@@ -56,8 +75,8 @@ int work_allowed(ModelInstance *m, double count, double h, const char *what, con
 }
 
 int substep_count(ModelInstance *m, double h, double max_step, const char *parameter) {
-    double count = ceil(h / max_step - 1e-9);
-    char what[128];
+    double count = ceil(h / max_step - SUBSTEP_ROUNDING);
+    char what[SHORT_TEXT_SIZE];
     if (count < 1.0) return 1;
     snprintf(what, sizeof what, "sub-steps of %s = %g s", parameter, max_step);
     if (!work_allowed(m, count, h, what, "take shorter communication steps or a larger sub-step"))
@@ -66,7 +85,7 @@ int substep_count(ModelInstance *m, double h, double max_step, const char *param
 }
 
 static fmi2Status fail(ModelInstance *m, const char *function, const char *format, ...) {
-    char message[900];
+    char message[FAIL_MESSAGE_SIZE];
     va_list args;
     va_start(args, format);
     vsnprintf(message, sizeof message, format, args);
@@ -79,7 +98,7 @@ static const char *const MODE_NAMES[] = {"instantiated", "in initialization mode
                                          "terminated", "in the error state"};
 
 static int allowed(ModelInstance *m, const char *function, unsigned modes) {
-    char list[128] = "";
+    char list[SHORT_TEXT_SIZE] = "";
     int k;
     if (!m) return 0;
     if ((1u << m->mode) & modes) return 1;
@@ -93,9 +112,23 @@ static int allowed(ModelInstance *m, const char *function, unsigned modes) {
     return 0;
 }
 
-#define ANY_MODE 0x1Fu
-#define BEFORE_STEPPING ((1u << MODE_INSTANTIATED) | (1u << MODE_INITIALIZATION))
-#define INITIALIZED ((1u << MODE_STEPPING) | (1u << MODE_TERMINATED))
+/* The modes in which each FMI function may be called (FMI 2.0, section 4.2.4), as bit masks
+ * named after the function; ALLOWED(m, f) checks f's mask and names the modes in its message. */
+#define IN(mode) (1u << (mode))
+#define MASK_fmi2SetupExperiment IN(MODE_INSTANTIATED)
+#define MASK_fmi2EnterInitializationMode IN(MODE_INSTANTIATED)
+#define MASK_fmi2ExitInitializationMode IN(MODE_INITIALIZATION)
+#define MASK_fmi2Terminate (IN(MODE_STEPPING) | IN(MODE_ERROR))
+#define MASK_GET (IN(MODE_INSTANTIATED) | IN(MODE_INITIALIZATION) | IN(MODE_STEPPING) | IN(MODE_TERMINATED))
+#define MASK_fmi2GetReal MASK_GET
+#define MASK_fmi2GetInteger MASK_GET
+#define MASK_fmi2GetBoolean MASK_GET
+#define MASK_SET (IN(MODE_INSTANTIATED) | IN(MODE_INITIALIZATION) | IN(MODE_STEPPING))
+#define MASK_fmi2SetReal MASK_SET
+#define MASK_fmi2SetInteger MASK_SET
+#define MASK_fmi2SetBoolean MASK_SET
+#define MASK_fmi2DoStep IN(MODE_STEPPING)
+#define ALLOWED(m, function) allowed((m), #function, MASK_##function)
 
 /* Index of the first non-finite Real variable, or -1. */
 static int first_non_finite(ModelInstance *m) {
@@ -182,7 +215,7 @@ void fmi2FreeInstance(fmi2Component c) {
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     ModelInstance *m = (ModelInstance *)c;
-    if (!allowed(m, "fmi2SetupExperiment", 1u << MODE_INSTANTIATED)) return fmi2Error;
+    if (!ALLOWED(m, fmi2SetupExperiment)) return fmi2Error;
     if (!isfinite(startTime))
         return fail(m, "fmi2SetupExperiment", "startTime = %g is not a finite number", startTime);
     if (toleranceDefined && !(tolerance > 0.0 && isfinite(tolerance)))
@@ -196,7 +229,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
     ModelInstance *m = (ModelInstance *)c;
-    if (!allowed(m, "fmi2EnterInitializationMode", 1u << MODE_INSTANTIATED)) return fmi2Error;
+    if (!ALLOWED(m, fmi2EnterInitializationMode)) return fmi2Error;
     m->mode = MODE_INITIALIZATION;
     return fmi2OK;
 }
@@ -205,7 +238,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     ModelInstance *m = (ModelInstance *)c;
     fmi2Status status;
     int bad;
-    if (!allowed(m, "fmi2ExitInitializationMode", 1u << MODE_INITIALIZATION)) return fmi2Error;
+    if (!ALLOWED(m, fmi2ExitInitializationMode)) return fmi2Error;
     status = model_initialize(m);
     if (status > fmi2Warning) {
         m->mode = MODE_ERROR;
@@ -225,7 +258,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 
 fmi2Status fmi2Terminate(fmi2Component c) {
     ModelInstance *m = (ModelInstance *)c;
-    if (!allowed(m, "fmi2Terminate", 1u << MODE_STEPPING | 1u << MODE_ERROR)) return fmi2Error;
+    if (!ALLOWED(m, fmi2Terminate)) return fmi2Error;
     m->mode = MODE_TERMINATED;
     return fmi2OK;
 }
@@ -278,7 +311,7 @@ static fmi2Status refresh_outputs(ModelInstance *m, const char *function) {
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
-    if (!allowed(m, "fmi2GetReal", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
+    if (!ALLOWED(m, fmi2GetReal)) return fmi2Error;
     if (check_refs(m, "fmi2GetReal", vr, nvr, N_REAL, "Real") != fmi2OK) return fmi2Error;
     if (nvr > 0 && !value) return fail(m, "fmi2GetReal", "null value array");
     if (refresh_outputs(m, "fmi2GetReal") != fmi2OK) return fmi2Error;
@@ -290,7 +323,7 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
                           fmi2Integer value[]) {
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
-    if (!allowed(m, "fmi2GetInteger", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
+    if (!ALLOWED(m, fmi2GetInteger)) return fmi2Error;
     if (check_refs(m, "fmi2GetInteger", vr, nvr, N_INTEGER, "Integer") != fmi2OK) return fmi2Error;
     if (nvr > 0 && !value) return fail(m, "fmi2GetInteger", "null value array");
     for (i = 0; i < nvr; i++) value[i] = m->integer[vr[i]];
@@ -301,7 +334,7 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
                           fmi2Boolean value[]) {
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
-    if (!allowed(m, "fmi2GetBoolean", ANY_MODE & ~(1u << MODE_ERROR))) return fmi2Error;
+    if (!ALLOWED(m, fmi2GetBoolean)) return fmi2Error;
     if (check_refs(m, "fmi2GetBoolean", vr, nvr, N_BOOLEAN, "Boolean") != fmi2OK) return fmi2Error;
     if (nvr > 0 && !value) return fail(m, "fmi2GetBoolean", "null value array");
     for (i = 0; i < nvr; i++) value[i] = m->boolean[vr[i]];
@@ -321,7 +354,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
                        const fmi2Real value[]) {
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
-    if (!allowed(m, "fmi2SetReal", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
+    if (!ALLOWED(m, fmi2SetReal)) return fmi2Error;
     if (check_refs(m, "fmi2SetReal", vr, nvr, N_REAL, "Real") != fmi2OK) return fmi2Error;
     if (nvr > 0 && !value) return fail(m, "fmi2SetReal", "null value array");
     for (i = 0; i < nvr; i++) {
@@ -342,7 +375,7 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
                           const fmi2Integer value[]) {
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
-    if (!allowed(m, "fmi2SetInteger", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
+    if (!ALLOWED(m, fmi2SetInteger)) return fmi2Error;
     if (check_refs(m, "fmi2SetInteger", vr, nvr, N_INTEGER, "Integer") != fmi2OK) return fmi2Error;
     if (nvr > 0 && !value) return fail(m, "fmi2SetInteger", "null value array");
     for (i = 0; i < nvr; i++)
@@ -356,7 +389,7 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
                           const fmi2Boolean value[]) {
     ModelInstance *m = (ModelInstance *)c;
     size_t i;
-    if (!allowed(m, "fmi2SetBoolean", BEFORE_STEPPING | 1u << MODE_STEPPING)) return fmi2Error;
+    if (!ALLOWED(m, fmi2SetBoolean)) return fmi2Error;
     if (check_refs(m, "fmi2SetBoolean", vr, nvr, N_BOOLEAN, "Boolean") != fmi2OK) return fmi2Error;
     if (nvr > 0 && !value) return fail(m, "fmi2SetBoolean", "null value array");
     for (i = 0; i < nvr; i++)
@@ -445,26 +478,29 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     fmi2Status status;
     int bad;
     UNUSED(noSetFMUStatePriorToCurrentPoint);
-    if (!allowed(m, "fmi2DoStep", 1u << MODE_STEPPING)) return fmi2Error;
+    if (!ALLOWED(m, fmi2DoStep)) return fmi2Error;
     if (!(h > 0.0) || !isfinite(h))
         return fail(m, "fmi2DoStep", "step size %g must be positive and finite", h);
     if (!isfinite(t) || !isfinite(t + h))
         return fail(m, "fmi2DoStep", "communication point %g (step %g) is not a finite time", t, h);
-    if (!(fabs(t - m->time) <= 1e-9 * (1.0 + fabs(m->time))))
+    if (!(fabs(t - m->time) <= TIME_MATCH_TOLERANCE * (1.0 + fabs(m->time))))
         return fail(m, "fmi2DoStep", "communication point %.12g differs from the model time %.12g", t,
                     m->time);
+    m->step_failed = 0;
     status = model_do_step(m, t, h);
-    if (status > fmi2Warning) {
+    if (m->step_failed && status < fmi2Error) status = fmi2Error;
+    if (status > fmi2Warning) { /* the time stays at the last successful communication point */
         m->mode = MODE_ERROR;
         return status;
     }
-    m->time = t + h;
+    m->time = t + h; /* the outputs are those at t + h */
     /* outputs (which include the state) are checked here, so that a state that became
      * non-finite fails this step rather than the next read */
     model_outputs(m);
     m->outputs_stale = 0;
     bad = first_non_finite(m);
     if (bad >= 0) {
+        m->time = t;
         m->mode = MODE_ERROR;
         return fail(m, "fmi2DoStep", "%s became %g in the step from t = %g to %g", REAL_INFO[bad].name,
                     m->real[bad], t, t + h);

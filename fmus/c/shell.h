@@ -41,6 +41,7 @@ typedef struct ModelInstance {
     int *integer;
     fmi2Boolean *boolean;
     int outputs_stale; /* inputs changed since the outputs were last computed */
+    int step_failed;   /* set by a shell helper that refused its work in this doStep */
     void *data;        /* the model's own state, MODEL_DATA_SIZE bytes */
 } ModelInstance;
 
@@ -62,7 +63,8 @@ int work_allowed(ModelInstance *m, double count, double h, const char *what, con
  * step h, at least 1; or 0, with the reason logged, beyond MAX_SUBSTEPS_PER_STEP. */
 int substep_count(ModelInstance *m, double h, double max_step, const char *parameter);
 
-/* Fixed-step classical RK4 over a model's state vector, for models that need nothing else. */
+/* Fixed-step classical RK4 over a model's state vector, for models that need nothing else.
+ * Its scratch holds the model's N_STATES states (variables.h); a larger n fails the step. */
 typedef void (*Derivatives)(ModelInstance *m, double t, const double *x, double *dx);
 void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, int n);
 

@@ -1,0 +1,137 @@
+"""Variable tables and the shell: names, not positions; SI base units; a failed step.
+
+The C models address vectors (a quaternion, rotor speeds, field directions) as arrays from
+their first member, so the build checks that each vector's rows are consecutive. A table
+reordered without splitting a vector builds into an FMU that gives identical results by name;
+a table that splits one is refused with a message that names it.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+from raw_fmu import RawFMU
+
+from fmus import MODELS, fmu_path
+from fmus.build import BuildError, build_fmu, table
+from fmus.variables import base_unit
+from orchestrator.fmu import FMUInstance
+
+# Inputs held over the check, by model: a rotating, tilted body with the motors unequal.
+INPUTS = {
+    "Quadrotor": {"omega_r1": 480.0, "omega_r2": 500.0, "omega_r3": 490.0, "omega_r4": 505.0},
+    "MotorMagnetics": {"c1": 0.35, "c2": 0.5, "c3": 0.62, "c4": 0.8},
+    "IMU": {"q0": 0.9, "q1": 0.3, "q2": -0.2, "q3": 0.1 * np.sqrt(10.0) - 0.2, "omega_x": 0.3, "omega_y": -0.2,
+            "omega_z": 0.1, "f_x": 1.0, "f_y": -0.5, "f_z": -9.7, "b_d_x": 1e-6, "b_d_y": -2e-6, "b_d_z": 3e-6},
+}
+PARAMETERS = {"IMU": {"noise_enabled": True, "bias_enabled": True}}
+
+
+def _units(tab):
+    """The table's rows as units that keep vectors whole: each vector, then each other variable."""
+    first, inside = {}, set()
+    for members in sorted(tab.vectors().values(), key=len, reverse=True):  # v1..v4 lie inside v
+        if members[0].name not in inside:
+            first[members[0].name] = members
+            inside |= {v.name for v in members}
+    units = []
+    for v in tab.variables:
+        if v.name in first:
+            units.append(list(first[v.name]))
+        elif v.name not in inside:
+            units.append([v])
+    return units
+
+
+def _reordered(tab, units):
+    return dataclasses.replace(tab, variables=[v for unit in units for v in unit])
+
+
+def _run(path, model, steps=300, h=1e-3):
+    fmu = FMUInstance(str(path), PARAMETERS.get(model), name=model)
+    try:
+        names, values = list(INPUTS[model]), list(INPUTS[model].values())
+        rows = []
+        for k in range(steps):
+            fmu.set(names, values)
+            rows.append(fmu.get(fmu.outputs))
+            fmu.step(k * h, h)
+        return {name: column for name, column in zip(fmu.outputs, np.array(rows).T, strict=True)}
+    finally:
+        fmu.close()
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_table_reordered_without_splitting_a_vector_gives_identical_results(model, tmp_path):
+    tab = table(model)
+    reordered = _reordered(tab, _units(tab)[::-1])
+    assert [tab.vr[n] for n in INPUTS[model]] != [reordered.vr[n] for n in INPUTS[model]]  # it did move
+    expected = _run(fmu_path(model), model)
+    got = _run(build_fmu(model, tmp_path, variables=reordered), model)
+    assert got.keys() == expected.keys()
+    for name in expected:
+        assert np.array_equal(got[name], expected[name]), name
+
+
+@pytest.mark.parametrize(("model", "vector"), [("Quadrotor", "q"), ("MotorMagnetics", "omega_r"),
+                                               ("IMU", "magneto")])
+def test_a_table_that_splits_a_vector_is_refused_by_the_build(model, vector, tmp_path):
+    tab = table(model)
+    units = _units(tab)
+    index = next(k for k, unit in enumerate(units) if len(unit) > 1 and unit[0].name.startswith(vector))
+    members = units.pop(index)
+    units.insert(index, members[:2])
+    units.append(members[2:])  # the tail of the vector moves to the end of the table
+    with pytest.raises(BuildError, match=rf"vector {vector} .* must be consecutive rows .* Move its rows together"):
+        build_fmu(model, tmp_path, variables=_reordered(tab, units))
+
+
+def test_a_vector_out_of_component_order_is_refused(tmp_path):
+    tab = table("Quadrotor")
+    names = [v.name for v in tab.variables]
+    variables = list(tab.variables)
+    i, j = names.index("q1"), names.index("q2")
+    variables[i], variables[j] = variables[j], variables[i]
+    with pytest.raises(BuildError, match="members of vector q are out of order in the table: q0, q2, q1, q3"):
+        build_fmu("Quadrotor", tmp_path, variables=dataclasses.replace(tab, variables=variables))
+
+
+@pytest.mark.parametrize(("unit", "expected"), [
+    ("T", {"kg": 1, "s": -2, "A": -1}),
+    ("N.m.s2", {"kg": 1, "m": 2}),
+    ("V.s/rad", {"kg": 1, "m": 2, "s": -2, "A": -1, "rad": -1}),
+    ("m/s2", {"m": 1, "s": -2}),
+    ("1", {}),
+    ("rad/s/Hz0.5", None),  # s^-1/2: no integer exponents in FMI 2.0
+])
+def test_si_base_units(unit, expected):
+    assert base_unit(unit) == expected
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_every_unit_definition_declares_its_si_base_unit(model):
+    description = read_model_description(str(fmu_path(model)))
+    definitions = {u.name: u for u in description.unitDefinitions}
+    used = {v.unit for v in table(model).variables if v.unit}
+    assert set(definitions) == used
+    for name, definition in definitions.items():
+        if "Hz0.5" in name:
+            assert definition.baseUnit is None
+            continue
+        base = definition.baseUnit
+        declared = {k: getattr(base, k) for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad") if getattr(base, k)}
+        assert declared == base_unit(name), name
+        assert base.factor == 1.0 and base.offset == 0.0
+
+
+def test_a_failed_step_leaves_the_model_time_at_the_last_good_point():
+    fmu = RawFMU("Quadrotor")
+    assert fmu.instantiate()
+    assert fmu.initialize() == 0, fmu.messages()
+    assert fmu.do_step(0.0, 1e-3) == 0
+    refs = [fmu.refs[f"omega_r{n}"] for n in range(1, 5)]
+    assert fmu.set_real(refs, [1e200] * 4) == 0
+    assert fmu.do_step(1e-3, 1e-3) == 3  # the state overflows: Error
+    assert fmu.time() == 1e-3  # fmi2LastSuccessfulTime: the step that failed did not count
+    fmu.free()
