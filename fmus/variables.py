@@ -113,7 +113,7 @@ class Table:
         ------
         ValueError
             A vector's members are not consecutive rows of one type in component order (the C
-            code addresses them as one array), or a vector's name is also a variable's.
+            code addresses them as one array).
         """
         by_name = {v.name: v for v in self.variables}
         groups: dict[tuple[str, str], list[Variable]] = {}
@@ -132,8 +132,6 @@ class Table:
         return found
 
     def _check_vector(self, name: str, members: list[Variable], declared: bool):
-        if name in self.vr:
-            raise ValueError(f"{self.model}: vector {name!r} has the name of a variable; rename one of them")
         names = [v.name for v in members]
         if len({v.type for v in members}) > 1:
             raise ValueError(f"{self.model}: vector {name} mixes types: {names}")
@@ -266,11 +264,12 @@ class Table:
                 lines.append("};")
         vectors = self.vectors()
         if vectors:
-            lines += ["", "/* Vectors: consecutive variables of one type, checked by the build; a model reads",
-                      " * the k-th member of vector v as (&R(v))[k] and its length as LEN_v. */", "enum {"]
+            lines += ["", "/* Vectors: consecutive variables of one type, checked by the build. VEC_v is the",
+                      " * value reference of the first member of vector v, LEN_v its length; a model reads",
+                      " * member k of a Real vector as REAL_VECTOR(m, v)[k]. */", "enum {"]
             for name, members in vectors.items():
                 prefix = prefixes[members[0].type]
-                lines.append(f"    {prefix}{name} = {prefix}{members[0].name}, LEN_{name} = {len(members)},")
+                lines.append(f"    VEC_{name} = {prefix}{members[0].name}, LEN_{name} = {len(members)},")
             lines.append("};")
         lines.append("")
         for type_, array in (("Real", "REAL_INFO"), ("Integer", "INTEGER_INFO"), ("Boolean", "BOOLEAN_INFO")):

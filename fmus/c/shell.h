@@ -45,6 +45,10 @@ typedef struct ModelInstance {
     void *data;        /* the model's own state, MODEL_DATA_SIZE bytes */
 } ModelInstance;
 
+/* Member k of the Real vector `name` of the variable table (VEC_name, LEN_name in variables.h),
+ * e.g. REAL_VECTOR(m, omega_r)[k]: the build checks that a vector's rows are consecutive. */
+#define REAL_VECTOR(m, name) (&(m)->real[VEC_##name])
+
 /* Logging from model code: error messages always reach the environment's logger. */
 void log_error(ModelInstance *m, const char *format, ...);
 void log_warning(ModelInstance *m, const char *format, ...);
