@@ -8,7 +8,11 @@ metrics.json, results) under the output folder, and ``summary.md`` gathers the n
 - the explicit filter without bias estimate: simulated steady error against the linearised
   prediction (estimators.analysis.explicit_bias_steady_error);
 - the passive filter: bias-convergence time against the linearised prediction for
-  kP = kI in {0.1, 1, 10, 100}, with R_reel and with TRIAD.
+  kP = kI in {0.1, 1, 10, 100}, with R_reel and with TRIAD;
+- the lab's findings as checks, each with its measured figures: the linear filter accurate in
+  quasi-stationary flight (a non-zero error below 1 degree on every axis) and degraded in
+  non-stationary flight; the explicit filter below 2 degrees RMS in both; the bias cases as
+  the analyses predict.
 """
 
 from __future__ import annotations
@@ -49,6 +53,11 @@ CASES = {
                                                 "feedback": "estimate"},
 }
 EXPLICIT_GAINS = (0.2, 1.0, 2.0)
+EXPLICIT_WITHOUT_BIAS = ("explicit-0.002-quasi-gt", "explicit-0.002-nonstationary-gt", "explicit-0.002-quasi-estimate",
+                         "explicit-0.2-nonstationary-estimate", "explicit-nonstationary-estimate-noise")
+LINEAR_ACCURATE_DEG = 1.0  # deg, every axis, quasi-stationary flight
+EXPLICIT_ACCURATE_DEG = 2.0  # deg, every axis, both flights
+PREDICTION_TOLERANCE = {"explicit": 0.1, "passive": 0.2}  # relative, as in tests/test_lab_cases.py
 PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
 
 
@@ -96,11 +105,37 @@ def run(out: Path | None) -> dict:
         "passive_bias_convergence_s": [{"ry": ry, "kP=kI": g, "simulated": s, "predicted": p}
                                        for ry, g, s, p in passive],
     }
+    summary["checks"] = checks(summary)
     if out:
         out.mkdir(parents=True, exist_ok=True)
         (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
         (out / "summary.md").write_text(markdown(summary))
     return summary
+
+
+def checks(summary: dict) -> list[dict]:
+    """The lab's findings as pass/fail checks with the figures they rest on (deg, s)."""
+    rms = {name: np.array(m["rms_error_deg"]) for name, m in summary["cases"].items()}
+    quasi, fast = rms["linear-quasi-gt"], rms["linear-nonstationary-gt"]
+    explicit = np.array([rms[name] for name in EXPLICIT_WITHOUT_BIAS])
+    explicit_gap = max(abs(r["simulated"][0] / r["predicted"][0] - 1)
+                       for r in summary["explicit_steady_bias_error_deg"] if r["k1=k2"] >= 1.0)
+    passive_gap = max(np.inf if r["simulated"] is None else abs(r["simulated"] / r["predicted"] - 1)
+                      for r in summary["passive_bias_convergence_s"])
+    return [
+        {"check": f"linear, quasi-stationary, GT: 0 < RMS < {LINEAR_ACCURATE_DEG:g} deg on every axis",
+         "measured": quasi.tolist(), "ok": bool(np.all(quasi > 0) and np.all(quasi < LINEAR_ACCURATE_DEG))},
+        {"check": "linear, non-stationary, GT: RMS above the quasi-stationary one on every axis (ratio)",
+         "measured": (fast / quasi).tolist(), "ok": bool(np.all(fast > quasi))},
+        {"check": f"explicit, without gyro bias, both flights: RMS < {EXPLICIT_ACCURATE_DEG:g} deg (largest)",
+         "measured": [float(explicit.max())], "ok": bool(explicit.max() < EXPLICIT_ACCURATE_DEG)},
+        {"check": "explicit without bias estimate, k1 = k2 >= 1: roll steady error as predicted "
+                  f"(largest relative gap < {PREDICTION_TOLERANCE['explicit']:g})",
+         "measured": [float(explicit_gap)], "ok": bool(explicit_gap < PREDICTION_TOLERANCE["explicit"])},
+        {"check": "passive, R_reel and TRIAD, hover: bias-convergence time as predicted "
+                  f"(largest relative gap < {PREDICTION_TOLERANCE['passive']:g})",
+         "measured": [float(passive_gap)], "ok": bool(passive_gap < PREDICTION_TOLERANCE["passive"])},
+    ]
 
 
 def markdown(summary: dict) -> str:
@@ -119,6 +154,10 @@ def markdown(summary: dict) -> str:
     for row in summary["passive_bias_convergence_s"]:
         simulated = "not reached" if row["simulated"] is None else f"{row['simulated']:.2f}"
         lines.append(f"| {row['ry']} | {row['kP=kI']:g} | {simulated} | {row['predicted']:.2f} |")
+    if "checks" in summary:
+        lines += ["", "| check | measured | holds |", "|---|---|---|"]
+        for row in summary["checks"]:
+            lines.append(f"| {row['check']} | {deg(row['measured'])} | {'yes' if row['ok'] else 'NO'} |")
     return "\n".join(lines) + "\n"
 
 
