@@ -24,6 +24,7 @@ import sys
 import numpy as np
 
 from estimators import estimate
+from estimators.core import euler_to_quaternion
 from fmus import vehicle
 
 VARIANTS = ("recorded", "ideal accelerometer", "true Euler rates", "both")
@@ -76,7 +77,8 @@ def linear_ablation(settings: dict | None = None) -> dict:
     rms = {"streaming": metrics["rms_error_deg"]}
     for name, (a, w) in zip(VARIANTS, [(acc, gyro), (ideal_acc, gyro), (acc, rates), (ideal_acc, rates)],
                             strict=True):
-        theta = estimate("linear", a, w, mag, dt, gains)["theta"][0]
+        theta = estimate("linear", gyro=w, acc=a, mag=mag, dt=dt, gains=gains,
+                         q0=euler_to_quaternion(*truth[0]))["theta"][0]
         error = (theta - truth + np.pi) % (2 * np.pi) - np.pi
         rms[name] = np.degrees(np.sqrt((error[after] ** 2).mean(axis=0))).tolist()
     return rms

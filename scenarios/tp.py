@@ -12,10 +12,11 @@ from functools import partial
 import numpy as np
 
 from estimators import LAB_GAINS, QuaternionEstim
+from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
-from scenarios.flight import FLIGHTS, SETPOINT, Controller, profile_at
+from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 OPTIONS = {
@@ -25,7 +26,9 @@ OPTIONS = {
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
     "noise": Option(False, "IMU white noise"),
     "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s"),
-    "drag": Option(0.0, "linear translational drag (N s/m)", minimum=0.0),
+    "rotor_drag": Option(True, "rotor drag (H-force) on the airspeed, the Quadrotor's k_d; off: k_d = 0"),
+    "wind_n": Option(0.0, "steady wind towards the north (m/s)"),
+    "wind_e": Option(0.0, "steady wind towards the east (m/s)"),
     "magnetic": Option(False, "field of the motor currents at the magnetometer"),
     "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
     "discretisation": Option("exp", "quaternion update", choices=("exp", "euler")),
@@ -64,12 +67,15 @@ def build(o: dict) -> System:
     system = System(dt=o["dt"])
     setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
     system.add(Table("Setpoint", SETPOINT, setpoint))
-    add_plant(system, quadrotor={"drag": o["drag"]}, motors={"omega0": vehicle.hover_rotor_speed()},
+    start = initial_state(o["flight"])  # the estimator starts from the vehicle's initial attitude
+    add_plant(system, quadrotor=start | ({} if o["rotor_drag"] else {"k_d": 0.0}), wind=(o["wind_n"], o["wind_e"], 0.0),
+              motors={"omega0": vehicle.hover_rotor_speed()},
               imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
               magnetic=o["magnetic"], imu_period=period)
     estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
                                            discretisation=o["discretisation"], ry=o["ry"],
-                                           corrections=o["corrections"]))
+                                           corrections=o["corrections"],
+                                           q0=euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)))
     for name in estimator.inputs:
         system.connect(f"IMU.{name}", f"Quaternion_estim.{name}")
     system.add(Controller())

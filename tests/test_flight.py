@@ -2,9 +2,11 @@
 
 import numpy as np
 import pytest
+from scipy.optimize import curve_fit
 
+import scenarios
 from fmus import vehicle
-from scenarios.flight import GAINS, Controller, allocation_matrix, esc_command, profile
+from scenarios.flight import GAINS, Controller, allocation_matrix, esc_command, initial_state, profile, profiles, trim
 from scenarios.flight import controller as law
 
 
@@ -55,11 +57,75 @@ def test_profiles_are_small_and_slow_or_large_and_fast():
     dt = 0.01
     quasi = profile("quasi", 60.0, dt)
     fast = profile("nonstationary", 60.0, dt)
-    assert np.all(quasi[:, 6] == 1) and np.all(fast[:, 6] == 0)
-    speed = np.abs(np.diff(quasi[:, 3:5], axis=0)).max() / dt
-    assert 0.9 < speed < 1.1  # m/s: 2 pi 0.04 Hz x 4 m
+    assert np.all(quasi[:, 6] == 0) and np.all(fast[:, 6] == 0)
+    cruise = initial_state("quasi")
+    assert cruise["theta2_0"] == quasi[0, 1] and np.degrees(cruise["theta2_0"]) == pytest.approx(-2.750, abs=0.001)
+    variation = np.degrees(np.abs(quasi[:, :2] - quasi[0, :2])).max()  # about the trim: 1 deg, 2 at most
+    rate = np.degrees(np.abs(np.diff(quasi[:, :3], axis=0)).max()) / dt
+    assert variation <= 2.0 and rate < 0.7  # deg, deg/s
     assert np.degrees(np.abs(fast[:, :2]).max()) == pytest.approx(20.0, rel=1e-3)
+    assert np.degrees(np.abs(np.diff(fast[:, :2], axis=0)).max()) / dt > 40.0  # deg/s
     tilt = profile("tilt", 3.0, dt, np.radians(5.0))
     assert tilt[0, 1] == 0.0 and np.degrees(tilt[-1, 1]) == pytest.approx(5.0)
     with pytest.raises(ValueError, match="flight 'quasy' must be one of quasi"):
         profile("quasy", 1.0, dt)
+
+
+def _accelerometer_tilt(result):
+    """Roll and pitch (deg) of the specific force the IMU measures, atan2 of its components."""
+    a = result["IMU.acc"]
+    return np.degrees(np.arctan2(-a[:, 1], -a[:, 2])), np.degrees(np.arctan2(a[:, 0], np.hypot(a[:, 1], a[:, 2])))
+
+
+@pytest.mark.parametrize("drag", [True, False])
+def test_steady_tilted_flight_accelerometer_sees_the_tilt_only_with_drag(drag):
+    """A 5 deg pitch held until the speed settles (30 s, 7 drag time constants): with rotor drag
+    the accelerometer's tilt is the true tilt (0.006 deg measured); without, it reads level."""
+    result, _ = scenarios.run("tp", {"flight": "tilt", "tilt_deg": 5.0, "duration": 30.0, "rotor_drag": drag})
+    _, pitch = _accelerometer_tilt(result)
+    true_pitch = np.degrees(result["Quadrotor.theta2"][-1])
+    assert true_pitch == pytest.approx(5.0, abs=1e-6)
+    if drag:
+        assert abs(pitch[-1] - true_pitch) < 0.01
+        assert np.linalg.norm(result["Quadrotor.v"][-1]) == pytest.approx(3.64, abs=0.01)  # m/s, steady
+    else:
+        assert abs(pitch[-1]) < 1e-9 and abs(result["Quadrotor.v"][-1, 0]) > 20.0  # still accelerating
+
+
+def test_accelerometer_tilt_lags_a_tilt_step_with_the_drag_time_constant():
+    """Martin and Salaun (2010): the accelerometer's tilt follows the true tilt through 1/(1 + tau s),
+    tau = m / (k_d sum|omega_n|). Fitted 4.257 s against 4.250 s predicted (0.2 %)."""
+    result, _ = scenarios.run("tp", {"flight": "tilt", "tilt_deg": 5.0, "duration": 25.0})
+    _, pitch = _accelerometer_tilt(result)
+    t = result.time
+    window = t > profiles.STEP_TIME + 1.0  # after the attitude loop has settled (0.3 s)
+
+    def lag(t, final, amplitude, tau):
+        return final - amplitude * np.exp(-(t - profiles.STEP_TIME) / tau)
+
+    (final, _, tau), _ = curve_fit(lag, t[window], pitch[window], p0=(5.0, 5.0, 4.0))
+    predicted = trim.drag_time_constant(thrust=result["Quadrotor.thrust"][-1])
+    assert tau == pytest.approx(predicted, rel=0.01)
+    assert final == pytest.approx(5.0, abs=0.01)
+
+
+def test_position_hold_in_steady_wind_at_the_tilt_that_balances_drag():
+    """3 m/s north wind, position hold: the integral brings the position back (0.5 m at most on
+    the way) and the vehicle leans into the wind at the predicted tilt (4.118 deg, agreement 1e-8)."""
+    result, _ = scenarios.run("tp", {"flight": "hover", "wind_n": 3.0, "duration": 40.0})
+    predicted, _ = trim.wind_hover_tilt(3.0)
+    assert np.degrees(result["Quadrotor.theta2"][-1]) == pytest.approx(np.degrees(predicted), rel=1e-4)
+    assert abs(result["Quadrotor.theta1"][-1]) < 1e-9
+    assert np.abs(result["Quadrotor.p"][-1, :2]).max() < 1e-3  # m, position held
+    assert np.abs(result["Quadrotor.p"][:, 0]).max() < 0.6  # m, blown off at most
+
+
+def test_without_integral_action_the_wind_pushes_the_vehicle_off():
+    """Ablation of the integral: with ki_xy = 0 the PD hold settles downwind, by the drag force
+    over kp_xy (0.72 m predicted from the trim)."""
+    system = scenarios.get("tp").build(scenarios.get("tp").parse({"flight": "hover", "wind_n": 3.0, "duration": 40.0}))
+    system.blocks["Controller"].parameters[law.P_KIXY] = 0.0
+    result = system.run(40.0)
+    tilt, _ = trim.wind_hover_tilt(3.0)
+    offset = np.tan(tilt) * vehicle.GRAVITY / GAINS["kp_xy"][0]  # m: kp_xy e = g tan(tilt)
+    assert result["Quadrotor.p"][-1, 0] == pytest.approx(offset, rel=0.02)

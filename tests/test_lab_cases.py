@@ -14,18 +14,21 @@ def run(**options):
 
 
 def test_linear_gt_quasi_stationary_without_noise():
+    """The cruise's tilt (2.75 deg) is seen by the accelerometer thanks to rotor drag: the linear
+    filter is accurate (0.049 / 0.061 / 0.043 deg measured). Without drag the accelerometer reads
+    level whatever the tilt, and the pitch error grows 15-fold (0.94 deg)."""
     _, m = run(estimator="linear", k=0.05)
-    roll, pitch, yaw = m["rms_error_deg"]
-    assert roll < 0.5 and pitch < 0.5 and yaw < 1.0
+    assert np.all(np.array(m["rms_error_deg"]) > 0.03) and max(m["rms_error_deg"]) < 0.07
+    _, without = run(estimator="linear", k=0.05, rotor_drag=False)
+    assert without["rms_error_deg"][1] > 12 * m["rms_error_deg"][1]
 
 
 def test_non_stationary_flight_degrades_linear_not_explicit():
     _, quasi = run(estimator="linear")
     _, linear = run(estimator="linear", flight="nonstationary")
     _, explicit = run(estimator="explicit", flight="nonstationary")
-    assert 0.0 < min(quasi["rms_error_deg"]) and max(quasi["rms_error_deg"]) < 0.4  # accurate, not zero
     grown = np.array(linear["rms_error_deg"]) / np.array(quasi["rms_error_deg"])
-    assert np.all(grown > 5) and min(linear["rms_error_deg"]) > 1.5  # the linear error grows
+    assert np.all(grown > 30) and min(linear["rms_error_deg"]) > 1.8  # the linear error grows (33 to 200 times)
     assert max(explicit["rms_error_deg"]) < 2.0
 
 
@@ -58,9 +61,9 @@ def test_estimate_fed_control_flies_with_noise_and_bias(estimator, flight):
     tilt = np.degrees(np.abs(np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])))
     assert tilt.max() < 60.0  # never tumbles
     assert max(m["tracking_rms_deg"]) < 20.0 and max(m["rms_error_deg"]) < 20.0
-    if flight == "quasi":  # the position hold follows its setpoint, on the true position (1.5 m measured)
-        setpoint = np.column_stack([result["Setpoint.x_d"], result["Setpoint.y_d"]])
-        assert np.abs(result["Quadrotor.p"][:, :2] - setpoint).max() < 2.0
+    if flight == "quasi" and estimator == "passive":  # it estimates the bias: the cruise stays as in GT
+        speed = np.hypot(result["Quadrotor.v"][:, 0], result["Quadrotor.v"][:, 1])
+        assert speed.min() > 1.25 and speed.max() < 2.01  # m/s; GT flight: 1.26 to 2.00
 
 
 def test_linear_gain_prediction_matches_simulation():

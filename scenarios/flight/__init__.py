@@ -9,6 +9,7 @@
 
 from scenarios.flight.controller import GAINS, SETPOINT, Controller
 from scenarios.flight.mixer import allocation_matrix, esc_command
-from scenarios.flight.profiles import FLIGHTS, profile, profile_at
+from scenarios.flight.profiles import FLIGHTS, initial_state, profile, profile_at
 
-__all__ = ["FLIGHTS", "GAINS", "SETPOINT", "Controller", "allocation_matrix", "esc_command", "profile", "profile_at"]
+__all__ = ["FLIGHTS", "GAINS", "SETPOINT", "Controller", "allocation_matrix", "esc_command", "initial_state", "profile",
+           "profile_at"]

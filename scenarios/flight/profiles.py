@@ -6,11 +6,14 @@ negative), ``hold`` (1: hold the horizontal position and derive roll and pitch f
 
 - ``hover``: hold the origin.
 - ``quasi`` (quasi-stationary, the lab's definition): small, slow attitude and position
-  changes. The position setpoint draws a slow Lissajous figure from rest at the origin,
-  ``x_d = A (1 - cos(2 pi f t))`` (A = 4 m; f = 0.04 Hz north, 0.03 Hz east), the yaw swings
-  by 20 degrees at 0.02 Hz, the altitude by 0.5 m at 0.05 Hz. The position hold tilts the
-  vehicle by a few degrees, slowly, so the vehicle stays near its steady velocity and, with
-  rotor drag, its accelerometer sees the tilt.
+  changes about a steady flight. The vehicle starts in trimmed cruise, 2 m/s north, pitched
+  nose-down by the angle at which rotor drag balances the tilted thrust (2.75 degrees,
+  :func:`scenarios.flight.trim.wind_hover_tilt`), and flies slow variations about it: pitch
+  1 degree at 0.02 Hz, roll 1 degree at 0.015 Hz, yaw 10 degrees at 0.01 Hz, altitude 0.5 m at
+  0.05 Hz, without position hold. Its velocity stays near the steady one (the variations are
+  slow against the drag's 4.2 s time constant), so the accelerometer, which reads gravity
+  minus acceleration, sees the tilt. Without rotor drag the same setpoints accelerate the
+  vehicle for ever and the accelerometer never sees the tilt.
 - ``nonstationary``: large, fast attitude changes and accelerations: roll and pitch of 20
   degrees at 0.4 and 0.3 Hz, yaw of 30 degrees at 0.1 Hz, altitude of 1 m at 0.2 Hz, no
   position hold. The accelerometer then measures much more than gravity.
@@ -22,17 +25,21 @@ negative), ``hold`` (1: hold the horizontal position and derive roll and pitch f
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
+
+from scenarios.flight import trim
 
 EASE_IN = 2.0  # s, ramp of the periodic profiles
 STEP_TIME = 1.0  # s, start of the tilt step
 DEG = math.pi / 180.0  # rad per degree
 
 # quasi-stationary
-QUASI_RADIUS = 4.0  # m, amplitude of the north and east position setpoints
-QUASI_FREQUENCY = (0.04, 0.03)  # Hz, north, east
-QUASI_YAW, QUASI_YAW_FREQUENCY = 20.0 * DEG, 0.02  # rad, Hz
+CRUISE_SPEED = 2.0  # m/s, north
+QUASI_PITCH, QUASI_PITCH_FREQUENCY = 1.0 * DEG, 0.02  # rad, Hz, about the cruise pitch
+QUASI_ROLL, QUASI_ROLL_FREQUENCY = 1.0 * DEG, 0.015  # rad, Hz
+QUASI_YAW, QUASI_YAW_FREQUENCY = 10.0 * DEG, 0.01  # rad, Hz
 QUASI_HEAVE, QUASI_HEAVE_FREQUENCY = 0.5, 0.05  # m, Hz
 # non-stationary
 FAST_ROLL, FAST_ROLL_FREQUENCY = 20.0 * DEG, 0.4  # rad, Hz
@@ -41,6 +48,21 @@ FAST_YAW, FAST_YAW_FREQUENCY = 30.0 * DEG, 0.1  # rad, Hz
 FAST_HEAVE, FAST_HEAVE_FREQUENCY = 1.0, 0.2  # m, Hz
 
 FLIGHTS = ("quasi", "nonstationary", "hover", "tilt")
+
+
+@lru_cache
+def cruise_pitch(speed: float = CRUISE_SPEED) -> float:
+    """Pitch (rad, negative: nose down) of steady level flight north at ``speed`` (m/s) with the
+    default vehicle's drag: the hover-in-wind trim mirrored (the airspeed is the same)."""
+    return -trim.wind_hover_tilt(speed)[0]
+
+
+def initial_state(flight: str) -> dict:
+    """Initial condition of a profile, as Quadrotor FMU parameters: the trimmed cruise of
+    ``quasi`` (velocity m/s, pitch rad), rest otherwise."""
+    if flight == "quasi":
+        return {"v_x0": CRUISE_SPEED, "theta2_0": cruise_pitch()}
+    return {}
 
 
 def _sine(amplitude, frequency, t, phase=0.0):
@@ -81,11 +103,11 @@ def profile_at(flight: str, t: np.ndarray, tilt: float = 5.0 * DEG) -> np.ndarra
     if flight == "hover":
         return np.column_stack([zero, zero, zero, zero, zero, zero, one])
     if flight == "quasi":
-        north = QUASI_RADIUS - _sine(QUASI_RADIUS, QUASI_FREQUENCY[0], t, np.pi / 2)  # from rest
-        east = QUASI_RADIUS - _sine(QUASI_RADIUS, QUASI_FREQUENCY[1], t, np.pi / 2)
+        roll = _sine(QUASI_ROLL, QUASI_ROLL_FREQUENCY, t)
+        pitch = cruise_pitch() + _sine(QUASI_PITCH, QUASI_PITCH_FREQUENCY, t)
         yaw = _sine(QUASI_YAW, QUASI_YAW_FREQUENCY, t)
         z = -_sine(QUASI_HEAVE, QUASI_HEAVE_FREQUENCY, t)
-        return np.column_stack([zero, zero, yaw * ramp, north, east, z * ramp, one])
+        return np.column_stack([roll, pitch, yaw, zero, zero, z, zero])
     if flight == "nonstationary":
         roll = _sine(FAST_ROLL, FAST_ROLL_FREQUENCY, t)
         pitch = _sine(FAST_PITCH, FAST_PITCH_FREQUENCY, t, FAST_PITCH_PHASE)
