@@ -18,7 +18,11 @@ Law, per sample of period ``dt``:
   feedforward would need a wind estimate; the integral needs none. It is clamped to what the
   tilt limit can deliver (anti-windup) and frozen while the profile flies attitude setpoints.
 - attitude: ``q_e = q_d* (x) q``, ``e = 2 sign(q_e0) q_e,v``,
-  ``tau = J (-kp e - kd omega) + omega x J omega``;
+  ``tau = J (-K_p e - K_d omega) + omega x J omega``, ``K_p = diag(kp, kp, kp_yaw)``, ``K_d`` alike.
+  Yaw is slower (8 against 12 rad/s): the rotors' reaction to their own acceleration,
+  ``J_r dω/dt``, acts in the sense of the drag torque and makes the yaw actuator's first
+  30 ms about 13 times stronger than ``k_m ω^2`` says; at 12 rad/s a 100 Hz control loop
+  saturates the motors in non-stationary flight, at 8 rad/s it does not;
 - altitude: ``a_z = kp_z (z_d - p_z) - kd_z v_z``, ``T = m (g - a_z) / R33``;
 - mixer: ``[T_1..T_4] = M^-1 [T, tau]`` (:func:`scenarios.flight.mixer.allocation_matrix`),
   each rotor thrust saturated to ``[0, T_max]``, ``omega_n = sqrt(T_n / k_f)``, and the ESC
@@ -51,6 +55,8 @@ OUTPUTS = ("c1", "c2", "c3", "c4", "thrust", "tau_x", "tau_y", "tau_z", "theta_d
 GAINS = {
     "kp": (144.0, "1/s^2", "attitude, proportional (natural frequency 12 rad/s)"),
     "kd": (19.2, "1/s", "attitude, derivative (damping 0.8)"),
+    "kp_yaw": (64.0, "1/s^2", "yaw, proportional (natural frequency 8 rad/s)"),
+    "kd_yaw": (12.8, "1/s", "yaw, derivative (damping 0.8)"),
     "kp_z": (9.0, "1/s^2", "altitude, proportional"),
     "kd_z": (5.4, "1/s", "altitude, derivative"),
     "kp_xy": (1.0, "1/s^2", "position hold, proportional"),
@@ -93,6 +99,7 @@ P_G, P_KF, P_TMAX = (_slot(PARAMETERS, n) for n in ("gravity", "thrust_coeff", "
 P_RES, P_KE, P_KM = (_slot(PARAMETERS, n) for n in ("resistance", "ke", "drag_torque_coeff"))
 P_TILT = _slot(PARAMETERS, "max_tilt")
 P_KP, P_KD, P_KPZ, P_KDZ = (_slot(PARAMETERS, n) for n in ("kp", "kd", "kp_z", "kd_z"))
+P_KPYAW, P_KDYAW = _slot(PARAMETERS, "kp_yaw"), _slot(PARAMETERS, "kd_yaw")
 P_KPXY, P_KDXY, P_KIXY = (_slot(PARAMETERS, n) for n in ("kp_xy", "kd_xy", "ki_xy"))
 # state
 S_INT_X, S_INT_Y = 0, 1  # integral of the north and east position errors (m s)
@@ -157,7 +164,7 @@ def control_law(u, p, mixer_inverse, state, dt, y):
     jx, jy, jz = p[P_JX], p[P_JY], p[P_JZ]
     tx = jx * (-p[P_KP] * sign * e1 - p[P_KD] * wx) + (jz - jy) * wy * wz
     ty = jy * (-p[P_KP] * sign * e2 - p[P_KD] * wy) + (jx - jz) * wz * wx
-    tz = jz * (-p[P_KP] * sign * e3 - p[P_KD] * wz) + (jy - jx) * wx * wy
+    tz = jz * (-p[P_KPYAW] * sign * e3 - p[P_KDYAW] * wz) + (jy - jx) * wx * wy
     r33 = max(1.0 - 2.0 * (q1 * q1 + q2 * q2), MIN_THRUST_COSINE)
     a_z = p[P_KPZ] * (u[U_Z_D] - u[U_P + 2]) - p[P_KDZ] * u[U_V + 2]
     thrust = p[P_MASS] * (g - a_z) / r33
