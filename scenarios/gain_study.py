@@ -54,7 +54,7 @@ def build(o: dict):
     tp = scenarios.get("tp")
     return tp.build(tp.parse({"estimator": "linear", "flight": "hover", "feedback": "gt", "noise": True,
                               "duration": o["duration"], "dt": 1.0 / o["imu_rate"], "imu_rate": o["imu_rate"],
-                              "seed": o["seed"], "settle": 0.0}))
+                              "seed": o["seed"], "settle": 0.0, "bench_supply": True}))
 
 
 RECORD = ["IMU.acc", "IMU.gyro", "IMU.magneto", "Quadrotor.theta1", "Quadrotor.theta2", "Quadrotor.theta3"]
@@ -68,8 +68,7 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
     variances, errors = [], []
     for chunk in np.array_split(gains, max(1, len(gains) // 2)):
         out = estimate("linear", acc=result["IMU.acc"], gyro=result["IMU.gyro"], mag=result["IMU.magneto"], dt=dt,
-                       gains={"k1": chunk, "k2": chunk, "k3": chunk}, outputs=("theta",),
-                       check_units=False)  # the battery runs down in long hovers: |acc| leaves g after ~220 s
+                       gains={"k1": chunk, "k2": chunk, "k3": chunk}, outputs=("theta",))
         for g in range(len(chunk)):
             error = out["theta"][g, start:, :2] - truth[start:]
             blocks = np.array_split(error, 20)

@@ -19,6 +19,8 @@ from scenarios import Option, Scenario
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
+BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
+
 OPTIONS = {
     "estimator": Option("linear", "attitude estimator", choices=("linear", "explicit", "passive", "vqf", "madgwick")),
     "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py)", choices=FLIGHTS),
@@ -29,6 +31,7 @@ OPTIONS = {
     "rotor_drag": Option(True, "rotor drag (H-force) on the airspeed, the Quadrotor's k_d; off: k_d = 0"),
     "wind_n": Option(0.0, "steady wind towards the north (m/s)"),
     "wind_e": Option(0.0, "steady wind towards the east (m/s)"),
+    "bench_supply": Option(False, "battery capacity x1000, for hovers longer than the battery's ten minutes"),
     "magnetic": Option(False, "field of the motor currents at the magnetometer"),
     "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
     "discretisation": Option("exp", "quaternion update", choices=("exp", "euler")),
@@ -69,7 +72,8 @@ def build(o: dict) -> System:
     system.add(Table("Setpoint", SETPOINT, setpoint))
     start = initial_state(o["flight"])  # the estimator starts from the vehicle's initial attitude
     add_plant(system, quadrotor=start | ({} if o["rotor_drag"] else {"k_d": 0.0}), wind=(o["wind_n"], o["wind_e"], 0.0),
-              motors={"omega0": vehicle.hover_rotor_speed()},
+              motors={"omega0": vehicle.hover_rotor_speed()}
+              | ({"capacity": BENCH_SUPPLY * vehicle.BATTERY_CAPACITY} if o["bench_supply"] else {}),
               imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
               magnetic=o["magnetic"], imu_period=period)
     estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
