@@ -3,10 +3,16 @@
 A fault sits on the connection into one block input. While it is active, the master gives
 that input a faulted copy of its source signal, held in a bus slot of its own, so that the
 source signal itself (and every other block reading it) stays intact.
+
+Several faults on one input compose in the order they are injected, each acting on the output
+of the one before: an offset of +10 then an offset of +100 add 110; an offset of +1 then a
+scale of 2 give ``2 (x + 1)``, the reverse order ``2 x + 1``. A fault's value must be finite,
+and a fault whose window no step of the run falls in is reported with a warning.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,6 +59,11 @@ class Fault:
             raise ValueError(f"fault on {self.target}: stop ({self.stop}) must come after start ({self.start})")
         if self.kind in ("offset", "scale", "noise") and self.value is None:
             raise ValueError(f"a {self.kind} fault needs a value")
+        for name in ("start", "stop"):
+            if math.isnan(getattr(self, name)):
+                raise ValueError(f"fault on {self.target}: {name} is NaN; give a time in seconds")
+        if self.value is not None and not math.isfinite(self.value):
+            raise ValueError(f"{self.kind} fault on {self.target}: value {self.value} is not a finite number")
         if self.kind == "noise" and self.value < 0:
             raise ValueError(f"noise fault on {self.target}: standard deviation {self.value} is negative")
 

@@ -6,7 +6,9 @@ The bus
 
 Building a plan (:class:`Plan`), in order:
 
-1. :meth:`Plan._lay_out_bus`: a slot per block output, then a slot per fault;
+1. :meth:`Plan._lay_out_bus`: a slot per block output, then a slot per fault (several faults
+   on one input form a chain, each reading the slot of the one before: they compose in the
+   order they were injected);
 2. :meth:`Plan._plan_recording`: the recorded signals, as :class:`Copy` slices from the bus
    into a row of a preallocated array;
 3. :meth:`Plan._wire_blocks`, block by block in dependency order:
@@ -31,6 +33,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -129,6 +132,7 @@ class Plan:
         self.logs = {}  # block name -> its FMU's log, kept after the FMU is freed
         for fault in system.faults:
             fault.reset()
+            _warn_if_idle(fault, t0, self.steps, self.dt)
         try:
             self._wire_blocks()
         except BaseException:
@@ -141,7 +145,14 @@ class Plan:
         for block in self.order:
             for y in block.outputs:
                 self.slot[f"{block.name}.{y}"] = len(self.slot)
-        self.fault_slot = {f.target: len(self.slot) + k for k, f in enumerate(self.system.faults)}
+        # fault k writes slot len(slot) + k and reads its signal's slot, or the slot of the
+        # fault before it on the same input; the input reads the last fault's slot
+        self.fault_slot: dict[str, int] = {}  # input -> slot of its last fault
+        self.fault_taps: list[FaultTap] = []
+        for k, fault in enumerate(self.system.faults):
+            source = self.fault_slot.get(fault.target, self.slot[self.system.connections[fault.target]])
+            self.fault_slot[fault.target] = len(self.slot) + k
+            self.fault_taps.append(FaultTap(fault, source, len(self.slot) + k))
         self.bus = np.zeros(len(self.slot) + len(self.system.faults))
 
     def _plan_recording(self, record):
@@ -170,8 +181,7 @@ class Plan:
         return first, self.bus[first:first + len(block.outputs)]
 
     def _taps(self, block) -> list[FaultTap]:
-        return [FaultTap(f, self.slot[self.system.connections[f.target]], self.fault_slot[f.target])
-                for f in self.system.faults if f.target.startswith(block.name + ".")]
+        return [tap for tap in self.fault_taps if tap.fault.target.startswith(block.name + ".")]
 
     def _wire_blocks(self):
         self.phase_a: list[Phase] = []
@@ -293,17 +303,19 @@ class Plan:
                 bar.close()
 
     def _non_finite(self, t: float) -> str:
+        bus = self.bus
+        for tap in self.fault_taps:  # a fault that turned a finite signal non-finite is the cause
+            if not math.isfinite(bus[tap.slot]) and math.isfinite(bus[tap.source]):
+                fault = tap.fault
+                return (f"the {fault.kind} fault on {fault.target} (value {fault.value}, from {fault.start} s "
+                        f"to {fault.stop} s) made it {bus[tap.slot]} at t = {t:.6g} s")
         for block in self.order:  # the first in the order is where it appeared
             for y in block.outputs:
                 name = f"{block.name}.{y}"
-                value = self.bus[self.slot[name]]
+                value = bus[self.slot[name]]
                 if not math.isfinite(value):
                     return (f"{name} became {value} at t = {t:.6g} s (the first non-finite signal in the block "
                             f"order). Check the block {block.name} and its inputs.")
-        for fault in self.system.faults:
-            value = self.bus[self.fault_slot[fault.target]]
-            if not math.isfinite(value):
-                return f"the {fault.kind} fault on {fault.target} made it {value} at t = {t:.6g} s"
         return f"a signal became non-finite at t = {t:.6g} s"
 
     def result(self, error: str | None = None) -> Result:
@@ -328,6 +340,16 @@ class Plan:
         for block in self.system.blocks.values():
             if isinstance(block, Block):
                 block.close()
+
+
+def _warn_if_idle(fault, t0: float, steps: int, dt: float):
+    """Warn when no macro step of the run, ``t0 + n dt`` for ``0 <= n <= steps``, falls in the
+    fault's window: the fault would do nothing."""
+    first = max(0, math.ceil((fault.start - t0) / dt - 1e-9))
+    if first > steps or not t0 + first * dt < fault.stop:
+        warnings.warn(f"the {fault.kind} fault on {fault.target} acts for {fault.start} s <= t < {fault.stop} s, "
+                      f"when no step of the run ({t0:g} s to {t0 + steps * dt:g} s, every {dt:g} s) falls: "
+                      "it has no effect", RuntimeWarning, stacklevel=4)
 
 
 def _progress(total_seconds: float):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 
@@ -54,7 +55,8 @@ def _parse_fault(text: str):
 
     parts = text.split(":")
     if len(parts) not in (4, 5):
-        raise ValueError(f"--fault {text!r}: write TARGET:KIND:START:STOP[:VALUE], e.g. IMU.gyro_x:offset:2:3:0.1")
+        raise ValueError(f"--fault {text!r}: write TARGET:KIND:START:STOP[:VALUE], e.g. IMU.omega_x:offset:0.5:1:0.05 "
+                         "(a gyro offset of 0.05 rad/s from 0.5 s to 1 s, on the true rate into the IMU)")
     value = float(parts[4]) if len(parts) == 5 else None
     return Fault(parts[0], parts[1], float(parts[2]), float(parts[3]), value)
 
@@ -168,11 +170,17 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    print(f"quadcosim: warning: {message}", file=sys.stderr)
+
+
 def main(argv=None) -> int:
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
     try:
-        with terminate_as_interrupt():  # SIGTERM ends the command as Ctrl-C does: cleanly
+        with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
+            warnings.simplefilter("default")
+            warnings.showwarning = _show_warning
             args = parser().parse_args(argv)
             return args.func(args)
     except KeyboardInterrupt as interrupt:  # before or after a run: nothing half-written is left

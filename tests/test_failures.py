@@ -92,11 +92,11 @@ def test_invalid_parameters_are_refused_with_the_fix(make, words):
 def test_cli_failure_saves_what_was_recorded(tmp_path, capsys):
     out = tmp_path / "run"
     code = cli(["run", "open-loop", "--set", "duration=1", "--out", str(out),
-                "--fault", "MotorMagnetics.c1:offset:0.5:0.6:inf"])
+                "--fault", "MotorMagnetics.c1:offset:0.5:0.6:1e308", "--fault", "MotorMagnetics.c1:scale:0.5:0.6:10"])
     assert code == 1
     err = capsys.readouterr().err
     assert "MotorMagnetics: fmi2SetReal returned Error at t = 0.5 s" in err
-    assert "offset fault on MotorMagnetics.c1 made it inf" in err
+    assert "the scale fault on MotorMagnetics.c1 (value 10.0, from 0.5 s to 0.6 s) made it inf at t = 0.5 s" in err
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["recorded_until_s"] == pytest.approx(0.499)
     with np.load(out / "results.npz") as saved:

@@ -4,11 +4,14 @@ what is left on disk."""
 
 import json
 import os
+import re
+import shlex
 import signal
 import subprocess
 import sys
 import time
 import tracemalloc
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +19,7 @@ import pytest
 from scipy.io import loadmat
 
 import orchestrator.files
-from orchestrator import FMUBlock, Result, System, Table
+from orchestrator import Block, Fault, FMUBlock, Result, SimulationError, System, Table
 from orchestrator.files import atomic_path
 from scenarios.cli import main as cli
 
@@ -189,3 +192,118 @@ def test_fmu_warnings_are_counted_and_the_first_shown(tmp_path, capsys):
     assert "MotorMagnetics: [Warning] c2 = " in err and "is outside [0, 1]: saturated" in err
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["fmu_warnings"]["MotorMagnetics"]["count"] == 1
+
+
+# ---------------------------------------------------------------------- faults
+class Echo(Block):
+    inputs, outputs = ("u",), ("y",)
+
+    def step(self, t, u, y):
+        y[0] = u[0]
+
+
+def echo_system(*faults):
+    system = System()
+    system.add(Table("Source", ["x"], [[1.0]]))
+    system.add(Echo("Echo"))
+    system.connect("Source.x", "Echo.u")
+    for fault in faults:
+        system.inject(fault)
+    return system
+
+
+def test_faults_on_one_input_compose_in_the_order_given():
+    result = echo_system(Fault("Echo.u", "offset", 0.0, 0.5, 10.0), Fault("Echo.u", "offset", 0.0, 0.5, 100.0),
+                         Fault("Echo.u", "scale", 0.25, 0.5, 2.0)).run(1.0)
+    y = result["Echo.y"]
+    assert y[0] == 111.0 and y[249] == 111.0  # 1 + 10 + 100
+    assert y[250] == 222.0  # then scaled: 2 (1 + 110)
+    assert y[500] == 1.0  # every window closed
+    swapped = echo_system(Fault("Echo.u", "scale", 0.0, 0.5, 2.0), Fault("Echo.u", "offset", 0.0, 0.5, 10.0)).run(0.1)
+    assert swapped["Echo.y"][0] == 12.0  # 2 x + 10, not 2 (x + 10)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf")])
+def test_a_non_finite_fault_value_is_refused(value):
+    with pytest.raises(ValueError, match=f"offset fault on Echo.u: value {value} is not a finite number"):
+        Fault("Echo.u", "offset", 0.0, 1.0, value)
+
+
+def test_a_non_finite_fault_value_is_refused_on_the_command_line(tmp_path, capsys):
+    assert cli(["run", "open-loop", "--out", str(tmp_path / "run"), "--fault", "IMU.omega_x:offset:0.5:1:nan"]) == 2
+    assert "offset fault on IMU.omega_x: value nan is not a finite number" in capsys.readouterr().err
+    assert not (tmp_path / "run" / "results.npz").exists()
+
+
+@pytest.mark.parametrize("start, stop", [(2.0, 3.0), (-2.0, -1.0), (0.1004, 0.1008)])
+def test_a_fault_window_no_step_falls_in_warns(start, stop):
+    with pytest.warns(RuntimeWarning, match=rf"the offset fault on Echo.u acts for {start} s <= t < {stop} s, "
+                                            r"when no step of the run \(0 s to 1 s, every 0.001 s\) falls: it has "
+                                            "no effect"):
+        result = echo_system(Fault("Echo.u", "offset", start, stop, 5.0)).run(1.0)
+    assert (result["Echo.y"] == 1.0).all()
+
+
+def test_a_fault_window_inside_the_run_does_not_warn():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = echo_system(Fault("Echo.u", "offset", 1.0, 3.0, 5.0)).run(1.0)  # active at the last step only
+    assert result["Echo.y"][-1] == 6.0
+
+
+def test_a_fault_window_outside_the_run_warns_on_the_command_line(tmp_path, capsys):
+    assert cli(["run", "open-loop", "--set", "duration=0.2", "--out", str(tmp_path / "run"),
+                "--fault", "IMU.omega_x:offset:5:6:0.1"]) == 0
+    assert "the offset fault on IMU.omega_x acts for 5.0 s <= t < 6.0 s, when no step of the run (0 s to 0.2 s" \
+        in capsys.readouterr().err
+
+
+def test_a_non_finite_value_made_by_a_fault_names_the_fault():
+    class Estimator(Block):  # a Python block that turns an infinite input into NaN
+        inputs, outputs = ("u",), ("y",)
+
+        def step(self, t, u, y):
+            y[0] = u[0] - u[0]
+
+    system = System()
+    system.add(Table("Source", ["x"], [[1.0]]))
+    system.add(Estimator("Estimator"))
+    system.connect("Source.x", "Estimator.u")
+    system.inject(Fault("Estimator.u", "scale", 0.1, 0.2, 1e300))
+    system.inject(Fault("Estimator.u", "scale", 0.1, 0.2, 1e300))
+    with pytest.raises(SimulationError) as error:
+        system.run(1.0)
+    assert str(error.value).startswith("the scale fault on Estimator.u (value 1e+300, from 0.1 s to 0.2 s) made it "
+                                       "inf at t = 0.1 s")
+    assert len(error.value.result) == 101
+
+
+# ---------------------------------------------------------------------- the README's commands
+def readme_commands() -> list[str]:
+    """Every ``quadcosim`` command in the README's shell blocks, comments removed."""
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```sh\n(.*?)```", text, flags=re.S)
+    lines = [line.split(" #")[0].strip() for block in blocks for line in block.splitlines()]
+    return [line for line in lines if line.startswith("quadcosim ")]
+
+
+def test_the_readme_has_command_examples():
+    commands = readme_commands()
+    assert len(commands) >= 8 and any("--fault" in c for c in commands)
+
+
+@pytest.mark.parametrize("command", readme_commands())
+def test_every_command_in_the_readme_runs(command, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)  # results/ and figures land here
+    code = run_cli(shlex.split(command)[1:])
+    assert code == 0, capsys.readouterr().err[-3000:]
+
+
+def test_the_help_fault_example_runs(tmp_path, capsys):
+    from scenarios.cli import _parse_fault
+
+    with pytest.raises(ValueError) as error:
+        _parse_fault("IMU.omega_x")
+    example = re.search(r"e\.g\. (\S+)", str(error.value)).group(1)
+    assert cli(["run", "open-loop", "--fault", example, "--out", str(tmp_path / "run")]) == 0
+    assert "warning" not in capsys.readouterr().err.lower()
