@@ -15,8 +15,9 @@ Modes:
 - ``METGE`` (1): eq. 9 with the bi-polynomial of the command and the voltage;
 - ``DYNAMIC`` (2): the commands pass through the identified motor dynamics
   (:class:`calibration.identify.MotorDynamics`): per motor a back-EMF state ``e`` (V) with
-  ``de/dt = rate (c u - e) - drag e |e|`` (DC motor, quasi-static current), the winding voltage
-  ``w = clip(c u - e, low, limit)`` with ``low = 0`` when the ESC free-wheels, and the amplitude
+  ``de/dt = rate w - drag e |e|`` (DC motor, quasi-static current), the winding voltage
+  ``w = clip(c u - e, low, limit)`` with ``low = 0`` when the ESC free-wheels (else
+  ``-limit``), and the amplitude
   ``gain c^exponent w``, with the command and voltage held over the last step (the current at
   ``t`` answers the voltage applied before ``t``) (``exponent = 1``: the supply cable carries the ESC input current
   ``c i``; ``0``: the motor current ``i``). Integrated by Heun's method on the macro step.
@@ -51,8 +52,15 @@ def steady_emf(c, u, rate, drag):
 
 
 @njit(cache=True, error_model="numpy")
-def _emf_rate(e, drive, rate, drag):
-    return rate * (drive - e) - drag * e * abs(e)
+def winding_voltage(drive, e, low, limit):
+    """``c u - e`` (V) clipped by the ESC: at ``low`` (0 when it free-wheels, else ``-limit``) and
+    at ``limit`` (the current limit times R)."""
+    return min(max(drive - e, low), limit)
+
+
+@njit(cache=True, error_model="numpy")
+def _emf_rate(e, drive, rate, drag, low, limit):
+    return rate * winding_voltage(drive, e, low, limit) - drag * e * abs(e)
 
 
 @njit(cache=True, error_model="numpy")
@@ -81,21 +89,20 @@ def step(t, dt, mag, c, u, A_inv, b_s, v, theta, I, J, dynamics, mode, sample_ra
     n_motors = v.shape[0]
     held = 2 * n_motors + 1
     started = 2 * n_motors + 4
-    c_clip = np.empty(n_motors)
-    for n in range(n_motors):
-        c_clip[n] = min(max(c[n], 0.0), 1.0)
+    limit = dynamics[LIMIT]
+    low = 0.0 if dynamics[FREEWHEEL] > 0.5 else -limit
     if mode == DYNAMIC:
         rate, drag = dynamics[RATE], dynamics[DRAG]
         if state[started] == 0.0:
             for n in range(n_motors):
-                state[n] = steady_emf(c_clip[n], u, rate, drag)
+                state[n] = steady_emf(min(max(c[n], 0.0), 1.0), u, rate, drag)
         else:
             u0 = state[2 * n_motors]
             for n in range(n_motors):  # Heun on [t - dt, t] with the command held over the step
                 drive = state[n_motors + n] * u0
                 e = state[n]
-                k1 = _emf_rate(e, drive, rate, drag)
-                k2 = _emf_rate(e + dt * k1, state[n_motors + n] * u, rate, drag)
+                k1 = _emf_rate(e, drive, rate, drag, low, limit)
+                k2 = _emf_rate(e + dt * k1, state[n_motors + n] * u, rate, drag, low, limit)
                 state[n] = e + 0.5 * dt * (k1 + k2)
     sample = sample_rate <= 0.0 or abs(t * sample_rate - round(t * sample_rate)) < 1e-6 or state[started] == 0.0
     if sample:
@@ -104,18 +111,16 @@ def step(t, dt, mag, c, u, A_inv, b_s, v, theta, I, J, dynamics, mode, sample_ra
         if mode != STATIC:
             for n in range(n_motors):
                 if mode == METGE:
-                    f = _amplitude_polynomial(c_clip[n], u, theta[n], I, J)
+                    f = _amplitude_polynomial(min(max(c[n], 0.0), 1.0), u, theta[n], I, J)
                 else:  # the current at t was driven by the command held over the last step
-                    c_held = state[n_motors + n] if state[started] > 0.0 else c_clip[n]
+                    c_held = state[n_motors + n] if state[started] > 0.0 else min(max(c[n], 0.0), 1.0)
                     u_held = state[2 * n_motors] if state[started] > 0.0 else u
-                    w = c_held * u_held - state[n]
-                    low = 0.0 if dynamics[FREEWHEEL] > 0.5 else -np.inf
-                    w = min(max(w, low), dynamics[LIMIT])
+                    w = winding_voltage(c_held * u_held, state[n], low, limit)
                     f = dynamics[GAINS + n] * w * (c_held if dynamics[EXPONENT] > 0.5 else 1.0)
                 for a in range(3):
                     state[held + a] += f * v[n, a]
     for n in range(n_motors):
-        state[n_motors + n] = c_clip[n]
+        state[n_motors + n] = min(max(c[n], 0.0), 1.0)
     state[2 * n_motors] = u
     state[started] = 1.0
     for a in range(3):

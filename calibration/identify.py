@@ -5,15 +5,16 @@ matches the motor's state. A brushless motor behind its ESC is, in the DC-motor 
 with a quasi-static current (electrical time constant far below the mechanical one), a
 back-EMF ``e = k_e omega`` that obeys::
 
-    de/dt = rate (c u - e) - drag e |e|,    rate = k_e^2 / (J_r R),  drag = k_m / (J_r k_e)
+    de/dt = rate w - drag e |e|,    rate = k_e^2 / (J_r R),  drag = k_m / (J_r k_e)
 
-and a winding current ``(c u - e) / R``. The field of a supply cable follows the ESC's input
+with the winding voltage ``w = c u - e`` and current ``w / R``. The field of a supply cable follows the ESC's input
 current ``c (c u - e) / R`` (``exponent = 1``), that of a motor lead the motor current
-(``exponent = 0``); an ESC that free-wheels passes no negative current, and a current limit
-clips it. :func:`fit_motor_dynamics` fits ``rate``, ``drag``, the limit and one gain per motor
-to the magnetometer record of the calibration sweeps (readings minus ``m0`` against the
-directions ``v_n`` of eq. 6), for each structural choice (exponent, free-wheeling), and keeps
-the best. Only what a real rig records is used: commands, battery voltage, magnetometer.
+(``exponent = 0``); an ESC that free-wheels passes no negative current (``w >= 0``), and a
+current limit clips it (``|w| <= limit``), in the dynamics as in the field.
+:func:`fit_motor_dynamics` fits ``rate``, ``drag``, the limit and one gain per motor to the
+magnetometer record of the calibration sweeps (readings minus ``m0`` against the directions
+``v_n`` of eq. 6), for each structural choice (exponent, free-wheeling), and keeps the best.
+Only what a real rig records is used: commands, battery voltage, magnetometer.
 """
 
 from __future__ import annotations
@@ -107,20 +108,21 @@ def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> Motor
                  for t, c, u, b, rows in data]
         return np.concatenate(parts).ravel()
 
-    best = None
-    for exponent in (1, 0):
-        for freewheel in (1.0, 0.0):
-            # start: a 25 ms mechanical constant, 85 % of the drive as back-EMF at full command
-            rate0 = 40.0
-            start = np.r_[np.log(rate0), np.log(rate0 * 0.15 / (0.85**2 * u_mean)), np.log(u_mean),
-                          np.full(len(v), 0.0)]
-            unit = _predicted(np.r_[start[:3], np.ones(len(v))], *data[0][:3], v, exponent, freewheel,
-                              sample_rate)[data[0][4]]
-            start[3:] = np.linalg.norm(data[0][3], axis=1).mean() / max(np.linalg.norm(unit, axis=1).mean(), 1e-30)
-            fit = least_squares(residual, start, args=(exponent, freewheel), x_scale="jac", max_nfev=400)
-            cost = float(np.sqrt(np.mean(fit.fun**2))) * scale
-            if best is None or cost < best[0]:
-                best = (cost, fit.x, exponent, freewheel)
+    def fit(exponent, freewheel, rate0, limit0, evaluations=300):
+        # start: back-EMF at 85 % of the drive at full command, gains matched on the first record
+        start = np.r_[np.log(rate0), np.log(rate0 * 0.15 / (0.85**2 * u_mean)), np.log(limit0), np.zeros(len(v))]
+        unit = _predicted(np.r_[start[:3], np.ones(len(v))], *data[0][:3], v, exponent, freewheel,
+                          sample_rate)[data[0][4]]
+        start[3:] = np.linalg.norm(data[0][3], axis=1).mean() / max(np.linalg.norm(unit, axis=1).mean(), 1e-30)
+        result = least_squares(residual, start, args=(exponent, freewheel), x_scale="jac", max_nfev=evaluations)
+        return float(np.sqrt(np.mean(result.fun**2))) * scale, result.x, exponent, freewheel
+
+    # The structure from a 25 ms mechanical time constant and a limit at 15 % of the voltage, then
+    # other starts against local minima (a limit never reached, slower and faster motors).
+    # The structures are told apart by short fits.
+    best = min((fit(e, f, 40.0, 0.15 * u_mean, 40) for e in (1, 0) for f in (1.0, 0.0)), key=lambda r: r[0])
+    for rate0, limit0 in ((40.0, 0.15 * u_mean), (40.0, u_mean), (10.0, 0.15 * u_mean), (150.0, 0.15 * u_mean)):
+        best = min(best, fit(best[2], best[3], rate0, limit0), key=lambda r: r[0])
     cost, x, exponent, freewheel = best
     limit = float(np.exp(x[2]))
     if limit > 10 * u_mean:  # never reached in the records: no limit seen

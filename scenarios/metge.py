@@ -22,6 +22,8 @@ clamped, so the Earth field is constant in the sensor frame.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
@@ -36,8 +38,9 @@ PAPER_TABLE1 = {"none": {"set1": 11.142, "set2": 10.623, "free": 55.853},
 
 OPTIONS = {
     "levels": Option(12, "K: command levels per motor", minimum=2),
-    "hold": Option(0.25, "time at each level (s)", minimum=0.02),
-    "settle": Option(0.15, "start of each level left out of the K measurements (s)", minimum=0.0),
+    "hold": Option(0.4, "time at each level (s)", minimum=0.02),
+    "settle": Option(0.3, "start of each level left out of the K measurements (s): a free-wheeling "
+                          "ESC lets the rotor coast down for a few tenths of a second", minimum=0.0),
     "reference": Option(1.0, "motors-off time at the start (s)", minimum=0.1),
     "rest": Option(0.5, "motors-off time after each motor (s)", minimum=0.0),
     "free": Option(12.0, "time of the free set: slow, fast, slow thirds (s)", minimum=0.0),
@@ -321,3 +324,37 @@ def duration(o: dict) -> float:
 
 SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
                     duration=duration, extra={"record": RECORD})
+
+
+# --- the compensation in the closed loop (``tp --set compensation=...``) ----------------
+
+COMPENSATIONS = ("none", "static", "metge", "dynamic")
+
+
+@functools.lru_cache(maxsize=4)
+def rig_calibration(orders: str = "4,1") -> Calibration:
+    """Calibration 1 of this scenario at its default options, made on the clamped rig (about
+    30 s of simulated rig time); cached for the process. The tp vehicle has no soft or hard
+    iron, so the static part is the identity."""
+    o = SCENARIO.parse({"orders": orders})
+    runs = []
+    for run in range(len(socs(o, 1))):
+        recorded = system_for(o, 1, run).run(commands(o, 1)[2], record=RECORD)
+        runs.append(RigRun(recorded, o, 1))
+    return calibrate(RigSet(runs), parse_orders(orders), None, o["mag_rate"], "set 1, made for tp")
+
+
+def add_compensator(system: System, mode: str, path: str, sample_rate: float, estimator: str = "Quaternion_estim"):
+    """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
+    ``mode = "none"``): commands from the controller, voltage from the battery."""
+    from calibration import MagCompensator
+
+    if mode == "none":
+        return None
+    calibration = Calibration.load(path, motors=4) if path else rig_calibration()
+    block = system.add(MagCompensator(calibration, mode, sample_rate=sample_rate))
+    system.connect("IMU.magneto", "MagCompensator.magneto")
+    system.connect("Controller.c", "MagCompensator.c")
+    system.connect("MotorMagnetics.u_batt", "MagCompensator.u_batt")
+    system.connect("MagCompensator.magneto", f"{estimator}.magneto")
+    return block

@@ -17,6 +17,7 @@ from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
+from scenarios.metge import add_compensator
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
@@ -46,6 +47,9 @@ OPTIONS = {
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
     "imu_rate": Option(1000.0, "IMU and estimator rate (Hz)", minimum=1.0),
     "seed": Option(1, "IMU noise seed"),
+    "compensation": Option("none", "field of the motor currents compensated (scenarios/metge.py)",
+                           choices=("none", "static", "metge", "dynamic")),
+    "calibration": Option("", "calibration file (JSON) for the compensation; empty: made on the clamped rig"),
 }
 
 
@@ -81,7 +85,8 @@ def build(o: dict) -> System:
                                            corrections=o["corrections"],
                                            q0=euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)))
     for name in estimator.inputs:
-        system.connect(f"IMU.{name}", f"Quaternion_estim.{name}")
+        if not (o["compensation"] != "none" and name.startswith("magneto")):  # else from MagCompensator
+            system.connect(f"IMU.{name}", f"Quaternion_estim.{name}")
     system.add(Controller())
     for name in SETPOINT:
         system.connect(f"Setpoint.{name}", f"Controller.{name}")
@@ -95,6 +100,7 @@ def build(o: dict) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
+    add_compensator(system, o["compensation"], o["calibration"], o["imu_rate"])
     return system
 
 
