@@ -108,19 +108,26 @@ def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> Motor
                  for t, c, u, b, rows in data]
         return np.concatenate(parts).ravel()
 
+    # physical bounds: mechanical time constants of 2 ms to 1 s, a drag and a limit within
+    # six decades, gains of either sign
+    lower = np.r_[np.log(1.0), np.log(1e-4), np.log(1e-3 * u_mean), np.full(len(v), -np.inf)]
+    upper = np.r_[np.log(500.0), np.log(1e2), np.log(1e3 * u_mean), np.full(len(v), np.inf)]
+
     def fit(exponent, freewheel, rate0, limit0, evaluations=300):
         # start: back-EMF at 85 % of the drive at full command, gains matched on the first record
         start = np.r_[np.log(rate0), np.log(rate0 * 0.15 / (0.85**2 * u_mean)), np.log(limit0), np.zeros(len(v))]
         unit = _predicted(np.r_[start[:3], np.ones(len(v))], *data[0][:3], v, exponent, freewheel,
                           sample_rate)[data[0][4]]
         start[3:] = np.linalg.norm(data[0][3], axis=1).mean() / max(np.linalg.norm(unit, axis=1).mean(), 1e-30)
-        result = least_squares(residual, start, args=(exponent, freewheel), x_scale="jac", max_nfev=evaluations)
+        result = least_squares(residual, np.clip(start, lower, upper), args=(exponent, freewheel), x_scale="jac",
+                               max_nfev=evaluations, bounds=(lower, upper), ftol=1e-6, xtol=1e-6)
         return float(np.sqrt(np.mean(result.fun**2))) * scale, result.x, exponent, freewheel
 
     # The structure from a 25 ms mechanical time constant and a limit at 15 % of the voltage, then
     # other starts against local minima (a limit never reached, slower and faster motors).
     # The structures are told apart by short fits.
-    best = min((fit(e, f, 40.0, 0.15 * u_mean, 40) for e in (1, 0) for f in (1.0, 0.0)), key=lambda r: r[0])
+    best = min((fit(e, f, 40.0, 0.15 * u_mean, 40) for e in (1, 0) for f in (1.0, 0.0)),
+               key=lambda r: r[0])
     for rate0, limit0 in ((40.0, 0.15 * u_mean), (40.0, u_mean), (10.0, 0.15 * u_mean), (150.0, 0.15 * u_mean)):
         best = min(best, fit(best[2], best[3], rate0, limit0), key=lambda r: r[0])
     cost, x, exponent, freewheel = best
