@@ -23,6 +23,8 @@ clamped, so the Earth field is constant in the sensor frame.
 from __future__ import annotations
 
 import functools
+import json
+from pathlib import Path
 
 import numpy as np
 
@@ -358,3 +360,55 @@ def add_compensator(system: System, mode: str, path: str, sample_rate: float, es
     system.connect("MotorMagnetics.u_batt", "MagCompensator.u_batt")
     system.connect("MagCompensator.magneto", f"{estimator}.magneto")
     return block
+
+
+# --- the closed loop: yaw error per estimator and compensation --------------------------
+
+STUDY_ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+
+
+def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), estimators=tuple(STUDY_ESTIMATORS),
+              duration: float = 20.0, noise: bool = True) -> dict:
+    """``tp`` with the field of the motor currents off, then on with each compensation; the
+    estimators' yaw RMS error (deg) for each, written to ``out/yaw_study.json`` and ``.md``."""
+    import scenarios
+
+    out = Path(out)
+    table = {}
+    cases = [("off", "none")] + [("on", mode) for mode in COMPENSATIONS]
+    for flight in flights:
+        for estimator in estimators:
+            for magnetic, mode in cases:
+                settings = {"estimator": estimator, "flight": flight, "noise": noise, "duration": duration,
+                            "magnetic": magnetic == "on", "compensation": mode,
+                            "calibration": calibration_path, **STUDY_ESTIMATORS[estimator]}
+                _, m = scenarios.run("tp", settings)
+                key = "magnetic_off" if magnetic == "off" else mode
+                table.setdefault(flight, {}).setdefault(estimator, {})[key] = m["rms_error_deg"][2]
+                print(f"{flight:14s} {estimator:9s} {key:13s} yaw RMS {m['rms_error_deg'][2]:8.3f} deg", flush=True)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "yaw_study.json").write_text(json.dumps(table, indent=2) + "\n")
+    columns = ["magnetic_off", *COMPENSATIONS]
+    lines = []
+    for flight, rows in table.items():
+        lines += [f"### {flight}", "", "| estimator | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
+        lines += [f"| {e} | " + " | ".join(f"{r[c]:.3f}" for c in columns) + " |" for e, r in rows.items()]
+        lines.append("")
+    (out / "yaw_study.md").write_text("\n".join(lines))
+    return table
+
+
+def main(argv=None):
+    import argparse
+
+    parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated.")
+    parser.add_argument("--calibration", required=True, help="calibration file, e.g. from quadcosim run metge")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
+    parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
+    args = parser.parse_args(argv)
+    yaw_study(args.out, args.calibration, estimators=tuple(args.estimators.split(",")), duration=args.duration)
+
+
+if __name__ == "__main__":
+    main()
