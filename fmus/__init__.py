@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-MODELS = ("Quadrotor", "MotorMagnetics", "IMU")
+MODELS = ("Quadrotor", "MotorMagnetics", "IMU", "InfraredSensor")
 
 
 class FMUNotFoundError(FileNotFoundError):
