@@ -15,6 +15,7 @@
  */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "variables.h"
 
@@ -154,10 +155,16 @@ fmi2Status model_initialize(ModelInstance *m) {
 
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
-    double r, tk;
+    double r, tk, last = ceil((t + h) * R(sample_rate) - 1e-6);
+    int64_t end;
+    char what[64];
     /* instants in [t, t + h) become final, with phi held over the step */
-    int64_t end = (int64_t)ceil((t + h) * R(sample_rate) - 1e-6);
     if (!bank_ok(m)) return fmi2Error;
+    snprintf(what, sizeof what, "samples at sample_rate = %g Hz", R(sample_rate));
+    if (!work_allowed(m, last - (double)d->next_sample, h, what,
+                      "take shorter communication steps or a lower sample_rate"))
+        return fmi2Error;
+    end = (int64_t)last;
     r = turn_rate(m);
     for (; d->next_sample < end; d->next_sample++) {
         if (!(d->current == d->next_sample && !m->outputs_stale)) {
