@@ -15,7 +15,7 @@ from pathlib import Path
 
 from orchestrator.fmu import nearest
 
-_MODULES = ("open_loop", "rig", "tp", "gain_study", "static_cal", "metge")
+_MODULES = ("open_loop", "rig", "tp", "gain_study", "static_cal", "metge", "ir_calibration")
 
 
 @dataclass

@@ -29,6 +29,7 @@ enum { CH_IR = 0, CH_HEADING = 1 };
 typedef struct {
     int64_t next_sample; /* first instant not yet final */
     int64_t current;     /* instant of the sample the outputs hold */
+    int64_t first;       /* first sample of the run */
     int delay, window;   /* GPS delay and window, in samples */
     double psi;          /* heading at the model time (rad) */
     double heading[HISTORY]; /* measured heading of sample k at k % HISTORY */
@@ -79,6 +80,9 @@ static void calibration(ModelInstance *m, double t, double *a, double *b) {
     *b = R(ir_offset) + R(offset_day_rate) * hours + R(offset_temperature) * wave + R(offset_cloud) * cloud;
 }
 
+/* Slot of sample k in the heading history; k < 0 when the FMU starts before t = 0. */
+static int slot(int64_t k) { return (int)(((k % HISTORY) + HISTORY) % HISTORY); }
+
 /* Sample k, at time t_k, with the heading psi there. */
 static void take_sample(ModelInstance *m, Data *d, int64_t k, double t, double psi) {
     int noisy = m->boolean[VB_noise_enabled], seed = m->integer[VI_seed];
@@ -86,9 +90,9 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k, double t, double p
     d->current = k;
     calibration(m, t, &a, &b);
     R(ir) = a * r + b + (noisy ? R(ir_noise) * gaussian(seed, k, CH_IR) : 0.0);
-    d->heading[k % HISTORY] = psi + (noisy ? R(gps_heading_noise) * gaussian(seed, k, CH_HEADING) : 0.0);
-    if (k >= d->delay + d->window) {
-        R(gps_turn_rate) = (d->heading[(k - d->delay) % HISTORY] - d->heading[(k - d->delay - d->window) % HISTORY]) /
+    d->heading[slot(k)] = psi + (noisy ? R(gps_heading_noise) * gaussian(seed, k, CH_HEADING) : 0.0);
+    if (k - d->first >= d->delay + d->window) {
+        R(gps_turn_rate) = (d->heading[slot(k - d->delay)] - d->heading[slot(k - d->delay - d->window)]) /
                            R(gps_window);
         R(gps_valid) = 1.0;
     } else {
@@ -149,7 +153,8 @@ fmi2Status model_initialize(ModelInstance *m) {
     if (!bank_ok(m)) return fmi2Error;
     d->psi = R(psi0);
     d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - 1e-6);
-    d->current = -1;
+    d->first = d->next_sample;
+    d->current = d->first - 1;
     return fmi2OK;
 }
 

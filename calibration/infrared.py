@@ -1,0 +1,692 @@
+"""In-flight calibration of an infrared horizon sensor against the GPS turn rate.
+
+After "Calibration d'un récepteur Infra-Rouge pour Micro Drone" (Paparazzi project, 2004): the
+infrared reading is linear in the turn rate for small bank angles, ``IR = a r + b``, with ``a``
+and ``b`` drifting with time of day, temperature and cloud. The GPS gives a reliable but late
+turn rate. Three estimators of ``(a, b)`` and of the present turn rate ``(IR - b) / a``:
+
+- :class:`TurnRateEKF`: the slides' extended Kalman filter on ``(a, b, r)``, measurements the GPS
+  turn rate and the IR, random-walk model (``F = I``). It is written as two sequential scalar
+  updates (``form="sequential"``, cheaper, the default) or as the slides' joint update
+  (``form="joint"``). Beyond the slides: innovation gating as in PX4's EKF2 (test ratio
+  ``nu^2 / (gamma^2 S)``, a rejected measurement is not fused), a fault declared after
+  ``declare`` consecutive rejections, attributed to the IR or the GPS by which one disagrees
+  with the state and the other sensor, and cleared after ``clear`` consecutive consistent
+  samples. While the GPS is not fused, the IR updates the turn rate only, so ``a`` and ``b``
+  keep their calibration.
+- :class:`Regression`: the slides' baseline, the least-squares line through all the paired
+  samples since take-off, recomputed every second, unrealistic points rejected.
+- :class:`ForgettingRLS`: the recursive least squares with forgetting factor 0.995 of
+  Paparazzi's flight code, updated only when the GPS bank angle lies in [0.05, 1] rad.
+
+Pairing: the GPS turn rate at sample ``k`` is the heading difference over the ``window``
+samples ``[k - delay - window, k - delay)``, i.e. the mean turn rate there. Every estimator is
+fed the mean IR over the same samples (:func:`window_mean`), so that the pair refers to one
+stretch of flight, as the slides pair IR and GPS "without offset".
+
+Each estimator's arithmetic is one compiled step function, called by the batch path (a
+compiled loop over recorded arrays, :func:`run`) and by the streaming block
+(:class:`InfraredCalibration`, an :class:`orchestrator.Block`). :func:`cost` counts the
+operations of each step by running the same Python source on counting numbers, and times it.
+
+Units: turn rate rad/s, IR in counts, ``a`` in counts per rad/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from orchestrator import Block
+
+# ----------------------------------------------------------------------------- state layouts
+# EKF state vector s: estimate, covariance (upper triangle), fault logic, last innovations.
+A, B, R = 0, 1, 2
+PAA, PAB, PAR, PBB, PBR, PRR = 3, 4, 5, 6, 7, 8
+GPS_BAD, GPS_GOOD, GPS_FAULT, IR_BAD, IR_GOOD, IR_FAULT = 9, 10, 11, 12, 13, 14
+NU_GPS, GATE_GPS, NU_IR, GATE_IR, RATE, STATUS = 15, 16, 17, 18, 19, 20
+GPS_USED, IR_USED = 21, 22
+EKF_SIZE = 23
+# EKF configuration c: process noise variances per sample, measurement variances, gate, rules.
+QA, QB, QR, RG, RI, GAMMA2, DECLARE, CLEAR = range(8)
+EKF_CONFIG_SIZE = 8
+# status codes
+OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
+
+# Regression state: sums of the accepted pairs, the fit and its residual spread.
+N, SR, SRR, SY, SRY, SYY, FIT_A, FIT_B, FIT_SD, COUNT, REG_RATE, REJECTED = range(12)
+REG_SIZE = 12
+# Regression configuration: recompute period (samples), largest realistic turn rate (rad/s),
+# rejection threshold (residual standard deviations), floor of that deviation (count),
+# samples and turn-rate spread (rad/s) needed before the first fit.
+PERIOD, MAX_RATE, REJECT_K, SD_FLOOR, MIN_N, MIN_SPREAD = range(6)
+REG_CONFIG_SIZE = 6
+
+# RLS state: (a, b), its covariance (upper triangle), the present turn rate.
+RLS_A, RLS_B, RLS_P00, RLS_P01, RLS_P11, RLS_RATE = range(6)
+RLS_SIZE = 6
+# RLS configuration: forgetting factor, airspeed (m/s) and gravity (m/s^2) for the bank angle,
+# bank-angle band (rad) in which it updates.
+RHO, AIRSPEED, GRAVITY, BANK_MIN, BANK_MAX = range(5)
+RLS_CONFIG_SIZE = 5
+
+
+# ----------------------------------------------------------------------------- step functions
+@njit(cache=True)
+def window_mean(buffer, k, ir, delay, window):
+    """Mean IR over the samples ``[k - delay - window, k - delay)``, from a ring buffer.
+
+    ``buffer`` holds ``delay + window + 3`` values: the last ``delay + window + 2`` samples
+    and, in its last slot, the running sum. Returns ``nan`` until ``k >= delay + window``.
+    """
+    size = delay + window
+    kept = size + 2
+    buffer[k % kept] = ir
+    if k < size:
+        return math.nan
+    # the sum moves on by one sample: in comes k - delay - 1, out goes k - delay - window - 1
+    if k == size:
+        total = 0.0
+        for j in range(0, window):
+            total += buffer[j]
+    else:
+        total = buffer[kept] + buffer[(k - delay - 1) % kept] - buffer[(k - delay - window - 1) % kept]
+    buffer[kept] = total
+    return total / window
+
+
+@njit(cache=True)
+def _record(s, passed, bad, good, fault, declare, clear):
+    """Persistence rule: ``declare`` rejections in a row declare a fault, ``clear``
+    consistent samples in a row end it."""
+    if passed:
+        s[bad] = 0.0
+        s[good] += 1.0
+        if s[fault] > 0.5 and s[good] >= clear:
+            s[fault] = 0.0
+    else:
+        s[good] = 0.0
+        s[bad] += 1.0
+        if s[bad] >= declare:
+            s[fault] = 1.0
+
+
+@njit(cache=True)
+def _fuse_gps(s, nu, S):
+    """Scalar update with H = (0, 0, 1)."""
+    ka, kb, kr = s[PAR] / S, s[PBR] / S, s[PRR] / S
+    s[A] += ka * nu
+    s[B] += kb * nu
+    s[R] += kr * nu
+    s[PAA] -= ka * s[PAR]
+    s[PAB] -= ka * s[PBR]
+    s[PBB] -= kb * s[PBR]
+    s[PAR] -= ka * s[PRR]
+    s[PBR] -= kb * s[PRR]
+    s[PRR] -= kr * s[PRR]
+
+
+@njit(cache=True)
+def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
+    """One sample of the EKF on (a, b, r), sequential scalar updates, gated.
+
+    Parameters
+    ----------
+    s : (EKF_SIZE,) float array
+        State, updated in place (layout: the module's ``A ... IR_USED`` indices).
+    c : (EKF_CONFIG_SIZE,) float array
+        Configuration; ``c[GAMMA2] = 0`` turns gating off.
+    ir_pair : float
+        Mean IR over the GPS window (count); ``nan`` before the window is filled.
+    gps : float
+        GPS turn rate (rad/s).
+    gps_available : bool
+        Whether the GPS turn rate is valid and to be used.
+    ir_now : float
+        Present IR (count); gives the present turn rate ``(ir_now - b) / a``.
+    """
+    s[PAA] += c[QA]
+    s[PBB] += c[QB]
+    s[PRR] += c[QR]
+    gamma2 = c[GAMMA2]
+    s[GPS_USED] = 0.0
+    s[IR_USED] = 0.0
+    if ir_pair == ir_pair:  # not nan: a pair is available
+        a, b, r = s[A], s[B], s[R]
+        gps_pass = False
+        if gps_available:
+            nu_g = gps - r
+            S_g = s[PRR] + c[RG]
+            s[NU_GPS] = nu_g
+            s[GATE_GPS] = S_g
+            gps_pass = gamma2 == 0.0 or nu_g * nu_g <= gamma2 * S_g
+            if gps_pass:
+                _fuse_gps(s, nu_g, S_g)
+                a, b, r = s[A], s[B], s[R]
+        # IR, against the state (after the GPS when it was fused): H = (r, 1, a)
+        ha = s[PAA] * r + s[PAB] + s[PAR] * a
+        hb = s[PAB] * r + s[PBB] + s[PBR] * a
+        hr = s[PAR] * r + s[PBR] + s[PRR] * a
+        S_i = r * ha + hb + a * hr + c[RI]
+        nu_i = ir_pair - (a * r + b)
+        s[NU_IR] = nu_i
+        s[GATE_IR] = S_i
+        ir_pass = gamma2 == 0.0 or nu_i * nu_i <= gamma2 * S_i
+        if gps_available and not gps_pass:
+            if not ir_pass:
+                # Both disagree with the state. If they agree with each other the aircraft
+                # manoeuvred beyond the model: reset r to the GPS. Otherwise fuse neither.
+                d = gps - nu_i / a - r
+                S_d = c[RG] + (c[RI] + s[PBB] + r * r * s[PAA]) / (a * a)
+                if d * d <= gamma2 * S_d:
+                    s[R] = gps
+                    s[PAR] = 0.0
+                    s[PBR] = 0.0
+                    s[PRR] = c[RG]
+                    gps_pass = True
+                    ir_pass = True
+            elif ir_pass:
+                # The GPS alone disagrees: the IR carries the turn rate, a and b are held.
+                k = hr / S_i
+                s[R] += k * nu_i
+                s[PAR] -= k * ha
+                s[PBR] -= k * hb
+                s[PRR] -= k * hr
+                s[IR_USED] = 1.0
+        elif ir_pass:
+            if gps_available:
+                ka, kb, kr = ha / S_i, hb / S_i, hr / S_i
+                s[A] += ka * nu_i
+                s[B] += kb * nu_i
+                s[R] += kr * nu_i
+                s[PAA] -= ka * ha
+                s[PAB] -= ka * hb
+                s[PAR] -= ka * hr
+                s[PBB] -= kb * hb
+                s[PBR] -= kb * hr
+                s[PRR] -= kr * hr
+            else:
+                # No GPS: the IR gives the turn rate; a and b are not observable and held.
+                k = hr / S_i
+                s[R] += k * nu_i
+                s[PAR] -= k * ha
+                s[PBR] -= k * hb
+                s[PRR] -= k * hr
+            s[IR_USED] = 1.0
+        if gps_available:
+            s[GPS_USED] = 1.0 if gps_pass else 0.0
+            if gamma2 > 0.0:
+                _record(s, gps_pass, GPS_BAD, GPS_GOOD, GPS_FAULT, c[DECLARE], c[CLEAR])
+        if gamma2 > 0.0:
+            _record(s, ir_pass, IR_BAD, IR_GOOD, IR_FAULT, c[DECLARE], c[CLEAR])
+    if not (s[PAA] > 0.0 and s[PBB] > 0.0 and s[PRR] > 0.0):
+        s[STATUS] = LOST_PD
+    if s[A] == 0.0:
+        s[STATUS] = ZERO_GAIN
+        s[RATE] = math.nan
+    else:
+        s[RATE] = (ir_now - s[B]) / s[A]
+
+
+@njit(cache=True)
+def ekf_joint_step(s, c, ir_pair, gps, gps_available, ir_now):
+    """One sample of the slides' EKF: both measurements in one update with a 2x2 innovation
+    covariance; no gating. Same state, configuration and arguments as :func:`ekf_step`."""
+    s[PAA] += c[QA]
+    s[PBB] += c[QB]
+    s[PRR] += c[QR]
+    s[GPS_USED] = 0.0
+    s[IR_USED] = 0.0
+    if ir_pair == ir_pair:
+        a, b, r = s[A], s[B], s[R]
+        # P H^T, columns for the GPS (0, 0, 1) and the IR (r, 1, a)
+        ga, gb, gr = s[PAR], s[PBR], s[PRR]
+        ha = s[PAA] * r + s[PAB] + s[PAR] * a
+        hb = s[PAB] * r + s[PBB] + s[PBR] * a
+        hr = s[PAR] * r + s[PBR] + s[PRR] * a
+        nu_i = ir_pair - (a * r + b)
+        s[NU_IR] = nu_i
+        s[IR_USED] = 1.0
+        if gps_available:
+            nu_g = gps - r
+            s[NU_GPS] = nu_g
+            s11 = gr + c[RG]
+            s12 = hr
+            s22 = r * ha + hb + a * hr + c[RI]
+            s[GATE_GPS] = s11
+            s[GATE_IR] = s22
+            det = s11 * s22 - s12 * s12
+            # K = P H^T S^-1
+            i11, i12, i22 = s22 / det, -s12 / det, s11 / det
+            ka1, ka2 = ga * i11 + ha * i12, ga * i12 + ha * i22
+            kb1, kb2 = gb * i11 + hb * i12, gb * i12 + hb * i22
+            kr1, kr2 = gr * i11 + hr * i12, gr * i12 + hr * i22
+            s[A] += ka1 * nu_g + ka2 * nu_i
+            s[B] += kb1 * nu_g + kb2 * nu_i
+            s[R] += kr1 * nu_g + kr2 * nu_i
+            # P -= K (H P)
+            s[PAA] -= ka1 * ga + ka2 * ha
+            s[PAB] -= ka1 * gb + ka2 * hb
+            s[PAR] -= ka1 * gr + ka2 * hr
+            s[PBB] -= kb1 * gb + kb2 * hb
+            s[PBR] -= kb1 * gr + kb2 * hr
+            s[PRR] -= kr1 * gr + kr2 * hr
+            s[GPS_USED] = 1.0
+        else:
+            S_i = r * ha + hb + a * hr + c[RI]
+            s[GATE_IR] = S_i
+            k = hr / S_i
+            s[R] += k * nu_i
+            s[PAR] -= k * ha
+            s[PBR] -= k * hb
+            s[PRR] -= k * hr
+    if not (s[PAA] > 0.0 and s[PBB] > 0.0 and s[PRR] > 0.0):
+        s[STATUS] = LOST_PD
+    if s[A] == 0.0:
+        s[STATUS] = ZERO_GAIN
+        s[RATE] = math.nan
+    else:
+        s[RATE] = (ir_now - s[B]) / s[A]
+
+
+@njit(cache=True)
+def regression_step(s, c, ir_pair, gps, gps_available, ir_now):
+    """One sample of the accumulated least-squares line, refitted every ``c[PERIOD]`` samples.
+
+    A pair is unrealistic, and left out, when its turn rate exceeds ``c[MAX_RATE]`` or, once
+    a line is fitted, when it lies more than ``c[REJECT_K]`` residual deviations off it.
+    """
+    if ir_pair == ir_pair and gps_available:
+        realistic = abs(gps) <= c[MAX_RATE]
+        if realistic and s[N] >= c[MIN_N]:
+            spread = s[FIT_SD] if s[FIT_SD] > c[SD_FLOOR] else c[SD_FLOOR]
+            residual = ir_pair - (s[FIT_A] * gps + s[FIT_B])
+            realistic = residual * residual <= c[REJECT_K] * c[REJECT_K] * spread * spread
+        if realistic:
+            s[N] += 1.0
+            s[SR] += gps
+            s[SRR] += gps * gps
+            s[SY] += ir_pair
+            s[SRY] += gps * ir_pair
+            s[SYY] += ir_pair * ir_pair
+        else:
+            s[REJECTED] += 1.0
+    s[COUNT] += 1.0
+    if s[COUNT] >= c[PERIOD]:
+        s[COUNT] = 0.0
+        n = s[N]
+        if n >= c[MIN_N]:
+            mean_r, mean_y = s[SR] / n, s[SY] / n
+            var_r = s[SRR] / n - mean_r * mean_r
+            if var_r >= c[MIN_SPREAD] * c[MIN_SPREAD]:
+                cov = s[SRY] / n - mean_r * mean_y
+                s[FIT_A] = cov / var_r
+                s[FIT_B] = mean_y - s[FIT_A] * mean_r
+                var_res = s[SYY] / n - mean_y * mean_y - s[FIT_A] * cov
+                s[FIT_SD] = math.sqrt(var_res) if var_res > 0.0 else 0.0
+    s[REG_RATE] = (ir_now - s[FIT_B]) / s[FIT_A]
+
+
+@njit(cache=True)
+def rls_step(s, c, ir_pair, gps, gps_available, ir_now):
+    """One sample of the recursive least squares with forgetting on ``IR = a r + b``,
+    updated only when the GPS bank angle ``atan(r V / g)`` lies in the configured band."""
+    if ir_pair == ir_pair and gps_available:
+        bank = abs(math.atan(gps * c[AIRSPEED] / c[GRAVITY]))
+        if c[BANK_MIN] <= bank <= c[BANK_MAX]:
+            p0 = s[RLS_P00] * gps + s[RLS_P01]
+            p1 = s[RLS_P01] * gps + s[RLS_P11]
+            den = c[RHO] + gps * p0 + p1
+            k0, k1 = p0 / den, p1 / den
+            e = ir_pair - (s[RLS_A] * gps + s[RLS_B])
+            s[RLS_A] += k0 * e
+            s[RLS_B] += k1 * e
+            s[RLS_P00] = (s[RLS_P00] - k0 * p0) / c[RHO]
+            s[RLS_P01] = (s[RLS_P01] - k0 * p1) / c[RHO]
+            s[RLS_P11] = (s[RLS_P11] - k1 * p1) / c[RHO]
+    s[RLS_RATE] = (ir_now - s[RLS_B]) / s[RLS_A]
+
+
+# ----------------------------------------------------------------------------- configuration
+def _check_positive(name: str, value: float, unit: str, fix: str):
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"{name} = {value!r} {unit} must be positive and finite; {fix}")
+
+
+@dataclass(frozen=True)
+class EKFSettings:
+    """Settings of :class:`TurnRateEKF`; standard deviations, per sample of 1 / rate.
+
+    Attributes
+    ----------
+    a0, b0 : float
+        Initial ``a`` (count per rad/s) and ``b`` (count): the last calibration, by default the
+        slides' regression ``IR = -400 r + 990``.
+    sd_a0, sd_b0, sd_r0 : float
+        Their initial standard deviations (count/(rad/s), count, rad/s).
+    q_a, q_b, q_r : float
+        Random-walk standard deviations per sample of ``a``, ``b`` and the paired turn rate.
+    sd_gps : float
+        GPS turn-rate noise (rad/s); the slides trust the GPS more than the IR.
+    sd_ir : float
+        Noise of the window-mean IR (count), inflated for the overlap of successive windows.
+    gate : float
+        Innovation gate gamma in standard deviations; 0 turns gating and fault logic off.
+    declare, clear : int
+        Consecutive rejections that declare a fault; consecutive consistent samples that end it.
+    form : str
+        ``"sequential"`` (two scalar updates, gated) or ``"joint"`` (the slides' 2x2 update,
+        never gated).
+    """
+
+    a0: float = -400.0
+    b0: float = 990.0
+    sd_a0: float = 25.0
+    sd_b0: float = 60.0
+    sd_r0: float = 0.3
+    q_a: float = 0.3
+    q_b: float = 1.0
+    q_r: float = 0.02
+    sd_gps: float = 0.04
+    sd_ir: float = 5.0
+    gate: float = 5.0
+    declare: int = 10
+    clear: int = 20
+    form: str = "sequential"
+
+    def __post_init__(self):
+        for name in ("sd_a0", "sd_b0", "sd_r0", "q_a", "q_b", "q_r", "sd_gps", "sd_ir"):
+            _check_positive(name, getattr(self, name), "", "a covariance must be positive definite")
+        if not (math.isfinite(self.a0) and self.a0 != 0.0 and math.isfinite(self.b0)):
+            raise ValueError(f"a0 = {self.a0!r}, b0 = {self.b0!r}: a0 must be finite and non-zero, b0 finite")
+        if not (self.gate == 0.0 or (math.isfinite(self.gate) and self.gate > 0.0)):
+            raise ValueError(f"gate = {self.gate!r} standard deviations must be positive, or 0 for no gating")
+        if self.declare < 1 or self.clear < 1:
+            raise ValueError(f"declare = {self.declare}, clear = {self.clear}: both must be at least 1 sample")
+        if self.form not in ("sequential", "joint"):
+            raise ValueError(f"form = {self.form!r} must be 'sequential' or 'joint'")
+        if self.form == "joint" and self.gate:
+            raise ValueError("the joint form is the slides' filter and is not gated: set gate=0 or form='sequential'")
+
+    def config(self) -> np.ndarray:
+        c = np.zeros(EKF_CONFIG_SIZE)
+        c[[QA, QB, QR, RG, RI]] = np.square([self.q_a, self.q_b, self.q_r, self.sd_gps, self.sd_ir])
+        c[GAMMA2] = self.gate**2
+        c[DECLARE], c[CLEAR] = self.declare, self.clear
+        return c
+
+    def initial_state(self, covariance=None) -> np.ndarray:
+        s = np.zeros(EKF_SIZE)
+        s[A], s[B] = self.a0, self.b0
+        P = np.diag(np.square([self.sd_a0, self.sd_b0, self.sd_r0])) if covariance is None else covariance
+        P = np.asarray(P, dtype=float)
+        if P.shape != (3, 3) or not np.isfinite(P).all() or not np.allclose(P, P.T):
+            raise ValueError(f"initial covariance must be a finite symmetric 3x3 matrix, not {P!r}")
+        if np.linalg.eigvalsh(P).min() <= 0.0:
+            raise ValueError(f"initial covariance is not positive definite (eigenvalues {np.linalg.eigvalsh(P)}); "
+                             "give positive variances")
+        s[[PAA, PAB, PAR, PBB, PBR, PRR]] = P[0, 0], P[0, 1], P[0, 2], P[1, 1], P[1, 2], P[2, 2]
+        return s
+
+
+@dataclass(frozen=True)
+class RegressionSettings:
+    """Settings of :class:`Regression` (the slides' baseline).
+
+    Attributes
+    ----------
+    a0, b0 : float
+        Line used until the first fit (count per rad/s, count).
+    period : int
+        Samples between refits (20: every second at 20 Hz).
+    max_rate : float
+        Largest realistic turn rate (rad/s).
+    reject : float
+        A pair further than this many residual deviations from the line is left out.
+    sd_floor : float
+        Floor of the residual deviation (count).
+    min_samples : int
+        Pairs needed before the first fit.
+    min_spread : float
+        Turn-rate standard deviation needed before the first fit (rad/s).
+    """
+
+    a0: float = -400.0
+    b0: float = 990.0
+    period: int = 20
+    max_rate: float = 1.5
+    reject: float = 4.0
+    sd_floor: float = 10.0
+    min_samples: int = 100
+    min_spread: float = 0.05
+
+    def config(self) -> np.ndarray:
+        _check_positive("period", self.period, "samples", "refit at least every sample")
+        _check_positive("max_rate", self.max_rate, "rad/s", "give the largest realistic turn rate")
+        return np.array([self.period, self.max_rate, self.reject, self.sd_floor, self.min_samples,
+                         self.min_spread], dtype=float)
+
+    def initial_state(self) -> np.ndarray:
+        s = np.zeros(REG_SIZE)
+        s[FIT_A], s[FIT_B] = self.a0, self.b0
+        return s
+
+
+@dataclass(frozen=True)
+class RLSSettings:
+    """Settings of :class:`ForgettingRLS` (Paparazzi's flight code).
+
+    Attributes
+    ----------
+    a0, b0, sd_a0, sd_b0 : float
+        Initial line and its standard deviations (count per rad/s, count).
+    forgetting : float
+        Forgetting factor rho, in (0, 1].
+    airspeed, gravity : float
+        For the GPS bank angle ``atan(r V / g)`` (m/s, m/s^2).
+    bank_min, bank_max : float
+        The RLS updates only when the absolute GPS bank angle lies in this band (rad).
+    """
+
+    a0: float = -400.0
+    b0: float = 990.0
+    sd_a0: float = 60.0
+    sd_b0: float = 60.0
+    forgetting: float = 0.995
+    airspeed: float = 12.0
+    gravity: float = 9.81
+    bank_min: float = 0.05
+    bank_max: float = 1.0
+
+    def config(self) -> np.ndarray:
+        if not 0.0 < self.forgetting <= 1.0:
+            raise ValueError(f"forgetting factor {self.forgetting!r} must lie in (0, 1]")
+        _check_positive("airspeed", self.airspeed, "m/s", "the bank angle needs a flying aircraft")
+        return np.array([self.forgetting, self.airspeed, self.gravity, self.bank_min, self.bank_max])
+
+    def initial_state(self) -> np.ndarray:
+        for name in ("sd_a0", "sd_b0"):
+            _check_positive(name, getattr(self, name), "", "a covariance must be positive definite")
+        return np.array([self.a0, self.b0, self.sd_a0**2, 0.0, self.sd_b0**2, 0.0])
+
+
+# ----------------------------------------------------------------------------- the estimators
+METHODS = ("kalman", "regression", "rls")
+_EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_gps": GATE_GPS, "nu_ir": NU_IR,
+               "S_ir": GATE_IR, "gps_fault": GPS_FAULT, "ir_fault": IR_FAULT, "gps_used": GPS_USED,
+               "ir_used": IR_USED, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS}
+_REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
+_RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
+_STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "
+                         "raise the process noise q_a, q_b, q_r or the measurement noise",
+                ZERO_GAIN: "the gain a reached zero, so the turn rate (IR - b) / a is undefined; "
+                           "check the initial a0 and the IR data"}
+
+
+class CalibrationError(ValueError):
+    """An estimator was given data or settings it cannot use."""
+
+
+@njit(cache=True)
+def _run(step, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, out):
+    """The batch path: the step function over recorded arrays. Returns the samples done."""
+    for k in range(ir.shape[0]):
+        pair = window_mean(buffer, k, ir[k], delay, window)
+        step(s, c, pair, gps[k], gps_use[k], ir[k])
+        for j in range(fields.shape[0]):
+            out[k, j] = s[fields[j]]
+        if status >= 0 and s[status] != 0.0:
+            return k + 1
+    return ir.shape[0]
+
+
+def _finite(name: str, values) -> np.ndarray:
+    values = np.ascontiguousarray(values, dtype=float)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise CalibrationError(f"{name} holds a non-finite value ({values[k]!r}) at sample {k}; "
+                               "the estimators take finite readings only: drop or repair that sample")
+    return values
+
+
+class Estimator:
+    """One estimator of ``(a, b)`` and of the present turn rate, on arrays or sample by sample.
+
+    Parameters
+    ----------
+    method : {"kalman", "regression", "rls"}
+        Which estimator.
+    settings : EKFSettings, RegressionSettings or RLSSettings, optional
+        Its settings; defaults for the method when omitted.
+    delay, window : int
+        GPS delay and window in samples (1 s each at 20 Hz).
+    covariance : (3, 3) array, optional
+        Initial covariance of the Kalman filter's (a, b, r), instead of the settings' diagonal.
+    """
+
+    def __init__(self, method: str = "kalman", settings=None, delay: int = 20, window: int = 20,
+                 covariance=None):
+        if method not in METHODS:
+            raise CalibrationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+        if int(delay) != delay or delay < 0 or int(window) != window or window < 1:
+            raise CalibrationError(f"delay = {delay!r} and window = {window!r} must be whole numbers of samples, "
+                                   "delay >= 0 and window >= 1")
+        self.method, self.delay, self.window = method, int(delay), int(window)
+        if method == "kalman":
+            self.settings = settings or EKFSettings()
+            self._step = ekf_step if self.settings.form == "sequential" else ekf_joint_step
+            self._fields, self._status = _EKF_FIELDS, STATUS
+            self._initial = self.settings.initial_state(covariance)
+        elif method == "regression":
+            self.settings = settings or RegressionSettings()
+            self._step, self._fields, self._status = regression_step, _REG_FIELDS, -1
+            self._initial = self.settings.initial_state()
+        else:
+            self.settings = settings or RLSSettings()
+            self._step, self._fields, self._status = rls_step, _RLS_FIELDS, -1
+            self._initial = self.settings.initial_state()
+        self.config = self.settings.config()
+        self.names = tuple(self._fields)
+        self._index = np.array(list(self._fields.values()), dtype=np.int64)
+        self.reset()
+
+    def reset(self):
+        """Back to the initial state, before any sample."""
+        self.state = self._initial.copy()
+        self.buffer = np.zeros(self.delay + self.window + 3)
+        self.k = 0
+
+    def update(self, ir: float, gps: float, gps_use: bool = True) -> np.ndarray:
+        """Take one sample: the IR (count), the GPS turn rate (rad/s) and whether to use it.
+
+        Returns the state vector (see the module's index constants); ``state[...]`` holds
+        ``a``, ``b`` and the present turn rate.
+        """
+        if not (math.isfinite(ir) and math.isfinite(gps)):
+            raise CalibrationError(f"sample {self.k}: IR = {ir!r}, GPS turn rate = {gps!r}; the estimators take "
+                                   "finite readings only: drop or repair that sample")
+        pair = window_mean(self.buffer, self.k, float(ir), self.delay, self.window)
+        self._step(self.state, self.config, pair, float(gps), bool(gps_use), float(ir))
+        self.k += 1
+        if self._status >= 0 and self.state[self._status] != 0.0:
+            raise CalibrationError(f"{self.method} at sample {self.k - 1}: {_STATUS_TEXT[self.state[self._status]]}")
+        return self.state
+
+    def run(self, ir, gps, gps_use=None) -> dict[str, np.ndarray]:
+        """The estimator over recorded arrays, from its initial state.
+
+        Parameters
+        ----------
+        ir : (n,) array
+            IR readings (count), one per sample.
+        gps : (n,) array
+            GPS turn rate (rad/s), one per sample.
+        gps_use : (n,) bool array, optional
+            Samples whose GPS is valid and to be used (default: all).
+
+        Returns
+        -------
+        dict of (n,) arrays
+            ``a``, ``b``, ``turn_rate`` (the present turn rate ``(IR - b) / a``, rad/s) and, for
+            the Kalman filter, ``r`` (paired turn rate), innovations ``nu_gps``, ``nu_ir`` and
+            their variances ``S_gps``, ``S_ir``, fault flags ``gps_fault``, ``ir_fault``, and
+            whether each measurement was fused (``gps_used``, ``ir_used``).
+        """
+        ir = _finite("IR", ir)
+        gps = _finite("GPS turn rate", gps)
+        if gps.shape != ir.shape or ir.ndim != 1:
+            raise CalibrationError(f"IR {ir.shape} and GPS {gps.shape} must be 1-D arrays of the same length")
+        use = np.ones(ir.shape, dtype=np.bool_) if gps_use is None else np.asarray(gps_use, dtype=np.bool_)
+        if use.shape != ir.shape:
+            raise CalibrationError(f"gps_use {use.shape} must have the shape of IR {ir.shape}")
+        self.reset()
+        out = np.full((ir.shape[0], self._index.shape[0]), np.nan)
+        done = _run(self._step, self.state, self.config, self.buffer, self.delay, self.window, ir, gps, use,
+                    self._index, self._status, out)
+        self.k = done
+        if done < ir.shape[0]:
+            raise CalibrationError(f"{self.method} at sample {done - 1}: {_STATUS_TEXT[self.state[self._status]]}")
+        return {name: out[:, j] for j, name in enumerate(self.names)}
+
+
+class InfraredCalibration(Block):
+    """Streaming block around one :class:`Estimator`, at the sensor's rate.
+
+    Inputs ``ir`` (count), ``gps_turn_rate`` (rad/s), ``gps_valid`` (1 when valid); outputs
+    the estimator's named values (``a``, ``b``, ``turn_rate`` and, for the Kalman filter, the
+    innovations, their variances and the fault flags). The GPS is used until ``gps_until``
+    (s; the slides' "real case" stops it after a calibration phase).
+
+    Parameters
+    ----------
+    name : str
+        Block name.
+    estimator : Estimator
+        The estimator, shared with the batch path.
+    gps_until : float
+        Time after which the GPS is no longer used (s); ``inf`` for always.
+    period : int
+        Runs every ``period`` macro steps (one sample of the sensor).
+    """
+
+    inputs = ("ir", "gps_turn_rate", "gps_valid")
+    feedthrough = True
+
+    def __init__(self, name: str, estimator: Estimator, gps_until: float = math.inf, period: int = 1):
+        super().__init__(name, period)
+        self.estimator = estimator
+        self.gps_until = float(gps_until)
+        self.outputs = estimator.names
+        self._index = estimator._index
+
+    def start(self, t0, dt):
+        self.estimator.reset()
+
+    def step(self, t, u, y):
+        use = u[2] > 0.5 and t < self.gps_until
+        s = self.estimator.update(u[0], u[1], use)
+        y[:] = s[self._index]

@@ -1,0 +1,249 @@
+"""``ir-calibration``: in-flight calibration of the infrared horizon sensor against the GPS.
+
+After "Calibration d'un récepteur Infra-Rouge pour Micro Drone" (Paparazzi project, 2004). A
+fixed-wing flies a scripted bank profile (turns and straight legs whose turn rate has the
+slides' mean 0.037 and standard deviation 0.24 rad/s); the InfraredSensor FMU gives the IR
+reading, whose ``a`` and ``b`` drift, and the GPS turn rate, 1 s late. Three estimators run
+side by side as streaming blocks: the Kalman filter (gated or not), the slides' regression and
+Paparazzi's forgetting RLS. Faults as in the slides: IR +1200 for 2000 samples from 100 s,
+GPS turn rate +1.5 rad/s for 2000 samples from 250 s.
+
+Figures: ``calibration.png`` (a, b and the turn rate against their truth), ``innovations.png``
+(the Kalman innovations and their gates), ``errors.png`` (turn-rate error histograms).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from calibration.infrared import METHODS, EKFSettings, Estimator, InfraredCalibration
+from fmus.build import table
+from orchestrator import Block, FMUBlock, System, Table
+from scenarios import Option, Scenario
+from scenarios.plant import save_figure
+
+RATE = 20.0  # Hz, the sensor's
+IR_FAULT = (100.0, 1200.0)  # onset (s), offset (count): 2000 samples
+GPS_FAULT = (250.0, 1.5)  # onset (s), offset (rad/s): 2000 samples
+FAULT_SAMPLES = 2000
+TURN_RATE_MEAN, TURN_RATE_STD = 0.037, 0.24  # rad/s, the slides' real flight
+
+OPTIONS = {
+    "duration": Option(400.0, "simulated time (s): 8000 samples at 20 Hz", minimum=5.0),
+    "drift": Option(True, "a and b drift with time of day, temperature and cloud"),
+    "faults": Option("none", "sensor faults of the slides", choices=("none", "ir", "gps", "both")),
+    "gps_resetting": Option(True, "GPS fused all flight (the slides' 'with GPS resetting'); off: only until "
+                                  "calibration_s (their 'real case')"),
+    "calibration_s": Option(60.0, "end of the GPS calibration phase when gps_resetting is off (s)", minimum=0.0),
+    "gating": Option(True, "innovation gating and fault declaration in the Kalman filter"),
+    "noise": Option(True, "sensor noise"),
+    "seed": Option(1, "seed of the sensor noise and of the bank profile"),
+}
+
+
+def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gravity: float | None = None,
+                 rate: float = RATE) -> np.ndarray:
+    """Bank angles (rad) of a flight of turns and straight legs, one per sample.
+
+    Legs of 4 to 20 s, 30 % of them straight, joined by 1.5 s roll transitions; the turn rate
+    ``g tan(phi) / V`` is then scaled to the slides' mean 0.037 and standard deviation 0.24 rad/s.
+    """
+    parameters = {v.name: v.start for v in table("InfraredSensor").of("parameter")}
+    airspeed = airspeed or parameters["airspeed"]
+    gravity = gravity or parameters["gravity"]
+    rng = np.random.default_rng(seed)
+    r = np.empty(samples)
+    ramp = int(1.5 * rate)
+    blend = np.sin(0.5 * np.pi * np.arange(1, ramp + 1) / ramp) ** 2
+    k, previous = 0, 0.0
+    while k < samples:
+        length = max(int(rng.uniform(4.0, 20.0) * rate), ramp)
+        target = rng.normal() if rng.random() < 0.7 else 0.0
+        leg = np.full(length, target)
+        leg[:ramp] = previous + (target - previous) * blend
+        r[k:k + length] = leg[:samples - k]
+        k, previous = k + length, target
+    r = TURN_RATE_MEAN + TURN_RATE_STD * (r - r.mean()) / r.std()
+    return np.arctan(r * airspeed / gravity)
+
+
+def fault_windows(faults: str) -> list[tuple[str, float, float, float]]:
+    """The injected faults: (sensor, onset s, end s, offset)."""
+    windows = []
+    if faults in ("ir", "both"):
+        windows.append(("ir", IR_FAULT[0], IR_FAULT[0] + FAULT_SAMPLES / RATE, IR_FAULT[1]))
+    if faults in ("gps", "both"):
+        windows.append(("gps", GPS_FAULT[0], GPS_FAULT[0] + FAULT_SAMPLES / RATE, GPS_FAULT[1]))
+    return windows
+
+
+class SensorFaults(Block):
+    """Adds the slides' offsets to the IR and the GPS turn rate over their fault windows."""
+
+    inputs = ("ir", "gps_turn_rate")
+    outputs = ("ir", "gps_turn_rate")
+
+    def __init__(self, name: str, windows):
+        super().__init__(name)
+        self.windows = [(0 if sensor == "ir" else 1, start, stop, offset) for sensor, start, stop, offset in windows]
+
+    def step(self, t, u, y):
+        y[:] = u
+        for channel, start, stop, offset in self.windows:
+            if start - 1e-9 <= t < stop - 1e-9:
+                y[channel] += offset
+
+
+def build(o: dict) -> System:
+    samples = int(round(o["duration"] * RATE))
+    system = System(dt=1.0 / RATE)
+    system.add(Table("Bank", ["phi"], bank_profile(samples + 1, o["seed"])[:, None]))
+    system.add(FMUBlock("InfraredSensor", parameters={"seed": o["seed"], "drift_enabled": o["drift"],
+                                                      "noise_enabled": o["noise"]}))
+    system.add(SensorFaults("Faults", fault_windows(o["faults"])))
+    system.connect("Bank.phi", "InfraredSensor.phi")
+    system.connect("InfraredSensor.ir", "Faults.ir")
+    system.connect("InfraredSensor.gps_turn_rate", "Faults.gps_turn_rate")
+    gps_until = math.inf if o["gps_resetting"] else o["calibration_s"]
+    settings = {"kalman": EKFSettings(gate=5.0 if o["gating"] else 0.0)}
+    for method in METHODS:
+        name = method.capitalize()
+        system.add(InfraredCalibration(name, Estimator(method, settings.get(method)), gps_until=gps_until))
+        system.connect("Faults.ir", f"{name}.ir")
+        system.connect("Faults.gps_turn_rate", f"{name}.gps_turn_rate")
+        system.connect("InfraredSensor.gps_valid", f"{name}.gps_valid")
+    return system
+
+
+def episodes(flag: np.ndarray, time: np.ndarray) -> list[tuple[float, float | None]]:
+    """(declared, cleared) times of each run of a 0/1 flag; ``None`` when still declared."""
+    on = np.asarray(flag) > 0.5
+    edges = np.diff(on.astype(int), prepend=0, append=0)
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    return [(float(time[s]), float(time[e]) if e < len(time) else None) for s, e in zip(starts, stops, strict=True)]
+
+
+def fault_report(windows, kalman_flags: dict[str, np.ndarray], time: np.ndarray) -> tuple[list[dict], int]:
+    """Match the declared fault episodes with the injected faults; the rest are false alarms."""
+    declared = {sensor: episodes(flag, time) for sensor, flag in kalman_flags.items()}
+    faults, matched = [], set()
+    for sensor, onset, end, _ in windows:
+        entry = {"sensor": sensor, "onset_s": onset, "end_s": end, "declared_s": None, "cleared_s": None}
+        for i, (start, stop) in enumerate(declared[sensor]):
+            if onset - 1e-9 <= start < end:
+                entry["declared_s"], entry["cleared_s"] = start, stop
+                matched.add((sensor, i))
+                break
+        faults.append(entry)
+    false_alarms = sum(1 for sensor, runs in declared.items() for i in range(len(runs)) if (sensor, i) not in matched)
+    return faults, false_alarms
+
+
+def _shade(ax, windows):
+    for sensor, start, stop, _ in windows:
+        ax.axvspan(start, stop, color="tab:red" if sensor == "ir" else "tab:purple", alpha=0.12,
+                   label=f"{sensor.upper()} fault")
+
+
+def report(result, o, out) -> dict:
+    import matplotlib.pyplot as plt
+
+    t = result.time
+    truth_r = result["InfraredSensor.r"]
+    windows = fault_windows(o["faults"])
+    errors = {m: np.degrees(result[f"{m.capitalize()}.turn_rate"] - truth_r) for m in METHODS}
+    valid = t >= 2.0  # the GPS window is filled
+    metrics = {"turn_rate_error_deg_s": {m: {"mean": float(e[valid].mean()), "std": float(e[valid].std())}
+                                         for m, e in errors.items()}}
+    flags = {"ir": result["Kalman.ir_fault"], "gps": result["Kalman.gps_fault"]}
+    metrics["faults"], metrics["false_alarms"] = fault_report(windows, flags, t)
+    ir, r = result["InfraredSensor.ir"], truth_r
+    slope, intercept = np.polyfit(r, ir, 1)
+    metrics["flight"] = {"ir_mean": float(ir.mean()), "ir_std": float(ir.std()), "turn_rate_mean": float(r.mean()),
+                         "turn_rate_std": float(r.std()), "ir_fit": {"a": float(slope), "b": float(intercept)}}
+    a, b = result["InfraredSensor.a"], result["InfraredSensor.b"]
+    recovery = []
+    for sensor, _onset, end, _ in windows:
+        after = (t >= end) & (t <= end + 10.0)
+        ok = (np.abs(result["Kalman.a"] - a) <= 0.05 * np.abs(a)) & (np.abs(result["Kalman.b"] - b) <= 0.05 * np.abs(b))
+        back = np.flatnonzero(after & ok)
+        recovery.append({"sensor": sensor, "back_within_5_percent_s": float(t[back[0]] - end) if len(back) else None,
+                         "a_error_at_end_plus_10_s": float(result["Kalman.a"][after][-1] - a[after][-1]),
+                         "b_error_at_end_plus_10_s": float(result["Kalman.b"][after][-1] - b[after][-1])})
+    metrics["recovery"] = recovery
+
+    figures = []
+    fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+    styles = {"kalman": "tab:blue", "regression": "tab:orange", "rls": "tab:green"}
+    for m in METHODS:
+        axes[0].plot(t, result[f"{m.capitalize()}.a"], color=styles[m], lw=1, label=m)
+        axes[1].plot(t, result[f"{m.capitalize()}.b"], color=styles[m], lw=1, label=m)
+    axes[0].plot(t, a, "k--", lw=1, label="truth")
+    axes[1].plot(t, b, "k--", lw=1, label="truth")
+    axes[2].plot(t, np.degrees(result["Faults.gps_turn_rate"]), color="0.6", lw=0.6, label="GPS (late)")
+    axes[2].plot(t, np.degrees(result["Kalman.turn_rate"]), color=styles["kalman"], lw=0.8,
+                 label="Kalman (IR - b) / a")
+    axes[2].plot(t, np.degrees(truth_r), "k--", lw=0.8, label="truth")
+    axes[0].set_ylabel("a (count per rad/s)")
+    axes[1].set_ylabel("b (count)")
+    axes[2].set_ylabel("turn rate (deg/s)")
+    axes[2].set_xlabel("time (s)")
+    span = np.ptp(a), np.ptp(b)
+    axes[0].set_ylim(a.min() - max(0.5 * span[0], 40), a.max() + max(0.5 * span[0], 40))
+    axes[1].set_ylim(b.min() - max(0.5 * span[1], 40), b.max() + max(0.5 * span[1], 40))
+    axes[2].set_ylim(np.degrees(truth_r.min()) - 20, np.degrees(truth_r.max()) + 20)
+    for ax in axes:
+        _shade(ax, windows)
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper right", fontsize=8, ncol=3)
+    axes[2].legend(loc="upper right", fontsize=8, ncol=3)
+    axes[0].set_title(f"IR calibration: drift {'on' if o['drift'] else 'off'}, faults {o['faults']}, "
+                      f"gating {'on' if o['gating'] else 'off'}, "
+                      f"GPS {'all flight' if o['gps_resetting'] else f'until {o["calibration_s"]:g} s'}")
+    figures.append(save_figure(fig, out, "calibration.png"))
+
+    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    gamma = 5.0 if o["gating"] else 0.0
+    for ax, key, unit, scale in ((axes[0], "gps", "GPS innovation (deg/s)", 180 / np.pi),
+                                 (axes[1], "ir", "IR innovation (count)", 1.0)):
+        nu, S = result[f"Kalman.nu_{key}"] * scale, result[f"Kalman.S_{key}"]
+        ax.plot(t, nu, lw=0.6, label="innovation")
+        if gamma:
+            gate = gamma * np.sqrt(S) * scale
+            ax.plot(t, gate, "r", lw=0.8, label=f"gate ±{gamma:g} sqrt(S)")
+            ax.plot(t, -gate, "r", lw=0.8)
+            ax.set_ylim(-4 * np.nanmedian(gate), 4 * np.nanmedian(gate))
+        ax.set_ylabel(unit)
+        _shade(ax, windows)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    axes[1].set_xlabel("time (s)")
+    figures.append(save_figure(fig, out, "innovations.png"))
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    stats = metrics["turn_rate_error_deg_s"]
+    limit = max(5.0, float(np.percentile(np.abs(np.concatenate([e[valid] for e in errors.values()])), 99.5)))
+    bins = np.linspace(-limit, limit, 121)
+    for m in METHODS:
+        ax.hist(np.clip(errors[m][valid], -limit, limit), bins=bins, histtype="step", color=styles[m], lw=1.2,
+                label=f"{m}: mean {stats[m]['mean']:.2f}, std {stats[m]['std']:.2f} deg/s")
+    ax.set_xlabel("turn-rate error, estimate - truth (deg/s)")
+    ax.set_ylabel("samples")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    figures.append(save_figure(fig, out, "errors.png"))
+    metrics["figures"] = [f for f in figures if f]
+    return metrics
+
+
+SCENARIO = Scenario(
+    name="ir-calibration",
+    description="In-flight calibration of an infrared horizon sensor against the GPS turn rate: Kalman filter "
+                "with fault detection, the slides' regression, Paparazzi's RLS",
+    options=OPTIONS,
+    build=build,
+    report=report,
+    extra={},
+)
