@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from orchestrator import Block
+from orchestrator.blocks import Block
 
 # ----------------------------------------------------------------------------- state layouts
 # EKF state vector s: estimate, covariance (upper triangle), fault logic, last innovations.
