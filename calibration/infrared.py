@@ -21,7 +21,7 @@ turn rate. Three estimators of ``(a, b)`` and of the present turn rate ``(IR - b
 
 Pairing: the GPS turn rate at sample ``k`` is the heading difference over the ``window``
 samples ``[k - delay - window, k - delay)``, i.e. the mean turn rate there. Every estimator is
-fed the mean IR over the same samples (:func:`window_mean`), so that the pair refers to one
+fed the mean IR over the same samples (:func:`pair_at`), so that the pair refers to one
 stretch of flight, as the slides pair IR and GPS "without offset".
 
 Each estimator's arithmetic is one compiled step function, called by the batch path (a
@@ -48,11 +48,11 @@ A, B, R = 0, 1, 2
 PAA, PAB, PAR, PBB, PBR, PRR = 3, 4, 5, 6, 7, 8
 GPS_BAD, GPS_GOOD, GPS_FAULT, IR_BAD, IR_GOOD, IR_FAULT = 9, 10, 11, 12, 13, 14
 NU_GPS, GATE_GPS, NU_IR, GATE_IR, RATE, STATUS = 15, 16, 17, 18, 19, 20
-GPS_USED, IR_USED = 21, 22
-EKF_SIZE = 23
+GPS_USED, IR_USED, IR_SUSPECT = 21, 22, 23
+EKF_SIZE = 24
 # EKF configuration c: process noise variances per sample, measurement variances, gate, rules.
-QA, QB, QR, RG, RI, GAMMA2, DECLARE, CLEAR = range(8)
-EKF_CONFIG_SIZE = 8
+QA, QB, QR, RG, RI, GAMMA2, DECLARE, CLEAR, LAG, RI1, PA0, PB0 = range(12)
+EKF_CONFIG_SIZE = 12
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 
@@ -76,42 +76,71 @@ RLS_CONFIG_SIZE = 5
 
 # ----------------------------------------------------------------------------- step functions
 @njit(cache=True)
-def window_mean(buffer, k, ir, delay, window):
-    """Mean IR over the samples ``[k - delay - window, k - delay)``, from a ring buffer.
+def pair_at(buffer, k, delay, window):
+    """Mean IR over the samples ``[k - delay - window, k - delay)``, the GPS window of sample
+    ``k``, from the ring buffer that :func:`push` fills; ``nan`` before the window is filled or
+    while it holds a sample flagged suspect.
 
-    ``buffer`` holds ``delay + window + 3`` values: the last ``delay + window + 2`` samples
-    and, in its last slot, the running sum. Returns ``nan`` until ``k >= delay + window``.
+    ``buffer`` holds ``2 (delay + window + 2) + 2`` values: the last ``delay + window + 2``
+    samples, their suspect flags, the running sum and the running count of flags.
     """
     size = delay + window
     kept = size + 2
-    buffer[k % kept] = ir
     if k < size:
         return math.nan
-    # the sum moves on by one sample: in comes k - delay - 1, out goes k - delay - window - 1
     if k == size:
-        total = 0.0
+        total, flagged = 0.0, 0.0
         for j in range(0, window):
             total += buffer[j]
+            flagged += buffer[kept + j]
     else:
-        total = buffer[kept] + buffer[(k - delay - 1) % kept] - buffer[(k - delay - window - 1) % kept]
-    buffer[kept] = total
-    return total / window
+        # in comes sample k - delay - 1, out goes k - delay - window - 1
+        i, o = (k - delay - 1) % kept, (k - delay - window - 1) % kept
+        total = buffer[2 * kept] + buffer[i] - buffer[o]
+        flagged = buffer[2 * kept + 1] + buffer[kept + i] - buffer[kept + o]
+    buffer[2 * kept] = total
+    buffer[2 * kept + 1] = flagged
+    return total / window if flagged == 0.0 else math.nan
+
+
+@njit(cache=True)
+def push(buffer, k, ir, suspect, delay, window):
+    """Store sample ``k``: its IR (count) and whether it is suspect (1.0) or not (0.0)."""
+    kept = delay + window + 2
+    buffer[k % kept] = ir
+    buffer[kept + k % kept] = suspect
 
 
 @njit(cache=True)
 def _record(s, passed, bad, good, fault, declare, clear):
     """Persistence rule: ``declare`` rejections in a row declare a fault, ``clear``
-    consistent samples in a row end it."""
+    consistent samples in a row end it. Returns whether the fault ended at this sample."""
     if passed:
         s[bad] = 0.0
         s[good] += 1.0
         if s[fault] > 0.5 and s[good] >= clear:
             s[fault] = 0.0
+            return True
     else:
         s[good] = 0.0
         s[bad] += 1.0
         if s[bad] >= declare:
             s[fault] = 1.0
+    return False
+
+
+@njit(cache=True)
+def _reopen(s, c):
+    """After a fault a and b have gone unobserved for its length, under drift the random walk
+    understates: their variances are raised back to the initial ones and their correlations
+    dropped (P stays positive definite), so the next turns recalibrate them."""
+    if s[PAA] < c[PA0]:
+        s[PAA] = c[PA0]
+    if s[PBB] < c[PB0]:
+        s[PBB] = c[PB0]
+    s[PAB] = 0.0
+    s[PAR] = 0.0
+    s[PBR] = 0.0
 
 
 @njit(cache=True)
@@ -136,17 +165,18 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     Parameters
     ----------
     s : (EKF_SIZE,) float array
-        State, updated in place (layout: the module's ``A ... IR_USED`` indices).
+        State, updated in place (layout: the module's ``A ... IR_SUSPECT`` indices).
     c : (EKF_CONFIG_SIZE,) float array
         Configuration; ``c[GAMMA2] = 0`` turns gating off.
     ir_pair : float
-        Mean IR over the GPS window (count); ``nan`` before the window is filled.
+        Mean IR over the GPS window (count); ``nan`` when there is none to fuse.
     gps : float
         GPS turn rate (rad/s).
     gps_available : bool
         Whether the GPS turn rate is valid and to be used.
     ir_now : float
-        Present IR (count); gives the present turn rate ``(ir_now - b) / a``.
+        Present IR (count): checked against the state, and gives the present turn rate
+        ``(ir_now - b) / a``.
     """
     s[PAA] += c[QA]
     s[PBB] += c[QB]
@@ -154,19 +184,20 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     gamma2 = c[GAMMA2]
     s[GPS_USED] = 0.0
     s[IR_USED] = 0.0
-    if ir_pair == ir_pair:  # not nan: a pair is available
-        a, b, r = s[A], s[B], s[R]
-        gps_pass = False
-        if gps_available:
-            nu_g = gps - r
-            S_g = s[PRR] + c[RG]
-            s[NU_GPS] = nu_g
-            s[GATE_GPS] = S_g
-            gps_pass = gamma2 == 0.0 or nu_g * nu_g <= gamma2 * S_g
-            if gps_pass:
-                _fuse_gps(s, nu_g, S_g)
-                a, b, r = s[A], s[B], s[R]
-        # IR, against the state (after the GPS when it was fused): H = (r, 1, a)
+    a, b, r = s[A], s[B], s[R]
+    gps_pass = False
+    if gps_available:
+        nu_g = gps - r
+        S_g = s[PRR] + c[RG]
+        s[NU_GPS] = nu_g
+        s[GATE_GPS] = S_g
+        gps_pass = gamma2 == 0.0 or nu_g * nu_g <= gamma2 * S_g
+        if gps_pass and ir_pair == ir_pair:
+            _fuse_gps(s, nu_g, S_g)
+            a, b, r = s[A], s[B], s[R]
+    ir_pass = True
+    if ir_pair == ir_pair:
+        # the pair, against the state (after the GPS when it was fused): H = (r, 1, a)
         ha = s[PAA] * r + s[PAB] + s[PAR] * a
         hb = s[PAB] * r + s[PBB] + s[PBR] * a
         hr = s[PAR] * r + s[PBR] + s[PRR] * a
@@ -188,7 +219,7 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
                     s[PRR] = c[RG]
                     gps_pass = True
                     ir_pass = True
-            elif ir_pass:
+            else:
                 # The GPS alone disagrees: the IR carries the turn rate, a and b are held.
                 k = hr / S_i
                 s[R] += k * nu_i
@@ -216,17 +247,29 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
                 s[PBR] -= k * hb
                 s[PRR] -= k * hr
             s[IR_USED] = 1.0
-        if gps_available:
-            s[GPS_USED] = 1.0 if gps_pass else 0.0
-            if gamma2 > 0.0:
-                _record(s, gps_pass, GPS_BAD, GPS_GOOD, GPS_FAULT, c[DECLARE], c[CLEAR])
-        if gamma2 > 0.0:
-            _record(s, ir_pass, IR_BAD, IR_GOOD, IR_FAULT, c[DECLARE], c[CLEAR])
+    elif gps_available and gps_pass:
+        # no clean pair: the GPS alone
+        _fuse_gps(s, gps - s[R], s[GATE_GPS])
+    if gps_available:
+        s[GPS_USED] = 1.0 if gps_pass else 0.0
+        if gamma2 > 0.0 and _record(s, gps_pass, GPS_BAD, GPS_GOOD, GPS_FAULT, c[DECLARE], c[CLEAR]):
+            _reopen(s, c)
+    if gamma2 > 0.0:
+        # The present IR against the state: the paired turn rate is delay + window / 2 old,
+        # so the turn may have changed by up to c[LAG] (as a variance) since.
+        a, b, r = s[A], s[B], s[R]
+        nu_now = ir_now - (a * r + b)
+        S_now = a * a * (s[PRR] + c[LAG]) + r * r * s[PAA] + s[PBB] + c[RI1]
+        s[IR_SUSPECT] = 0.0 if nu_now * nu_now <= gamma2 * S_now else 1.0
+        if _record(s, ir_pass and s[IR_SUSPECT] == 0.0, IR_BAD, IR_GOOD, IR_FAULT, c[DECLARE], c[CLEAR]):
+            _reopen(s, c)
     if not (s[PAA] > 0.0 and s[PBB] > 0.0 and s[PRR] > 0.0):
         s[STATUS] = LOST_PD
     if s[A] == 0.0:
         s[STATUS] = ZERO_GAIN
         s[RATE] = math.nan
+    elif s[IR_FAULT] > 0.5:
+        s[RATE] = s[R]  # the IR is faulty: the late GPS-based turn rate is the better one
     else:
         s[RATE] = (ir_now - s[B]) / s[A]
 
@@ -373,10 +416,17 @@ class EKFSettings:
         GPS turn-rate noise (rad/s); the slides trust the GPS more than the IR.
     sd_ir : float
         Noise of the window-mean IR (count), inflated for the overlap of successive windows.
+    sd_ir_sample : float
+        Noise of one IR sample (count), for the check of the present IR.
+    sd_lag : float
+        How much the turn rate may change over the GPS lag (rad/s), for the check of the
+        present IR against the paired turn rate; it lets a fault of the IR be declared before
+        it reaches the paired window, 1 s later.
     gate : float
         Innovation gate gamma in standard deviations; 0 turns gating and fault logic off.
     declare, clear : int
         Consecutive rejections that declare a fault; consecutive consistent samples that end it.
+        When a fault ends, the variances of a and b are raised back to ``sd_a0^2, sd_b0^2``.
     form : str
         ``"sequential"`` (two scalar updates, gated) or ``"joint"`` (the slides' 2x2 update,
         never gated).
@@ -387,18 +437,20 @@ class EKFSettings:
     sd_a0: float = 25.0
     sd_b0: float = 60.0
     sd_r0: float = 0.3
-    q_a: float = 0.3
+    q_a: float = 0.5
     q_b: float = 1.0
     q_r: float = 0.02
     sd_gps: float = 0.04
     sd_ir: float = 5.0
+    sd_ir_sample: float = 6.0
+    sd_lag: float = 0.3
     gate: float = 5.0
     declare: int = 10
     clear: int = 20
     form: str = "sequential"
 
     def __post_init__(self):
-        for name in ("sd_a0", "sd_b0", "sd_r0", "q_a", "q_b", "q_r", "sd_gps", "sd_ir"):
+        for name in ("sd_a0", "sd_b0", "sd_r0", "q_a", "q_b", "q_r", "sd_gps", "sd_ir", "sd_ir_sample", "sd_lag"):
             _check_positive(name, getattr(self, name), "", "a covariance must be positive definite")
         if not (math.isfinite(self.a0) and self.a0 != 0.0 and math.isfinite(self.b0)):
             raise ValueError(f"a0 = {self.a0!r}, b0 = {self.b0!r}: a0 must be finite and non-zero, b0 finite")
@@ -416,6 +468,8 @@ class EKFSettings:
         c[[QA, QB, QR, RG, RI]] = np.square([self.q_a, self.q_b, self.q_r, self.sd_gps, self.sd_ir])
         c[GAMMA2] = self.gate**2
         c[DECLARE], c[CLEAR] = self.declare, self.clear
+        c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
+        c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c
 
     def initial_state(self, covariance=None) -> np.ndarray:
@@ -517,7 +571,7 @@ class RLSSettings:
 METHODS = ("kalman", "regression", "rls")
 _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_gps": GATE_GPS, "nu_ir": NU_IR,
                "S_ir": GATE_IR, "gps_fault": GPS_FAULT, "ir_fault": IR_FAULT, "gps_used": GPS_USED,
-               "ir_used": IR_USED, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS}
+               "ir_used": IR_USED, "ir_suspect": IR_SUSPECT, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS}
 _REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
 _RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
 _STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "
@@ -531,11 +585,17 @@ class CalibrationError(ValueError):
 
 
 @njit(cache=True)
-def _run(step, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, out):
+def _sample(step, s, c, buffer, k, ir, gps, gps_use, delay, window, suspect):
+    """One sample of any estimator: pair the IR with the GPS window, step, store the IR."""
+    step(s, c, pair_at(buffer, k, delay, window), gps, gps_use, ir)
+    push(buffer, k, ir, s[suspect] if suspect >= 0 else 0.0, delay, window)
+
+
+@njit(cache=True)
+def _run(step, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, suspect, out):
     """The batch path: the step function over recorded arrays. Returns the samples done."""
     for k in range(ir.shape[0]):
-        pair = window_mean(buffer, k, ir[k], delay, window)
-        step(s, c, pair, gps[k], gps_use[k], ir[k])
+        _sample(step, s, c, buffer, k, ir[k], gps[k], gps_use[k], delay, window, suspect)
         for j in range(fields.shape[0]):
             out[k, j] = s[fields[j]]
         if status >= 0 and s[status] != 0.0:
@@ -580,14 +640,15 @@ class Estimator:
             self.settings = settings or EKFSettings()
             self._step = ekf_step if self.settings.form == "sequential" else ekf_joint_step
             self._fields, self._status = _EKF_FIELDS, STATUS
+            self._suspect = IR_SUSPECT if self.settings.form == "sequential" else -1
             self._initial = self.settings.initial_state(covariance)
         elif method == "regression":
             self.settings = settings or RegressionSettings()
-            self._step, self._fields, self._status = regression_step, _REG_FIELDS, -1
+            self._step, self._fields, self._status, self._suspect = regression_step, _REG_FIELDS, -1, -1
             self._initial = self.settings.initial_state()
         else:
             self.settings = settings or RLSSettings()
-            self._step, self._fields, self._status = rls_step, _RLS_FIELDS, -1
+            self._step, self._fields, self._status, self._suspect = rls_step, _RLS_FIELDS, -1, -1
             self._initial = self.settings.initial_state()
         self.config = self.settings.config()
         self.names = tuple(self._fields)
@@ -597,7 +658,7 @@ class Estimator:
     def reset(self):
         """Back to the initial state, before any sample."""
         self.state = self._initial.copy()
-        self.buffer = np.zeros(self.delay + self.window + 3)
+        self.buffer = np.zeros(2 * (self.delay + self.window + 2) + 2)
         self.k = 0
 
     def update(self, ir: float, gps: float, gps_use: bool = True) -> np.ndarray:
@@ -609,8 +670,8 @@ class Estimator:
         if not (math.isfinite(ir) and math.isfinite(gps)):
             raise CalibrationError(f"sample {self.k}: IR = {ir!r}, GPS turn rate = {gps!r}; the estimators take "
                                    "finite readings only: drop or repair that sample")
-        pair = window_mean(self.buffer, self.k, float(ir), self.delay, self.window)
-        self._step(self.state, self.config, pair, float(gps), bool(gps_use), float(ir))
+        _sample(self._step, self.state, self.config, self.buffer, self.k, float(ir), float(gps), bool(gps_use),
+                self.delay, self.window, self._suspect)
         self.k += 1
         if self._status >= 0 and self.state[self._status] != 0.0:
             raise CalibrationError(f"{self.method} at sample {self.k - 1}: {_STATUS_TEXT[self.state[self._status]]}")
@@ -646,7 +707,7 @@ class Estimator:
         self.reset()
         out = np.full((ir.shape[0], self._index.shape[0]), np.nan)
         done = _run(self._step, self.state, self.config, self.buffer, self.delay, self.window, ir, gps, use,
-                    self._index, self._status, out)
+                    self._index, self._status, self._suspect, out)
         self.k = done
         if done < ir.shape[0]:
             raise CalibrationError(f"{self.method} at sample {done - 1}: {_STATUS_TEXT[self.state[self._status]]}")

@@ -21,12 +21,13 @@ import numpy as np
 from calibration.infrared import METHODS, EKFSettings, Estimator, InfraredCalibration
 from fmus.build import table
 from orchestrator import Block, FMUBlock, System, Table
+from orchestrator.fmu import FMUInstance
 from scenarios import Option, Scenario
 from scenarios.plant import save_figure
 
 RATE = 20.0  # Hz, the sensor's
-IR_FAULT = (100.0, 1200.0)  # onset (s), offset (count): 2000 samples
-GPS_FAULT = (250.0, 1.5)  # onset (s), offset (rad/s): 2000 samples
+IR_FAULT = (60.0, 1200.0)  # onset (s), offset (count): 2000 samples
+GPS_FAULT = (280.0, 1.5)  # onset (s), offset (rad/s): 2000 samples
 FAULT_SAMPLES = 2000
 TURN_RATE_MEAN, TURN_RATE_STD = 0.037, 0.24  # rad/s, the slides' real flight
 
@@ -47,7 +48,8 @@ def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gra
                  rate: float = RATE) -> np.ndarray:
     """Bank angles (rad) of a flight of turns and straight legs, one per sample.
 
-    Legs of 4 to 20 s, 30 % of them straight, joined by 1.5 s roll transitions; the turn rate
+    Legs of 2 to 8 s, 20 % of them straight, joined by 1.5 s roll transitions (a small
+    aircraft navigating between waypoints and circling over targets); the turn rate
     ``g tan(phi) / V`` is then scaled to the slides' mean 0.037 and standard deviation 0.24 rad/s.
     """
     parameters = {v.name: v.start for v in table("InfraredSensor").of("parameter")}
@@ -59,8 +61,8 @@ def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gra
     blend = np.sin(0.5 * np.pi * np.arange(1, ramp + 1) / ramp) ** 2
     k, previous = 0, 0.0
     while k < samples:
-        length = max(int(rng.uniform(4.0, 20.0) * rate), ramp)
-        target = rng.normal() if rng.random() < 0.7 else 0.0
+        length = max(int(rng.uniform(2.0, 8.0) * rate), ramp)
+        target = rng.normal() if rng.random() < 0.8 else 0.0
         leg = np.full(length, target)
         leg[:ramp] = previous + (target - previous) * blend
         r[k:k + length] = leg[:samples - k]
@@ -77,6 +79,74 @@ def fault_windows(faults: str) -> list[tuple[str, float, float, float]]:
     if faults in ("gps", "both"):
         windows.append(("gps", GPS_FAULT[0], GPS_FAULT[0] + FAULT_SAMPLES / RATE, GPS_FAULT[1]))
     return windows
+
+
+def sensor_parameters(seed: int, drift: bool, noise: bool) -> dict:
+    return {"seed": seed, "drift_enabled": drift, "noise_enabled": noise}
+
+
+def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, noise: bool = True,
+                    faults: str = "none") -> dict[str, np.ndarray]:
+    """The InfraredSensor FMU over a flight of :func:`bank_profile`, on arrays, without the master.
+
+    Returns arrays of ``samples`` values at 20 Hz: ``time`` (s), the truth ``r`` (rad/s), ``a``,
+    ``b``, and the sensors as the estimators see them, faults added: ``ir`` (count),
+    ``gps_turn_rate`` (rad/s), ``gps_valid``.
+    """
+    phi = bank_profile(samples, seed)
+    names = ["r", "a", "b", "ir", "gps_turn_rate", "gps_valid"]
+    fmu = FMUInstance("InfraredSensor", sensor_parameters(seed, drift, noise))
+    values = np.empty((samples, len(names)))
+    try:
+        for k in range(samples):
+            fmu.set(["phi"], [phi[k]])
+            values[k] = fmu.get(names)
+            fmu.step(k / RATE, 1.0 / RATE)
+    finally:
+        fmu.close()
+    flight = {name: values[:, j] for j, name in enumerate(names)}
+    flight["time"] = np.arange(samples) / RATE
+    for sensor, start, stop, offset in fault_windows(faults):
+        window = (flight["time"] >= start - 1e-9) & (flight["time"] < stop - 1e-9)
+        flight["ir" if sensor == "ir" else "gps_turn_rate"][window] += offset
+    return flight
+
+
+def estimate(flight: dict, gating: bool = True, gps_until: float = math.inf) -> dict[str, dict]:
+    """The three estimators over a flight from :func:`simulate_flight` (the batch path)."""
+    use = (flight["gps_valid"] > 0.5) & (flight["time"] < gps_until)
+    settings = {"kalman": EKFSettings(gate=5.0 if gating else 0.0)}
+    return {m: Estimator(m, settings.get(m)).run(flight["ir"], flight["gps_turn_rate"], use) for m in METHODS}
+
+
+def summarize(time, truth: dict, estimates: dict, windows) -> dict:
+    """Metrics of a run: turn-rate errors, faults declared and false alarms, recovery of a and b.
+
+    ``truth`` holds ``r``, ``a``, ``b``; ``estimates`` maps each method to its ``turn_rate``,
+    ``a``, ``b`` (and, for the Kalman filter, ``ir_fault`` and ``gps_fault``).
+    """
+    valid = time >= 2.0  # the GPS window is filled
+    metrics = {"turn_rate_error_deg_s": {}}
+    for m, e in estimates.items():
+        error = np.degrees(e["turn_rate"] - truth["r"])[valid]
+        metrics["turn_rate_error_deg_s"][m] = {"mean": float(error.mean()), "std": float(error.std())}
+    kalman = estimates["kalman"]
+    flags = {"ir": kalman["ir_fault"], "gps": kalman["gps_fault"]}
+    metrics["faults"], metrics["false_alarms"] = fault_report(windows, flags, time)
+    recovery = []
+    a, b = truth["a"], truth["b"]
+    close = (np.abs(kalman["a"] - a) <= 0.05 * np.abs(a)) & (np.abs(kalman["b"] - b) <= 0.05 * np.abs(b))
+    for sensor, _onset, end, _ in windows:
+        after = (time >= end) & (time <= end + 10.0)
+        # back within 5 % and staying there until 10 s after the end
+        inside = close[after]
+        bad = np.flatnonzero(~inside)
+        back = 0.0 if not len(bad) else (float(time[after][bad[-1] + 1] - end) if bad[-1] + 1 < len(inside) else None)
+        recovery.append({"sensor": sensor, "back_within_5_percent_s": back,
+                         "a_error_percent_at_end_plus_10_s": float(100 * (kalman["a"][after][-1] / a[after][-1] - 1)),
+                         "b_error_percent_at_end_plus_10_s": float(100 * (kalman["b"][after][-1] / b[after][-1] - 1))})
+    metrics["recovery"] = recovery
+    return metrics
 
 
 class SensorFaults(Block):
@@ -100,8 +170,7 @@ def build(o: dict) -> System:
     samples = int(round(o["duration"] * RATE))
     system = System(dt=1.0 / RATE)
     system.add(Table("Bank", ["phi"], bank_profile(samples + 1, o["seed"])[:, None]))
-    system.add(FMUBlock("InfraredSensor", parameters={"seed": o["seed"], "drift_enabled": o["drift"],
-                                                      "noise_enabled": o["noise"]}))
+    system.add(FMUBlock("InfraredSensor", parameters=sensor_parameters(o["seed"], o["drift"], o["noise"])))
     system.add(SensorFaults("Faults", fault_windows(o["faults"])))
     system.connect("Bank.phi", "InfraredSensor.phi")
     system.connect("InfraredSensor.ir", "Faults.ir")
@@ -153,26 +222,17 @@ def report(result, o, out) -> dict:
     t = result.time
     truth_r = result["InfraredSensor.r"]
     windows = fault_windows(o["faults"])
-    errors = {m: np.degrees(result[f"{m.capitalize()}.turn_rate"] - truth_r) for m in METHODS}
-    valid = t >= 2.0  # the GPS window is filled
-    metrics = {"turn_rate_error_deg_s": {m: {"mean": float(e[valid].mean()), "std": float(e[valid].std())}
-                                         for m, e in errors.items()}}
-    flags = {"ir": result["Kalman.ir_fault"], "gps": result["Kalman.gps_fault"]}
-    metrics["faults"], metrics["false_alarms"] = fault_report(windows, flags, t)
+    truth = {"r": truth_r, "a": result["InfraredSensor.a"], "b": result["InfraredSensor.b"]}
+    estimates = {m: {k: result[f"{m.capitalize()}.{k}"] for k in ("turn_rate", "a", "b")} for m in METHODS}
+    estimates["kalman"] |= {k: result[f"Kalman.{k}"] for k in ("ir_fault", "gps_fault")}
+    metrics = summarize(t, truth, estimates, windows)
+    valid = t >= 2.0
+    errors = {m: np.degrees(estimates[m]["turn_rate"] - truth_r) for m in METHODS}
     ir, r = result["InfraredSensor.ir"], truth_r
     slope, intercept = np.polyfit(r, ir, 1)
     metrics["flight"] = {"ir_mean": float(ir.mean()), "ir_std": float(ir.std()), "turn_rate_mean": float(r.mean()),
                          "turn_rate_std": float(r.std()), "ir_fit": {"a": float(slope), "b": float(intercept)}}
-    a, b = result["InfraredSensor.a"], result["InfraredSensor.b"]
-    recovery = []
-    for sensor, _onset, end, _ in windows:
-        after = (t >= end) & (t <= end + 10.0)
-        ok = (np.abs(result["Kalman.a"] - a) <= 0.05 * np.abs(a)) & (np.abs(result["Kalman.b"] - b) <= 0.05 * np.abs(b))
-        back = np.flatnonzero(after & ok)
-        recovery.append({"sensor": sensor, "back_within_5_percent_s": float(t[back[0]] - end) if len(back) else None,
-                         "a_error_at_end_plus_10_s": float(result["Kalman.a"][after][-1] - a[after][-1]),
-                         "b_error_at_end_plus_10_s": float(result["Kalman.b"][after][-1] - b[after][-1])})
-    metrics["recovery"] = recovery
+    a, b = truth["a"], truth["b"]
 
     figures = []
     fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)

@@ -16,7 +16,7 @@ from fmus.variables import Boolean, Integer, Real, Table
 GRAVITY = 9.81  # m/s^2
 AIRSPEED = 12.0  # m/s: cruise of a 1.4 kg, 1.4 m span fixed-wing
 IR_GAIN = -410.0  # IR count per rad/s at take-off: -400 on average over the flight
-IR_OFFSET = 945.0  # IR count at take-off
+IR_OFFSET = 933.0  # IR count at take-off
 IR_NOISE = 4.0  # IR count, standard deviation per sample
 GPS_HEADING_NOISE = 0.01  # rad, standard deviation of each GPS course sample
 
@@ -37,13 +37,13 @@ TABLE = Table(
         Boolean("drift_enabled", "parameter", True, "a and b drift with time of day, temperature and cloud"),
         Real("gain_day_rate", "parameter", -0.25, "1/h", "time of day: relative change of a per hour"),
         Real("offset_day_rate", "parameter", 500.0, "1/h", "time of day: change of b per hour (count/h)"),
-        Real("gain_temperature", "parameter", 0.06, "1", "temperature: relative amplitude on a"),
+        Real("gain_temperature", "parameter", 0.02, "1", "temperature: relative amplitude on a"),
         Real("offset_temperature", "parameter", 10.0, "1", "temperature: amplitude on b (count)"),
-        Real("temperature_period", "parameter", 300.0, "s", "temperature: period of the oscillation"),
-        Real("cloud_start", "parameter", 150.0, "s", "cloud: time the aircraft enters it"),
-        Real("cloud_duration", "parameter", 80.0, "s", "cloud: time under full cover"),
+        Real("temperature_period", "parameter", 600.0, "s", "temperature: period of the oscillation"),
+        Real("cloud_start", "parameter", 170.0, "s", "cloud: time the aircraft enters it"),
+        Real("cloud_duration", "parameter", 70.0, "s", "cloud: time under full cover"),
         Real("cloud_ramp", "parameter", 15.0, "s", "cloud: time to enter or leave full cover"),
-        Real("gain_cloud", "parameter", -0.12, "1", "cloud: relative change of a under full cover"),
+        Real("gain_cloud", "parameter", -0.08, "1", "cloud: relative change of a under full cover"),
         Real("offset_cloud", "parameter", 70.0, "1", "cloud: change of b under full cover (count)"),
         # GPS
         Real("gps_window", "parameter", 1.0, "s", "GPS turn rate: heading difference over this time"),
