@@ -57,9 +57,9 @@ def test_drift_follows_time_of_day_temperature_and_cloud():
                      np.where(into < ramp, np.sin(0.5 * np.pi * into / ramp) ** 2,
                               np.where(into <= ramp + full, 1.0,
                                        np.cos(0.5 * np.pi * (into - ramp - full) / ramp) ** 2)))
-    a = tab["ir_gain"] * (1 + tab["gain_day_rate"] * t / 3600 + tab["gain_temperature"] * wave
+    a = tab["ir_gain"] * (1 + tab["gain_day_rate"] * t + tab["gain_temperature"] * wave
                           + tab["gain_cloud"] * cloud)
-    b = tab["ir_offset"] + tab["offset_day_rate"] * t / 3600 + tab["offset_temperature"] * wave \
+    b = tab["ir_offset"] + tab["offset_day_rate"] * t + tab["offset_temperature"] * wave \
         + tab["offset_cloud"] * cloud
     assert np.allclose(out["a"], a, rtol=1e-12) and np.allclose(out["b"], b, rtol=1e-12)
     assert np.allclose(out["ir"], b, rtol=1e-12)  # straight flight: IR = b
@@ -130,7 +130,7 @@ def test_twin_agrees_with_the_fmu():
 
     inputs = {"phi": "0.1 + 0.5*sin(1.3*time)"}
     params = {"noise_enabled": False, "cloud_start": 0.4, "cloud_ramp": 0.5, "cloud_duration": 0.6,
-              "temperature_period": 1.7, "offset_day_rate": 3.6e4, "gain_day_rate": 50.0}
+              "temperature_period": 1.7, "offset_day_rate": 10.0, "gain_day_rate": 0.014}
     stop, step, every = 3.0, 1e-3, 50
     outputs = OUTPUTS
     times, fmu = simulate_fmu("InfraredSensor", inputs, params, stop, step, outputs)

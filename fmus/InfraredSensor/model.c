@@ -2,7 +2,7 @@
  * turn rate ("Calibration d'un récepteur Infra-Rouge pour Micro Drone", Paparazzi, 2004).
  *
  *   r = g tan(phi) / V,   dpsi/dt = r
- *   a(t) = a0 (1 + day_a t + temp_a sin(2 pi t / T) + cloud_a c(t))
+ *   a(t) = a0 (1 + day_a t + temp_a sin(2 pi t / T) + cloud_a c(t))      (day rates per second)
  *   b(t) = b0 + day_b t + temp_b sin(2 pi t / T) + cloud_b c(t)
  *   IR_k = a(t_k) r(t_k) + b(t_k) + n_IR
  *   GPS_k = (psi_m[k - D] - psi_m[k - D - W]) / window,   psi_m = psi + n_psi
@@ -68,7 +68,7 @@ static double cloud_cover(ModelInstance *m, double t) {
 
 /* True a and b at time t. */
 static void calibration(ModelInstance *m, double t, double *a, double *b) {
-    double hours = t / 3600.0, wave, cloud;
+    double wave, cloud;
     if (!m->boolean[VB_drift_enabled]) {
         *a = R(ir_gain);
         *b = R(ir_offset);
@@ -76,8 +76,8 @@ static void calibration(ModelInstance *m, double t, double *a, double *b) {
     }
     wave = sin(TWO_PI * t / R(temperature_period));
     cloud = cloud_cover(m, t);
-    *a = R(ir_gain) * (1.0 + R(gain_day_rate) * hours + R(gain_temperature) * wave + R(gain_cloud) * cloud);
-    *b = R(ir_offset) + R(offset_day_rate) * hours + R(offset_temperature) * wave + R(offset_cloud) * cloud;
+    *a = R(ir_gain) * (1.0 + R(gain_day_rate) * t + R(gain_temperature) * wave + R(gain_cloud) * cloud);
+    *b = R(ir_offset) + R(offset_day_rate) * t + R(offset_temperature) * wave + R(offset_cloud) * cloud;
 }
 
 /* Slot of sample k in the heading history; k < 0 when the FMU starts before t = 0. */

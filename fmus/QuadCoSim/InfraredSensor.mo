@@ -14,8 +14,8 @@ model InfraredSensor "Fixed-wing in coordinated turns, infrared horizon sensor w
   parameter Real ir_gain(unit = "s/rad") = -410 "a at t = 0";
   parameter Real ir_offset = 933 "b at t = 0 (count)";
   parameter Boolean drift_enabled = true "a and b drift with time of day, temperature and cloud";
-  parameter Real gain_day_rate(unit = "1/h") = -0.25 "time of day: relative change of a per hour";
-  parameter Real offset_day_rate(unit = "1/h") = 500 "time of day: change of b per hour";
+  parameter Real gain_day_rate(unit = "1/s") = -0.25/3600 "time of day: relative change of a per second";
+  parameter Real offset_day_rate(unit = "1/s") = 500/3600 "time of day: change of b per second (count/s)";
   parameter Real gain_temperature = 0.02 "temperature: relative amplitude on a";
   parameter Real offset_temperature = 10 "temperature: amplitude on b";
   parameter Real temperature_period(unit = "s") = 600 "temperature: period";
@@ -54,8 +54,8 @@ equation
     elseif time < cloud_start + cloud_ramp then sin(0.5*3.141592653589793*(time - cloud_start)/cloud_ramp)^2
     elseif time <= cloud_start + cloud_ramp + cloud_duration then 1
     else cos(0.5*3.141592653589793*(time - cloud_start - cloud_ramp - cloud_duration)/cloud_ramp)^2;
-  a = if drift_enabled then ir_gain*(1 + gain_day_rate*time/3600 + gain_temperature*wave + gain_cloud*cloud) else ir_gain;
-  b = if drift_enabled then ir_offset + offset_day_rate*time/3600 + offset_temperature*wave + offset_cloud*cloud else ir_offset;
+  a = if drift_enabled then ir_gain*(1 + gain_day_rate*time + gain_temperature*wave + gain_cloud*cloud) else ir_gain;
+  b = if drift_enabled then ir_offset + offset_day_rate*time + offset_temperature*wave + offset_cloud*cloud else ir_offset;
   when time >= t_next then
     n = pre(n) + 1;
     t_next = (pre(n) + 1)/sample_rate "from the count: a running sum of 1/sample_rate drifts off the sample instants";
