@@ -19,6 +19,7 @@
 #include "variables.h"
 
 #define R(name) (m->real[VR_##name])
+#define RV(name) REAL_VECTOR(m, name)
 
 enum { CH_ACC = 0, CH_GYRO = 3, CH_MAG = 6, CH_WALK_GYRO = 9, CH_WALK_ACC = 12 };
 
@@ -47,8 +48,8 @@ static double gaussian(int seed, int64_t k, int channel) {
 
 static void take_sample(ModelInstance *m, Data *d, int64_t k) {
     d->current = k;
-    const double *q = &R(q0), *w = &R(omega_x), *f = &R(f_x), *bd = &R(b_d_x);
-    const double *a = &R(A_11), *bs = &R(b_s_x), *mi = &R(m_I_x);
+    const double *q = RV(q), *w = RV(omega), *f = RV(f), *bd = RV(b_d);
+    const double *a = RV(A), *bs = RV(b_s), *mi = RV(m_I);
     double r[9], body[3], sd_acc = 0.0, sd_gyro = 0.0, sd_mag = 0.0, noise[CH_WALK_GYRO];
     int noisy = m->boolean[VB_noise_enabled], biased = m->boolean[VB_bias_enabled], i, c;
     rotation_from_quaternion(q, r);
@@ -61,14 +62,14 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k) {
     for (c = 0; c < CH_WALK_GYRO; c++) noise[c] = noisy ? gaussian(m->integer[VI_seed], k, c) : 0.0;
     for (i = 0; i < 3; i++) body[i] = r[i] * mi[0] + r[3 + i] * mi[1] + r[6 + i] * mi[2]; /* R^T m_I */
     for (i = 0; i < 3; i++) {
-        (&R(acc_x))[i] = f[i] + (biased ? d->acc_bias[i] : 0.0) + sd_acc * noise[CH_ACC + i];
-        (&R(gyro_x))[i] = w[i] + (biased ? d->gyro_bias[i] : 0.0) + sd_gyro * noise[CH_GYRO + i];
-        (&R(magneto_x))[i] = a[3 * i] * body[0] + a[3 * i + 1] * body[1] + a[3 * i + 2] * body[2] + bs[i] +
+        RV(acc)[i] = f[i] + (biased ? d->acc_bias[i] : 0.0) + sd_acc * noise[CH_ACC + i];
+        RV(gyro)[i] = w[i] + (biased ? d->gyro_bias[i] : 0.0) + sd_gyro * noise[CH_GYRO + i];
+        RV(magneto)[i] = a[3 * i] * body[0] + a[3 * i + 1] * body[1] + a[3 * i + 2] * body[2] + bs[i] +
                              bd[i] + sd_mag * noise[CH_MAG + i];
-        (&R(gyro_bias_x))[i] = biased ? d->gyro_bias[i] : 0.0;
-        (&R(acc_bias_x))[i] = biased ? d->acc_bias[i] : 0.0;
+        RV(gyro_bias)[i] = biased ? d->gyro_bias[i] : 0.0;
+        RV(acc_bias)[i] = biased ? d->acc_bias[i] : 0.0;
     }
-    for (i = 0; i < 9; i++) (&R(R_reel_11))[i] = r[i];
+    for (i = 0; i < LEN_R_reel; i++) RV(R_reel)[i] = r[i];
 }
 
 /* Sample k is final: the biases walk on to sample k + 1. */
@@ -96,8 +97,8 @@ fmi2Status model_initialize(ModelInstance *m) {
         return fmi2Error;
     }
     for (i = 0; i < 3; i++) {
-        d->gyro_bias[i] = (&R(b_g_x))[i];
-        d->acc_bias[i] = (&R(b_a_x))[i];
+        d->gyro_bias[i] = RV(b_g)[i];
+        d->acc_bias[i] = RV(b_a)[i];
     }
     d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - 1e-6);
     d->current = -1;

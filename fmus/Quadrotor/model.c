@@ -23,6 +23,7 @@
 #include "variables.h"
 
 #define R(name) (m->real[VR_##name])
+#define RV(name) REAL_VECTOR(m, name)
 
 typedef struct {
     double x[N_STATES];
@@ -32,7 +33,7 @@ const size_t MODEL_DATA_SIZE = sizeof(Data);
 
 /* Thrust and torques of the rotors at the present inputs. */
 static void rotor_forces(ModelInstance *m, double *thrust, double tau[3]) {
-    const double *w = &R(omega_r1), *dw = &R(domega_r1);
+    const double *w = RV(omega_r), *dw = RV(domega_r);
     int n;
     *thrust = 0.0;
     tau[0] = tau[1] = tau[2] = 0.0;
@@ -48,10 +49,10 @@ static void rotor_forces(ModelInstance *m, double *thrust, double tau[3]) {
 
 /* Drag force in {B} at velocity v (NED) and rotation r (body to NED, row-major). */
 static void drag_force(ModelInstance *m, const double *v, const double r[9], double f[3]) {
-    const double *w = &R(omega_r1), *c = &R(c_Dx);
+    const double *w = RV(omega_r), *c = RV(c_D);
     double air[3], va[3], speed, rotor = 0.0;
     int i;
-    for (i = 0; i < 3; i++) air[i] = v[i] - (&R(wind_x))[i];
+    for (i = 0; i < 3; i++) air[i] = v[i] - RV(wind)[i];
     for (i = 0; i < 3; i++) va[i] = r[i] * air[0] + r[3 + i] * air[1] + r[6 + i] * air[2];
     for (i = 0; i < N_MOTORS; i++) rotor += fabs(w[i]);
     speed = sqrt(va[0] * va[0] + va[1] * va[1] + va[2] * va[2]);
@@ -62,7 +63,7 @@ static void drag_force(ModelInstance *m, const double *v, const double r[9], dou
 static double spin_sum(ModelInstance *m) {
     double total = 0.0;
     int n;
-    for (n = 0; n < N_MOTORS; n++) total += SPIN[n] * (&R(omega_r1))[n];
+    for (n = 0; n < N_MOTORS; n++) total += SPIN[n] * RV(omega_r)[n];
     return total;
 }
 
@@ -184,8 +185,8 @@ void model_outputs(ModelInstance *m) {
     R(omega_z) = x[12];
     /* f_B = R^T (dv - g e3) */
     for (i = 0; i < 3; i++)
-        (&R(f_x))[i] = r[i] * dx[3] + r[3 + i] * dx[4] + r[6 + i] * (dx[5] - R(g));
-    for (i = 0; i < 9; i++) (&R(R11))[i] = r[i];
+        RV(f)[i] = r[i] * dx[3] + r[3 + i] * dx[4] + r[6 + i] * (dx[5] - R(g));
+    for (i = 0; i < LEN_R; i++) RV(R)[i] = r[i];
     R(theta1) = atan2(r[7], r[8]);
     R(theta2) = -asin(fmax(-1.0, fmin(1.0, r[6])));
     R(theta3) = atan2(r[3], r[0]);
@@ -193,5 +194,5 @@ void model_outputs(ModelInstance *m) {
     R(tau_x) = tau[0];
     R(tau_y) = tau[1];
     R(tau_z) = tau[2];
-    for (i = 0; i < 3; i++) (&R(drag_x))[i] = m->boolean[VB_clamped] ? 0.0 : f[i];
+    for (i = 0; i < 3; i++) RV(drag)[i] = m->boolean[VB_clamped] ? 0.0 : f[i];
 }
