@@ -48,8 +48,8 @@ A, B, R = 0, 1, 2
 PAA, PAB, PAR, PBB, PBR, PRR = 3, 4, 5, 6, 7, 8
 GPS_BAD, GPS_GOOD, GPS_FAULT, IR_BAD, IR_GOOD, IR_FAULT = 9, 10, 11, 12, 13, 14
 NU_GPS, GATE_GPS, NU_IR, GATE_IR, RATE, STATUS = 15, 16, 17, 18, 19, 20
-GPS_USED, IR_USED, IR_SUSPECT = 21, 22, 23
-EKF_SIZE = 24
+GPS_USED, IR_USED, IR_SUSPECT, NU_NOW, GATE_NOW = 21, 22, 23, 24, 25
+EKF_SIZE = 26
 # EKF configuration c: process noise variances per sample, measurement variances, gate, rules.
 QA, QB, QR, RG, RI, GAMMA2, DECLARE, CLEAR, LAG, RI1, PA0, PB0 = range(12)
 EKF_CONFIG_SIZE = 12
@@ -184,6 +184,7 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     gamma2 = c[GAMMA2]
     s[GPS_USED] = 0.0
     s[IR_USED] = 0.0
+    s[NU_GPS] = s[GATE_GPS] = s[NU_IR] = s[GATE_IR] = 0.0  # S = 0: not computed at this sample
     a, b, r = s[A], s[B], s[R]
     gps_pass = False
     if gps_available:
@@ -260,6 +261,8 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
         a, b, r = s[A], s[B], s[R]
         nu_now = ir_now - (a * r + b)
         S_now = a * a * (s[PRR] + c[LAG]) + r * r * s[PAA] + s[PBB] + c[RI1]
+        s[NU_NOW] = nu_now
+        s[GATE_NOW] = S_now
         s[IR_SUSPECT] = 0.0 if nu_now * nu_now <= gamma2 * S_now else 1.0
         if _record(s, ir_pass and s[IR_SUSPECT] == 0.0, IR_BAD, IR_GOOD, IR_FAULT, c[DECLARE], c[CLEAR]):
             _reopen(s, c)
@@ -268,8 +271,8 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     if s[A] == 0.0:
         s[STATUS] = ZERO_GAIN
         s[RATE] = math.nan
-    elif s[IR_FAULT] > 0.5:
-        s[RATE] = s[R]  # the IR is faulty: the late GPS-based turn rate is the better one
+    elif s[IR_FAULT] > 0.5 or s[IR_SUSPECT] > 0.5:
+        s[RATE] = s[R]  # the IR is faulty or suspect: the late paired turn rate is the better one
     else:
         s[RATE] = (ir_now - s[B]) / s[A]
 
@@ -283,6 +286,7 @@ def ekf_joint_step(s, c, ir_pair, gps, gps_available, ir_now):
     s[PRR] += c[QR]
     s[GPS_USED] = 0.0
     s[IR_USED] = 0.0
+    s[NU_GPS] = s[GATE_GPS] = s[NU_IR] = s[GATE_IR] = 0.0  # S = 0: not computed at this sample
     if ir_pair == ir_pair:
         a, b, r = s[A], s[B], s[R]
         # P H^T, columns for the GPS (0, 0, 1) and the IR (r, 1, a)
@@ -571,7 +575,8 @@ class RLSSettings:
 METHODS = ("kalman", "regression", "rls")
 _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_gps": GATE_GPS, "nu_ir": NU_IR,
                "S_ir": GATE_IR, "gps_fault": GPS_FAULT, "ir_fault": IR_FAULT, "gps_used": GPS_USED,
-               "ir_used": IR_USED, "ir_suspect": IR_SUSPECT, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS}
+               "ir_used": IR_USED, "ir_suspect": IR_SUSPECT, "nu_ir_now": NU_NOW,
+               "S_ir_now": GATE_NOW, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS}
 _REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
 _RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
 _STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "
@@ -751,3 +756,196 @@ class InfraredCalibration(Block):
         use = u[2] > 0.5 and t < self.gps_until
         s = self.estimator.update(u[0], u[1], use)
         y[:] = s[self._index]
+
+
+# ----------------------------------------------------------------------------- cost per iteration
+SLIDES_OPERATIONS = 300  # per iteration, counted by the slides
+SLIDES_RATE = 20.0  # Hz
+SLIDES_PROCESSOR = 20e6  # Hz, the aircraft's processor in the slides
+
+
+class _Tally:
+    def __init__(self):
+        self.flops = self.comparisons = self.functions = 0
+
+
+_TALLY = _Tally()
+
+
+class _Counted(float):
+    """A float that counts the operations made on it (the cost model of :func:`cost`)."""
+
+    def _arith(self, other, op):
+        _TALLY.flops += 1
+        return _Counted(op(float(self), float(other)))
+
+    def __add__(self, o):
+        return self._arith(o, float.__add__)
+
+    def __radd__(self, o):
+        return self._arith(o, lambda x, y: y + x)
+
+    def __sub__(self, o):
+        return self._arith(o, float.__sub__)
+
+    def __rsub__(self, o):
+        return self._arith(o, lambda x, y: y - x)
+
+    def __mul__(self, o):
+        return self._arith(o, float.__mul__)
+
+    def __rmul__(self, o):
+        return self._arith(o, lambda x, y: y * x)
+
+    def __truediv__(self, o):
+        return self._arith(o, float.__truediv__)
+
+    def __rtruediv__(self, o):
+        return self._arith(o, lambda x, y: y / x)
+
+    def __neg__(self):
+        _TALLY.flops += 1
+        return _Counted(-float(self))
+
+    def __abs__(self):
+        _TALLY.functions += 1
+        return _Counted(abs(float(self)))
+
+    def _compare(self, other, op):
+        _TALLY.comparisons += 1
+        return op(float(self), float(other))
+
+    def __lt__(self, o):
+        return self._compare(o, float.__lt__)
+
+    def __le__(self, o):
+        return self._compare(o, float.__le__)
+
+    def __gt__(self, o):
+        return self._compare(o, float.__gt__)
+
+    def __ge__(self, o):
+        return self._compare(o, float.__ge__)
+
+    def __eq__(self, o):
+        return self._compare(o, float.__eq__)
+
+    def __ne__(self, o):
+        return self._compare(o, float.__ne__)
+
+    __hash__ = float.__hash__
+
+
+_REAL_MATH = math  # the counting run swaps the module's math for _CountedMath
+
+
+class _CountedMath:
+    nan = math.nan
+
+    @staticmethod
+    def sqrt(x):
+        _TALLY.functions += 1
+        return _Counted(_REAL_MATH.sqrt(x))
+
+    @staticmethod
+    def atan(x):
+        _TALLY.functions += 1
+        return _Counted(_REAL_MATH.atan(x))
+
+
+_COMPILED = ("pair_at", "push", "_record", "_reopen", "_fuse_gps", "ekf_step", "ekf_joint_step", "regression_step",
+             "rls_step", "_sample")
+
+
+def _count_operations(estimator: Estimator, ir, gps, use) -> np.ndarray:
+    """Operations of each sample (flops, comparisons, functions), running the step functions'
+    Python source on counting numbers: the arithmetic counted is the arithmetic compiled."""
+    namespace = globals()
+    saved = {name: namespace[name] for name in _COMPILED}
+    saved_math = namespace["math"]
+    try:
+        for name in _COMPILED:
+            namespace[name] = saved[name].py_func
+        namespace["math"] = _CountedMath
+        state = [_Counted(v) for v in estimator._initial]
+        config = [_Counted(v) for v in estimator.config]
+        buffer = [_Counted(0.0) for _ in range(2 * (estimator.delay + estimator.window + 2) + 2)]
+        step = namespace[estimator._step.__name__]
+        counts = np.zeros((len(ir), 3), dtype=np.int64)
+        for k in range(len(ir)):
+            _TALLY.flops = _TALLY.comparisons = _TALLY.functions = 0
+            namespace["_sample"](step, state, config, buffer, k, _Counted(ir[k]), _Counted(gps[k]), bool(use[k]),
+                                 estimator.delay, estimator.window, estimator._suspect)
+            counts[k] = _TALLY.flops, _TALLY.comparisons, _TALLY.functions
+        return counts
+    finally:
+        namespace.update(saved)
+        namespace["math"] = saved_math
+
+
+def cost(ir, gps, gps_use=None, repeats: int = 3, methods=None) -> dict[str, dict]:
+    """Operations per iteration and time per update of each estimator, on a recorded flight.
+
+    Parameters
+    ----------
+    ir, gps : (n,) arrays
+        IR readings (count) and GPS turn rates (rad/s), one per sample.
+    gps_use : (n,) bool array, optional
+        Samples whose GPS is used (default: all).
+    repeats : int
+        Timings are the best of this many runs.
+    methods : sequence of str, optional
+        Which of the variants below to measure (default: all).
+
+    Returns
+    -------
+    dict
+        For ``kalman`` (sequential, gated), ``kalman_ungated``, ``kalman_joint`` (the slides'
+        2x2 update), ``regression`` and ``rls``: ``operations_mean`` and ``operations_max`` per
+        iteration (flops + comparisons + functions), ``flops_mean``, ``comparisons_mean``,
+        ``functions_mean``; ``us_per_update_batch`` (compiled loop over the arrays) and
+        ``us_per_update_streaming`` (one :meth:`Estimator.update` call from Python); and
+        ``operations_per_s`` at the slides' 20 Hz. ``slides`` holds their figures: 300
+        operations per iteration at 20 Hz on a 20 MHz processor.
+    """
+    import time
+
+    ir = _finite("IR", ir)
+    gps = _finite("GPS turn rate", gps)
+    use = np.ones(ir.shape, dtype=np.bool_) if gps_use is None else np.asarray(gps_use, dtype=np.bool_)
+    variants = {"kalman": ("kalman", EKFSettings()), "kalman_ungated": ("kalman", EKFSettings(gate=0.0)),
+                "kalman_joint": ("kalman", EKFSettings(gate=0.0, form="joint")),
+                "regression": ("regression", None), "rls": ("rls", None)}
+    unknown = set(methods or ()) - set(variants)
+    if unknown:
+        raise CalibrationError(f"unknown estimators {sorted(unknown)}; choose among {', '.join(variants)}")
+    out = {}
+    for label, (method, settings) in variants.items():
+        if methods is not None and label not in methods:
+            continue
+        estimator = Estimator(method, settings)
+        counts = _count_operations(estimator, ir, gps, use)
+        total = counts.sum(axis=1)
+        estimator.run(ir[:100], gps[:100], use[:100])  # compile
+        batch = min(_timed(lambda e=estimator: e.run(ir, gps, use), time) for _ in range(repeats)) / len(ir)
+        streaming = min(_timed(lambda e=estimator: _stream(e, ir, gps, use), time) for _ in range(repeats)) / len(ir)
+        out[label] = {"operations_mean": float(total.mean()), "operations_max": int(total.max()),
+                      "flops_mean": float(counts[:, 0].mean()), "comparisons_mean": float(counts[:, 1].mean()),
+                      "functions_mean": float(counts[:, 2].mean()),
+                      "operations_per_s": float(total.mean() * SLIDES_RATE),
+                      "us_per_update_batch": batch * 1e6, "us_per_update_streaming": streaming * 1e6}
+    out["slides"] = {"operations_per_iteration": SLIDES_OPERATIONS, "rate_hz": SLIDES_RATE,
+                     "processor_hz": SLIDES_PROCESSOR, "operations_per_s": SLIDES_OPERATIONS * SLIDES_RATE}
+    return out
+
+
+def _timed(function, time) -> float:
+    start = time.perf_counter()
+    function()
+    return time.perf_counter() - start
+
+
+def _stream(estimator: Estimator, ir, gps, use):
+    estimator.reset()
+    for k in range(len(ir)):
+        estimator.update(ir[k], gps[k], use[k])

@@ -5,6 +5,7 @@
   quadcosim run SCENARIO [--set k=v]... [--out DIR] [--fault ...]
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
   quadcosim bench [--json]                 speed of the master
+  quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
 """
 
 from __future__ import annotations
@@ -129,6 +130,10 @@ def _diagram(args) -> int:
 
 
 def _bench(args) -> int:
+    if args.suite == "infrared":
+        from benchmarks import infrared
+
+        return infrared.main(["--json"] if args.json else [])
     from benchmarks import master as bench
 
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
@@ -163,7 +168,8 @@ def parser() -> argparse.ArgumentParser:
     diagram.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
     diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmark the co-simulation master")
+    bench = sub.add_parser("bench", help="benchmark the co-simulation master (or the IR calibration's cost)")
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared"))
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)

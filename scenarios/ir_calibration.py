@@ -265,22 +265,27 @@ def report(result, o, out) -> dict:
                       f"GPS {'all flight' if o['gps_resetting'] else f'until {o["calibration_s"]:g} s'}")
     figures.append(save_figure(fig, out, "calibration.png"))
 
-    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    gamma = 5.0 if o["gating"] else 0.0
-    for ax, key, unit, scale in ((axes[0], "gps", "GPS innovation (deg/s)", 180 / np.pi),
-                                 (axes[1], "ir", "IR innovation (count)", 1.0)):
-        nu, S = result[f"Kalman.nu_{key}"] * scale, result[f"Kalman.S_{key}"]
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    gamma = EKFSettings().gate if o["gating"] else 0.0
+    panels = ((axes[0], "gps", "GPS turn rate (deg/s)", 180 / np.pi),
+              (axes[1], "ir", "paired IR (count)", 1.0),
+              (axes[2], "ir_now", "present IR (count)", 1.0))
+    for ax, key, unit, scale in panels:
+        S = result[f"Kalman.S_{key}"]
+        computed = S > 0.0
+        nu = np.where(computed, result[f"Kalman.nu_{key}"] * scale, np.nan)
         ax.plot(t, nu, lw=0.6, label="innovation")
         if gamma:
-            gate = gamma * np.sqrt(S) * scale
+            gate = np.where(computed, gamma * np.sqrt(np.where(computed, S, 1.0)) * scale, np.nan)
             ax.plot(t, gate, "r", lw=0.8, label=f"gate ±{gamma:g} sqrt(S)")
             ax.plot(t, -gate, "r", lw=0.8)
-            ax.set_ylim(-4 * np.nanmedian(gate), 4 * np.nanmedian(gate))
+            ax.set_ylim(-3 * np.nanmedian(gate), 3 * np.nanmedian(gate))
         ax.set_ylabel(unit)
         _shade(ax, windows)
         ax.grid(alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
-    axes[1].set_xlabel("time (s)")
+        ax.legend(loc="upper right", fontsize=8, ncol=4)
+    axes[0].set_title("Kalman innovations: GPS and paired IR (fused when inside the gate), present IR (checked)")
+    axes[2].set_xlabel("time (s)")
     figures.append(save_figure(fig, out, "innovations.png"))
 
     fig, ax = plt.subplots(figsize=(8, 4.5))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import scenarios
-from calibration.infrared import CalibrationError, EKFSettings, Estimator
+from calibration.infrared import SLIDES_OPERATIONS, CalibrationError, EKFSettings, Estimator, cost
 from scenarios.ir_calibration import estimate, fault_windows, simulate_flight, summarize
 
 
@@ -100,3 +100,22 @@ def test_non_finite_input_and_bad_covariance_are_refused():
         Estimator("kalman", covariance=np.diag([1.0, -1.0, 1.0]))
     with pytest.raises(ValueError, match="must be positive"):
         EKFSettings(sd_ir=0.0)
+
+
+def test_gated_filter_costs_at_most_the_slides_300_operations_per_iteration():
+    flight = simulate_flight(8000, seed=1, faults="both")
+    figures = cost(flight["ir"], flight["gps_turn_rate"], flight["gps_valid"] > 0.5, repeats=1, methods=("kalman",))
+    kalman = figures["kalman"]
+    print(f"\ngated Kalman filter over a flight with both faults: {kalman['operations_mean']:.1f} operations per "
+          f"iteration on average, {kalman['operations_max']} at most (slides: {SLIDES_OPERATIONS})")
+    assert kalman["operations_max"] <= SLIDES_OPERATIONS
+    assert kalman["operations_max"] == 125  # the count is exact: a change of the arithmetic shows here
+
+
+def test_sequential_scalar_updates_cost_fewer_flops_than_the_slides_joint_update():
+    flight = simulate_flight(1000, seed=2)
+    figures = cost(flight["ir"], flight["gps_turn_rate"], flight["gps_valid"] > 0.5, repeats=1,
+                   methods=("kalman_ungated", "kalman_joint"))
+    sequential, joint = figures["kalman_ungated"]["flops_mean"], figures["kalman_joint"]["flops_mean"]
+    print(f"\nflops per iteration: sequential {sequential:.1f}, joint {joint:.1f}")
+    assert sequential < 0.85 * joint
