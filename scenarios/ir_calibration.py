@@ -279,7 +279,9 @@ def report(result, o, out) -> dict:
             gate = np.where(computed, gamma * np.sqrt(np.where(computed, S, 1.0)) * scale, np.nan)
             ax.plot(t, gate, "r", lw=0.8, label=f"gate ±{gamma:g} sqrt(S)")
             ax.plot(t, -gate, "r", lw=0.8)
-            ax.set_ylim(-3 * np.nanmedian(gate), 3 * np.nanmedian(gate))
+            # the gates, and the innovations of a fault
+            top = 1.1 * max(3 * np.nanmedian(gate), np.nanpercentile(np.abs(nu), 99.9))
+            ax.set_ylim(-top, top)
         ax.set_ylabel(unit)
         _shade(ax, windows)
         ax.grid(alpha=0.3)
@@ -295,7 +297,7 @@ def report(result, o, out) -> dict:
     for m in METHODS:
         ax.hist(np.clip(errors[m][valid], -limit, limit), bins=bins, histtype="step", color=styles[m], lw=1.2,
                 label=f"{m}: mean {stats[m]['mean']:.2f}, std {stats[m]['std']:.2f} deg/s")
-    ax.set_xlabel("turn-rate error, estimate - truth (deg/s)")
+    ax.set_xlabel(f"turn-rate error, estimate - truth (deg/s); beyond ±{limit:.0f} counted in the end bins")
     ax.set_ylabel("samples")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
