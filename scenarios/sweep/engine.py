@@ -1,0 +1,440 @@
+"""Running a sweep's members on Dask distributed, streaming their results to disk.
+
+One code path: a :class:`distributed.LocalCluster` of worker processes (one thread each) by
+default, or any running scheduler given by its address. Each worker prepares itself once
+(:class:`Preload`: imports, FMU extraction, shared libraries loaded); every member then
+builds fresh FMU instances from that extraction. Members are deterministic: their seed is
+one of their options, so the table does not depend on the number of workers or on which
+worker ran what.
+
+On disk, in the sweep folder:
+
+- ``sweep.json``: the scenario and every member's options (what ``--resume`` checks against);
+- ``members/NNNNNN/metrics.json``: one member's options, metrics, status, error, wall time,
+  written atomically when it finishes; ``error.txt`` holds the traceback of a failure, and the
+  member's results and figures are there only when asked (``keep_results``);
+- ``sweep.csv`` and ``sweep.parquet``: the table of every finished member, rewritten
+  atomically as members finish.
+
+The member folders are the record: ``--resume`` reads them, skips the members that
+finished, runs the others (failed ones included) and rewrites the table.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import sys
+import tempfile
+import time
+import traceback
+import uuid
+from contextlib import ExitStack
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from distributed import WorkerPlugin
+
+from scenarios.sweep import table
+from scenarios.sweep.grid import Member, Plan
+
+#: Keys of a scenario's metrics that are not metrics of a member.
+NOT_METRICS = ("scenario", "options", "figures")
+_members_run = 0  # members run by this process (reported by worker_state)
+
+
+class SweepError(ValueError):
+    """A sweep cannot start: its folder, its plan or its cluster is not what it should be."""
+
+
+# ---------------------------------------------------------------------------- on the workers
+class Preload(WorkerPlugin):
+    """Prepares a worker once for all its members: imports the scenario, extracts every built
+    FMU and loads its shared library (fmpy's extraction is cached per process, and a library
+    once loaded stays loaded), and records how long that took."""
+
+    name = "quadcosim-preload"
+
+    def __init__(self, scenario: str):
+        self.scenario = scenario
+
+    def setup(self, worker):
+        started = time.perf_counter()
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import scenarios
+        from fmus import MODELS, FMUNotFoundError
+        from orchestrator.fmu import FMUInstance
+
+        scenarios.get(self.scenario)
+        for model in MODELS:
+            try:
+                FMUInstance(model).close()
+            except FMUNotFoundError:
+                pass  # a member that needs it will say how to build it
+        worker.quadcosim_preload_s = time.perf_counter() - started
+
+
+def worker_state(dask_worker=None) -> dict:
+    """What this worker process has done: members run, FMU extractions, preparation time (s).
+    Called through ``Client.run``."""
+    from orchestrator import fmu
+
+    return {"members": _members_run, "extractions": len(fmu._extracted),
+            "preload_s": getattr(dask_worker, "quadcosim_preload_s", None)}
+
+
+def _plain(value):
+    """JSON-ready copies of metrics (NumPy scalars and arrays to Python numbers and lists)."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if hasattr(value, "tolist"):
+        return _plain(value.tolist())
+    return value
+
+
+def first_non_finite(metrics: dict) -> str | None:
+    """Name and value of the first NaN or infinite metric, if any."""
+    for name, value in table.flatten(metrics).items():
+        if isinstance(value, float) and not math.isfinite(value):
+            return f"{name} = {value}"
+    return None
+
+
+def _resolve(reference: str):
+    import importlib
+
+    module, _, name = reference.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def run_member(scenario: str, options: dict, keep_results: bool = False, extra_metrics: str | None = None) -> dict:
+    """Run one member where this is called (a Dask worker); never raises for a member's failure.
+
+    Parameters
+    ----------
+    scenario : str
+        Scenario name.
+    options : dict
+        The member's complete options.
+    keep_results : bool
+        Also return the files the scenario writes (results, figures), as bytes by name.
+    extra_metrics : str, optional
+        ``"module:function"`` computing more metrics from ``(result, options)``.
+
+    Returns
+    -------
+    dict
+        ``status`` ("ok" or "failed"), ``error``, ``traceback``, ``metrics``, ``wall_s`` (s),
+        ``worker``, ``files``.
+    """
+    global _members_run
+    import scenarios
+
+    try:
+        from distributed import get_worker
+
+        worker = str(get_worker().name)
+    except ValueError:
+        worker = f"pid {os.getpid()}"
+    started = time.perf_counter()
+    record = {"status": "ok", "error": None, "traceback": None, "metrics": {}, "files": {}}
+    try:
+        if keep_results:
+            with tempfile.TemporaryDirectory() as folder:
+                try:
+                    result, metrics = scenarios.run(scenario, options, Path(folder))
+                finally:
+                    record["files"] = {p.name: p.read_bytes() for p in Path(folder).iterdir() if p.is_file()}
+        else:
+            result, metrics = scenarios.run(scenario, options)
+        if extra_metrics:
+            metrics = metrics | _resolve(extra_metrics)(result, options)
+        record["metrics"] = _plain({k: v for k, v in metrics.items() if k not in NOT_METRICS})
+        bad = first_non_finite(record["metrics"])
+        if bad:
+            record |= {"status": "failed", "error": f"non-finite metric: {bad}"}
+    except Exception as error:  # the member failed; the sweep goes on and records why
+        record |= {"status": "failed", "error": f"{type(error).__name__}: {error}",
+                   "traceback": traceback.format_exc()}
+    _members_run += 1
+    record["wall_s"] = time.perf_counter() - started
+    record["worker"] = worker
+    return record
+
+
+# ---------------------------------------------------------------------------- on the client
+@dataclass
+class Summary:
+    """How a sweep went: counts over the whole table, and what this call ran."""
+
+    out: Path
+    total: int
+    ok: int
+    failed: int
+    ran: int
+    skipped: int
+    seconds: float
+    workers: int
+    interrupted: bool = False
+    failures: list = field(default_factory=list)  # (member, label, error), first few
+
+    @property
+    def missing(self) -> int:
+        return self.total - self.ok - self.failed
+
+    def exit_code(self) -> int:
+        """0 if every member finished well, 1 if any failed or is missing, 130 if interrupted."""
+        if self.interrupted:
+            return 130
+        return 0 if self.failed == 0 and self.missing == 0 else 1
+
+    def text(self) -> str:
+        rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
+        lines = [f"{self.ok} of {self.total} members done, {self.failed} failed"
+                 + (f", {self.missing} not run" if self.missing else "")
+                 + f" ({self.ran} run now in {self.seconds:.1f} s on {self.workers} workers, {rate:.2f} members/s"
+                 + (f", {self.skipped} already done" if self.skipped else "") + ")"]
+        for member, label, error in self.failures[:5]:
+            lines.append(f"  failed: member {member} ({label}): {error.splitlines()[0] if error else ''}")
+        if self.failed > 5:
+            lines.append(f"  ... and {self.failed - 5} more: see the status and error columns of sweep.csv")
+        if self.interrupted:
+            lines.append(f"interrupted: finished members are kept; continue with --resume --out {self.out}")
+        lines.append(f"table: {self.out / 'sweep.csv'} and sweep.parquet; members in {self.out / 'members'}/")
+        return "\n".join(lines)
+
+
+def _write_json(path: Path, data: dict) -> None:
+    temporary = path.with_name(f".{path.name}.tmp")
+    temporary.write_text(json.dumps(data, indent=1, default=float) + "\n")
+    os.replace(temporary, path)
+
+
+def member_folder(out: Path, index: int) -> Path:
+    return out / "members" / f"{index:06d}"
+
+
+def _prepare_folder(plan: Plan, out: Path, resume: bool) -> dict[int, dict]:
+    """Check the sweep folder against the plan; the finished members' records when resuming."""
+    stored_path = out / "sweep.json"
+    described = json.loads(json.dumps(plan.to_json(), default=float))
+    if stored_path.exists():
+        stored = json.loads(stored_path.read_text())
+        if not resume:
+            finished = len(list((out / "members").glob("*/metrics.json")))
+            raise SweepError(f"{out} already holds a sweep of {stored['scenario']} ({len(stored['members'])} members, "
+                             f"{finished} finished). Continue it with --resume, or choose another --out.")
+        if stored["scenario"] != plan.scenario or len(stored["members"]) != len(plan.members):
+            raise SweepError(f"{out} holds a sweep of {stored['scenario']} with {len(stored['members'])} members; "
+                             f"this one is {plan.scenario} with {len(plan.members)}. Resume with the same grid, "
+                             "or choose another --out.")
+        for old, new in zip(stored["members"], described["members"], strict=True):
+            if old["options"] != new["options"]:
+                changed = {k: (old["options"].get(k), v) for k, v in new["options"].items()
+                           if old["options"].get(k) != v}
+                raise SweepError(f"{out}: member {new['label'] or '?'} was run with other options "
+                                 f"(stored, now: {changed}). Resume with the same grid and --set, "
+                                 "or choose another --out.")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "members").mkdir(exist_ok=True)
+    _write_json(stored_path, described)
+    records = {}
+    if resume:
+        for member in plan.members:
+            path = member_folder(out, member.index) / "metrics.json"
+            if path.exists():
+                records[member.index] = json.loads(path.read_text())
+    return records
+
+
+def _save_member(out: Path, member: Member, record: dict, attempts: int, scenario: str) -> dict:
+    folder = member_folder(out, member.index)
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, data in (record.get("files") or {}).items():
+        (folder / name).write_bytes(data)
+    if record.get("traceback"):
+        (folder / "error.txt").write_text(record["traceback"])
+    saved = {"member": member.index, "label": member.label, "status": record["status"], "error": record["error"],
+             "attempts": attempts, "wall_s": record.get("wall_s"), "worker": record.get("worker"),
+             "scenario": scenario, "options": member.options, "metrics": record.get("metrics") or {}}
+    # metrics.json is written last: its presence means the member finished (well or not).
+    _write_json(folder / "metrics.json", saved)
+    return saved
+
+
+class _Progress:
+    """A bar (members done, failed, rate) on a terminal; a few plain lines otherwise."""
+
+    def __init__(self, total: int, label: str, mode):
+        self.total, self.label, self.done, self.failed = total, label, 0, 0
+        self.started = time.perf_counter()
+        tty = sys.stderr.isatty()
+        self.mode = None if mode is False or total == 0 else ("bar" if (mode is None and tty) or mode == "bar"
+                                                              else "lines")
+        self.bar = None
+        self.next_line = 0
+        if self.mode == "bar":
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=label, unit="member", file=sys.stderr, dynamic_ncols=True)
+            self.bar.set_postfix(failed=0)
+
+    def update(self, failed: bool):
+        self.done += 1
+        self.failed += failed
+        if self.bar is not None:
+            self.bar.update(1)
+            self.bar.set_postfix(failed=self.failed)
+        elif self.mode == "lines" and (self.done >= self.next_line or self.done == self.total):
+            elapsed = time.perf_counter() - self.started
+            rate = self.done / elapsed if elapsed > 0 else 0.0
+            left = (self.total - self.done) / rate if rate > 0 else float("nan")
+            print(f"{self.label}: {self.done}/{self.total} members, {self.failed} failed, {rate:.2f} members/s, "
+                  f"about {left:.0f} s left", file=sys.stderr, flush=True)
+            self.next_line = self.done + max(1, self.total // 10)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _cluster(stack: ExitStack, workers: int | None, scheduler: str | None, retries: int, timeout: float):
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            client = stack.enter_context(Client(scheduler, timeout=timeout))
+        except OSError as error:
+            raise SweepError(f"cannot reach the Dask scheduler at {scheduler} ({error}). Start one with "
+                             "`dask scheduler`, and workers with `dask worker ADDRESS`.") from None
+    else:
+        import dask
+
+        # Each worker death is reported at once, so that --retries counts every attempt.
+        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                dashboard_address=None, silence_logs=logging.ERROR))
+        client = stack.enter_context(Client(cluster))
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        raise SweepError(f"no Dask worker joined the scheduler {scheduler} within {timeout:g} s: start one with "
+                         f"`dask worker {scheduler}`.") from None
+    return client
+
+
+def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = None, resume: bool = False,
+        retries: int = 2, retry_errors: bool = False, keep_results: bool = False, progress=None,
+        extra_metrics: str | None = None, timeout: float = 60.0) -> Summary:
+    """Run every member of ``plan`` on Dask; results stream into ``out`` as members finish.
+
+    Parameters
+    ----------
+    plan : Plan
+        The scenario and its members (:func:`scenarios.sweep.plan`).
+    out : path
+        Sweep folder (see the module documentation).
+    workers : int, optional
+        Worker processes of the local cluster (default: the number of CPUs). Ignored with
+        ``scheduler``.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``) to use instead.
+    resume : bool
+        Continue the sweep in ``out``: skip the members that finished well.
+    retries : int
+        How many more times a member is submitted after its worker died (and after it raised,
+        with ``retry_errors``; members are deterministic, so an error usually repeats).
+    retry_errors : bool
+        Retry members that raised or gave a non-finite metric too.
+    keep_results : bool
+        Save each member's results and figures in its folder (off: a large sweep would fill
+        the disk).
+    progress : None, bool or "lines"
+        None: a bar on a terminal, a few lines otherwise; False: silent.
+    extra_metrics : str, optional
+        ``"module:function"`` computing more metrics on the worker from ``(result, options)``.
+    timeout : float
+        Seconds to wait for a scheduler and its first worker (s).
+
+    Returns
+    -------
+    Summary
+    """
+    if retries < 0:
+        raise SweepError(f"retries = {retries} must be zero or more")
+    out = Path(out)
+    records = _prepare_folder(plan, out, resume)
+    finished = {i: r for i, r in records.items() if r["status"] == "ok"}
+    rows = {i: table.row(r, plan.varied) for i, r in records.items()}
+    todo = [m for m in plan.members if m.index not in finished]
+    started = time.perf_counter()
+    bar = _Progress(len(todo), f"sweep {plan.name or plan.scenario}", progress)
+    interrupted, ran, worker_count = False, 0, 0
+    last_write, write_cost = 0.0, 0.0
+
+    def flush(force=False):
+        nonlocal last_write, write_cost
+        # Rewriting the table costs time proportional to its size: keep it under 5 % of the run.
+        if force or time.perf_counter() - last_write >= 20 * write_cost:
+            t = time.perf_counter()
+            table.write(list(rows.values()), out)
+            last_write, write_cost = time.perf_counter(), time.perf_counter() - t
+
+    if todo:
+        token = uuid.uuid4().hex[:8]
+        with ExitStack() as stack:
+            client = _cluster(stack, workers, scheduler, retries, timeout)
+            client.register_plugin(Preload(plan.scenario))
+            worker_count = len(client.scheduler_info(n_workers=-1)["workers"])
+            from distributed import as_completed
+
+            by_key: dict[str, tuple[Member, int]] = {}
+
+            def submit(member: Member, attempt: int):
+                key = f"quadcosim-{token}-member-{member.index}-try-{attempt}"
+                future = client.submit(run_member, plan.scenario, member.options, keep_results, extra_metrics,
+                                       key=key, pure=False)
+                by_key[key] = (member, attempt)
+                return future
+
+            pending = as_completed()
+            try:
+                pending.update([submit(m, 1) for m in todo])
+                for future in pending:
+                    member, attempt = by_key.pop(future.key)
+                    lost = False
+                    try:
+                        record = future.result()
+                    except Exception as error:  # the worker died (KilledWorker), or the connection
+                        lost = True
+                        record = {"status": "failed", "error": f"worker lost: {type(error).__name__}: {error}",
+                                  "traceback": None, "metrics": {}, "wall_s": None, "worker": None}
+                    future.release()
+                    if record["status"] != "ok" and attempt <= retries and (lost or retry_errors):
+                        pending.add(submit(member, attempt + 1))
+                        continue
+                    saved = _save_member(out, member, record, attempt, plan.scenario)
+                    rows[member.index] = table.row(saved, plan.varied)
+                    ran += 1
+                    bar.update(record["status"] != "ok")
+                    flush()
+            except KeyboardInterrupt:
+                interrupted = True
+                client.cancel(list(pending.futures))
+            finally:
+                bar.close()
+                if rows:
+                    flush(force=True)
+    elif rows:
+        flush(force=True)
+    ok = sum(r["status"] == "ok" for r in rows.values())
+    failures = sorted((i, r["label"], r["error"]) for i, r in rows.items() if r["status"] != "ok")
+    return Summary(out, len(plan.members), ok, len(failures), ran, len(finished), time.perf_counter() - started,
+                   worker_count, interrupted, failures)
