@@ -6,6 +6,9 @@
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
+  quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
+                  [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
+  quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
 """
 
 from __future__ import annotations
@@ -173,6 +176,12 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
+    from scenarios.sweep import command as sweep
+
+    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
+        .set_defaults(func=sweep.sweep)
+    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
+        .set_defaults(func=sweep.sweep_plot)
     return p
 
 

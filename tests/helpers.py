@@ -27,3 +27,12 @@ def rotation(q):
     q0, qv = q[0], np.asarray(q[1:])
     s = np.array([[0, -qv[2], qv[1]], [qv[2], 0, -qv[0]], [-qv[1], qv[0], 0]])
     return np.eye(3) + 2 * q0 * s + 2 * s @ s
+
+
+def exit_worker_on_large_gain(result, options):
+    """Sweep extra metric for tests: the worker process dies (as on a crash) when k > 1000."""
+    import os
+
+    if options["k"] > 1000:
+        os._exit(3)
+    return {}

@@ -10,11 +10,27 @@
 - :mod:`scenarios.sweep.engine`: running them on a local or remote Dask cluster, the member
   folders, the table, ``--resume``, retries;
 - :mod:`scenarios.sweep.table`: ``sweep.csv`` and ``sweep.parquet``;
-- :mod:`scenarios.sweep.figure`: a metric against an option, grouped by another.
+- :mod:`scenarios.sweep.figure`: a metric against an option, grouped by another;
+- :mod:`scenarios.sweep.named`: sweeps by name (``lab-matrix``);
+- :mod:`scenarios.sweep.command`: ``quadcosim sweep`` and ``quadcosim sweep-plot``.
+
+A script that runs a local cluster needs ``if __name__ == "__main__":`` around its sweep:
+the worker processes are started by ``multiprocessing``'s spawn, which imports the script.
 """
 
-from scenarios.sweep.engine import Summary, SweepError, run, run_member
-from scenarios.sweep.grid import Member, Plan, plan, plan_of_cases
-from scenarios.sweep.table import read as read_table
+import importlib
 
-__all__ = ["Member", "Plan", "Summary", "SweepError", "plan", "plan_of_cases", "read_table", "run", "run_member"]
+# Imported on first use: the command line builds its parser without loading Dask.
+_EXPORTS = {
+    "Summary": "engine", "SweepError": "engine", "run": "engine", "run_member": "engine",
+    "Member": "grid", "Plan": "grid", "plan": "grid", "plan_of_cases": "grid",
+    "plot": "figure", "read_table": "table",
+}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'scenarios.sweep' has no attribute {name!r}")
+    module = importlib.import_module(f"scenarios.sweep.{_EXPORTS[name]}")
+    return getattr(module, "read" if name == "read_table" else name)

@@ -181,6 +181,7 @@ class Summary:
     skipped: int
     seconds: float
     workers: int
+    startup_s: float = 0.0  # cluster up, workers prepared (s)
     interrupted: bool = False
     failures: list = field(default_factory=list)  # (member, label, error), first few
 
@@ -195,10 +196,13 @@ class Summary:
         return 0 if self.failed == 0 and self.missing == 0 else 1
 
     def text(self) -> str:
-        rate = self.ran / self.seconds if self.seconds > 0 else float("nan")
+        running = self.seconds - self.startup_s
+        rate = self.ran / running if running > 0 else float("nan")
         lines = [f"{self.ok} of {self.total} members done, {self.failed} failed"
                  + (f", {self.missing} not run" if self.missing else "")
-                 + f" ({self.ran} run now in {self.seconds:.1f} s on {self.workers} workers, {rate:.2f} members/s"
+                 + f" ({self.ran} run now in {self.seconds:.1f} s on {self.workers} workers:"
+                 + f" {self.startup_s:.1f} s to start"
+                 + f" them, then {rate:.2f} members/s"
                  + (f", {self.skipped} already done" if self.skipped else "") + ")"]
         for member, label, error in self.failures[:5]:
             lines.append(f"  failed: member {member} ({label}): {error.splitlines()[0] if error else ''}")
@@ -375,8 +379,7 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     rows = {i: table.row(r, plan.varied) for i, r in records.items()}
     todo = [m for m in plan.members if m.index not in finished]
     started = time.perf_counter()
-    bar = _Progress(len(todo), f"sweep {plan.name or plan.scenario}", progress)
-    interrupted, ran, worker_count = False, 0, 0
+    interrupted, ran, worker_count, startup = False, 0, 0, 0.0
     last_write, write_cost = 0.0, 0.0
 
     def flush(force=False):
@@ -393,6 +396,8 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
             client = _cluster(stack, workers, scheduler, retries, timeout)
             client.register_plugin(Preload(plan.scenario))
             worker_count = len(client.scheduler_info(n_workers=-1)["workers"])
+            startup = time.perf_counter() - started
+            bar = _Progress(len(todo), f"sweep {plan.name or plan.scenario}", progress)
             from distributed import as_completed
 
             by_key: dict[str, tuple[Member, int]] = {}
@@ -437,4 +442,4 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     ok = sum(r["status"] == "ok" for r in rows.values())
     failures = sorted((i, r["label"], r["error"]) for i, r in rows.items() if r["status"] != "ok")
     return Summary(out, len(plan.members), ok, len(failures), ran, len(finished), time.perf_counter() - started,
-                   worker_count, interrupted, failures)
+                   worker_count, startup, interrupted, failures)

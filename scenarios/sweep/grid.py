@@ -56,6 +56,11 @@ def values_of(spec: str, where: str = "--grid") -> list:
     return [float(f"{p:.12g}") for p in points]
 
 
+def _text(value) -> str:
+    """A grid value as the option parser reads it: 2.0 as "2", so that integer options take it."""
+    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
+
+
 def split_assignment(text: str, flag: str) -> tuple[str, str]:
     name, eq, spec = text.partition("=")
     if not eq or not name.strip():
@@ -125,7 +130,7 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None) ->
             raise ValueError(f"option {name} is both varied (--grid) and fixed (--set); keep one")
     # Type and check every value once, through the scenario's own options.
     scenario.parse(fixed)
-    typed = {name: [scenario.parse({name: str(v)})[name] for v in values] for name, values in dimensions.items()}
+    typed = {name: [scenario.parse({name: _text(v)})[name] for v in values] for name, values in dimensions.items()}
     for name, values in typed.items():
         if len(set(map(repr, values))) != len(values):
             raise ValueError(f"--grid {name}: repeated values {values}")

@@ -112,6 +112,8 @@ def read(path) -> dict[str, list]:
 def _number_or_text(text: str):
     if text == "":
         return None
+    if text in ("True", "False"):
+        return text == "True"
     try:
         value = float(text)
     except ValueError:

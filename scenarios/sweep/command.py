@@ -1,0 +1,119 @@
+"""``quadcosim sweep`` and ``quadcosim sweep-plot`` (also ``python -m scenarios.sweep``).
+
+    quadcosim sweep tp --grid k=0.01:10:log12 --grid estimator=linear,explicit \\
+        --set duration=5 --seeds 4 --workers 2 --out results/k-sweep
+    quadcosim sweep tp --out results/k-sweep --resume
+    quadcosim sweep tp ... --scheduler tcp://192.168.1.10:8786
+    quadcosim sweep-plot results/k-sweep "rms_error_deg[0]" --x k --by estimator
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    p.add_argument("scenario", help="a scenario (quadcosim list) or a named sweep (lab-matrix)")
+    p.add_argument("--grid", action="append", default=[], metavar="NAME=SPEC",
+                   help="vary an option: a,b,c | start:stop:logN | start:stop:linN | start:stop (integers)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="fix an option")
+    p.add_argument("--seeds", metavar="N|A:B", help="Monte Carlo: the seed option over 1..N (or A..B)")
+    p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the CPUs)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="use a running Dask scheduler (tcp://host:8786)")
+    p.add_argument("--out", help="sweep folder (default results/sweep-SCENARIO)")
+    p.add_argument("--resume", action="store_true", help="continue the sweep in --out; skip finished members")
+    p.add_argument("--retries", type=int, default=2, metavar="N",
+                   help="resubmissions of a member whose worker died (default 2)")
+    p.add_argument("--retry-errors", action="store_true",
+                   help="also retry members that raised or gave a NaN (members are deterministic)")
+    p.add_argument("--results", action="store_true", help="keep each member's results and figures (large)")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    return p
+
+
+def add_plot_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    p.add_argument("table", help="a sweep folder, or its sweep.parquet / sweep.csv")
+    p.add_argument("metric", help="a metric column, e.g. 'rms_error_deg[0]'")
+    p.add_argument("--x", required=True, help="the option along the horizontal axis")
+    p.add_argument("--by", help="the option whose values make the curves")
+    p.add_argument("--out", help="PNG or SVG file (default METRIC-vs-X.png in the sweep folder)")
+    p.add_argument("--logy", action="store_true", help="logarithmic metric axis")
+    return p
+
+
+def _stored_plan(out: Path):
+    from scenarios.sweep.grid import Member, Plan
+
+    stored = json.loads((out / "sweep.json").read_text())
+    members = [Member(i, m["options"], m["label"]) for i, m in enumerate(stored["members"])]
+    return Plan(stored["scenario"], members, stored["varied"], stored["description"], stored.get("name"))
+
+
+def make_plan(args):
+    """The plan the arguments describe (a named sweep, a grid, or the stored one on --resume)."""
+    from scenarios.sweep import grid, named
+
+    out = Path(args.out) if args.out else Path("results") / f"sweep-{args.scenario}"
+    args.out = str(out)
+    if args.resume and not (args.grid or args.set or args.seeds) and (out / "sweep.json").exists():
+        plan = _stored_plan(out)
+        if args.scenario not in (plan.scenario, plan.name):
+            raise ValueError(f"{out} holds a sweep of {plan.name or plan.scenario}, not {args.scenario}")
+        return plan
+    sweeps = named.registry()
+    if args.scenario in sweeps:
+        if args.grid or args.seeds:
+            raise ValueError(f"{args.scenario} is a named sweep: its members are fixed; only --set applies")
+        return sweeps[args.scenario].plan(args.set)
+    return grid.plan(args.scenario, args.grid, args.set, args.seeds)
+
+
+def sweep(args) -> int:
+    from scenarios.sweep import engine, named
+
+    try:
+        if args.workers is not None and args.workers < 1:
+            raise ValueError(f"--workers {args.workers}: give at least 1")
+        if args.workers and args.scheduler:
+            raise ValueError("--workers and --scheduler: the scheduler's own workers run the sweep; give one")
+        plan = make_plan(args)
+        if not args.quiet:
+            print(f"sweep {plan.name or plan.scenario}: {len(plan.members)} members"
+                  + (f" over {', '.join(plan.varied)}" if plan.varied else "") + f", into {args.out}/",
+                  file=sys.stderr)
+        summary = engine.run(plan, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
+                             retries=args.retries, retry_errors=args.retry_errors, keep_results=args.results,
+                             progress=False if args.quiet else None,
+                             extra_metrics=named.extra_metrics(plan))
+    except (KeyError, ValueError) as error:  # SweepError is a ValueError
+        print(f"quadcosim sweep {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
+        return 2
+    named.summarise(plan, args.out, summary)
+    print(summary.text())
+    return summary.exit_code()
+
+
+def sweep_plot(args) -> int:
+    from scenarios.sweep import figure, table
+
+    try:
+        columns = table.read(args.table)
+        source = Path(args.table)
+        folder = source if source.is_dir() else source.parent
+        safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in f"{args.metric}-vs-{args.x}")
+        path = figure.plot(columns, args.metric, args.x, by=args.by, logy=args.logy,
+                           out=args.out or folder / f"{safe}.png")
+    except (KeyError, ValueError, FileNotFoundError) as error:
+        print(f"quadcosim sweep-plot: {error.args[0] if error.args else error}", file=sys.stderr)
+        return 2
+    print(path)
+    return 0
+
+
+def main(argv=None) -> int:
+    p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,
+                                              formatter_class=argparse.RawDescriptionHelpFormatter))
+    return sweep(p.parse_args(argv))

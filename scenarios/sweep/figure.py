@@ -1,0 +1,111 @@
+"""A metric of a sweep table against one option, one curve per value of another.
+
+Members that share the option values (Monte Carlo seeds, or options not shown) are pooled:
+the curve is their mean, the band their spread (minimum to maximum), and each member is a
+faint point. Failed members are left out and counted in the title.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+
+def _number(value) -> float | None:
+    if isinstance(value, bool) or value is None:
+        return None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if math.isfinite(number) else None
+
+
+def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, out=None, logy: bool = False,
+         ax=None):
+    """Draw ``metric`` against option ``x``, grouped by option ``by``.
+
+    Parameters
+    ----------
+    columns : dict
+        A sweep table as columns (:func:`scenarios.sweep.read_table`).
+    metric, x, by : str
+        Column names: a metric, the option along the horizontal axis, the option that splits
+        the members into curves (optional).
+    out : path, optional
+        File to save (PNG, SVG); the figure is returned when absent.
+    logy : bool
+        Logarithmic metric axis. The ``x`` axis is logarithmic by itself when ``x`` is positive
+        and spans more than a decade.
+    ax : matplotlib Axes, optional
+        Draw into it instead of a new figure.
+
+    Returns
+    -------
+    str or matplotlib.figure.Figure
+        The saved path, or the figure.
+    """
+    import matplotlib.pyplot as plt
+
+    for name in (metric, x, by):
+        if name is not None and name not in columns:
+            from orchestrator.fmu import nearest
+
+            raise KeyError(f"the sweep table has no column {name!r}.{nearest(name, columns)}")
+    count = len(columns[x])
+    status = columns.get("status", ["ok"] * count)
+    kept = [i for i in range(count) if status[i] == "ok" and _number(columns[metric][i]) is not None]
+    failed = sum(s != "ok" for s in status)
+    if not kept:
+        raise ValueError(f"no finished member has a numeric {metric!r}")
+    xs = [columns[x][i] for i in kept]
+    numeric_x = all(_number(v) is not None for v in xs)
+    categories = sorted(set(map(str, xs))) if not numeric_x else []
+    position = (lambda v: float(v)) if numeric_x else (lambda v: float(categories.index(str(v))))
+    groups: dict[object, dict[float, list[float]]] = defaultdict(lambda: defaultdict(list))
+    for i in kept:
+        key = columns[by][i] if by else None
+        groups[key][position(columns[x][i])].append(float(columns[metric][i]))
+
+    if ax is None:
+        figure, ax = plt.subplots(figsize=(8, 5))
+    else:
+        figure = ax.figure
+    for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: str(item[0]))):
+        at = np.array(sorted(series))
+        values = [np.array(series[a]) for a in at]
+        mean = np.array([v.mean() for v in values])
+        colour = f"C{n % 10}"
+        label = f"{by} = {key}" if by else metric
+        pooled = max(len(v) for v in values)
+        ax.plot(at, mean, "o-", color=colour, label=label + (f" (mean of {pooled})" if pooled > 1 else ""))
+        if pooled > 1:
+            ax.fill_between(at, [v.min() for v in values], [v.max() for v in values], color=colour, alpha=0.15)
+            for a, v in zip(at, values, strict=True):
+                ax.plot(np.full(len(v), a), v, ".", color=colour, alpha=0.3, ms=3)
+    positive = numeric_x and min(float(v) for v in xs) > 0
+    if positive and max(float(v) for v in xs) / min(float(v) for v in xs) > 10:
+        ax.set_xscale("log")
+    if logy:
+        ax.set_yscale("log")
+    if categories:
+        ax.set_xticks(range(len(categories)), categories)
+    ax.set_xlabel(x)
+    ax.set_ylabel(metric)
+    title = f"{metric} against {x}" + (f", by {by}" if by else "")
+    if failed:
+        title += f" ({failed} failed member{'s' * (failed > 1)} not shown)"
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    if out is None:
+        return figure
+    path = Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+    return str(path)

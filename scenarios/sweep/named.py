@@ -1,0 +1,86 @@
+"""Named sweeps: a fixed set of labelled cases of one scenario, and what is made of their table.
+
+A module that declares ``SWEEP = NamedSweep(...)`` and is listed in :data:`MODULES` can be run
+by name: ``quadcosim sweep lab-matrix``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+
+from orchestrator.fmu import nearest
+
+MODULES = ("lab_matrix",)
+
+
+@dataclass
+class NamedSweep:
+    """A sweep by name.
+
+    Parameters
+    ----------
+    name : str
+        Command-line name.
+    scenario : str
+        The scenario every case runs.
+    cases : callable
+        ``() -> {label: options}``.
+    description : str
+        One line for ``quadcosim list``.
+    summarise : callable, optional
+        ``(columns, out_dir) -> None``: reports written from the finished table.
+    extra_metrics : str, optional
+        ``"module:function"`` computing more metrics from ``(result, options)`` on the worker.
+    """
+
+    name: str
+    scenario: str
+    cases: object
+    description: str = ""
+    summarise: object = None
+    extra_metrics: str | None = None
+
+    def plan(self, settings=()):
+        from scenarios.sweep.grid import plan_of_cases, split_assignment
+
+        fixed = dict(split_assignment(s, "--set") for s in settings)
+        cases = {label: options | fixed for label, options in self.cases().items()}
+        return plan_of_cases(self.scenario, cases, name=self.name)
+
+
+def registry() -> dict[str, NamedSweep]:
+    sweeps = {}
+    for module in MODULES:
+        try:
+            found = getattr(importlib.import_module(f"scenarios.{module}"), "SWEEP", None)
+        except ModuleNotFoundError as error:
+            if error.name != f"scenarios.{module}":
+                raise
+            continue
+        if found is not None:
+            sweeps[found.name] = found
+    return sweeps
+
+
+def get(name: str) -> NamedSweep:
+    sweeps = registry()
+    if name not in sweeps:
+        raise KeyError(f"unknown named sweep {name!r}.{nearest(name, sweeps)} Named sweeps: {', '.join(sweeps)}.")
+    return sweeps[name]
+
+
+def extra_metrics(plan) -> str | None:
+    return registry()[plan.name].extra_metrics if plan.name else None
+
+
+def summarise(plan, out, summary) -> None:
+    """Run a named sweep's summary on its table, once every member has finished well."""
+    if not plan.name or summary.ok != summary.total:
+        return
+    named = registry()[plan.name]
+    if named.summarise is not None:
+        from scenarios.sweep import table
+
+        named.summarise(table.read(out), Path(out))

@@ -1,0 +1,219 @@
+"""Sweeps on a real Dask cluster: failures recorded, resume after a kill, identical tables
+whatever the workers or the scheduler, FMUs extracted once per worker.
+
+The reference sweep: the lab's closed loop for 0.5 s, noise on, linear filter gains
+{0.05, 0.2, 1e5} x seeds {1..4}. The gain 1e5 makes the discrete filter diverge (NaN at
+0.15 s): those members fail, the others must complete.
+"""
+
+import json
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from scenarios import sweep
+from scenarios.sweep import command, table
+from scenarios.sweep.engine import worker_state
+
+ROOT = Path(__file__).resolve().parent.parent
+GRID = ["--grid", "k=0.05,0.2,1e5", "--set", "duration=0.5", "--set", "noise=on", "--seeds", "4"]
+MEMBERS, FAILING = 12, 4
+BIN = Path(sys.executable).parent
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep") / "two-workers"
+    code = command.main(["tp", *GRID, "--workers", "2", "--out", str(out), "--quiet"])
+    return code, out, table.read(out)
+
+
+def test_failing_members_are_recorded_and_the_others_complete(reference, capsys):
+    code, out, columns = reference
+    assert code == 1  # some members failed
+    assert len(columns["member"]) == MEMBERS
+    failed = [i for i, s in enumerate(columns["status"]) if s != "ok"]
+    assert [columns["k"][i] for i in failed] == [1e5] * FAILING
+    for i in failed:
+        assert "SimulationError" in columns["error"][i] and "became nan" in columns["error"][i]
+        assert (out / "members" / f"{i:06d}" / "error.txt").read_text().startswith("Traceback")
+    finished = [i for i in range(MEMBERS) if i not in failed]
+    roll = np.array([columns["rms_error_deg[0]"][i] for i in finished])
+    # Lab gain 0.05 with noise on: roll error of a few thousandths of a degree, never NaN.
+    assert np.all(np.isfinite(roll)) and np.all(roll < 0.05) and np.all(roll > 1e-4)
+    # Different seeds give different noise, hence different errors.
+    assert len(set(roll[:4])) == 4
+    assert set(columns["worker"][i] for i in range(MEMBERS)) == {"0", "1"}
+    # The same table, as Parquet and as CSV.
+    assert table.same(columns, table.read(out / "sweep.csv"))
+    summary = sweep.Summary(out, MEMBERS, MEMBERS - FAILING, FAILING, MEMBERS, 0, 1.0, 2)
+    assert summary.exit_code() == 1 and "4 failed" in summary.text()
+
+
+def test_one_and_two_workers_give_the_same_table(reference, tmp_path):
+    _, _, two = reference
+    out = tmp_path / "one-worker"
+    assert command.main(["tp", *GRID, "--workers", "1", "--out", str(out), "--quiet"]) == 1
+    one = table.read(out)
+    assert set(one["worker"]) == {"0"}
+    assert table.same(one, two)
+    assert not table.same(one, {**two, "rms_error_deg[0]": two["rms_error_deg[0]"][::-1]})
+
+
+def test_killed_sweep_resumes_to_the_same_table(reference, tmp_path):
+    _, _, uninterrupted = reference
+    out = tmp_path / "killed"
+    process = subprocess.Popen([sys.executable, "-m", "scenarios.sweep", "tp", *GRID, "--workers", "1",
+                                "--out", str(out), "--quiet"], cwd=tmp_path, start_new_session=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while len(list(out.glob("members/*/metrics.json"))) < 4:
+        assert process.poll() is None and time.monotonic() < deadline, "the sweep ended before it was killed"
+        time.sleep(0.01)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    done = {p.parent.name: p.stat().st_mtime_ns for p in out.glob("members/*/metrics.json")}
+    assert 4 <= len(done) < MEMBERS
+    # What was written is whole: every member file parses, and the table (if written yet) too.
+    for path in out.glob("members/*/metrics.json"):
+        json.loads(path.read_text())
+    if (out / "sweep.parquet").exists():
+        assert len(table.read(out)["member"]) <= len(done)
+    # Without --resume the folder is refused, not overwritten.
+    assert command.main(["tp", *GRID, "--out", str(out), "--quiet"]) == 2
+    code = command.main(["tp", "--out", str(out), "--resume", "--workers", "2", "--quiet"])
+    assert code == 1
+    resumed = table.read(out)
+    assert table.same(resumed, uninterrupted)
+    # Only the missing members ran: the finished ones were not touched.
+    assert {p.parent.name: p.stat().st_mtime_ns for p in out.glob("members/*/metrics.json")
+            if p.parent.name in done} == done
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_sweep_through_a_separately_started_scheduler(reference, tmp_path):
+    from distributed import Client
+
+    _, _, local = reference
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    scheduler = subprocess.Popen([BIN / "dask", "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":")[-1],
+                                  "--no-dashboard"], cwd=tmp_path, stderr=subprocess.DEVNULL)
+    worker = subprocess.Popen([BIN / "dask", "worker", address, "--nthreads", "1", "--no-dashboard"],
+                              cwd=tmp_path, stderr=subprocess.DEVNULL)
+    try:
+        out = tmp_path / "remote"
+        assert command.main(["tp", *GRID, "--scheduler", address, "--out", str(out), "--quiet"]) == 1
+        assert table.same(table.read(out), local)
+        with Client(address) as client:
+            state = next(iter(client.run(worker_state).values()))
+        # One worker ran every member, from one extraction of each FMU.
+        assert state["members"] == MEMBERS
+        assert state["extractions"] == 3
+        assert state["preload_s"] > 0
+    finally:
+        for process in (worker, scheduler):
+            process.terminate()
+            process.wait(timeout=30)
+
+
+def test_a_dead_worker_is_retried_then_recorded(tmp_path):
+    plan = sweep.plan("tp", ["k=0.05,2000"], ["duration=0.2"])
+    summary = sweep.run(plan, tmp_path / "dead", workers=1, retries=1, progress=False,
+                        extra_metrics="helpers:exit_worker_on_large_gain")
+    columns = table.read(tmp_path / "dead")
+    assert columns["status"] == ["ok", "failed"]
+    assert columns["attempts"] == [1, 2]
+    assert columns["error"][1].startswith("worker lost: KilledWorker")
+    assert summary.failed == 1 and summary.exit_code() == 1
+
+
+# ------------------------------------------------------------------ without a cluster
+def test_grid_values_and_members():
+    plan = sweep.plan("tp", ["k=0.01:10:log4", "estimator=linear,explicit"], ["duration=2", "noise=on"], seeds="2")
+    assert len(plan.members) == 4 * 2 * 2
+    assert plan.varied == ["k", "estimator", "seed"]
+    assert [m.options["k"] for m in plan.members[::4]] == [0.01, 0.1, 1.0, 10.0]
+    first = plan.members[0]
+    assert first.options | {} == first.options and first.options["duration"] == 2.0
+    assert first.options["noise"] is True and first.label == "k=0.01 estimator=linear seed=1"
+    assert [m.options["seed"] for m in plan.members[:4]] == [1, 2, 1, 2]
+    assert sweep.plan("tp", ["k=0:1:lin5"]).members[2].options["k"] == 0.5
+    assert [m.options["seed"] for m in sweep.plan("tp", seeds="3:5").members] == [3, 4, 5]
+
+
+@pytest.mark.parametrize("grids, settings, seeds, message", [
+    (["kk=1,2"], [], None, "unknown option 'kk' for scenario tp. Did you mean k"),
+    (["k=1,x"], [], None, "option k='x' is not a valid float"),
+    (["k=-1,1"], [], None, "must be at least 0.0"),
+    (["estimator=linear,kalman"], [], None, "must be one of linear, explicit, passive"),
+    (["k=0:1:log3"], [], None, "a log grid needs positive bounds"),
+    (["k=0.5:2"], [], None, "integer range"),
+    (["seed=1:2:lin3"], [], None, "option seed='1.5' is not a valid int"),
+    (["k=1,2"], ["k=3"], None, "both varied (--grid) and fixed (--set)"),
+    (["k=1,1"], [], None, "repeated values"),
+    (["k"], [], None, "write NAME=VALUES"),
+    ([], [], "4", None),
+])
+def test_bad_grids_are_refused_before_any_run(grids, settings, seeds, message):
+    if message is None:
+        assert len(sweep.plan("tp", grids, settings, seeds).members) == 4
+        return
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace(".", r"\.")):
+        sweep.plan("tp", grids, settings, seeds)
+
+
+def test_seeds_need_a_seed_option(monkeypatch):
+    import scenarios
+
+    tp = scenarios.get("tp")
+    unseeded = scenarios.Scenario("unseeded", "", {k: o for k, o in tp.options.items() if k != "seed"}, tp.build,
+                                  tp.report)
+    monkeypatch.setattr(scenarios, "get", lambda name: unseeded)
+    with pytest.raises(ValueError, match="has no seed option"):
+        sweep.plan("unseeded", seeds="3")
+    assert [m.options["k"] for m in sweep.plan("unseeded", ["k=1:3:lin3"]).members] == [1.0, 2.0, 3.0]
+
+
+def test_table_flattening_and_round_trip(tmp_path):
+    record = {"member": 0, "label": "k=1", "status": "ok", "error": None, "attempts": 1, "wall_s": 0.5,
+              "worker": "0", "options": {"k": 1.0, "noise": True, "estimator": "linear"},
+              "metrics": {"rms": [0.1, 0.2, math.nan], "nested": {"a": 1}, "long": list(range(20)), "k": 3.0}}
+    failed = record | {"member": 1, "status": "failed", "error": "SimulationError: x", "metrics": {}}
+    rows = [table.row(failed), table.row(record)]
+    assert rows[1]["rms[1]"] == 0.2 and rows[1]["nested.a"] == 1 and rows[1]["metric.k"] == 3.0
+    assert json.loads(rows[1]["long"]) == list(range(20))
+    table.write(rows, tmp_path)
+    parquet, csv = table.read(tmp_path), table.read(tmp_path / "sweep.csv")
+    assert parquet["member"] == [0, 1] and parquet["status"] == ["ok", "failed"]
+    assert parquet["rms[1]"] == [0.2, None] and math.isnan(parquet["rms[2]"][0])
+    assert table.same(parquet, csv)
+    assert not list(tmp_path.glob(".*tmp"))
+
+
+def test_figure_pools_seeds_and_groups(tmp_path):
+    columns = {"member": list(range(8)), "status": ["ok"] * 7 + ["failed"],
+               "k": [0.1, 0.1, 1.0, 1.0, 0.1, 0.1, 1.0, 1.0], "estimator": ["linear"] * 4 + ["explicit"] * 4,
+               "err": [1.0, 3.0, 2.0, 4.0, 5.0, 7.0, 6.0, None]}
+    figure = sweep.plot(columns, "err", "k", by="estimator")
+    lines = {line.get_label(): line for line in figure.axes[0].get_lines() if not line.get_label().startswith("_")}
+    assert np.allclose(lines["estimator = linear (mean of 2)"].get_ydata(), [2.0, 3.0])
+    assert np.allclose(lines["estimator = explicit (mean of 2)"].get_ydata(), [6.0, 6.0])
+    assert figure.axes[0].get_xscale() == "linear"
+    assert "1 failed member not shown" in figure.axes[0].get_title()
+    path = sweep.plot(columns, "err", "estimator", out=tmp_path / "by-estimator.png")
+    assert Path(path).stat().st_size > 10_000
+    with pytest.raises(KeyError, match="no column 'erro'. Did you mean err"):
+        sweep.plot(columns, "erro", "k")
