@@ -6,6 +6,7 @@
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
+  quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
@@ -137,6 +138,10 @@ def _bench(args) -> int:
         from benchmarks import infrared
 
         return infrared.main(["--json"] if args.json else [])
+    if args.suite == "sweep":
+        from benchmarks import sweep
+
+        return sweep.main(["--json"] if args.json else [])
     from benchmarks import master as bench
 
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
@@ -171,8 +176,8 @@ def parser() -> argparse.ArgumentParser:
     diagram.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
     diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmark the co-simulation master (or the IR calibration's cost)")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared"))
+    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)

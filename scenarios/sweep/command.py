@@ -114,6 +114,13 @@ def sweep_plot(args) -> int:
 
 
 def main(argv=None) -> int:
+    from orchestrator.interrupts import exit_code, terminate_as_interrupt
+
     p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,
                                               formatter_class=argparse.RawDescriptionHelpFormatter))
-    return sweep(p.parse_args(argv))
+    try:
+        with terminate_as_interrupt():
+            return sweep(p.parse_args(argv))
+    except KeyboardInterrupt as interrupt:  # before the members started: nothing to keep yet
+        print("quadcosim sweep: interrupted", file=sys.stderr)
+        return exit_code(interrupt)

@@ -131,7 +131,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
     -------
     dict
         ``status`` ("ok" or "failed"), ``error``, ``traceback``, ``metrics``, ``wall_s`` (s),
-        ``worker``, ``files``.
+        ``cpu_s`` (s of this process's CPU time), ``worker``, ``files``.
     """
     global _members_run
     import scenarios
@@ -142,7 +142,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
         worker = str(get_worker().name)
     except ValueError:
         worker = f"pid {os.getpid()}"
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), time.process_time()
     record = {"status": "ok", "error": None, "traceback": None, "metrics": {}, "files": {}}
     try:
         if keep_results:
@@ -164,6 +164,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
                    "traceback": traceback.format_exc()}
     _members_run += 1
     record["wall_s"] = time.perf_counter() - started
+    record["cpu_s"] = time.process_time() - cpu
     record["worker"] = worker
     return record
 
@@ -182,7 +183,7 @@ class Summary:
     seconds: float
     workers: int
     startup_s: float = 0.0  # cluster up, workers prepared (s)
-    interrupted: bool = False
+    interrupted: int = 0  # the signal that stopped the sweep (SIGINT, SIGTERM), 0 if none
     failures: list = field(default_factory=list)  # (member, label, error), first few
 
     @property
@@ -190,9 +191,9 @@ class Summary:
         return self.total - self.ok - self.failed
 
     def exit_code(self) -> int:
-        """0 if every member finished well, 1 if any failed or is missing, 130 if interrupted."""
+        """0 if every member finished well, 1 if any failed or is missing, 128 + signal if interrupted."""
         if self.interrupted:
-            return 130
+            return 128 + self.interrupted
         return 0 if self.failed == 0 and self.missing == 0 else 1
 
     def text(self) -> str:
@@ -265,8 +266,9 @@ def _save_member(out: Path, member: Member, record: dict, attempts: int, scenari
     if record.get("traceback"):
         (folder / "error.txt").write_text(record["traceback"])
     saved = {"member": member.index, "label": member.label, "status": record["status"], "error": record["error"],
-             "attempts": attempts, "wall_s": record.get("wall_s"), "worker": record.get("worker"),
-             "scenario": scenario, "options": member.options, "metrics": record.get("metrics") or {}}
+             "attempts": attempts, "wall_s": record.get("wall_s"), "cpu_s": record.get("cpu_s"),
+             "worker": record.get("worker"), "scenario": scenario, "options": member.options,
+             "metrics": record.get("metrics") or {}}
     # metrics.json is written last: its presence means the member finished (well or not).
     _write_json(folder / "metrics.json", saved)
     return saved
@@ -379,7 +381,7 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     rows = {i: table.row(r, plan.varied) for i, r in records.items()}
     todo = [m for m in plan.members if m.index not in finished]
     started = time.perf_counter()
-    interrupted, ran, worker_count, startup = False, 0, 0, 0.0
+    interrupted, ran, worker_count, startup = 0, 0, 0, 0.0
     last_write, write_cost = 0.0, 0.0
 
     def flush(force=False):
@@ -430,8 +432,10 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
                     ran += 1
                     bar.update(record["status"] != "ok")
                     flush()
-            except KeyboardInterrupt:
-                interrupted = True
+            except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM under the command line
+                from orchestrator.interrupts import signal_number
+
+                interrupted = signal_number(interrupt)
                 client.cancel(list(pending.futures))
             finally:
                 bar.close()
