@@ -127,7 +127,8 @@ def comparable(columns: dict[str, list]) -> dict[str, list]:
 
 
 def same(a: dict[str, list], b: dict[str, list]) -> bool:
-    """Whether two tables hold the same values (NaN equal to NaN), volatile columns aside."""
+    """Whether two tables hold the same values, volatile columns aside. NaN equals NaN, and an
+    empty text equals a missing value (CSV writes both as an empty field)."""
     a, b = comparable(a), comparable(b)
     if list(a) != list(b):
         return False
@@ -136,6 +137,6 @@ def same(a: dict[str, list], b: dict[str, list]) -> bool:
             return False
         for x, y in zip(a[name], b[name], strict=True):
             both_nan = isinstance(x, float) and isinstance(y, float) and math.isnan(x) and math.isnan(y)
-            if x != y and not both_nan:
+            if x != y and not both_nan and {x, y} != {"", None}:
                 return False
     return True
