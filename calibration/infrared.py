@@ -57,8 +57,8 @@ EKF_CONFIG_SIZE = 12
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 
 # Regression state: sums of the accepted pairs, the fit and its residual spread.
-N, SR, SRR, SY, SRY, SYY, FIT_A, FIT_B, FIT_SD, COUNT, REG_RATE, REJECTED = range(12)
-REG_SIZE = 12
+N, SR, SRR, SY, SRY, SYY, FIT_A, FIT_B, FIT_SD, COUNT, REG_RATE, REJECTED, FITTED = range(13)
+REG_SIZE = 13
 # Regression configuration: recompute period (samples), largest realistic turn rate (rad/s),
 # rejection threshold (residual standard deviations), floor of that deviation (count),
 # samples and turn-rate spread (rad/s) needed before the first fit.
@@ -344,11 +344,12 @@ def regression_step(s, c, ir_pair, gps, gps_available, ir_now):
     """One sample of the accumulated least-squares line, refitted every ``c[PERIOD]`` samples.
 
     A pair is unrealistic, and left out, when its turn rate exceeds ``c[MAX_RATE]`` or, once
-    a line is fitted, when it lies more than ``c[REJECT_K]`` residual deviations off it.
+    a line has been fitted to the data, when it lies more than ``c[REJECT_K]`` residual
+    deviations off it.
     """
     if ir_pair == ir_pair and gps_available:
         realistic = abs(gps) <= c[MAX_RATE]
-        if realistic and s[N] >= c[MIN_N]:
+        if realistic and s[FITTED] > 0.5:  # the initial line is no reference for rejection
             spread = s[FIT_SD] if s[FIT_SD] > c[SD_FLOOR] else c[SD_FLOOR]
             residual = ir_pair - (s[FIT_A] * gps + s[FIT_B])
             realistic = residual * residual <= c[REJECT_K] * c[REJECT_K] * spread * spread
@@ -374,6 +375,7 @@ def regression_step(s, c, ir_pair, gps, gps_available, ir_now):
                 s[FIT_B] = mean_y - s[FIT_A] * mean_r
                 var_res = s[SYY] / n - mean_y * mean_y - s[FIT_A] * cov
                 s[FIT_SD] = math.sqrt(var_res) if var_res > 0.0 else 0.0
+                s[FITTED] = 1.0
     s[REG_RATE] = (ir_now - s[FIT_B]) / s[FIT_A]
 
 

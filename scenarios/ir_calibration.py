@@ -86,16 +86,17 @@ def sensor_parameters(seed: int, drift: bool, noise: bool) -> dict:
 
 
 def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, noise: bool = True,
-                    faults: str = "none") -> dict[str, np.ndarray]:
+                    faults: str = "none", parameters: dict | None = None) -> dict[str, np.ndarray]:
     """The InfraredSensor FMU over a flight of :func:`bank_profile`, on arrays, without the master.
 
     Returns arrays of ``samples`` values at 20 Hz: ``time`` (s), the truth ``r`` (rad/s), ``a``,
     ``b``, and the sensors as the estimators see them, faults added: ``ir`` (count),
-    ``gps_turn_rate`` (rad/s), ``gps_valid``.
+    ``gps_turn_rate`` (rad/s), ``gps_valid``. ``parameters`` overrides the FMU's (for instance
+    ``{"cloud_start": 100.0}`` to put the cloud inside the IR fault).
     """
     phi = bank_profile(samples, seed)
     names = ["r", "a", "b", "ir", "gps_turn_rate", "gps_valid"]
-    fmu = FMUInstance("InfraredSensor", sensor_parameters(seed, drift, noise))
+    fmu = FMUInstance("InfraredSensor", sensor_parameters(seed, drift, noise) | dict(parameters or {}))
     values = np.empty((samples, len(names)))
     try:
         for k in range(samples):
@@ -130,6 +131,9 @@ def summarize(time, truth: dict, estimates: dict, windows) -> dict:
     for m, e in estimates.items():
         error = np.degrees(e["turn_rate"] - truth["r"])[valid]
         metrics["turn_rate_error_deg_s"][m] = {"mean": float(error.mean()), "std": float(error.std())}
+        settled = np.degrees(e["turn_rate"] - truth["r"])[time >= 30.0]
+        metrics.setdefault("turn_rate_error_after_30_s_deg_s", {})[m] = {"mean": float(settled.mean()),
+                                                                         "std": float(settled.std())}
     kalman = estimates["kalman"]
     flags = {"ir": kalman["ir_fault"], "gps": kalman["gps_fault"]}
     metrics["faults"], metrics["false_alarms"] = fault_report(windows, flags, time)
