@@ -232,6 +232,7 @@ class MagCompensator(Block):
 
     @property
     def feedthrough_inputs(self) -> set[str]:
+        """The magnetometer only: commands and voltage may arrive one macro step late."""
         return {"magneto_x", "magneto_y", "magneto_z"}
 
     def start(self, t0, dt):

@@ -79,6 +79,7 @@ class MotorFieldModel:
 
     @property
     def motors(self) -> int:
+        """Number of motors N."""
         return len(self.v)
 
     def amplitude(self, c, u) -> np.ndarray:
@@ -88,6 +89,8 @@ class MotorFieldModel:
         return np.einsum("...nk,nk->...n", basis(c, np.broadcast_to(u, c.shape), self.orders), self.theta)
 
     def field(self, c, u) -> np.ndarray:
+        """Eq. 3: ``sum_n f(c_n, u) v_n`` (T, sensor frame), shape ``(..., 3)``, for commands
+        ``c`` (1) of shape ``(..., N)`` and voltages ``u`` (V) of shape ``(...)``."""
         return self.amplitude(c, u) @ self.v
 
 

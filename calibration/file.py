@@ -65,6 +65,7 @@ class Calibration:
     notes: dict = _default(default_factory=dict)
 
     def to_dict(self) -> dict:
+        """The calibration as the JSON object of the file format (lists of floats, SI units)."""
         s, f, d = self.static, self.field, self.dynamics
         return {
             "format": FORMAT,
@@ -92,77 +93,42 @@ class Calibration:
     @classmethod
     def from_dict(cls, data: dict, motors: int | None = None, orders: tuple[int, int] | None = None,
                   where: str = "calibration") -> Calibration:
-        def fail(message):
-            raise CalibrationError(f"{where}: {message}")
+        """The calibration held by a decoded file, checked field by field.
 
-        def array(value, shape, name):
-            try:
-                out = np.asarray(value, dtype=float)
-            except (TypeError, ValueError):
-                fail(f"{name} must be numbers, not {value!r}")
-            if out.shape != shape:
-                fail(f"{name} must have shape {shape}, not {out.shape}")
-            if not np.isfinite(out).all():
-                fail(f"{name} holds NaN or Inf")
-            return out
+        Parameters
+        ----------
+        data : dict
+            The decoded JSON object (see the module docstring).
+        motors : int, optional
+            Number of motors the vehicle has; a file for another number is refused.
+        orders : (int, int), optional
+            Orders ``(I, J)`` expected; a file with others is refused.
+        where : str
+            Name of the source (the file's path) in error messages.
 
+        Raises
+        ------
+        CalibrationError
+            Naming the defective field and what it should hold.
+        """
+        reader = _Reader(where)
         if not isinstance(data, dict):
-            fail("the file must hold a JSON object")
+            reader.fail("the file must hold a JSON object")
         if data.get("format") != FORMAT:
-            fail(f"not a magnetometer calibration (format {data.get('format')!r}, expected {FORMAT!r})")
+            reader.fail(f"not a magnetometer calibration (format {data.get('format')!r}, expected {FORMAT!r})")
         if data.get("version") != VERSION:
-            fail(f"version {data.get('version')!r} is not supported (this reader knows version {VERSION})")
+            reader.fail(f"version {data.get('version')!r} is not supported (this reader knows version {VERSION})")
         missing = [k for k in ("motors", "static", "reference", "field", "dynamics") if k not in data]
         if missing:
-            fail(f"missing key(s) {', '.join(missing)}")
+            reader.fail(f"missing key(s) {', '.join(missing)}")
         n = data["motors"]
         if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-            fail(f"motors = {n!r} must be a positive integer")
+            reader.fail(f"motors = {n!r} must be a positive integer")
         if motors is not None and n != motors:
-            fail(f"the file calibrates {n} motors; this vehicle has {motors}. Calibrate this vehicle")
-        static = None
-        if data["static"] is not None:
-            s = data["static"]
-            if not isinstance(s, dict) or not {"A", "b_s", "field_norm"} <= set(s):
-                fail("static must hold A, b_s and field_norm")
-            A = array(s["A"], (3, 3), "static.A")
-            if abs(np.linalg.det(A)) < 1e-12 * np.abs(A).max() ** 3:
-                fail("static.A is singular")
-            static = StaticCalibration(A=A, b_s=array(s["b_s"], (3,), "static.b_s"),
-                                       field_norm=float(array(s["field_norm"], (), "static.field_norm")))
-        reference = None if data["reference"] is None else array(data["reference"], (3,), "reference")
-        model = None
-        if data["field"] is not None:
-            f = data["field"]
-            if not isinstance(f, dict) or not {"orders", "v", "theta"} <= set(f):
-                fail("field must hold orders, v and theta")
-            o = f["orders"]
-            if not (isinstance(o, dict) and isinstance(o.get("I"), int) and isinstance(o.get("J"), int)
-                    and o["I"] >= 1 and o["J"] >= 0):
-                fail(f"field.orders = {o!r} must be {{'I': integer >= 1, 'J': integer >= 0}}")
-            I, J = o["I"], o["J"]
-            if orders is not None and (I, J) != tuple(orders):
-                fail(f"the file has orders I = {I}, J = {J}; ({orders[0]}, {orders[1]}) were asked for")
-            v = array(f["v"], (n, 3), "field.v")
-            if np.abs(np.linalg.norm(v, axis=1) - 1.0).max() > 1e-6:
-                fail("field.v must hold unit vectors")
-            model = MotorFieldModel(v, array(f["theta"], (n, I * (J + 1)), f"field.theta (orders I = {I}, J = {J})"),
-                                    (I, J))
-        dynamics = None
-        if data["dynamics"] is not None:
-            d = data["dynamics"]
-            keys = {"rate", "drag", "limit", "exponent", "freewheel", "gain"}
-            if not isinstance(d, dict) or not keys <= set(d):
-                fail(f"dynamics must hold {', '.join(sorted(keys))}")
-            rate, drag = (float(array(d[k], (), f"dynamics.{k}")) for k in ("rate", "drag"))
-            limit = np.inf if d["limit"] is None else float(array(d["limit"], (), "dynamics.limit"))
-            if not (rate > 0 and drag >= 0 and limit > 0):
-                fail("dynamics.rate and dynamics.limit must be positive and dynamics.drag non-negative")
-            if d["exponent"] not in (0, 1) or not isinstance(d["freewheel"], bool):
-                fail("dynamics.exponent must be 0 or 1 and dynamics.freewheel true or false")
-            dynamics = MotorDynamics(rate, drag, limit, int(d["exponent"]), d["freewheel"],
-                                     array(d["gain"], (n,), "dynamics.gain"))
-        return cls(n, static, model, dynamics, reference, dict(data.get("notes") or {}))
+            reader.fail(f"the file calibrates {n} motors; this vehicle has {motors}. Calibrate this vehicle")
+        reference = None if data["reference"] is None else reader.array(data["reference"], (3,), "reference")
+        return cls(n, reader.static(data["static"]), reader.field(data["field"], n, orders),
+                   reader.dynamics(data["dynamics"], n), reference, dict(data.get("notes") or {}))
 
     @classmethod
     def load(cls, path, motors: int | None = None, orders: tuple[int, int] | None = None) -> Calibration:
@@ -178,3 +144,68 @@ class Calibration:
         except json.JSONDecodeError as error:
             raise CalibrationError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
         return cls.from_dict(data, motors, orders, where=str(path))
+
+
+class _Reader:
+    """Checks of the parts of a calibration file; every refusal names the source and the field."""
+
+    def __init__(self, where: str):
+        self.where = where
+
+    def fail(self, message: str):
+        raise CalibrationError(f"{self.where}: {message}")
+
+    def array(self, value, shape: tuple, name: str) -> np.ndarray:
+        try:
+            out = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            self.fail(f"{name} must be numbers, not {value!r}")
+        if out.shape != shape:
+            self.fail(f"{name} must have shape {shape}, not {out.shape}")
+        if not np.isfinite(out).all():
+            self.fail(f"{name} holds NaN or Inf")
+        return out
+
+    def static(self, s) -> StaticCalibration | None:
+        if s is None:
+            return None
+        if not isinstance(s, dict) or not {"A", "b_s", "field_norm"} <= set(s):
+            self.fail("static must hold A, b_s and field_norm")
+        A = self.array(s["A"], (3, 3), "static.A")
+        if abs(np.linalg.det(A)) < 1e-12 * np.abs(A).max() ** 3:
+            self.fail("static.A is singular")
+        return StaticCalibration(A=A, b_s=self.array(s["b_s"], (3,), "static.b_s"),
+                                 field_norm=float(self.array(s["field_norm"], (), "static.field_norm")))
+
+    def field(self, f, n: int, orders) -> MotorFieldModel | None:
+        if f is None:
+            return None
+        if not isinstance(f, dict) or not {"orders", "v", "theta"} <= set(f):
+            self.fail("field must hold orders, v and theta")
+        o = f["orders"]
+        if not (isinstance(o, dict) and isinstance(o.get("I"), int) and isinstance(o.get("J"), int)
+                and o["I"] >= 1 and o["J"] >= 0):
+            self.fail(f"field.orders = {o!r} must be {{'I': integer >= 1, 'J': integer >= 0}}")
+        I, J = o["I"], o["J"]
+        if orders is not None and (I, J) != tuple(orders):
+            self.fail(f"the file has orders I = {I}, J = {J}; ({orders[0]}, {orders[1]}) were asked for")
+        v = self.array(f["v"], (n, 3), "field.v")
+        if np.abs(np.linalg.norm(v, axis=1) - 1.0).max() > 1e-6:
+            self.fail("field.v must hold unit vectors")
+        theta = self.array(f["theta"], (n, I * (J + 1)), f"field.theta (orders I = {I}, J = {J})")
+        return MotorFieldModel(v, theta, (I, J))
+
+    def dynamics(self, d, n: int) -> MotorDynamics | None:
+        if d is None:
+            return None
+        keys = {"rate", "drag", "limit", "exponent", "freewheel", "gain"}
+        if not isinstance(d, dict) or not keys <= set(d):
+            self.fail(f"dynamics must hold {', '.join(sorted(keys))}")
+        rate, drag = (float(self.array(d[k], (), f"dynamics.{k}")) for k in ("rate", "drag"))
+        limit = np.inf if d["limit"] is None else float(self.array(d["limit"], (), "dynamics.limit"))
+        if not (rate > 0 and drag >= 0 and limit > 0):
+            self.fail("dynamics.rate and dynamics.limit must be positive and dynamics.drag non-negative")
+        if d["exponent"] not in (0, 1) or not isinstance(d["freewheel"], bool):
+            self.fail("dynamics.exponent must be 0 or 1 and dynamics.freewheel true or false")
+        return MotorDynamics(rate, drag, limit, int(d["exponent"]), d["freewheel"],
+                             self.array(d["gain"], (n,), "dynamics.gain"))

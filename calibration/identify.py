@@ -59,6 +59,7 @@ class MotorDynamics:
     rms: float = float("nan")
 
     def vector(self) -> np.ndarray:
+        """``rate, drag, limit, exponent, freewheel, gain[N]`` as the compensator's dynamics vector."""
         return np.r_[self.rate, self.drag, self.limit, float(self.exponent), float(self.freewheel),
                      np.asarray(self.gain, dtype=float)]
 

@@ -111,6 +111,8 @@ class StaticCalibration:
         return np.linalg.solve(self.A, (x - self.b_s).T).T
 
     def quality(self) -> dict:
+        """Quality figures: ``spread`` (1), ``rms`` (samples' unit), ``coverage`` (1), ``samples``,
+        ``field_norm`` (samples' unit)."""
         return {"spread": self.spread, "rms": self.rms, "coverage": self.coverage, "samples": self.samples,
                 "field_norm": self.field_norm}
 

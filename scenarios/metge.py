@@ -95,6 +95,7 @@ def free_commands(o: dict, t: np.ndarray) -> np.ndarray:
 
 
 def socs(o: dict, set_number: int) -> list[float]:
+    """Battery states of charge (1) of the runs of set ``set_number``, from its option."""
     text = o[f"soc{set_number}"]
     try:
         values = [float(x) for x in text.split(",")]
@@ -132,6 +133,7 @@ def system_for(o: dict, set_number: int, run: int) -> System:
 
 
 def build(o: dict) -> System:
+    """The first run of set 1 (full battery, then the free set), after checking the options."""
     if not 0 <= o["settle"] < o["hold"]:
         raise ValueError(f"settle = {o['settle']} s must be shorter than hold = {o['hold']} s")
     socs(o, 1), socs(o, 2)
@@ -142,6 +144,7 @@ def build(o: dict) -> System:
 
 
 def parse_orders(text: str):
+    """``(I, J)`` from ``"I,J"``, or ``None`` for ``"cv"`` (chosen by cross-validation)."""
     if text == "cv":
         return None
     try:
@@ -173,6 +176,7 @@ class RigRun:
         self.free = t >= self.end
 
     def record(self):
+        """``(time (s), magneto (T), commands (1), voltage (V))`` up to the end of the sweeps."""
         rows = self.time < self.end
         return self.time[rows], self.field[rows], self.commands[rows], self.voltage[rows]
 
@@ -186,6 +190,7 @@ class RigSet:
         self.reference = np.mean([r.reference for r in runs], axis=0)
 
     def sweeps(self) -> list[Sweep]:
+        """Each motor's K measurements over all runs, against the set's mean ``m0``."""
         out = []
         for n in range(4):
             parts = [(r.field[r.motor_of == n] - r.reference + self.reference, r.commands[r.motor_of == n, n],
@@ -195,10 +200,12 @@ class RigSet:
 
 
 def load_static(o):
+    """The static calibration of option ``static`` (a calibration file), or ``None``."""
     return Calibration.load(o["static"]).static if o["static"] else None
 
 
 def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Calibration:
+    """Eqs. 5 to 8 on a set's K measurements and the motor dynamics on its records."""
     model = fit_dynamic(rig.reference, rig.sweeps(), orders)
     dynamics = fit_motor_dynamics([r.record() for r in rig.runs], [r.reference for r in rig.runs], model.v,
                                   sample_rate)
@@ -218,12 +225,9 @@ def set_error(cal, rig: RigSet, mode, rate, rows: str) -> float:
     return float(np.concatenate([errors_deg(cal, r, mode, rate)[getattr(r, rows)] for r in rig.runs]).mean())
 
 
-def report(result, o, out) -> dict:
-    import matplotlib.pyplot as plt
-
-    orders = parse_orders(o["orders"])
-    rate = o["mag_rate"]
-    static = load_static(o)
+def record_sets(result, o: dict, out) -> dict[int, list[RigRun]]:
+    """The runs of both calibration sets: the scenario's own run (set 1, first battery state, with
+    the free set) and the others, each saved under ``out/set<k>_run<i>``."""
     runs = {1: [RigRun(result, o, 1)], 2: []}
     for set_number in (1, 2):
         for run in range(len(runs[set_number]), len(socs(o, set_number))):
@@ -231,16 +235,17 @@ def report(result, o, out) -> dict:
             if out is not None:
                 recorded.save(out / f"set{set_number}_run{run}")
             runs[set_number].append(RigRun(recorded, o, set_number))
-    rig1, rig2 = RigSet(runs[1]), RigSet(runs[2])
-    first = runs[1][0]
-    study = order_study([(rig1.reference, rig1.sweeps()), (rig2.reference, rig2.sweeps())])
-    if orders is None:
-        orders = study["best"]
-    cals = {"calibration1": calibrate(rig1, orders, static, rate, "set 1"),
-            "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
-    none = Calibration(4, static)
-    table, dynamic_free, series, whole = {}, {}, {}, {}
-    for row, cal in [("none", none)] + list(cals.items()):
+    return runs
+
+
+def table1(cals: dict, rig1: RigSet, rig2: RigSet, rate: float) -> dict:
+    """Table 1 (deg): rows ``none`` (static calibration only) and each calibration (eq. 9),
+    columns the settled rows of set 1 and set 2 and the free set; the same sets with every row
+    (step transients included); the dynamics-aware free-set errors; and the error series of the
+    first run of set 1 (for Figure 3)."""
+    first = rig1.runs[0]
+    table, whole, dynamic_free, series = {}, {}, {}, {}
+    for row, cal in cals.items():
         mode = "static" if row == "none" else "metge"
         series[row] = errors_deg(cal, first, mode, rate)
         table[row] = {"set1": set_error(cal, rig1, mode, rate, "settled"),
@@ -251,28 +256,23 @@ def report(result, o, out) -> dict:
         if row != "none":
             series[row + "_dynamic"] = errors_deg(cal, first, "dynamic", rate)
             dynamic_free[row] = float(series[row + "_dynamic"][first.free].mean())
-    free_rows = first.free
-    t_free = first.time[free_rows] - first.end
+    return {"table": table, "whole": whole, "dynamic_free": dynamic_free, "series": series}
+
+
+def figure3(first: RigRun, numbers: dict, o: dict, out):
+    """The paper's Figure 3: angular error against time on the free set, before and after
+    compensation, above the four commands."""
+    import matplotlib.pyplot as plt
+
+    rows, series, table = first.free, numbers["series"], numbers["table"]
+    t = first.time[rows] - first.end
     third = o["free"] / 3
-    fast = (t_free >= third) & (t_free < 2 * third)
-    e_free = series["calibration1"][free_rows]
-    ed_free = series["calibration1_dynamic"][free_rows]
-    true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
-    true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
-    v_error = {name: np.degrees(np.arccos(np.clip((c.field.v * true_v).sum(axis=1), -1, 1))).tolist()
-               for name, c in cals.items()}
-    figures = []
-    if out is not None:
-        for name, cal in cals.items():
-            cal.save(out / f"{name}.json")
-    # Figure 3 of the paper
     fig, axes = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
-    axes[0].plot(t_free, series["none"][free_rows], lw=0.8,
-                 label=f"no dynamic calibration (mean {table['none']['free']:.1f}°)")
-    axes[0].plot(t_free, e_free, lw=0.8, label=f"eq. 9, calibration 1 (mean {table['calibration1']['free']:.2f}°)")
-    axes[0].plot(t_free, ed_free, lw=0.8,
-                 label=f"motor dynamics, calibration 1 (mean {dynamic_free['calibration1']:.2f}°)")
-    axes[0].axvspan(third, 2 * third, alpha=0.08, color="k")
+    axes[0].plot(t, series["none"][rows], lw=0.8, label=f"no dynamic calibration (mean {table['none']['free']:.1f}°)")
+    axes[0].plot(t, series["calibration1"][rows], lw=0.8,
+                 label=f"eq. 9, calibration 1 (mean {table['calibration1']['free']:.2f}°)")
+    axes[0].plot(t, series["calibration1_dynamic"][rows], lw=0.8,
+                 label=f"motor dynamics, calibration 1 (mean {numbers['dynamic_free']['calibration1']:.2f}°)")
     axes[0].set_ylabel("angular error (deg)")
     axes[0].set_yscale("log")
     axes[0].legend(fontsize=8)
@@ -280,23 +280,56 @@ def report(result, o, out) -> dict:
     axes[0].set_title("Free set, drone clamped: field error before and after compensation (cf. Metge et al., Fig. 3)",
                       fontsize=10)
     for n in range(4):
-        axes[1].plot(t_free, first.commands[free_rows, n], lw=0.8, label=f"c{n + 1}")
-    axes[1].axvspan(third, 2 * third, alpha=0.08, color="k")
+        axes[1].plot(t, first.commands[rows, n], lw=0.8, label=f"c{n + 1}")
     axes[1].set_ylabel("ESC command (1)")
     axes[1].set_xlabel("time in the free set (s); shaded: fast command changes")
     axes[1].legend(fontsize=8, ncol=4)
-    figures.append(save_figure(fig, out, "figure3_free_set.png"))
-    # Table 1 beside the paper's
-    fig, ax = plt.subplots(figsize=(9, 2.6))
+    for ax in axes:
+        ax.axvspan(third, 2 * third, alpha=0.08, color="k")
+    return save_figure(fig, out, "figure3_free_set.png")
+
+
+def table1_figure(numbers: dict, orders, out):
+    """Table 1 as a figure, each cell beside the paper's value."""
+    import matplotlib.pyplot as plt
+
+    table, dynamic = numbers["table"], numbers["dynamic_free"]
+    fig, ax = plt.subplots(figsize=(9, 2.2))
     ax.axis("off")
-    rows = ["none", "calibration1", "calibration2"]
-    cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")] for r in rows]
-    cells.append(["", "", f"{dynamic_free['calibration1']:.3f} / {dynamic_free['calibration2']:.3f}"])
+    cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")]
+             for r in ("none", "calibration1", "calibration2")]
+    cells.append(["", "", f"{dynamic['calibration1']:.3f} / {dynamic['calibration2']:.3f}"])
     ax.table(cellText=cells, rowLabels=["no dynamic calibration", "calibration 1", "calibration 2",
                                         "motor dynamics (cal. 1 / 2)"],
              colLabels=["set 1", "set 2", "free set"], loc="center")
     ax.set_title(f"Mean angular error (deg), simulated (paper), orders I = {orders[0]}, J = {orders[1]}")
-    figures.append(save_figure(fig, out, "table1.png"))
+    return save_figure(fig, out, "table1.png")
+
+
+def report(result, o, out) -> dict:
+    """Record set 2 and the second battery state, calibrate on each set, and return Table 1,
+    the dynamics-aware free-set error, the order study and the identified motor dynamics;
+    writes ``calibration1.json``, ``calibration2.json`` and the two figures into ``out``."""
+    orders, rate = parse_orders(o["orders"]), o["mag_rate"]
+    static = load_static(o)
+    runs = record_sets(result, o, out)
+    rig1, rig2 = RigSet(runs[1]), RigSet(runs[2])
+    study = order_study([(rig1.reference, rig1.sweeps()), (rig2.reference, rig2.sweeps())])
+    orders = orders or study["best"]
+    cals = {"calibration1": calibrate(rig1, orders, static, rate, "set 1"),
+            "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
+    if out is not None:
+        for name, cal in cals.items():
+            cal.save(out / f"{name}.json")
+    numbers = table1({"none": Calibration(4, static), **cals}, rig1, rig2, rate)
+    table, dynamic_free, first = numbers["table"], numbers["dynamic_free"], rig1.runs[0]
+    t_free = first.time[first.free] - first.end
+    fast = (t_free >= o["free"] / 3) & (t_free < 2 * o["free"] / 3)
+    e_free = numbers["series"]["calibration1"][first.free]
+    ed_free = numbers["series"]["calibration1_dynamic"][first.free]
+    true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
+    true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
+    figures = [figure3(first, numbers, o, out), table1_figure(numbers, orders, out)]
     return {
         "table1_deg": table,
         "free_set_dynamic_deg": dynamic_free["calibration1"],
@@ -305,10 +338,11 @@ def report(result, o, out) -> dict:
         "improvement_factor_sets": {f"{r}_{c}": table["none"][c] / table[r][c]
                                     for r in ("calibration1", "calibration2") for c in ("set1", "set2")},
         "dynamic_gain_free": table["calibration1"]["free"] / dynamic_free["calibration1"],
-        "sets_with_transients_deg": whole,
+        "sets_with_transients_deg": numbers["whole"],
         "free_eq9_slow_fast_deg": {"slow": float(e_free[~fast].mean()), "fast": float(e_free[fast].mean())},
         "free_dynamic_slow_fast_deg": {"slow": float(ed_free[~fast].mean()), "fast": float(ed_free[fast].mean())},
-        "direction_error_deg": v_error,
+        "direction_error_deg": {name: np.degrees(np.arccos(np.clip((c.field.v * true_v).sum(axis=1), -1, 1))).tolist()
+                                for name, c in cals.items()},
         "orders": list(orders),
         "order_study_uT": {f"I={i},J={j}": s * 1e6 for (i, j), s in study["scores"].items()},
         "order_study_best": list(study["best"]),
@@ -321,6 +355,7 @@ def report(result, o, out) -> dict:
 
 
 def duration(o: dict) -> float:
+    """Length (s) of the scenario's own run: set 1's sweeps and the free set."""
     return commands(o, 1, free=True)[2]
 
 
@@ -346,15 +381,31 @@ def rig_calibration(orders: str = "4,1") -> Calibration:
     return calibrate(RigSet(runs), parse_orders(orders), None, o["mag_rate"], "set 1, made for tp")
 
 
-def add_compensator(system: System, mode: str, path: str, sample_rate: float, estimator: str = "Quaternion_estim"):
+def magnetometer_rate(system: System) -> float:
+    """Rate (Hz) at which the system's IMU samples and holds its magnetometer."""
+    from fmpy import read_model_description
+
+    from fmus import fmu_path
+
+    imu = system.blocks["IMU"]
+    starts = {v.name: v.start for v in read_model_description(str(fmu_path(imu.model))).modelVariables}
+    for name in ("mag_sample_rate", "sample_rate"):
+        if name in starts:
+            return float(imu.parameters.get(name, starts[name]))
+    raise KeyError("the IMU declares no magnetometer rate (mag_sample_rate or sample_rate)")
+
+
+def add_compensator(system: System, mode: str, path: str, estimator: str = "Quaternion_estim"):
     """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
-    ``mode = "none"``): commands from the controller, voltage from the battery."""
+    ``mode = "none"``): commands from the controller, voltage from the battery, ``b_d``
+    refreshed at the magnetometer's sample instants. ``path``: a calibration file, or empty for
+    :func:`rig_calibration`."""
     from calibration import MagCompensator
 
     if mode == "none":
         return None
     calibration = Calibration.load(path, motors=4) if path else rig_calibration()
-    block = system.add(MagCompensator(calibration, mode, sample_rate=sample_rate))
+    block = system.add(MagCompensator(calibration, mode, sample_rate=magnetometer_rate(system)))
     system.connect("IMU.magneto", "MagCompensator.magneto")
     system.connect("Controller.c", "MagCompensator.c")
     system.connect("MotorMagnetics.u_batt", "MagCompensator.u_batt")
@@ -399,6 +450,7 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
 
 
 def main(argv=None):
+    """Command line of the yaw study: ``python -m scenarios.metge --calibration FILE --out DIR``."""
     import argparse
 
     parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated.")

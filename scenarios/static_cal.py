@@ -54,6 +54,7 @@ def attitude(o: dict) -> tuple[np.ndarray, np.ndarray]:
 
 
 def quaternions(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions (scalar first, q0 >= 0) of rotations ``R`` (n, 3, 3)."""
     from scipy.spatial.transform import Rotation
 
     xyzw = Rotation.from_matrix(R).as_quat()
@@ -63,12 +64,14 @@ def quaternions(R: np.ndarray) -> np.ndarray:
 
 
 def iron(o: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The IMU's true soft iron ``A`` (1) and hard iron ``b_s`` (T) for option ``iron``."""
     if o["iron"]:
         return np.array(SOFT_IRON), np.array(HARD_IRON)
     return np.eye(3), np.zeros(3)
 
 
 def build(o: dict) -> System:
+    """A scripted attitude table driving the IMU, motors off."""
     t, R = attitude(o)
     q = quaternions(R)
     force = np.einsum("nji,j->ni", R, [0.0, 0.0, -vehicle.GRAVITY])  # at rest: R^T (0, 0, -g)
@@ -94,10 +97,13 @@ def build(o: dict) -> System:
 
 
 def duration(o: dict) -> float:
+    """Length of the sweep (s)."""
     return o["duration"]
 
 
 def report(result, o, out) -> dict:
+    """Fit ``A``, ``b_s`` to the magnetometer samples; compare with the truth; write
+    ``static.json`` and the figure; return the figures of merit."""
     import matplotlib.pyplot as plt
 
     A, b = iron(o)

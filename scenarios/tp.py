@@ -100,7 +100,7 @@ def build(o: dict) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
-    add_compensator(system, o["compensation"], o["calibration"], o["imu_rate"])
+    add_compensator(system, o["compensation"], o["calibration"])
     return system
 
 
