@@ -23,6 +23,7 @@ from benchmarks import estimators
 
 
 def orchestrator_us_per_step(seconds: float, repeats: int) -> float:
+    """Microseconds per step of the master on ``open-loop`` over ``seconds`` simulated, best of ``repeats``."""
     import scenarios
 
     scenario = scenarios.get("open-loop")
@@ -101,6 +102,7 @@ def raw_us_per_step(seconds: float, repeats: int) -> float:
 
 
 def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
+    """Every benchmark figure as a dict: runs of ``seconds`` simulated, best of ``repeats``."""
     orchestrator = orchestrator_us_per_step(seconds, repeats)
     raw = raw_us_per_step(seconds, repeats)
     figures = {
@@ -113,6 +115,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
 
 
 def main(argv=None) -> int:
+    """``quadcosim bench`` with the arguments ``argv``; prints the figures and returns 0."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="quadcosim bench", description=__doc__.splitlines()[0])

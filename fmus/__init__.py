@@ -21,13 +21,35 @@ class FMUNotFoundError(FileNotFoundError):
 
 
 def default_fmu_dir() -> Path:
-    """Where built FMUs live: ``$QUADCOSIM_FMU_DIR`` or ``build/fmus`` beside the package."""
+    """Where built FMUs live.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$QUADCOSIM_FMU_DIR`` if set, else ``build/fmus`` beside the package.
+    """
     env = os.environ.get("QUADCOSIM_FMU_DIR")
     return Path(env) if env else Path(__file__).resolve().parent.parent / "build" / "fmus"
 
 
 def fmu_path(name: str) -> Path:
-    """Path of the built FMU called ``name``; says how to build it when it is missing."""
+    """Path of the built FMU called ``name``.
+
+    Parameters
+    ----------
+    name : str
+        Model name (one of :data:`MODELS`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``<default_fmu_dir()>/<name>.fmu``.
+
+    Raises
+    ------
+    FMUNotFoundError
+        The FMU is not built; the message says how to build it.
+    """
     path = default_fmu_dir() / f"{name}.fmu"
     if not path.is_file():
         known = ", ".join(MODELS)

@@ -31,7 +31,18 @@ class BuildError(RuntimeError):
 
 
 def table(model: str):
-    """The variable table of ``model``."""
+    """The variable table of ``model``.
+
+    Parameters
+    ----------
+    model : str
+        Model folder under ``fmus/``.
+
+    Returns
+    -------
+    fmus.variables.Table
+        ``fmus.<model>.variables.TABLE``.
+    """
     return importlib.import_module(f"fmus.{model}.variables").TABLE
 
 
@@ -108,7 +119,22 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
 
 
 def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) -> list[Path]:
-    """Build every plant FMU into ``out_dir`` (default :func:`fmus.default_fmu_dir`)."""
+    """Build every plant FMU.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path, optional
+        Output folder; :func:`fmus.default_fmu_dir` by default.
+    models : sequence of str
+        Model names (folders under ``fmus/``); all of :data:`fmus.MODELS` by default.
+    verbose : bool
+        Print each FMU's path as it is built.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The ``.fmu`` files.
+    """
     out_dir = Path(out_dir or default_fmu_dir())
     out_dir.mkdir(parents=True, exist_ok=True)
     built = []

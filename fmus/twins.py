@@ -26,7 +26,13 @@ _FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "pi": math.pi}
 
 
 def package_source() -> str:
-    """The QuadCoSim package as one Modelica text, class files nested in package.mo."""
+    """The QuadCoSim package as one Modelica text, class files nested in ``package.mo``.
+
+    Returns
+    -------
+    str
+        The package, as the ``modelica`` toolchain reads a single program.
+    """
     package = (PACKAGE_DIR / "package.mo").read_text()
     order = (PACKAGE_DIR / "package.order").read_text().split()
     body = []
@@ -46,9 +52,27 @@ def _modelica_value(value) -> str:
 
 def simulate_twin(model: str, inputs: dict[str, str], parameters: dict, stop: float,
                   times: np.ndarray, tolerance: float = 1e-10) -> dict[str, np.ndarray]:
-    """Simulate ``QuadCoSim.<model>`` with inputs bound to expressions of time.
+    """Simulate ``QuadCoSim.<model>`` with its inputs bound to expressions of time.
 
-    Returns every variable of the model at ``times`` (values after any event at that time).
+    Parameters
+    ----------
+    model : str
+        Class name in the QuadCoSim package (the FMU's name).
+    inputs : dict of str to str
+        Input name to an expression of ``time`` (s) valid in Modelica and Python.
+    parameters : dict
+        Parameter bindings by name, in SI units (bool for Boolean parameters).
+    stop : float
+        End time (s).
+    times : ndarray
+        Times (s) at which to return the variables.
+    tolerance : float
+        Relative tolerance of the variable-step solver.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Every variable of the model at ``times`` (values after any event at that time).
     """
     from modelica.lang import parse
     from modelica.sim import causalize, flatten, simulate
@@ -72,7 +96,20 @@ def simulate_twin(model: str, inputs: dict[str, str], parameters: dict, stop: fl
 
 
 def input_values(inputs: dict[str, str], t: np.ndarray) -> dict[str, np.ndarray]:
-    """Evaluate the input expressions at the times ``t`` (Python side)."""
+    """Evaluate the input expressions at the times ``t``, in Python.
+
+    Parameters
+    ----------
+    inputs : dict of str to str
+        Input name to an expression of ``time`` (s).
+    t : array_like
+        Times (s).
+
+    Returns
+    -------
+    dict of str to ndarray
+        Each input at ``t``, shaped like ``t``.
+    """
     t = np.asarray(t, dtype=float)
     return {name: np.broadcast_to(eval(expr, {"__builtins__": {}}, {**_FUNCTIONS, "time": t}), t.shape)
             for name, expr in inputs.items()}

@@ -23,11 +23,31 @@ TYPES = ("Real", "Integer", "Boolean")
 
 @dataclass(frozen=True)
 class Variable:
-    """One FMI variable.
+    """One FMI variable of a model's table.
 
-    ``depends`` applies to outputs: ``None`` means the output depends on no input (it is a
-    function of the state only), ``"all"`` means it depends on every input, and a tuple names
-    the inputs it depends on directly (direct feedthrough).
+    Parameters
+    ----------
+    name : str
+        Variable name, as in the Modelica twin.
+    causality : str
+        ``"parameter"``, ``"input"`` or ``"output"``.
+    type : str
+        ``"Real"``, ``"Integer"`` or ``"Boolean"``.
+    start : float, int or bool, optional
+        Start value, in ``unit``; required for parameters and inputs, refused for outputs.
+    unit : str
+        SI unit, written as the tables do (``"m/s2"``, ``"N.m.s2"``, ``"T/Hz0.5"``).
+    description : str
+        One line, with the frame for vectors (NED {I} or FRD {B}).
+    min, max : float, optional
+        Bounds declared in the model description.
+    variability : str, optional
+        FMI variability; by default ``fixed`` for parameters, ``continuous`` for Real
+        variables and ``discrete`` for the others.
+    depends : tuple of str, "all" or None
+        For outputs: None means the output depends on no input (a function of the state
+        only), ``"all"`` on every input, a tuple names the inputs it depends on directly
+        (direct feedthrough).
     """
 
     name: str
@@ -53,6 +73,7 @@ class Variable:
 
     @property
     def fmi_variability(self) -> str:
+        """The FMI 2.0 variability attribute of the variable."""
         if self.variability:
             return self.variability
         if self.causality == "parameter":
@@ -61,20 +82,61 @@ class Variable:
 
 
 def Real(name, causality, start=None, unit="", description="", **kw) -> Variable:
+    """A Real :class:`Variable`.
+
+    Parameters
+    ----------
+    name, causality, start, unit, description
+        As for :class:`Variable`.
+    **kw
+        Other :class:`Variable` fields (``min``, ``max``, ``depends``, ...).
+    """
     return Variable(name, causality, "Real", start, unit, description, **kw)
 
 
 def Integer(name, causality, start=None, description="", **kw) -> Variable:
+    """An Integer :class:`Variable` (no unit).
+
+    Parameters
+    ----------
+    name, causality, start, description
+        As for :class:`Variable`.
+    **kw
+        Other :class:`Variable` fields.
+    """
     return Variable(name, causality, "Integer", start, "", description, **kw)
 
 
 def Boolean(name, causality, start=None, description="", **kw) -> Variable:
+    """A Boolean :class:`Variable` (no unit).
+
+    Parameters
+    ----------
+    name, causality, start, description
+        As for :class:`Variable`.
+    **kw
+        Other :class:`Variable` fields.
+    """
     return Variable(name, causality, "Boolean", start, "", description, **kw)
 
 
 @dataclass
 class Table:
-    """The variables of one model, and what is derived from them."""
+    """The variables of one model, and what the build derives from them.
+
+    Parameters
+    ----------
+    model : str
+        Model name (FMU model identifier).
+    description : str
+        One line for the model description.
+    variables : list of Variable
+        The rows; value references are given per type in this order.
+    states : int
+        Length of the model's continuous state vector (sizes the shell's RK4 scratch).
+    extra_vectors : dict of str to tuple of str
+        Vectors beyond those the names imply (see :meth:`vectors`).
+    """
 
     model: str
     description: str
@@ -149,6 +211,20 @@ class Table:
                     f"value reference {present}, not {previous + 1}. Move its rows together.")
 
     def of(self, causality: str, type_: str | None = None) -> list[Variable]:
+        """The variables of one causality (and type).
+
+        Parameters
+        ----------
+        causality : str
+            ``"parameter"``, ``"input"`` or ``"output"``.
+        type_ : str, optional
+            ``"Real"``, ``"Integer"`` or ``"Boolean"``; any by default.
+
+        Returns
+        -------
+        list of Variable
+            In table order.
+        """
         return [
             v for v in self.variables
             if v.causality == causality and (type_ is None or v.type == type_)
@@ -156,12 +232,25 @@ class Table:
 
     @property
     def guid(self) -> str:
+        """The model's GUID: stable for a given interface, so a rebuild keeps it."""
         # Stable for a given interface: a rebuild with the same table keeps the GUID.
         text = "|".join(f"{v.name}:{v.causality}:{v.type}" for v in self.variables)
         return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"quadcosim/{self.model}/{text}")) + "}"
 
     # ----------------------------------------------------------------- modelDescription.xml
     def model_description(self, source_files: list[str]) -> str:
+        """The ``modelDescription.xml`` of the model.
+
+        Parameters
+        ----------
+        source_files : list of str
+            C sources listed for a source FMU.
+
+        Returns
+        -------
+        str
+            The XML text, with SI base units declared for each unit definition.
+        """
         index = {v.name: i + 1 for i, v in enumerate(self.variables)}
         inputs = [v.name for v in self.variables if v.causality == "input"]
         units = sorted({v.unit for v in self.variables if v.unit})
@@ -240,6 +329,14 @@ class Table:
 
     # ----------------------------------------------------------------- variables.h
     def c_header(self) -> str:
+        """The ``variables.h`` the shell and the model's equations include.
+
+        Returns
+        -------
+        str
+            Value reference constants (``VR_name``), vector constants (``VEC_name``,
+            ``LEN_name``) and the variable information arrays.
+        """
         lines = [
             f"/* Generated from fmus/{self.model}/variables.py by fmus.build: do not edit. */",
             "#ifndef VARIABLES_H",

@@ -89,12 +89,14 @@ def cell_voltage(soc: float) -> float:
 
 
 def hover_rotor_speed(mass: float = MASS, thrust_coeff: float = THRUST_COEFF) -> float:
-    """Rotor speed (rad/s) at which four rotors carry ``mass`` (kg)."""
+    """Rotor speed (rad/s) at which four rotors carry ``mass`` (kg) with thrust coefficient ``thrust_coeff`` (N s^2)."""
     return math.sqrt(mass * GRAVITY / (4.0 * thrust_coeff))
 
 
 def steady_current(omega: float, drag_torque_coeff: float = DRAG_TORQUE_COEFF, ke: float = MOTOR_KE) -> float:
-    """Motor current (A) that holds rotor speed ``omega`` (rad/s) against propeller drag."""
+    """Motor current (A) that holds rotor speed ``omega`` (rad/s) against propeller drag, with
+    drag torque coefficient ``drag_torque_coeff`` (N m s^2) and motor constant ``ke`` (V s/rad).
+    """
     return drag_torque_coeff * omega * abs(omega) / ke
 
 
@@ -102,8 +104,9 @@ def steady_command(omega, u_batt, resistance: float = MOTOR_RESISTANCE, ke: floa
                    drag_torque_coeff: float = DRAG_TORQUE_COEFF):
     """ESC command (1) that holds rotor speed ``omega`` (rad/s) at battery voltage ``u_batt`` (V).
 
-    The steady-state map of the DC-motor model, c u = R i + k_e omega with i = k_m omega^2 / k_e;
-    it ignores the electrical and mechanical transients, as a command-based model does.
+    The steady-state map of the DC-motor model, c u = R i + k_e omega with i = k_m omega^2 / k_e
+    (``resistance`` R in ohm, ``ke`` in V s/rad, ``drag_torque_coeff`` k_m in N m s^2); it
+    ignores the electrical and mechanical transients, as a command-based model does.
     """
     current = drag_torque_coeff * omega * abs(omega) / ke
     return (resistance * current + ke * omega) / u_batt

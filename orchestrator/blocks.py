@@ -22,6 +22,13 @@ class Block:
     Subclasses set ``inputs`` and ``outputs`` (tuples of names), may set ``feedthrough``
     (``True``: every output depends on the present inputs; ``False``: none does) and
     implement :meth:`step`. ``parameters`` documents the tunable values with their units.
+
+    Parameters
+    ----------
+    name : str
+        Block name, without a dot (signals are written ``"Block.signal"``).
+    period : int
+        The block runs every ``period`` macro steps; its own step is ``period * dt`` (s).
     """
 
     inputs: tuple[str, ...] = ()
@@ -36,10 +43,19 @@ class Block:
 
     @property
     def feedthrough_inputs(self) -> set[str]:
+        """Inputs whose present value the outputs depend on (orders the blocks)."""
         return set(self.inputs) if self.feedthrough else set()
 
     def start(self, t0: float, dt: float) -> None:
-        """Reset the state before a run; ``dt`` is this block's own step (s)."""
+        """Reset the state before a run.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time (s).
+        dt : float
+            This block's own step, ``period`` macro steps (s).
+        """
 
     def step(self, t: float, u: np.ndarray, y: np.ndarray) -> None:
         """Compute the outputs at time ``t`` (s) from the inputs ``u``, writing ``y`` in place."""
@@ -63,6 +79,8 @@ class Table(Block):
         A callable ``values(t)`` maps an array of times ``t`` (s) to the rows at those times;
         it is evaluated a chunk of rows at a time as the run goes, so that a long run never
         holds its whole table in memory.
+    period : int
+        Runs every ``period`` macro steps.
     chunk : int
         Rows evaluated at once from a callable.
     """
@@ -88,6 +106,7 @@ class Table(Block):
         return values
 
     def start(self, t0, dt):
+        """Rewind the table to its first row; ``t0`` (s) is the start time, ``dt`` (s) the block's step."""
         if self.function is None:
             self._rows = iter(self.values)
             self._last = self.values[-1]
@@ -179,12 +198,25 @@ class FMUBlock:
         self.instance = None
 
     def instantiate(self, t0: float):
+        """Instantiate and initialize the FMU, parameters set.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time (s).
+
+        Returns
+        -------
+        orchestrator.fmu.FMUInstance
+            The live instance, also kept as ``self.instance``.
+        """
         from orchestrator.fmu import FMUInstance
 
         self.instance = FMUInstance(self.model, self.parameters, name=self.name, start_time=t0)
         return self.instance
 
     def close(self):
+        """Free the FMU instance after a run."""
         if self.instance is not None:
             self.instance.close()
             self.instance = None

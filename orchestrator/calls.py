@@ -114,6 +114,15 @@ class SetInputs:
     """``fmi2SetReal`` of FMU inputs whose sources sit in consecutive bus slots from ``slot``.
 
     The FMU reads straight from the bus: no copy.
+
+    Parameters
+    ----------
+    block : orchestrator.FMUBlock
+        The block, with a live instance.
+    refs : ndarray of uint32
+        Value references of the inputs, in bus order.
+    slot : int
+        Bus slot of the first input's source.
     """
 
     block: object  # an FMUBlock with a live instance
@@ -125,7 +134,17 @@ class SetInputs:
 
 @dataclass(frozen=True)
 class GetOutputs:
-    """``fmi2GetReal`` of all of an FMU's outputs into its bus slots from ``slot``."""
+    """``fmi2GetReal`` of all of an FMU's outputs into its bus slots from ``slot``.
+
+    Parameters
+    ----------
+    block : orchestrator.FMUBlock
+        The block, with a live instance.
+    refs : ndarray of uint32
+        Value references of the outputs, in bus order.
+    slot : int
+        Bus slot of the first output.
+    """
 
     block: object
     refs: np.ndarray
@@ -136,7 +155,15 @@ class GetOutputs:
 
 @dataclass(frozen=True)
 class DoStep:
-    """``fmi2DoStep`` of one communication step ``h`` (s) from the present time."""
+    """``fmi2DoStep`` of one communication step from the present time.
+
+    Parameters
+    ----------
+    block : orchestrator.FMUBlock
+        The block, with a live instance.
+    h : float
+        Communication step (s).
+    """
 
     block: object
     h: float
@@ -158,9 +185,24 @@ def _pack(call: FMICall, bus: np.ndarray) -> _CCall:
 
 
 def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
-    """A function of time ``t`` (s) that applies ``taps`` (faults) and runs ``calls`` in one
-    call into the runner; it raises :class:`orchestrator.fmu.FMUError` naming the block, the
-    FMI function, the time and the FMU's log when a call returns Error or Fatal."""
+    """One phase of the loop: faults applied, then FMI calls run by one call into C.
+
+    Parameters
+    ----------
+    calls : list of SetInputs, GetOutputs or DoStep
+        In the order they run.
+    taps : list of orchestrator.faults.FaultTap
+        Faults to apply first.
+    bus : ndarray
+        The bus the calls read and write (float64; its address is resolved now).
+
+    Returns
+    -------
+    callable
+        ``phase(t)`` with ``t`` the present time (s); it raises
+        :class:`orchestrator.fmu.FMUError`, naming the block, the FMI function, the time and
+        the FMU's log, when a call returns Error or Fatal.
+    """
     from orchestrator.faults import apply_faults
     from orchestrator.fmu import FMUError
 

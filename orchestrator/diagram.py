@@ -16,7 +16,19 @@ from orchestrator.blocks import Constant, FMUBlock
 
 
 def fold(names: list[str]) -> str:
-    """Fold vector components: ``[omega_r1, omega_r2, omega_r3, omega_r4]`` -> ``omega_r[1-4]``."""
+    """Fold vector components into one label.
+
+    Parameters
+    ----------
+    names : list of str
+        Signal names.
+
+    Returns
+    -------
+    str
+        ``[omega_r1, omega_r2, omega_r3, omega_r4]`` gives ``omega_r[1-4]``; ``acc_x, acc_y,
+        acc_z`` gives ``acc[xyz]``.
+    """
     groups: dict[str, list[str]] = defaultdict(list)
     order = []
     for name in names:

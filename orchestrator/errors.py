@@ -6,7 +6,15 @@ from orchestrator.result import Result
 
 
 class SimulationError(RuntimeError):
-    """A run failed. ``result`` holds what was recorded up to the failure."""
+    """A run failed.
+
+    Parameters
+    ----------
+    message : str
+        What failed, where and when.
+    result : orchestrator.Result, optional
+        What was recorded up to the failure.
+    """
 
     def __init__(self, message: str, result: Result | None = None):
         super().__init__(message)
@@ -15,8 +23,17 @@ class SimulationError(RuntimeError):
 
 class RunInterrupted(SimulationError):
     """The run was interrupted (Ctrl-C, or SIGTERM turned into
-    :class:`orchestrator.interrupts.Terminated`). ``result`` holds what was recorded;
-    ``signal_number`` is the signal that stopped it."""
+    :class:`orchestrator.interrupts.Terminated`).
+
+    Parameters
+    ----------
+    message : str
+        When it stopped.
+    result : orchestrator.Result or None
+        What was recorded.
+    signal_number : int
+        The signal that stopped it.
+    """
 
     def __init__(self, message: str, result: Result | None, signal_number: int):
         super().__init__(message, result)

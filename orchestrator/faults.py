@@ -93,7 +93,17 @@ class Fault:
 
 @dataclass(frozen=True)
 class FaultTap:
-    """Where one fault reads its source signal and writes the faulted copy, as bus slots."""
+    """Where one fault reads its source signal and writes the faulted copy.
+
+    Parameters
+    ----------
+    fault : Fault
+        The fault.
+    source : int
+        Bus slot of the source signal.
+    slot : int
+        Bus slot of the faulted copy, which the faulted input reads.
+    """
 
     fault: Fault
     source: int
@@ -101,6 +111,16 @@ class FaultTap:
 
 
 def apply_faults(taps: list[FaultTap], bus: np.ndarray, t: float) -> None:
-    """Write each tap's faulted copy of its source into its own bus slot at time ``t`` (s)."""
+    """Write each tap's faulted copy of its source into its own bus slot.
+
+    Parameters
+    ----------
+    taps : list of FaultTap
+        The faults and their slots.
+    bus : ndarray
+        The bus.
+    t : float
+        Present time (s).
+    """
     for tap in taps:
         bus[tap.slot] = tap.fault.apply(t, bus[tap.source])

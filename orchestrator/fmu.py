@@ -38,7 +38,13 @@ _instances = itertools.count(1)
 class FMULog(deque):
     """The last messages of one FMU instance, with a count of its warnings and the first few
     of them (a warning, such as a saturated command, is kept even when later messages push it
-    out of the log)."""
+    out of the log).
+
+    Parameters
+    ----------
+    maxlen : int
+        Messages kept.
+    """
 
     FIRST = 5
 
@@ -71,7 +77,21 @@ addLoggerProxy(ctypes.byref(_CALLBACKS))
 
 
 class FMUError(RuntimeError):
-    """An FMU refused a call: the block, the time, the status and what the FMU logged."""
+    """An FMU refused a call: the block, the time, the status and what the FMU logged.
+
+    Parameters
+    ----------
+    block : str
+        Block (instance) name.
+    function : str
+        FMI function that failed, e.g. ``"fmi2DoStep"``.
+    status : int
+        FMI status returned (3 Error, 4 Fatal).
+    time : float or None
+        Communication time of the call (s).
+    log : list of str
+        The FMU's last messages.
+    """
 
     def __init__(self, block: str, function: str, status: int, time: float | None, log: list[str]):
         self.block, self.function, self.status, self.time, self.log = block, function, status, time, log
@@ -271,6 +291,7 @@ class FMUInstance:
         self.time = t + h
 
     def close(self):
+        """Terminate and free the instance (once; an instance in error is freed all the same)."""
         if not getattr(self, "closed", True):
             try:
                 self._slave.terminate()

@@ -24,7 +24,18 @@ def signal_number(interrupt: BaseException) -> int:
 
 
 def signal_name(number: int) -> str:
-    """``"SIGINT"`` for 2, and so on."""
+    """The name of a signal.
+
+    Parameters
+    ----------
+    number : int
+        Signal number.
+
+    Returns
+    -------
+    str
+        ``"SIGINT"`` for 2, and so on; ``"signal N"`` for a number with no name.
+    """
     try:
         return signal.Signals(number).name
     except ValueError:

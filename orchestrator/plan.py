@@ -92,6 +92,11 @@ def copies(slots: list[int]) -> tuple[Copy, ...]:
 def input_runs(refs: list[tuple[int, int]]) -> list[tuple[np.ndarray, int]]:
     """Split (value reference, bus slot) pairs into runs of consecutive slots.
 
+    Parameters
+    ----------
+    refs : list of (int, int)
+        Value reference of each input and the bus slot it reads.
+
     Returns
     -------
     list of (ndarray, int)
@@ -255,7 +260,18 @@ class Plan:
 
     # ------------------------------------------------------------------ running
     def run(self, progress: bool = False):
-        """Step from ``t0`` to ``t0 + steps * dt``; raises :class:`SimulationError` on a failure."""
+        """Step from ``t0`` to ``t0 + steps * dt``.
+
+        Parameters
+        ----------
+        progress : bool
+            Show a progress bar on runs longer than a few seconds of wall time.
+
+        Raises
+        ------
+        orchestrator.SimulationError
+            On any failure; its ``result`` holds what was recorded up to it.
+        """
         bus, record, dt, t0, dec = self.bus, self.record, self.dt, self.t0, self.decimation
         phase_a, phase_b, gather = self.phase_a, self.phase_b, self.record_copies
         reduce, isfinite = np.add.reduce, math.isfinite
@@ -319,8 +335,18 @@ class Plan:
         return f"a signal became non-finite at t = {t:.6g} s"
 
     def result(self, error: str | None = None) -> Result:
-        """What was recorded so far, as a :class:`Result` (time in s from ``t0``). The data
-        are a view of the record, not a copy: a run's memory stays that of its record."""
+        """What was recorded so far.
+
+        Parameters
+        ----------
+        error : str, optional
+            The message of the failure that ended the run, kept in the result.
+
+        Returns
+        -------
+        orchestrator.Result
+            Time in s from ``t0``, one column per recorded signal.
+        """
         rows = self.recorded
         times = np.arange(rows, dtype=np.float64)  # in place, one vector: the values of
         times *= self.decimation                   # t0 + arange(rows) * decimation * dt

@@ -33,9 +33,28 @@ RECORD_SHARE = 0.8
 
 
 def check_record_fits(rows: int, signals: int, decimation: int = 1) -> int:
-    """Bytes a record of ``rows`` samples of ``signals`` float64 signals will take; raises
-    :class:`MemoryError` naming the figure and the way out if that exceeds
-    :data:`RECORD_SHARE` of the available memory."""
+    """Bytes a record will take; refuses one that would not fit in memory.
+
+    Parameters
+    ----------
+    rows : int
+        Samples to record.
+    signals : int
+        Recorded signals (float64 each).
+    decimation : int
+        The run's decimation, named in the message as a way out.
+
+    Returns
+    -------
+    int
+        Bytes of the record.
+
+    Raises
+    ------
+    MemoryError
+        The record exceeds :data:`RECORD_SHARE` of the available memory; the message gives
+        the figure and the way out.
+    """
     need = rows * signals * 8
     available = available_memory()
     if available is not None and need > RECORD_SHARE * available:
@@ -56,6 +75,18 @@ def expand(name: str, available) -> list[str]:
     ``"IMU.acc"`` stands for ``IMU.acc_x``, ``IMU.acc_y``, ``IMU.acc_z``;
     ``"MotorMagnetics.omega_r"`` for ``omega_r1`` to ``omega_r4``; ``"Quadrotor.q"`` for
     ``q0`` to ``q3``; ``"IMU.R_reel"`` for ``R_reel_11`` to ``R_reel_33``.
+
+    Parameters
+    ----------
+    name : str
+        A signal or vector name.
+    available : sequence of str
+        The names to choose from.
+
+    Returns
+    -------
+    list of str
+        The matching names, in the order of ``available``; empty if none.
     """
     available = list(available)
     if name in available:
@@ -71,11 +102,22 @@ def _is_component(suffix: str) -> bool:
 
 
 class Result:
-    """Signals recorded at ``time`` (s). ``result["IMU.acc_x"]`` is one signal;
+    """Signals recorded at ``time``. ``result["IMU.acc_x"]`` is one signal;
     ``result["IMU.acc"]`` stacks its components as columns.
 
-    ``error`` holds the message of the failure that ended the run early, if any; what was
-    recorded up to it is kept.
+    Parameters
+    ----------
+    time : ndarray
+        Sample times (s).
+    names : list of str
+        Signal names, ``"Block.signal"``.
+    data : ndarray, shape (len(time), len(names))
+        The samples, in each signal's unit (SI).
+    meta : dict, optional
+        Run information (macro step, block order, connections, scenario).
+    error : str, optional
+        The message of the failure that ended the run early, if any; what was recorded up
+        to it is kept.
     """
 
     def __init__(self, time: np.ndarray, names: list[str], data: np.ndarray, meta: dict | None = None,
@@ -94,6 +136,23 @@ class Result:
         return name in self._index or bool(expand(name, self.names))
 
     def columns(self, name: str) -> list[str]:
+        """The recorded names a signal or vector name stands for.
+
+        Parameters
+        ----------
+        name : str
+            ``"IMU.acc_x"`` or ``"IMU.acc"``.
+
+        Returns
+        -------
+        list of str
+            Recorded signal names.
+
+        Raises
+        ------
+        KeyError
+            Nothing recorded matches; the message names the nearest.
+        """
         members = expand(name, self.names)
         if not members:
             raise KeyError(f"no recorded signal {name!r}.{nearest(name, self.names)}")
@@ -110,7 +169,18 @@ class Result:
     # Each export writes a temporary file beside the target and renames it when complete, so
     # an interrupt while saving never leaves a truncated file over earlier results.
     def to_npz(self, path) -> Path:
-        """NumPy archive: ``time``, one array per signal, and ``_meta`` (JSON)."""
+        """Write a NumPy archive: ``time``, one array per signal, and ``_meta`` (JSON).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file, written atomically.
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+        """
         path = Path(path)
         with atomic_path(path) as temporary:
             np.savez(temporary, time=self.time, **{n: self.data[:, i] for i, n in enumerate(self.names)},
@@ -118,7 +188,18 @@ class Result:
         return path
 
     def to_csv(self, path) -> Path:
-        """One row per sample: ``time`` (s) then every signal, full precision."""
+        """Write one row per sample: ``time`` (s) then every signal, full precision.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file, written atomically.
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+        """
         path = Path(path)
         with atomic_path(path) as temporary, temporary.open("w", newline="") as handle:
             writer = csv.writer(handle)
@@ -128,7 +209,18 @@ class Result:
         return path
 
     def to_mat(self, path) -> Path:
-        """MATLAB file: one struct per block (``IMU.acc_x`` becomes ``IMU.acc_x`` in MATLAB)."""
+        """Write a MATLAB file: one struct per block (``IMU.acc_x`` reads ``IMU.acc_x`` in MATLAB).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file, written atomically.
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+        """
         from scipy.io import savemat
 
         blocks: dict[str, dict[str, np.ndarray]] = {}
@@ -141,6 +233,18 @@ class Result:
 
     @classmethod
     def from_npz(cls, path) -> Result:
+        """Read a result written by :meth:`to_npz`.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The archive.
+
+        Returns
+        -------
+        Result
+            With its meta data and error message.
+        """
         with np.load(path) as archive:
             names = [n for n in archive.files if n not in ("time", "_meta")]
             meta = json.loads(str(archive["_meta"]))
@@ -161,7 +265,24 @@ class Result:
 
     # ------------------------------------------------------------------ plots
     def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = ""):
-        """Plot signals against time on ``ax`` (a new figure if None); returns the axes."""
+        """Plot signals against time.
+
+        Parameters
+        ----------
+        *names : str
+            Signal or vector names.
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; a new figure if None.
+        scale : float
+            Factor applied to the values (e.g. ``180 / pi`` for degrees).
+        label_prefix : str
+            Prefix of each curve's label.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes.
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:

@@ -183,11 +183,33 @@ class System:
     # ------------------------------------------------------------------ running
     def run(self, duration: float, decimation: int = 1, progress: bool = False, start_time: float = 0.0,
             record=None) -> Result:
-        """Run for ``duration`` seconds and return the recorded :class:`Result`.
+        """Run the system and return what was recorded.
 
-        ``record`` lists the signals to keep (vector names allowed); by default every output
-        of every block. They are recorded every ``decimation`` macro steps. On a failure a
-        :class:`SimulationError` is raised whose ``result`` holds what was recorded up to it.
+        Parameters
+        ----------
+        duration : float
+            Simulated time (s), at least one macro step.
+        decimation : int
+            Record every ``decimation`` macro steps.
+        progress : bool
+            Show a progress bar on long runs.
+        start_time : float
+            Time of the first step (s).
+        record : list of str, optional
+            Signals to keep (vector names such as ``"IMU.acc"`` allowed); every output of every
+            block by default.
+
+        Returns
+        -------
+        orchestrator.Result
+            The recorded signals, indexed by name.
+
+        Raises
+        ------
+        ValueError
+            Invalid duration or decimation, or an input left unconnected.
+        orchestrator.SimulationError
+            A failure during the run; its ``result`` holds what was recorded up to it.
         """
         if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
             raise ValueError(f"duration = {duration!r} s must be a positive number of seconds")

@@ -26,6 +26,25 @@ class Option:
     minimum: float | None = None
 
     def parse(self, name: str, text):
+        """The option's value from text, checked against its type, choices and minimum.
+
+        Parameters
+        ----------
+        name : str
+            Option name, for messages.
+        text : str or value
+            ``"0.5"``, ``"true"``, ...
+
+        Returns
+        -------
+        object
+            The value, of the default's type.
+
+        Raises
+        ------
+        ValueError
+            Not a valid value; the message says what is expected.
+        """
         default = self.default
         try:
             if isinstance(default, bool):
@@ -91,6 +110,7 @@ def registry() -> dict[str, Scenario]:
 
 
 def get(name: str) -> Scenario:
+    """The scenario called ``name``; a :class:`KeyError` naming the nearest otherwise."""
     scenarios = registry()
     if name not in scenarios:
         raise KeyError(f"unknown scenario {name!r}.{nearest(name, scenarios)} Scenarios: {', '.join(scenarios)}.")

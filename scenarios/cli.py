@@ -148,6 +148,7 @@ def _bench(args) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
+    """The ``quadcosim`` argument parser, one sub-command per action."""
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
@@ -195,6 +196,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 
 
 def main(argv=None) -> int:
+    """Run ``quadcosim`` with ``argv`` (the process arguments if None); returns the exit code."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
     try:

@@ -1,11 +1,11 @@
 """``rig``: the drone clamped to the ground, each motor swept in turn, then all four together.
 
-The test rig of Metge et al. (seed 000): with the body fixed, the Earth field in the sensor
+The test rig of Metge et al. (GRETSI 2013): with the body fixed, the Earth field in the sensor
 frame is constant, so whatever moves the measured field comes from the motor currents.
 Phases: motors off (the reference field m0), then each motor alone with its command ramped
 from 0 to 1 and back to 0, then a free set where all four commands vary fast and together.
 The metrics are the uncompensated mean angular errors between the measured field and m0
-(seed 000, Table 1, row "no dynamic calibration").
+(Metge et al., Table 1, row "no dynamic calibration").
 """
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ def report(result, o, out) -> dict:
         axes[0].plot(t, result[f"IMU.magneto_{axis}"] * 1e6, label=f"m_{axis}")
     axes[0].set_ylabel("measured field (µT)")
     axes[0].legend(fontsize=8)
-    axes[0].set_title("Clamped drone: measured field as the motor commands rise (cf. seed 000, Fig. 1)")
+    axes[0].set_title("Clamped drone: measured field as the motor commands rise (cf. Metge et al., Fig. 1)")
     result.plot("Setpoint.c", ax=axes[1])
     axes[1].set_ylabel("ESC command (1)")
     axes[2].plot(t, error)

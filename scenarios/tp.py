@@ -1,6 +1,6 @@
 """``tp``: the lab's closed loop: Setpoint -> Controller -> MotorMagnetics -> Quadrotor -> IMU -> Quaternion_estim.
 
-One case of the lab's matrix (seed 002) per run: estimator x flight profile x feedback (the
+One case of the lab's matrix (Bao and Yuan, lab report, 2024) per run: estimator x flight profile x feedback (the
 controller fed by the ground truth, "gt", or by the estimate) x noise x gyro bias, with or
 without the field of the motor currents at the magnetometer (the lab had none).
 """

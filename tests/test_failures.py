@@ -1,4 +1,4 @@
-"""Each failure of SPEC section 4 is a clear error naming the problem and the fix, and what
+"""Each failure the master can meet is a clear error naming the problem and the fix, and what
 was recorded before it is returned (and, with --out, saved)."""
 
 import json

@@ -1,4 +1,4 @@
-"""The lab's cases (seed 002), checked with numbers on the tp scenario."""
+"""The lab's cases (Bao and Yuan, lab report, 2024), checked with numbers on the tp scenario."""
 
 import numpy as np
 import pytest

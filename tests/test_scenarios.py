@@ -35,7 +35,7 @@ def test_rig_reproduces_seed_000_figure_1(tmp_path):
         assert deviation[rising].max() > 10.0
     rests = (t >= o["reference"] + o["sweep"] + 0.2) & (t < o["reference"] + o["sweep"] + o["rest"])
     assert deviation[rests].max() < 0.5  # motors off again: back to the reference
-    assert 5.0 < metrics["mean_angular_error_single_motor_deg"] < 15.0  # the order of seed 000's Table 1
+    assert 5.0 < metrics["mean_angular_error_single_motor_deg"] < 15.0  # the order of Metge et al.'s Table 1
 
 
 def test_cli_run_writes_results_metrics_and_figures(tmp_path):

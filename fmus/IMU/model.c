@@ -1,8 +1,8 @@
-/* IMU: accelerometer, gyrometer and magnetometer sampled at sample_rate and held (SPEC 3.3).
+/* IMU: accelerometer, gyrometer and magnetometer sampled at sample_rate and held.
  *
  *   acc = f_B + b_a + n_a
  *   gyro = omega + b_g + n_g
- *   magneto = A R^T m_I + b_s + b_d + n_m         (seed 000, eq. 1)
+ *   magneto = A R^T m_I + b_s + b_d + n_m         (Metge et al. 2013, eq. 1)
  *   R_reel = R(q)
  *
  * The sample at t_k = k / sample_rate uses the inputs at t_k: while the time is t_k it follows

@@ -6,7 +6,7 @@ Noise defaults come from datasheets:
   spectral density 300 ug/sqrt(Hz);
 - magnetometer: ST LIS3MDL datasheet (DocID024204 rev. 5), RMS noise 3.2 mgauss on x and y
   in ultra-high-performance mode at 80 Hz, i.e. 0.32 uT / sqrt(80 Hz) = 3.6e-8 T/sqrt(Hz).
-The gyro bias is the lab's case (seed 002): (0.02, -0.01, 0.015) rad/s.
+The gyro bias is the lab's case (Bao and Yuan, lab report, 2024): (0.02, -0.01, 0.015) rad/s.
 """
 
 import math

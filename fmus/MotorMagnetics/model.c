@@ -1,5 +1,5 @@
 /* MotorMagnetics: four brushless motors in the DC-motor approximation, their ESCs, a LiPo
- * battery, and the magnetic field of the motor currents at the magnetometer (SPEC 3.2).
+ * battery, and the magnetic field of the motor currents at the magnetometer.
  *
  *   L di_n = c_n u - R i_n - k_e omega_n           c_n saturated to [0, 1]
  *   J_r domega_n = k_e i_n - k_m omega_n |omega_n|
