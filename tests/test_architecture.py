@@ -105,3 +105,31 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
 ])
 def test_the_rule_itself(layer, module, expected):
     assert _allowed(layer, module, _modules() | {"fmus.build", "orchestrator.system"}) is expected
+
+
+# Functions written before this rule, still to be split by their owners; the list may only shrink.
+LONG_PENDING = {"estimators/core.py:update", "calibration/file.py:from_dict", "calibration/infrared.py:ekf_step",
+                "scenarios/ir_calibration.py:report", "scenarios/metge.py:report"}
+MAX_FUNCTION_LINES = 60  # code lines, the docstring not counted
+
+
+def _function_lengths():
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                    first = node.body[0]
+                    documented = isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) \
+                        and isinstance(first.value.value, str)
+                    doc = first.end_lineno - first.lineno + 1 if documented else 0
+                    yield f"{path.relative_to(ROOT)}:{node.name}", node.end_lineno - node.lineno + 1 - doc
+
+
+def test_no_function_is_over_sixty_lines():
+    long = [f"{name} ({n} lines)" for name, n in _function_lengths()
+            if n > MAX_FUNCTION_LINES and name not in LONG_PENDING]
+    assert not long, "split these functions into named steps:\n" + "\n".join(long)
+
+
+def test_the_master_module_stays_short():
+    assert len((ROOT / "orchestrator" / "system.py").read_text().splitlines()) < 300
