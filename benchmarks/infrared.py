@@ -15,6 +15,8 @@ import sys
 
 
 def measure(samples: int = 8000, start_s: float = 0.0, repeats: int = 3) -> dict:
+    """:func:`calibration.infrared.cost` on ``samples`` samples (20 Hz) of the ``ir-calibration``
+    flight with both faults, from ``start_s`` (s); timings best of ``repeats``."""
     from calibration.infrared import cost
     from scenarios.ir_calibration import RATE, simulate_flight
 
@@ -26,6 +28,7 @@ def measure(samples: int = 8000, start_s: float = 0.0, repeats: int = 3) -> dict
 
 
 def main(argv=None) -> int:
+    """Print the cost table (or one JSON object with ``--json``); returns the exit status."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="quadcosim bench infrared", description=__doc__.splitlines()[0])

@@ -185,94 +185,127 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     s[GPS_USED] = 0.0
     s[IR_USED] = 0.0
     s[NU_GPS] = s[GATE_GPS] = s[NU_IR] = s[GATE_IR] = 0.0  # S = 0: not computed at this sample
-    a, b, r = s[A], s[B], s[R]
+    have_pair = ir_pair == ir_pair
     gps_pass = False
     if gps_available:
-        nu_g = gps - r
-        S_g = s[PRR] + c[RG]
-        s[NU_GPS] = nu_g
-        s[GATE_GPS] = S_g
-        gps_pass = gamma2 == 0.0 or nu_g * nu_g <= gamma2 * S_g
-        if gps_pass and ir_pair == ir_pair:
-            _fuse_gps(s, nu_g, S_g)
-            a, b, r = s[A], s[B], s[R]
+        gps_pass = _test_gps(s, c, gps)
+        if gps_pass and have_pair:
+            _fuse_gps(s, s[NU_GPS], s[GATE_GPS])
     ir_pass = True
-    if ir_pair == ir_pair:
-        # the pair, against the state (after the GPS when it was fused): H = (r, 1, a)
-        ha = s[PAA] * r + s[PAB] + s[PAR] * a
-        hb = s[PAB] * r + s[PBB] + s[PBR] * a
-        hr = s[PAR] * r + s[PBR] + s[PRR] * a
-        S_i = r * ha + hb + a * hr + c[RI]
-        nu_i = ir_pair - (a * r + b)
-        s[NU_IR] = nu_i
-        s[GATE_IR] = S_i
-        ir_pass = gamma2 == 0.0 or nu_i * nu_i <= gamma2 * S_i
-        if gps_available and not gps_pass:
-            if not ir_pass:
-                # Both disagree with the state. If they agree with each other the aircraft
-                # manoeuvred beyond the model: reset r to the GPS. Otherwise fuse neither.
-                d = gps - nu_i / a - r
-                S_d = c[RG] + (c[RI] + s[PBB] + r * r * s[PAA]) / (a * a)
-                if d * d <= gamma2 * S_d:
-                    s[R] = gps
-                    s[PAR] = 0.0
-                    s[PBR] = 0.0
-                    s[PRR] = c[RG]
-                    gps_pass = True
-                    ir_pass = True
-            else:
-                # The GPS alone disagrees: the IR carries the turn rate, a and b are held.
-                k = hr / S_i
-                s[R] += k * nu_i
-                s[PAR] -= k * ha
-                s[PBR] -= k * hb
-                s[PRR] -= k * hr
-                s[IR_USED] = 1.0
-        elif ir_pass:
-            if gps_available:
-                ka, kb, kr = ha / S_i, hb / S_i, hr / S_i
-                s[A] += ka * nu_i
-                s[B] += kb * nu_i
-                s[R] += kr * nu_i
-                s[PAA] -= ka * ha
-                s[PAB] -= ka * hb
-                s[PAR] -= ka * hr
-                s[PBB] -= kb * hb
-                s[PBR] -= kb * hr
-                s[PRR] -= kr * hr
-            else:
-                # No GPS: the IR gives the turn rate; a and b are not observable and held.
-                k = hr / S_i
-                s[R] += k * nu_i
-                s[PAR] -= k * ha
-                s[PBR] -= k * hb
-                s[PRR] -= k * hr
-            s[IR_USED] = 1.0
+    if have_pair:
+        ir_pass, gps_pass = _pair_update(s, c, ir_pair, gps, gps_available, gps_pass)
     elif gps_available and gps_pass:
-        # no clean pair: the GPS alone
-        _fuse_gps(s, gps - s[R], s[GATE_GPS])
+        _fuse_gps(s, s[NU_GPS], s[GATE_GPS])  # no clean pair: the GPS alone
     if gps_available:
         s[GPS_USED] = 1.0 if gps_pass else 0.0
         if gamma2 > 0.0 and _record(s, gps_pass, GPS_BAD, GPS_GOOD, GPS_FAULT, c[DECLARE], c[CLEAR]):
             _reopen(s, c)
     if gamma2 > 0.0:
-        # The present IR against the state: the paired turn rate is delay + window / 2 old,
-        # so the turn may have changed by up to c[LAG] (as a variance) since.
-        a, b, r = s[A], s[B], s[R]
-        nu_now = ir_now - (a * r + b)
-        S_now = a * a * (s[PRR] + c[LAG]) + r * r * s[PAA] + s[PBB] + c[RI1]
-        s[NU_NOW] = nu_now
-        s[GATE_NOW] = S_now
-        s[IR_SUSPECT] = 0.0 if nu_now * nu_now <= gamma2 * S_now else 1.0
-        if _record(s, ir_pass and s[IR_SUSPECT] == 0.0, IR_BAD, IR_GOOD, IR_FAULT, c[DECLARE], c[CLEAR]):
-            _reopen(s, c)
+        _check_present(s, c, ir_now, ir_pass)
+    _finish(s, ir_now)
+
+
+@njit(cache=True)
+def _test_gps(s, c, gps):
+    """GPS innovation against the predicted state, and whether it passes the gate."""
+    nu = gps - s[R]
+    S = s[PRR] + c[RG]
+    s[NU_GPS] = nu
+    s[GATE_GPS] = S
+    return c[GAMMA2] == 0.0 or nu * nu <= c[GAMMA2] * S
+
+
+@njit(cache=True)
+def _pair_update(s, c, ir_pair, gps, gps_available, gps_pass):
+    """The paired IR against the state (after the GPS when it was fused), H = (r, 1, a); fused
+    by the attribution rules. Returns whether the IR and the GPS passed."""
+    a, b, r = s[A], s[B], s[R]
+    ha = s[PAA] * r + s[PAB] + s[PAR] * a
+    hb = s[PAB] * r + s[PBB] + s[PBR] * a
+    hr = s[PAR] * r + s[PBR] + s[PRR] * a
+    S_i = r * ha + hb + a * hr + c[RI]
+    nu_i = ir_pair - (a * r + b)
+    s[NU_IR] = nu_i
+    s[GATE_IR] = S_i
+    ir_pass = c[GAMMA2] == 0.0 or nu_i * nu_i <= c[GAMMA2] * S_i
+    if gps_available and not gps_pass:
+        if not ir_pass:
+            if _manoeuvre(s, c, gps, nu_i):
+                return True, True
+        else:
+            _fuse_ir(s, nu_i, S_i, ha, hb, hr, False)  # the GPS alone disagrees: a and b held
+    elif ir_pass:
+        _fuse_ir(s, nu_i, S_i, ha, hb, hr, gps_available)  # without the GPS a and b are held
+    return ir_pass, gps_pass
+
+
+@njit(cache=True)
+def _manoeuvre(s, c, gps, nu_i):
+    """Both sensors disagree with the state. If they agree with each other the aircraft
+    manoeuvred beyond the model: r is reset to the GPS and True returned. Otherwise neither
+    is fused."""
+    a, r = s[A], s[R]
+    d = gps - nu_i / a - r
+    S_d = c[RG] + (c[RI] + s[PBB] + r * r * s[PAA]) / (a * a)
+    if d * d <= c[GAMMA2] * S_d:
+        s[R] = gps
+        s[PAR] = 0.0
+        s[PBR] = 0.0
+        s[PRR] = c[RG]
+        return True
+    return False
+
+
+@njit(cache=True)
+def _fuse_ir(s, nu, S, ha, hb, hr, calibrate):
+    """Scalar update with H = (r, 1, a), ``ha, hb, hr = P H^T``. Without ``calibrate`` only r
+    is updated (a Schmidt update: a and b are held, their covariance with r kept right)."""
+    if calibrate:
+        ka, kb, kr = ha / S, hb / S, hr / S
+        s[A] += ka * nu
+        s[B] += kb * nu
+        s[R] += kr * nu
+        s[PAA] -= ka * ha
+        s[PAB] -= ka * hb
+        s[PAR] -= ka * hr
+        s[PBB] -= kb * hb
+        s[PBR] -= kb * hr
+        s[PRR] -= kr * hr
+    else:
+        k = hr / S
+        s[R] += k * nu
+        s[PAR] -= k * ha
+        s[PBR] -= k * hb
+        s[PRR] -= k * hr
+    s[IR_USED] = 1.0
+
+
+@njit(cache=True)
+def _check_present(s, c, ir_now, pair_passed):
+    """The present IR against the state: the paired turn rate is delay + window / 2 old, so the
+    turn may have changed by c[LAG] (a variance) since. Flags the sample suspect and records
+    the IR's consistency for the fault rule."""
+    a, b, r = s[A], s[B], s[R]
+    nu = ir_now - (a * r + b)
+    S = a * a * (s[PRR] + c[LAG]) + r * r * s[PAA] + s[PBB] + c[RI1]
+    s[NU_NOW] = nu
+    s[GATE_NOW] = S
+    s[IR_SUSPECT] = 0.0 if nu * nu <= c[GAMMA2] * S else 1.0
+    if _record(s, pair_passed and s[IR_SUSPECT] == 0.0, IR_BAD, IR_GOOD, IR_FAULT, c[DECLARE], c[CLEAR]):
+        _reopen(s, c)
+
+
+@njit(cache=True)
+def _finish(s, ir_now):
+    """Covariance check, and the present turn rate (IR - b) / a, or the paired one when the IR
+    is faulty or suspect."""
     if not (s[PAA] > 0.0 and s[PBB] > 0.0 and s[PRR] > 0.0):
         s[STATUS] = LOST_PD
     if s[A] == 0.0:
         s[STATUS] = ZERO_GAIN
         s[RATE] = math.nan
     elif s[IR_FAULT] > 0.5 or s[IR_SUSPECT] > 0.5:
-        s[RATE] = s[R]  # the IR is faulty or suspect: the late paired turn rate is the better one
+        s[RATE] = s[R]
     else:
         s[RATE] = (ir_now - s[B]) / s[A]
 
@@ -470,6 +503,7 @@ class EKFSettings:
             raise ValueError("the joint form is the slides' filter and is not gated: set gate=0 or form='sequential'")
 
     def config(self) -> np.ndarray:
+        """The configuration vector of the step functions (variances per sample, gate, rules)."""
         c = np.zeros(EKF_CONFIG_SIZE)
         c[[QA, QB, QR, RG, RI]] = np.square([self.q_a, self.q_b, self.q_r, self.sd_gps, self.sd_ir])
         c[GAMMA2] = self.gate**2
@@ -479,6 +513,15 @@ class EKFSettings:
         return c
 
     def initial_state(self, covariance=None) -> np.ndarray:
+        """The state vector before the first sample.
+
+        Parameters
+        ----------
+        covariance : (3, 3) array, optional
+            Covariance of (a, b, r) (count^2 s^2/rad^2, count^2, rad^2/s^2 on the diagonal);
+            default ``diag(sd_a0^2, sd_b0^2, sd_r0^2)``. Refused unless finite, symmetric and
+            positive definite.
+        """
         s = np.zeros(EKF_SIZE)
         s[A], s[B] = self.a0, self.b0
         P = np.diag(np.square([self.sd_a0, self.sd_b0, self.sd_r0])) if covariance is None else covariance
@@ -524,12 +567,14 @@ class RegressionSettings:
     min_spread: float = 0.05
 
     def config(self) -> np.ndarray:
+        """The configuration vector of :func:`regression_step`."""
         _check_positive("period", self.period, "samples", "refit at least every sample")
         _check_positive("max_rate", self.max_rate, "rad/s", "give the largest realistic turn rate")
         return np.array([self.period, self.max_rate, self.reject, self.sd_floor, self.min_samples,
                          self.min_spread], dtype=float)
 
     def initial_state(self) -> np.ndarray:
+        """The state vector before the first sample: no data, the initial line."""
         s = np.zeros(REG_SIZE)
         s[FIT_A], s[FIT_B] = self.a0, self.b0
         return s
@@ -562,12 +607,14 @@ class RLSSettings:
     bank_max: float = 1.0
 
     def config(self) -> np.ndarray:
+        """The configuration vector of :func:`rls_step`."""
         if not 0.0 < self.forgetting <= 1.0:
             raise ValueError(f"forgetting factor {self.forgetting!r} must lie in (0, 1]")
         _check_positive("airspeed", self.airspeed, "m/s", "the bank angle needs a flying aircraft")
         return np.array([self.forgetting, self.airspeed, self.gravity, self.bank_min, self.bank_max])
 
     def initial_state(self) -> np.ndarray:
+        """The state vector before the first sample: the initial line and its covariance."""
         for name in ("sd_a0", "sd_b0"):
             _check_positive(name, getattr(self, name), "", "a covariance must be positive definite")
         return np.array([self.a0, self.b0, self.sd_a0**2, 0.0, self.sd_b0**2, 0.0])
@@ -855,8 +902,9 @@ class _CountedMath:
         return _Counted(_REAL_MATH.atan(x))
 
 
-_COMPILED = ("pair_at", "push", "_record", "_reopen", "_fuse_gps", "ekf_step", "ekf_joint_step", "regression_step",
-             "rls_step", "_sample")
+_COMPILED = ("pair_at", "push", "_record", "_reopen", "_fuse_gps", "_test_gps", "_pair_update", "_manoeuvre",
+             "_fuse_ir", "_check_present", "_finish", "ekf_step", "ekf_joint_step", "regression_step", "rls_step",
+             "_sample")
 
 
 def _count_operations(estimator: Estimator, ir, gps, use) -> np.ndarray:

@@ -82,6 +82,7 @@ def fault_windows(faults: str) -> list[tuple[str, float, float, float]]:
 
 
 def sensor_parameters(seed: int, drift: bool, noise: bool) -> dict:
+    """InfraredSensor parameters for a noise ``seed``, drift on or off, noise on or off."""
     return {"seed": seed, "drift_enabled": drift, "noise_enabled": noise}
 
 
@@ -171,6 +172,13 @@ class SensorFaults(Block):
 
 
 def build(o: dict) -> System:
+    """Bank profile -> InfraredSensor -> faults -> the three estimators, all at 20 Hz.
+
+    Parameters
+    ----------
+    o : dict
+        The scenario's options (see ``OPTIONS``).
+    """
     samples = int(round(o["duration"] * RATE))
     system = System(dt=1.0 / RATE)
     # the profile of samples rows (the last is held), the same as simulate_flight flies
@@ -221,34 +229,50 @@ def _shade(ax, windows):
                    label=f"{sensor.upper()} fault")
 
 
-def report(result, o, out) -> dict:
-    import matplotlib.pyplot as plt
+_STYLES = {"kalman": "tab:blue", "regression": "tab:orange", "rls": "tab:green"}
 
+
+def report(result, o, out) -> dict:
+    """Metrics (:func:`summarize`, and the flight's statistics) and the three figures.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The run.
+    o : dict
+        The scenario's options.
+    out : pathlib.Path or None
+        Folder of the figures; none are written when ``None``.
+    """
     t = result.time
-    truth_r = result["InfraredSensor.r"]
     windows = fault_windows(o["faults"])
-    truth = {"r": truth_r, "a": result["InfraredSensor.a"], "b": result["InfraredSensor.b"]}
+    truth = {"r": result["InfraredSensor.r"], "a": result["InfraredSensor.a"], "b": result["InfraredSensor.b"]}
     estimates = {m: {k: result[f"{m.capitalize()}.{k}"] for k in ("turn_rate", "a", "b")} for m in METHODS}
     estimates["kalman"] |= {k: result[f"Kalman.{k}"] for k in ("ir_fault", "gps_fault")}
     metrics = summarize(t, truth, estimates, windows)
-    valid = t >= 2.0
-    errors = {m: np.degrees(estimates[m]["turn_rate"] - truth_r) for m in METHODS}
-    ir, r = result["InfraredSensor.ir"], truth_r
+    ir, r = result["InfraredSensor.ir"], truth["r"]
     slope, intercept = np.polyfit(r, ir, 1)
     metrics["flight"] = {"ir_mean": float(ir.mean()), "ir_std": float(ir.std()), "turn_rate_mean": float(r.mean()),
                          "turn_rate_std": float(r.std()), "ir_fit": {"a": float(slope), "b": float(intercept)}}
-    a, b = truth["a"], truth["b"]
+    figures = [_calibration_figure(result, o, truth, windows, out), _innovations_figure(result, o, windows, out),
+               _errors_figure(t, truth, estimates, metrics["turn_rate_error_deg_s"], out)]
+    metrics["figures"] = [f for f in figures if f]
+    return metrics
 
-    figures = []
+
+def _calibration_figure(result, o, truth, windows, out):
+    """a, b and the turn rate against time, with their truth."""
+    import matplotlib.pyplot as plt
+
+    t, a, b, truth_r = result.time, truth["a"], truth["b"], truth["r"]
     fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
-    styles = {"kalman": "tab:blue", "regression": "tab:orange", "rls": "tab:green"}
     for m in METHODS:
-        axes[0].plot(t, result[f"{m.capitalize()}.a"], color=styles[m], lw=1, label=m)
-        axes[1].plot(t, result[f"{m.capitalize()}.b"], color=styles[m], lw=1, label=m)
+        axes[0].plot(t, result[f"{m.capitalize()}.a"], color=_STYLES[m], lw=1, label=m)
+        axes[1].plot(t, result[f"{m.capitalize()}.b"], color=_STYLES[m], lw=1, label=m)
     axes[0].plot(t, a, "k--", lw=1, label="truth")
     axes[1].plot(t, b, "k--", lw=1, label="truth")
     axes[2].plot(t, np.degrees(result["Faults.gps_turn_rate"]), color="0.6", lw=0.6, label="GPS (late)")
-    axes[2].plot(t, np.degrees(result["Kalman.turn_rate"]), color=styles["kalman"], lw=0.8,
+    axes[2].plot(t, np.degrees(result["Kalman.turn_rate"]), color=_STYLES["kalman"], lw=0.8,
                  label="Kalman (IR - b) / a")
     axes[2].plot(t, np.degrees(truth_r), "k--", lw=0.8, label="truth")
     axes[0].set_ylabel("a (count per rad/s)")
@@ -264,11 +288,17 @@ def report(result, o, out) -> dict:
         ax.grid(alpha=0.3)
     axes[0].legend(loc="upper right", fontsize=8, ncol=3)
     axes[2].legend(loc="upper right", fontsize=8, ncol=3)
+    gps = "all flight" if o["gps_resetting"] else f"until {o['calibration_s']:g} s"
     axes[0].set_title(f"IR calibration: drift {'on' if o['drift'] else 'off'}, faults {o['faults']}, "
-                      f"gating {'on' if o['gating'] else 'off'}, "
-                      f"GPS {'all flight' if o['gps_resetting'] else f'until {o["calibration_s"]:g} s'}")
-    figures.append(save_figure(fig, out, "calibration.png"))
+                      f"gating {'on' if o['gating'] else 'off'}, GPS {gps}")
+    return save_figure(fig, out, "calibration.png")
 
+
+def _innovations_figure(result, o, windows, out):
+    """The Kalman filter's innovations with their gates: GPS, paired IR, present IR."""
+    import matplotlib.pyplot as plt
+
+    t = result.time
     fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     gamma = EKFSettings().gate if o["gating"] else 0.0
     panels = ((axes[0], "gps", "GPS turn rate (deg/s)", 180 / np.pi),
@@ -292,22 +322,26 @@ def report(result, o, out) -> dict:
         ax.legend(loc="upper right", fontsize=8, ncol=4)
     axes[0].set_title("Kalman innovations: GPS and paired IR (fused when inside the gate), present IR (checked)")
     axes[2].set_xlabel("time (s)")
-    figures.append(save_figure(fig, out, "innovations.png"))
+    return save_figure(fig, out, "innovations.png")
 
+
+def _errors_figure(t, truth, estimates, stats, out):
+    """Histograms of the turn-rate error of each method."""
+    import matplotlib.pyplot as plt
+
+    valid = t >= 2.0
+    errors = {m: np.degrees(estimates[m]["turn_rate"] - truth["r"])[valid] for m in METHODS}
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    stats = metrics["turn_rate_error_deg_s"]
-    limit = max(5.0, float(np.percentile(np.abs(np.concatenate([e[valid] for e in errors.values()])), 99.5)))
+    limit = max(5.0, float(np.percentile(np.abs(np.concatenate(list(errors.values()))), 99.5)))
     bins = np.linspace(-limit, limit, 121)
     for m in METHODS:
-        ax.hist(np.clip(errors[m][valid], -limit, limit), bins=bins, histtype="step", color=styles[m], lw=1.2,
+        ax.hist(np.clip(errors[m], -limit, limit), bins=bins, histtype="step", color=_STYLES[m], lw=1.2,
                 label=f"{m}: mean {stats[m]['mean']:.2f}, std {stats[m]['std']:.2f} deg/s")
     ax.set_xlabel(f"turn-rate error, estimate - truth (deg/s); beyond ±{limit:.0f} counted in the end bins")
     ax.set_ylabel("samples")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    figures.append(save_figure(fig, out, "errors.png"))
-    metrics["figures"] = [f for f in figures if f]
-    return metrics
+    return save_figure(fig, out, "errors.png")
 
 
 SCENARIO = Scenario(

@@ -109,7 +109,7 @@ def test_gated_filter_costs_at_most_the_slides_300_operations_per_iteration():
     print(f"\ngated Kalman filter over a flight with both faults: {kalman['operations_mean']:.1f} operations per "
           f"iteration on average, {kalman['operations_max']} at most (slides: {SLIDES_OPERATIONS})")
     assert kalman["operations_max"] <= SLIDES_OPERATIONS
-    assert kalman["operations_max"] == 125  # the count is exact: a change of the arithmetic shows here
+    assert kalman["operations_max"] == 124  # the count is exact: a change of the arithmetic shows here
 
 
 def test_sequential_scalar_updates_cost_fewer_flops_than_the_slides_joint_update():
