@@ -100,7 +100,8 @@ def report(f: dict) -> str:
         f"  disk per member: {f['disk_per_member_bytes']:.0f} B of metrics.json "
         f"({f['disk_per_member_allocated_bytes']:.0f} B allocated), {f['table_bytes_per_member']:.0f} B of table",
         "  a 10 000-member study of such runs: "
-        + ", ".join(f"{n} worker{'s' * (n > 1)} {s['hours']:.2f} h" for n, s in f["study_10000"]["workers"].items())
+        + ", ".join(f"{n} worker{'s' * (int(n) > 1)} {s['hours']:.2f} h"
+                    for n, s in f["study_10000"]["workers"].items())
         + f" (beyond 2: each worker at its 2-worker rate); {f['study_10000']['disk_mb']:.0f} MB on disk",
         "    on idle cores (CPU time per member): "
         + ", ".join(f"{n}: {s['cpu_bound_hours']:.2f} h" for n, s in f["study_10000"]["workers"].items()),

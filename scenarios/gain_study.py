@@ -5,9 +5,10 @@
    gain of a log grid at once. Its roll and pitch error variances are set against the
    variance python-control predicts from the IMU's noise densities
    (estimators/analysis.py), and the two optimal gains are compared.
-2. Estimate-fed mode: one closed-loop run per gain, the controller fed by the estimate, in
-   parallel on the available cores; their roll and pitch error variances go on the same
-   figure.
+2. Estimate-fed mode: one closed-loop run per gain, the controller fed by the estimate, run
+   as a sweep on Dask (a local cluster, or the scheduler given by ``scheduler``); their roll
+   and pitch error variances go on the same figure, and a run that fails is named with its
+   gain and error, its point left out, the others kept.
 
 The statistical uncertainty of each simulated variance is measured by batch means: the
 stream is cut into 20 blocks, each far longer than the filter's time constant 1/k, and the
@@ -18,8 +19,8 @@ needed: T >= 800 / k_min seconds for 5 % on one axis, half that for roll and pit
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ProcessPoolExecutor
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
@@ -35,10 +36,13 @@ OPTIONS = {
     "burn_in": Option(200.0, "stream time discarded at the start of every filter (s)", minimum=0.0),
     "imu_rate": Option(100.0, "IMU and estimator rate (Hz); also the macro step rate", minimum=1.0),
     "seed": Option(1, "IMU noise seed"),
-    "closed_loop": Option(True, "also run the estimate-fed closed loop for each gain, in parallel"),
+    "closed_loop": Option(True, "also run the estimate-fed closed loop for each gain, as a Dask sweep"),
     "closed_duration": Option(120.0, "length of each estimate-fed run (s)", minimum=1.0),
     "closed_flight": Option("hover", "flight of the estimate-fed runs", choices=("hover", "quasi")),
+    "workers": Option(0, "Dask worker processes for the estimate-fed runs (0: one per CPU)", minimum=0),
+    "scheduler": Option("", "address of a running Dask scheduler for them (empty: a local cluster)"),
 }
+BLOCKS = 20  # batch means: the stream after burn-in is cut into this many blocks
 
 
 def grid(o: dict) -> np.ndarray:
@@ -47,10 +51,27 @@ def grid(o: dict) -> np.ndarray:
     return np.geomspace(o["k_min"], o["k_max"], o["count"])
 
 
+def validate(o: dict) -> None:
+    """Refuse options that would give meaningless variances, before anything runs."""
+    grid(o)
+    if not o["burn_in"] < o["duration"]:
+        raise ValueError(f"burn_in = {o['burn_in']:g} s must be shorter than duration = {o['duration']:g} s: "
+                         "no stream would be left to measure the error on")
+    block = (o["duration"] - o["burn_in"]) / BLOCKS
+    if block < 1.0 / o["k_min"]:
+        raise ValueError(f"duration - burn_in = {o['duration'] - o['burn_in']:g} s is too short for k_min = "
+                         f"{o['k_min']:g} 1/s: each of the {BLOCKS} batch-means blocks must outlast the slowest "
+                         f"filter's time constant 1/k_min; give duration >= {o['burn_in'] + BLOCKS / o['k_min']:g} s")
+    if o["k_max"] / o["imu_rate"] >= 1.0:
+        raise ValueError(f"k_max = {o['k_max']:g} 1/s at imu_rate = {o['imu_rate']:g} Hz: k dt = "
+                         f"{o['k_max'] / o['imu_rate']:.3g} must stay below 1 for the discrete filter to be the "
+                         "one analysed; lower k_max or raise imu_rate")
+
+
 def build(o: dict):
     import scenarios
 
-    grid(o)
+    validate(o)
     tp = scenarios.get("tp")
     return tp.build(tp.parse({"estimator": "linear", "flight": "hover", "feedback": "gt", "noise": True,
                               "duration": o["duration"], "dt": 1.0 / o["imu_rate"], "imu_rate": o["imu_rate"],
@@ -71,28 +92,49 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
                        gains={"k1": chunk, "k2": chunk, "k3": chunk}, outputs=("theta",))
         for g in range(len(chunk)):
             error = out["theta"][g, start:, :2] - truth[start:]
-            blocks = np.array_split(error, 20)
+            blocks = np.array_split(error, BLOCKS)
             block_vars = np.array([(b**2).mean() for b in blocks])
             variances.append(block_vars.mean())
             errors.append(block_vars.std(ddof=1) / np.sqrt(len(blocks)) / block_vars.mean())
     return np.array(variances), np.array(errors)
 
 
-def _closed_loop(args):
-    import scenarios
-
-    k, o = args
-    result, metrics = scenarios.run("tp", {"estimator": "linear", "k": k, "flight": o["closed_flight"],
-                                           "feedback": "estimate", "noise": True, "duration": o["closed_duration"],
-                                           "settle": min(20.0, o["closed_duration"] / 4), "seed": o["seed"]})
-    rms = np.radians(metrics["rms_error_deg"][:2])
-    return float((rms**2).mean()), metrics["tracking_rms_deg"]
+def closed_loop_options(k: float, o: dict) -> dict:
+    return {"estimator": "linear", "k": k, "flight": o["closed_flight"], "feedback": "estimate", "noise": True,
+            "duration": o["closed_duration"], "settle": min(20.0, o["closed_duration"] / 4), "seed": o["seed"]}
 
 
-def closed_loop_variances(gains, o) -> tuple[np.ndarray, list]:
-    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        results = list(pool.map(_closed_loop, [(float(k), o) for k in gains]))
-    return np.array([r[0] for r in results]), [r[1] for r in results]
+def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
+    """Roll/pitch error variance (rad^2, NaN for a failed run) and tracking RMS of one
+    estimate-fed closed-loop run per gain, run as a sweep (into ``out``/closed-loop if given);
+    and the failures, as (gain, error)."""
+    import shutil
+
+    from scenarios.sweep import engine, grid, named
+
+    plan = grid.plan_of_cases("tp", {f"k={k:.6g}": closed_loop_options(float(k), o) for k in gains})
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = Path(out) / "closed-loop" if out is not None else Path(scratch)
+        settings = {"workers": o["workers"] or None, "scheduler": o["scheduler"] or None, "progress": False}
+        try:  # the same runs left by an interrupted study are kept
+            summary = engine.run(plan, folder, resume=(folder / "sweep.json").exists(), **settings)
+        except engine.SweepError:  # another study's runs: this one replaces them, as it replaces its figures
+            shutil.rmtree(folder)
+            summary = engine.run(plan, folder, **settings)
+        if summary.interrupted:
+            raise KeyboardInterrupt
+        records = named.records(plan, folder)
+    variances, tracking, failures = [], [], []
+    for k, record in zip(gains, records, strict=True):
+        if record["status"] == "ok":
+            rms = np.radians(record["metrics"]["rms_error_deg"][:2])
+            variances.append(float((rms**2).mean()))
+            tracking.append(record["metrics"]["tracking_rms_deg"])
+        else:
+            variances.append(np.nan)
+            tracking.append(None)
+            failures.append((float(k), record["error"]))
+    return np.array(variances), tracking, failures
 
 
 def optimum_of(gains, values) -> float:
@@ -114,7 +156,7 @@ def report(result, o, out) -> dict:
     simulated, relative_se = simulated_variances(result, gains, o)
     k_predicted = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle)
     k_simulated = optimum_of(gains, simulated)
-    closed, tracking = (closed_loop_variances(gains, o) if o["closed_loop"] else (None, None))
+    closed, tracking, failures = closed_loop_variances(gains, o, out) if o["closed_loop"] else (None, None, [])
 
     fig, ax = plt.subplots(figsize=(8, 5))
     fine = np.geomspace(gains[0], gains[-1], 200)
@@ -147,6 +189,7 @@ def report(result, o, out) -> dict:
         "optimum_ratio": max(k_predicted, k_simulated) / min(k_predicted, k_simulated),
         "bandwidth_at_lab_gain_rad_s": analysis.linear_bandwidth(0.05),
         "closed_loop_variance_rad2": None if closed is None else closed.tolist(),
+        "closed_loop_failures": [{"k": k, "error": error} for k, error in failures],
         "closed_loop_tracking_rms_deg": tracking,
         "figures": [figure] if figure else [],
     }

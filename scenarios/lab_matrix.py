@@ -1,9 +1,10 @@
 """The lab's matrix in one go: every ``tp`` case of the report, and the checks against analysis.
 
-    python -m scenarios.lab_matrix --out results/lab-matrix
+    quadcosim sweep lab-matrix --out results/lab-matrix      (or python -m scenarios.lab_matrix)
 
-Runs the cases in parallel on the available cores; each case leaves its own folder (figures,
-metrics.json, results) under the output folder, and ``summary.md`` gathers the numbers:
+A named sweep: its members run on Dask like any sweep (``--workers``, ``--scheduler``,
+``--resume``); each case leaves its own folder (figures, metrics.json, results) under
+``members/`` with ``sweep.csv`` beside, and ``summary.md`` gathers the numbers:
 - estimation RMS error (roll, pitch, yaw) and tracking RMS for each case;
 - the explicit filter without bias estimate: simulated steady error against the linearised
   prediction (estimators.analysis.explicit_bias_steady_error);
@@ -19,9 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -61,55 +60,59 @@ PREDICTION_TOLERANCE = {"explicit": 0.1, "passive": 0.2}  # relative, as in test
 PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
 
 
-def _case(args):
-    import scenarios
+def cases() -> dict[str, dict]:
+    """Every member: the matrix's cases, then the runs the checks against analysis rest on."""
+    members = dict(CASES)
+    for k in EXPLICIT_GAINS:  # the explicit filter's steady error without bias estimate
+        members[f"explicit-steady-k{k:g}-hover-bias"] = {"estimator": "explicit", "flight": "hover", "bias": True,
+                                                        "k1": k, "k2": k, "kI": 0.0, "duration": 60.0}
+    for ry in ("reel", "triad"):  # the passive filter's bias-convergence time
+        for g in PASSIVE_GAINS:
+            members[f"passive-{ry}-{g:g}-hover-bias-convergence"] = {
+                "estimator": "passive", "flight": "hover", "bias": True, "kP": g, "kI": g, "ry": ry,
+                "duration": max(10.0, 1.5 * _passive_prediction(g))}
+    return members
 
-    name, options, out = args
-    _, metrics = scenarios.run("tp", options, out / name if out else None)
-    return name, metrics
+
+def _passive_prediction(gain: float) -> float:
+    return analysis.passive_bias_convergence_time(gain, gain, max(np.abs(LAB_GYRO_BIAS)), 1e-3)
 
 
-def _explicit(k):
-    import scenarios
-
-    result, _ = scenarios.run("tp", {"estimator": "explicit", "flight": "hover", "bias": True, "k1": k, "k2": k,
-                                     "kI": 0.0, "duration": 60.0})
-    late = result.time > 45.0
+def late_mean_error(result, options) -> dict:
+    """Mean estimation error over the last quarter of the run (deg; roll, pitch, yaw): the
+    steady error of a filter that does not estimate the gyro bias (after 45 s of 60)."""
+    late = result.time > 0.75 * options["duration"]
     error = np.column_stack([result[f"Quaternion_estim.theta_est{i}"] - result[f"Quadrotor.theta{i}"]
                              for i in (1, 2, 3)])[late].mean(axis=0)
-    return k, np.degrees(error).tolist()
+    return {"late_mean_error_deg": np.degrees(error).tolist()}
 
 
-def _passive(args):
-    import scenarios
-
-    ry, gain = args
-    predicted = analysis.passive_bias_convergence_time(gain, gain, max(np.abs(LAB_GYRO_BIAS)), 1e-3)
-    _, metrics = scenarios.run("tp", {"estimator": "passive", "flight": "hover", "bias": True, "kP": gain, "kI": gain,
-                                      "ry": ry, "duration": max(10.0, 1.5 * predicted)})
-    return ry, gain, metrics["bias_convergence_s"], predicted
-
-
-def run(out: Path | None) -> dict:
-    with ProcessPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
-        cases = dict(pool.map(_case, [(name, options, out) for name, options in CASES.items()]))
-        explicit = list(pool.map(_explicit, EXPLICIT_GAINS))
-        passive = list(pool.map(_passive, [(ry, g) for ry in ("reel", "triad") for g in PASSIVE_GAINS]))
+def summary_of(records: list[dict]) -> dict:
+    """The matrix's numbers and checks, from its members' records (metrics.json)."""
+    by_label = {r["label"]: r["metrics"] for r in records}
     summary = {
-        "cases": {name: {k: m[k] for k in ("rms_error_deg", "tracking_rms_deg", "bias_error_final")}
-                  for name, m in cases.items()},
+        "cases": {name: {k: by_label[name][k] for k in ("rms_error_deg", "tracking_rms_deg", "bias_error_final")}
+                  for name in CASES},
         "explicit_steady_bias_error_deg": [
-            {"k1=k2": k, "simulated": sim,
+            {"k1=k2": k, "simulated": by_label[f"explicit-steady-k{k:g}-hover-bias"]["late_mean_error_deg"],
              "predicted": np.degrees(analysis.explicit_bias_steady_error(k, k, 1.0, LAB_GYRO_BIAS)).tolist()}
-            for k, sim in explicit],
-        "passive_bias_convergence_s": [{"ry": ry, "kP=kI": g, "simulated": s, "predicted": p}
-                                       for ry, g, s, p in passive],
+            for k in EXPLICIT_GAINS],
+        "passive_bias_convergence_s": [
+            {"ry": ry, "kP=kI": g,
+             "simulated": by_label[f"passive-{ry}-{g:g}-hover-bias-convergence"]["bias_convergence_s"],
+             "predicted": _passive_prediction(g)}
+            for ry in ("reel", "triad") for g in PASSIVE_GAINS],
     }
     summary["checks"] = checks(summary)
-    if out:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-        (out / "summary.md").write_text(markdown(summary))
+    return summary
+
+
+def summarise(records: list[dict], out: Path) -> dict:
+    """Write ``summary.json`` and ``summary.md`` in ``out``; return the summary."""
+    summary = summary_of(records)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    (out / "summary.md").write_text(markdown(summary))
     return summary
 
 
@@ -162,12 +165,33 @@ def markdown(summary: dict) -> str:
 
 
 def main(argv=None) -> int:
+    from scenarios.sweep import command
+
     parser = argparse.ArgumentParser(prog="python -m scenarios.lab_matrix", description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="results/lab-matrix", help="output folder")
-    args = parser.parse_args(argv)
-    summary = run(Path(args.out))
-    print(markdown(summary))
-    return 0
+    parser.add_argument("--workers", help="local Dask worker processes (default: the CPUs)")
+    parser.add_argument("--scheduler", help="address of a running Dask scheduler")
+    parser.add_argument("--resume", action="store_true", help="continue the matrix in --out")
+    args, rest = parser.parse_known_args(argv)
+    forwarded = ["lab-matrix", "--out", args.out, *rest]
+    forwarded += ["--workers", args.workers] if args.workers else []
+    forwarded += ["--scheduler", args.scheduler] if args.scheduler else []
+    forwarded += ["--resume"] if args.resume else []
+    code = command.main(forwarded)
+    summary = Path(args.out) / "summary.md"
+    if code == 0 and summary.exists():
+        print(summary.read_text())
+    return code
+
+
+def _sweep():
+    from scenarios.sweep.named import NamedSweep
+
+    return NamedSweep("lab-matrix", "tp", cases, "every tp case of the lab report, and the checks against analysis",
+                      summarise=summarise, extra_metrics="scenarios.lab_matrix:late_mean_error", keep_results=True)
+
+
+SWEEP = _sweep()
 
 
 if __name__ == "__main__":

@@ -218,3 +218,34 @@ def test_figure_pools_seeds_and_groups(tmp_path):
     assert Path(path).stat().st_size > 10_000
     with pytest.raises(KeyError, match="no column 'erro'. Did you mean err"):
         sweep.plot(columns, "erro", "k")
+
+
+@pytest.mark.parametrize("settings, message", [
+    ({"burn_in": 300.0, "duration": 200.0}, "burn_in = 300 s must be shorter than duration = 200 s"),
+    ({"duration": 400.0}, "give duration >= 600 s"),
+    ({"k_max": 200.0}, "k dt = 2 must stay below 1"),
+    ({"k_min": 2.0, "k_max": 1.0}, "k_max = 1.0 must exceed k_min = 2.0"),
+])
+def test_gain_study_options_are_checked_before_any_run(settings, message, monkeypatch):
+    import scenarios
+    from orchestrator import System
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a run started with invalid options")
+
+    monkeypatch.setattr(System, "run", no_run)
+    with pytest.raises(ValueError, match=message.replace(".", r"\.")):
+        scenarios.run("gain-study", settings)
+
+
+def test_lab_matrix_is_a_named_sweep_of_every_case():
+    from scenarios import lab_matrix
+    from scenarios.sweep import named
+
+    plan = named.get("lab-matrix").plan(["noise=on"])
+    labels = [m.label for m in plan.members]
+    assert labels[:len(lab_matrix.CASES)] == list(lab_matrix.CASES)
+    assert len(labels) == len(lab_matrix.CASES) + len(lab_matrix.EXPLICIT_GAINS) + 2 * len(lab_matrix.PASSIVE_GAINS)
+    assert all(m.options["noise"] is True for m in plan.members)
+    passive = plan.members[-1].options  # TRIAD, kP = kI = 100: 1.5 times the predicted convergence, at least 10 s
+    assert passive["ry"] == "triad" and passive["kP"] == 100.0 and passive["duration"] == 10.0

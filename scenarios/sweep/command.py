@@ -85,7 +85,8 @@ def sweep(args) -> int:
                   + (f" over {', '.join(plan.varied)}" if plan.varied else "") + f", into {args.out}/",
                   file=sys.stderr)
         summary = engine.run(plan, args.out, workers=args.workers, scheduler=args.scheduler, resume=args.resume,
-                             retries=args.retries, retry_errors=args.retry_errors, keep_results=args.results,
+                             retries=args.retries, retry_errors=args.retry_errors,
+                             keep_results=args.results or named.keep_results(plan),
                              progress=False if args.quiet else None,
                              extra_metrics=named.extra_metrics(plan))
     except (KeyError, ValueError) as error:  # SweepError is a ValueError

@@ -30,9 +30,12 @@ class NamedSweep:
     description : str
         One line for ``quadcosim list``.
     summarise : callable, optional
-        ``(columns, out_dir) -> None``: reports written from the finished table.
+        ``(records, out_dir) -> None``: reports written from the finished members' records
+        (their ``metrics.json``, in member order).
     extra_metrics : str, optional
         ``"module:function"`` computing more metrics from ``(result, options)`` on the worker.
+    keep_results : bool
+        Keep every member's results and figures (a small sweep whose cases are looked at).
     """
 
     name: str
@@ -41,6 +44,7 @@ class NamedSweep:
     description: str = ""
     summarise: object = None
     extra_metrics: str | None = None
+    keep_results: bool = False
 
     def plan(self, settings=()):
         from scenarios.sweep.grid import plan_of_cases, split_assignment
@@ -75,12 +79,23 @@ def extra_metrics(plan) -> str | None:
     return registry()[plan.name].extra_metrics if plan.name else None
 
 
+def keep_results(plan) -> bool:
+    return registry()[plan.name].keep_results if plan.name else False
+
+
+def records(plan, out) -> list[dict]:
+    """The members' records (``metrics.json``), in member order."""
+    import json
+
+    from scenarios.sweep.engine import member_folder
+
+    return [json.loads((member_folder(Path(out), m.index) / "metrics.json").read_text()) for m in plan.members]
+
+
 def summarise(plan, out, summary) -> None:
-    """Run a named sweep's summary on its table, once every member has finished well."""
+    """Run a named sweep's summary on its members, once every member has finished well."""
     if not plan.name or summary.ok != summary.total:
         return
     named = registry()[plan.name]
     if named.summarise is not None:
-        from scenarios.sweep import table
-
-        named.summarise(table.read(out), Path(out))
+        named.summarise(records(plan, out), Path(out))
