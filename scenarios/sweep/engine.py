@@ -375,75 +375,91 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     """
     if retries < 0:
         raise SweepError(f"retries = {retries} must be zero or more")
-    out = Path(out)
-    records = _prepare_folder(plan, out, resume)
-    finished = {i: r for i, r in records.items() if r["status"] == "ok"}
-    rows = {i: table.row(r, plan.varied) for i, r in records.items()}
-    todo = [m for m in plan.members if m.index not in finished]
-    started = time.perf_counter()
-    interrupted, ran, worker_count, startup = 0, 0, 0, 0.0
-    last_write, write_cost = 0.0, 0.0
-
-    def flush(force=False):
-        nonlocal last_write, write_cost
-        # Rewriting the table costs time proportional to its size: keep it under 5 % of the run.
-        if force or time.perf_counter() - last_write >= 20 * write_cost:
-            t = time.perf_counter()
-            table.write(list(rows.values()), out)
-            last_write, write_cost = time.perf_counter(), time.perf_counter() - t
-
-    if todo:
-        token = uuid.uuid4().hex[:8]
+    sweep = _Sweep(plan, Path(out), resume)
+    if sweep.todo:
         with ExitStack() as stack:
             client = _cluster(stack, workers, scheduler, retries, timeout)
             client.register_plugin(Preload(plan.scenario))
-            worker_count = len(client.scheduler_info(n_workers=-1)["workers"])
-            startup = time.perf_counter() - started
-            bar = _Progress(len(todo), f"sweep {plan.name or plan.scenario}", progress)
-            from distributed import as_completed
+            sweep.stream(client, retries, retry_errors, keep_results, extra_metrics, progress)
+    elif sweep.rows:
+        sweep.flush(force=True)
+    return sweep.summary()
 
-            by_key: dict[str, tuple[Member, int]] = {}
 
-            def submit(member: Member, attempt: int):
-                key = f"quadcosim-{token}-member-{member.index}-try-{attempt}"
-                future = client.submit(run_member, plan.scenario, member.options, keep_results, extra_metrics,
-                                       key=key, pure=False)
-                by_key[key] = (member, attempt)
-                return future
+class _Sweep:
+    """One call of :func:`run`: the table's rows, the members left to run, and the streaming of
+    their results into the sweep folder."""
 
-            pending = as_completed()
-            try:
-                pending.update([submit(m, 1) for m in todo])
-                for future in pending:
-                    member, attempt = by_key.pop(future.key)
-                    lost = False
-                    try:
-                        record = future.result()
-                    except Exception as error:  # the worker died (KilledWorker), or the connection
-                        lost = True
-                        record = {"status": "failed", "error": f"worker lost: {type(error).__name__}: {error}",
-                                  "traceback": None, "metrics": {}, "wall_s": None, "worker": None}
-                    future.release()
-                    if record["status"] != "ok" and attempt <= retries and (lost or retry_errors):
-                        pending.add(submit(member, attempt + 1))
-                        continue
-                    saved = _save_member(out, member, record, attempt, plan.scenario)
-                    rows[member.index] = table.row(saved, plan.varied)
-                    ran += 1
-                    bar.update(record["status"] != "ok")
-                    flush()
-            except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM under the command line
-                from orchestrator.interrupts import signal_number
+    def __init__(self, plan: Plan, out: Path, resume: bool):
+        self.plan, self.out = plan, out
+        records = _prepare_folder(plan, out, resume)
+        self.finished = {i for i, r in records.items() if r["status"] == "ok"}
+        self.rows = {i: table.row(r, plan.varied) for i, r in records.items()}
+        self.todo = [m for m in plan.members if m.index not in self.finished]
+        self.started = time.perf_counter()
+        self.interrupted, self.ran, self.workers, self.startup = 0, 0, 0, 0.0
+        self.last_write, self.write_cost = 0.0, 0.0
 
-                interrupted = signal_number(interrupt)
-                client.cancel(list(pending.futures))
-            finally:
-                bar.close()
-                if rows:
-                    flush(force=True)
-    elif rows:
-        flush(force=True)
-    ok = sum(r["status"] == "ok" for r in rows.values())
-    failures = sorted((i, r["label"], r["error"]) for i, r in rows.items() if r["status"] != "ok")
-    return Summary(out, len(plan.members), ok, len(failures), ran, len(finished), time.perf_counter() - started,
-                   worker_count, startup, interrupted, failures)
+    def flush(self, force: bool = False):
+        # Rewriting the table costs time proportional to its size: keep it under 5 % of the run.
+        if force or time.perf_counter() - self.last_write >= 20 * self.write_cost:
+            t = time.perf_counter()
+            table.write(list(self.rows.values()), self.out)
+            self.last_write, self.write_cost = time.perf_counter(), time.perf_counter() - t
+
+    def stream(self, client, retries, retry_errors, keep_results, extra_metrics, progress):
+        """Submit every member left, and record each as it finishes (retrying as configured)."""
+        from distributed import as_completed
+
+        self.workers = len(client.scheduler_info(n_workers=-1)["workers"])
+        self.startup = time.perf_counter() - self.started
+        bar = _Progress(len(self.todo), f"sweep {self.plan.name or self.plan.scenario}", progress)
+        token, by_key = uuid.uuid4().hex[:8], {}
+
+        def submit(member: Member, attempt: int):
+            key = f"quadcosim-{token}-member-{member.index}-try-{attempt}"
+            by_key[key] = (member, attempt)
+            return client.submit(run_member, self.plan.scenario, member.options, keep_results, extra_metrics,
+                                 key=key, pure=False)
+
+        pending = as_completed()
+        try:
+            pending.update([submit(m, 1) for m in self.todo])
+            for future in pending:
+                member, attempt = by_key.pop(future.key)
+                record, lost = _outcome(future)
+                if record["status"] != "ok" and attempt <= retries and (lost or retry_errors):
+                    pending.add(submit(member, attempt + 1))
+                    continue
+                saved = _save_member(self.out, member, record, attempt, self.plan.scenario)
+                self.rows[member.index] = table.row(saved, self.plan.varied)
+                self.ran += 1
+                bar.update(record["status"] != "ok")
+                self.flush()
+        except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM under the command line
+            from orchestrator.interrupts import signal_number
+
+            self.interrupted = signal_number(interrupt)
+            client.cancel(list(pending.futures))
+        finally:
+            bar.close()
+            if self.rows:
+                self.flush(force=True)
+
+    def summary(self) -> Summary:
+        rows = self.rows
+        ok = sum(r["status"] == "ok" for r in rows.values())
+        failures = sorted((i, r["label"], r["error"]) for i, r in rows.items() if r["status"] != "ok")
+        return Summary(self.out, len(self.plan.members), ok, len(failures), self.ran, len(self.finished),
+                       time.perf_counter() - self.started, self.workers, self.startup, self.interrupted, failures)
+
+
+def _outcome(future) -> tuple[dict, bool]:
+    """A finished member's record, and whether its worker was lost on the way."""
+    try:
+        record, lost = future.result(), False
+    except Exception as error:  # the worker died (KilledWorker), or the connection
+        record, lost = {"status": "failed", "error": f"worker lost: {type(error).__name__}: {error}",
+                        "traceback": None, "metrics": {}, "wall_s": None, "worker": None}, True
+    future.release()
+    return record, lost

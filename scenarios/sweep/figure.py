@@ -50,44 +50,15 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     """
     import matplotlib.pyplot as plt
 
-    for name in (metric, x, by):
-        if name is not None and name not in columns:
-            from orchestrator.fmu import nearest
-
-            raise KeyError(f"the sweep table has no column {name!r}.{nearest(name, columns)}")
-    count = len(columns[x])
-    status = columns.get("status", ["ok"] * count)
-    kept = [i for i in range(count) if status[i] == "ok" and _number(columns[metric][i]) is not None]
-    failed = sum(s != "ok" for s in status)
-    if not kept:
-        raise ValueError(f"no finished member has a numeric {metric!r}")
-    xs = [columns[x][i] for i in kept]
-    numeric_x = all(_number(v) is not None for v in xs)
-    categories = sorted(set(map(str, xs))) if not numeric_x else []
-    position = (lambda v: float(v)) if numeric_x else (lambda v: float(categories.index(str(v))))
-    groups: dict[object, dict[float, list[float]]] = defaultdict(lambda: defaultdict(list))
-    for i in kept:
-        key = columns[by][i] if by else None
-        groups[key][position(columns[x][i])].append(float(columns[metric][i]))
-
+    groups, categories, numeric_x, failed = _groups(columns, metric, x, by)
     if ax is None:
         figure, ax = plt.subplots(figsize=(8, 5))
     else:
         figure = ax.figure
     for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: str(item[0]))):
-        at = np.array(sorted(series))
-        values = [np.array(series[a]) for a in at]
-        mean = np.array([v.mean() for v in values])
-        colour = f"C{n % 10}"
-        label = f"{by} = {key}" if by else metric
-        pooled = max(len(v) for v in values)
-        ax.plot(at, mean, "o-", color=colour, label=label + (f" (mean of {pooled})" if pooled > 1 else ""))
-        if pooled > 1:
-            ax.fill_between(at, [v.min() for v in values], [v.max() for v in values], color=colour, alpha=0.15)
-            for a, v in zip(at, values, strict=True):
-                ax.plot(np.full(len(v), a), v, ".", color=colour, alpha=0.3, ms=3)
-    positive = numeric_x and min(float(v) for v in xs) > 0
-    if positive and max(float(v) for v in xs) / min(float(v) for v in xs) > 10:
+        _curve(ax, series, f"C{n % 10}", f"{by} = {key}" if by else metric)
+    xs = [a for series in groups.values() for a in series]
+    if numeric_x and min(xs) > 0 and max(xs) / min(xs) > 10:
         ax.set_xscale("log")
     if logy:
         ax.set_yscale("log")
@@ -109,3 +80,40 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return str(path)
+
+
+def _groups(columns, metric, x, by):
+    """The finished members' metric by group and x position; the x categories (text options),
+    whether x is numeric, and how many members failed."""
+    for name in (metric, x, by):
+        if name is not None and name not in columns:
+            from orchestrator.fmu import nearest
+
+            raise KeyError(f"the sweep table has no column {name!r}.{nearest(name, columns)}")
+    count = len(columns[x])
+    status = columns.get("status", ["ok"] * count)
+    kept = [i for i in range(count) if status[i] == "ok" and _number(columns[metric][i]) is not None]
+    failed = sum(s != "ok" for s in status)
+    if not kept:
+        raise ValueError(f"no finished member has a numeric {metric!r}")
+    xs = [columns[x][i] for i in kept]
+    numeric_x = all(_number(v) is not None for v in xs)
+    categories = [] if numeric_x else sorted(set(map(str, xs)))
+    groups: dict[object, dict[float, list[float]]] = defaultdict(lambda: defaultdict(list))
+    for i in kept:
+        at = float(columns[x][i]) if numeric_x else float(categories.index(str(columns[x][i])))
+        groups[columns[by][i] if by else None][at].append(float(columns[metric][i]))
+    return groups, categories, numeric_x, failed
+
+
+def _curve(ax, series: dict[float, list[float]], colour: str, label: str):
+    """One group: the mean through its x positions; with pooled members, their band and points."""
+    at = np.array(sorted(series))
+    values = [np.array(series[a]) for a in at]
+    pooled = max(len(v) for v in values)
+    ax.plot(at, [v.mean() for v in values], "o-", color=colour,
+            label=label + (f" (mean of {pooled})" if pooled > 1 else ""))
+    if pooled > 1:
+        ax.fill_between(at, [v.min() for v in values], [v.max() for v in values], color=colour, alpha=0.15)
+        for a, v in zip(at, values, strict=True):
+            ax.plot(np.full(len(v), a), v, ".", color=colour, alpha=0.3, ms=3)
