@@ -36,6 +36,21 @@ def _disk(paths) -> tuple[int, int]:
 
 
 def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
+    """Run the benchmark sweep on 1 then 2 local workers.
+
+    Parameters
+    ----------
+    members : int
+        Closed-loop runs (seeds 1 to ``members``).
+    duration : float
+        Simulated time of each run (s).
+
+    Returns
+    -------
+    dict
+        Rates (members/s), start-up (s), CPU and wall time per member (s), disk per member
+        (bytes), the 10 000-member extrapolation (h, MB), load averages.
+    """
     from scenarios.sweep import engine, grid, table
 
     settings = [s for s in SETTINGS if not s.startswith("duration=")] + [f"duration={duration:g}"]
@@ -84,6 +99,7 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
 
 
 def report(f: dict) -> str:
+    """The figures of :func:`measure` as lines of text."""
     one, two = f["workers_1"], f["workers_2"]
     lines = [
         f"sweep engine: {f['members']} closed-loop members of {f['simulated_s_per_member']:g} s simulated "
@@ -110,6 +126,7 @@ def report(f: dict) -> str:
 
 
 def main(argv=None) -> int:
+    """``quadcosim bench sweep [--json]``: measure and print; returns 0."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="quadcosim bench sweep", description=__doc__.splitlines()[0])

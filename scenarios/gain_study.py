@@ -100,6 +100,7 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
 
 
 def closed_loop_options(k: float, o: dict) -> dict:
+    """The ``tp`` options of the estimate-fed closed-loop run at gain ``k`` (1/s)."""
     return {"estimator": "linear", "k": k, "flight": o["closed_flight"], "feedback": "estimate", "noise": True,
             "duration": o["closed_duration"], "settle": min(20.0, o["closed_duration"] / 4), "seed": o["seed"]}
 

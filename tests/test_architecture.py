@@ -109,8 +109,7 @@ def test_the_rule_itself(layer, module, expected):
 
 # Functions written before this rule, still to be split by their owners; the list may only shrink.
 LONG_PENDING = {"estimators/core.py:update", "calibration/file.py:from_dict", "calibration/infrared.py:ekf_step",
-                "scenarios/ir_calibration.py:report", "scenarios/metge.py:report", "scenarios/sweep/engine.py:run",
-                "scenarios/sweep/figure.py:plot"}
+                "scenarios/ir_calibration.py:report", "scenarios/metge.py:report"}
 MAX_FUNCTION_LINES = 60  # code lines, the docstring not counted
 
 

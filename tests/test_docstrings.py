@@ -21,25 +21,6 @@ STRICT = ("fmus", "orchestrator")  # parameters named in the docstring, too
 # Callables written before this test, still to be documented by their owners; the list may
 # only shrink (a new undocumented callable fails at once).
 PENDING = {
-    # w10-sweep
-    "scenarios.sweep.command.add_arguments",
-    "scenarios.sweep.command.add_plot_arguments",
-    "scenarios.sweep.command.sweep",
-    "scenarios.sweep.command.sweep_plot",
-    "scenarios.sweep.command.main",
-    "scenarios.sweep.engine.Summary.missing",
-    "scenarios.sweep.engine.Summary.text",
-    "scenarios.sweep.engine.member_folder",
-    "scenarios.sweep.grid.split_assignment",
-    "scenarios.sweep.grid.Plan.to_json",
-    "scenarios.sweep.named.NamedSweep.plan",
-    "scenarios.sweep.named.registry",
-    "scenarios.sweep.named.get",
-    "scenarios.sweep.named.extra_metrics",
-    "scenarios.sweep.table.columns_of",
-    "benchmarks.sweep.measure",
-    "benchmarks.sweep.report",
-    "benchmarks.sweep.main",
     # w9-infrared
     "benchmarks.infrared.measure",
     "benchmarks.infrared.main",

@@ -16,6 +16,7 @@ from pathlib import Path
 
 
 def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Add the options of ``quadcosim sweep`` to the parser ``p``; return it."""
     p.add_argument("scenario", help="a scenario (quadcosim list) or a named sweep (lab-matrix)")
     p.add_argument("--grid", action="append", default=[], metavar="NAME=SPEC",
                    help="vary an option: a,b,c | start:stop:logN | start:stop:linN | start:stop (integers)")
@@ -35,6 +36,7 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def add_plot_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Add the options of ``quadcosim sweep-plot`` to the parser ``p``; return it."""
     p.add_argument("table", help="a sweep folder, or its sweep.parquet / sweep.csv")
     p.add_argument("metric", help="a metric column, e.g. 'rms_error_deg[0]'")
     p.add_argument("--x", required=True, help="the option along the horizontal axis")
@@ -72,6 +74,14 @@ def make_plan(args):
 
 
 def sweep(args) -> int:
+    """Run ``quadcosim sweep`` from parsed arguments; print the summary.
+
+    Returns
+    -------
+    int
+        Exit code: 0 when every member finished well, 1 when any failed, 2 for bad arguments,
+        128 + the signal when interrupted.
+    """
     from scenarios.sweep import engine, named
 
     try:
@@ -98,6 +108,13 @@ def sweep(args) -> int:
 
 
 def sweep_plot(args) -> int:
+    """Run ``quadcosim sweep-plot`` from parsed arguments; print the figure's path.
+
+    Returns
+    -------
+    int
+        Exit code: 0, or 2 for a missing table or column.
+    """
     from scenarios.sweep import figure, table
 
     try:
@@ -115,6 +132,7 @@ def sweep_plot(args) -> int:
 
 
 def main(argv=None) -> int:
+    """``python -m scenarios.sweep``: the same as ``quadcosim sweep``; returns its exit code."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
     p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,

@@ -188,6 +188,7 @@ class Summary:
 
     @property
     def missing(self) -> int:
+        """Members neither finished nor failed (an interrupted sweep)."""
         return self.total - self.ok - self.failed
 
     def exit_code(self) -> int:
@@ -197,6 +198,7 @@ class Summary:
         return 0 if self.failed == 0 and self.missing == 0 else 1
 
     def text(self) -> str:
+        """A few lines for a person: counts, rate, the first failures, where the table is."""
         running = self.seconds - self.startup_s
         rate = self.ran / running if running > 0 else float("nan")
         lines = [f"{self.ok} of {self.total} members done, {self.failed} failed"
@@ -222,6 +224,7 @@ def _write_json(path: Path, data: dict) -> None:
 
 
 def member_folder(out: Path, index: int) -> Path:
+    """The folder of member ``index`` in the sweep folder ``out``."""
     return out / "members" / f"{index:06d}"
 
 

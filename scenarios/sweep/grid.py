@@ -62,6 +62,7 @@ def _text(value) -> str:
 
 
 def split_assignment(text: str, flag: str) -> tuple[str, str]:
+    """``"k=0.1,1"`` as ``("k", "0.1,1")``; a clear error naming ``flag`` otherwise."""
     name, eq, spec = text.partition("=")
     if not eq or not name.strip():
         raise ValueError(f"{flag} {text!r}: write NAME=VALUES, e.g. k=0.01:10:log12 or estimator=linear,explicit")
@@ -88,6 +89,7 @@ class Plan:
     name: str | None = None  # a named sweep's name
 
     def to_json(self) -> dict:
+        """The plan as stored in ``sweep.json`` (every member's options)."""
         return {"scenario": self.scenario, "name": self.name, "varied": self.varied,
                 "description": self.description,
                 "members": [{"label": m.label, "options": m.options} for m in self.members]}

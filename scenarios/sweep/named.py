@@ -47,6 +47,7 @@ class NamedSweep:
     keep_results: bool = False
 
     def plan(self, settings=()):
+        """The sweep's plan, with ``settings`` (``["duration=5", ...]``) applied to every case."""
         from scenarios.sweep.grid import plan_of_cases, split_assignment
 
         fixed = dict(split_assignment(s, "--set") for s in settings)
@@ -55,6 +56,7 @@ class NamedSweep:
 
 
 def registry() -> dict[str, NamedSweep]:
+    """Every named sweep, by name."""
     sweeps = {}
     for module in MODULES:
         try:
@@ -69,6 +71,7 @@ def registry() -> dict[str, NamedSweep]:
 
 
 def get(name: str) -> NamedSweep:
+    """The named sweep ``name``; an error listing the known ones otherwise."""
     sweeps = registry()
     if name not in sweeps:
         raise KeyError(f"unknown named sweep {name!r}.{nearest(name, sweeps)} Named sweeps: {', '.join(sweeps)}.")
@@ -76,10 +79,12 @@ def get(name: str) -> NamedSweep:
 
 
 def extra_metrics(plan) -> str | None:
+    """The extra-metrics function of the plan's named sweep, if any."""
     return registry()[plan.name].extra_metrics if plan.name else None
 
 
 def keep_results(plan) -> bool:
+    """Whether the plan's named sweep keeps its members' results and figures."""
     return registry()[plan.name].keep_results if plan.name else False
 
 

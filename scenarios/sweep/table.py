@@ -54,6 +54,7 @@ def row(record: dict, varied_first=()) -> dict:
 
 
 def columns_of(rows: list[dict]) -> list[str]:
+    """Every column of ``rows``, in the order they first appear."""
     names: dict[str, None] = {}
     for r in rows:
         names.update(dict.fromkeys(r))
