@@ -124,7 +124,11 @@ def sweep_plot(args) -> int:
         safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in f"{args.metric}-vs-{args.x}")
         path = figure.plot(columns, args.metric, args.x, by=args.by, logy=args.logy,
                            out=args.out or folder / f"{safe}.png")
-    except (KeyError, ValueError, FileNotFoundError) as error:
+    except FileNotFoundError as error:
+        print(f"quadcosim sweep-plot: no sweep table at {error.filename}: give a sweep folder (--out of "
+              "quadcosim sweep) or its sweep.parquet / sweep.csv", file=sys.stderr)
+        return 2
+    except (KeyError, ValueError) as error:
         print(f"quadcosim sweep-plot: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
     print(path)
