@@ -68,9 +68,12 @@ def test_torque_of_each_motor_follows_the_airframe(motor):
     inputs[f"omega_r{motor.number}"] = 1.1 * W_HOVER
     out = run_fmu("Quadrotor", {}, inputs, 1, outputs=["tau_x", "tau_y", "tau_z"])
     x, y = motor.direction
-    assert np.sign(out["tau_x"][-1]) == -np.sign(y)  # more lift on the right rolls left
-    assert np.sign(out["tau_y"][-1]) == np.sign(x)  # more lift in front pitches up
-    assert np.sign(out["tau_z"][-1]) == motor.spin
+    extra = (1.1**2 - 1.0) * W_HOVER**2  # the other three cancel in pairs
+    lift, drag = vehicle.THRUST_COEFF * extra, vehicle.DRAG_TORQUE_COEFF * extra
+    # thrust along -z_B at r = arm (x, y): tau = r x F = (-y T, x T); more lift on the right
+    # rolls left, in front pitches up; the yaw reaction follows the spin (measured: 4e-15 relative)
+    expected = [-y * vehicle.ARM * lift, x * vehicle.ARM * lift, motor.spin * drag]
+    assert [out["tau_x"][-1], out["tau_y"][-1], out["tau_z"][-1]] == pytest.approx(expected, rel=1e-12)
 
 
 def test_rotor_drag_pulls_a_level_hover_to_the_wind_speed():

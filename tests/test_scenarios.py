@@ -16,7 +16,7 @@ from scenarios.rig import phases
 README = Path(__file__).resolve().parent.parent / "README.md"
 
 
-def test_rig_reproduces_seed_000_figure_1(tmp_path):
+def test_rig_reproduces_metge_figure_1(tmp_path):
     """Clamped drone: the measured field moves as one motor's command rises, and comes back to
     the motors-off reference when it falls."""
     options = {"sweep": 4.0, "rest": 0.3, "free": 1.0, "reference": 0.5, "noise": False}
@@ -34,8 +34,9 @@ def test_rig_reproduces_seed_000_figure_1(tmp_path):
         assert spearmanr(command, deviation[rising]).statistic > 0.99
         assert deviation[rising].max() > 10.0
     rests = (t >= o["reference"] + o["sweep"] + 0.2) & (t < o["reference"] + o["sweep"] + o["rest"])
-    assert deviation[rests].max() < 0.5  # motors off again: back to the reference
-    assert 5.0 < metrics["mean_angular_error_single_motor_deg"] < 15.0  # the order of Metge et al.'s Table 1
+    assert deviation[rests].max() < 0.01  # motors off again: back to the reference (measured 0.0025 deg)
+    # the order of Metge et al.'s Table 1, about 10 deg (measured 9.9 deg)
+    assert 8.0 < metrics["mean_angular_error_single_motor_deg"] < 12.0
 
 
 def test_cli_run_writes_results_metrics_and_figures(tmp_path):
