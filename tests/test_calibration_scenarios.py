@@ -2,6 +2,7 @@
 iron; metge reproduces the shape of Metge et al.'s Table 1 and the motor-dynamics gain."""
 
 import numpy as np
+import pytest
 
 import scenarios
 
@@ -16,6 +17,7 @@ def test_static_cal_recovers_the_iron_of_the_imu(tmp_path):
     assert (tmp_path / "static.json").exists()
 
 
+@pytest.mark.slow
 def test_metge_table1_and_the_motor_dynamics(tmp_path):
     _, m = scenarios.run("metge", {"levels": 6, "free": 6.0}, out_dir=tmp_path)
     table = m["table1_deg"]

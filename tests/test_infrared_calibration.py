@@ -15,6 +15,7 @@ def both_faults():
     return scenarios.run("ir-calibration", {"faults": "both"})
 
 
+@pytest.mark.slow
 def test_kalman_turn_rate_error_is_a_third_of_the_regression_on_drifting_data():
     result, metrics = scenarios.run("ir-calibration", {})
     stats = metrics["turn_rate_error_deg_s"]

@@ -113,6 +113,7 @@ def test_wrong_state_messages_name_the_states():
 FUZZ_CALLS = 10_000
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", MODELS)
 def test_fuzz(model, tmp_path):
     """Random calls in random order, run in a child process so that a crash is a failure with

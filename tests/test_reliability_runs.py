@@ -27,6 +27,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 # ---------------------------------------------------------------------- interrupts
+@pytest.mark.slow
 @pytest.mark.parametrize("sent, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_an_interrupted_run_saves_what_it_recorded_and_leaves_no_temporary_files(tmp_path, sent, code):
     temporary, out, errors = tmp_path / "tmp", tmp_path / "run", tmp_path / "stderr"
@@ -154,6 +155,7 @@ def test_a_run_that_would_not_fit_in_memory_is_refused_with_the_figure_and_the_w
     assert time.perf_counter() - start < 20
 
 
+@pytest.mark.slow
 def test_the_record_is_not_copied_at_the_end_of_a_run():
     """Python-side allocations during a run: the record, its time vector, and little else."""
     steps = 200_000
