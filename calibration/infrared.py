@@ -5,19 +5,24 @@ infrared reading is linear in the turn rate for small bank angles, ``IR = a r + 
 and ``b`` drifting with time of day, temperature and cloud. The GPS gives a reliable but late
 turn rate. Three estimators of ``(a, b)`` and of the present turn rate ``(IR - b) / a``:
 
-- :class:`TurnRateEKF`: the slides' extended Kalman filter on ``(a, b, r)``, measurements the GPS
-  turn rate and the IR, random-walk model (``F = I``). It is written as two sequential scalar
-  updates (``form="sequential"``, cheaper, the default) or as the slides' joint update
-  (``form="joint"``). Beyond the slides: innovation gating as in PX4's EKF2 (test ratio
+- ``Estimator("kalman")`` (:class:`EKFSettings`, :func:`ekf_step`): the slides' extended Kalman
+  filter on ``(a, b, r)``, measurements the GPS turn rate and the IR, random-walk model
+  (``F = I``). It is written as two sequential scalar updates (``form="sequential"``, cheaper,
+  the default) or as the slides' joint update (``form="joint"``, :func:`ekf_joint_step`).
+  Beyond the slides: innovation gating as in PX4's EKF2 (test ratio
   ``nu^2 / (gamma^2 S)``, a rejected measurement is not fused), a fault declared after
   ``declare`` consecutive rejections, attributed to the IR or the GPS by which one disagrees
   with the state and the other sensor, and cleared after ``clear`` consecutive consistent
-  samples. While the GPS is not fused, the IR updates the turn rate only, so ``a`` and ``b``
-  keep their calibration.
-- :class:`Regression`: the slides' baseline, the least-squares line through all the paired
-  samples since take-off, recomputed every second, unrealistic points rejected.
-- :class:`ForgettingRLS`: the recursive least squares with forgetting factor 0.995 of
-  Paparazzi's flight code, updated only when the GPS bank angle lies in [0.05, 1] rad.
+  samples. The present IR is also checked against the state, so that an IR fault is declared
+  before it reaches the paired window. While the GPS is not fused, the IR updates the turn rate
+  only, so ``a`` and ``b`` keep their calibration; when a fault ends their variances are
+  raised back to the initial ones.
+- ``Estimator("regression")`` (:class:`RegressionSettings`, :func:`regression_step`): the
+  slides' baseline, the least-squares line through all the paired samples since take-off,
+  recomputed every second, unrealistic points rejected.
+- ``Estimator("rls")`` (:class:`RLSSettings`, :func:`rls_step`): the recursive least squares
+  with forgetting factor 0.995 of Paparazzi's flight code, updated only when the GPS bank angle
+  lies in [0.05, 1] rad.
 
 Pairing: the GPS turn rate at sample ``k`` is the heading difference over the ``window``
 samples ``[k - delay - window, k - delay)``, i.e. the mean turn rate there. Every estimator is
@@ -25,7 +30,7 @@ fed the mean IR over the same samples (:func:`pair_at`), so that the pair refers
 stretch of flight, as the slides pair IR and GPS "without offset".
 
 Each estimator's arithmetic is one compiled step function, called by the batch path (a
-compiled loop over recorded arrays, :func:`run`) and by the streaming block
+compiled loop over recorded arrays, :meth:`Estimator.run`) and by the streaming block
 (:class:`InfraredCalibration`, an :class:`orchestrator.Block`). :func:`cost` counts the
 operations of each step by running the same Python source on counting numbers, and times it.
 
