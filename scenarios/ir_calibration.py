@@ -5,8 +5,9 @@ fixed-wing flies a scripted bank profile (turns and straight legs whose turn rat
 slides' mean 0.037 and standard deviation 0.24 rad/s); the InfraredSensor FMU gives the IR
 reading, whose ``a`` and ``b`` drift, and the GPS turn rate, 1 s late. Three estimators run
 side by side as streaming blocks: the Kalman filter (gated or not), the slides' regression and
-Paparazzi's forgetting RLS. Faults as in the slides: IR +1200 for 2000 samples from 100 s,
-GPS turn rate +1.5 rad/s for 2000 samples from 250 s.
+Paparazzi's forgetting RLS. Faults as in the slides: IR +1200 for 2000 samples from 60 s,
+GPS turn rate +1.5 rad/s for 2000 samples from 280 s; the drift's cloud (170 to 270 s) lies
+between them.
 
 Figures: ``calibration.png`` (a, b and the turn rate against their truth), ``innovations.png``
 (the Kalman innovations and their gates), ``errors.png`` (turn-rate error histograms).
