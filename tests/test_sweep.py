@@ -37,6 +37,7 @@ def reference(tmp_path_factory):
     return code, out, table.read(out)
 
 
+@pytest.mark.slow
 def test_failing_members_are_recorded_and_the_others_complete(reference, capsys):
     code, out, columns = reference
     assert code == 1  # some members failed
@@ -59,6 +60,7 @@ def test_failing_members_are_recorded_and_the_others_complete(reference, capsys)
     assert summary.exit_code() == 1 and "4 failed" in summary.text()
 
 
+@pytest.mark.slow
 def test_one_and_two_workers_give_the_same_table(reference, tmp_path):
     _, _, two = reference
     out = tmp_path / "one-worker"
@@ -69,6 +71,7 @@ def test_one_and_two_workers_give_the_same_table(reference, tmp_path):
     assert not table.same(one, {**two, "rms_error_deg[0]": two["rms_error_deg[0]"][::-1]})
 
 
+@pytest.mark.slow
 def test_killed_sweep_resumes_to_the_same_table(reference, tmp_path):
     _, _, uninterrupted = reference
     out = tmp_path / "killed"
@@ -105,6 +108,7 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_sweep_through_a_separately_started_scheduler(reference, tmp_path):
     from distributed import Client
 
@@ -130,6 +134,7 @@ def test_sweep_through_a_separately_started_scheduler(reference, tmp_path):
             process.wait(timeout=30)
 
 
+@pytest.mark.slow
 def test_a_dead_worker_is_retried_then_recorded(tmp_path):
     plan = sweep.plan("tp", ["k=0.05,2000"], ["duration=0.2"])
     summary = sweep.run(plan, tmp_path / "dead", workers=1, retries=1, progress=False,
