@@ -369,11 +369,11 @@ COMPENSATIONS = ("none", "static", "metge", "dynamic")
 
 
 @functools.lru_cache(maxsize=4)
-def rig_calibration(orders: str = "4,1") -> Calibration:
-    """Calibration 1 of this scenario at its default options, made on the clamped rig (about
-    30 s of simulated rig time); cached for the process. The tp vehicle has no soft or hard
-    iron, so the static part is the identity."""
-    o = SCENARIO.parse({"orders": orders})
+def rig_calibration(orders: str = "4,1", levels: int = 8) -> Calibration:
+    """Calibration 1 of this scenario with ``levels`` command levels, made on the clamped rig
+    (about 30 s of simulated rig time); cached for the process. The tp vehicle has no soft or
+    hard iron, so the static part is the identity."""
+    o = SCENARIO.parse({"orders": orders, "levels": levels})
     runs = []
     for run in range(len(socs(o, 1))):
         recorded = system_for(o, 1, run).run(commands(o, 1)[2], record=RECORD)
