@@ -33,6 +33,7 @@ def test_metge_table1_and_the_motor_dynamics(tmp_path):
         p.name for p in tmp_path.iterdir()}
 
 
+@pytest.mark.slow
 def test_tp_compensation_restores_the_yaw(tmp_path):
     """The closed loop with the motor field at the magnetometer: the explicit filter's yaw
     error without and with the dynamics-aware compensation, from a rig calibration."""
