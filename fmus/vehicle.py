@@ -61,6 +61,16 @@ MOTOR_KE = 60.0 / (2.0 * math.pi * MOTOR_KV)  # V s/rad (= N m/A)
 MOTOR_RESISTANCE = 0.10  # ohm
 MOTOR_INDUCTANCE = 4.0e-5  # H
 ROTOR_INERTIA = 3.0e-5  # kg m^2, rotor bell plus propeller
+# ESC. Free-wheeling by default: with non-complementary PWM the motor current decays through
+# the free-wheeling diodes and cannot reverse, so no current returns to the battery. The
+# alternative, complementary PWM (BLHeli's "damped light"), shorts the motor while the PWM is off
+# and brakes regeneratively (BLHeli SiLabs manual, rev. 14; O. Duffy, "BLHeli 14.8 damped
+# light and active freewheeling", 2016).
+ESC_REGENERATIVE = False  # 1 (Boolean): False free-wheeling, True regenerative braking
+# Motor current limit: the 18 A rating of the DJI opto ESC of the F450 class (E. Boldt,
+# "DJI ESC and brushless motor", robotic-controls.com, 2013); BLHeli_S's current protection
+# limits the current fast enough to act during accelerations (Turnigy Multistar BLHeli_S manual).
+ESC_CURRENT_LIMIT = 18.0  # A
 
 # Battery
 BATTERY_CELLS = 3  # in series
@@ -73,7 +83,7 @@ CELL_OCV_COEFFS = (3.27, 1.53, -2.03, 1.43)  # V, V, V, V
 
 # Magnetic field of the motor currents at the magnetometer, sensor frame {B}.
 # kappa_n in T/A; v_n unit vectors (normalised by the FMU).
-MOTOR_FIELD_GAIN = (1.85e-6, 1.60e-6, 2.10e-6, 1.75e-6)  # T/A
+MOTOR_FIELD_GAIN = (2.78e-6, 2.40e-6, 3.15e-6, 2.63e-6)  # T/A, field per ampere of supply current
 MOTOR_FIELD_DIRECTION = (
     (0.30, 0.80, -0.52),  # 1, unit-less
     (-0.55, -0.35, 0.76),  # 2, unit-less

@@ -4,7 +4,8 @@ Each twin is simulated by the PyPI package ``modelica`` (pinned) with its inputs
 functions of time in a wrapper model; the FMU is stepped with the same functions (see
 fmus/twins.py). Noise is off. Tolerance: 1e-6 of each signal's peak over 2 s, except MotorMagnetics at 2e-5:
 the FMU holds each input over a communication step while the twin sees it continuously, and
-the stiff motor current follows the command within L/R = 0.4 ms, so the hold shows there.
+the stiff motor current follows the command within L/R = 0.4 ms, so the hold shows there (the
+commands that swing ten times faster, onto the current bounds, are stepped at 20 us for it).
 
 What the toolchain cannot check: the IMU's white noise and bias random walk are drawn by a
 counter-based generator inside the FMU, which has no equation-based Modelica form; they are
@@ -57,6 +58,14 @@ def test_quadrotor_twin_clamped():
 def test_motor_magnetics_twin():
     inputs = {f"c{n}": f"0.45 + 0.25*sin({n}*time)" for n in range(1, 5)}
     compare("MotorMagnetics", inputs, {}, 5e-5, 200, tolerance=2e-5)
+
+
+@pytest.mark.parametrize("regenerative", [False, True], ids=["free-wheeling", "regenerative"])
+def test_motor_magnetics_twin_on_the_current_bounds(regenerative):
+    """Commands that swing fast enough to stop the currents at zero (or reverse them) and to
+    drive them onto the limit: the FMU's located mode switches against the twin's state events."""
+    inputs = {f"c{n}": f"0.5 + 0.45*sin({6 * n}*time)" for n in range(1, 5)}
+    compare("MotorMagnetics", inputs, {"regenerative": regenerative}, 2e-5, 500, tolerance=2e-5)
 
 
 def test_imu_twin_at_sample_instants():

@@ -1,23 +1,33 @@
 /* MotorMagnetics: four brushless motors in the DC-motor approximation, their ESCs, a LiPo
- * battery, and the magnetic field of the motor currents at the magnetometer.
+ * battery, and the magnetic field the ESCs' supply cables make at the magnetometer.
  *
  *   L di_n = c_n u - R i_n - k_e omega_n           c_n saturated to [0, 1]
  *   J_r domega_n = k_e i_n - k_m omega_n |omega_n|
- *   u = E(soc) - R_b i_batt,  i_batt = sum c_n max(i_n, 0)
- *   dsoc = -i_batt / capacity
- *   b_d = sum kappa_n i_n v_n
+ *   i_s,n = c_n i_n                                 ESC input (supply) current, averaged PWM model
+ *   u = E(soc) - R_b i_batt,  i_batt = sum i_s,n,  dsoc = -i_batt / capacity
+ *   b_d = sum kappa_n i_s,n v_n                     field of the supply cables
  *
- * The battery current is the ESC's average input current c_n i_n (PWM power balance); an ESC
- * never pushes current back into the battery, hence max(i_n, 0).
+ * ESC behaviour when the back-EMF exceeds its output (c_n u < k_e omega_n):
+ * - free-wheeling (regenerative = false, the default): the motor current decays through the
+ *   free-wheeling diodes and stops at zero; the ESC's output then floats and the rotor coasts
+ *   (i_n = 0) until c_n u exceeds k_e omega_n again. Motor and supply currents stay >= 0.
+ * - regenerative braking (regenerative = true, complementary PWM): the current reverses, brakes
+ *   the rotor and flows back into the battery (i_s,n < 0).
+ * Current limit: |i_n| <= i_max; at the limit the ESC holds the current there (i_n = i_max)
+ * until the motor's own dynamics would take it below.
  *
- * The electrical time constant L/R (0.4 ms) is far below the mechanical one (about 25 ms), so
- * the currents are stiff. Each motor's linear part, y = (omega, i) with
+ * Integration. Each conducting motor's linear part, y = (omega, i) with
  *   dy = A y + N(y),  A = [0, k_e/J_r; -k_e/L, -R/L],  N = (-k_m omega|omega|/J_r, c u/L),
- * is integrated by the exponential time-differencing RK4 of Cox and Matthews (J. Comput. Phys.
- * 176, 2002): exp(hA) and the phi-functions of hA are exact (2x2, by Lagrange interpolation
- * on the eigenvalues of A), and the slow remainder N gets RK4-like weights. Putting the
- * back-EMF and torque coupling in A keeps the fast current transient out of N, which would
- * otherwise reduce the order of the method. The state of charge uses classical RK4.
+ * is integrated by the exponential time-differencing RK4 of Cox and Matthews ("Exponential
+ * time differencing for stiff systems", J. Comput. Phys. 176, 2002): exp(hA) and the
+ * phi-functions of hA are exact (2x2, by Lagrange interpolation on the eigenvalues of A), and
+ * the slow remainder N gets RK4-like weights. A motor held at a current bound has A = 0 and
+ * N = ((k_e i - k_m omega|omega|)/J_r, 0), for which the same formulas are classical RK4.
+ * The bounds make the right-hand side switch; integrating across a switch would cost the
+ * method its order (a current falling at 25 kA/s overshoots zero by amperes within a
+ * sub-step). So a sub-step that would cross a bound is cut at the crossing, located to 1e-12
+ * of the sub-step by the Illinois method on the step length, and resumed in the new mode.
+ * The state of charge uses classical RK4.
  */
 #include <complex.h>
 #include <math.h>
@@ -28,26 +38,33 @@
 #define R(name) (m->real[VR_##name])
 
 enum { OMEGA = 0, CURRENT = N_MOTORS, SOC = 2 * N_MOTORS };
+/* Mode of a motor: conducting freely, or held at a bound of its current. */
+enum { CONDUCTING = 0, COASTING, AT_MAX, AT_MIN };
+#define MAX_SWITCHES 32 /* mode switches located per sub-step; beyond, the step projects */
+
+/* 2x2 row-major functions of h A: exp(hA), exp(hA/2), (h/2) phi1(hA/2), and the
+ * ETDRK4 weights h(phi1 - 3 phi2 + 4 phi3), h(phi2 - 2 phi3), h(-phi2 + 4 phi3). */
+typedef struct {
+    double h, e[4], e2[4], q[4], f1[4], f2[4], f3[4];
+} Etd;
 
 typedef struct {
     double x[N_STATES];
     double v[N_MOTORS][3]; /* unit field directions */
-    double step;           /* sub-step the matrices below were computed for */
-    /* 2x2 row-major functions of h A: exp(hA), exp(hA/2), (h/2) phi1(hA/2), and the
-     * ETDRK4 weights h(phi1 - 3 phi2 + 4 phi3), h(phi2 - 2 phi3), h(-phi2 + 4 phi3) */
-    double e[4], e2[4], q[4], f1[4], f2[4], f3[4];
+    Etd main;              /* for the sub-step of the last doStep */
+    int mode[N_MOTORS];
     int saturated[N_MOTORS];
 } Data;
 
 const size_t MODEL_DATA_SIZE = sizeof(Data);
 
 static double clamp01(double c) { return c < 0.0 ? 0.0 : (c > 1.0 ? 1.0 : c); }
+static double command(ModelInstance *m, int n) { return clamp01((&R(c1))[n]); }
 
 static double battery_current(ModelInstance *m, const double *x) {
     double total = 0.0;
     int n;
-    for (n = 0; n < N_MOTORS; n++)
-        if (x[CURRENT + n] > 0.0) total += clamp01((&R(c1))[n]) * x[CURRENT + n];
+    for (n = 0; n < N_MOTORS; n++) total += command(m, n) * x[CURRENT + n];
     return total;
 }
 
@@ -57,14 +74,62 @@ static double battery_voltage(ModelInstance *m, const double *x) {
     return R(n_cells) * cell - R(R_b) * battery_current(m, x);
 }
 
-/* The slow remainder N(x): drag and the command voltage for each motor, and dsoc. */
-static void nonstiff(ModelInstance *m, const double *x, double *nx) {
+/* The voltage the ESC applies beyond the back-EMF, c u - k_e omega (V). */
+static double drive(ModelInstance *m, const double *x, double u, int n) {
+    return command(m, n) * u - R(k_e) * x[OMEGA + n];
+}
+
+static double lower_bound(ModelInstance *m) {
+    return m->boolean[VB_regenerative] ? -R(i_max) : 0.0;
+}
+
+/* The mode each motor takes at state x; a current at a bound is set exactly on it. */
+static void select_modes(ModelInstance *m, Data *d, double *x) {
+    double u = battery_voltage(m, x), low = lower_bound(m);
+    int n;
+    for (n = 0; n < N_MOTORS; n++) {
+        double i = x[CURRENT + n], v = drive(m, x, u, n);
+        if (i <= low && v - R(R_m) * low <= 0.0) {
+            d->mode[n] = low == 0.0 ? COASTING : AT_MIN;
+            x[CURRENT + n] = low;
+        } else if (i >= R(i_max) && v - R(R_m) * R(i_max) >= 0.0) {
+            d->mode[n] = AT_MAX;
+            x[CURRENT + n] = R(i_max);
+        } else {
+            d->mode[n] = CONDUCTING;
+        }
+    }
+}
+
+/* How far each motor is from leaving its mode, worst of the four: negative once one has. */
+static double margin(ModelInstance *m, const Data *d, const double *x) {
+    double u = battery_voltage(m, x), low = lower_bound(m), worst = INFINITY, g;
+    int n;
+    for (n = 0; n < N_MOTORS; n++) {
+        double i = x[CURRENT + n], v = drive(m, x, u, n);
+        switch (d->mode[n]) {
+        case CONDUCTING: g = fmin(i - low, R(i_max) - i); break;
+        case AT_MAX: g = (v - R(R_m) * R(i_max)) / R(R_m); break; /* current would fall */
+        default: g = (R(R_m) * low - v) / R(R_m); break;          /* current would rise */
+        }
+        worst = fmin(worst, g);
+    }
+    return worst;
+}
+
+/* The slow remainder N(x) of each motor in its mode, and dsoc. */
+static void nonstiff(ModelInstance *m, const Data *d, const double *x, double *nx) {
     double u = battery_voltage(m, x);
     int n;
     for (n = 0; n < N_MOTORS; n++) {
-        double w = x[OMEGA + n];
-        nx[OMEGA + n] = -R(k_m) * w * fabs(w) / R(J_r);
-        nx[CURRENT + n] = clamp01((&R(c1))[n]) * u / R(L_m);
+        double w = x[OMEGA + n], drag = -R(k_m) * w * fabs(w) / R(J_r);
+        if (d->mode[n] == CONDUCTING) {
+            nx[OMEGA + n] = drag;
+            nx[CURRENT + n] = command(m, n) * u / R(L_m);
+        } else {
+            nx[OMEGA + n] = drag + R(k_e) * x[CURRENT + n] / R(J_r);
+            nx[CURRENT + n] = 0.0;
+        }
     }
     nx[SOC] = -battery_current(m, x) / R(capacity);
 }
@@ -98,7 +163,7 @@ static void interpolate(const double a[4], double complex l1, double complex l2,
     out[3] = scale * creal(alpha + beta * a[3]);
 }
 
-static void etd_coefficients(ModelInstance *m, Data *d, double h) {
+static void etd_coefficients(ModelInstance *m, Etd *c, double h) {
     const double a[4] = {0.0, R(k_e) / R(J_r), -R(k_e) / R(L_m), -R(R_m) / R(L_m)};
     double trace = a[0] + a[3], det = a[0] * a[3] - a[1] * a[2];
     double complex root = csqrt((double complex)(trace * trace - 4.0 * det));
@@ -112,64 +177,125 @@ static void etd_coefficients(ModelInstance *m, Data *d, double h) {
     phi0123(h * l2, p2);
     phi0123(0.5 * h * l1, h1);
     phi0123(0.5 * h * l2, h2);
-    interpolate(a, l1, l2, p1[0], p2[0], 1.0, d->e);
-    interpolate(a, l1, l2, h1[0], h2[0], 1.0, d->e2);
-    interpolate(a, l1, l2, h1[1], h2[1], 0.5 * h, d->q);
+    interpolate(a, l1, l2, p1[0], p2[0], 1.0, c->e);
+    interpolate(a, l1, l2, h1[0], h2[0], 1.0, c->e2);
+    interpolate(a, l1, l2, h1[1], h2[1], 0.5 * h, c->q);
     w1[0] = p1[1] - 3.0 * p1[2] + 4.0 * p1[3];
     w2[0] = p2[1] - 3.0 * p2[2] + 4.0 * p2[3];
     w1[1] = p1[2] - 2.0 * p1[3];
     w2[1] = p2[2] - 2.0 * p2[3];
     w1[2] = -p1[2] + 4.0 * p1[3];
     w2[2] = -p2[2] + 4.0 * p2[3];
-    interpolate(a, l1, l2, w1[0], w2[0], h, d->f1);
-    interpolate(a, l1, l2, w1[1], w2[1], h, d->f2);
-    interpolate(a, l1, l2, w1[2], w2[2], h, d->f3);
-    d->step = h;
+    interpolate(a, l1, l2, w1[0], w2[0], h, c->f1);
+    interpolate(a, l1, l2, w1[1], w2[1], h, c->f2);
+    interpolate(a, l1, l2, w1[2], w2[2], h, c->f3);
+    c->h = h;
 }
 
-/* out = e y + q n on each motor's (omega, i) pair, with the 2x2 matrices e and q;
- * the state of charge gets e = 1 and q = h/2. */
-static void stage(const double e[4], const double q[4], double h, const double *y, const double *n, double *out) {
+/* out = M1 y + M2 n on motor k's (omega, i) pair, M1, M2 2x2 row-major. */
+static void pair(const double m1[4], const double m2[4], const double *y, const double *n, int k, double *out) {
+    double w = y[OMEGA + k], i = y[CURRENT + k], nw = n[OMEGA + k], ni = n[CURRENT + k];
+    out[OMEGA + k] = m1[0] * w + m1[1] * i + m2[0] * nw + m2[1] * ni;
+    out[CURRENT + k] = m1[2] * w + m1[3] * i + m2[2] * nw + m2[3] * ni;
+}
+
+/* An ETDRK4 stage, out = exp(hA/2) y + (h/2) phi1(hA/2) n; A = 0 for a motor at a bound. */
+static void stage(const Data *d, const Etd *c, const double *y, const double *n, double *out) {
+    const double one[4] = {1.0, 0.0, 0.0, 1.0}, half[4] = {0.5 * c->h, 0.0, 0.0, 0.5 * c->h};
     int k;
     for (k = 0; k < N_MOTORS; k++) {
-        double w = y[OMEGA + k], i = y[CURRENT + k], nw = n[OMEGA + k], ni = n[CURRENT + k];
-        out[OMEGA + k] = e[0] * w + e[1] * i + q[0] * nw + q[1] * ni;
-        out[CURRENT + k] = e[2] * w + e[3] * i + q[2] * nw + q[3] * ni;
+        if (d->mode[k] == CONDUCTING) pair(c->e2, c->q, y, n, k, out);
+        else pair(one, half, y, n, k, out);
     }
-    out[SOC] = y[SOC] + 0.5 * h * n[SOC];
+    out[SOC] = y[SOC] + 0.5 * c->h * n[SOC];
 }
 
-static void etdrk4_step(ModelInstance *m, Data *d, double h) {
-    double *x = d->x, nu[N_STATES], na[N_STATES], nb[N_STATES], nc[N_STATES];
-    double a[N_STATES], b[N_STATES], c[N_STATES], tmp[N_STATES];
-    int n, k;
-    if (h != d->step) etd_coefficients(m, d, h);
-    nonstiff(m, x, nu);
-    stage(d->e2, d->q, h, x, nu, a);
-    nonstiff(m, a, na);
-    stage(d->e2, d->q, h, x, na, b);
-    nonstiff(m, b, nb);
+/* One ETDRK4 step of length c->h from x to out (which may be x), the modes held. */
+static void advance(ModelInstance *m, const Data *d, const Etd *c, const double *x, double *out) {
+    double nu[N_STATES], na[N_STATES], nb[N_STATES], nc[N_STATES];
+    double a[N_STATES], b[N_STATES], s[N_STATES], tmp[N_STATES];
+    const double one[4] = {1.0, 0.0, 0.0, 1.0}, sixth[4] = {c->h / 6.0, 0.0, 0.0, c->h / 6.0};
+    int k;
+    nonstiff(m, d, x, nu);
+    stage(d, c, x, nu, a);
+    nonstiff(m, d, a, na);
+    stage(d, c, x, na, b);
+    nonstiff(m, d, b, nb);
     for (k = 0; k < N_STATES; k++) tmp[k] = 2.0 * nb[k] - nu[k];
-    stage(d->e2, d->q, h, a, tmp, c);
-    nonstiff(m, c, nc);
+    stage(d, c, a, tmp, s);
+    nonstiff(m, d, s, nc);
     for (k = 0; k < N_STATES; k++) tmp[k] = na[k] + nb[k];
-    for (n = 0; n < N_MOTORS; n++) {
-        const double *e = d->e, *f1 = d->f1, *f2 = d->f2, *f3 = d->f3;
-        double w = x[OMEGA + n], i = x[CURRENT + n];
-        x[OMEGA + n] = e[0] * w + e[1] * i + f1[0] * nu[OMEGA + n] + f1[1] * nu[CURRENT + n] +
-                       2.0 * (f2[0] * tmp[OMEGA + n] + f2[1] * tmp[CURRENT + n]) + f3[0] * nc[OMEGA + n] +
-                       f3[1] * nc[CURRENT + n];
-        x[CURRENT + n] = e[2] * w + e[3] * i + f1[2] * nu[OMEGA + n] + f1[3] * nu[CURRENT + n] +
-                         2.0 * (f2[2] * tmp[OMEGA + n] + f2[3] * tmp[CURRENT + n]) + f3[2] * nc[OMEGA + n] +
-                         f3[3] * nc[CURRENT + n];
+    out[SOC] = x[SOC] + c->h / 6.0 * (nu[SOC] + 2.0 * tmp[SOC] + nc[SOC]);
+    for (k = 0; k < N_MOTORS; k++) {
+        int held = d->mode[k] != CONDUCTING;
+        const double *e = held ? one : c->e, *f1 = held ? sixth : c->f1, *f2 = held ? sixth : c->f2,
+                     *f3 = held ? sixth : c->f3;
+        double w = x[OMEGA + k], i = x[CURRENT + k];
+        double uw = nu[OMEGA + k], ui = nu[CURRENT + k], sw = tmp[OMEGA + k], si = tmp[CURRENT + k];
+        double cw = nc[OMEGA + k], ci = nc[CURRENT + k];
+        out[OMEGA + k] = e[0] * w + e[1] * i + f1[0] * uw + f1[1] * ui + 2.0 * (f2[0] * sw + f2[1] * si) +
+                         f3[0] * cw + f3[1] * ci;
+        out[CURRENT + k] = e[2] * w + e[3] * i + f1[2] * uw + f1[3] * ui + 2.0 * (f2[2] * sw + f2[3] * si) +
+                           f3[2] * cw + f3[3] * ci;
     }
-    x[SOC] += h / 6.0 * (nu[SOC] + 2.0 * tmp[SOC] + nc[SOC]);
+}
+
+/* Advance x by one sub-step h, cutting it where a motor's current reaches a bound or leaves
+ * one, so that each piece is smooth. */
+static void substep(ModelInstance *m, Data *d, double h) {
+    double remaining = h, trial[N_STATES];
+    int switches;
+    if (h != d->main.h) etd_coefficients(m, &d->main, h);
+    for (switches = 0; remaining > 0.0; switches++) {
+        Etd piece;
+        const Etd *c = &d->main;
+        select_modes(m, d, d->x);
+        if (remaining != h) {
+            etd_coefficients(m, &piece, remaining);
+            c = &piece;
+        }
+        advance(m, d, c, d->x, trial);
+        if (margin(m, d, trial) >= 0.0 || switches >= MAX_SWITCHES) break;
+        {   /* Illinois on the fraction s of the remaining step: margin >= 0 at lo, < 0 at hi */
+            double lo = 0.0, hi = 1.0, g_lo = margin(m, d, d->x), g_hi = margin(m, d, trial);
+            int side = 0, k;
+            if (g_lo < 0.0) g_lo = 0.0; /* on the bound already: the crossing is at once */
+            for (k = 0; k < 100 && hi - lo > 1e-12; k++) {
+                double s = hi - g_hi * (hi - lo) / (g_hi - g_lo), g;
+                if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
+                etd_coefficients(m, &piece, s * remaining);
+                advance(m, d, &piece, d->x, trial);
+                g = margin(m, d, trial);
+                if (g >= 0.0) {
+                    lo = s;
+                    g_lo = g;
+                    if (side == -1) g_hi *= 0.5;
+                    side = -1;
+                } else {
+                    hi = s;
+                    g_hi = g;
+                    if (side == 1) g_lo *= 0.5;
+                    side = 1;
+                }
+            }
+            /* end just past the switch, where the new mode's condition holds */
+            etd_coefficients(m, &piece, hi * remaining);
+            advance(m, d, &piece, d->x, d->x);
+            remaining -= hi * remaining;
+        }
+    }
+    if (remaining > 0.0) {
+        int k;
+        for (k = 0; k < N_STATES; k++) d->x[k] = trial[k];
+        /* a sub-step that ran out of located switches projects on the bounds */
+        for (k = CURRENT; k < CURRENT + N_MOTORS; k++) d->x[k] = fmin(fmax(d->x[k], lower_bound(m)), R(i_max));
+    }
 }
 
 fmi2Status model_initialize(ModelInstance *m) {
     Data *d = (Data *)m->data;
-    const char *names[] = {"R_m", "L_m", "k_e", "J_r", "n_cells", "capacity", "sub_step"};
-    const double values[] = {R(R_m), R(L_m), R(k_e), R(J_r), R(n_cells), R(capacity), R(sub_step)};
+    const char *names[] = {"R_m", "L_m", "k_e", "J_r", "n_cells", "capacity", "i_max", "sub_step"};
+    const double values[] = {R(R_m), R(L_m), R(k_e), R(J_r), R(n_cells), R(capacity), R(i_max), R(sub_step)};
     unsigned i;
     int n;
     for (i = 0; i < sizeof values / sizeof values[0]; i++) {
@@ -194,9 +320,15 @@ fmi2Status model_initialize(ModelInstance *m) {
         for (i = 0; i < 3; i++) d->v[n][i] = v[i] / norm;
         d->x[OMEGA + n] = R(omega0);
         d->x[CURRENT + n] = R(k_m) * R(omega0) * fabs(R(omega0)) / R(k_e);
+        if (fabs(d->x[CURRENT + n]) > R(i_max)) {
+            log_error(m, "omega0 = %g rad/s needs a motor current of %.3g A, beyond i_max = %g A: lower "
+                      "omega0 or raise i_max", R(omega0), d->x[CURRENT + n], R(i_max));
+            return fmi2Error;
+        }
     }
     d->x[SOC] = R(soc0);
-    d->step = -1.0;
+    d->main.h = -1.0;
+    select_modes(m, d, d->x);
     return fmi2OK;
 }
 
@@ -212,7 +344,7 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
             log_warning(m, "c%d = %g at t = %g is outside [0, 1]: saturated", k + 1, c, m->time);
         d->saturated[k] = outside;
     }
-    for (k = 0; k < n; k++) etdrk4_step(m, d, h / n);
+    for (k = 0; k < n; k++) substep(m, d, h / n);
     return fmi2OK;
 }
 
@@ -222,10 +354,11 @@ void model_outputs(ModelInstance *m) {
     int n, a;
     for (a = 0; a < 3; a++) (&R(b_d_x))[a] = 0.0;
     for (n = 0; n < N_MOTORS; n++) {
-        double field = (&R(kappa1))[n] * x[CURRENT + n];
+        double supply = command(m, n) * x[CURRENT + n], field = (&R(kappa1))[n] * supply;
         (&R(omega_r1))[n] = x[OMEGA + n];
         (&R(domega_r1))[n] = (R(k_e) * x[CURRENT + n] - R(k_m) * x[OMEGA + n] * fabs(x[OMEGA + n])) / R(J_r);
         (&R(i1))[n] = x[CURRENT + n];
+        (&R(i_s1))[n] = supply;
         for (a = 0; a < 3; a++) {
             (&R(b_d1_x))[3 * n + a] = field * d->v[n][a];
             (&R(b_d_x))[a] += field * d->v[n][a];
