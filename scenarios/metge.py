@@ -127,7 +127,8 @@ def system_for(o: dict, set_number: int, run: int) -> System:
     system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], c))
     seed = o[f"seed{set_number}"] + 10 * run
     add_plant(system, quadrotor={"clamped": True}, motors={"soc0": socs(o, set_number)[run]},
-              imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"]))
+              imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"],
+                                 mag_sample_rate=o["mag_rate"]))
     system.connect("Setpoint.c", "MotorMagnetics.c")
     return system
 

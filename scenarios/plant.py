@@ -1,8 +1,9 @@
 """The plant of the lab's diagram, wired once for every scenario.
 
-``MotorMagnetics -> (omega_r, domega_r) -> Quadrotor -> (q, omega, f) -> IMU``, and the field of
-the supply currents ``b_d`` into the IMU (or zero when the perturbation is off). The wind into
-the Quadrotor is a constant NED vector, or left for the caller to connect.
+``MotorMagnetics -> (omega_r, domega_r) -> Quadrotor -> (q, omega, f) -> IMU``, the field of
+the supply currents ``b_d`` into the IMU (or zero when the perturbation is off), and the rotor
+speeds into the IMU for its optional vibration. The wind into the Quadrotor is a constant NED
+vector, or left for the caller to connect.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: b
     system.connect("Quadrotor.q", "IMU.q")
     system.connect("Quadrotor.omega", "IMU.omega")
     system.connect("Quadrotor.f", "IMU.f")
+    system.connect("MotorMagnetics.omega_r", "IMU.omega_r")
     if magnetic:
         system.connect("MotorMagnetics.b_d", "IMU.b_d")
     else:

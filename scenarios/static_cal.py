@@ -86,13 +86,15 @@ def build(o: dict) -> System:
     system = System(dt=o["dt"])
     names = ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z"]
     system.add(Table("Hand", names, np.column_stack([q, omega, force])))
-    parameters = imu_parameters(o["noise"], False, o["seed"], sample_rate=o["mag_rate"])
+    parameters = imu_parameters(o["noise"], False, o["seed"], sample_rate=o["mag_rate"],
+                                mag_sample_rate=o["mag_rate"])
     parameters |= {f"A_{i + 1}{j + 1}": A[i, j] for i in range(3) for j in range(3)}
     parameters |= {f"b_s_{a}": b[k] for k, a in enumerate("xyz")}
     system.add(FMUBlock("IMU", parameters=parameters))
     for name in names:
         system.connect(f"Hand.{name}", f"IMU.{name}")
     system.set_input("IMU.b_d", 0.0)  # motors off
+    system.set_input("IMU.omega_r", 0.0)
     return system
 
 

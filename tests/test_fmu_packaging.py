@@ -49,6 +49,8 @@ def test_nan_input_is_an_error_with_a_message():
     ("Quadrotor", "drag", -0.2, "drag = -0.2 must be non-negative"),
     ("Quadrotor", "J_r", -3e-5, "J_r = -3e-05 must be non-negative"),
     ("MotorMagnetics", "i_max", 0.0, "i_max = 0 must be positive"),
+    ("IMU", "mag_sample_rate", 0.0, "mag_sample_rate = 0 Hz must be positive"),
+    ("IMU", "vibration_amplitude", -0.1, "vibration_amplitude = -0.1 m/s2 must be non-negative"),
     ("MotorMagnetics", "i_max", -5.0, "i_max = -5 must be positive"),
     ("MotorMagnetics", "omega0", 2000.0, "omega0 = 2000 rad/s needs a motor current of 61.7 A, beyond i_max = 18 A"),
 ])

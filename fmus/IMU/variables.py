@@ -7,6 +7,9 @@ Noise defaults come from datasheets:
 - magnetometer: ST LIS3MDL datasheet (DocID024204 rev. 5), RMS noise 3.2 mgauss on x and y
   in ultra-high-performance mode at 80 Hz, i.e. 0.32 uT / sqrt(80 Hz) = 3.6e-8 T/sqrt(Hz).
 The gyro bias is the lab's case (Bao and Yuan, lab report, 2024): (0.02, -0.01, 0.015) rad/s.
+Rates: accelerometer and gyrometer at 1 kHz; the magnetometer at 100 Hz, its own rate, as the
+parts of this class run (LIS3MDL up to 80 Hz in its low-noise modes, AK8963 at 100 Hz in
+continuous mode 2, HMC5883L at 75 Hz).
 """
 
 import math
@@ -18,17 +21,21 @@ _Q = ("q0", "q1", "q2", "q3")
 _W = ("omega_x", "omega_y", "omega_z")
 _F = ("f_x", "f_y", "f_z")
 _B = ("b_d_x", "b_d_y", "b_d_z")
+_ROTORS = ("omega_r1", "omega_r2", "omega_r3", "omega_r4")
 _AXES = "xyz"
 
 GYRO_NOISE_DENSITY = math.radians(0.01)  # rad/s/sqrt(Hz)
 ACC_NOISE_DENSITY = 300e-6 * 9.80665  # m/s^2/sqrt(Hz)
 MAG_NOISE_DENSITY = 0.32e-6 / math.sqrt(80.0)  # T/sqrt(Hz)
 LAB_GYRO_BIAS = (0.02, -0.01, 0.015)  # rad/s
+INERTIAL_RATE = 1000.0  # Hz, accelerometer and gyrometer
+MAG_RATE = 100.0  # Hz, magnetometer (AK8963 continuous mode 2: AK8963 datasheet, MS1356-E-02)
 
 TABLE = Table(
     "IMU",
-    "Sampled accelerometer, gyrometer and magnetometer with seeded white noise, biases, soft and "
-    "hard iron and the field of the motor currents; exposes the true rotation R_reel",
+    "Accelerometer and gyrometer sampled at 1 kHz, magnetometer at its own rate, with seeded white "
+    "noise, biases, soft and hard iron, the field of the supply currents and optional rotor "
+    "vibration; exposes the true rotation R_reel",
     variables=[
         Real("q0", "input", 1.0, "1", "true attitude quaternion, scalar part"),
         Real("q1", "input", 0.0, "1", "true attitude quaternion, x"),
@@ -38,9 +45,15 @@ TABLE = Table(
         Real("f_x", "input", 0.0, "m/s2", "true specific force along x_B"),
         Real("f_y", "input", 0.0, "m/s2", "true specific force along y_B"),
         Real("f_z", "input", -V.GRAVITY, "m/s2", "true specific force along z_B"),
-        *[Real(f"b_d_{a}", "input", 0.0, "T", f"field of the motor currents, {a}_B") for a in _AXES],
+        *[Real(f"b_d_{a}", "input", 0.0, "T", f"field of the supply currents, {a}_B") for a in _AXES],
+        *[Real(f"omega_r{n}", "input", 0.0, "rad/s", f"speed of rotor {n} (for the vibration)") for n in range(1, 5)],
         # parameters
-        Real("sample_rate", "parameter", 1000.0, "Hz", "sampling rate of all three sensors"),
+        Real("sample_rate", "parameter", INERTIAL_RATE, "Hz", "sampling rate of accelerometer and gyrometer"),
+        Real("mag_sample_rate", "parameter", MAG_RATE, "Hz", "sampling rate of the magnetometer"),
+        Real("vibration_amplitude", "parameter", 0.0, "m/s2",
+             "rotor-imbalance acceleration of one rotor at vibration_speed (0: off)"),
+        Real("vibration_speed", "parameter", V.hover_rotor_speed(), "rad/s",
+             "rotor speed at which vibration_amplitude is given; it grows as the speed squared"),
         Boolean("noise_enabled", "parameter", True, "white measurement noise on"),
         Boolean("bias_enabled", "parameter", False, "accelerometer and gyrometer biases on"),
         Integer("seed", "parameter", 1, "seed of the noise generator"),
@@ -58,7 +71,8 @@ TABLE = Table(
         *[Real(f"m_I_{a}", "parameter", V.EARTH_FIELD[k], "T", f"Earth field in NED, {'NED'[k]}")
           for k, a in enumerate(_AXES)],
         # outputs
-        *[Real(f"acc_{a}", "output", unit="m/s2", description=f"accelerometer, {a}_B", depends=_F) for a in _AXES],
+        *[Real(f"acc_{a}", "output", unit="m/s2", description=f"accelerometer, {a}_B", depends=_F + _ROTORS)
+          for a in _AXES],
         *[Real(f"gyro_{a}", "output", unit="rad/s", description=f"gyrometer, {a}_B", depends=_W) for a in _AXES],
         *[Real(f"magneto_{a}", "output", unit="T", description=f"magnetometer, {a}_B", depends=_Q + _B)
           for a in _AXES],
