@@ -81,8 +81,9 @@ BATTERY_SOC0 = 0.9  # 1, initial state of charge
 # E_cell(s) = c0 + c1 s + c2 s^2 + c3 s^3, monotone, 4.20 V full, 3.71 V at half, 3.27 V empty.
 CELL_OCV_COEFFS = (3.27, 1.53, -2.03, 1.43)  # V, V, V, V
 
-# Magnetic field of the motor currents at the magnetometer, sensor frame {B}.
-# kappa_n in T/A; v_n unit vectors (normalised by the FMU).
+# Magnetic field of the ESC supply cables at the magnetometer, sensor frame {B}: kappa_n times the
+# supply current c_n i_n along v_n (v_n normalised by the FMU). Chosen for the rig's one-motor
+# error (see Sources above): 10.5 degrees, with the free set at 17.5 degrees.
 MOTOR_FIELD_GAIN = (2.78e-6, 2.40e-6, 3.15e-6, 2.63e-6)  # T/A, field per ampere of supply current
 MOTOR_FIELD_DIRECTION = (
     (0.30, 0.80, -0.52),  # 1, unit-less
@@ -134,3 +135,18 @@ def hover_command(soc: float = BATTERY_SOC0) -> float:
         c = steady_command(w, u)
         u = open_circuit - BATTERY_RESISTANCE * 4 * c * steady_current(w)
     return c
+
+
+# IMU
+# Noise densities from datasheets: InvenSense MPU-9250 product specification (PS-MPU-9250A-01
+# rev. 1.1) for the gyrometer (0.01 deg/s/sqrt(Hz)) and the accelerometer (300 ug/sqrt(Hz));
+# ST LIS3MDL datasheet (DocID024204 rev. 5) for the magnetometer, RMS noise 3.2 mgauss at 80 Hz
+# in ultra-high-performance mode, 0.32 uT / sqrt(80 Hz).
+GYRO_NOISE_DENSITY = math.radians(0.01)  # rad/s/sqrt(Hz), MPU-9250
+ACC_NOISE_DENSITY = 300e-6 * 9.80665  # m/s^2/sqrt(Hz), MPU-9250
+MAG_NOISE_DENSITY = 0.32e-6 / math.sqrt(80.0)  # T/sqrt(Hz), LIS3MDL
+LAB_GYRO_BIAS = (0.02, -0.01, 0.015)  # rad/s, the lab's gyro bias case (Bao and Yuan, lab report, 2024)
+IMU_RATE = 1000.0  # Hz, accelerometer and gyrometer sampling (MPU-9250 output data rate 1 kHz)
+# Magnetometers of this class run far slower: AK8963 at 100 Hz in continuous mode 2 (AK8963
+# datasheet, MS1356-E-02), LIS3MDL up to 80 Hz in its low-noise modes, HMC5883L at 75 Hz.
+MAG_RATE = 100.0  # Hz, magnetometer sampling, AK8963 continuous mode 2

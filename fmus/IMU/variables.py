@@ -1,18 +1,8 @@
 """Variable table of the IMU FMU: accelerometer, gyrometer, magnetometer, and R_reel.
 
-Noise defaults come from datasheets:
-- gyrometer and accelerometer: InvenSense MPU-9250 product specification (PS-MPU-9250A-01
-  rev. 1.1): rate noise spectral density 0.01 deg/s/sqrt(Hz), accelerometer noise power
-  spectral density 300 ug/sqrt(Hz);
-- magnetometer: ST LIS3MDL datasheet (DocID024204 rev. 5), RMS noise 3.2 mgauss on x and y
-  in ultra-high-performance mode at 80 Hz, i.e. 0.32 uT / sqrt(80 Hz) = 3.6e-8 T/sqrt(Hz).
-The gyro bias is the lab's case (Bao and Yuan, lab report, 2024): (0.02, -0.01, 0.015) rad/s.
-Rates: accelerometer and gyrometer at 1 kHz; the magnetometer at 100 Hz, its own rate, as the
-parts of this class run (LIS3MDL up to 80 Hz in its low-noise modes, AK8963 at 100 Hz in
-continuous mode 2, HMC5883L at 75 Hz).
+The defaults (noise densities, rates, the lab's gyro bias) and their sources are in
+:mod:`fmus.vehicle`.
 """
-
-import math
 
 from fmus import vehicle as V
 from fmus.variables import Boolean, Integer, Real, Table
@@ -24,12 +14,10 @@ _B = ("b_d_x", "b_d_y", "b_d_z")
 _ROTORS = ("omega_r1", "omega_r2", "omega_r3", "omega_r4")
 _AXES = "xyz"
 
-GYRO_NOISE_DENSITY = math.radians(0.01)  # rad/s/sqrt(Hz)
-ACC_NOISE_DENSITY = 300e-6 * 9.80665  # m/s^2/sqrt(Hz)
-MAG_NOISE_DENSITY = 0.32e-6 / math.sqrt(80.0)  # T/sqrt(Hz)
-LAB_GYRO_BIAS = (0.02, -0.01, 0.015)  # rad/s
-INERTIAL_RATE = 1000.0  # Hz, accelerometer and gyrometer
-MAG_RATE = 100.0  # Hz, magnetometer (AK8963 continuous mode 2: AK8963 datasheet, MS1356-E-02)
+GYRO_NOISE_DENSITY = V.GYRO_NOISE_DENSITY  # rad/s/sqrt(Hz)
+ACC_NOISE_DENSITY = V.ACC_NOISE_DENSITY  # m/s^2/sqrt(Hz)
+MAG_NOISE_DENSITY = V.MAG_NOISE_DENSITY  # T/sqrt(Hz)
+LAB_GYRO_BIAS = V.LAB_GYRO_BIAS  # rad/s
 
 TABLE = Table(
     "IMU",
@@ -48,8 +36,8 @@ TABLE = Table(
         *[Real(f"b_d_{a}", "input", 0.0, "T", f"field of the supply currents, {a}_B") for a in _AXES],
         *[Real(f"omega_r{n}", "input", 0.0, "rad/s", f"speed of rotor {n} (for the vibration)") for n in range(1, 5)],
         # parameters
-        Real("sample_rate", "parameter", INERTIAL_RATE, "Hz", "sampling rate of accelerometer and gyrometer"),
-        Real("mag_sample_rate", "parameter", MAG_RATE, "Hz", "sampling rate of the magnetometer"),
+        Real("sample_rate", "parameter", V.IMU_RATE, "Hz", "sampling rate of accelerometer and gyrometer"),
+        Real("mag_sample_rate", "parameter", V.MAG_RATE, "Hz", "sampling rate of the magnetometer"),
         Real("vibration_amplitude", "parameter", 0.0, "m/s2",
              "rotor-imbalance acceleration of one rotor at vibration_speed (0: off)"),
         Real("vibration_speed", "parameter", V.hover_rotor_speed(), "rad/s",
