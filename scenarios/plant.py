@@ -50,6 +50,27 @@ def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: b
 
 
 def imu_parameters(noise: bool, bias: bool, seed: int, sample_rate: float = 1000.0, **extra) -> dict:
+    """Parameter overrides of the IMU FMU.
+
+    Parameters
+    ----------
+    noise : bool
+        White measurement noise on all three sensors.
+    bias : bool
+        Accelerometer and gyrometer biases (the gyro's default is the lab's, rad/s, {B}).
+    seed : int
+        Seed of the IMU's noise generator.
+    sample_rate : float
+        Accelerometer and gyrometer sampling rate (Hz); the magnetometer keeps its own
+        ``mag_sample_rate`` (100 Hz by default) unless given in ``extra``.
+    **extra
+        Any other IMU parameter, by its FMU name (e.g. ``mag_sample_rate`` in Hz).
+
+    Returns
+    -------
+    dict
+        FMU parameter name to value.
+    """
     return {"noise_enabled": noise, "bias_enabled": bias, "seed": seed, "sample_rate": sample_rate, **extra}
 
 
@@ -62,6 +83,21 @@ def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def save_figure(figure, out_dir, name: str):
+    """Save ``figure`` as ``out_dir / name`` (PNG, 120 dpi) and close it.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+    out_dir : pathlib.Path or None
+        Output folder; ``None`` closes the figure without saving it.
+    name : str
+        File name.
+
+    Returns
+    -------
+    str or None
+        The file name written, or ``None``.
+    """
     if out_dir is None:
         import matplotlib.pyplot as plt
 

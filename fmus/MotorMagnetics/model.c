@@ -36,6 +36,7 @@
 #include "variables.h"
 
 #define R(name) (m->real[VR_##name])
+#define RV(name) REAL_VECTOR(m, name)
 
 enum { OMEGA = 0, CURRENT = N_MOTORS, SOC = 2 * N_MOTORS };
 /* Mode of a motor: conducting freely, or held at a bound of its current. */
@@ -59,7 +60,7 @@ typedef struct {
 const size_t MODEL_DATA_SIZE = sizeof(Data);
 
 static double clamp01(double c) { return c < 0.0 ? 0.0 : (c > 1.0 ? 1.0 : c); }
-static double command(ModelInstance *m, int n) { return clamp01((&R(c1))[n]); }
+static double command(ModelInstance *m, int n) { return clamp01(RV(c)[n]); }
 
 static double battery_current(ModelInstance *m, const double *x) {
     double total = 0.0;
@@ -310,7 +311,7 @@ fmi2Status model_initialize(ModelInstance *m) {
         return fmi2Error;
     }
     for (n = 0; n < N_MOTORS; n++) {
-        const double *v = &R(v1_x) + 3 * n;
+        const double *v = RV(v) + 3 * n;
         double norm = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         if (!(norm > 0.0) || !isfinite(norm)) {
             log_error(m, "field direction of motor %d is zero or not finite; give v%d_x/y/z", n + 1,
@@ -338,7 +339,7 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     (void)t;
     if (n == 0) return fmi2Error;
     for (k = 0; k < N_MOTORS; k++) {
-        double c = (&R(c1))[k];
+        double c = RV(c)[k];
         int outside = c < 0.0 || c > 1.0;
         if (outside && !d->saturated[k])
             log_warning(m, "c%d = %g at t = %g is outside [0, 1]: saturated", k + 1, c, m->time);
@@ -352,16 +353,16 @@ void model_outputs(ModelInstance *m) {
     Data *d = (Data *)m->data;
     const double *x = d->x;
     int n, a;
-    for (a = 0; a < 3; a++) (&R(b_d_x))[a] = 0.0;
+    for (a = 0; a < 3; a++) RV(b_d)[a] = 0.0;
     for (n = 0; n < N_MOTORS; n++) {
-        double supply = command(m, n) * x[CURRENT + n], field = (&R(kappa1))[n] * supply;
-        (&R(omega_r1))[n] = x[OMEGA + n];
-        (&R(domega_r1))[n] = (R(k_e) * x[CURRENT + n] - R(k_m) * x[OMEGA + n] * fabs(x[OMEGA + n])) / R(J_r);
-        (&R(i1))[n] = x[CURRENT + n];
-        (&R(i_s1))[n] = supply;
+        double supply = command(m, n) * x[CURRENT + n], field = RV(kappa)[n] * supply;
+        RV(omega_r)[n] = x[OMEGA + n];
+        RV(domega_r)[n] = (R(k_e) * x[CURRENT + n] - R(k_m) * x[OMEGA + n] * fabs(x[OMEGA + n])) / R(J_r);
+        RV(i)[n] = x[CURRENT + n];
+        RV(i_s)[n] = supply;
         for (a = 0; a < 3; a++) {
-            (&R(b_d1_x))[3 * n + a] = field * d->v[n][a];
-            (&R(b_d_x))[a] += field * d->v[n][a];
+            RV(b_d_motor)[3 * n + a] = field * d->v[n][a];
+            RV(b_d)[a] += field * d->v[n][a];
         }
     }
     R(i_batt) = battery_current(m, x);
