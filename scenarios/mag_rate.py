@@ -36,6 +36,18 @@ def rms_errors(settings: dict, mag_rate: float) -> np.ndarray:
 
 
 def main(argv=None) -> int:
+    """Print the ablation table (deg) for the estimators and flights of the lab.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (``--duration`` in s, ``--noise off|on|both``).
+
+    Returns
+    -------
+    int
+        Exit status, 0.
+    """
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--duration", type=float, default=20.0, help="simulated time per run (s)")
     parser.add_argument("--noise", choices=("off", "on", "both"), default="both", help="IMU white noise")

@@ -46,8 +46,6 @@ PENDING = {
     "scenarios.tp.report",
 
     # w7-plant
-    "scenarios.plant.imu_parameters",
-    "scenarios.plant.save_figure",
 }
 
 
