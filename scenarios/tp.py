@@ -7,6 +7,7 @@ without the field of the motor currents at the magnetometer (the lab had none).
 
 from __future__ import annotations
 
+import math
 from functools import partial
 
 import numpy as np
@@ -15,6 +16,7 @@ from estimators import LAB_GAINS, QuaternionEstim
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator import System, Table
+from orchestrator.result import envelope
 from scenarios import Option, Scenario
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.metge import add_compensator
@@ -111,28 +113,53 @@ def wrapped(angle: np.ndarray) -> np.ndarray:
 def errors(result) -> tuple[np.ndarray, np.ndarray]:
     """Estimation and tracking errors (rad), columns roll, pitch, yaw. Tracking compares the
     attitude with the controller's setpoint (the position hold's roll and pitch when holding)."""
-    truth = np.column_stack([result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])
-    estimate = result["Quaternion_estim.theta_est"]
-    setpoint = np.column_stack([result["Controller.theta_d1"], result["Controller.theta_d2"],
-                                result["Setpoint.theta_d3"]])
-    return wrapped(estimate - truth), wrapped(setpoint - truth)
+    estimation = np.column_stack([_error(result, "Quaternion_estim.theta_est", k) for k in range(3)])
+    tracking = np.column_stack([_error(result, _SETPOINTS[k], k) for k in range(3)])
+    return estimation, tracking
+
+
+_SETPOINTS = ("Controller.theta_d1", "Controller.theta_d2", "Setpoint.theta_d3")
+
+
+def _error(result, signal: str, k: int) -> np.ndarray:
+    """``signal`` (or its component ``k + 1``) minus the true Euler angle ``k``, wrapped to
+    [-pi, pi) (rad): one new column, computed in place."""
+    name = signal if signal.startswith(("Controller", "Setpoint")) else f"{signal}{k + 1}"
+    difference = np.subtract(result[name], result[f"Quadrotor.theta{k + 1}"])
+    difference += np.pi
+    np.mod(difference, 2 * np.pi, out=difference)
+    difference -= np.pi
+    return difference
 
 
 def report(result, o, out) -> dict:
+    """Figures and metrics of one run. Statistics are taken column by column and the figures
+    drawn from envelopes, so that the report adds little to the memory of the record."""
     import matplotlib.pyplot as plt
 
-    estimation, tracking = errors(result)
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
-    after = result.time >= settle
-    truth = np.column_stack([result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])
-    estimate = result["Quaternion_estim.theta_est"]
+    after = slice(np.searchsorted(result.time, settle), None)
     t = result.time
     label = f"{o['estimator']}, {o['flight']}, {o['feedback']}, noise {o['noise']}, bias {o['bias']}"
+    rms, peak, tracking_rms = [], [], []
+    for k in range(3):
+        error = _error(result, "Quaternion_estim.theta_est", k)[after]
+        rms.append(math.degrees(math.sqrt(np.dot(error, error) / len(error))))
+        peak.append(math.degrees(max(error.max(), -error.min())))
+        del error  # one error column at a time
+        error = _error(result, _SETPOINTS[k], k)[after]
+        tracking_rms.append(math.degrees(math.sqrt(np.dot(error, error) / len(error))))
+        del error
+
+    def curve(ax, signal, style="-", **options):
+        times, values = envelope(t, result[signal])
+        return ax.plot(times, np.degrees(values) if "theta" in signal else values, style, **options)[0]
+
     figures = []
     fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     for k, name in enumerate(("roll", "pitch")):
-        axes[k].plot(t, np.degrees(truth[:, k]), label=f"{name} (truth)")
-        axes[k].plot(t, np.degrees(estimate[:, k]), "--", label=f"{name} (estimate)")
+        curve(axes[k], f"Quadrotor.theta{k + 1}", label=f"{name} (truth)")
+        curve(axes[k], f"Quaternion_estim.theta_est{k + 1}", "--", label=f"{name} (estimate)")
         axes[k].set_ylabel(f"{name} (deg)")
         axes[k].legend(fontsize=8)
         axes[k].grid(True, alpha=0.3)
@@ -140,20 +167,18 @@ def report(result, o, out) -> dict:
     axes[0].set_title(label)
     figures.append(save_figure(fig, out, "roll_pitch.png"))
     fig, ax = plt.subplots(figsize=(9, 3.5))
-    ax.plot(t, np.degrees(truth[:, 2]), label="yaw (truth)")
-    ax.plot(t, np.degrees(estimate[:, 2]), "--", label="yaw (estimate)")
+    curve(ax, "Quadrotor.theta3", label="yaw (truth)")
+    curve(ax, "Quaternion_estim.theta_est3", "--", label="yaw (estimate)")
     ax.set_ylabel("yaw (deg)")
     ax.set_xlabel("time (s)")
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
     ax.set_title(label)
     figures.append(save_figure(fig, out, "yaw.png"))
-    true_bias = result["IMU.gyro_bias"]
-    estimated_bias = result["Quaternion_estim.b_est"]
     fig, ax = plt.subplots(figsize=(9, 3.5))
-    for k, axis in enumerate("xyz"):
-        line = ax.plot(t, estimated_bias[:, k], label=f"b_est_{axis}")[0]
-        ax.plot(t, true_bias[:, k], ":", color=line.get_color(), label=f"b_{axis} (true)")
+    for axis in "xyz":
+        line = curve(ax, f"Quaternion_estim.b_est_{axis}", label=f"b_est_{axis}")
+        curve(ax, f"IMU.gyro_bias_{axis}", ":", color=line.get_color(), label=f"b_{axis} (true)")
     ax.set_ylabel("gyro bias (rad/s)")
     ax.set_xlabel("time (s)")
     ax.legend(fontsize=7, ncol=3)
@@ -161,15 +186,17 @@ def report(result, o, out) -> dict:
     figures.append(save_figure(fig, out, "bias.png"))
     metrics = {
         "settle_s": settle,
-        "rms_error_deg": np.degrees(np.sqrt((estimation[after] ** 2).mean(axis=0))).tolist(),
-        "max_error_deg": np.degrees(np.abs(estimation[after]).max(axis=0)).tolist(),
-        "tracking_rms_deg": np.degrees(np.sqrt((tracking[after] ** 2).mean(axis=0))).tolist(),
+        "rms_error_deg": rms,
+        "max_error_deg": peak,
+        "tracking_rms_deg": tracking_rms,
         "bias_error_final": None,
         "figures": [f for f in figures if f],
     }
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
-        metrics["bias_error_final"] = (estimated_bias[-1] - true_bias[-1]).tolist()
-        metrics["bias_convergence_s"] = bias_convergence_time(t, estimated_bias - true_bias, 1e-3)
+        metrics["bias_error_final"] = [
+            float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]
+        metrics["bias_convergence_s"] = bias_convergence_time(
+            t, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"), 1e-3)
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
@@ -177,13 +204,18 @@ def report(result, o, out) -> dict:
 
 
 def bias_convergence_time(t, error, tolerance) -> float | None:
-    """First time after which every component of ``error`` stays within ``tolerance``."""
-    outside = np.flatnonzero(np.abs(error).max(axis=1) > tolerance)
-    if len(outside) == 0:
-        return float(t[0])
-    if outside[-1] == len(t) - 1:
+    """First time (s) after which every component of ``error`` stays within ``tolerance``.
+
+    ``error`` is an (n, m) array, or an iterable of m length-n arrays (taken one at a time)."""
+    columns = error.T if isinstance(error, np.ndarray) else error
+    last = -1  # index of the last sample outside the tolerance, over every component
+    for column in columns:
+        outside = np.abs(column) > tolerance
+        if outside.any():
+            last = max(last, len(outside) - 1 - int(np.argmax(outside[::-1])))
+    if last == len(t) - 1:
         return None
-    return float(t[outside[-1] + 1])
+    return float(t[last + 1])
 
 
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report)

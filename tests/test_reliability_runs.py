@@ -19,6 +19,7 @@ import pytest
 from scipy.io import loadmat
 
 import orchestrator.files
+import scenarios
 from orchestrator import Block, Fault, FMUBlock, Result, SimulationError, System, Table
 from orchestrator.files import atomic_path
 from scenarios.cli import main as cli
@@ -309,3 +310,22 @@ def test_the_help_fault_example_runs(tmp_path, capsys):
     example = re.search(r"e\.g\. (\S+)", str(error.value)).group(1)
     assert cli(["run", "open-loop", "--fault", example, "--out", str(tmp_path / "run")]) == 0
     assert "warning" not in capsys.readouterr().err.lower()
+
+
+def test_the_tp_report_adds_little_to_the_memory_of_its_record(tmp_path):
+    """The report's own allocations grow by under 5 % of what a longer run records (the full
+    benchmark, peak RSS of whole runs, is ``python -m benchmarks.memory``)."""
+    scenario = scenarios.get("tp")
+    peaks, recorded = [], []
+    for duration in (5.0, 40.0):
+        options = scenario.parse({"duration": duration})
+        result = scenario.build(options).run(duration)
+        tracemalloc.start()
+        scenario.report(result, options, tmp_path)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        recorded.append(result.data.nbytes + result.time.nbytes)
+    growth = (peaks[1] - peaks[0]) / (recorded[1] - recorded[0])
+    print(f"tp report: peak allocation {peaks[0] / 1e6:.2f} MB at 5 s, {peaks[1] / 1e6:.2f} MB at 40 s: "
+          f"{growth:.3f} of the record's growth")
+    assert growth < 0.05
