@@ -36,6 +36,8 @@ def peak_rss(command: list[str]) -> int:
 
 
 def measure(duration: float, decimation: int, folder: Path) -> dict:
+    """Peak RSS and recorded bytes of one ``tp`` run of ``duration`` s recording every
+    ``decimation``-th step, with its results written under ``folder``."""
     out = folder / f"tp-{duration:g}-{decimation}"
     command = [sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", f"duration={duration}",
                "--decimation", str(decimation), "--out", str(out), "--format", "npz", "--overwrite"]
@@ -48,6 +50,7 @@ def measure(duration: float, decimation: int, folder: Path) -> dict:
 
 
 def main(argv=None) -> int:
+    """Run the cases given on the command line and print one line (or a JSON list) for each."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--durations", type=float, nargs="+", default=[20.0, 200.0, 600.0])
     parser.add_argument("--decimations", type=int, nargs="+", default=[1, 10])

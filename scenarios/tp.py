@@ -135,21 +135,42 @@ def _error(result, signal: str, k: int) -> np.ndarray:
 def report(result, o, out) -> dict:
     """Figures and metrics of one run. Statistics are taken column by column and the figures
     drawn from envelopes, so that the report adds little to the memory of the record."""
-    import matplotlib.pyplot as plt
-
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
+    metrics = {"settle_s": settle, **_error_statistics(result, settle), "bias_error_final": None,
+               "figures": _figures(result, o, out)}
+    if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
+        metrics["bias_error_final"] = [
+            float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]
+        metrics["bias_convergence_s"] = bias_convergence_time(
+            result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"), 1e-3)
+    loop = result.meta.get("loop_seconds")
+    if loop:
+        metrics["real_time_factor"] = o["duration"] / loop
+    return metrics
+
+
+def _error_statistics(result, settle: float) -> dict:
+    """RMS and largest estimation error, RMS tracking error (deg; roll, pitch, yaw) after
+    ``settle`` seconds, one error column at a time."""
     after = slice(np.searchsorted(result.time, settle), None)
-    t = result.time
-    label = f"{o['estimator']}, {o['flight']}, {o['feedback']}, noise {o['noise']}, bias {o['bias']}"
     rms, peak, tracking_rms = [], [], []
     for k in range(3):
         error = _error(result, "Quaternion_estim.theta_est", k)[after]
         rms.append(math.degrees(math.sqrt(np.dot(error, error) / len(error))))
         peak.append(math.degrees(max(error.max(), -error.min())))
-        del error  # one error column at a time
+        del error
         error = _error(result, _SETPOINTS[k], k)[after]
         tracking_rms.append(math.degrees(math.sqrt(np.dot(error, error) / len(error))))
         del error
+    return {"rms_error_deg": rms, "max_error_deg": peak, "tracking_rms_deg": tracking_rms}
+
+
+def _figures(result, o, out) -> list[str]:
+    """Roll and pitch, yaw, and gyro bias against time, truth and estimate; the files written."""
+    import matplotlib.pyplot as plt
+
+    t = result.time
+    label = f"{o['estimator']}, {o['flight']}, {o['feedback']}, noise {o['noise']}, bias {o['bias']}"
 
     def curve(ax, signal, style="-", **options):
         times, values = envelope(t, result[signal])
@@ -184,23 +205,7 @@ def report(result, o, out) -> dict:
     ax.legend(fontsize=7, ncol=3)
     ax.grid(True, alpha=0.3)
     figures.append(save_figure(fig, out, "bias.png"))
-    metrics = {
-        "settle_s": settle,
-        "rms_error_deg": rms,
-        "max_error_deg": peak,
-        "tracking_rms_deg": tracking_rms,
-        "bias_error_final": None,
-        "figures": [f for f in figures if f],
-    }
-    if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
-        metrics["bias_error_final"] = [
-            float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]
-        metrics["bias_convergence_s"] = bias_convergence_time(
-            t, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"), 1e-3)
-    loop = result.meta.get("loop_seconds")
-    if loop:
-        metrics["real_time_factor"] = o["duration"] / loop
-    return metrics
+    return [f for f in figures if f]
 
 
 def bias_convergence_time(t, error, tolerance) -> float | None:

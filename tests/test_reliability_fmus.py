@@ -5,11 +5,13 @@ and a leak check over many instantiate/step/free cycles."""
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 from raw_fmu import RawFMU
 
@@ -94,6 +96,56 @@ def test_a_state_becoming_non_finite_fails_the_step_itself():
     assert "in the step from t = 0 to 0.001" in fmu.messages()
     assert fmu.get_real([fmu.refs["p_z"]])[0] == ERROR  # the FMU is in its error state
     assert "the FMU is in the error state" in fmu.messages()
+    fmu.free()
+
+
+def test_an_empty_battery_fails_the_step_and_the_charge_never_goes_negative():
+    fmu = stepping("MotorMagnetics", {"capacity": 20.0, "soc0": 0.5})  # 10 A.s of charge
+    commands = [fmu.refs[f"c{n}"] for n in range(1, 5)]
+    soc, volts = fmu.refs["soc"], fmu.refs["u_batt"]
+    fmu.set_real(commands, [0.8] * 4)
+    charges, status, k = [], OK, 0
+    while status == OK and k < 10000:
+        status = fmu.do_step(k * 1e-3, 1e-3)
+        if status == OK:
+            _, (charge, voltage) = fmu.get_real([soc, volts])
+            charges.append(charge)
+            assert voltage > 0
+        k += 1
+    assert status == ERROR and 0.0 <= min(charges) < 0.01
+    message = fmu.messages()
+    empty = float(re.search(r"fmi2DoStep: the battery is empty at t = (\S+) s", message).group(1))
+    assert (k - 1) * 1e-3 < empty <= k * 1e-3 + 1e-12  # within the failed step, to the sub-step
+    assert "raise capacity (20 A.s) or soc0 (0.5), or shorten the run" in message
+    print(f"battery of 20 A.s at 50 % empty after {k} ms: {message.splitlines()[-1]}")
+    fmu.free()
+
+
+IMU_INPUTS = {"omega_x": 0.0, "omega_y": 0.0, "omega_z": 0.0, "f_x": 0.0, "f_y": 0.0, "f_z": -9.81,
+              "b_d_x": 0.0, "b_d_y": 0.0, "b_d_z": 0.0}
+
+
+@pytest.mark.parametrize("q, accepted", [
+    ((1.0005, 0.0, 0.0, 0.0), True),  # rounding of a recorded attitude: normalised
+    ((0.6 * 0.9995, 0.8 * 0.9995, 0.0, 0.0), True),
+    ((10.0, 10.0, 0.0, 0.0), False),  # R(q) would not be a rotation (R_reel_11 = -399 before)
+    ((0.0, 0.0, 0.0, 0.0), False),
+])
+def test_the_imu_normalises_a_nearly_unit_quaternion_and_refuses_others(q, accepted):
+    fmu = stepping("IMU", {"noise_enabled": 0})
+    names = ["q0", "q1", "q2", "q3", *IMU_INPUTS]
+    assert fmu.set_real([fmu.refs[n] for n in names], [*q, *IMU_INPUTS.values()]) == OK
+    status = fmu.do_step(0.0, 1e-3)
+    if accepted:
+        assert status == OK, fmu.messages()
+        _, r = fmu.get_real([fmu.refs[f"R_reel_{i}{j}"] for i in (1, 2, 3) for j in (1, 2, 3)])
+        r = np.reshape(r, (3, 3))
+        assert np.abs(r @ r.T - np.eye(3)).max() < 1e-15
+        unit = np.array(q) / np.linalg.norm(q)
+        assert r[0, 0] == pytest.approx(1 - 2 * (unit[2] ** 2 + unit[3] ** 2), abs=1e-15)
+    else:
+        assert status == ERROR
+        assert "the IMU takes a unit quaternion and normalises one only within 0.001 of norm 1" in fmu.messages()
     fmu.free()
 
 

@@ -22,7 +22,7 @@ from orchestrator.fmu import FMUInstance
 INPUTS = {
     "Quadrotor": {"omega_r1": 480.0, "omega_r2": 500.0, "omega_r3": 490.0, "omega_r4": 505.0},
     "MotorMagnetics": {"c1": 0.35, "c2": 0.5, "c3": 0.62, "c4": 0.8},
-    "IMU": {"q0": 0.9, "q1": 0.3, "q2": -0.2, "q3": 0.1 * np.sqrt(10.0) - 0.2, "omega_x": 0.3, "omega_y": -0.2,
+    "IMU": {"q0": 0.9, "q1": 0.3, "q2": -0.2, "q3": np.sqrt(0.06), "omega_x": 0.3, "omega_y": -0.2,
             "omega_z": 0.1, "f_x": 1.0, "f_y": -0.5, "f_z": -9.7, "b_d_x": 1e-6, "b_d_y": -2e-6, "b_d_z": 3e-6},
     "InfraredSensor": {"phi": 0.3},
 }

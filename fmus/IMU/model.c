@@ -16,6 +16,9 @@
  * the inputs held over the step. Noise sample k of channel c is a pure function of (seed, k, c),
  * so streams do not depend on the co-simulation step; its standard deviation is
  * density * sqrt(rate) of its sensor.
+ * The input q is normalised when its norm is within QUATERNION_TOLERANCE of 1 (the rounding
+ * of a recorded or integrated attitude); further off, the step is refused, since R(q) would
+ * not be a rotation.
  */
 #include <math.h>
 #include <stdint.h>
@@ -27,6 +30,7 @@
 
 #define R(name) (m->real[VR_##name])
 #define RV(name) REAL_VECTOR(m, name)
+#define QUATERNION_TOLERANCE 1e-3 /* largest | |q| - 1 | normalised rather than refused */
 #define PI 3.141592653589793
 
 enum { CH_ACC = 0, CH_GYRO = 3, CH_MAG = 6, CH_WALK_GYRO = 9, CH_WALK_ACC = 12 };
@@ -60,6 +64,14 @@ static double gaussian(int seed, int64_t k, int channel) {
     return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
 }
 
+/* r = R(q / |q|): doStep refuses a q far from unit norm, q = 0 among them. */
+static void unit_rotation(const double *q, double r[9]) {
+    double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]), unit[4];
+    int i;
+    for (i = 0; i < 4; i++) unit[i] = norm > 0.0 ? q[i] / norm : (i == 0);
+    rotation_from_quaternion(unit, r);
+}
+
 /* Rotor-imbalance acceleration at instant `at` (s), the rotor speeds held since m->time. */
 static void vibration(ModelInstance *m, const Data *d, double at, double out[3]) {
     const double *w = RV(omega_r);
@@ -80,7 +92,7 @@ static void take_inertial(ModelInstance *m, Data *d, int64_t k) {
     double r[9], sd_acc = 0.0, sd_gyro = 0.0, vib[3];
     int noisy = m->boolean[VB_noise_enabled], biased = m->boolean[VB_bias_enabled], seed = m->integer[VI_seed], i;
     d->inertial.current = k;
-    rotation_from_quaternion(q, r);
+    unit_rotation(q, r);
     vibration(m, d, (double)k / R(sample_rate), vib);
     if (noisy) {
         double root_rate = sqrt(R(sample_rate));
@@ -104,7 +116,7 @@ static void take_magnetic(ModelInstance *m, Data *d, int64_t k) {
     double r[9], body[3], sd = 0.0;
     int noisy = m->boolean[VB_noise_enabled], i;
     d->magnetic.current = k;
-    rotation_from_quaternion(q, r);
+    unit_rotation(q, r);
     if (noisy) sd = R(mag_noise_density) * sqrt(R(mag_sample_rate));
     for (i = 0; i < 3; i++) body[i] = r[i] * mi[0] + r[3 + i] * mi[1] + r[6 + i] * mi[2]; /* R^T m_I */
     for (i = 0; i < 3; i++)
@@ -169,8 +181,17 @@ static int64_t end_of_step(ModelInstance *m, const Clock *c, double rate, const 
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     /* instants in [t, t + h) become final, with the inputs held over the step */
-    int64_t inertial_end = end_of_step(m, &d->inertial, R(sample_rate), "sample_rate", t, h);
-    int64_t magnetic_end = end_of_step(m, &d->magnetic, R(mag_sample_rate), "mag_sample_rate", t, h);
+    const double *q = RV(q);
+    double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    int64_t inertial_end, magnetic_end;
+    if (!(fabs(norm - 1.0) <= QUATERNION_TOLERANCE)) {
+        log_error(m, "fmi2DoStep: the attitude q = (%g, %g, %g, %g) at t = %g has norm %g; the IMU takes a unit "
+                     "quaternion and normalises one only within %g of norm 1",
+                  q[0], q[1], q[2], q[3], t, norm, QUATERNION_TOLERANCE);
+        return fmi2Error;
+    }
+    inertial_end = end_of_step(m, &d->inertial, R(sample_rate), "sample_rate", t, h);
+    magnetic_end = end_of_step(m, &d->magnetic, R(mag_sample_rate), "mag_sample_rate", t, h);
     int n;
     if (inertial_end < 0 || magnetic_end < 0) return fmi2Error;
     for (; d->inertial.next < inertial_end; d->inertial.next++) {

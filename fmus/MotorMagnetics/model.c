@@ -28,6 +28,8 @@
  * sub-step). So a sub-step that would cross a bound is cut at the crossing, located to 1e-12
  * of the sub-step by the Illinois method on the step length, and resumed in the new mode.
  * The state of charge uses classical RK4.
+ * A battery run empty (state of charge below 0) fails the step with an error saying when: the
+ * flight cannot go on, and the charge never leaves its physical range.
  */
 #include <complex.h>
 #include <math.h>
@@ -336,7 +338,6 @@ fmi2Status model_initialize(ModelInstance *m) {
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     int n = substep_count(m, h, R(sub_step), "sub_step"), k;
-    (void)t;
     if (n == 0) return fmi2Error;
     for (k = 0; k < N_MOTORS; k++) {
         double c = RV(c)[k];
@@ -345,7 +346,15 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
             log_warning(m, "c%d = %g at t = %g is outside [0, 1]: saturated", k + 1, c, m->time);
         d->saturated[k] = outside;
     }
-    for (k = 0; k < n; k++) substep(m, d, h / n);
+    for (k = 0; k < n; k++) {
+        substep(m, d, h / n);
+        if (d->x[SOC] < 0.0) { /* an empty battery is the end of the flight, not a negative charge */
+            log_error(m, "fmi2DoStep: the battery is empty at t = %g s (state of charge %g); raise capacity "
+                         "(%g A.s) or soc0 (%g), or shorten the run",
+                      t + (k + 1) * h / n, d->x[SOC], R(capacity), R(soc0));
+            return fmi2Error;
+        }
+    }
     return fmi2OK;
 }
 
