@@ -58,8 +58,9 @@ def check_record_fits(rows: int, signals: int, decimation: int = 1) -> int:
     need = rows * signals * 8
     available = available_memory()
     if available is not None and need > RECORD_SHARE * available:
+        count = rows if rows < 1e12 else f"{rows:.3g}"
         raise RecordTooLarge(
-            f"this run would record {rows} samples of {signals} signals, {need / 1e9:.3g} GB, more than "
+            f"this run would record {count} samples of {signals} signals, {need / 1e9:.3g} GB, more than "
             f"{RECORD_SHARE:.0%} of the {available / 1e9:.3g} GB of memory available. Record less: every N-th "
             f"step (--decimation N, now {decimation}), fewer signals (--record SIGNAL ...), or a shorter run.")
     return need
