@@ -14,6 +14,9 @@ the streaming block) four times:
 - ``both``: the two swaps together.
 
 The roll, pitch and yaw RMS errors after ``settle`` say which input the error comes from.
+
+``--triad`` does the same for the passive filter on TRIAD with the lab's gyro bias: its final
+bias-estimate error with the recorded accelerometer and with gravity alone in its place.
 """
 
 from __future__ import annotations
@@ -26,8 +29,29 @@ import numpy as np
 from estimators import estimate
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
+from orchestrator.blocks import Block
 
 VARIANTS = ("recorded", "ideal accelerometer", "true Euler rates", "both")
+
+
+class GravityOnly(Block):
+    """Specific force of a vehicle at rest in its present attitude, ``f = R^T (0, 0, -g)`` (m/s^2,
+    body FRD), from the true quaternion ``q0..q3``: wired into ``IMU.f`` in place of
+    ``Quadrotor.f``, it gives an accelerometer that sees gravity alone (with the IMU's own noise
+    and bias), in the closed loop."""
+
+    inputs = ("q0", "q1", "q2", "q3")
+    outputs = ("f_x", "f_y", "f_z")
+
+    def __init__(self, name: str = "GravityOnly", g: float = vehicle.GRAVITY):
+        super().__init__(name)
+        self.g = g
+
+    def step(self, t, u, y):
+        q0, q1, q2, q3 = u
+        y[0] = -self.g * 2.0 * (q1 * q3 - q0 * q2)  # -g (R^T e3), the third row of R
+        y[1] = -self.g * 2.0 * (q2 * q3 + q0 * q1)
+        y[2] = -self.g * (1.0 - 2.0 * (q1 * q1 + q2 * q2))
 
 
 def euler_rates(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
@@ -84,6 +108,31 @@ def linear_ablation(settings: dict | None = None) -> dict:
     return rms
 
 
+def triad_ablation(settings: dict | None = None) -> dict:
+    """Passive filter on TRIAD (R_y from accelerometer and magnetometer) with the lab's gyro bias:
+    final bias-estimate error (rad/s, x/y/z) with the recorded accelerometer and with gravity
+    alone in its place, and the true bias. ``settings``: ``tp`` options (``estimator``,
+    ``ry``, ``bias`` and ``feedback`` forced)."""
+    import scenarios
+
+    options = dict(settings or {}) | {"estimator": "passive", "ry": "triad", "bias": True, "feedback": "gt"}
+    result, _ = scenarios.run("tp", options)
+    o = scenarios.get("tp").parse(options)
+    step = round(1.0 / (o["imu_rate"] * o["dt"]))
+    picked = slice(0, None, step)
+    gyro, acc, mag = result["IMU.gyro"][picked], result["IMU.acc"][picked], result["IMU.magneto"][picked]
+    truth = np.column_stack([result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])[picked]
+    gains = scenarios.tp.estimator_gains(o)
+    true_bias = result["IMU.gyro_bias"][-1]
+    out = {"true bias": true_bias.tolist(),
+           "streaming": (result["Quaternion_estim.b_est"][-1] - true_bias).tolist()}
+    for name, a in (("recorded", acc), ("ideal accelerometer", gravity_only(result["IMU.R_reel"][picked]))):
+        b = estimate("passive", gyro=gyro, acc=a, mag=mag, dt=o["dt"] * step, gains=gains, ry="triad",
+                     q0=euler_to_quaternion(*truth[0]), outputs=("b",))["b"][0]
+        out[name] = (b[-1] - true_bias).tolist()
+    return out
+
+
 def markdown(rms: dict) -> str:
     lines = ["| linear filter fed with | RMS error (deg, roll / pitch / yaw) |", "|---|---|"]
     for name, values in rms.items():
@@ -94,8 +143,15 @@ def markdown(rms: dict) -> str:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m scenarios.ablation", description=__doc__.splitlines()[0])
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="a tp option")
+    parser.add_argument("--triad", action="store_true", help="the passive filter on TRIAD: bias error instead")
     args = parser.parse_args(argv)
-    print(markdown(linear_ablation(dict(s.split("=", 1) for s in args.set))))
+    settings = dict(s.split("=", 1) for s in args.set)
+    if args.triad:
+        print("| passive on TRIAD, gyro bias | final bias error (rad/s, x / y / z) |\n|---|---|")
+        for name, values in triad_ablation(settings).items():
+            print(f"| {name} | {' / '.join(f'{v:+.4f}' for v in values)} |")
+    else:
+        print(markdown(linear_ablation(settings)))
     return 0
 
 

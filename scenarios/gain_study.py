@@ -9,6 +9,9 @@
    as a sweep on Dask (a local cluster, or the scheduler given by ``scheduler``); their roll
    and pitch error variances go on the same figure, and a run that fails is named with its
    gain and error, its point left out, the others kept.
+   With the AR(1) standard error of a run that long. ``closed_accelerometer=gravity`` feeds
+   the IMU gravity alone (``R^T (0, 0, -g)``, its own noise kept) in these runs: the ablation
+   that shows why, at large gains, they leave the prediction (see the README).
 
 The statistical uncertainty of each simulated variance is measured by batch means: the
 stream is cut into 20 blocks, each far longer than the filter's time constant 1/k, and the
@@ -41,6 +44,10 @@ OPTIONS = {
     "closed_flight": Option("hover", "flight of the estimate-fed runs", choices=("hover", "quasi")),
     "workers": Option(0, "Dask worker processes for the estimate-fed runs (0: one per CPU)", minimum=0),
     "scheduler": Option("", "address of a running Dask scheduler for them (empty: a local cluster)"),
+    "closed_accelerometer": Option("measured", "estimate-fed runs: the true specific force, or gravity alone "
+                                   "(the ablation that shows where they leave the prediction)",
+                                   choices=("measured", "gravity")),
+    "closed_drag": Option(True, "estimate-fed runs: rotor drag on"),
 }
 BLOCKS = 20  # batch means: the stream after burn-in is cut into this many blocks
 
@@ -99,10 +106,18 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
     return np.array(variances), np.array(errors)
 
 
+def closed_loop_relative_standard_error(gains, o) -> np.ndarray:
+    """Relative standard error of an estimate-fed run's pooled roll/pitch variance: the AR(1)
+    formula sqrt(2 / (k T)) per axis over the ``T`` seconds after settling, over two axes."""
+    kept = o["closed_duration"] - min(20.0, o["closed_duration"] / 4)
+    return np.sqrt(2.0 / (np.asarray(gains) * kept)) / np.sqrt(2.0)
+
+
 def closed_loop_options(k: float, o: dict) -> dict:
     """The ``tp`` options of the estimate-fed closed-loop run at gain ``k`` (1/s)."""
     return {"estimator": "linear", "k": k, "flight": o["closed_flight"], "feedback": "estimate", "noise": True,
-            "duration": o["closed_duration"], "settle": min(20.0, o["closed_duration"] / 4), "seed": o["seed"]}
+            "duration": o["closed_duration"], "settle": min(20.0, o["closed_duration"] / 4), "seed": o["seed"],
+            "accelerometer": o["closed_accelerometer"], "rotor_drag": o["closed_drag"]}
 
 
 def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
@@ -166,7 +181,11 @@ def report(result, o, out) -> dict:
     ax.errorbar(gains, np.degrees(np.sqrt(simulated)), yerr=np.degrees(np.sqrt(simulated)) * relative_se / 2,
                 fmt="o", label="simulated, GT mode (batch path)")
     if closed is not None:
-        ax.loglog(gains, np.degrees(np.sqrt(closed)), "s", mfc="none", label="simulated, estimate-fed closed loop")
+        closed_se = closed_loop_relative_standard_error(gains, o)
+        label = "simulated, estimate-fed closed loop" + (", gravity-only accelerometer"
+                                                         if o["closed_accelerometer"] == "gravity" else "")
+        ax.errorbar(gains, np.degrees(np.sqrt(closed)), yerr=np.degrees(np.sqrt(closed)) * closed_se / 2, fmt="s",
+                    mfc="none", label=label)
     ax.axvline(0.05, color="grey", ls=":", label="lab gain 0.05")
     ax.axvline(k_predicted, color="C0", ls="--", lw=0.8, label=f"predicted optimum {k_predicted:.2f}")
     ax.axvline(k_simulated, color="C1", ls="--", lw=0.8, label=f"simulated optimum {k_simulated:.2f}")
@@ -191,6 +210,9 @@ def report(result, o, out) -> dict:
         "bandwidth_at_lab_gain_rad_s": analysis.linear_bandwidth(0.05),
         "closed_loop_variance_rad2": None if closed is None else closed.tolist(),
         "closed_loop_failures": [{"k": k, "error": error} for k, error in failures],
+        "closed_loop_relative_difference": None if closed is None else (closed / predicted - 1.0).tolist(),
+        "closed_loop_relative_standard_error": None if closed is None
+        else closed_loop_relative_standard_error(gains, o).tolist(),
         "closed_loop_tracking_rms_deg": tracking,
         "figures": [figure] if figure else [],
     }

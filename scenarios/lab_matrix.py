@@ -50,6 +50,8 @@ CASES = {
        for g in (0.1, 1.0, 10.0, 100.0)},
     "passive-triad-quasi-estimate-noise-bias": {"estimator": "passive", "ry": "triad", "bias": True, "noise": True,
                                                 "feedback": "estimate"},
+    "passive-triad-hover-estimate-noise-bias": {"estimator": "passive", "ry": "triad", "bias": True, "noise": True,
+                                                "feedback": "estimate", "flight": "hover"},
 }
 EXPLICIT_GAINS = (0.2, 1.0, 2.0)
 EXPLICIT_WITHOUT_BIAS = ("explicit-0.002-quasi-gt", "explicit-0.002-nonstationary-gt", "explicit-0.002-quasi-estimate",

@@ -14,7 +14,7 @@ from orchestrator import FMUBlock, System
 
 
 def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: bool = True,
-              imu_period: int = 1, wind=(0.0, 0.0, 0.0)) -> System:
+              imu_period: int = 1, wind=(0.0, 0.0, 0.0), specific_force: str = "Quadrotor.f") -> System:
     """Add the three plant FMUs to ``system`` and wire them.
 
     Parameters
@@ -26,6 +26,9 @@ def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: b
         Feed the field of the supply currents ``b_d`` (T, sensor frame) to the IMU; zero if False.
     imu_period : int
         IMU period in macro steps.
+    specific_force : str
+        Source of the IMU's specific-force input (m/s^2, body), a block added beforehand; the
+        Quadrotor's by default (an ablation swaps in gravity alone).
     wind : sequence of 3 floats or None
         Constant wind velocity (m/s, NED: north, east, down). ``None`` leaves ``Quadrotor.wind``
         unconnected, for the caller to connect a wind source.
@@ -40,7 +43,7 @@ def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: b
             system.set_input(f"Quadrotor.wind_{axis}", float(value))
     system.connect("Quadrotor.q", "IMU.q")
     system.connect("Quadrotor.omega", "IMU.omega")
-    system.connect("Quadrotor.f", "IMU.f")
+    system.connect(specific_force, "IMU.f")
     system.connect("MotorMagnetics.omega_r", "IMU.omega_r")
     if magnetic:
         system.connect("MotorMagnetics.b_d", "IMU.b_d")

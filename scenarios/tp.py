@@ -18,6 +18,7 @@ from fmus import vehicle
 from orchestrator import System, Table
 from orchestrator.result import envelope
 from scenarios import Option, Scenario
+from scenarios.ablation import GravityOnly
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.metge import add_compensator
 from scenarios.plant import add_plant, imu_parameters, save_figure
@@ -34,6 +35,8 @@ OPTIONS = {
     "rotor_drag": Option(True, "rotor drag (H-force) on the airspeed, the Quadrotor's k_d; off: k_d = 0"),
     "wind_n": Option(0.0, "steady wind towards the north (m/s)"),
     "wind_e": Option(0.0, "steady wind towards the east (m/s)"),
+    "accelerometer": Option("measured", "IMU fed the true specific force, or gravity alone (an ablation)",
+                            choices=("measured", "gravity")),
     "bench_supply": Option(False, "battery capacity x1000, for hovers longer than the battery's ten minutes"),
     "magnetic": Option(False, "field of the motor currents at the magnetometer"),
     "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
@@ -76,12 +79,17 @@ def build(o: dict) -> System:
     system = System(dt=o["dt"])
     setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
     system.add(Table("Setpoint", SETPOINT, setpoint))
+    if o["accelerometer"] == "gravity":
+        system.add(GravityOnly())
     start = initial_state(o["flight"])  # the estimator starts from the vehicle's initial attitude
     add_plant(system, quadrotor=start | ({} if o["rotor_drag"] else {"k_d": 0.0}), wind=(o["wind_n"], o["wind_e"], 0.0),
               motors={"omega0": vehicle.hover_rotor_speed()}
               | ({"capacity": BENCH_SUPPLY * vehicle.BATTERY_CAPACITY} if o["bench_supply"] else {}),
               imu=imu_parameters(o["noise"], o["bias"], o["seed"], sample_rate=o["imu_rate"]),
-              magnetic=o["magnetic"], imu_period=period)
+              magnetic=o["magnetic"], imu_period=period,
+              specific_force="GravityOnly.f" if o["accelerometer"] == "gravity" else "Quadrotor.f")
+    if o["accelerometer"] == "gravity":
+        system.connect("Quadrotor.q", "GravityOnly.q")
     estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
                                            discretisation=o["discretisation"], ry=o["ry"],
                                            corrections=o["corrections"],
@@ -196,15 +204,17 @@ def _figures(result, o, out) -> list[str]:
     ax.grid(True, alpha=0.3)
     ax.set_title(label)
     figures.append(save_figure(fig, out, "yaw.png"))
-    fig, ax = plt.subplots(figsize=(9, 3.5))
-    for axis in "xyz":
-        line = curve(ax, f"Quaternion_estim.b_est_{axis}", label=f"b_est_{axis}")
-        curve(ax, f"IMU.gyro_bias_{axis}", ":", color=line.get_color(), label=f"b_{axis} (true)")
-    ax.set_ylabel("gyro bias (rad/s)")
-    ax.set_xlabel("time (s)")
-    ax.legend(fontsize=7, ncol=3)
-    ax.grid(True, alpha=0.3)
-    figures.append(save_figure(fig, out, "bias.png"))
+    biases = [f"IMU.gyro_bias_{axis}" for axis in "xyz"] + [f"Quaternion_estim.b_est_{axis}" for axis in "xyz"]
+    if any(np.any(result[name]) for name in biases):  # no figure of zeros (no bias, none estimated)
+        fig, ax = plt.subplots(figsize=(9, 3.5))
+        for axis in "xyz":
+            line = curve(ax, f"Quaternion_estim.b_est_{axis}", label=f"b_est_{axis}")
+            curve(ax, f"IMU.gyro_bias_{axis}", ":", color=line.get_color(), label=f"b_{axis} (true)")
+        ax.set_ylabel("gyro bias (rad/s)")
+        ax.set_xlabel("time (s)")
+        ax.legend(fontsize=7, ncol=3)
+        ax.grid(True, alpha=0.3)
+        figures.append(save_figure(fig, out, "bias.png"))
     return [f for f in figures if f]
 
 
