@@ -52,12 +52,13 @@ CONFIG_LAYOUT = (("gravity", 3), ("earth_field", 3), ("discretisation", 1), ("ry
 CONFIG_SLOTS, CONFIG_SIZE = _offsets(CONFIG_LAYOUT)
 GRAVITY, FIELD, DISCRETE, RY = (CONFIG_SLOTS[n][0] for n in ("gravity", "earth_field", "discretisation", "ry"))
 
-# "pending" is 1 until the first sample has set the attitude from TRIAD (initial="triad")
+# "pending" is 1 until the first sample has set the attitude from TRIAD (initial="triad");
+# "started" is 0 until the first sample has set the rest detector's low-pass filters
 STATE_LAYOUT = (("q", 4), ("b", 3), ("theta", 3), ("gyro_lowpass", 3), ("acc_lowpass", 3), ("rest_time", 1),
-                ("pending", 1))
+                ("pending", 1), ("started", 1))
 STATE_SLOTS, STATE_SIZE = _offsets(STATE_LAYOUT)
-Q, B, THETA, GYRO_LP, ACC_LP, REST_TIME, PENDING = (STATE_SLOTS[n][0] for n in (
-    "q", "b", "theta", "gyro_lowpass", "acc_lowpass", "rest_time", "pending"))
+Q, B, THETA, GYRO_LP, ACC_LP, REST_TIME, PENDING, STARTED = (STATE_SLOTS[n][0] for n in (
+    "q", "b", "theta", "gyro_lowpass", "acc_lowpass", "rest_time", "pending", "started"))
 
 # weights: accelerometer weight, magnetometer weight (0..1), at rest (0 or 1)
 OUTPUT_LAYOUT = (("q", 4), ("theta", 3), ("b", 3), ("omega", 3), ("weights", 3))
@@ -300,6 +301,10 @@ def _linear(x, u, gains, config, dt):
 def _rest(x, acc, gyro, gains, g, dt):
     """Rest detector on low-passed gyro and accelerometer; True once at rest for ``rest_time``."""
     alpha = dt / (REST_LOWPASS_TAU + dt)
+    if x[STARTED] == 0.0:
+        x[STARTED] = 1.0
+        for i in range(3):
+            x[GYRO_LP + i], x[ACC_LP + i] = gyro[i], acc[i]
     for i in range(3):
         x[GYRO_LP + i] += alpha * (gyro[i] - x[GYRO_LP + i])
         x[ACC_LP + i] += alpha * (acc[i] - x[ACC_LP + i])

@@ -543,5 +543,5 @@ def score(q, reference, scored=None, gravity=vehicle.GRAVITY, align_heading: boo
     q = np.ascontiguousarray(q[None] if q.ndim == 2 else q)
     reference, scored = _scoring(reference, scored, q.shape[1])
     g, _ = references(gravity)
-    return {k: (v[0] if q.shape[0] == 1 else v) for k, v in _with_errors(
+    return {k: (float(v[0]) if q.shape[0] == 1 else v) for k, v in _with_errors(
         {"q_all": q}, reference, scored, config_vector(gravity=g), align_heading)["errors"].items()}

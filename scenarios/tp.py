@@ -12,7 +12,7 @@ from functools import partial
 
 import numpy as np
 
-from estimators import LAB_GAINS, QuaternionEstim
+from estimators import LAB_GAINS, QuaternionEstim, score
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator import System, Table
@@ -42,9 +42,9 @@ OPTIONS = {
     "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
     "discretisation": Option("exp", "quaternion update", choices=("exp", "euler")),
     "k": Option(0.05, "linear filter gain, all three axes (1/s)", minimum=0.0),
-    "k1": Option(0.2, "explicit filter: accelerometer gain (1/s)", minimum=0.0),
-    "k2": Option(0.2, "explicit filter: magnetometer gain (1/s)", minimum=0.0),
-    "kP": Option(1.0, "explicit: overall gain (1); passive: proportional gain (1/s)", minimum=0.0),
+    "k1": Option(0.2, "explicit filter: accelerometer weight (1; Mahony's Kp = kP k1)", minimum=0.0),
+    "k2": Option(0.2, "explicit filter: magnetometer weight (1)", minimum=0.0),
+    "kP": Option(1.0, "explicit and passive: proportional gain (1/s)", minimum=0.0),
     "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)"),
     "corrections": Option(False, "explicit/passive: disturbance-aware corrections (estimators.CORRECTIONS)"),
     "duration": Option(20.0, "simulated time (s)", minimum=0.01),
@@ -146,6 +146,8 @@ def report(result, o, out) -> dict:
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
     metrics = {"settle_s": settle, **_error_statistics(result, settle), "bias_error_final": None,
                "figures": _figures(result, o, out)}
+    metrics["quaternion_rmse_deg"] = score(result["Quaternion_estim.q_est"], result["Quadrotor.q"],
+                                           result.time >= settle)
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
         metrics["bias_error_final"] = [
             float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]

@@ -1,0 +1,60 @@
+"""Recorded files and the replay command: a tp run written to a file and replayed gives tp's error."""
+
+import json
+
+import numpy as np
+import pytest
+
+import scenarios
+from estimators import recording
+from scenarios import replay
+
+
+@pytest.mark.parametrize("kind, options", [("explicit", {"kI": 0.05, "corrections": True}),
+                                           ("passive", {"ry": "triad"}), ("vqf", {})])
+def test_replay_of_a_tp_recording_reproduces_its_error(tmp_path, kind, options):
+    _, metrics = scenarios.run("tp", {"estimator": kind, "flight": "nonstationary", "feedback": "estimate",
+                                      "noise": True, "bias": True, "duration": 3.0, **options}, tmp_path / "run")
+    path = replay.from_tp(tmp_path / "run", tmp_path / "recording.npz")
+    result = replay.replay(recording.load(path))
+    reported = metrics["quaternion_rmse_deg"]
+    print(kind, "tp", reported["total_rmse_deg"], "replay", result["errors"]["total_rmse_deg"])
+    for key in ("total_rmse_deg", "inclination_rmse_deg", "heading_rmse_deg"):
+        assert abs(result["errors"][key] - reported[key]) < 1e-9
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".mat", ".csv"])
+def test_recordings_round_trip_in_every_format(tmp_path, suffix):
+    rng = np.random.default_rng(1)
+    data = {"gyro": rng.standard_normal((50, 3)), "acc": rng.standard_normal((50, 3)) + [0, 0, -9.81],
+            "mag": rng.standard_normal((50, 3)), "quat": rng.standard_normal((50, 4))}
+    scored = np.arange(50) > 10
+    path = recording.save(tmp_path / f"r{suffix}", rate=200.0, scored=scored, meta={"frame": "enu"}, **data)
+    back = recording.load(path)
+    for key, value in data.items():
+        assert np.array_equal(back[key], value)
+    assert back["rate"] == pytest.approx(200.0, rel=1e-12)
+    assert np.array_equal(back["scored"], scored)
+    if suffix != ".csv":
+        assert back["meta"] == {"frame": "enu"}
+
+
+def test_a_recording_without_rate_or_sensor_is_refused_by_name(tmp_path):
+    np.savez(tmp_path / "a.npz", gyro=np.zeros((5, 3)), acc=np.zeros((5, 3)), mag=np.zeros((5, 3)))
+    with pytest.raises(ValueError, match="gives no sampling rate"):
+        recording.load(tmp_path / "a.npz")
+    np.savez(tmp_path / "b.npz", gyro=np.zeros((5, 3)), acc=np.zeros((5, 3)), rate=100.0)
+    with pytest.raises(ValueError, match="has no mag array"):
+        recording.load(tmp_path / "b.npz")
+
+
+def test_replay_command_line(tmp_path, capsys):
+    scenarios.run("tp", {"estimator": "madgwick", "duration": 1.0}, tmp_path / "run")
+    assert replay.main(["--from-tp", str(tmp_path / "run"), "--write", str(tmp_path / "r.csv")]) == 0
+    assert replay.main([str(tmp_path / "r.csv"), "--estimator", "explicit", "--set", "kP=0.5",
+                        "--json", str(tmp_path / "out.json")]) == 0
+    result = json.loads((tmp_path / "out.json").read_text())
+    assert result["estimator"] == "explicit" and result["gains"] == {"kP": 0.5}
+    assert result["errors"]["total_rmse_deg"] < 1.0
+    assert replay.main([str(tmp_path / "missing.npz")]) == 2
+    assert "no recording at" in capsys.readouterr().err
