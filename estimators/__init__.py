@@ -16,9 +16,10 @@ from estimators.filters import (
     QuaternionEstim,
     estimate,
     gain_grid,
+    parse_corrections,
     references,
     score,
 )
 
-__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "LAB_GAINS", "QuaternionEstim", "estimate", "gain_grid", "references",
+__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "LAB_GAINS", "QuaternionEstim", "estimate", "gain_grid", "parse_corrections", "references",
            "score"]

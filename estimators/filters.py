@@ -163,6 +163,22 @@ def _corrections(corrections) -> dict:
     return chosen
 
 
+def parse_corrections(text: str):
+    """Corrections from text: ``"on"`` (all), ``"off"``, or comma-separated names of :data:`CORRECTIONS`,
+    each optionally ``name=value`` (``"heading_only,mag_norm_tolerance=0.3"``); for command lines."""
+    text = str(text).strip().lower()
+    if text in ("on", "true", "1", "yes"):
+        return True
+    if text in ("off", "false", "0", "no", ""):
+        return None
+    chosen = {}
+    for item in text.split(","):
+        name, _, value = item.strip().partition("=")
+        chosen[name] = float(value) if value else True
+    _corrections(chosen)  # refuses unknown names here, before a run
+    return chosen
+
+
 def gain_table(kind: str, gains: dict | None = None, corrections=None) -> np.ndarray:
     """(G, core.GAIN_SIZE) table of gain sets, each column placed by its name."""
     merged = check_gains(kind, gains, corrections)

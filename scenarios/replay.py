@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from estimators import estimate, recording
+from estimators import estimate, parse_corrections, recording
 
 
 def field_from_data(acc, mag, samples: int) -> dict:
@@ -112,7 +112,7 @@ def from_tp(results_dir, path) -> Path:
     settle = min(o["settle"], 0.5 * o["duration"])
     meta = {"frame": "ned", "source": f"tp run {results_dir}",
             "estimator": {"kind": o["estimator"], "gains": estimator_gains(o) or None,
-                          "corrections": o.get("corrections", False), "ry": o["ry"],
+                          "corrections": parse_corrections(o.get("corrections", "off")), "ry": o["ry"],
                           "discretisation": o["discretisation"]},
             "reported_quaternion_rmse_deg": metrics.get("quaternion_rmse_deg")}
     return recording.save(path, gyro=result["IMU.gyro"], acc=result["IMU.acc"], mag=result["IMU.magneto"],

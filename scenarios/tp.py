@@ -12,7 +12,7 @@ from functools import partial
 
 import numpy as np
 
-from estimators import LAB_GAINS, QuaternionEstim, score
+from estimators import LAB_GAINS, QuaternionEstim, parse_corrections, score
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator import System, Table
@@ -46,7 +46,7 @@ OPTIONS = {
     "k2": Option(0.2, "explicit filter: magnetometer weight (1)", minimum=0.0),
     "kP": Option(1.0, "explicit and passive: proportional gain (1/s)", minimum=0.0),
     "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)"),
-    "corrections": Option(False, "explicit/passive: disturbance-aware corrections (estimators.CORRECTIONS)"),
+    "corrections": Option("off", "explicit/passive: disturbance-aware corrections, on, off or names (a,b)"),
     "duration": Option(20.0, "simulated time (s)", minimum=0.01),
     "settle": Option(2.0, "time excluded from the error metrics (s)", minimum=0.0),
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
@@ -92,7 +92,7 @@ def build(o: dict) -> System:
         system.connect("Quadrotor.q", "GravityOnly.q")
     estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
                                            discretisation=o["discretisation"], ry=o["ry"],
-                                           corrections=o["corrections"],
+                                           corrections=parse_corrections(o["corrections"]),
                                            q0=euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)))
     for name in estimator.inputs:
         if not (o["compensation"] != "none" and name.startswith("magneto")):  # else from MagCompensator

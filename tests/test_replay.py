@@ -10,7 +10,7 @@ from estimators import recording
 from scenarios import replay
 
 
-@pytest.mark.parametrize("kind, options", [("explicit", {"kI": 0.05, "corrections": True}),
+@pytest.mark.parametrize("kind, options", [("explicit", {"kI": 0.05, "corrections": "on"}),
                                            ("passive", {"ry": "triad"}), ("vqf", {})])
 def test_replay_of_a_tp_recording_reproduces_its_error(tmp_path, kind, options):
     _, metrics = scenarios.run("tp", {"estimator": kind, "flight": "nonstationary", "feedback": "estimate",
