@@ -21,5 +21,5 @@ from estimators.filters import (
     score,
 )
 
-__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "LAB_GAINS", "QuaternionEstim", "estimate", "gain_grid", "parse_corrections", "references",
-           "score"]
+__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "LAB_GAINS", "QuaternionEstim", "estimate", "gain_grid",
+           "parse_corrections", "references", "score"]
