@@ -440,7 +440,8 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
         Time series to return; ``("q",)`` keeps memory to 32 bytes per sample and gain set,
         ``()`` keeps none (with ``reference``, for studies over thousands of gain sets).
     reference : (N, 4) array, optional
-        True attitude; the errors against it are reduced inside the compiled loop.
+        True attitude; the errors against it are reduced inside the compiled loop. Samples
+        whose reference is NaN (an occluded marker) are not scored.
     scored : (N,) bool array, optional
         Samples that count in the errors (default all), e.g. the movement phases.
     align_heading : bool
@@ -512,14 +513,20 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
 def _scoring(reference, scored, count):
     if reference is None:
         return np.zeros((0, 4)), np.zeros(0, dtype=bool)
-    reference = np.ascontiguousarray(reference, dtype=float)
-    if reference.shape != (count, 4) or not np.isfinite(reference).all():
-        raise ValueError(f"reference must be a finite ({count}, 4) array of quaternions, not shape {reference.shape}")
-    reference = reference / np.linalg.norm(reference, axis=1, keepdims=True)
+    reference = np.array(reference, dtype=float)
+    if reference.shape != (count, 4):
+        raise ValueError(f"reference must be a ({count}, 4) array of quaternions, not shape {reference.shape}")
     scored = np.ones(count, dtype=bool) if scored is None else np.asarray(scored, dtype=bool).reshape(-1)
-    if scored.shape != (count,) or not scored.any():
-        raise ValueError(f"scored must be a ({count},) boolean array with at least one true sample")
-    return reference, scored
+    if scored.shape != (count,):
+        raise ValueError(f"scored must be a ({count},) boolean array, not shape {scored.shape}")
+    # samples without a reference (NaN: an occluded optical marker) are not scored
+    known = np.isfinite(reference).all(axis=1) & (np.linalg.norm(np.nan_to_num(reference), axis=1) > 0)
+    scored = scored & known
+    if not scored.any():
+        raise ValueError("no sample is both scored and given a finite reference")
+    reference[~known] = (1.0, 0.0, 0.0, 0.0)
+    reference /= np.linalg.norm(reference, axis=1, keepdims=True)
+    return np.ascontiguousarray(reference), scored
 
 
 def _errors(sums, offsets) -> dict:

@@ -238,3 +238,15 @@ def test_published_filters_are_turned_into_the_configured_frame(kind, bound):
                       outputs=())["errors"]
     print(kind, {k: round(float(v[0]), 3) for k, v in errors.items()})
     assert errors["total_rmse_deg"][0] < bound
+
+
+def test_samples_without_a_reference_are_not_scored():
+    truth, acc, gyro, mag = synthetic(1000)
+    occluded = truth.copy()
+    occluded[200:400] = np.nan
+    scored = np.ones(1000, dtype=bool)
+    scored[200:400] = False
+    with_nan = estimate("explicit", acc=acc, gyro=gyro, mag=mag, dt=1e-3, reference=occluded, outputs=())["errors"]
+    masked = estimate("explicit", acc=acc, gyro=gyro, mag=mag, dt=1e-3, reference=truth, scored=scored,
+                      outputs=())["errors"]
+    assert with_nan["total_rmse_deg"][0] == masked["total_rmse_deg"][0]
