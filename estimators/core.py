@@ -325,6 +325,108 @@ def _split(w, vhat, tilt_weight, heading_weight):
 
 
 @njit(cache=True, error_model="numpy")
+def _weights(acc, mag, gains, v_up, v_field, g, field):
+    """Accelerometer and magnetometer weights (0..1) of the disturbance-aware corrections."""
+    na, nm = _norm3(acc), _norm3(mag)
+    # a null measurement (free fall, a dropped sensor) carries no direction: weight 0
+    acc_weight = _ramp(na - g, gains[ACC_TOL]) if na > 0.0 else 0.0
+    mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL]) if nm > 0.0 else 0.0
+    if nm > 0.0 and gains[MAG_DIP_TOL] > 0.0:
+        # dip: angle of the field below the horizontal plane, measured against the estimate's vertical
+        sin_dip = -(mag[0] * v_up[0] + mag[1] * v_up[1] + mag[2] * v_up[2]) / nm
+        sin_ref = -(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2])
+        mag_weight *= _ramp(math.asin(min(1.0, max(-1.0, sin_dip))) - math.asin(min(1.0, max(-1.0, sin_ref))),
+                            gains[MAG_DIP_TOL])
+    return acc_weight, mag_weight
+
+
+@njit(cache=True, error_model="numpy")
+def _explicit_correction(acc, mag, gains, acc_weight, mag_weight, work, w):
+    """w = sum k_i v_i x vhat_i, weighted; the magnetometer's part kept vertical when heading only."""
+    v_up, v_field = work[W_UP:W_UP + 3], work[W_FIELD:W_FIELD + 3]
+    if acc_weight > 0.0:
+        _add_cross(acc, _norm3(acc), v_up, gains[K1] * acc_weight, w)
+    if mag_weight > 0.0:
+        if gains[HEADING_ONLY] > 0.0:
+            # the magnetometer's correction kept along the vertical: it turns the heading only
+            m = work[W_SCRATCH:W_SCRATCH + 3]
+            m[:] = 0.0
+            _add_cross(mag, _norm3(mag), v_field, gains[K2] * mag_weight, m)
+            _split(m, v_up, 0.0, 1.0)
+            for i in range(3):
+                w[i] += m[i]
+        else:
+            _add_cross(mag, _norm3(mag), v_field, gains[K2] * mag_weight, w)
+
+
+@njit(cache=True, error_model="numpy")
+def _passive_correction(u, config, gains, acc_weight, mag_weight, r, work, w):
+    """w = vex(Pa(R^T R_y)), R_y from R_reel or TRIAD, split into tilt and heading when asked."""
+    acc, mag, v_up = u[ACC:ACC + 3], u[MAG:MAG + 3], work[W_UP:W_UP + 3]
+    ry = work[W_RY:W_RY + 9].reshape((3, 3))
+    if config[RY] == TRIAD:
+        if not triad(acc, mag, config, ry):
+            return
+    else:
+        for i in range(3):
+            for j in range(3):
+                ry[i, j] = u[R_Y + 3 * i + j]
+        acc_weight, mag_weight = 1.0, 1.0  # R_reel carries no sensor disturbance
+    # only the antisymmetric part of R^T R_y is needed
+    for i, j, k in ((2, 1, 0), (0, 2, 1), (1, 0, 2)):
+        upper, lower = 0.0, 0.0
+        for m in range(3):
+            upper += r[m, i] * ry[m, j]
+            lower += r[m, j] * ry[m, i]
+        w[k] = 0.5 * (upper - lower)
+    if gains[HEADING_ONLY] > 0.0:
+        # tilt from R_y's vertical alone (the accelerometer for TRIAD), heading from the rest
+        along = w[0] * v_up[0] + w[1] * v_up[1] + w[2] * v_up[2]
+        v_meas = work[W_SCRATCH:W_SCRATCH + 3]
+        _body(ry, -config[GRAVITY], -config[GRAVITY + 1], -config[GRAVITY + 2], v_meas)
+        w[:] = 0.0
+        _add_cross(v_meas, 1.0, v_up, acc_weight, w)
+        for i in range(3):
+            w[i] += mag_weight * along * v_up[i]
+    elif acc_weight < 1.0 or mag_weight < 1.0:
+        _split(w, v_up, acc_weight, mag_weight)
+
+
+@njit(cache=True, error_model="numpy")
+def _complementary(kind, x, u, gains, config, dt, work, flags):
+    """The explicit or passive filter's step; ``flags`` receives the weights and the rest flag."""
+    acc, gyro, mag = u[ACC:ACC + 3], u[GYRO:GYRO + 3], u[MAG:MAG + 3]
+    q, b = x[Q:Q + 4], x[B:B + 3]
+    r = work[W_R:W_R + 9].reshape((3, 3))
+    w = work[W_OMEGA:W_OMEGA + 3]
+    v_up, v_field = work[W_UP:W_UP + 3], work[W_FIELD:W_FIELD + 3]
+    rotation(q, r)
+    gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
+    mx, my, mz = config[FIELD], config[FIELD + 1], config[FIELD + 2]
+    g = math.sqrt(gx * gx + gy * gy + gz * gz)
+    _body(r, -gx, -gy, -gz, v_up)  # estimated direction of the specific force at rest ("up")
+    _body(r, mx, my, mz, v_field)
+    acc_weight, mag_weight = _weights(acc, mag, gains, v_up, v_field, g, math.sqrt(mx * mx + my * my + mz * mz))
+    w[:] = 0.0
+    if kind == EXPLICIT:
+        _explicit_correction(acc, mag, gains, acc_weight, mag_weight, work, w)
+    else:
+        _passive_correction(u, config, gains, acc_weight, mag_weight, r, work, w)
+        if config[RY] != TRIAD:
+            acc_weight, mag_weight = 1.0, 1.0
+    at_rest = _rest(x, acc, gyro, gains, g, dt)
+    for i in range(3):
+        b[i] -= dt * gains[KI] * w[i]
+        if at_rest:
+            b[i] += dt * gains[REST_GAIN] * (gyro[i] - b[i])
+    kp = gains[KP]
+    _integrate(q, gyro[0] - b[0] + kp * w[0], gyro[1] - b[1] + kp * w[1], gyro[2] - b[2] + kp * w[2], dt,
+               int(config[DISCRETE]))
+    euler_from_quaternion(q, x[THETA:THETA + 3])
+    flags[0], flags[1], flags[2] = acc_weight, mag_weight, 1.0 if at_rest else 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def update(kind, x, u, gains, config, dt, y, work):
     """One estimator step with the sample ``u``; writes the outputs ``y``.
 
@@ -332,101 +434,24 @@ def update(kind, x, u, gains, config, dt, y, work):
     gain vector and ``config`` the configuration, each in the layout declared above; ``work``
     is a scratch array of WORK_SIZE floats owned by the caller, so that nothing is allocated.
     """
-    acc, gyro, mag = u[ACC:ACC + 3], u[GYRO:GYRO + 3], u[MAG:MAG + 3]
-    q, b = x[Q:Q + 4], x[B:B + 3]
+    gyro, q, b = u[GYRO:GYRO + 3], x[Q:Q + 4], x[B:B + 3]
     if x[PENDING] > 0.0:
         x[PENDING] = 0.0
-        if triad(acc, mag, config, work[W_RY:W_RY + 9].reshape((3, 3))):
+        if triad(u[ACC:ACC + 3], u[MAG:MAG + 3], config, work[W_RY:W_RY + 9].reshape((3, 3))):
             quaternion_from_rotation(work[W_RY:W_RY + 9].reshape((3, 3)), q)
             euler_from_quaternion(q, x[THETA:THETA + 3])
-    acc_weight, mag_weight, at_rest = 1.0, 1.0, False
+    flags = y[OUT_WEIGHTS:OUT_WEIGHTS + 3]
     if kind == LINEAR:
         _linear(x, u, gains, config, dt)
+        flags[0], flags[1], flags[2] = 1.0, 1.0, 0.0
     else:
-        r = work[W_R:W_R + 9].reshape((3, 3))
-        w = work[W_OMEGA:W_OMEGA + 3]
-        v_up, v_field = work[W_UP:W_UP + 3], work[W_FIELD:W_FIELD + 3]
-        rotation(q, r)
-        gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
-        mx, my, mz = config[FIELD], config[FIELD + 1], config[FIELD + 2]
-        g = math.sqrt(gx * gx + gy * gy + gz * gz)
-        field = math.sqrt(mx * mx + my * my + mz * mz)
-        _body(r, -gx, -gy, -gz, v_up)  # estimated direction of the specific force at rest ("up")
-        _body(r, mx, my, mz, v_field)
-        na, nm = _norm3(acc), _norm3(mag)
-        # a null measurement (free fall, a dropped sensor) carries no direction: weight 0
-        acc_weight = _ramp(na - g, gains[ACC_TOL]) if na > 0.0 else 0.0
-        mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL]) if nm > 0.0 else 0.0
-        if nm > 0.0 and gains[MAG_DIP_TOL] > 0.0:
-            # dip: angle of the field below the horizontal plane, measured against the estimate's vertical
-            sin_dip = -(mag[0] * v_up[0] + mag[1] * v_up[1] + mag[2] * v_up[2]) / nm
-            sin_ref = -(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2])
-            mag_weight *= _ramp(math.asin(min(1.0, max(-1.0, sin_dip))) - math.asin(min(1.0, max(-1.0, sin_ref))),
-                                gains[MAG_DIP_TOL])
-        w[:] = 0.0
-        if kind == EXPLICIT:
-            # v1 = acc/|acc| against R^T(-g_I)/|g|; v2 = mag/|mag| against R^T m_I/|m_I|
-            if acc_weight > 0.0:
-                _add_cross(acc, na, v_up, gains[K1] * acc_weight, w)
-            if mag_weight > 0.0:
-                if gains[HEADING_ONLY] > 0.0:
-                    # the magnetometer's correction kept along the vertical: it turns the heading only
-                    m = work[W_SCRATCH:W_SCRATCH + 3]
-                    m[:] = 0.0
-                    _add_cross(mag, nm, v_field, gains[K2] * mag_weight, m)
-                    _split(m, v_up, 0.0, 1.0)
-                    for i in range(3):
-                        w[i] += m[i]
-                else:
-                    _add_cross(mag, nm, v_field, gains[K2] * mag_weight, w)
-        else:
-            ry = work[W_RY:W_RY + 9].reshape((3, 3))
-            usable = True
-            if config[RY] == TRIAD:
-                usable = triad(acc, mag, config, ry)
-            else:
-                for i in range(3):
-                    for j in range(3):
-                        ry[i, j] = u[R_Y + 3 * i + j]
-                acc_weight, mag_weight = 1.0, 1.0  # R_reel carries no sensor disturbance
-            # omega = vex(Pa(R^T R_y)): only the antisymmetric part of R^T R_y is needed
-            for i, j, k in ((2, 1, 0), (0, 2, 1), (1, 0, 2)):
-                if not usable:
-                    break
-                upper, lower = 0.0, 0.0
-                for m in range(3):
-                    upper += r[m, i] * ry[m, j]
-                    lower += r[m, j] * ry[m, i]
-                w[k] = 0.5 * (upper - lower)
-            if usable and gains[HEADING_ONLY] > 0.0:
-                # tilt from R_y's vertical alone (the accelerometer for TRIAD), heading from the rest
-                along = w[0] * v_up[0] + w[1] * v_up[1] + w[2] * v_up[2]
-                v_meas = work[W_SCRATCH:W_SCRATCH + 3]
-                _body(ry, -gx, -gy, -gz, v_meas)
-                w[:] = 0.0
-                _add_cross(v_meas, 1.0, v_up, acc_weight, w)
-                for i in range(3):
-                    w[i] += mag_weight * along * v_up[i]
-            elif usable and (acc_weight < 1.0 or mag_weight < 1.0):
-                _split(w, v_up, acc_weight, mag_weight)
-        kp, ki = (gains[KP], gains[KI])
-        at_rest = _rest(x, acc, gyro, gains, g, dt)
-        for i in range(3):
-            b[i] -= dt * ki * w[i]
-            if at_rest:
-                b[i] += dt * gains[REST_GAIN] * (gyro[i] - b[i])
-        _integrate(q, gyro[0] - b[0] + kp * w[0], gyro[1] - b[1] + kp * w[1], gyro[2] - b[2] + kp * w[2], dt,
-                   int(config[DISCRETE]))
-        euler_from_quaternion(q, x[THETA:THETA + 3])
+        _complementary(kind, x, u, gains, config, dt, work, flags)
     for i in range(4):
         y[OUT_Q + i] = q[i]
     for i in range(3):
         y[OUT_THETA + i] = x[THETA + i]
         y[OUT_B + i] = b[i]
         y[OUT_OMEGA + i] = gyro[i] - b[i]
-    y[OUT_WEIGHTS] = acc_weight
-    y[OUT_WEIGHTS + 1] = mag_weight
-    y[OUT_WEIGHTS + 2] = 1.0 if at_rest else 0.0
 
 
 @njit(cache=True, error_model="numpy")

@@ -79,6 +79,7 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
         "ry": meta.get("ry", "triad"),
         "discretisation": meta.get("discretisation", "exp"),
         "initial": initial if initial is not None else meta.get("initial"),
+        "q0": meta.get("q0"),
     }
     frame = frame or data["meta"].get("frame", "ned")
     dip = norm = None
@@ -90,7 +91,7 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
     out = estimate(kind, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], dt=1.0 / data["rate"],
                    gains=settings["gains"], corrections=settings["corrections"] if kind in ("explicit", "passive")
                    else None, ry=settings["ry"], discretisation=settings["discretisation"],
-                   initial=settings["initial"], outputs=(), reference=quat, scored=data["scored"],
+                   initial=settings["initial"], q0=settings["q0"], outputs=(), reference=quat, scored=data["scored"],
                    align_heading=align_heading, **refs)
     errors = {k: float(v[0]) for k, v in out.get("errors", {}).items()}
     return {"estimator": kind, **settings, "frame": frame, "dip_deg": None if dip is None else math.degrees(dip),
@@ -99,8 +100,9 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
 
 def from_tp(results_dir, path) -> Path:
     """Write the recording of a ``tp`` run's results folder (see the module docstring)."""
+    from estimators.core import euler_to_quaternion
     from orchestrator.result import Result
-    from scenarios.tp import estimator_gains
+    from scenarios.tp import estimator_gains, initial_state
 
     results_dir = Path(results_dir)
     result = Result.from_npz(results_dir / "results.npz")
@@ -113,7 +115,8 @@ def from_tp(results_dir, path) -> Path:
     meta = {"frame": "ned", "source": f"tp run {results_dir}",
             "estimator": {"kind": o["estimator"], "gains": estimator_gains(o) or None,
                           "corrections": parse_corrections(o.get("corrections", "off")), "ry": o["ry"],
-                          "discretisation": o["discretisation"]},
+                          "discretisation": o["discretisation"],
+                          "q0": list(euler_to_quaternion(0.0, initial_state(o["flight"]).get("theta2_0", 0.0), 0.0))},
             "reported_quaternion_rmse_deg": metrics.get("quaternion_rmse_deg")}
     return recording.save(path, gyro=result["IMU.gyro"], acc=result["IMU.acc"], mag=result["IMU.magneto"],
                           rate=1.0 / o["dt"], quat=result["Quadrotor.q"], scored=result.time >= settle, meta=meta)

@@ -108,7 +108,7 @@ def test_the_rule_itself(layer, module, expected):
 
 
 # Functions written before this rule, still to be split by their owners; the list may only shrink.
-LONG_PENDING = {"estimators/core.py:update"}
+LONG_PENDING: set[str] = set()
 MAX_FUNCTION_LINES = 60  # code lines, the docstring not counted
 
 
