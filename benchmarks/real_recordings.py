@@ -74,6 +74,7 @@ def evaluate(folder, frame: str = "enu", published: bool = True) -> dict:
 
 
 def main(argv=None) -> int:
+    """Command line (see the module docstring); prints the mean errors, returns 0."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks.real_recordings", description=__doc__.splitlines()[0])
     parser.add_argument("folder")
     parser.add_argument("--frame", default="enu", choices=("ned", "enu"))

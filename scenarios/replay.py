@@ -123,6 +123,7 @@ def from_tp(results_dir, path) -> Path:
 
 
 def main(argv=None) -> int:
+    """Command line (see the module docstring); returns the exit status (2 on bad input)."""
     parser = argparse.ArgumentParser(prog="python -m scenarios.replay", description=__doc__.splitlines()[0])
     parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording")
     parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")
