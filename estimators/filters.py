@@ -513,7 +513,7 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
     return result
 
 
-def _scoring(reference, scored, count):
+def _scoring(reference, scored, count, allow_empty=False):
     if reference is None:
         return np.zeros((0, 4)), np.zeros(0, dtype=bool)
     reference = np.array(reference, dtype=float)
@@ -525,7 +525,7 @@ def _scoring(reference, scored, count):
     # samples without a reference (NaN: an occluded optical marker) are not scored
     known = np.isfinite(reference).all(axis=1) & (np.linalg.norm(np.nan_to_num(reference), axis=1) > 0)
     scored = scored & known
-    if not scored.any():
+    if not scored.any() and not allow_empty:
         raise ValueError("no sample is both scored and given a finite reference")
     reference[~known] = (1.0, 0.0, 0.0, 0.0)
     reference /= np.linalg.norm(reference, axis=1, keepdims=True)
@@ -563,11 +563,29 @@ def score(q, reference, scored=None, gravity=vehicle.GRAVITY, align_heading: boo
     """Quaternion-error RMSE of estimates ``q`` (N, 4) or (G, N, 4) against ``reference`` (N, 4).
 
     The same reduction as :func:`estimate`'s ``reference`` (total, inclination and heading
-    RMSE in degrees, over the ``scored`` samples; see :func:`estimators.core.error_angles`).
+    RMSE in degrees, over the ``scored`` samples; see :func:`estimators.core.error_angles`),
+    taken a block of samples at a time so that it adds little memory to a long record.
     """
-    q = np.asarray(q, dtype=float)
-    q = np.ascontiguousarray(q[None] if q.ndim == 2 else q)
-    reference, scored = _scoring(reference, scored, q.shape[1])
+    q = np.asarray(q)
+    single = q.ndim == 2
+    count = q.shape[-2]
+    scored = np.ones(count, dtype=bool) if scored is None else np.asarray(scored, dtype=bool).reshape(-1)
     g, _ = references(gravity)
-    return {k: (float(v[0]) if q.shape[0] == 1 else v) for k, v in _with_errors(
-        {"q_all": q}, reference, scored, config_vector(gravity=g), align_heading)["errors"].items()}
+    sets = 1 if single else q.shape[0]
+    offsets, sums = np.zeros(sets), np.zeros((sets, core.ERROR_SIZE))
+    for attempt in range(2 if align_heading else 1):
+        if attempt:
+            offsets = np.arctan2(sums[:, core.E_SIN], sums[:, core.E_COS])
+            sums[:] = 0.0
+        for start in range(0, count, _SCORE_BLOCK):
+            block = slice(start, min(count, start + _SCORE_BLOCK))
+            part = np.ascontiguousarray((q[None, block] if single else q[:, block]), dtype=float)
+            ref, mask = _scoring(np.asarray(reference)[block], scored[block], part.shape[1], allow_empty=True)
+            core.score_series(part, ref, mask, g, offsets, sums)
+    if not sums[:, core.E_COUNT].all():
+        raise ValueError("no sample is both scored and given a finite reference")
+    errors = _errors(sums, offsets)
+    return {k: (float(v[0]) if single else v) for k, v in errors.items()}
+
+
+_SCORE_BLOCK = 65536  # samples per block of score()

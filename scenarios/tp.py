@@ -12,7 +12,7 @@ from functools import partial
 
 import numpy as np
 
-from estimators import LAB_GAINS, QuaternionEstim, parse_corrections, score
+from estimators import LAB_GAINS, QuaternionEstim, parse_corrections
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator import System, Table
@@ -146,8 +146,6 @@ def report(result, o, out) -> dict:
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
     metrics = {"settle_s": settle, **_error_statistics(result, settle), "bias_error_final": None,
                "figures": _figures(result, o, out)}
-    metrics["quaternion_rmse_deg"] = score(result["Quaternion_estim.q_est"], result["Quadrotor.q"],
-                                           result.time >= settle)
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
         metrics["bias_error_final"] = [
             float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]
