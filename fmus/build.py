@@ -98,6 +98,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     shutil.copy(HERE / "c" / "shell.c", sources / "shell.c")
     shutil.copy(HERE / "c" / "shell.h", sources / "shell.h")
     shutil.copy(HERE / "c" / "quaternion.h", sources / "quaternion.h")
+    shutil.copy(HERE / "c" / "noise.h", sources / "noise.h")
     shutil.copy(HERE / model / "model.c", sources / "model.c")
     (sources / "variables.h").write_text(header)
     (sources / "airframe.h").write_text(airframe_header())

@@ -25,6 +25,7 @@
 #include <stdio.h>
 
 #include "airframe.h"
+#include "noise.h"
 #include "quaternion.h"
 #include "variables.h"
 
@@ -48,21 +49,6 @@ typedef struct {
 } Data;
 
 const size_t MODEL_DATA_SIZE = sizeof(Data);
-
-static uint64_t splitmix64(uint64_t z) {
-    z += 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-/* Standard normal draw number `channel` of sample `k` (Box-Muller on two hashed uniforms). */
-static double gaussian(int seed, int64_t k, int channel) {
-    uint64_t key = splitmix64((uint64_t)(uint32_t)seed) ^ ((uint64_t)k * 64u + 2u * (uint64_t)channel);
-    double u1 = ((double)(splitmix64(key) >> 11) + 1.0) * 0x1.0p-53; /* (0, 1] */
-    double u2 = (double)(splitmix64(key ^ 0xD1B54A32D192ED03ull) >> 11) * 0x1.0p-53;
-    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
-}
 
 /* r = R(q / |q|): doStep refuses a q far from unit norm, q = 0 among them. */
 static void unit_rotation(const double *q, double r[9]) {
