@@ -6,7 +6,8 @@ then 2 worker processes, and prints:
 
 - members per second with 1 and 2 workers (cluster start excluded) and the speed-up;
 - the per-worker start-up cost: cluster start with the workers' preparation, and the extra
-  time of each worker's first member (compiled code loaded from numba's cache);
+  time of each worker's first member (compiled code loaded from numba's cache, which one
+  discarded warm-up member has filled beforehand);
 - the disk per member (its ``metrics.json``) and per table row;
 - the cost of a 10 000-member study, measured rate extrapolated to N workers;
 - how idle the machine was: load average before and after, CPUs, this process's niceness.
@@ -58,6 +59,8 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
     figures = {"members": members, "simulated_s_per_member": duration, "cpus": os.cpu_count(),
                "niceness": os.nice(0), "load_average_before": list(os.getloadavg())}
     with tempfile.TemporaryDirectory() as folder:
+        # Fills numba's on-disk cache, so neither measured cluster pays a first compilation.
+        engine.run(grid.plan("tp", settings=settings, seeds="1"), Path(folder) / "warm-up", workers=1, progress=False)
         for workers in (1, 2):
             out = Path(folder) / f"workers-{workers}"
             summary = engine.run(plan, out, workers=workers, progress=False)
