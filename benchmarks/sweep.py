@@ -4,7 +4,8 @@ Runs the same 40 short closed-loop members (the lab's loop, linear filter fed ba
 controller, IMU noise on, 5 s simulated each, seeds 1 to 40) on a local Dask cluster of 1 and
 then 2 worker processes, and prints:
 
-- members per second with 1 and 2 workers (cluster start excluded) and the speed-up;
+- members per second with 1 and 2 workers (cluster start and shut-down excluded) and the
+  speed-up;
 - the per-worker start-up cost: cluster start with the workers' preparation, and the extra
   time of each worker's first member (compiled code loaded from numba's cache, which one
   discarded warm-up member has filled beforehand);
@@ -72,10 +73,11 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
             for worker, wall in zip(columns["worker"], walls, strict=True):
                 firsts.setdefault(worker, wall)  # members run in order on a worker, first one first
             typical = statistics.median(walls)
-            running = summary.seconds - summary.startup_s
+            running = summary.seconds - summary.startup_s - summary.shutdown_s
             figures[f"workers_{workers}"] = {
                 "members_per_s": members / running,
                 "start_s": summary.startup_s,
+                "shutdown_s": summary.shutdown_s,
                 "first_member_extra_s": statistics.mean(firsts.values()) - typical,
                 "median_member_s": typical,
                 "median_member_cpu_s": statistics.median(columns["cpu_s"]),
@@ -115,7 +117,8 @@ def report(f: dict) -> str:
         f"{two['median_member_cpu_s']:.3f} s of CPU)",
         f"  speed-up with 2 workers: {f['speed_up_2_workers']:.2f}",
         f"  start-up per worker: cluster and preparation {one['start_s']:.2f} s (1 worker), {two['start_s']:.2f} s "
-        f"(2 workers at once); first member {one['first_member_extra_s']:.2f} s longer than the others",
+        f"(2 workers at once); first member {one['first_member_extra_s']:.2f} s longer than the others; "
+        f"shut-down {one['shutdown_s']:.2f} s (1 worker), {two['shutdown_s']:.2f} s (2 workers)",
         f"  disk per member: {f['disk_per_member_bytes']:.0f} B of metrics.json "
         f"({f['disk_per_member_allocated_bytes']:.0f} B allocated), {f['table_bytes_per_member']:.0f} B of table",
         "  a 10 000-member study of such runs: "

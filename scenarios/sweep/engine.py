@@ -183,6 +183,7 @@ class Summary:
     seconds: float
     workers: int
     startup_s: float = 0.0  # cluster up, workers prepared (s)
+    shutdown_s: float = 0.0  # after the last member: cluster closed (s)
     interrupted: int = 0  # the signal that stopped the sweep (SIGINT, SIGTERM), 0 if none
     failures: list = field(default_factory=list)  # (member, label, error), first few
 
@@ -199,7 +200,7 @@ class Summary:
 
     def text(self) -> str:
         """A few lines for a person: counts, rate, the first failures, where the table is."""
-        running = self.seconds - self.startup_s
+        running = self.seconds - self.startup_s - self.shutdown_s
         rate = self.ran / running if running > 0 else float("nan")
         lines = [f"{self.ok} of {self.total} members done, {self.failed} failed"
                  + (f", {self.missing} not run" if self.missing else "")
@@ -384,6 +385,8 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
             client = _cluster(stack, workers, scheduler, retries, timeout)
             client.register_plugin(Preload(plan.scenario))
             sweep.stream(client, retries, retry_errors, keep_results, extra_metrics, progress)
+            sweep.streamed = time.perf_counter()
+        sweep.shutdown = time.perf_counter() - sweep.streamed
     elif sweep.rows:
         sweep.flush(force=True)
     return sweep.summary()
@@ -401,6 +404,7 @@ class _Sweep:
         self.todo = [m for m in plan.members if m.index not in self.finished]
         self.started = time.perf_counter()
         self.interrupted, self.ran, self.workers, self.startup = 0, 0, 0, 0.0
+        self.streamed, self.shutdown = 0.0, 0.0
         self.last_write, self.write_cost = 0.0, 0.0
 
     def flush(self, force: bool = False):
@@ -454,7 +458,8 @@ class _Sweep:
         ok = sum(r["status"] == "ok" for r in rows.values())
         failures = sorted((i, r["label"], r["error"]) for i, r in rows.items() if r["status"] != "ok")
         return Summary(self.out, len(self.plan.members), ok, len(failures), self.ran, len(self.finished),
-                       time.perf_counter() - self.started, self.workers, self.startup, self.interrupted, failures)
+                       time.perf_counter() - self.started, self.workers, self.startup, self.shutdown, self.interrupted,
+                       failures)
 
 
 def _outcome(future) -> tuple[dict, bool]:
