@@ -290,8 +290,12 @@ class Result:
         return [writers[f](out / f"results.{f}") for f in formats]
 
     # ------------------------------------------------------------------ plots
-    def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = ""):
+    def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = "", unit: str | None = None):
         """Plot signals against time; long series are drawn from their :func:`envelope`.
+
+        The y axis is labelled with the names and their unit, from the variable tables (the
+        run's ``meta["units"]``), or ``unit`` when given (as it must be with a ``scale``:
+        ``scale=180 / pi, unit="deg"``).
 
         Parameters
         ----------
@@ -303,20 +307,41 @@ class Result:
             Factor applied to the values (e.g. ``180 / pi`` for degrees).
         label_prefix : str
             Prefix of each curve's label.
+        unit : str, optional
+            Unit of the values drawn (after ``scale``); by default the signals' own unit,
+            ``1`` for a dimensionless one.
 
         Returns
         -------
         matplotlib.axes.Axes
             The axes.
+
+        Raises
+        ------
+        ValueError
+            A ``scale`` without a ``unit``.
         """
         import matplotlib.pyplot as plt
 
         if ax is None:
             _, ax = plt.subplots(figsize=(8, 3))
+        if unit is None and scale != 1.0:
+            raise ValueError(f"plot of {', '.join(names)} scaled by {scale:g}: give the unit of the scaled values "
+                             "(unit=...)")
+        known = self.meta.get("units", {})
+        parts = []  # "name (unit)", one per name, or one for all when they share their unit
         for name in names:
-            for member in self.columns(name):
+            members = self.columns(name)
+            for member in members:
                 t, y = envelope(self.time, self[member])
                 ax.plot(t, y * scale, label=label_prefix + member)
+            found = {known[m] for m in members if m in known}
+            shown = unit if unit is not None else (found.pop() or "1") if len(found) == 1 else "unit unknown"
+            parts.append((name, shown))
+        if len({shown for _, shown in parts}) == 1:
+            ax.set_ylabel(f"{', '.join(name for name, _ in parts)} ({parts[0][1]})")
+        else:
+            ax.set_ylabel(", ".join(f"{name} ({shown})" for name, shown in parts))
         ax.set_xlabel("time (s)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="best")

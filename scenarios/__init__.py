@@ -153,6 +153,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         partial = error.result
         if out is not None and partial is not None:
             partial.meta["scenario"] = {"name": name, "options": options}
+            partial.meta["faults"] = [fault_record(f) for f in faults]
             written = partial.save(out, formats=formats)
             stopped = {"status": "interrupted" if isinstance(error, RunInterrupted) else "failed",
                        "error": str(error),
@@ -164,6 +165,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
             _write_metrics(out, base | stopped | {"files": sorted(p.name for p in written)})
         raise
     result.meta["scenario"] = {"name": name, "options": options}
+    result.meta["faults"] = [fault_record(f) for f in faults]
     metrics = base | {"status": "completed", "samples": len(result), "fmu_warnings": _warning_counts(result)}
     written = result.save(out, formats=formats) if out is not None else []
     try:
@@ -177,6 +179,21 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         figures = sorted(p.name for p in out.iterdir() if p.suffix in (".png", ".svg", ".pdf"))
         _write_metrics(out, metrics | {"files": sorted([p.name for p in written] + figures)})
     return result, metrics
+
+
+def fault_record(fault) -> dict:
+    """A fault as recorded with a run: target, kind, start and stop (s), value (the signal's unit).
+
+    Parameters
+    ----------
+    fault : orchestrator.Fault
+
+    Returns
+    -------
+    dict
+    """
+    return {"target": fault.target, "kind": fault.kind, "start": fault.start, "stop": fault.stop,
+            "value": fault.value}
 
 
 def _warning_counts(result) -> dict:

@@ -14,6 +14,7 @@ import numpy as np
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
+from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 OPTIONS = {
@@ -27,6 +28,12 @@ OPTIONS = {
 }
 
 
+# the differential pulses: axis, start (s), sign per motor (columns are motors 1..4: 1 front-right,
+# 2 rear-left, 3 front-left, 4 rear-right)
+PULSES = (("roll", 0.8, (-1, 1, 1, -1)), ("pitch", 1.2, (1, -1, 1, -1)), ("yaw", 1.6, (1, 1, -1, -1)))
+PULSE_LENGTH = 0.05  # s
+
+
 def commands(duration: float, dt: float, pulse: float) -> np.ndarray:
     """(n, 4) ESC commands at 0, dt, ..., duration: see :func:`commands_at`."""
     return commands_at(np.arange(int(round(duration / dt)) + 1) * dt, pulse)
@@ -37,9 +44,8 @@ def commands_at(t: np.ndarray, pulse: float) -> np.ndarray:
     pulses of 50 ms."""
     c = np.full((len(t), 4), vehicle.hover_command())
     c *= np.clip(t / 0.3, 0.0, 1.0)[:, None]
-    # columns are motors 1..4: 1 front-right, 2 rear-left, 3 front-left, 4 rear-right
-    for start, pattern in ((0.8, (-1, 1, 1, -1)), (1.2, (1, -1, 1, -1)), (1.6, (1, 1, -1, -1))):
-        window = (t >= start) & (t < start + 0.05)
+    for _, start, pattern in PULSES:
+        window = (t >= start) & (t < start + PULSE_LENGTH)
         c[window] += pulse * np.array(pattern)
     return c
 
@@ -53,7 +59,30 @@ def build(o: dict) -> System:
 
 
 def report(result, o, out) -> dict:
+    """Final position, largest attitude, hover current; figures ``open_loop.png`` (commands,
+    rotor speeds, attitude) and ``imu.png`` (the three sensors), pulses and faults shaded."""
     import matplotlib.pyplot as plt
+
+    faults = faults_of(result)
+    title = title_lines("open-loop: scripted ESC commands, no controller: spin-up, hover, then "
+                        f"differential pulses of \u00b1{o['pulse']:g} on the commands, {PULSE_LENGTH * 1e3:g} ms each "
+                        "(roll, pitch, yaw)",
+                        f"IMU noise {'on' if o['noise'] else 'off'}, biases {'on' if o['bias'] else 'off'}, "
+                        f"motor-current field {'on' if o['magnetic'] else 'off'}", fault_text(faults))
+
+    def finish(fig, axes, name):
+        for ax in axes:
+            for _, start, _ in PULSES:
+                if start < result.time[-1]:
+                    ax.axvspan(start, start + PULSE_LENGTH, color="#7f7f7f", alpha=0.15, lw=0)
+            ax.label_outer()
+        shade_faults(axes, faults)
+        if faults:
+            axes[0].legend(fontsize=7, loc="best")  # with the fault window
+        axes[0].set_title("grey: command pulses", fontsize=7, loc="right")
+        fig.suptitle(title, fontsize=9)
+        label_axes(axes)
+        return save_figure(fig, out, name)
 
     figures = []
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
@@ -61,17 +90,17 @@ def report(result, o, out) -> dict:
     axes[0].set_ylabel("ESC command (1)")
     result.plot("MotorMagnetics.omega_r", ax=axes[1])
     axes[1].set_ylabel("rotor speed (rad/s)")
-    result.plot("Quadrotor.theta1", "Quadrotor.theta2", "Quadrotor.theta3", ax=axes[2], scale=180 / np.pi)
-    axes[2].set_ylabel("attitude (deg)")
-    figures.append(save_figure(fig, out, "open_loop.png"))
+    result.plot("Quadrotor.theta1", "Quadrotor.theta2", "Quadrotor.theta3", ax=axes[2], scale=180 / np.pi, unit="deg")
+    axes[2].set_ylabel("roll, pitch, yaw (deg)")
+    figures.append(finish(fig, axes, "open_loop.png"))
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
     result.plot("IMU.acc", ax=axes[0])
     axes[0].set_ylabel("accelerometer (m/s²)")
     result.plot("IMU.gyro", ax=axes[1])
     axes[1].set_ylabel("gyrometer (rad/s)")
-    result.plot("IMU.magneto", ax=axes[2], scale=1e6)
+    result.plot("IMU.magneto", ax=axes[2], scale=1e6, unit="µT")
     axes[2].set_ylabel("magnetometer (µT)")
-    figures.append(save_figure(fig, out, "imu.png"))
+    figures.append(finish(fig, axes, "imu.png"))
     loop = result.meta.get("loop_seconds")
     return {
         "final_position_m": result["Quadrotor.p"][-1].tolist(),

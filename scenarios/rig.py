@@ -14,6 +14,7 @@ import numpy as np
 
 from orchestrator import System, Table
 from scenarios import Option, Scenario
+from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
 OPTIONS = {
@@ -90,25 +91,42 @@ def mean_errors(result, o) -> tuple[np.ndarray, dict[str, float]]:
 
 
 def report(result, o, out) -> dict:
+    """Mean angular errors of each phase and the figure ``rig_field.png``: the measured field,
+    the ESC commands and the angle between the field and the motors-off reference, phases and
+    fault windows shaded."""
     import matplotlib.pyplot as plt
 
     error, means = mean_errors(result, o)
     t = result.time
+    faults = faults_of(result)
     fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
-    for axis in "xyz":
-        axes[0].plot(t, result[f"IMU.magneto_{axis}"] * 1e6, label=f"m_{axis}")
+    result.plot("IMU.magneto", ax=axes[0], scale=1e6, unit="µT")
     axes[0].set_ylabel("measured field (µT)")
-    axes[0].legend(fontsize=8)
-    axes[0].set_title("Clamped drone: measured field as the motor commands rise (cf. Metge et al., Fig. 1)")
     result.plot("Setpoint.c", ax=axes[1])
     axes[1].set_ylabel("ESC command (1)")
-    axes[2].plot(t, error)
+    axes[2].plot(t, error, lw=0.8)
     axes[2].set_ylabel("angle to m0 (deg)")
+    axes[2].set_xlabel("time (s)")
+    top = max(float(error.max()), 1.0)
     for name, a, b in phases(o)[1:]:
-        axes[2].axvspan(a, b, alpha=0.08)
-        axes[2].text(0.5 * (a + b), error.max() * 0.95, f"{name}\n{means[name]:.1f}°", ha="center", va="top",
+        for ax in axes:
+            ax.axvspan(a, b, color="#1f77b4", alpha=0.06, lw=0)
+        axes[2].text(0.5 * (a + b), top * 1.02, f"{name}\nmean {means[name]:.1f}°", ha="center", va="bottom",
                      fontsize=7)
-    axes[2].grid(True, alpha=0.3)
+    axes[2].set_ylim(0.0, top * 1.25)
+    shade_faults(axes, faults)
+    for ax in axes:
+        ax.label_outer()
+        ax.grid(True, alpha=0.3)
+    if faults:
+        axes[0].legend(fontsize=7, loc="upper left")  # with the fault window
+    attitude = ", ".join(f"{k} {np.degrees(o[k]):g}°" for k in ("roll", "pitch", "yaw"))
+    fig.suptitle(title_lines("rig: drone clamped to the ground, each motor's command ramped 0 to 1 to 0 in turn, "
+                             "then all four varied together (free set)",
+                             f"rig attitude {attitude}; IMU noise {'on' if o['noise'] else 'off'}; "
+                             f"reference (motors off) {o['reference']:g} s, sweeps {o['sweep']:g} s",
+                             fault_text(faults)), fontsize=9)
+    label_axes(axes)
     figure = save_figure(fig, out, "rig_field.png")
     single = [means[f"motor{n}"] for n in range(1, 5)]
     return {

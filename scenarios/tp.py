@@ -19,6 +19,7 @@ from orchestrator import System, Table
 from orchestrator.result import envelope
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
+from scenarios.figures import fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.metge import add_compensator
 from scenarios.plant import add_plant, imu_parameters, save_figure
@@ -173,48 +174,146 @@ def _error_statistics(result, settle: float) -> dict:
     return {"rms_error_deg": rms, "max_error_deg": peak, "tracking_rms_deg": tracking_rms}
 
 
+FLIGHT_NAMES = {"quasi": "quasi-stationary flight", "nonstationary": "non-stationary flight", "hover": "hover",
+                "tilt": "tilt"}
+FEEDBACK_NAMES = {"gt": "controller fed by the ground truth", "estimate": "controller fed by the estimate"}
+# options the title states in words; any other option off its default is listed as key=value
+_TITLED = {"estimator", "flight", "tilt_deg", "feedback", "noise", "bias", "magnetic", "compensation", "k", "k1",
+           "k2", "kP", "kI", "corrections", "duration", "settle", "seed", "calibration", "ry", "discretisation"}
+
+
+def estimator_text(o: dict, name: str | None = None) -> str:
+    """The estimator and the gains it runs with, as a figure title states them.
+
+    Parameters
+    ----------
+    o : dict
+        tp's options.
+    name : str, optional
+        A user's estimator, named as given (its gains are its own and not stated).
+
+    Returns
+    -------
+    str
+        ``"explicit filter (k1 = 0.2, k2 = 0.2, kP = 1 1/s, kI = 0.1 1/s^2)"``.
+    """
+    if name:
+        return f"estimator {name}"
+    kind = o["estimator"]
+    gains = estimator_gains(o)
+    if kind == "linear":
+        text = f"k = {gains['k1']:g} 1/s"
+    elif kind in ("explicit", "passive"):
+        parts = [f"k1 = {gains['k1']:g}", f"k2 = {gains['k2']:g}"] if kind == "explicit" else []
+        parts += [f"kP = {gains['kP']:g} 1/s", f"kI = {gains['kI']:g} 1/s\u00b2"]
+        text = ", ".join(parts)
+        if o["corrections"] != "off":
+            text += f", corrections {o['corrections']}"
+        if kind == "passive" and o["ry"] != "reel":
+            text += f", R_y by {o['ry'].upper()}"
+    else:
+        text = "the package's default gains"
+    if o["discretisation"] != "exp":
+        text += f", {o['discretisation']} update"
+    return f"{kind} filter ({text})"
+
+
+def figure_title(result, o: dict) -> str:
+    """Title of tp's figures: estimator and gains, flight and feedback, sensors, the other
+    options off their defaults, and the faults.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The run (its ``meta`` may name a user's estimator and the faults).
+    o : dict
+        tp's options.
+
+    Returns
+    -------
+    str
+        Several lines.
+    """
+    flight = FLIGHT_NAMES[o["flight"]] + (f" {o['tilt_deg']:g} deg" if o["flight"] == "tilt" else "")
+    sensors = [f"IMU noise {'on' if o['noise'] else 'off'}",
+               "gyro bias (0.02, -0.01, 0.015) rad/s" if o["bias"] else "no gyro bias",
+               "motor-current field " + ("on" if o["magnetic"] else "off")]
+    if o["compensation"] != "none":
+        sensors.append(f"{o['compensation']} compensation")
+    defaults = {key: option.default for key, option in OPTIONS.items()}
+    others = [f"{key}={o[key]}" for key in OPTIONS if key not in _TITLED and o[key] != defaults[key]]
+    units = {f["target"]: result.meta.get("units", {}).get(result.meta.get("connections", {}).get(f["target"], ""), "")
+             for f in faults_of(result)}
+    return title_lines(f"tp: {estimator_text(o, result.meta.get('estimator'))}",
+                       f"{flight}, {FEEDBACK_NAMES[o['feedback']]}",
+                       ", ".join(sensors) + ("; " + ", ".join(others) if others else ""),
+                       fault_text(faults_of(result), units))
+
+
+# Smallest span of the y axes (deg, rad/s): a still vehicle's axis shows a flat line, not
+# rounding noise stretched over the figure.
+ANGLE_SPAN_DEG, ERROR_SPAN_DEG, BIAS_SPAN = 1.0, 0.05, 2e-3
+
+
 def _figures(result, o, out) -> list[str]:
-    """Roll and pitch, yaw, and gyro bias against time, truth and estimate; the files written."""
+    """Roll and pitch, yaw, and (when estimated) the gyro bias: truth and estimate, then the
+    estimate's error, fault windows shaded; the files written."""
     import matplotlib.pyplot as plt
 
     t = result.time
-    label = f"{o['estimator']}, {o['flight']}, {o['feedback']}, noise {o['noise']}, bias {o['bias']}"
+    title = figure_title(result, o)
+    faults = faults_of(result)
 
-    def curve(ax, signal, style="-", **options):
-        times, values = envelope(t, result[signal])
-        return ax.plot(times, np.degrees(values) if "theta" in signal else values, style, **options)[0]
+    def curve(ax, values, style="-", scale=1.0, **options):
+        times, values = envelope(t, values)
+        return ax.plot(times, values * scale, style, **options)[0]
+
+    def finish(fig, axes, spans, name):
+        shade_faults(axes, faults)
+        for ax, span in zip(axes, spans, strict=True):
+            floor_span(ax, span)
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=7, loc="upper left", ncol=4)
+        axes[-1].set_xlabel("time (s)")
+        axes[-1].set_xlim(t[0], t[-1])
+        fig.suptitle(title, fontsize=9)
+        label_axes(axes)
+        return save_figure(fig, out, name)
 
     figures = []
-    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True, height_ratios=(1, 1, 0.8))
     for k, name in enumerate(("roll", "pitch")):
-        curve(axes[k], f"Quadrotor.theta{k + 1}", label=f"{name} (truth)")
-        curve(axes[k], f"Quaternion_estim.theta_est{k + 1}", "--", label=f"{name} (estimate)")
+        curve(axes[k], result[f"Quadrotor.theta{k + 1}"], scale=180 / np.pi, label=f"{name}, truth")
+        curve(axes[k], result[f"Quaternion_estim.theta_est{k + 1}"], "--", scale=180 / np.pi,
+              label=f"{name}, estimate")
         axes[k].set_ylabel(f"{name} (deg)")
-        axes[k].legend(fontsize=8)
-        axes[k].grid(True, alpha=0.3)
-    axes[1].set_xlabel("time (s)")
-    axes[0].set_title(label)
-    figures.append(save_figure(fig, out, "roll_pitch.png"))
-    fig, ax = plt.subplots(figsize=(9, 3.5))
-    curve(ax, "Quadrotor.theta3", label="yaw (truth)")
-    curve(ax, "Quaternion_estim.theta_est3", "--", label="yaw (estimate)")
-    ax.set_ylabel("yaw (deg)")
-    ax.set_xlabel("time (s)")
-    ax.legend(fontsize=8)
-    ax.grid(True, alpha=0.3)
-    ax.set_title(label)
-    figures.append(save_figure(fig, out, "yaw.png"))
-    biases = [f"IMU.gyro_bias_{axis}" for axis in "xyz"] + [f"Quaternion_estim.b_est_{axis}" for axis in "xyz"]
-    if any(np.any(result[name]) for name in biases):  # no figure of zeros (no bias, none estimated)
-        fig, ax = plt.subplots(figsize=(9, 3.5))
+        curve(axes[2], _error(result, "Quaternion_estim.theta_est", k), scale=180 / np.pi, label=f"{name} error",
+              lw=0.9)
+    axes[2].axhline(0.0, color="k", lw=0.5)
+    axes[2].set_ylabel("estimate - truth (deg)")
+    figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "roll_pitch.png"))
+
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
+    curve(axes[0], result["Quadrotor.theta3"], scale=180 / np.pi, label="yaw, truth")
+    curve(axes[0], result["Quaternion_estim.theta_est3"], "--", scale=180 / np.pi, label="yaw, estimate")
+    axes[0].set_ylabel("yaw (deg)")
+    curve(axes[1], _error(result, "Quaternion_estim.theta_est", 2), scale=180 / np.pi, label="yaw error", lw=0.9)
+    axes[1].axhline(0.0, color="k", lw=0.5)
+    axes[1].set_ylabel("estimate - truth (deg)")
+    figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "yaw.png"))
+
+    # the bias figure only for an estimator that estimates one (the linear filter does not)
+    if any(np.any(result[f"Quaternion_estim.b_est_{axis}"]) for axis in "xyz"):
+        fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
         for axis in "xyz":
-            line = curve(ax, f"Quaternion_estim.b_est_{axis}", label=f"b_est_{axis}")
-            curve(ax, f"IMU.gyro_bias_{axis}", ":", color=line.get_color(), label=f"b_{axis} (true)")
-        ax.set_ylabel("gyro bias (rad/s)")
-        ax.set_xlabel("time (s)")
-        ax.legend(fontsize=7, ncol=3)
-        ax.grid(True, alpha=0.3)
-        figures.append(save_figure(fig, out, "bias.png"))
+            estimate, truth = result[f"Quaternion_estim.b_est_{axis}"], result[f"IMU.gyro_bias_{axis}"]
+            line = curve(axes[0], estimate, label=f"b_{axis}, estimate")
+            curve(axes[0], truth, ":", color=line.get_color(), label=f"b_{axis}, truth")
+            curve(axes[1], estimate - truth, color=line.get_color(), label=f"b_{axis} error", lw=0.9)
+        axes[0].set_ylabel("gyro bias (rad/s)")
+        axes[1].axhline(0.0, color="k", lw=0.5)
+        axes[1].set_ylabel("estimate - truth (rad/s)")
+        figures.append(finish(fig, axes, (BIAS_SPAN, BIAS_SPAN), "bias.png"))
     return [f for f in figures if f]
 
 

@@ -1,0 +1,121 @@
+"""What the scenarios' figures say: titles naming gains and faults, no empty axis, a unit on
+every axis, a floor under the span of a still vehicle's axes, fault windows shaded."""
+
+import re
+
+import matplotlib
+import numpy as np
+import pytest
+
+import scenarios
+from orchestrator import Fault, Result
+
+matplotlib.use("Agg")
+
+
+def drawn(monkeypatch, module_name: str) -> dict:
+    """Keep the figures a scenario module saves, by file name, instead of closing them."""
+    import importlib
+
+    module = importlib.import_module(f"scenarios.{module_name}")
+    figures = {}
+
+    def keep(figure, out_dir, name):
+        figures[name] = figure
+        return name
+
+    monkeypatch.setattr(module, "save_figure", keep)
+    return figures
+
+
+def check_axes(figure):
+    """Every axis draws something and states its unit; the bottom one says time (s)."""
+    axes = [ax for ax in figure.axes if ax.get_visible()]
+    for ax in axes:
+        assert ax.lines or ax.collections, f"empty axis {ax.get_ylabel()!r}"
+        assert any(len(line.get_xdata()) > 1 for line in ax.lines), ax.get_ylabel()
+        assert re.search(r"\(.+\)", ax.get_ylabel()), f"no unit in {ax.get_ylabel()!r}"
+    assert axes[-1].get_xlabel() == "time (s)"
+
+
+def spans(ax) -> list[tuple[float, float]]:
+    """Shaded time windows (axvspan) of an axis, (start, stop) in s."""
+    return [(round(p.get_x(), 9), round(p.get_x() + p.get_width(), 9)) for p in ax.patches if hasattr(p, "get_width")]
+
+
+def title_of(options, faults=()):
+    tp = scenarios.get("tp")
+    meta = {"faults": [scenarios.fault_record(f) for f in faults]}
+    from scenarios.tp import figure_title
+
+    return figure_title(Result(np.zeros(1), [], np.zeros((1, 0)), meta), tp.parse(options))
+
+
+def test_tp_titles_tell_gains_and_faults_apart():
+    """The lab's runs with kP = kI = 0.1 and 100 differ in their titles, which name the gains."""
+    small = title_of({"estimator": "passive", "kP": 0.1, "kI": 0.1})
+    large = title_of({"estimator": "passive", "kP": 100.0, "kI": 100.0})
+    assert small != large
+    assert "kP = 0.1 1/s" in small and "kI = 100 1/s²" in large
+    assert "k = 0.05 1/s" in title_of({})
+    faulted = title_of({"feedback": "estimate"}, [Fault("IMU.omega_x", "offset", 2.0, 3.0, 0.1)])
+    assert "fault: offset +0.1 on IMU.omega_x, 2-3 s" in faulted
+    assert "controller fed by the estimate" in faulted
+    assert "wind_n=3.0" in title_of({"wind_n": 3.0})  # an option off its default is stated
+    assert "seed" not in title_of({})
+
+
+def test_tp_figures_show_truth_estimate_error_and_the_fault(monkeypatch, tmp_path):
+    figures = drawn(monkeypatch, "tp")
+    scenarios.run("tp", {"estimator": "explicit", "kI": 0.3, "bias": True, "duration": 1.0},
+                  faults=[Fault("IMU.omega_x", "offset", 0.4, 0.6, 0.1)])
+    assert set(figures) == {"roll_pitch.png", "yaw.png", "bias.png"}
+    for figure in figures.values():
+        check_axes(figure)
+        assert "kI = 0.3 1/s²" in figure.get_suptitle() and "IMU.omega_x" in figure.get_suptitle()
+        for ax in figure.axes:
+            assert (0.4, 0.6) in spans(ax)
+    roll_pitch = figures["roll_pitch.png"].axes
+    assert [line.get_label() for line in roll_pitch[0].lines] == ["roll, truth", "roll, estimate"]
+    assert roll_pitch[2].get_ylabel() == "estimate - truth (deg)"
+
+
+def test_a_still_axis_keeps_a_floor_under_its_span(monkeypatch):
+    """Hovering without noise, the attitude moves by under 1e-6 deg: the axes still span 1 deg
+    (angles) and 0.05 deg (errors), and no bias figure is drawn for the linear filter."""
+    figures = drawn(monkeypatch, "tp")
+    result, _ = scenarios.run("tp", {"flight": "hover", "duration": 0.5, "bias": True})
+    assert np.degrees(np.ptp(result["Quadrotor.theta1"])) < 1e-3
+    assert set(figures) == {"roll_pitch.png", "yaw.png"}  # the linear filter estimates no bias
+    roll, pitch, error = figures["roll_pitch.png"].axes
+    for ax, floor in ((roll, 1.0), (pitch, 1.0), (error, 0.05)):
+        low, high = ax.get_ylim()
+        assert high - low >= floor * (1 - 1e-9)
+        assert not ax.yaxis.get_major_formatter().get_offset()
+
+
+@pytest.mark.parametrize("name, options, files", [
+    ("open-loop", {"duration": 1.0}, {"open_loop.png", "imu.png"}),
+    ("rig", {"reference": 0.2, "sweep": 0.3, "rest": 0.1, "free": 0.3}, {"rig_field.png"}),
+])
+def test_open_loop_and_rig_figures_name_the_run(monkeypatch, name, options, files):
+    figures = drawn(monkeypatch, name.replace("-", "_"))
+    scenarios.run(name, options, faults=[Fault("IMU.omega_x", "offset", 0.3, 0.5, 0.1)])
+    assert set(figures) == files
+    for figure in figures.values():
+        check_axes(figure)
+        title = figure.get_suptitle()
+        assert title.startswith(f"{name}:") and "IMU noise on" in title
+        assert "fault: offset +0.1 on IMU.omega_x, 0.3-0.5 s" in title
+        assert "seed" not in title.lower() and "cf." not in title
+
+
+def test_result_plot_labels_the_unit(tmp_path):
+    result = Result(np.arange(3.0), ["IMU.acc_x", "IMU.acc_y", "Setpoint.c1"], np.ones((3, 3)),
+                    {"units": {"IMU.acc_x": "m/s2", "IMU.acc_y": "m/s2", "Setpoint.c1": ""}})
+    assert result.plot("IMU.acc").get_ylabel() == "IMU.acc (m/s2)"
+    assert result.plot("Setpoint.c").get_ylabel() == "Setpoint.c (1)"
+    assert result.plot("IMU.acc_x", "Setpoint.c1").get_ylabel() == "IMU.acc_x (m/s2), Setpoint.c1 (1)"
+    assert result.plot("IMU.acc", scale=100.0, unit="cm/s2").get_ylabel() == "IMU.acc (cm/s2)"
+    with pytest.raises(ValueError, match="give the unit of the scaled values"):
+        result.plot("IMU.acc", scale=100.0)
