@@ -81,6 +81,25 @@ class Scenario:
     duration: object = None  # (options) -> seconds
     extra: dict = field(default_factory=dict)
 
+    def title(self, options: dict) -> str:
+        """The scenario's name and its options off their defaults, as a figure title names a run.
+
+        Parameters
+        ----------
+        options : dict
+            Parsed options (:meth:`parse`).
+
+        Returns
+        -------
+        str
+            ``"tp: feedback=estimate, k=0.1"``; a scenario may state it in words instead
+            (``extra["title"]``, a function of the options).
+        """
+        if "title" in self.extra:
+            return self.extra["title"](options)
+        changed = [f"{key}={value}" for key, value in options.items() if value != self.options[key].default]
+        return f"{self.name}: " + (", ".join(changed) if changed else "default options")
+
     def parse(self, settings: dict | list | None) -> dict:
         """Options with defaults, from ``{"k": v}`` or ``["k=v", ...]``; refuses unknown keys."""
         values = {k: o.default for k, o in self.options.items()}
@@ -142,6 +161,10 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         raise ValueError(f"--format {','.join(formats)}: choose among {', '.join(FORMATS)}")
     out = prepare_out_dir(out_dir, overwrite) if out_dir else None
     system = scenario.build(options)
+    if out is not None and scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs
+        from orchestrator.diagram import draw
+
+        draw(system, out / "diagram.png", scenario.title(options))
     for fault in faults:
         system.inject(fault)
     duration = scenario.duration(options) if scenario.duration else options["duration"]

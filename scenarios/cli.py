@@ -124,11 +124,12 @@ def _diagram(args) -> int:
 
     try:
         scenario = scenarios.get(args.scenario)
-        system = scenario.build(scenario.parse(args.set))
+        options = scenario.parse(args.set)
+        system = scenario.build(options)
     except (KeyError, ValueError) as error:
         print(error.args[0] if error.args else error, file=sys.stderr)
         return 2
-    path = draw(system, args.out or f"results/{args.scenario}/diagram.png")
+    path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
     print(path)
     return 0
 

@@ -218,21 +218,20 @@ def estimator_text(o: dict, name: str | None = None) -> str:
     return f"{kind} filter ({text})"
 
 
-def figure_title(result, o: dict) -> str:
-    """Title of tp's figures: estimator and gains, flight and feedback, sensors, the other
-    options off their defaults, and the faults.
+def describe(o: dict, estimator: str | None = None) -> list[str]:
+    """The run in words, one line each: estimator and gains; flight and feedback; sensors and
+    the other options off their defaults.
 
     Parameters
     ----------
-    result : orchestrator.Result
-        The run (its ``meta`` may name a user's estimator and the faults).
     o : dict
         tp's options.
+    estimator : str, optional
+        A user's estimator, by name.
 
     Returns
     -------
-    str
-        Several lines.
+    list of str
     """
     flight = FLIGHT_NAMES[o["flight"]] + (f" {o['tilt_deg']:g} deg" if o["flight"] == "tilt" else "")
     sensors = [f"IMU noise {'on' if o['noise'] else 'off'}",
@@ -242,12 +241,31 @@ def figure_title(result, o: dict) -> str:
         sensors.append(f"{o['compensation']} compensation")
     defaults = {key: option.default for key, option in OPTIONS.items()}
     others = [f"{key}={o[key]}" for key in OPTIONS if key not in _TITLED and o[key] != defaults[key]]
-    units = {f["target"]: result.meta.get("units", {}).get(result.meta.get("connections", {}).get(f["target"], ""), "")
-             for f in faults_of(result)}
-    return title_lines(f"tp: {estimator_text(o, result.meta.get('estimator'))}",
-                       f"{flight}, {FEEDBACK_NAMES[o['feedback']]}",
-                       ", ".join(sensors) + ("; " + ", ".join(others) if others else ""),
-                       fault_text(faults_of(result), units))
+    return [f"tp: {estimator_text(o, estimator)}", f"{flight}, {FEEDBACK_NAMES[o['feedback']]}",
+            ", ".join(sensors) + ("; " + ", ".join(others) if others else "")]
+
+
+def figure_title(result, o: dict) -> str:
+    """Title of tp's figures: :func:`describe`'s lines and the faults.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The run (its ``meta`` may name a user's estimator, and names the faults).
+    o : dict
+        tp's options.
+
+    Returns
+    -------
+    str
+        Several lines.
+    """
+    units = result.meta.get("units", {})
+    connections = result.meta.get("connections", {})
+    faults = faults_of(result)
+    return title_lines(*describe(o, result.meta.get("estimator")),
+                       fault_text(faults, {f["target"]: units.get(connections.get(f["target"], ""), "")
+                                           for f in faults}))
 
 
 # Smallest span of the y axes (deg, rad/s): a still vehicle's axis shows a flat line, not
@@ -332,4 +350,20 @@ def bias_convergence_time(t, error, tolerance) -> float | None:
     return float(t[last + 1])
 
 
-SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report)
+def diagram_title(o: dict) -> str:
+    """Title of tp's wiring diagram: the estimator and what feeds the controller.
+
+    Parameters
+    ----------
+    o : dict
+        tp's options.
+
+    Returns
+    -------
+    str
+    """
+    return title_lines(*describe(o))
+
+
+SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
+                    extra={"diagram": True, "title": diagram_title})

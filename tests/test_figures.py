@@ -119,3 +119,59 @@ def test_result_plot_labels_the_unit(tmp_path):
     assert result.plot("IMU.acc", scale=100.0, unit="cm/s2").get_ylabel() == "IMU.acc (cm/s2)"
     with pytest.raises(ValueError, match="give the unit of the scaled values"):
         result.plot("IMU.acc", scale=100.0)
+
+
+LOOP = ["Setpoint", "Controller", "MotorMagnetics", "Quadrotor", "IMU", "Quaternion_estim"]
+
+
+@pytest.mark.parametrize("feedback", ["gt", "estimate"])
+def test_tp_diagram_reads_as_the_labs_loop(feedback):
+    """Blocks in the order of the lab's diagram; feedbacks below the row; every box, arrow and
+    label inside the canvas; no two labels overlap; the title clear of the drawing; each
+    label just above its arrow's run."""
+    from orchestrator import diagram
+
+    tp = scenarios.get("tp")
+    options = tp.parse({"feedback": feedback})
+    system = tp.build(options)
+    order, links, _ = diagram._wiring(system)
+    assert order == LOOP
+    column = {n: i for i, n in enumerate(order)}
+    arrows = diagram._route(order, links, column, diagram._box_height(links, column))
+    back = {(a.source, a.destination) for a in arrows if a.side < 0}
+    fed_back = "Quaternion_estim" if feedback == "estimate" else "Quadrotor"
+    assert {("MotorMagnetics", "Controller"), (fed_back, "Controller")} <= back
+    figure = diagram.figure(system, tp.title(options))
+    ax = figure.axes[0]
+    renderer = figure.canvas.get_renderer()
+    canvas = ax.get_window_extent(renderer)
+    texts = [t for t in ax.texts if t.get_text()]
+    parts = [*texts, *ax.patches, *ax.lines]
+    for part in parts:
+        box = part.get_window_extent(renderer)
+        assert canvas.x0 - 1 <= box.x0 and box.x1 <= canvas.x1 + 1, part
+        assert canvas.y0 - 1 <= box.y0 and box.y1 <= canvas.y1 + 1, part
+    title = ax.title.get_window_extent(renderer)
+    assert title.y0 >= canvas.y1 and "controller fed by the" in ax.title.get_text()
+    boxes = [t.get_window_extent(renderer) for t in texts]
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not a.overlaps(b), (texts[boxes.index(a)].get_text(), texts[boxes.index(b)].get_text())
+    runs = [line for line in ax.lines if len(line.get_ydata()) == 3]  # out, along the lane, in
+    for arrow in (a for a in arrows if a.side):
+        label = next(t for t in texts if t.get_text() == arrow.label)
+        run = next(line for line in runs if line.get_ydata()[1] == pytest.approx(arrow.level)
+                   and min(line.get_xdata()) <= label.get_position()[0] <= max(line.get_xdata()))
+        assert 0 < label.get_position()[1] - run.get_ydata()[1] < 0.1  # just above its own run
+    import matplotlib.pyplot as plt
+
+    plt.close(figure)
+
+
+def test_fold_names_vectors_and_renamed_components():
+    from orchestrator.diagram import fold
+
+    assert fold(["acc_x", "acc_y", "acc_z", "hold"]) == "acc[xyz], hold"
+    assert fold([f"omega_r{n}" for n in range(1, 5)]) == "omega_r[1-4]"
+    assert fold([f"q_est{n}→q{n}" for n in range(4)]) == "q_est[0-3]→q[0-3]"
+    assert fold(["u_batt"]) == "u_batt"
