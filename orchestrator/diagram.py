@@ -69,23 +69,41 @@ def _split(name: str) -> tuple[str, str]:
 
 @dataclass
 class Arrow:
-    """One group of connections, as drawn: from block ``source`` to block ``destination``."""
+    """One group of connections, as drawn.
+
+    Parameters
+    ----------
+    source, destination : str
+        The blocks it joins.
+    label : str
+        The signals it carries, folded (:func:`fold`).
+    side : int
+        0: a straight arrow to the next block; +1: a run above the row (it skips blocks);
+        -1: a dashed run below the row (a feedback, against the flow).
+    lane : int
+        The lane of its horizontal run, 0 nearest the row.
+    x0, x1 : float
+        Where it leaves its source and enters its destination (axis units).
+    label_x : float
+        Centre of its label on the horizontal run (axis units).
+    box : float
+        Height of the block boxes (axis units).
+    """
 
     source: str
     destination: str
     label: str
-    side: int = 0  # 0: straight, to the next block; +1: above the row; -1: below (a feedback)
+    side: int = 0
     lane: int = 0
-    x0: float = 0.0  # where it leaves its source and enters its destination (axis units)
+    x0: float = 0.0
     x1: float = 0.0
-    label_x: float = 0.0  # centre of the label on the horizontal run
+    label_x: float = 0.0
+    box: float = 1.0
 
     @property
     def level(self) -> float:
         """Height of the horizontal run (axis units)."""
         return self.side * (self.box / 2 + LANE * (self.lane + 1))
-
-    box: float = 1.0
 
 
 def draw(system, path, title: str | None = None) -> Path:
