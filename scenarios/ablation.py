@@ -134,6 +134,18 @@ def triad_ablation(settings: dict | None = None) -> dict:
 
 
 def markdown(rms: dict) -> str:
+    """Markdown table of the linear filter's RMS errors, one row per ablation variant.
+
+    Parameters
+    ----------
+    rms : dict
+        Variant name -> RMS error (deg; roll, pitch, yaw), as :func:`linear_ablation` returns.
+
+    Returns
+    -------
+    str
+        The table, two header lines and one line per variant.
+    """
     lines = ["| linear filter fed with | RMS error (deg, roll / pitch / yaw) |", "|---|---|"]
     for name, values in rms.items():
         lines.append(f"| {name} | {' / '.join(f'{v:.3f}' for v in values)} |")
@@ -141,6 +153,19 @@ def markdown(rms: dict) -> str:
 
 
 def main(argv=None) -> int:
+    """Command line ``python -m scenarios.ablation``: print the ablation table.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (default ``sys.argv[1:]``): ``--set KEY=VALUE`` (tp options, repeated) and
+        ``--triad`` (the passive filter on TRIAD: final gyro bias errors, rad/s, instead).
+
+    Returns
+    -------
+    int
+        Exit status, 0.
+    """
     parser = argparse.ArgumentParser(prog="python -m scenarios.ablation", description=__doc__.splitlines()[0])
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="a tp option")
     parser.add_argument("--triad", action="store_true", help="the passive filter on TRIAD: bias error instead")

@@ -53,6 +53,23 @@ BLOCKS = 20  # batch means: the stream after burn-in is cut into this many block
 
 
 def grid(o: dict) -> np.ndarray:
+    """The log-spaced gains of the study.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options; ``k_min``, ``k_max`` (1/s) and ``count`` are used.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``count`` gains (1/s) from ``k_min`` to ``k_max``, geometrically spaced.
+
+    Raises
+    ------
+    ValueError
+        ``k_max`` does not exceed ``k_min``.
+    """
     if not o["k_max"] > o["k_min"]:
         raise ValueError(f"k_max = {o['k_max']} must exceed k_min = {o['k_min']}")
     return np.geomspace(o["k_min"], o["k_max"], o["count"])
@@ -76,6 +93,19 @@ def validate(o: dict) -> None:
 
 
 def build(o: dict):
+    """The ground-truth-fed hover whose sensor stream the study filters (tp's system, linear filter,
+    IMU noise on, macro step ``1 / imu_rate``, bench supply).
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options of the study; checked first by :func:`validate`.
+
+    Returns
+    -------
+    orchestrator.System
+        The system to run for ``duration`` seconds.
+    """
     import scenarios
 
     validate(o)
@@ -163,6 +193,25 @@ def optimum_of(gains, values) -> float:
 
 
 def report(result, o, out) -> dict:
+    """Error variance against gain: python-control's prediction, the batch path on the recorded
+    stream, and (option ``closed_loop``) one estimate-fed run per gain on Dask.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The recorded hover (IMU signals and true Euler angles).
+    o : dict
+        Parsed options of the study.
+    out : pathlib.Path or None
+        Folder of the figure ``gain_study.png`` and of the closed-loop members; None writes no file.
+
+    Returns
+    -------
+    dict
+        Metrics: gains (1/s), predicted and simulated roll/pitch error variances (rad^2), their
+        relative differences and standard errors, both optimal gains (1/s), the closed-loop
+        variances, failures and tracking RMS (deg), and the figures written.
+    """
     import matplotlib.pyplot as plt
 
     gains = grid(o)
@@ -219,6 +268,18 @@ def report(result, o, out) -> dict:
 
 
 def duration(o: dict) -> float:
+    """Simulated length (s) of the recorded stream: the option ``duration``.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options.
+
+    Returns
+    -------
+    float
+        Duration (s).
+    """
     return o["duration"]
 
 

@@ -144,6 +144,20 @@ def checks(summary: dict) -> list[dict]:
 
 
 def markdown(summary: dict) -> str:
+    """The matrix's tables in Markdown: estimation and tracking RMS per case (deg), the explicit
+    filter's steady bias error against its prediction (deg), the passive filter's bias
+    convergence time against its prediction (s), and the checks.
+
+    Parameters
+    ----------
+    summary : dict
+        As :func:`summary_of` returns (with ``checks`` when present).
+
+    Returns
+    -------
+    str
+        The tables, separated by blank lines.
+    """
     def deg(values):
         return " / ".join(f"{v:.3f}" for v in values)
 
@@ -167,6 +181,20 @@ def markdown(summary: dict) -> str:
 
 
 def main(argv=None) -> int:
+    """Command line ``python -m scenarios.lab_matrix``: run the matrix as the named sweep
+    ``lab-matrix`` and print its summary.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments (default ``sys.argv[1:]``): ``--out``, ``--workers``, ``--scheduler``,
+        ``--resume``; the others are passed on to ``quadcosim sweep``.
+
+    Returns
+    -------
+    int
+        The sweep's exit status (0: every member completed).
+    """
     from scenarios.sweep import command
 
     parser = argparse.ArgumentParser(prog="python -m scenarios.lab_matrix", description=__doc__.splitlines()[0])

@@ -51,6 +51,19 @@ def commands_at(t: np.ndarray, pulse: float) -> np.ndarray:
 
 
 def build(o: dict) -> System:
+    """The plant driven by a table of ESC commands (:func:`commands_at`): no controller, no estimator.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options; ``dt`` (s), ``pulse`` (height of the differential command pulses, 1),
+        ``noise``, ``bias``, ``seed`` and ``magnetic`` are used.
+
+    Returns
+    -------
+    orchestrator.System
+        Blocks ``Setpoint``, ``MotorMagnetics``, ``Quadrotor`` and ``IMU``.
+    """
     system = System(dt=o["dt"])
     system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], partial(commands_at, pulse=o["pulse"])))
     add_plant(system, imu=imu_parameters(o["noise"], o["bias"], o["seed"]), magnetic=o["magnetic"])
@@ -60,7 +73,24 @@ def build(o: dict) -> System:
 
 def report(result, o, out) -> dict:
     """Final position, largest attitude, hover current; figures ``open_loop.png`` (commands,
-    rotor speeds, attitude) and ``imu.png`` (the three sensors), pulses and faults shaded."""
+    rotor speeds, attitude) and ``imu.png`` (the three sensors), pulses and faults shaded.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The recorded run.
+    o : dict
+        Parsed options.
+    out : pathlib.Path or None
+        Folder of ``open_loop.png`` and ``imu.png``; None writes no file.
+
+    Returns
+    -------
+    dict
+        ``final_position_m`` (NED), ``max_abs_attitude_deg`` (roll, pitch, yaw),
+        ``hover_current_A`` (motor 1 at 0.7 s), ``us_per_step`` and ``real_time_factor`` of the
+        loop, and the figures written.
+    """
     import matplotlib.pyplot as plt
 
     faults = faults_of(result)

@@ -44,10 +44,35 @@ def phases(o: dict) -> list[tuple[str, float, float]]:
 
 
 def duration(o: dict) -> float:
+    """Simulated length (s) of the rig's run: the end of its last phase (:func:`phases`).
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options; ``reference``, ``sweep``, ``rest`` and ``free`` (s) are used.
+
+    Returns
+    -------
+    float
+        Duration (s).
+    """
     return phases(o)[-1][2]
 
 
 def commands(o: dict) -> np.ndarray:
+    """ESC commands of every phase: none during the reference, a triangle 0 -> 1 -> 0 on one motor
+    at a time, then (``free`` > 0) sums of random sinusoids up to 3 Hz on all four.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options; ``dt`` (s), the phase lengths (s) and ``seed`` are used.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 4) commands (1, in [0, 1]) at 0, dt, ..., :func:`duration`; columns are motors 1..4.
+    """
     dt = o["dt"]
     t = np.arange(int(round(duration(o) / dt)) + 1) * dt
     c = np.zeros((len(t), 4))
@@ -68,6 +93,19 @@ def commands(o: dict) -> np.ndarray:
 
 
 def build(o: dict) -> System:
+    """The clamped vehicle (the test rig) at a fixed attitude, its motors driven by :func:`commands`.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options; ``dt`` (s), ``roll``, ``pitch``, ``yaw`` (rad, Z-Y-X, NED), ``noise`` and
+        ``seed`` are used.
+
+    Returns
+    -------
+    orchestrator.System
+        Blocks ``Setpoint``, ``MotorMagnetics``, ``Quadrotor`` (clamped) and ``IMU``.
+    """
     system = System(dt=o["dt"])
     system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], commands(o)))
     add_plant(system, quadrotor={"clamped": True, "theta1_0": o["roll"], "theta2_0": o["pitch"],
@@ -93,7 +131,23 @@ def mean_errors(result, o) -> tuple[np.ndarray, dict[str, float]]:
 def report(result, o, out) -> dict:
     """Mean angular errors of each phase and the figure ``rig_field.png``: the measured field,
     the ESC commands and the angle between the field and the motors-off reference, phases and
-    fault windows shaded."""
+    fault windows shaded.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The recorded run.
+    o : dict
+        Parsed options.
+    out : pathlib.Path or None
+        Folder of the figure; None writes no file.
+
+    Returns
+    -------
+    dict
+        ``mean_angular_error_deg`` per phase and its mean over the four one-motor phases (deg),
+        ``reference_field_uT`` (body frame, motors off), and the figures written.
+    """
     import matplotlib.pyplot as plt
 
     error, means = mean_errors(result, o)

@@ -26,20 +26,6 @@ PENDING = {
     # w9-infrared
 
     # w7-flight
-    "scenarios.ablation.markdown",
-    "scenarios.ablation.main",
-    "scenarios.gain_study.grid",
-    "scenarios.gain_study.build",
-    "scenarios.gain_study.report",
-    "scenarios.gain_study.duration",
-    "scenarios.lab_matrix.markdown",
-    "scenarios.lab_matrix.main",
-    "scenarios.open_loop.build",
-    "scenarios.open_loop.report",
-    "scenarios.rig.duration",
-    "scenarios.rig.commands",
-    "scenarios.rig.build",
-    "scenarios.rig.report",
     "scenarios.tp.estimator_gains",
     "scenarios.tp.build",
     "scenarios.tp.wrapped",
