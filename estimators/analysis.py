@@ -30,6 +30,9 @@ from scipy.optimize import minimize_scalar
 
 from fmus import vehicle
 
+HORIZON_TIME_CONSTANTS = 12.0  # simulated span of a bias transient, in time constants of its slowest pole
+RESPONSE_SAMPLES = 20001  # samples of that transient (the convergence time is read to span / 20000)
+
 
 # ------------------------------------------------------------------ linear filter
 def linear_transfer_functions(k: float, dt: float) -> dict:
@@ -103,8 +106,8 @@ def passive_bias_convergence_time(kP: float, kI: float, initial_bias_error: floa
                                   horizon: float | None = None) -> float:
     """Time (s) after which the linearised bias error stays within ``tolerance``."""
     slowest = min(abs(p.real) for p in control.poles(passive_error_system(kP, kI)))
-    horizon = horizon or 12.0 * math.log(abs(initial_bias_error) / tolerance + 1.0) / slowest + 1.0
-    t = np.linspace(0.0, horizon, 20001)
+    horizon = horizon or HORIZON_TIME_CONSTANTS * math.log(abs(initial_bias_error) / tolerance + 1.0) / slowest + 1.0
+    t = np.linspace(0.0, horizon, RESPONSE_SAMPLES)
     response = control.initial_response(passive_error_system(kP, kI), t, X0=[0.0, initial_bias_error])
     outside = np.flatnonzero(np.abs(np.squeeze(response.outputs)) > tolerance)
     return 0.0 if len(outside) == 0 else float(t[min(outside[-1] + 1, len(t) - 1)])

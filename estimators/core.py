@@ -77,6 +77,7 @@ REST_GYRO, REST_ACC, REST_MIN_TIME, REST_GAIN = (GAIN_SLOTS[n] for n in ("rest_g
                                                                           "rest_gain"))
 
 REST_LOWPASS_TAU = 0.5  # s, time constant of the low-pass filters of the rest detector
+SMALL_ANGLE = 1e-12  # rad: a smaller rotation in one step is integrated to first order (sin x = x)
 WORK_LAYOUT = (("R", 9), ("omega", 3), ("R_y", 9), ("v_up", 3), ("v_field", 3), ("scratch", 3))
 WORK_SLOTS, WORK_SIZE = _offsets(WORK_LAYOUT)
 W_R, W_OMEGA, W_RY, W_UP, W_FIELD, W_SCRATCH = (WORK_SLOTS[n][0] for n in ("R", "omega", "R_y", "v_up", "v_field",
@@ -194,7 +195,7 @@ def _integrate(q, wx, wy, wz, dt, discretisation):
         q[3] += dt * d3
     else:
         angle = math.sqrt(wx * wx + wy * wy + wz * wz) * dt
-        if angle > 1e-12:
+        if angle > SMALL_ANGLE:
             s = math.sin(0.5 * angle) / (angle / dt)
             c = math.cos(0.5 * angle)
         else:

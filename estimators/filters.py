@@ -102,6 +102,7 @@ OUTPUTS = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")
 R_REEL = tuple(f"R_reel_{i}{j}" for i in range(1, 4) for j in range(1, 4))
 assert len(OUTPUTS) == core.OUTPUT_SIZE and len(MEASUREMENTS) + len(R_REEL) == core.INPUT_SIZE
+WARM_UP_STEP = 1e-3  # s, step of the throw-away update that compiles the kernel before a run
 
 
 def _reference_kinds():
@@ -365,7 +366,7 @@ def _compile(code: int):
     u[core.ACC + 2], u[core.MAG] = -1.0, 1.0
     x = np.zeros(core.STATE_SIZE)
     x[core.Q] = 1.0
-    core.update(code, x, u, np.zeros(core.GAIN_SIZE), config_vector(), 1e-3, np.empty(core.OUTPUT_SIZE),
+    core.update(code, x, u, np.zeros(core.GAIN_SIZE), config_vector(), WARM_UP_STEP, np.empty(core.OUTPUT_SIZE),
                 np.empty(core.WORK_SIZE))
 
 

@@ -32,7 +32,7 @@ DEFAULT_GAINS = {"vqf": {}, "madgwick": {"beta": 0.041}}
 def _vqf_parameters() -> dict:
     from vqf import VQF
 
-    return dict(VQF(0.01).params)
+    return dict(VQF(gyrTs=0.01).params)
 
 
 def check_gains(kind: str, gains: dict | None) -> dict:

@@ -148,16 +148,16 @@ fmi2Status model_initialize(ModelInstance *m) {
         d->acc_bias[i] = RV(b_a)[i];
     }
     for (i = 0; i < N_MOTORS; i++) d->phase[i] = 0.0;
-    d->inertial.next = (int64_t)ceil(m->time * R(sample_rate) - 1e-6);
-    d->magnetic.next = (int64_t)ceil(m->time * R(mag_sample_rate) - 1e-6);
+    d->inertial.next = (int64_t)ceil(m->time * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
+    d->magnetic.next = (int64_t)ceil(m->time * R(mag_sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     d->inertial.current = d->magnetic.current = -1;
     return fmi2OK;
 }
 
 /* Index one past the last instant of clock `rate` in [t, t + h), or -1 when too many. */
 static int64_t end_of_step(ModelInstance *m, const Clock *c, double rate, const char *name, double t, double h) {
-    double last = ceil((t + h) * rate - 1e-6);
-    char what[64];
+    double last = ceil((t + h) * rate - SAMPLE_INSTANT_TOLERANCE);
+    char what[WORK_TEXT_SIZE];
     snprintf(what, sizeof what, "samples at %s = %g Hz", name, rate);
     if (!work_allowed(m, last - (double)c->next, h, what, "take shorter communication steps or a lower rate"))
         return -1;
@@ -194,8 +194,8 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
 /* At an instant of `rate` not yet final, the sample follows the present inputs. */
 static int due(ModelInstance *m, const Clock *c, double rate, int64_t *k) {
     double position = m->time * rate;
-    *k = (int64_t)floor(position + 1e-6);
-    return *k == c->next && fabs(position - (double)*k) < 1e-6;
+    *k = (int64_t)floor(position + SAMPLE_INSTANT_TOLERANCE);
+    return *k == c->next && fabs(position - (double)*k) < SAMPLE_INSTANT_TOLERANCE;
 }
 
 void model_outputs(ModelInstance *m) {

@@ -23,6 +23,7 @@
 #define R(name) (m->real[VR_##name])
 #define HISTORY 4096 /* GPS heading samples kept: (delay + window) * sample_rate at most */
 #define HALF_PI 1.5707963267948966
+#define WHOLE_SAMPLES_TOLERANCE 1e-9 /* relative: a duration counts as a whole number of samples */
 #define TWO_PI 6.283185307179586
 
 enum { CH_IR = 0, CH_HEADING = 1 };
@@ -90,7 +91,7 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k, double t, double p
 /* A whole number of samples in `seconds`, or -1. */
 static int samples(ModelInstance *m, double seconds) {
     double n = seconds * R(sample_rate);
-    if (!(n >= 0.0) || fabs(n - floor(n + 0.5)) > 1e-9 * (1.0 + n)) return -1;
+    if (!(n >= 0.0) || fabs(n - floor(n + 0.5)) > WHOLE_SAMPLES_TOLERANCE * (1.0 + n)) return -1;
     return (int)floor(n + 0.5);
 }
 
@@ -138,7 +139,7 @@ fmi2Status model_initialize(ModelInstance *m) {
     }
     if (!bank_ok(m)) return fmi2Error;
     d->psi = R(psi0);
-    d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - 1e-6);
+    d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     d->first = d->next_sample;
     d->current = d->first - 1;
     return fmi2OK;
@@ -146,9 +147,9 @@ fmi2Status model_initialize(ModelInstance *m) {
 
 fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
-    double r, tk, last = ceil((t + h) * R(sample_rate) - 1e-6);
+    double r, tk, last = ceil((t + h) * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     int64_t end;
-    char what[64];
+    char what[WORK_TEXT_SIZE];
     /* instants in [t, t + h) become final, with phi held over the step */
     if (!bank_ok(m)) return fmi2Error;
     snprintf(what, sizeof what, "samples at sample_rate = %g Hz", R(sample_rate));
@@ -170,12 +171,12 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
 void model_outputs(ModelInstance *m) {
     Data *d = (Data *)m->data;
     double position = m->time * R(sample_rate), a, b;
-    int64_t k = (int64_t)floor(position + 1e-6);
+    int64_t k = (int64_t)floor(position + SAMPLE_INSTANT_TOLERANCE);
     calibration(m, m->time, &a, &b);
     R(a) = a;
     R(b) = b;
     R(psi) = d->psi;
     R(r) = fabs(R(phi)) < HALF_PI ? turn_rate(m) : NAN;
     /* at a sample instant not yet final, the sample follows the present input */
-    if (k == d->next_sample && fabs(position - (double)k) < 1e-6) take_sample(m, d, k, m->time, d->psi);
+    if (k == d->next_sample && fabs(position - (double)k) < SAMPLE_INSTANT_TOLERANCE) take_sample(m, d, k, m->time, d->psi);
 }

@@ -44,6 +44,11 @@ enum { OMEGA = 0, CURRENT = N_MOTORS, SOC = 2 * N_MOTORS };
 /* Mode of a motor: conducting freely, or held at a bound of its current. */
 enum { CONDUCTING = 0, COASTING, AT_MAX, AT_MIN };
 #define MAX_SWITCHES 32 /* mode switches located per sub-step; beyond, the step projects */
+#define CROSSING_TOLERANCE 1e-12 /* a crossing is located to this fraction of the sub-step */
+#define CROSSING_ITERATIONS 100  /* Illinois iterations at most per crossing */
+#define PHI3_SERIES_TERMS 20     /* where |hA| < 0.5 the 20th term is below 1e-28 of phi3 */
+#define CONFLUENT 1e-6           /* eigenvalues closer than this, relatively, count as one */
+#define CONFLUENT_SPLIT 1e-5     /* relative split of confluent eigenvalues (error O(split^2)) */
 
 /* 2x2 row-major functions of h A: exp(hA), exp(hA/2), (h/2) phi1(hA/2), and the
  * ETDRK4 weights h(phi1 - 3 phi2 + 4 phi3), h(phi2 - 2 phi3), h(-phi2 + 4 phi3). */
@@ -143,7 +148,7 @@ static void phi0123(double complex z, double complex p[4]) {
     if (cabs(z) < 0.5) {
         double complex term = 1.0 / 6.0, sum = 0.0;
         int j;
-        for (j = 0; j < 20; j++) {
+        for (j = 0; j < PHI3_SERIES_TERMS; j++) {
             sum += term;
             term *= z / (j + 4);
         }
@@ -172,9 +177,9 @@ static void etd_coefficients(ModelInstance *m, Etd *c, double h) {
     double complex root = csqrt((double complex)(trace * trace - 4.0 * det));
     double complex l1 = 0.5 * (trace + root), l2 = 0.5 * (trace - root);
     double complex p1[4], p2[4], h1[4], h2[4], w1[3], w2[3];
-    if (cabs(l1 - l2) < 1e-6 * cabs(l1)) { /* confluent: split by a negligible amount */
-        l1 += 1e-5 * cabs(l1);
-        l2 -= 1e-5 * cabs(l2);
+    if (cabs(l1 - l2) < CONFLUENT * cabs(l1)) { /* confluent: split by a negligible amount */
+        l1 += CONFLUENT_SPLIT * cabs(l1);
+        l2 -= CONFLUENT_SPLIT * cabs(l2);
     }
     phi0123(h * l1, p1);
     phi0123(h * l2, p2);
@@ -263,7 +268,7 @@ static void substep(ModelInstance *m, Data *d, double h) {
             double lo = 0.0, hi = 1.0, g_lo = margin(m, d, d->x), g_hi = margin(m, d, trial);
             int side = 0, k;
             if (g_lo < 0.0) g_lo = 0.0; /* on the bound already: the crossing is at once */
-            for (k = 0; k < 100 && hi - lo > 1e-12; k++) {
+            for (k = 0; k < CROSSING_ITERATIONS && hi - lo > CROSSING_TOLERANCE; k++) {
                 double s = hi - g_hi * (hi - lo) / (g_hi - g_lo), g;
                 if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
                 etd_coefficients(m, &piece, s * remaining);

@@ -25,6 +25,10 @@
 #define R(name) (m->real[VR_##name])
 #define RV(name) REAL_VECTOR(m, name)
 
+/* Where each part of the state starts in x (p, v, q, omega); the table declares N_STATES. */
+enum { POSITION = 0, VELOCITY = 3, ATTITUDE = 6, RATE = 10 };
+typedef char state_layout_matches_the_table[(N_STATES == RATE + 3) ? 1 : -1];
+
 typedef struct {
     double x[N_STATES];
 } Data;
@@ -68,7 +72,8 @@ static double spin_sum(ModelInstance *m) {
 }
 
 static void derivatives(ModelInstance *m, double t, const double *x, double *dx) {
-    const double *v = x + 3, *q = x + 6, *w = x + 10;
+    const double *v = x + VELOCITY, *q = x + ATTITUDE, *w = x + RATE;
+    double *dp = dx + POSITION, *dv = dx + VELOCITY, *dq = dx + ATTITUDE, *dw = dx + RATE;
     double thrust, tau[3], r[9], f[3], body[3], norm_error, gyro;
     (void)t;
     if (m->boolean[VB_clamped]) {
@@ -82,21 +87,21 @@ static void derivatives(ModelInstance *m, double t, const double *x, double *dx)
     body[0] = f[0] / R(m);
     body[1] = f[1] / R(m);
     body[2] = (f[2] - thrust) / R(m);
-    dx[0] = v[0];
-    dx[1] = v[1];
-    dx[2] = v[2];
-    dx[3] = r[0] * body[0] + r[1] * body[1] + r[2] * body[2];
-    dx[4] = r[3] * body[0] + r[4] * body[1] + r[5] * body[2];
-    dx[5] = R(g) + r[6] * body[0] + r[7] * body[1] + r[8] * body[2];
+    dp[0] = v[0];
+    dp[1] = v[1];
+    dp[2] = v[2];
+    dv[0] = r[0] * body[0] + r[1] * body[1] + r[2] * body[2];
+    dv[1] = r[3] * body[0] + r[4] * body[1] + r[5] * body[2];
+    dv[2] = R(g) + r[6] * body[0] + r[7] * body[1] + r[8] * body[2];
     norm_error = R(k_norm) * (1.0 - (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]));
-    dx[6] = 0.5 * (-q[1] * w[0] - q[2] * w[1] - q[3] * w[2]) + norm_error * q[0];
-    dx[7] = 0.5 * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1]) + norm_error * q[1];
-    dx[8] = 0.5 * (q[0] * w[1] + q[3] * w[0] - q[1] * w[2]) + norm_error * q[2];
-    dx[9] = 0.5 * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0]) + norm_error * q[3];
+    dq[0] = 0.5 * (-q[1] * w[0] - q[2] * w[1] - q[3] * w[2]) + norm_error * q[0];
+    dq[1] = 0.5 * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1]) + norm_error * q[1];
+    dq[2] = 0.5 * (q[0] * w[1] + q[3] * w[0] - q[1] * w[2]) + norm_error * q[2];
+    dq[3] = 0.5 * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0]) + norm_error * q[3];
     gyro = R(J_r) * spin_sum(m); /* -omega x h_r = gyro (omega_y, -omega_x, 0) */
-    dx[10] = (tau[0] + gyro * w[1] - (R(Jzz) - R(Jyy)) * w[1] * w[2]) / R(Jxx);
-    dx[11] = (tau[1] - gyro * w[0] - (R(Jxx) - R(Jzz)) * w[2] * w[0]) / R(Jyy);
-    dx[12] = (tau[2] - (R(Jyy) - R(Jxx)) * w[0] * w[1]) / R(Jzz);
+    dw[0] = (tau[0] + gyro * w[1] - (R(Jzz) - R(Jyy)) * w[1] * w[2]) / R(Jxx);
+    dw[1] = (tau[1] - gyro * w[0] - (R(Jxx) - R(Jzz)) * w[2] * w[0]) / R(Jyy);
+    dw[2] = (tau[2] - (R(Jyy) - R(Jxx)) * w[0] * w[1]) / R(Jzz);
 }
 
 fmi2Status model_initialize(ModelInstance *m) {
@@ -124,12 +129,12 @@ fmi2Status model_initialize(ModelInstance *m) {
                   R(Jxx), R(Jyy), R(Jzz));
         return fmi2Error;
     }
-    d->x[0] = R(p_x0);
-    d->x[1] = R(p_y0);
-    d->x[2] = R(p_z0);
-    d->x[3] = R(v_x0);
-    d->x[4] = R(v_y0);
-    d->x[5] = R(v_z0);
+    d->x[POSITION] = R(p_x0);
+    d->x[POSITION + 1] = R(p_y0);
+    d->x[POSITION + 2] = R(p_z0);
+    d->x[VELOCITY] = R(v_x0);
+    d->x[VELOCITY + 1] = R(v_y0);
+    d->x[VELOCITY + 2] = R(v_z0);
     /* Z-Y-X Euler angles to quaternion */
     c1 = cos(0.5 * R(theta1_0));
     s1 = sin(0.5 * R(theta1_0));
@@ -137,16 +142,15 @@ fmi2Status model_initialize(ModelInstance *m) {
     s2 = sin(0.5 * R(theta2_0));
     c3 = cos(0.5 * R(theta3_0));
     s3 = sin(0.5 * R(theta3_0));
-    d->x[6] = c3 * c2 * c1 + s3 * s2 * s1;
-    d->x[7] = c3 * c2 * s1 - s3 * s2 * c1;
-    d->x[8] = c3 * s2 * c1 + s3 * c2 * s1;
-    d->x[9] = s3 * c2 * c1 - c3 * s2 * s1;
-    d->x[10] = R(omega_x0);
-    d->x[11] = R(omega_y0);
-    d->x[12] = R(omega_z0);
+    d->x[ATTITUDE] = c3 * c2 * c1 + s3 * s2 * s1;
+    d->x[ATTITUDE + 1] = c3 * c2 * s1 - s3 * s2 * c1;
+    d->x[ATTITUDE + 2] = c3 * s2 * c1 + s3 * c2 * s1;
+    d->x[ATTITUDE + 3] = s3 * c2 * c1 - c3 * s2 * s1;
+    d->x[RATE] = R(omega_x0);
+    d->x[RATE + 1] = R(omega_y0);
+    d->x[RATE + 2] = R(omega_z0);
     if (m->boolean[VB_clamped]) {
-        for (i = 3; i < 6; i++) d->x[i] = 0.0;
-        for (i = 10; i < 13; i++) d->x[i] = 0.0;
+        for (i = 0; i < 3; i++) d->x[VELOCITY + i] = d->x[RATE + i] = 0.0;
     }
     return fmi2OK;
 }
@@ -168,24 +172,24 @@ void model_outputs(ModelInstance *m) {
     int i;
     derivatives(m, m->time, x, dx);
     rotor_forces(m, &thrust, tau);
-    rotation_from_quaternion(x + 6, r);
-    drag_force(m, x + 3, r, f);
-    R(p_x) = x[0];
-    R(p_y) = x[1];
-    R(p_z) = x[2];
-    R(v_x) = x[3];
-    R(v_y) = x[4];
-    R(v_z) = x[5];
-    R(q0) = x[6];
-    R(q1) = x[7];
-    R(q2) = x[8];
-    R(q3) = x[9];
-    R(omega_x) = x[10];
-    R(omega_y) = x[11];
-    R(omega_z) = x[12];
+    rotation_from_quaternion(x + ATTITUDE, r);
+    drag_force(m, x + VELOCITY, r, f);
+    R(p_x) = x[POSITION];
+    R(p_y) = x[POSITION + 1];
+    R(p_z) = x[POSITION + 2];
+    R(v_x) = x[VELOCITY];
+    R(v_y) = x[VELOCITY + 1];
+    R(v_z) = x[VELOCITY + 2];
+    R(q0) = x[ATTITUDE];
+    R(q1) = x[ATTITUDE + 1];
+    R(q2) = x[ATTITUDE + 2];
+    R(q3) = x[ATTITUDE + 3];
+    R(omega_x) = x[RATE];
+    R(omega_y) = x[RATE + 1];
+    R(omega_z) = x[RATE + 2];
     /* f_B = R^T (dv - g e3) */
     for (i = 0; i < 3; i++)
-        RV(f)[i] = r[i] * dx[3] + r[3 + i] * dx[4] + r[6 + i] * (dx[5] - R(g));
+        RV(f)[i] = r[i] * dx[VELOCITY] + r[3 + i] * dx[VELOCITY + 1] + r[6 + i] * (dx[VELOCITY + 2] - R(g));
     for (i = 0; i < LEN_R; i++) RV(R)[i] = r[i];
     R(theta1) = atan2(r[7], r[8]);
     R(theta2) = -asin(fmax(-1.0, fmin(1.0, r[6])));

@@ -14,9 +14,11 @@ static inline uint64_t splitmix64(uint64_t z) {
 }
 
 /* Standard normal draw number `channel` of sample `k` (Box-Muller on two hashed uniforms). */
+#define KEYS_PER_SAMPLE 64u /* sample k owns the keys 64 k to 64 k + 63: 32 channels, two keys apart */
+
 static inline double gaussian(int seed, int64_t k, int channel) {
     const double two_pi = 6.283185307179586;
-    uint64_t key = splitmix64((uint64_t)(uint32_t)seed) ^ ((uint64_t)k * 64u + 2u * (uint64_t)channel);
+    uint64_t key = splitmix64((uint64_t)(uint32_t)seed) ^ ((uint64_t)k * KEYS_PER_SAMPLE + 2u * (uint64_t)channel);
     double u1 = ((double)(splitmix64(key) >> 11) + 1.0) * 0x1.0p-53; /* (0, 1] */
     double u2 = (double)(splitmix64(key ^ 0xD1B54A32D192ED03ull) >> 11) * 0x1.0p-53;
     return sqrt(-2.0 * log(u1)) * cos(two_pi * u2);

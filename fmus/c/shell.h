@@ -59,6 +59,12 @@ void log_warning(ModelInstance *m, const char *format, ...);
  * default sub-step, 200 s of the IMU at 1 kHz). */
 #define MAX_SUBSTEPS_PER_STEP 200000
 
+/* Sample clocks of the sensor models: t * rate within this many sample periods of an integer k
+ * is the instant k (it absorbs the rounding of t * rate, far below any step a caller takes). */
+#define SAMPLE_INSTANT_TOLERANCE 1e-6
+/* Size of the short description a model hands to work_allowed. */
+#define WORK_TEXT_SIZE 64
+
 /* Whether `count` sub-steps or samples (a real number: it may be huge or non-finite) fit in one
  * doStep of h seconds; if not, logs why, naming `what` (e.g. "sub-steps of sub_step = 0.01 s")
  * and the `fix`, and returns 0. */

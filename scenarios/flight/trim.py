@@ -25,6 +25,9 @@ from scipy.optimize import brentq
 
 from fmus import vehicle
 
+THRUST_ITERATIONS = 50  # fixed-point iterations of the vertical balance (they converge: drag << weight)
+LARGEST_TRIM_TILT = math.radians(60.0)  # rad, upper end of the search for the tilt into the wind
+
 
 def _rotor_sum(thrust: float, thrust_coeff: float) -> float:
     """``sum |omega_n|`` (rad/s) of four equal rotors giving ``thrust`` (N)."""
@@ -88,7 +91,7 @@ def wind_hover_tilt(wind_speed: float, mass: float = vehicle.MASS, thrust_coeff:
 
     def thrust_of(theta):  # from the vertical balance, by fixed point (it converges: drag << weight)
         t = mass * g
-        for _ in range(50):
+        for _ in range(THRUST_ITERATIONS):
             t = (mass * g - rotor_drag * _rotor_sum(t, thrust_coeff) * w * math.cos(theta) * math.sin(theta)) \
                 / math.cos(theta)
         return t
@@ -100,5 +103,5 @@ def wind_hover_tilt(wind_speed: float, mass: float = vehicle.MASS, thrust_coeff:
 
     if w == 0.0:
         return 0.0, mass * g
-    tilt = brentq(horizontal, 0.0, math.radians(60.0), xtol=1e-14)
+    tilt = brentq(horizontal, 0.0, LARGEST_TRIM_TILT, xtol=1e-14)
     return tilt, thrust_of(tilt)
