@@ -28,7 +28,8 @@ def measure(samples: int = 8000, start_s: float = 0.0, repeats: int = 3) -> dict
 
 
 def main(argv=None) -> int:
-    """Print the cost table (or one JSON object with ``--json``); returns the exit status."""
+    """Print the cost table (or one JSON object with ``--json``); returns the exit status.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="quadcosim bench infrared", description=__doc__.splitlines()[0])

@@ -50,7 +50,8 @@ def measure(duration: float, decimation: int, folder: Path) -> dict:
 
 
 def main(argv=None) -> int:
-    """Run the cases given on the command line and print one line (or a JSON list) for each."""
+    """Run the cases given on the command line and print one line (or a JSON list) for each.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--durations", type=float, nargs="+", default=[20.0, 200.0, 600.0])
     parser.add_argument("--decimations", type=int, nargs="+", default=[1, 10])

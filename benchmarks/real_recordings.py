@@ -39,7 +39,23 @@ def _errors(kind, data, refs, gains=None, corrections=None):
 
 
 def evaluate(folder, frame: str = "enu", published: bool = True) -> dict:
-    """Total RMSE (deg) per recording and filter variant, and the tuned gain sets."""
+    """Total RMSE (deg) per recording and filter variant, and the tuned gain sets.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder of the recordings (``.mat``, ``.npz``, ``.csv``).
+    frame : {"enu", "ned"}
+        Navigation frame of the recordings' reference attitudes.
+    published : bool
+        Also run the published filters (VQF, Madgwick) at their packages' defaults.
+
+    Returns
+    -------
+    dict
+        ``recordings`` (name -> variant -> total RMSE, deg), ``mean_total_rmse_deg``,
+        ``tuned_gains`` (variant -> gain set) and the ``defaults``.
+    """
     paths = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in (".mat", ".npz", ".csv"))
     if not paths:
         raise ValueError(f"no recordings (.mat, .npz, .csv) in {folder}")
@@ -74,7 +90,8 @@ def evaluate(folder, frame: str = "enu", published: bool = True) -> dict:
 
 
 def main(argv=None) -> int:
-    """Command line (see the module docstring); prints the mean errors, returns 0."""
+    """Command line (see the module docstring); prints the mean errors, returns 0.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks.real_recordings", description=__doc__.splitlines()[0])
     parser.add_argument("folder")
     parser.add_argument("--frame", default="enu", choices=("ned", "enu"))

@@ -132,7 +132,8 @@ def report(f: dict) -> str:
 
 
 def main(argv=None) -> int:
-    """``quadcosim bench sweep [--json]``: measure and print; returns 0."""
+    """``quadcosim bench sweep [--json]``: measure and print; returns 0.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="quadcosim bench sweep", description=__doc__.splitlines()[0])

@@ -44,7 +44,11 @@ RATE, DRAG, LIMIT, EXPONENT, FREEWHEEL, GAINS = 0, 1, 2, 3, 4, 5
 
 @njit(cache=True, error_model="numpy")
 def steady_emf(c, u, rate, drag):
-    """Back-EMF (V) at which de/dt = 0 for command c and voltage u."""
+    """Back-EMF (V) at which de/dt = 0 for command ``c`` (1) and supply voltage ``u`` (V).
+
+    ``rate`` (1/s) and ``drag`` (1/(V s)) are the identified motor dynamics
+    ``de/dt = rate (c u - e) - drag e |e|``.
+    """
     drive = max(c, 0.0) * u
     if drag <= 0.0:
         return drive
@@ -54,7 +58,7 @@ def steady_emf(c, u, rate, drag):
 @njit(cache=True, error_model="numpy")
 def winding_voltage(drive, e, low, limit):
     """``c u - e`` (V) clipped by the ESC: at ``low`` (0 when it free-wheels, else ``-limit``) and
-    at ``limit`` (the current limit times R)."""
+    at ``limit`` (the current limit times R); ``drive`` is ``c u`` (V), ``e`` the back-EMF (V)."""
     return min(max(drive - e, low), limit)
 
 
@@ -85,6 +89,12 @@ def step(t, dt, mag, c, u, A_inv, b_s, v, theta, I, J, dynamics, mode, sample_ra
     ``mag`` (3, T) raw reading; ``c`` (N, 1) commands and ``u`` (V) voltage at ``t``;
     ``state``: back-EMF ``[0:N]``, previous commands ``[N:2N]``, previous voltage ``[2N]``,
     held ``b_d`` ``[2N+1:2N+4]``, started flag ``[2N+4]``. Writes the compensated field to ``out``.
+    The calibration: ``A_inv`` (3, 3) and ``b_s`` (3, T) the static (hard and soft iron)
+    correction, ``v`` (N, 3) the motors' field directions (sensor frame), ``theta`` (N, I (J + 1))
+    the amplitude coefficients of orders ``I``, ``J``, ``dynamics`` the identified motor
+    dynamics (indices ``RATE``, ``DRAG``, ``LIMIT``, ``FREEWHEEL``, ``EXPONENT``, ``GAINS``).
+    ``mode`` is ``STATIC``, ``METGE`` or ``DYNAMIC``; with ``sample_rate`` (Hz) > 0 the motor field
+    is refreshed only at that rate's instants (held between), as the magnetometer samples.
     """
     n_motors = v.shape[0]
     held = 2 * n_motors + 1

@@ -29,7 +29,8 @@ from calibration.static import CalibrationError
 
 
 def basis(c, u, orders: tuple[int, int]) -> np.ndarray:
-    """Columns ``u^j c^i`` (``i = 1..I`` outer, ``j = 0..J`` inner) of eq. 4, shape ``(..., I (J + 1))``."""
+    """Columns ``u^j c^i`` (``i = 1..I`` outer, ``j = 0..J`` inner) of eq. 4, shape ``(..., I (J + 1))``,
+    for commands ``c`` (1) and voltages ``u`` (V) of one shape; ``orders`` is ``(I, J)``."""
     I, J = orders
     c = np.asarray(c, dtype=float)[..., None]
     u = np.asarray(u, dtype=float)[..., None]
@@ -62,7 +63,8 @@ class MotorFieldModel:
     """The paper's perturbation model: directions ``v`` (N, 3) and amplitudes ``theta`` (N, I (J + 1)).
 
     ``field(c, u)`` evaluates eq. 3 for commands ``c`` of shape ``(..., N)`` (1) and voltages
-    ``u`` of shape ``(...)`` (V); returns ``(..., 3)`` (T).
+    ``u`` of shape ``(...)`` (V); returns ``(..., 3)`` (T). ``orders`` ``(I, J)``: powers of the
+    command and of the voltage (eq. 4).
     """
 
     v: np.ndarray
@@ -145,7 +147,17 @@ def fit_dynamic(reference, sweeps, orders: tuple[int, int] = (4, 1)) -> MotorFie
 
 def amplitude_residual(model: MotorFieldModel, reference, sweeps) -> float:
     """RMS of ``|b_n,k| - f(c, u)`` over every motor's points (T): the eq. 8 residual on
-    any set, which is the cross-validation score of :func:`order_study`."""
+    any set, which is the cross-validation score of :func:`order_study`.
+
+    Parameters
+    ----------
+    model : MotorFieldModel
+        The fitted model.
+    reference : (3,) array
+        Field with the motors off (T, sensor frame), subtracted from every point.
+    sweeps : sequence
+        One sweep per motor, with ``field`` (k, 3) (T), ``command`` (k,) (1) and ``voltage`` (k,) (V).
+    """
     m0 = np.asarray(reference, dtype=float)
     squares = []
     for n, sweep in enumerate(sweeps):
@@ -161,6 +173,7 @@ def order_study(sets, I_range=range(1, 7), J_range=range(0, 3)) -> dict:
     Each set (``(reference, sweeps)``) is fitted in turn and scored on the others; the score
     is the mean held-out amplitude RMS (T). Returns the score table and the best orders (the
     smallest model within 2 % of the lowest score: extra coefficients must earn their place).
+    ``I_range`` and ``J_range`` are the command and voltage orders tried.
     """
     if len(sets) < 2:
         raise CalibrationError("cross-validation needs at least two calibration sets")

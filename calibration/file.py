@@ -132,8 +132,9 @@ class Calibration:
 
     @classmethod
     def load(cls, path, motors: int | None = None, orders: tuple[int, int] | None = None) -> Calibration:
-        """Read a calibration file; refuse a malformed one, or one for another number of motors
-        or other orders (when ``motors`` or ``orders`` is given), with a message naming the defect."""
+        """Read the calibration file at ``path`` (JSON); refuse a malformed one, or one for another
+        number of motors or other orders (when ``motors`` or ``orders`` is given), with a message
+        naming the defect."""
         path = Path(path)
         try:
             text = path.read_text()

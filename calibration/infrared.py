@@ -110,7 +110,9 @@ def pair_at(buffer, k, delay, window):
 
 @njit(cache=True)
 def push(buffer, k, ir, suspect, delay, window):
-    """Store sample ``k``: its IR (count) and whether it is suspect (1.0) or not (0.0)."""
+    """Store sample ``k`` in ``buffer``: its IR ``ir`` (count) and whether it is ``suspect`` (1.0)
+    or not (0.0). The buffer is circular over ``delay + window + 2`` samples (the GPS delay and
+    averaging window, in samples)."""
     kept = delay + window + 2
     buffer[k % kept] = ir
     buffer[kept + k % kept] = suspect
@@ -318,7 +320,21 @@ def _finish(s, ir_now):
 @njit(cache=True)
 def ekf_joint_step(s, c, ir_pair, gps, gps_available, ir_now):
     """One sample of the slides' EKF: both measurements in one update with a 2x2 innovation
-    covariance; no gating. Same state, configuration and arguments as :func:`ekf_step`."""
+    covariance; no gating. Same state and configuration as :func:`ekf_step`.
+
+    Parameters
+    ----------
+    s, c : float arrays
+        State (updated in place) and configuration.
+    ir_pair : float
+        Mean IR over the GPS window (count); ``nan`` when there is none to fuse.
+    gps : float
+        GPS turn rate (rad/s).
+    gps_available : bool
+        Whether the GPS turn rate is valid and to be used.
+    ir_now : float
+        Present IR (count), which gives the present turn rate ``(ir_now - b) / a``.
+    """
     s[PAA] += c[QA]
     s[PBB] += c[QB]
     s[PRR] += c[QR]
@@ -384,6 +400,19 @@ def regression_step(s, c, ir_pair, gps, gps_available, ir_now):
     A pair is unrealistic, and left out, when its turn rate exceeds ``c[MAX_RATE]`` or, once
     a line has been fitted to the data, when it lies more than ``c[REJECT_K]`` residual
     deviations off it.
+
+    Parameters
+    ----------
+    s, c : float arrays
+        State (updated in place) and configuration.
+    ir_pair : float
+        Mean IR over the GPS window (count); ``nan`` when there is none to fuse.
+    gps : float
+        GPS turn rate (rad/s).
+    gps_available : bool
+        Whether the GPS turn rate is valid and to be used.
+    ir_now : float
+        Present IR (count), which gives the present turn rate ``(ir_now - b) / a``.
     """
     if ir_pair == ir_pair and gps_available:
         realistic = abs(gps) <= c[MAX_RATE]
@@ -420,7 +449,21 @@ def regression_step(s, c, ir_pair, gps, gps_available, ir_now):
 @njit(cache=True)
 def rls_step(s, c, ir_pair, gps, gps_available, ir_now):
     """One sample of the recursive least squares with forgetting on ``IR = a r + b``,
-    updated only when the GPS bank angle ``atan(r V / g)`` lies in the configured band."""
+    updated only when the GPS bank angle ``atan(r V / g)`` lies in the configured band.
+
+    Parameters
+    ----------
+    s, c : float arrays
+        State (updated in place) and configuration.
+    ir_pair : float
+        Mean IR over the GPS window (count); ``nan`` when there is none to fuse.
+    gps : float
+        GPS turn rate (rad/s).
+    gps_available : bool
+        Whether the GPS turn rate is valid and to be used.
+    ir_now : float
+        Present IR (count), which gives the present turn rate ``(ir_now - b) / a``.
+    """
     if ir_pair == ir_pair and gps_available:
         bank = abs(math.atan(gps * c[AIRSPEED] / c[GRAVITY]))
         if c[BANK_MIN] <= bank <= c[BANK_MAX]:
@@ -721,7 +764,8 @@ class Estimator:
         self.k = 0
 
     def update(self, ir: float, gps: float, gps_use: bool = True) -> np.ndarray:
-        """Take one sample: the IR (count), the GPS turn rate (rad/s) and whether to use it.
+        """Take one sample: the IR ``ir`` (count), the GPS turn rate ``gps`` (rad/s) and whether to
+        use it, ``gps_use``.
 
         Returns the state vector (see the module's index constants); ``state[...]`` holds
         ``a``, ``b`` and the present turn rate.

@@ -37,7 +37,8 @@ RESPONSE_SAMPLES = 20001  # samples of that transient (the convergence time is r
 # ------------------------------------------------------------------ linear filter
 def linear_transfer_functions(k: float, dt: float) -> dict:
     """Discrete transfer functions from gyro noise, measured-angle noise and gyro bias to the
-    estimation error of one axis, and their continuous-time limits."""
+    estimation error of one axis, and their continuous-time limits, at gain ``k`` (1/s) and
+    sample time ``dt`` (s)."""
     pole = 1.0 - k * dt
     return {
         "gyro_noise": control.tf([dt], [1.0, -pole], dt),
@@ -61,7 +62,9 @@ def linear_bandwidth(k: float) -> float:
 
 
 def linear_error_variance(k, dt: float, sigma_gyro: float, sigma_angle: float) -> np.ndarray:
-    """Predicted steady error variance (rad^2) of one axis, for each gain in ``k``."""
+    """Predicted steady error variance (rad^2) of one axis, for each gain in ``k`` (1/s), at sample
+    time ``dt`` (s), with per-sample noise standard deviations ``sigma_gyro`` (rad/s) and
+    ``sigma_angle`` (rad, the accelerometer-derived angle); see :func:`imu_noise_per_sample`."""
     out = []
     for gain in np.atleast_1d(k):
         tf = linear_transfer_functions(float(gain), dt)
@@ -70,7 +73,9 @@ def linear_error_variance(k, dt: float, sigma_gyro: float, sigma_angle: float) -
 
 
 def linear_optimal_gain(dt: float, sigma_gyro: float, sigma_angle: float, bounds=(1e-4, 50.0)) -> float:
-    """Gain (1/s) that minimises the predicted error variance."""
+    """Gain (1/s) that minimises the predicted error variance at sample time ``dt`` (s), with the
+    per-sample noise ``sigma_gyro`` (rad/s) and ``sigma_angle`` (rad), searched within
+    ``bounds`` (1/s)."""
     fit = minimize_scalar(lambda logk: math.log(linear_error_variance(math.exp(logk), dt, sigma_gyro,
                                                                       sigma_angle)[0]),
                           bounds=tuple(math.log(b) for b in bounds), method="bounded",
@@ -80,7 +85,9 @@ def linear_optimal_gain(dt: float, sigma_gyro: float, sigma_angle: float, bounds
 
 def imu_noise_per_sample(sample_rate: float, gyro_density: float | None = None, acc_density: float | None = None):
     """Per-sample standard deviations of the gyro (rad/s) and of the accelerometer-derived
-    roll/pitch angle (rad, accelerometer noise over g) at ``sample_rate`` (Hz)."""
+    roll/pitch angle (rad, accelerometer noise over g) at ``sample_rate`` (Hz), from the noise
+    densities ``gyro_density`` (rad/s/sqrt(Hz)) and ``acc_density`` (m/s^2/sqrt(Hz)), by default
+    the IMU model's."""
     from fmus.IMU.variables import ACC_NOISE_DENSITY, GYRO_NOISE_DENSITY
 
     root = math.sqrt(sample_rate)
@@ -91,12 +98,14 @@ def imu_noise_per_sample(sample_rate: float, gyro_density: float | None = None, 
 
 # ------------------------------------------------------------------ passive filter
 def passive_error_system(kP: float, kI: float):
-    """Linearised error dynamics of one axis: state (x, b~), output b~."""
+    """Linearised error dynamics of one axis: state (x, b~), output b~, at the gains ``kP``
+    (1/s) and ``kI`` (1/s^2)."""
     return control.ss([[-kP, -1.0], [kI, 0.0]], [[0.0], [0.0]], [[0.0, 1.0]], [[0.0]])
 
 
 def passive_poles(kP: float, kI: float) -> dict:
-    """Poles, natural frequency and damping of the linearised passive filter."""
+    """Poles, natural frequency and damping of the linearised passive filter at the gains ``kP``
+    (1/s) and ``kI`` (1/s^2)."""
     system = passive_error_system(kP, kI)
     wn, zeta, poles = control.damp(system, doprint=False)
     return {"poles": poles, "natural_frequency": float(wn[0]), "damping": float(zeta[0])}
@@ -104,7 +113,9 @@ def passive_poles(kP: float, kI: float) -> dict:
 
 def passive_bias_convergence_time(kP: float, kI: float, initial_bias_error: float, tolerance: float,
                                   horizon: float | None = None) -> float:
-    """Time (s) after which the linearised bias error stays within ``tolerance``."""
+    """Time (s) after which the linearised bias error stays within ``tolerance`` (rad/s), at the
+    gains ``kP`` (1/s) and ``kI`` (1/s^2), from ``initial_bias_error`` (rad/s); the response is
+    simulated over ``horizon`` (s; default: long enough for the slowest pole)."""
     slowest = min(abs(p.real) for p in control.poles(passive_error_system(kP, kI)))
     horizon = horizon or HORIZON_TIME_CONSTANTS * math.log(abs(initial_bias_error) / tolerance + 1.0) / slowest + 1.0
     t = np.linspace(0.0, horizon, RESPONSE_SAMPLES)
@@ -117,7 +128,9 @@ def passive_bias_convergence_time(kP: float, kI: float, initial_bias_error: floa
 def explicit_bias_steady_error(k1: float, k2: float, kP: float, bias, attitude=(0.0, 0.0, 0.0),
                                earth_field=vehicle.EARTH_FIELD) -> np.ndarray:
     """Predicted steady estimation error (rad, body axes) of the explicit filter without bias
-    estimation, for a constant gyro bias (rad/s), at a fixed attitude (roll, pitch, yaw)."""
+    estimation, for a constant gyro ``bias`` (rad/s, body axes), at a fixed ``attitude`` (rad;
+    roll, pitch, yaw), with the weights ``k1`` (gravity), ``k2`` (field), the gain ``kP`` (1/s)
+    and the reference field ``earth_field`` (T, NED; only its direction counts)."""
     from estimators.core import quaternion_from_euler, rotation
 
     q, r = np.empty(4), np.empty((3, 3))

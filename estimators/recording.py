@@ -62,7 +62,8 @@ def _read_csv(path: Path) -> dict:
 
 
 def load(path, rate: float | None = None) -> dict:
-    """Read a recording; ``rate`` (Hz) overrides or supplies the sampling rate.
+    """Read the recording at ``path`` (``.npz``, ``.mat`` or ``.csv``); ``rate`` (Hz) overrides or
+    supplies the sampling rate.
 
     Returns
     -------
@@ -108,7 +109,21 @@ def load(path, rate: float | None = None) -> dict:
 
 
 def save(path, *, gyro, acc, mag, rate: float, quat=None, scored=None, meta: dict | None = None) -> Path:
-    """Write a recording (format from the suffix: ``.npz``, ``.mat`` or ``.csv``)."""
+    """Write a recording to ``path`` (format from the suffix: ``.npz``, ``.mat`` or ``.csv``).
+
+    Parameters
+    ----------
+    gyro, acc, mag : (N, 3) arrays
+        Gyro (rad/s), accelerometer (m/s^2, specific force) and magnetometer (any unit), body axes.
+    rate : float
+        Sampling rate (Hz).
+    quat : (N, 4) array, optional
+        Reference attitude, body to inertial, scalar first.
+    scored : (N,) bool array, optional
+        Samples to score.
+    meta : dict, optional
+        Anything else worth keeping (JSON-serialisable).
+    """
     path = Path(path)
     data = {"gyro": np.asarray(gyro, float), "acc": np.asarray(acc, float), "mag": np.asarray(mag, float),
             "rate": np.array(float(rate))}

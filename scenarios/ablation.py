@@ -38,7 +38,7 @@ class GravityOnly(Block):
     """Specific force of a vehicle at rest in its present attitude, ``f = R^T (0, 0, -g)`` (m/s^2,
     body FRD), from the true quaternion ``q0..q3``: wired into ``IMU.f`` in place of
     ``Quadrotor.f``, it gives an accelerometer that sees gravity alone (with the IMU's own noise
-    and bias), in the closed loop."""
+    and bias), in the closed loop. ``name``: the block's name; ``g`` (m/s^2): gravity."""
 
     inputs = ("q0", "q1", "q2", "q3")
     outputs = ("f_x", "f_y", "f_z")
@@ -55,8 +55,8 @@ class GravityOnly(Block):
 
 
 def euler_rates(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Z-Y-X Euler-angle rates (rad/s, roll, pitch, yaw) from the angles (rad) and the body rates
-    ``omega`` (rad/s, FRD), row by row."""
+    """Z-Y-X Euler-angle rates (rad/s, roll, pitch, yaw) from the angles ``theta`` (N, 3) (rad)
+    and the body rates ``omega`` (N, 3) (rad/s, FRD), row by row."""
     roll, pitch = theta[:, 0], theta[:, 1]
     p, q, r = omega.T
     lateral = q * np.sin(roll) + r * np.cos(roll)

@@ -119,7 +119,9 @@ RECORD = ["IMU.acc", "IMU.gyro", "IMU.magneto", "Quadrotor.theta1", "Quadrotor.t
 
 
 def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
-    """Roll and pitch error variances (rad^2, pooled) and their relative standard errors."""
+    """Roll and pitch error variances (rad^2, pooled) and their relative standard errors, of the
+    linear filter run by the batch path at each of ``gains`` (1/s) on the stream of ``result``
+    (the recorded hover), after ``o["burn_in"]``."""
     dt = 1.0 / o["imu_rate"]
     truth = np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])
     start = int(round(o["burn_in"] / dt))
@@ -138,7 +140,8 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
 
 def closed_loop_relative_standard_error(gains, o) -> np.ndarray:
     """Relative standard error of an estimate-fed run's pooled roll/pitch variance: the AR(1)
-    formula sqrt(2 / (k T)) per axis over the ``T`` seconds after settling, over two axes."""
+    formula sqrt(2 / (k T)) per axis over the ``T`` seconds after settling, over two axes, for
+    each of ``gains`` (1/s) and the options ``o``."""
     kept = o["closed_duration"] - min(20.0, o["closed_duration"] / 4)
     return np.sqrt(2.0 / (np.asarray(gains) * kept)) / np.sqrt(2.0)
 
@@ -152,8 +155,8 @@ def closed_loop_options(k: float, o: dict) -> dict:
 
 def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
     """Roll/pitch error variance (rad^2, NaN for a failed run) and tracking RMS of one
-    estimate-fed closed-loop run per gain, run as a sweep (into ``out``/closed-loop if given);
-    and the failures, as (gain, error)."""
+    estimate-fed closed-loop run per gain of ``gains`` (1/s), run as a sweep (into
+    ``out``/closed-loop if given); and the failures, as (gain, error)."""
     import shutil
 
     from scenarios.sweep import engine, grid, named
@@ -184,8 +187,8 @@ def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
 
 
 def optimum_of(gains, values) -> float:
-    """Minimum of a sampled curve: parabola through the three points around the smallest sample
-    (in log gain, log value)."""
+    """Minimum of a sampled curve ``values`` against ``gains``: parabola through the three points
+    around the smallest sample (in log gain, log value)."""
     i = int(np.clip(np.argmin(values), 1, len(values) - 2))
     x, y = np.log(gains[i - 1:i + 2]), np.log(values[i - 1:i + 2])
     a, b, _ = np.polyfit(x, y, 2)

@@ -82,7 +82,8 @@ def _passive_prediction(gain: float) -> float:
 
 def late_mean_error(result, options) -> dict:
     """Mean estimation error over the last quarter of the run (deg; roll, pitch, yaw): the
-    steady error of a filter that does not estimate the gyro bias (after 45 s of 60)."""
+    steady error of a filter that does not estimate the gyro bias (after 45 s of 60), from a
+    member's ``result`` and its tp ``options``."""
     late = result.time > 0.75 * options["duration"]
     error = np.column_stack([result[f"Quaternion_estim.theta_est{i}"] - result[f"Quadrotor.theta{i}"]
                              for i in (1, 2, 3)])[late].mean(axis=0)
@@ -110,7 +111,8 @@ def summary_of(records: list[dict]) -> dict:
 
 
 def summarise(records: list[dict], out: Path) -> dict:
-    """Write ``summary.json`` and ``summary.md`` in ``out``; return the summary."""
+    """Write ``summary.json`` and ``summary.md`` in ``out``; return the summary of the members'
+    ``records`` (their metrics.json)."""
     summary = summary_of(records)
     out.mkdir(parents=True, exist_ok=True)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
@@ -119,7 +121,8 @@ def summarise(records: list[dict], out: Path) -> dict:
 
 
 def checks(summary: dict) -> list[dict]:
-    """The lab's findings as pass/fail checks with the figures they rest on (deg, s)."""
+    """The lab's findings as pass/fail checks with the figures they rest on (deg, s), from the
+    matrix's ``summary`` (:func:`summary_of`)."""
     rms = {name: np.array(m["rms_error_deg"]) for name, m in summary["cases"].items()}
     quasi, fast = rms["linear-quasi-gt"], rms["linear-nonstationary-gt"]
     explicit = np.array([rms[name] for name in EXPLICIT_WITHOUT_BIAS])

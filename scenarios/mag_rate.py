@@ -22,7 +22,8 @@ from scenarios import tp
 
 
 def rms_errors(settings: dict, mag_rate: float) -> np.ndarray:
-    """RMS estimation error (deg) of a ``tp`` run with the magnetometer at ``mag_rate`` (Hz)."""
+    """RMS estimation error (deg) of a ``tp`` run with the options ``settings`` (name -> text)
+    and the magnetometer at ``mag_rate`` (Hz)."""
     scenario = scenarios.get("tp")
     o = scenario.parse(settings)
     system = scenario.build(o)

@@ -35,13 +35,14 @@ PULSE_LENGTH = 0.05  # s
 
 
 def commands(duration: float, dt: float, pulse: float) -> np.ndarray:
-    """(n, 4) ESC commands at 0, dt, ..., duration: see :func:`commands_at`."""
+    """(n, 4) ESC commands at 0, dt, ..., duration (s), with pulses of height ``pulse`` (1): see
+    :func:`commands_at`."""
     return commands_at(np.arange(int(round(duration / dt)) + 1) * dt, pulse)
 
 
 def commands_at(t: np.ndarray, pulse: float) -> np.ndarray:
     """(len(t), 4) ESC commands at times ``t`` (s): spin-up, hover, then roll, pitch and yaw
-    pulses of 50 ms."""
+    pulses of 50 ms and height ``pulse`` (1)."""
     c = np.full((len(t), 4), vehicle.hover_command())
     c *= np.clip(t / 0.3, 0.0, 1.0)[:, None]
     for _, start, pattern in PULSES:

@@ -116,8 +116,8 @@ def build(o: dict) -> System:
 
 
 def mean_errors(result, o) -> tuple[np.ndarray, dict[str, float]]:
-    """Angular error (deg) of the measured field against the motors-off reference, and its
-    mean over each phase."""
+    """Angular error (deg) of the field measured in ``result`` against the motors-off reference,
+    and its mean over each phase of the options ``o``."""
     field = result["IMU.magneto"]
     t = result.time
     spans = phases(o)

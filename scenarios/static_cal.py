@@ -104,8 +104,9 @@ def duration(o: dict) -> float:
 
 
 def report(result, o, out) -> dict:
-    """Fit ``A``, ``b_s`` to the magnetometer samples; compare with the truth; write
-    ``static.json`` and the figure; return the figures of merit."""
+    """Fit ``A``, ``b_s`` to the magnetometer samples of ``result``; compare with the truth; write
+    ``static.json`` and the figure into ``out`` (none when None); return the figures of merit.
+    ``o``: the parsed options."""
     import matplotlib.pyplot as plt
 
     A, b = iron(o)

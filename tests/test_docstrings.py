@@ -1,5 +1,5 @@
-"""Every public callable of the package has a docstring; in the engine (``orchestrator``) and
-the plant (``fmus``) the docstring also names every parameter (NumPy style).
+"""Every public callable of the package has a docstring, and the docstring names every
+parameter (NumPy style).
 
 The public API is listed, not sampled: every module of every package is imported, and every
 function, class, method and property whose name does not start with an underscore and that
@@ -16,7 +16,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("fmus", "orchestrator", "estimators", "calibration", "scenarios", "benchmarks")
-STRICT = ("fmus", "orchestrator")  # parameters named in the docstring, too
 
 # Callables written before this test, still to be documented by their owners; the list may
 # only shrink (a new undocumented callable fails at once).
@@ -32,6 +31,40 @@ PENDING = {
     "scenarios.tp.report",
 
     # w7-plant
+}
+
+# Callables whose docstring does not yet name every parameter, by the owner of the file; the
+# list may only shrink (a new callable, or a new parameter, must be described at once).
+PARAMETERS_PENDING = {
+    # estimators: the batch kernels (core) and the block and reference-filter front ends
+    "estimators.core.euler_from_quaternion", "estimators.core.euler_to_quaternion", "estimators.core.wrap",
+    "estimators.core.triad", "estimators.core.update", "estimators.core.initial_state",
+    "estimators.core.accumulate_error", "estimators.core.run_batch", "estimators.core.score_series",
+    "estimators.filters.gain_table", "estimators.filters.config_vector", "estimators.filters.check_measurements",
+    "estimators.filters.score",
+    "estimators.reference.check_gains", "estimators.reference.frame_rotation", "estimators.reference.streaming_step",
+    "estimators.reference.estimate",
+    # scenarios: the registry, the controller, tp, replay
+    "scenarios.Scenario.parse", "scenarios.run",
+    "scenarios.flight.controller.control_law", "scenarios.flight.controller.Controller.start",
+    "scenarios.flight.profiles.initial_state", "scenarios.flight.profiles.profile",
+    "scenarios.tp.errors",
+    "scenarios.replay.field_from_data", "scenarios.replay.references", "scenarios.replay.replay",
+    "scenarios.replay.from_tp", "scenarios.replay.main",
+    # scenarios: infrared calibration, Metge et al.'s calibration, sweeps
+    "scenarios.ir_calibration.bank_profile", "scenarios.ir_calibration.simulate_flight",
+    "scenarios.ir_calibration.estimate", "scenarios.ir_calibration.summarize", "scenarios.ir_calibration.SensorFaults",
+    "scenarios.ir_calibration.fault_report",
+    "scenarios.metge.schedule", "scenarios.metge.commands", "scenarios.metge.parse_orders", "scenarios.metge.RigRun",
+    "scenarios.metge.calibrate", "scenarios.metge.errors_deg", "scenarios.metge.set_error",
+    "scenarios.metge.record_sets", "scenarios.metge.table1", "scenarios.metge.figure3", "scenarios.metge.table1_figure",
+    "scenarios.metge.report", "scenarios.metge.add_compensator", "scenarios.metge.yaw_study", "scenarios.metge.main",
+    "scenarios.sweep.command.make_plan", "scenarios.sweep.command.sweep", "scenarios.sweep.command.sweep_plot",
+    "scenarios.sweep.command.main", "scenarios.sweep.engine.worker_state", "scenarios.sweep.engine.first_non_finite",
+    "scenarios.sweep.engine.Summary", "scenarios.sweep.grid.values_of", "scenarios.sweep.grid.split_assignment",
+    "scenarios.sweep.grid.Plan", "scenarios.sweep.grid.plan_of_cases", "scenarios.sweep.named.records",
+    "scenarios.sweep.named.summarise", "scenarios.sweep.table.flatten", "scenarios.sweep.table.row",
+    "scenarios.sweep.table.write", "scenarios.sweep.table.read",
 }
 
 
@@ -90,7 +123,7 @@ def _problems() -> list[str]:
             if not text.strip():
                 problems.append(f"{name}: no docstring")
                 continue
-            if module_name.split(".")[0] in STRICT:
+            if name not in PARAMETERS_PENDING:
                 if inspect.isclass(obj):
                     text += "\n" + (inspect.getdoc(obj.__init__) or "")
                 missing = [p for p in _parameters(obj) if p not in text]
@@ -105,6 +138,11 @@ def test_the_public_api_is_listed():
     assert {"orchestrator.system.System.run", "orchestrator.system.System.connect",
             "orchestrator.fmu.FMUInstance.step", "fmus.build.build_fmu"} <= names
     assert len(names) > 150
+
+
+def test_the_pending_lists_name_existing_callables():
+    names = {name for m in _modules() for name, _, _ in _public(importlib.import_module(m))}
+    assert not (PENDING | PARAMETERS_PENDING) - names, "remove these from the pending lists: they are gone"
 
 
 @pytest.mark.parametrize("package", PACKAGES)
