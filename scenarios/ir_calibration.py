@@ -52,6 +52,8 @@ def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gra
     Legs of 2 to 8 s, 20 % of them straight, joined by 1.5 s roll transitions (a small
     aircraft navigating between waypoints and circling over targets); the turn rate
     ``g tan(phi) / V`` is then scaled to the slides' mean 0.037 and standard deviation 0.24 rad/s.
+    ``samples`` at ``rate`` (Hz), drawn with ``seed``; ``airspeed`` V (m/s) and ``gravity`` g
+    (m/s^2) default to the FMU's.
     """
     parameters = {v.name: v.start for v in table("InfraredSensor").of("parameter")}
     airspeed = airspeed or parameters["airspeed"]
@@ -94,7 +96,9 @@ def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, nois
     Returns arrays of ``samples`` values at 20 Hz: ``time`` (s), the truth ``r`` (rad/s), ``a``,
     ``b``, and the sensors as the estimators see them, faults added: ``ir`` (count),
     ``gps_turn_rate`` (rad/s), ``gps_valid``. ``parameters`` overrides the FMU's (for instance
-    ``{"cloud_start": 100.0}`` to put the cloud inside the IR fault).
+    ``{"cloud_start": 100.0}`` to put the cloud inside the IR fault). ``seed`` draws the bank
+    profile and the noise; ``drift`` (of a and b), ``noise`` and ``faults`` (``none``, ``ir``,
+    ``gps``, ``both``) switch the slides' effects.
     """
     phi = bank_profile(samples, seed)
     names = ["r", "a", "b", "ir", "gps_turn_rate", "gps_valid"]
@@ -116,7 +120,8 @@ def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, nois
 
 
 def estimate(flight: dict, gating: bool = True, gps_until: float = math.inf) -> dict[str, dict]:
-    """The three estimators over a flight from :func:`simulate_flight` (the batch path)."""
+    """The three estimators over a ``flight`` from :func:`simulate_flight` (the batch path); the
+    Kalman filter's innovation ``gating`` on or off; the GPS used only before ``gps_until`` (s)."""
     use = (flight["gps_valid"] > 0.5) & (flight["time"] < gps_until)
     settings = {"kalman": EKFSettings(gate=5.0 if gating else 0.0)}
     return {m: Estimator(m, settings.get(m)).run(flight["ir"], flight["gps_turn_rate"], use) for m in METHODS}
@@ -126,7 +131,8 @@ def summarize(time, truth: dict, estimates: dict, windows) -> dict:
     """Metrics of a run: turn-rate errors, faults declared and false alarms, recovery of a and b.
 
     ``truth`` holds ``r``, ``a``, ``b``; ``estimates`` maps each method to its ``turn_rate``,
-    ``a``, ``b`` (and, for the Kalman filter, ``ir_fault`` and ``gps_fault``).
+    ``a``, ``b`` (and, for the Kalman filter, ``ir_fault`` and ``gps_fault``), at the instants
+    ``time`` (s); ``windows`` are the injected faults ``(sensor, start, stop, offset)``.
     """
     valid = time >= 2.0  # the GPS window is filled
     metrics = {"turn_rate_error_deg_s": {}}
@@ -156,7 +162,9 @@ def summarize(time, truth: dict, estimates: dict, windows) -> dict:
 
 
 class SensorFaults(Block):
-    """Adds the slides' offsets to the IR and the GPS turn rate over their fault windows."""
+    """Adds the slides' offsets to the IR and the GPS turn rate over their fault windows; ``name``:
+    the block's; ``windows``: ``(sensor, start, stop, offset)`` with sensor ``ir`` (count) or
+    ``gps`` (rad/s), times in s."""
 
     inputs = ("ir", "gps_turn_rate")
     outputs = ("ir", "gps_turn_rate")
@@ -209,7 +217,8 @@ def episodes(flag: np.ndarray, time: np.ndarray) -> list[tuple[float, float | No
 
 
 def fault_report(windows, kalman_flags: dict[str, np.ndarray], time: np.ndarray) -> tuple[list[dict], int]:
-    """Match the declared fault episodes with the injected faults; the rest are false alarms."""
+    """Match the fault episodes declared by the Kalman filter (``kalman_flags``: sensor -> flag per
+    instant of ``time``, s) with the injected faults ``windows``; the rest are false alarms."""
     declared = {sensor: episodes(flag, time) for sensor, flag in kalman_flags.items()}
     faults, matched = [], set()
     for sensor, onset, end, _ in windows:

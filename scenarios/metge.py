@@ -63,7 +63,8 @@ RECORD = ["Setpoint.c", "MotorMagnetics.u_batt", "IMU.magneto"]
 def schedule(o: dict, set_number: int) -> tuple[list[tuple[str, float, float, int, float]], float]:
     """Phases ``(name, start, stop, motor, command)`` of a calibration set and its end time (s).
 
-    Set 1: motors 1..4, levels rising; set 2: motors 4..1, levels shuffled."""
+    Set 1: motors 1..4, levels rising; set 2: motors 4..1, levels shuffled (``set_number``);
+    ``o``: the parsed options (levels, hold and settle times)."""
     levels = np.arange(1, o["levels"] + 1) / o["levels"]
     motors = [0, 1, 2, 3]
     if set_number == 2:
@@ -107,7 +108,8 @@ def socs(o: dict, set_number: int) -> list[float]:
 
 
 def commands(o: dict, set_number: int, free: bool = False) -> tuple[np.ndarray, float, float]:
-    """Command table (rows every macro step), the end of the sweeps and the end of the run (s)."""
+    """Command table (rows every macro step, columns motors 1..4), the end of the sweeps and the end
+    of the run (s), of calibration set ``set_number``, followed by the free set when ``free``."""
     phases, end = schedule(o, set_number)
     stop = end + (o["free"] if free else 0.0)
     t = np.arange(int(round(stop / o["dt"])) + 1) * o["dt"]
@@ -145,7 +147,7 @@ def build(o: dict) -> System:
 
 
 def parse_orders(text: str):
-    """``(I, J)`` from ``"I,J"``, or ``None`` for ``"cv"`` (chosen by cross-validation)."""
+    """``(I, J)`` from ``text`` ``"I,J"``, or ``None`` for ``"cv"`` (chosen by cross-validation)."""
     if text == "cv":
         return None
     try:
@@ -158,7 +160,8 @@ def parse_orders(text: str):
 
 
 class RigRun:
-    """One recorded run on the clamped rig: arrays, phases, and the rows of its K measurements."""
+    """One recorded run on the clamped rig: arrays, phases, and the rows of its K measurements,
+    from the run's ``result``, its options ``o`` and its calibration set ``set_number``."""
 
     def __init__(self, result, o: dict, set_number: int):
         self.time = result.time
@@ -206,7 +209,11 @@ def load_static(o):
 
 
 def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Calibration:
-    """Eqs. 5 to 8 on a set's K measurements and the motor dynamics on its records."""
+    """Eqs. 5 to 8 on the K measurements of the set ``rig`` and the motor dynamics on its records.
+
+    ``orders``: ``(I, J)``; ``static``: the static (hard and soft iron) calibration;
+    ``sample_rate`` (Hz): the magnetometer's; ``name``: recorded in the file as its maker.
+    """
     model = fit_dynamic(rig.reference, rig.sweeps(), orders)
     dynamics = fit_motor_dynamics([r.record() for r in rig.runs], [r.reference for r in rig.runs], model.v,
                                   sample_rate)
@@ -214,21 +221,23 @@ def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Cal
 
 
 def errors_deg(cal: Calibration, run: RigRun, mode: str, sample_rate: float) -> np.ndarray:
-    """Angular error (deg) of the compensated field against the statically corrected
-    motors-off reference of the run, at every row."""
+    """Angular error (deg) of the field compensated by ``cal`` in ``mode`` (refreshed at
+    ``sample_rate``, Hz) against the statically corrected motors-off reference of the run, at
+    every row."""
     out = compensate(cal, run.time, run.field, run.commands, run.voltage, mode, sample_rate)
     m0 = run.reference if cal.static is None else cal.static.correct(run.reference)
     return np.degrees(angle_between(out, m0))
 
 
 def set_error(cal, rig: RigSet, mode, rate, rows: str) -> float:
-    """Mean error over the chosen rows (``settled`` or ``sweeping``) of every run of a set."""
+    """Mean error (deg) over the chosen rows (``settled`` or ``sweeping``) of every run of the set
+    ``rig``, compensated by ``cal`` in ``mode`` at ``rate`` (Hz)."""
     return float(np.concatenate([errors_deg(cal, r, mode, rate)[getattr(r, rows)] for r in rig.runs]).mean())
 
 
 def record_sets(result, o: dict, out) -> dict[int, list[RigRun]]:
     """The runs of both calibration sets: the scenario's own run (set 1, first battery state, with
-    the free set) and the others, each saved under ``out/set<k>_run<i>``."""
+    the free set, ``result``) and the others, each saved under ``out/set<k>_run<i>``."""
     runs = {1: [RigRun(result, o, 1)], 2: []}
     for set_number in (1, 2):
         for run in range(len(runs[set_number]), len(socs(o, set_number))):
@@ -243,7 +252,8 @@ def table1(cals: dict, rig1: RigSet, rig2: RigSet, rate: float) -> dict:
     """Table 1 (deg): rows ``none`` (static calibration only) and each calibration (eq. 9),
     columns the settled rows of set 1 and set 2 and the free set; the same sets with every row
     (step transients included); the dynamics-aware free-set errors; and the error series of the
-    first run of set 1 (for Figure 3)."""
+    first run of set 1 (for Figure 3). ``cals``: the calibrations by name; ``rig1``, ``rig2``: the
+    two sets; ``rate`` (Hz): the magnetometer's."""
     first = rig1.runs[0]
     table, whole, dynamic_free, series = {}, {}, {}, {}
     for row, cal in cals.items():
@@ -262,7 +272,8 @@ def table1(cals: dict, rig1: RigSet, rig2: RigSet, rate: float) -> dict:
 
 def figure3(first: RigRun, numbers: dict, o: dict, out):
     """The paper's Figure 3: angular error against time on the free set, before and after
-    compensation, above the four commands."""
+    compensation, above the four commands. ``first``: the first run of set 1; ``numbers``: as
+    :func:`table1` returns; ``out``: the folder of the figure (None: no file)."""
     import matplotlib.pyplot as plt
 
     rows, series, table = first.free, numbers["series"], numbers["table"]
@@ -291,7 +302,8 @@ def figure3(first: RigRun, numbers: dict, o: dict, out):
 
 
 def table1_figure(numbers: dict, orders, out):
-    """Table 1 as a figure, each cell beside the paper's value."""
+    """Table 1 as a figure, each cell beside the paper's value; ``numbers`` as :func:`table1`
+    returns, ``orders`` the model's ``(I, J)``, ``out`` the folder of the figure (None: no file)."""
     import matplotlib.pyplot as plt
 
     table, dynamic = numbers["table"], numbers["dynamic_free"]
@@ -310,7 +322,8 @@ def table1_figure(numbers: dict, orders, out):
 def report(result, o, out) -> dict:
     """Record set 2 and the second battery state, calibrate on each set, and return Table 1,
     the dynamics-aware free-set error, the order study and the identified motor dynamics;
-    writes ``calibration1.json``, ``calibration2.json`` and the two figures into ``out``."""
+    writes ``calibration1.json``, ``calibration2.json`` and the two figures into ``out``.
+    ``result``: the scenario's own run; ``o``: the parsed options."""
     orders, rate = parse_orders(o["orders"]), o["mag_rate"]
     static = load_static(o)
     runs = record_sets(result, o, out)
@@ -400,7 +413,7 @@ def add_compensator(system: System, mode: str, path: str, estimator: str = "Quat
     """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
     ``mode = "none"``): commands from the controller, voltage from the battery, ``b_d``
     refreshed at the magnetometer's sample instants. ``path``: a calibration file, or empty for
-    :func:`rig_calibration`."""
+    :func:`rig_calibration`. ``system``: the tp system; ``estimator``: the name of its block."""
     from calibration import MagCompensator
 
     if mode == "none":
@@ -422,7 +435,9 @@ STUDY_ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "v
 def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), estimators=tuple(STUDY_ESTIMATORS),
               duration: float = 20.0, noise: bool = True) -> dict:
     """``tp`` with the field of the motor currents off, then on with each compensation; the
-    estimators' yaw RMS error (deg) for each, written to ``out/yaw_study.json`` and ``.md``."""
+    estimators' yaw RMS error (deg) for each, written to ``out/yaw_study.json`` and ``.md``.
+    ``calibration_path``: the calibration file; ``flights``, ``estimators``: those compared;
+    ``duration`` (s) and ``noise``: of every run."""
     import scenarios
 
     out = Path(out)
@@ -451,7 +466,8 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
 
 
 def main(argv=None):
-    """Command line of the yaw study: ``python -m scenarios.metge --calibration FILE --out DIR``."""
+    """Command line of the yaw study: ``python -m scenarios.metge --calibration FILE --out DIR``.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
     parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated.")

@@ -51,20 +51,6 @@ PARAMETERS_PENDING = {
     "scenarios.tp.errors",
     "scenarios.replay.field_from_data", "scenarios.replay.references", "scenarios.replay.replay",
     "scenarios.replay.from_tp", "scenarios.replay.main",
-    # scenarios: infrared calibration, Metge et al.'s calibration, sweeps
-    "scenarios.ir_calibration.bank_profile", "scenarios.ir_calibration.simulate_flight",
-    "scenarios.ir_calibration.estimate", "scenarios.ir_calibration.summarize", "scenarios.ir_calibration.SensorFaults",
-    "scenarios.ir_calibration.fault_report",
-    "scenarios.metge.schedule", "scenarios.metge.commands", "scenarios.metge.parse_orders", "scenarios.metge.RigRun",
-    "scenarios.metge.calibrate", "scenarios.metge.errors_deg", "scenarios.metge.set_error",
-    "scenarios.metge.record_sets", "scenarios.metge.table1", "scenarios.metge.figure3", "scenarios.metge.table1_figure",
-    "scenarios.metge.report", "scenarios.metge.add_compensator", "scenarios.metge.yaw_study", "scenarios.metge.main",
-    "scenarios.sweep.command.make_plan", "scenarios.sweep.command.sweep", "scenarios.sweep.command.sweep_plot",
-    "scenarios.sweep.command.main", "scenarios.sweep.engine.worker_state", "scenarios.sweep.engine.first_non_finite",
-    "scenarios.sweep.engine.Summary", "scenarios.sweep.grid.values_of", "scenarios.sweep.grid.split_assignment",
-    "scenarios.sweep.grid.Plan", "scenarios.sweep.grid.plan_of_cases", "scenarios.sweep.named.records",
-    "scenarios.sweep.named.summarise", "scenarios.sweep.table.flatten", "scenarios.sweep.table.row",
-    "scenarios.sweep.table.write", "scenarios.sweep.table.read",
 }
 
 

@@ -55,7 +55,8 @@ def _stored_plan(out: Path):
 
 
 def make_plan(args):
-    """The plan the arguments describe (a named sweep, a grid, or the stored one on --resume)."""
+    """The plan the parsed arguments ``args`` describe (a named sweep, a grid, or the stored one
+    on --resume)."""
     from scenarios.sweep import grid, named
 
     out = Path(args.out) if args.out else Path("results") / f"sweep-{args.scenario}"
@@ -74,7 +75,7 @@ def make_plan(args):
 
 
 def sweep(args) -> int:
-    """Run ``quadcosim sweep`` from parsed arguments; print the summary.
+    """Run ``quadcosim sweep`` from parsed arguments ``args``; print the summary.
 
     Returns
     -------
@@ -108,7 +109,7 @@ def sweep(args) -> int:
 
 
 def sweep_plot(args) -> int:
-    """Run ``quadcosim sweep-plot`` from parsed arguments; print the figure's path.
+    """Run ``quadcosim sweep-plot`` from parsed arguments ``args``; print the figure's path.
 
     Returns
     -------
@@ -136,7 +137,8 @@ def sweep_plot(args) -> int:
 
 
 def main(argv=None) -> int:
-    """``python -m scenarios.sweep``: the same as ``quadcosim sweep``; returns its exit code."""
+    """``python -m scenarios.sweep``: the same as ``quadcosim sweep``; returns its exit code.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
     p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,

@@ -80,7 +80,7 @@ class Preload(WorkerPlugin):
 
 def worker_state(dask_worker=None) -> dict:
     """What this worker process has done: members run, FMU extractions, preparation time (s).
-    Called through ``Client.run``."""
+    Called through ``Client.run``, which passes the worker as ``dask_worker``."""
     from orchestrator import fmu
 
     return {"members": _members_run, "extractions": len(fmu._extracted),
@@ -99,7 +99,7 @@ def _plain(value):
 
 
 def first_non_finite(metrics: dict) -> str | None:
-    """Name and value of the first NaN or infinite metric, if any."""
+    """Name and value of the first NaN or infinite metric of ``metrics``, if any."""
     for name, value in table.flatten(metrics).items():
         if isinstance(value, float) and not math.isfinite(value):
             return f"{name} = {value}"
@@ -172,7 +172,14 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
 # ---------------------------------------------------------------------------- on the client
 @dataclass
 class Summary:
-    """How a sweep went: counts over the whole table, and what this call ran."""
+    """How a sweep went: counts over the whole table, and what this call ran.
+
+    ``out`` is the sweep's folder; ``total``, ``ok``, ``failed`` count the members of the
+    table, ``ran`` and ``skipped`` (already done, on --resume) those of this call; ``seconds``
+    its wall time (s) on ``workers`` workers, of which ``startup_s`` and ``shutdown_s`` (s) went
+    to the cluster; ``interrupted`` the signal that stopped it (0 if none); ``failures`` the
+    first few (member, label, error).
+    """
 
     out: Path
     total: int

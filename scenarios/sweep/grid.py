@@ -30,7 +30,8 @@ def _number(text: str, where: str) -> float:
 
 
 def values_of(spec: str, where: str = "--grid") -> list:
-    """The raw values (numbers or strings, not yet typed) of one grid specification."""
+    """The raw values (numbers or strings, not yet typed) of one grid specification ``spec``
+    (``a,b,c`` or a range); ``where`` names it in error messages."""
     match = _RANGE.match(spec)
     if match is None or "," in spec:
         items = [item.strip() for item in spec.split(",")]
@@ -62,7 +63,7 @@ def _text(value) -> str:
 
 
 def split_assignment(text: str, flag: str) -> tuple[str, str]:
-    """``"k=0.1,1"`` as ``("k", "0.1,1")``; a clear error naming ``flag`` otherwise."""
+    """``text`` ``"k=0.1,1"`` as ``("k", "0.1,1")``; a clear error naming ``flag`` otherwise."""
     name, eq, spec = text.partition("=")
     if not eq or not name.strip():
         raise ValueError(f"{flag} {text!r}: write NAME=VALUES, e.g. k=0.01:10:log12 or estimator=linear,explicit")
@@ -80,7 +81,8 @@ class Member:
 
 @dataclass
 class Plan:
-    """What a sweep runs: a scenario and its members, with the command-line description kept."""
+    """What a sweep runs: a scenario and its members, with the command-line description kept;
+    ``varied`` are the options the grid varies, ``name`` a named sweep's name (else None)."""
 
     scenario: str
     members: list[Member]
@@ -146,7 +148,8 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None) ->
 
 
 def plan_of_cases(scenario_name: str, cases: dict[str, dict], name: str | None = None) -> Plan:
-    """A plan from named cases (label -> options), as a named sweep declares them."""
+    """A plan of the scenario ``scenario_name`` from named ``cases`` (label -> options), as a named
+    sweep (its ``name``) declares them."""
     import scenarios
 
     scenario = scenarios.get(scenario_name)

@@ -89,7 +89,8 @@ def keep_results(plan) -> bool:
 
 
 def records(plan, out) -> list[dict]:
-    """The members' records (``metrics.json``), in member order."""
+    """The records (``metrics.json``) of the members of ``plan`` in the sweep folder ``out``, in
+    member order."""
     import json
 
     from scenarios.sweep.engine import member_folder
@@ -98,7 +99,8 @@ def records(plan, out) -> list[dict]:
 
 
 def summarise(plan, out, summary) -> None:
-    """Run a named sweep's summary on its members, once every member has finished well."""
+    """Run a named sweep's summary on the members of ``plan`` in ``out``, once every member has
+    finished well (according to the ``summary`` of the run)."""
     if not plan.name or summary.ok != summary.total:
         return
     named = registry()[plan.name]

@@ -26,7 +26,7 @@ SPREAD = 8
 
 def flatten(metrics: dict, prefix: str = "") -> dict:
     """Scalar columns from a metrics dict: nested dicts as ``a.b``, short lists as ``a[i]``,
-    anything else as JSON text."""
+    anything else as JSON text; every name starts with ``prefix``."""
     flat = {}
     for key, value in metrics.items():
         name = f"{prefix}{key}"
@@ -43,7 +43,8 @@ def flatten(metrics: dict, prefix: str = "") -> dict:
 
 
 def row(record: dict, varied_first=()) -> dict:
-    """The table row of one member record (as kept in its ``metrics.json``)."""
+    """The table row of one member ``record`` (as kept in its ``metrics.json``), the options named
+    in ``varied_first`` first."""
     options = record["options"]
     metrics = flatten(record.get("metrics") or {})
     out = {key: record.get(key) for key in LEADING}
@@ -76,7 +77,7 @@ def _replace(path: Path, write):
 
 
 def write(rows: list[dict], out: Path) -> None:
-    """Write ``sweep.csv`` and ``sweep.parquet`` in ``out``, each atomically."""
+    """Write the ``rows`` as ``sweep.csv`` and ``sweep.parquet`` in ``out``, each atomically."""
     rows = sorted(rows, key=lambda r: r["member"])
     names = columns_of(rows)
 
@@ -98,7 +99,8 @@ def write(rows: list[dict], out: Path) -> None:
 
 
 def read(path) -> dict[str, list]:
-    """A sweep table as columns (name -> list), from a sweep folder, a ``.parquet`` or a ``.csv``."""
+    """A sweep table as columns (name -> list), from ``path``: a sweep folder, a ``.parquet`` or a
+    ``.csv``."""
     path = Path(path)
     if path.is_dir():
         path = path / "sweep.parquet"
