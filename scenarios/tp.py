@@ -60,6 +60,21 @@ OPTIONS = {
 
 
 def estimator_gains(o: dict) -> dict:
+    """The estimator's gains from the options: ``k`` for the three axes of the linear filter
+    (1/s); ``k1``, ``k2`` (weights of gravity and field), ``kP`` (1/s) and ``kI`` (1/s^2) for the
+    explicit filter; ``kP`` and ``kI`` for the passive one; none for ``vqf`` and ``madgwick``
+    (their packages' defaults). ``kI = -1`` takes the lab's value.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options.
+
+    Returns
+    -------
+    dict
+        Gain name -> value, as :class:`estimators.QuaternionEstim` takes them.
+    """
     kind = o["estimator"]
     if kind == "linear":
         return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
@@ -72,6 +87,26 @@ def estimator_gains(o: dict) -> dict:
 
 
 def build(o: dict) -> System:
+    """The lab's closed loop: setpoint profile, controller, motors and battery, rigid body, IMU
+    (at ``imu_rate``, a divisor of the macro step rate) and the attitude estimator, the
+    controller fed by the truth or by the estimate (``feedback``), with the optional
+    compensation of the motors' field.
+
+    Parameters
+    ----------
+    o : dict
+        Parsed options (``quadcosim list`` shows them with their units).
+
+    Returns
+    -------
+    orchestrator.System
+        The system, ready to run for ``duration`` seconds.
+
+    Raises
+    ------
+    ValueError
+        ``kI`` negative (but -1), or ``imu_rate`` not a divisor of ``1 / dt``.
+    """
     if o["kI"] < 0 and o["kI"] != -1.0:
         raise ValueError(f"option kI={o['kI']} must be non-negative (or -1 for the default)")
     period = round(1.0 / (o["imu_rate"] * o["dt"]))
@@ -116,12 +151,14 @@ def build(o: dict) -> System:
 
 
 def wrapped(angle: np.ndarray) -> np.ndarray:
+    """``angle`` (rad) wrapped to [-pi, pi)."""
     return (angle + np.pi) % (2 * np.pi) - np.pi
 
 
 def errors(result) -> tuple[np.ndarray, np.ndarray]:
-    """Estimation and tracking errors (rad), columns roll, pitch, yaw. Tracking compares the
-    attitude with the controller's setpoint (the position hold's roll and pitch when holding)."""
+    """Estimation and tracking errors (rad), columns roll, pitch, yaw, of the recorded run
+    ``result``. Tracking compares the attitude with the controller's setpoint (the position
+    hold's roll and pitch when holding)."""
     estimation = np.column_stack([_error(result, "Quaternion_estim.theta_est", k) for k in range(3)])
     tracking = np.column_stack([_error(result, _SETPOINTS[k], k) for k in range(3)])
     return estimation, tracking
@@ -143,7 +180,24 @@ def _error(result, signal: str, k: int) -> np.ndarray:
 
 def report(result, o, out) -> dict:
     """Figures and metrics of one run. Statistics are taken column by column and the figures
-    drawn from envelopes, so that the report adds little to the memory of the record."""
+    drawn from envelopes, so that the report adds little to the memory of the record.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The recorded run.
+    o : dict
+        Parsed options.
+    out : pathlib.Path or None
+        Folder of the figures; None writes none.
+
+    Returns
+    -------
+    dict
+        Estimation and tracking errors (deg; roll, pitch, yaw) after ``settle_s``, the final
+        gyro bias error (rad/s) and its convergence time (s) when the bias is estimated, the
+        real-time factor, and the figures written.
+    """
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
     metrics = {"settle_s": settle, **_error_statistics(result, settle), "bias_error_final": None,
                "figures": _figures(result, o, out)}
