@@ -338,12 +338,13 @@ class QuaternionEstim(Block):
             self.step = reference.streaming_step(self.kind, self.gains, self.config, dt, self.q0, self.b0,
                                                  self.from_triad)
             return
-        self.state = np.empty(core.STATE_SIZE)
-        self.work = np.empty(core.WORK_SIZE)
+        self.data = np.zeros(_DATA_SIZE)  # shared by the Python step and the compiled step
+        self.data[_D_KIND], self.data[_D_DT] = self._code, dt
+        self.state, gains, config, self.work = (self.data[a:b] for a, b in _D_PARTS)
+        gains[:], config[:] = self._gains, self.config
         core.initial_state(self.q0, self.b0, self.from_triad, self.state)
-        update, code, state, gains, config, work = (core.update, self._code, self.state, self._gains,
-                                                    self.config, self.work)
-        sample = np.zeros(core.INPUT_SIZE)  # the block's inputs may omit R_reel: padded once here
+        update, code, state, work = core.update, self._code, self.state, self.work
+        sample = self.sample = np.zeros(core.INPUT_SIZE)  # the inputs may omit R_reel: padded once here
         width = len(self.inputs)
 
         def step(t, u, y):
@@ -352,6 +353,45 @@ class QuaternionEstim(Block):
 
         self.step = step  # bound once: the hot loop calls the compiled update directly
         _compile(code)
+
+    def compiled(self):
+        """The update as a C-callable step on the block's memory (see :meth:`Block.compiled`);
+        ``None`` for the published filters, which run in Python."""
+        if self.kind in _reference_kinds():
+            return None
+        from orchestrator.blocks import CompiledStep
+
+        function = _compiled_step()
+        return CompiledStep(function.address, self.sample, self.data, function)
+
+
+# the streaming block's memory: filter code, period (s), state, gains, configuration, scratch
+_D_KIND, _D_DT = 0, 1
+_D_PARTS = tuple(itertools.pairwise(itertools.accumulate((2, core.STATE_SIZE, core.GAIN_SIZE, core.CONFIG_SIZE,
+                                                          core.WORK_SIZE))))
+_DATA_SIZE = _D_PARTS[-1][1]
+_COMPILED = None
+
+
+def _compiled_step():
+    """The numba ``cfunc`` of the streaming update, compiled (or loaded from numba's cache) on first use."""
+    global _COMPILED
+    if _COMPILED is None:
+        from numba import carray, cfunc
+
+        from orchestrator.blocks import COMPILED_SIGNATURE
+
+        (s0, s1), (g0, g1), (c0, c1), (w0, w1) = _D_PARTS
+
+        @cfunc(COMPILED_SIGNATURE, cache=True, error_model="numpy")
+        def step(t, u, y, data):
+            memory = carray(data, _DATA_SIZE)
+            core.update(int(memory[_D_KIND]), memory[s0:s1], carray(u, core.INPUT_SIZE), memory[g0:g1],
+                        memory[c0:c1], memory[_D_DT], carray(y, core.OUTPUT_SIZE), memory[w0:w1])
+            return 0
+
+        _COMPILED = step
+    return _COMPILED
 
 
 def _check_frame(kind, config):

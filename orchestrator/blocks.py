@@ -9,11 +9,47 @@ Blocks are stepped in dependency order (Gauss-Seidel): a block whose outputs dep
 present inputs (direct feedthrough) runs after the blocks that feed it. A Python block that
 declares no feedthrough sees, from blocks ordered after it, the values of the previous macro
 step: a unit delay.
+
+A block may also expose its step as compiled code (:meth:`Block.compiled`): a C-callable
+function that the chunk runner calls for whole chunks of steps without returning to Python.
+Such a block keeps its Python ``step`` too, and both must compute the same numbers from the
+same memory (the per-step master and the chunk runner give bit-identical results).
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
+
+#: C signature of a compiled block step: ``int step(double t, const double *u, double *y, double *data)``,
+#: time ``t`` (s), inputs ``u`` and outputs ``y`` in declaration order, ``data`` the block's own
+#: state and parameters; it returns 0, or a non-zero code that stops the run.
+COMPILED_SIGNATURE = "int32(float64, CPointer(float64), CPointer(float64), CPointer(float64))"
+
+
+class CompiledStep(NamedTuple):
+    """A block's step as a C function, for the chunk runner.
+
+    Parameters
+    ----------
+    address : int
+        Address of a function of signature :data:`COMPILED_SIGNATURE` (e.g. a numba ``cfunc``'s
+        ``address``).
+    inputs : ndarray
+        float64 buffer, at least as long as the block's inputs: the runner gathers the inputs
+        into its first elements before each call.
+    data : ndarray
+        float64 state, parameters and scratch the function reads and writes; the same memory
+        the Python ``step`` uses, so both forms continue one another.
+    keep : object
+        Whatever must stay alive while the address is called (the compiled function object).
+    """
+
+    address: int
+    inputs: np.ndarray
+    data: np.ndarray
+    keep: object = None
 
 
 class Block:
@@ -60,6 +96,17 @@ class Block:
     def step(self, t: float, u: np.ndarray, y: np.ndarray) -> None:
         """Compute the outputs at time ``t`` (s) from the inputs ``u``, writing ``y`` in place."""
         raise NotImplementedError(f"{type(self).__name__} must implement step(t, u, y)")
+
+    def compiled(self) -> CompiledStep | None:
+        """The step as compiled code, after :meth:`start`; ``None`` (the default): Python only.
+
+        Returns
+        -------
+        CompiledStep or None
+            The C-callable step and its memory; the chunk runner calls it instead of
+            :meth:`step`. A Python-only block costs one return to Python per step.
+        """
+        return None
 
     def close(self) -> None:
         """Release resources after a run."""
@@ -119,13 +166,35 @@ class Table(Block):
             y[:] = next(self._rows, self._last)
             return
         row = next(self._rows, None)
-        if row is None:  # the next chunk: times (k0 + i) dt, as an array of the whole run has them
-            k = self._next + np.arange(self.chunk)
+        if row is None:
+            _, rows = self.segment(self._next)
             self._next += self.chunk
-            self._rows = iter(self._checked(np.ascontiguousarray(self.function(self._t0 + k * self._dt),
-                                                                 dtype=float)))
+            self._rows = iter(rows)
             row = next(self._rows)
         y[:] = row
+
+    def segment(self, row: int) -> tuple[int, np.ndarray]:
+        """The rows of the table around row ``row`` (the block's ``row``-th step).
+
+        Parameters
+        ----------
+        row : int
+            Index of a step of the block (0 at the start time).
+
+        Returns
+        -------
+        first : int
+            Index of the first row returned.
+        rows : ndarray
+            ``(n, len(outputs))``: the whole table (``first`` = 0, the last row held after
+            it), or, for a callable, its chunk of ``chunk`` rows at times ``t0 + k dt`` (s),
+            ``k = first, first + 1, ...``, with ``first`` a multiple of ``chunk``.
+        """
+        if self.function is None:
+            return 0, self.values
+        first = row // self.chunk * self.chunk
+        k = first + np.arange(self.chunk)
+        return first, self._checked(np.ascontiguousarray(self.function(self._t0 + k * self._dt), dtype=float))
 
 
 class Constant(Block):

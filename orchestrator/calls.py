@@ -20,7 +20,7 @@ import numpy as np
 
 SOURCE = Path(__file__).resolve().parent / "c" / "calls.c"
 LIBRARY_NAME = "libquadcosim_calls.so"
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-shared")
+CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-Wall", "-Wextra", "-Werror", "-shared")
 
 
 class RunnerBuildError(RuntimeError):
@@ -88,17 +88,31 @@ def runner_path() -> Path:
     return library
 
 
-_run_calls = None
+_library = None
+
+
+def runner_library() -> ctypes.CDLL:
+    """The compiled runner, loaded once per process, its functions' types declared.
+
+    Returns
+    -------
+    ctypes.CDLL
+        ``run_calls(calls, count, t, failed)`` (a list of FMI calls) and
+        ``run_chunk(program, end)`` (the chunk runner of :mod:`orchestrator.chunks`).
+    """
+    global _library
+    if _library is None:
+        library = ctypes.CDLL(str(runner_path()))
+        library.run_calls.restype = ctypes.c_int
+        library.run_chunk.restype = ctypes.c_int
+        library.run_chunk.argtypes = [ctypes.c_void_p, ctypes.c_long]
+        _library = library
+    return _library
 
 
 def run_calls():
     """The runner's ``run_calls(calls, count, t, failed)`` function, loaded once per process."""
-    global _run_calls
-    if _run_calls is None:
-        function = ctypes.CDLL(str(runner_path())).run_calls
-        function.restype = ctypes.c_int
-        _run_calls = function
-    return _run_calls
+    return runner_library().run_calls
 
 
 class _CCall(ctypes.Structure):

@@ -62,6 +62,20 @@ class Phase(NamedTuple):
     run: Callable[[float], None]
 
 
+class Entry(NamedTuple):
+    """One phase as the chunk runner reads it: the FMI ``calls`` of a batch or a Python
+    ``block`` (its inputs and outputs found in the plan), the faults applied first, and the
+    per-step form ``phase``. The entry :data:`RECORD` stands for the recording and the check."""
+
+    phase: Phase | None
+    calls: tuple
+    taps: tuple
+    block: Block | None
+
+
+RECORD = Entry(None, (), (), None)
+
+
 class _BatchPart(NamedTuple):
     period: int
     calls: list[FMICall]
@@ -191,6 +205,7 @@ class Plan:
     def _wire_blocks(self):
         self.phase_a: list[Phase] = []
         self.phase_b: list[Phase] = []
+        self.program: list[Entry] = []  # what each phase runs, for the chunk runner: A, then B
         pending: list[_BatchPart] = []  # FMU blocks gathered into the next phase-A batch
         late: dict[int, list[FMICall]] = {}  # period -> phase-B calls
         for block in self.order:
@@ -198,19 +213,22 @@ class Plan:
             if isinstance(block, FMUBlock):
                 calls_a, calls_b = self._wire_fmu(block)
                 if pending and (taps or pending[0].period != block.period):
-                    self.phase_a.append(self._batch(pending))
+                    self._add_batch(self.phase_a, pending)
                     pending = []
                 pending.append(_BatchPart(block.period, calls_a, taps))
                 late.setdefault(block.period, []).extend(calls_b)
             else:
                 if pending:
-                    self.phase_a.append(self._batch(pending))
+                    self._add_batch(self.phase_a, pending)
                     pending = []
-                self.phase_a.append(Phase(block.period, self._wire_python(block, taps)))
+                phase = Phase(block.period, self._wire_python(block, taps))
+                self.phase_a.append(phase)
+                self.program.append(Entry(phase, (), tuple(taps), block))
         if pending:
-            self.phase_a.append(self._batch(pending))
+            self._add_batch(self.phase_a, pending)
+        self.program.append(RECORD)
         for period, calls in late.items():
-            self.phase_b.append(self._batch([_BatchPart(period, calls, [])]))
+            self._add_batch(self.phase_b, [_BatchPart(period, calls, [])])
 
     def _wire_fmu(self, block: FMUBlock) -> tuple[list[FMICall], list[FMICall]]:
         """Instantiate ``block``, read its first outputs; its phase-A and phase-B calls."""
@@ -229,10 +247,12 @@ class Plan:
         calls_b.append(DoStep(block, block.period * self.dt))
         return calls_a, calls_b
 
-    def _batch(self, parts: list[_BatchPart]) -> Phase:
+    def _add_batch(self, phases: list[Phase], parts: list[_BatchPart]):
         calls = [c for part in parts for c in part.calls]
         taps = [t for part in parts for t in part.taps]
-        return Phase(parts[0].period, batch(calls, taps, self.bus))
+        phase = Phase(parts[0].period, batch(calls, taps, self.bus))
+        phases.append(phase)
+        self.program.append(Entry(phase, tuple(calls), tuple(taps), None))
 
     def _wire_python(self, block: Block, taps: list[FaultTap]) -> Callable[[float], None]:
         """``block.step`` with its inputs gathered from the bus and its outputs written there."""
@@ -259,26 +279,59 @@ class Plan:
         return phase
 
     # ------------------------------------------------------------------ running
-    def run(self, progress: bool = False):
+    def run(self, progress: bool = False, master: str = "chunk"):
         """Step from ``t0`` to ``t0 + steps * dt``.
 
         Parameters
         ----------
         progress : bool
             Show a progress bar on runs longer than a few seconds of wall time.
+        master : {"chunk", "step"}
+            ``"chunk"``: the compiled chunk runner (:mod:`orchestrator.chunks`) runs whole chunks
+            of steps in C; ``"step"``: this loop, in Python, one step at a time. Both give
+            bit-identical results.
 
         Raises
         ------
         orchestrator.SimulationError
             On any failure; its ``result`` holds what was recorded up to it.
         """
+        bar = _progress(self.steps * self.dt) if progress else None
+        self.n = 0
+        started = time.perf_counter()
+        try:
+            if master == "chunk":
+                from orchestrator.chunks import ChunkRunner
+
+                ChunkRunner(self).run(bar)
+            else:
+                self._run_steps(bar)
+        except _Failure as failure:
+            raise SimulationError(str(failure), self.result(error=str(failure))) from None
+        except FMUError as error:
+            message = str(error)
+            if "not a finite number" in message:
+                message = self._non_finite(self.t0 + self.n * self.dt) + "\n" + message
+            raise SimulationError(message, self.result(error=message)) from None
+        except Exception as error:  # a Python block failed: keep what was recorded
+            message = f"at t = {self.t0 + self.n * self.dt:.6g} s: {type(error).__name__}: {error}"
+            raise SimulationError(message, self.result(error=message)) from error
+        except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM by way of Terminated
+            number = signal_number(interrupt)
+            message = f"interrupted by {signal_name(number)} at t = {self.t0 + self.n * self.dt:.6g} s"
+            raise RunInterrupted(message, self.result(error=message), number) from None
+        finally:
+            self.loop_seconds = time.perf_counter() - started
+            if bar is not None:
+                bar.close()
+
+    def _run_steps(self, bar):
+        """The per-step loop; ``self.n`` is the step it stopped at."""
         bus, record, dt, t0, dec = self.bus, self.record, self.dt, self.t0, self.decimation
         phase_a, phase_b, gather = self.phase_a, self.phase_b, self.record_copies
         reduce, isfinite = np.add.reduce, math.isfinite
-        bar = _progress(self.steps * dt) if progress else None
         chunk = max(1, self.steps // 200)
         n = 0
-        started = time.perf_counter()
         try:
             for n in range(self.steps + 1):
                 t = t0 + n * dt
@@ -299,24 +352,12 @@ class Plan:
                         fn(t)
                 if bar is not None and n % chunk == 0 and n:
                     bar.update(n * dt - bar.n)  # respects the bar's delay, unlike refresh()
-        except _Failure as failure:
-            raise SimulationError(str(failure), self.result(error=str(failure))) from None
-        except FMUError as error:
-            message = str(error)
-            if "not a finite number" in message:
-                message = self._non_finite(t0 + n * dt) + "\n" + message
-            raise SimulationError(message, self.result(error=message)) from None
-        except Exception as error:  # a Python block failed: keep what was recorded
-            message = f"at t = {t0 + n * dt:.6g} s: {type(error).__name__}: {error}"
-            raise SimulationError(message, self.result(error=message)) from error
-        except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM by way of Terminated
-            number = signal_number(interrupt)
-            message = f"interrupted by {signal_name(number)} at t = {t0 + n * dt:.6g} s"
-            raise RunInterrupted(message, self.result(error=message), number) from None
         finally:
-            self.loop_seconds = time.perf_counter() - started
-            if bar is not None:
-                bar.close()
+            self.n = n
+
+    def non_finite(self, t: float):
+        """The failure to raise for a non-finite signal found at time ``t`` (s)."""
+        return _Failure(self._non_finite(t))
 
     def _non_finite(self, t: float) -> str:
         bus = self.bus

@@ -18,6 +18,7 @@ Per macro step ``n`` (time ``t_n``), in dependency order:
 from __future__ import annotations
 
 import math
+import os
 
 from orchestrator.blocks import Block, Constant, FMUBlock
 from orchestrator.errors import AlgebraicLoopError, SimulationError  # noqa: F401 (public here too)
@@ -182,7 +183,7 @@ class System:
 
     # ------------------------------------------------------------------ running
     def run(self, duration: float, decimation: int = 1, progress: bool = False, start_time: float = 0.0,
-            record=None) -> Result:
+            record=None, master: str | None = None) -> Result:
         """Run the system and return what was recorded.
 
         Parameters
@@ -198,6 +199,10 @@ class System:
         record : list of str, optional
             Signals to keep (vector names such as ``"IMU.acc"`` allowed); every output of every
             block by default.
+        master : {"chunk", "step"}, optional
+            ``"chunk"`` (the default, or ``$QUADCOSIM_MASTER``): compiled code runs whole chunks
+            of steps (:mod:`orchestrator.chunks`); ``"step"``: one step at a time from Python.
+            Both give bit-identical results.
 
         Returns
         -------
@@ -215,13 +220,16 @@ class System:
             raise ValueError(f"duration = {duration!r} s must be a positive number of seconds")
         if int(decimation) != decimation or decimation < 1:
             raise ValueError(f"decimation = {decimation!r} must be a positive integer")
+        master = master or os.environ.get("QUADCOSIM_MASTER") or "chunk"
+        if master not in ("chunk", "step"):
+            raise ValueError(f"master = {master!r} must be 'chunk' or 'step' (also in $QUADCOSIM_MASTER)")
         missing = self.unconnected()
         if missing:
             raise ValueError(f"unconnected input{'s' * (len(missing) > 1)}: {', '.join(missing)}. Connect each "
                              "with system.connect(source, destination) or tie it with system.set_input(name, value).")
         plan = Plan(self, duration, int(decimation), start_time, record)
         try:
-            plan.run(progress)
+            plan.run(progress, master)
         finally:
             plan.close()
         return plan.result()

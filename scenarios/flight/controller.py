@@ -105,6 +105,13 @@ P_KPXY, P_KDXY, P_KIXY = (_slot(PARAMETERS, n) for n in ("kp_xy", "kd_xy", "ki_x
 # state
 S_INT_X, S_INT_Y = 0, 1  # integral of the north and east position errors (m s)
 STATE_SIZE = 2
+# the block's memory, shared by its Python step and its compiled step: parameters, inverse
+# allocation matrix (row-major), state, period (s)
+MOTORS = 4
+D_PARAMETERS, D_MIXER = 0, len(PARAMETERS)
+D_STATE = D_MIXER + MOTORS * 4
+D_DT = D_STATE + STATE_SIZE
+DATA_SIZE = D_DT + 1
 
 
 def parameters(gains: dict | None = None) -> np.ndarray:
@@ -207,8 +214,12 @@ class Controller(Block):
 
     def start(self, t0, dt):
         """Reset the integral; compile the law before the run. ``dt``: the block's period (s)."""
-        law, p, mix = control_law, self.parameters, self.mixer_inverse
-        state = np.zeros(STATE_SIZE)
+        self.data = np.zeros(DATA_SIZE)
+        self.data[D_PARAMETERS:D_MIXER] = self.parameters
+        self.data[D_MIXER:D_STATE] = self.mixer_inverse.ravel()
+        self.data[D_DT] = dt
+        law, p, mix = control_law, self.data[D_PARAMETERS:D_MIXER], self.data[D_MIXER:D_STATE].reshape(MOTORS, 4)
+        state = self.data[D_STATE:D_DT]
         law(np.zeros(len(INPUTS)), p, mix, state, dt, np.empty(len(OUTPUTS)))
         state[:] = 0.0
         self.state = state
@@ -217,3 +228,33 @@ class Controller(Block):
             law(u, p, mix, state, dt, y)
 
         self.step = step
+
+    def compiled(self):
+        """The law as a C-callable step on the block's memory (see :meth:`Block.compiled`)."""
+        from orchestrator.blocks import CompiledStep
+
+        function = _compiled_step()
+        return CompiledStep(function.address, np.zeros(len(INPUTS)), self.data, function)
+
+
+def _compiled_step():
+    """The numba ``cfunc`` of the law, compiled (or loaded from numba's cache) on first use."""
+    global _COMPILED
+    if _COMPILED is None:
+        from numba import carray, cfunc
+
+        from orchestrator.blocks import COMPILED_SIGNATURE
+
+        @cfunc(COMPILED_SIGNATURE, cache=True, error_model="numpy")
+        def step(t, u, y, data):
+            memory = carray(data, DATA_SIZE)
+            control_law(carray(u, len(INPUTS)), memory[D_PARAMETERS:D_MIXER],
+                        memory[D_MIXER:D_STATE].reshape((MOTORS, 4)), memory[D_STATE:D_DT], memory[D_DT],
+                        carray(y, len(OUTPUTS)))
+            return 0
+
+        _COMPILED = step
+    return _COMPILED
+
+
+_COMPILED = None
