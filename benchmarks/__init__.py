@@ -1,8 +1,56 @@
 """Benchmark scripts that print figures (``quadcosim bench``); they are not timed tests.
 
-- :mod:`benchmarks.master`: the co-simulation master against a hand-written ctypes loop;
+- :mod:`benchmarks.master`: the co-simulation master, open and closed loop, against reference
+  loops written in C (``benchmarks/c/loops.c``) that make the same FMI calls;
 - :mod:`benchmarks.estimators`: the closed loop's real-time factor and the estimators'
   batch path against the ``ahrs`` package;
 - :mod:`benchmarks.infrared`: operations per iteration and time per update of the IR
   calibration estimators against the slides' 300 operations at 20 Hz.
+
+The C references in ``benchmarks/c/`` are compiled by ``quadcosim build`` with the system C
+compiler into ``build/benchmarks`` beside the package (:func:`build_references`); they are not
+part of the installed package.
 """
+
+from __future__ import annotations
+
+from pathlib import Path
+
+SOURCES = Path(__file__).resolve().parent / "c"
+LIBRARIES = Path(__file__).resolve().parent.parent / "build" / "benchmarks"
+
+
+def build_references() -> list[Path]:
+    """Compile every ``benchmarks/c/*.c`` into ``build/benchmarks/lib<name>.so``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The libraries written.
+    """
+    from orchestrator.calls import compile_shared
+
+    return [compile_shared(source, LIBRARIES / f"lib{source.stem}.so") for source in sorted(SOURCES.glob("*.c"))]
+
+
+def reference_library(name: str):
+    """The compiled reference ``benchmarks/c/<name>.c``, compiled first if missing or stale.
+
+    Parameters
+    ----------
+    name : str
+        Stem of the C file.
+
+    Returns
+    -------
+    ctypes.CDLL
+        The loaded library.
+    """
+    import ctypes
+
+    from orchestrator.calls import compile_shared
+
+    source, library = SOURCES / f"{name}.c", LIBRARIES / f"lib{name}.so"
+    if not library.is_file() or library.stat().st_mtime < source.stat().st_mtime:
+        compile_shared(source, library)
+    return ctypes.CDLL(str(library))

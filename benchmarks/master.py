@@ -1,117 +1,244 @@
-"""Benchmark of the co-simulation master (``quadcosim bench``).
+"""Benchmark of the co-simulation master against C reference loops (``quadcosim bench``).
 
-Measures, in one run:
-- the orchestrator on the ``open-loop`` scenario at 1 kHz (three FMUs, scripted commands,
-  every output recorded at every step);
-- a hand-written minimal loop on the same three FMUs with the same connections, the same
-  command table and the same recording, calling the FMI functions directly through ctypes
-  with preallocated arguments (the fastest per-call path found here);
-- their ratio, and the real-time factor of the orchestrator.
-Times are of the stepping loop only (instantiation excluded), best of ``repeats``.
+Measures, in one run, per macro step at 1 kHz, CPU time of the stepping loop only
+(instantiation excluded), in the same process:
+
+- the open loop: the orchestrator on the ``open-loop`` scenario (three FMUs, scripted commands,
+  every output recorded at every step), and ``open_loop`` of ``benchmarks/c/loops.c``: the
+  same FMI calls on FMUs with the same parameters, the same command table, the same recording
+  and non-finite check, written by hand in C;
+- the closed loop: the orchestrator on ``tp`` with the explicit filter (IMU noise and bias on,
+  controller fed by the ground truth), and ``closed_loop`` of ``loops.c``: the same FMI calls,
+  the explicit filter and the controller written in C, the same recording;
+- in each repeat the orchestrator and the C loop are timed back to back and their ratio kept;
+  the figures are the median ratio over ``repeats`` and its spread (lowest, highest). The
+  trajectories are compared bit for bit: every recorded signal of the C loop must equal the
+  orchestrator's (``*_identical``).
+
+The keys of :func:`benchmarks.estimators.measure` (the batch path) join the same JSON object.
 """
 
 from __future__ import annotations
 
 import ctypes
 import json
+import statistics
 import sys
 import time
 
 import numpy as np
 
-from benchmarks import estimators
+from benchmarks import estimators, reference_library
+
+CLOSED_LOOP = {"estimator": "explicit", "noise": True, "bias": True}  # tp options of the closed loop
+
+_double, _pointer, _size = ctypes.c_double, ctypes.c_void_p, ctypes.c_size_t
 
 
-def orchestrator_us_per_step(seconds: float, repeats: int) -> float:
-    """Microseconds per step of the master on ``open-loop`` over ``seconds`` simulated, best of ``repeats``."""
+class _Fmu(ctypes.Structure):
+    _fields_ = [("set", _pointer), ("get", _pointer), ("step", _pointer), ("component", _pointer)]
+
+
+class _Refs(ctypes.Structure):
+    _fields_ = [("vr", _pointer), ("n", _size)]
+
+
+_CONTROL_NAMES = ("mass", "jx", "jy", "jz", "gravity", "thrust_coeff", "max_rotor_thrust", "resistance", "ke",
+                  "drag_torque_coeff", "max_tilt", "kp", "kd", "kp_yaw", "kd_yaw", "kp_z", "kd_z", "kp_xy",
+                  "kd_xy", "ki_xy")
+
+
+class _Control(ctypes.Structure):
+    _fields_ = [(name, _double) for name in _CONTROL_NAMES] + [("mixer_inverse", _double * 16)]
+
+
+class _Explicit(ctypes.Structure):
+    _fields_ = [("k1", _double), ("k2", _double), ("kP", _double), ("kI", _double), ("gravity", _double * 3),
+                ("field", _double * 3), ("q0", _double * 4), ("b0", _double * 3)]
+
+
+_REFS = ("motors_in", "motors_out", "body_rotors", "body_wind", "body_out", "imu_rotors", "imu_field", "imu_motion",
+         "imu_out")
+
+
+class _Loop(ctypes.Structure):
+    _fields_ = ([("motors", _Fmu), ("body", _Fmu), ("imu", _Fmu)] + [(name, _Refs) for name in _REFS]
+                + [("setpoint", _pointer), ("setpoint_width", ctypes.c_long), ("wind", _pointer), ("field", _pointer),
+                   ("steps", ctypes.c_long), ("dt", _double), ("record", _pointer), ("width", ctypes.c_long),
+                   ("control", _pointer), ("filter", _pointer), ("failed_step", ctypes.c_long),
+                   ("failed_call", ctypes.c_int)])
+
+
+def _address(function) -> int:
+    return ctypes.cast(function, _pointer).value
+
+
+class ReferenceLoop:
+    """The C loop of ``benchmarks/c/loops.c`` on fresh FMU instances of a built ``system``.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+        The ``open-loop`` or ``tp`` system, whose blocks give the FMU parameters, the setpoint
+        table, the constant inputs, and the filter's and controller's settings.
+    seconds : float
+        Simulated time (s).
+    """
+
+    def __init__(self, system, seconds: float):
+        from orchestrator.fmu import FMUInstance
+
+        blocks = system.blocks
+        self.closed = "Controller" in blocks
+        self.steps, self.dt = int(round(seconds / system.dt)), system.dt
+        self.keep = []  # arrays the C loop points into
+        self.fmus = {name: FMUInstance(blocks[name].model, blocks[name].parameters, name=name)
+                     for name in ("MotorMagnetics", "Quadrotor", "IMU")}
+        setpoint = blocks["Setpoint"]
+        setpoint.start(0.0, system.dt)
+        rows = [setpoint.segment(k)[1] for k in range(0, self.steps + 1, setpoint.chunk)]
+        table = self._kept(np.concatenate(rows)[:self.steps + 1])
+        self.names = [f"{name}.{y}" for name in ("Setpoint", "MotorMagnetics", "Quadrotor", "IMU")
+                      + (("Quaternion_estim", "Controller") if self.closed else ()) for y in blocks[name].outputs]
+        self.record = np.empty((self.steps + 1, len(self.names)))
+        wind = self._kept([blocks[f"Const_Quadrotor_wind_{axis}"].values[0] for axis in "xyz"])
+        field = self._kept(blocks["Const_IMU_b_d"].values if "Const_IMU_b_d" in blocks else np.zeros(3))
+        self.loop = _Loop(**self._fmu_fields(blocks), setpoint=table.ctypes.data, setpoint_width=table.shape[1],
+                          wind=wind.ctypes.data, field=field.ctypes.data, steps=self.steps, dt=self.dt,
+                          record=self.record.ctypes.data, width=len(self.names))
+        if self.closed:
+            self.control, self.filter = _control(blocks["Controller"]), _explicit(blocks["Quaternion_estim"])
+            self.loop.control, self.loop.filter = ctypes.addressof(self.control), ctypes.addressof(self.filter)
+
+    def _kept(self, values) -> np.ndarray:
+        array = np.ascontiguousarray(values, dtype=float)
+        self.keep.append(array)
+        return array
+
+    def _refs(self, fmu, names) -> _Refs:
+        vr = self.fmus[fmu].vr(list(names))
+        self.keep.append(vr)
+        return _Refs(vr.ctypes.data, len(vr))
+
+    def _fmu_fields(self, blocks) -> dict:
+        fields = {key: _Fmu(_address(f.raw_set_real), _address(f.raw_get_real), _address(f.raw_do_step), f.component)
+                  for key, f in zip(("motors", "body", "imu"), self.fmus.values(), strict=True)}
+        rotors = [f"omega_r{n}" for n in range(1, 5)]
+        return fields | {
+            "motors_in": self._refs("MotorMagnetics", [f"c{n}" for n in range(1, 5)]),
+            "motors_out": self._refs("MotorMagnetics", blocks["MotorMagnetics"].outputs),
+            "body_rotors": self._refs("Quadrotor", rotors + [f"domega_r{n}" for n in range(1, 5)]),
+            "body_wind": self._refs("Quadrotor", ["wind_x", "wind_y", "wind_z"]),
+            "body_out": self._refs("Quadrotor", blocks["Quadrotor"].outputs),
+            "imu_rotors": self._refs("IMU", rotors),
+            "imu_field": self._refs("IMU", ["b_d_x", "b_d_y", "b_d_z"]),
+            "imu_motion": self._refs("IMU", ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "f_x", "f_y",
+                                             "f_z"]),
+            "imu_out": self._refs("IMU", blocks["IMU"].outputs),
+        }
+
+    def run(self) -> float:
+        """Run the loop once; its CPU time (s).
+
+        Raises
+        ------
+        RuntimeError
+            An FMI call failed or a value became non-finite (the step is named).
+        """
+        function = getattr(reference_library("loops"), "closed_loop" if self.closed else "open_loop")
+        function.restype = ctypes.c_int
+        started = time.process_time()
+        status = function(ctypes.byref(self.loop))
+        seconds = time.process_time() - started
+        if status:
+            raise RuntimeError(f"the C reference loop failed at step {self.loop.failed_step} (status {status})")
+        return seconds
+
+    def close(self):
+        """Free the FMU instances."""
+        for fmu in self.fmus.values():
+            fmu.close()
+
+
+def _control(block) -> _Control:
+    from scenarios.flight.controller import PARAMETERS
+
+    values = dict(zip(PARAMETERS, block.parameters, strict=True))
+    return _Control(*[values[name] for name in _CONTROL_NAMES], (_double * 16)(*block.mixer_inverse.ravel()))
+
+
+def _explicit(block) -> _Explicit:
+    from estimators import core
+
+    gains, config, vector = block.gains, block.config, _double * 3
+    if block.kind != "explicit" or any(gains[name] for name in gains if name not in ("k1", "k2", "kP", "kI")):
+        raise ValueError("the C reference is the explicit filter without corrections")
+    return _Explicit(gains["k1"], gains["k2"], gains["kP"], gains["kI"], vector(*config[core.GRAVITY:core.GRAVITY + 3]),
+                     vector(*config[core.FIELD:core.FIELD + 3]), (_double * 4)(*block.q0), vector(*block.b0))
+
+
+def compare(scenario: str, settings: dict, seconds: float, repeats: int) -> dict:
+    """The orchestrator against its C reference loop on one scenario, ``repeats`` times.
+
+    Parameters
+    ----------
+    scenario : str
+        ``"open-loop"`` or ``"tp"``.
+    settings : dict
+        Scenario options.
+    seconds : float
+        Simulated time per run (s).
+    repeats : int
+        Runs of each, back to back.
+
+    Returns
+    -------
+    dict
+        ``ratios`` (orchestrator over C, CPU time, one per repeat), ``us_per_step`` and
+        ``c_us_per_step`` (the lowest over the repeats, µs), ``identical`` (every recorded signal
+        of the C loop equal, bit for bit, to the orchestrator's, in every repeat).
+    """
     import scenarios
 
-    scenario = scenarios.get("open-loop")
-    options = scenario.parse({"duration": seconds})
-    best = np.inf
+    definition = scenarios.get(scenario)
+    options = definition.parse({"duration": seconds} | settings)
+    ratios, ours, theirs, identical = [], [], [], True
     for _ in range(repeats):
-        result = scenario.build(options).run(seconds)
-        best = min(best, result.meta["loop_seconds"] / (len(result) - 1))
-    return best * 1e6
-
-
-def _at(array: np.ndarray, index: int = 0) -> ctypes.c_void_p:
-    """Address of ``array[index]``, as a ctypes argument."""
-    return ctypes.c_void_p(array.ctypes.data + array.itemsize * index)
-
-
-def raw_us_per_step(seconds: float, repeats: int) -> float:
-    """Microseconds per step of the hand-written ctypes loop (best of ``repeats``)."""
-    from orchestrator.fmu import FMUInstance
-    from scenarios.open_loop import commands
-
-    void, size = ctypes.c_void_p, ctypes.c_size_t
-    steps = int(round(seconds / 1e-3))
-    table = commands(seconds, 1e-3, 0.01)
-    best = np.inf
-    for _ in range(repeats):
-        motors, body, imu = FMUInstance("MotorMagnetics"), FMUInstance("Quadrotor"), FMUInstance("IMU")
-        keep = []  # the value reference arrays the ctypes arguments point into
-
-        def refs(fmu, names, keep=keep):
-            array = fmu.vr(names)
-            keep.append(array)
-            return void(array.ctypes.data), size(len(array))
-
-        m_out, q_out, i_out = (np.zeros(len(f.outputs)) for f in (motors, body, imu))
-        record = np.empty((steps + 1, len(m_out) + len(q_out) + len(i_out)))
-        m_in_vr, m_in_n = refs(motors, ["c1", "c2", "c3", "c4"])
-        m_vr, m_n = refs(motors, motors.outputs)
-        q_in_vr, q_in_n = refs(body, ["omega_r1", "omega_r2", "omega_r3", "omega_r4"])
-        q_vr, q_n = refs(body, body.outputs)
-        i_in_vr, i_in_n = refs(imu, ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z"])
-        i_bd_vr, i_bd_n = refs(imu, ["b_d_x", "b_d_y", "b_d_z"])
-        i_vr, i_n = refs(imu, imu.outputs)
-        omega_r = _at(m_out, motors.outputs.index("omega_r1"))
-        b_d = _at(m_out, motors.outputs.index("b_d_x"))
-        q = _at(q_out, body.outputs.index("q0"))
-        rows = [_at(table, 4 * k) for k in range(len(table))]
-        ms, mg, md, mc = motors.raw_set_real, motors.raw_get_real, motors.raw_do_step, motors.component_arg
-        qs, qg, qd, qc = body.raw_set_real, body.raw_get_real, body.raw_do_step, body.component_arg
-        is_, ig, id_, ic = imu.raw_set_real, imu.raw_get_real, imu.raw_do_step, imu.component_arg
-        m_ptr, q_ptr, i_ptr = _at(m_out), _at(q_out), _at(i_out)
-        a, b = len(m_out), len(m_out) + len(q_out)
-        now, h, one = ctypes.c_double(0.0), ctypes.c_double(1e-3), ctypes.c_int(1)
-        started = time.perf_counter()
-        for n in range(steps + 1):
-            ms(mc, m_in_vr, m_in_n, rows[n])
-            mg(mc, m_vr, m_n, m_ptr)
-            qs(qc, q_in_vr, q_in_n, omega_r)
-            qg(qc, q_vr, q_n, q_ptr)
-            is_(ic, i_in_vr, i_in_n, q)
-            is_(ic, i_bd_vr, i_bd_n, b_d)
-            ig(ic, i_vr, i_n, i_ptr)
-            record[n, :a] = m_out
-            record[n, a:b] = q_out
-            record[n, b:] = i_out
-            if n == steps:
-                break
-            now.value = n * 1e-3
-            md(mc, now, h, one)
-            qd(qc, now, h, one)
-            id_(ic, now, h, one)
-        best = min(best, (time.perf_counter() - started) / steps)
-        for fmu in (motors, body, imu):
-            fmu.close()
-    return best * 1e6
+        result = definition.build(options).run(seconds)
+        reference = ReferenceLoop(definition.build(options), seconds)
+        try:
+            c_seconds = reference.run()
+        finally:
+            reference.close()
+        steps = reference.steps
+        identical &= all(np.array_equal(result[name], reference.record[:, k]) for k, name in enumerate(reference.names))
+        ours.append(result.meta["loop_cpu_seconds"] / steps)
+        theirs.append(c_seconds / steps)
+        ratios.append(ours[-1] / theirs[-1])
+    return {"ratios": ratios, "us_per_step": min(ours) * 1e6, "c_us_per_step": min(theirs) * 1e6,
+            "identical": bool(identical)}
 
 
 def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
-    """Every benchmark figure as a dict: runs of ``seconds`` simulated, best of ``repeats``."""
-    orchestrator = orchestrator_us_per_step(seconds, repeats)
-    raw = raw_us_per_step(seconds, repeats)
-    figures = {
-        "orchestrator_us_per_step": orchestrator,
-        "raw_us_per_step": raw,
-        "overhead_ratio": orchestrator / raw,
-        "rtf_open_loop": 1e3 / orchestrator,
-    }
-    return figures | estimators.measure(seconds, repeats)
+    """Every benchmark figure as a dict: runs of ``seconds`` simulated, ``repeats`` of each.
+
+    Returns
+    -------
+    dict
+        ``open_loop_over_c`` and ``closed_loop_over_c`` (median ratio of CPU times), their
+        ``*_spread`` (lowest, highest), the µs per step of each loop, ``rtf_open_loop``,
+        ``rtf_closed_loop`` and ``rtf_closed_loop_c`` (simulated over CPU seconds, best run),
+        ``*_identical``, then the batch-path figures of :func:`benchmarks.estimators.measure`.
+    """
+    figures = {}
+    for key, scenario, settings in (("open_loop", "open-loop", {}), ("closed_loop", "tp", CLOSED_LOOP)):
+        run = compare(scenario, settings, seconds, repeats)
+        figures |= {f"{key}_over_c": statistics.median(run["ratios"]),
+                    f"{key}_over_c_spread": [min(run["ratios"]), max(run["ratios"])],
+                    f"{key}_us_per_step": run["us_per_step"], f"{key}_c_us_per_step": run["c_us_per_step"],
+                    f"rtf_{key}": 1e3 / run["us_per_step"], f"rtf_{key}_c": 1e3 / run["c_us_per_step"],
+                    f"{key}_identical": run["identical"]}
+    return estimators.measure(seconds, repeats) | figures
 
 
 def main(argv=None) -> int:
@@ -121,14 +248,14 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="quadcosim bench", description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per measurement")
-    parser.add_argument("--repeats", type=int, default=3, help="measurements, best kept")
+    parser.add_argument("--repeats", type=int, default=3, help="measurements of each loop")
     args = parser.parse_args(argv)
     figures = measure(args.seconds, args.repeats)
     if args.json:
         print(json.dumps(figures))
     else:
         for key, value in figures.items():
-            print(f"{key:28s} {value:12.4g}")
+            print(f"{key:28s} {value:12.4g}" if isinstance(value, float) else f"{key:28s} {value}")
     return 0
 
 

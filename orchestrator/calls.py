@@ -52,16 +52,41 @@ def build_runner(out_dir: str | Path | None = None, compiler: str | None = None)
     Returns
     -------
     pathlib.Path
-        Path of the library. It is written under a temporary name and renamed, so that
+        Path of the library.
+    """
+    out = Path(out_dir) if out_dir is not None else runner_dir()
+    return compile_shared(SOURCE, out / LIBRARY_NAME, compiler)
+
+
+def compile_shared(source: Path, library: Path, compiler: str | None = None) -> Path:
+    """Compile one C file into a shared library with :data:`CFLAGS` (warnings as errors, no
+    floating-point contraction, no machine-specific instructions).
+
+    Parameters
+    ----------
+    source : pathlib.Path
+        The C file.
+    library : pathlib.Path
+        The library to write. It is written under a temporary name and renamed, so that
         processes starting together never load a half-written file.
+    compiler : str, optional
+        C compiler command; ``$CC`` or ``cc`` by default.
+
+    Returns
+    -------
+    pathlib.Path
+        ``library``.
+
+    Raises
+    ------
+    RunnerBuildError
+        No compiler, or it refused the source (its messages included).
     """
     compiler = compiler or os.environ.get("CC", "cc")
-    out = Path(out_dir) if out_dir is not None else runner_dir()
-    out.mkdir(parents=True, exist_ok=True)
-    library = out / LIBRARY_NAME
-    handle, partial = tempfile.mkstemp(prefix=".calls-", suffix=".so", dir=out)
+    library.parent.mkdir(parents=True, exist_ok=True)
+    handle, partial = tempfile.mkstemp(prefix=f".{library.stem}-", suffix=".so", dir=library.parent)
     os.close(handle)
-    command = [compiler, *CFLAGS, "-o", partial, str(SOURCE)]
+    command = [compiler, *CFLAGS, "-o", partial, str(source), "-lm"]
     try:
         done = subprocess.run(command, capture_output=True, text=True)
     except FileNotFoundError:
@@ -69,7 +94,7 @@ def build_runner(out_dir: str | Path | None = None, compiler: str | None = None)
         raise RunnerBuildError(f"no C compiler {compiler!r}: install one (e.g. gcc) or set $CC") from None
     if done.returncode != 0:
         os.unlink(partial)
-        raise RunnerBuildError(f"call runner: {' '.join(command)}\n{done.stderr}")
+        raise RunnerBuildError(f"{source.name}: {' '.join(command)}\n{done.stderr}")
     os.replace(partial, library)
     return library
 

@@ -129,12 +129,12 @@ class ChunkRunner:
         plan, block = self.plan, entry.block
         first, outputs = plan._outputs(block)
         y = plan.bus.ctypes.data + 8 * first
-        if isinstance(block, Table | Constant) and not entry.taps:
+        if type(block) in (Table, Constant):  # exactly these: a subclass may step otherwise
             rows = block.values.reshape(1, -1) if isinstance(block, Constant) else block.segment(0)[1]
             rows = np.ascontiguousarray(rows, dtype=float)
             op = _Op(kind=OP_TABLE, period=period, y=y, table=rows.ctypes.data, first_row=0, rows=len(rows),
                      width=len(block.outputs))
-            self.items.append(_Item(op, owner=block, table=block if isinstance(block, Table) else None,
+            self.items.append(_Item(op, owner=block, table=block if type(block) is Table else None,
                                     keep=[rows]))
             return
         compiled = block.compiled()

@@ -301,7 +301,7 @@ class Plan:
         runner = ChunkRunner(self) if master == "chunk" else None  # compiled steps loaded here, not timed
         bar = _progress(self.steps * self.dt) if progress else None
         self.n = 0
-        started = time.perf_counter()
+        started, cpu = time.perf_counter(), time.process_time()
         try:
             if runner is not None:
                 runner.run(bar)
@@ -323,6 +323,7 @@ class Plan:
             raise RunInterrupted(message, self.result(error=message), number) from None
         finally:
             self.loop_seconds = time.perf_counter() - started
+            self.loop_cpu_seconds = time.process_time() - cpu
             if bar is not None:
                 bar.close()
 
@@ -397,6 +398,7 @@ class Plan:
         warnings = {name: {"count": log.warnings, "first": list(log.first_warnings)}
                     for name, log in self.logs.items() if log.warnings}
         meta = {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
+                "loop_cpu_seconds": getattr(self, "loop_cpu_seconds", None),
                 "order": [b.name for b in self.order],
                 "connections": dict(self.system.connections), "fmu_warnings": warnings}
         return Result(times, self.names, self.record[:rows], meta, error)

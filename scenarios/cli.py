@@ -27,6 +27,10 @@ def _build(args) -> int:
     try:
         build_all(args.out)
         print(f"built {build_runner()}")
+        from benchmarks import build_references
+
+        for library in build_references():
+            print(f"built {library}")
     except (BuildError, RunnerBuildError) as error:
         print(error, file=sys.stderr)
         return 1
@@ -153,7 +157,8 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus) and the master's C call runner")
+    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus), the master's C runner and "
+                           "the benchmark's C references")
     build.add_argument("--out", default=None, help="output folder (default build/fmus)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
