@@ -308,8 +308,8 @@ class Result:
         label_prefix : str
             Prefix of each curve's label.
         unit : str, optional
-            Unit of the values drawn (after ``scale``); by default the signals' own unit,
-            ``1`` for a dimensionless one.
+            Unit of the values drawn (after ``scale``); by default the signals' own unit
+            (``1`` for a dimensionless one, as the variable tables write it).
 
         Returns
         -------
@@ -335,8 +335,8 @@ class Result:
             for member in members:
                 t, y = envelope(self.time, self[member])
                 ax.plot(t, y * scale, label=label_prefix + member)
-            found = {known[m] for m in members if m in known}
-            shown = unit if unit is not None else (found.pop() or "1") if len(found) == 1 else "unit unknown"
+            found = {known[m] for m in members if known.get(m)}  # "" is a unit not known
+            shown = unit if unit is not None else found.pop() if len(found) == 1 else "unit unknown"
             parts.append((name, shown))
         if len({shown for _, shown in parts}) == 1:
             ax.set_ylabel(f"{', '.join(name for name, _ in parts)} ({parts[0][1]})")

@@ -29,6 +29,7 @@ import numpy as np
 
 from estimators import analysis, estimate
 from scenarios import Option, Scenario
+from scenarios.figures import fault_text, faults_of, title_lines
 from scenarios.plant import save_figure
 
 OPTIONS = {
@@ -243,7 +244,13 @@ def report(result, o, out) -> dict:
     ax.axvline(k_simulated, color="C1", ls="--", lw=0.8, label=f"simulated optimum {k_simulated:.2f}")
     ax.set_xlabel("gain k (1/s)")
     ax.set_ylabel("roll/pitch error, standard deviation (deg)")
-    ax.set_title(f"Linear filter: error against gain ({o['imu_rate']:g} Hz IMU, {o['duration']:g} s stream)")
+    closed_text = (f"estimate-fed runs: {o['closed_duration']:g} s each, {o['closed_flight']}, rotor drag "
+                   f"{'on' if o['closed_drag'] else 'off'}" + (", gravity-only accelerometer"
+                                                                 if o["closed_accelerometer"] == "gravity" else "")
+                   if o["closed_loop"] else "no estimate-fed runs")
+    ax.set_title(title_lines(f"gain-study: linear filter's roll/pitch error against its gain k, {o['count']} gains",
+                             f"GT stream {o['duration']:g} s at {o['imu_rate']:g} Hz (first {o['burn_in']:g} s left "
+                             f"out), IMU noise on; {closed_text}", fault_text(faults_of(result)), width=90), fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     figure = save_figure(fig, out, "gain_study.png")

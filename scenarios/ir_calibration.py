@@ -24,6 +24,7 @@ from fmus.build import table
 from orchestrator import Block, FMUBlock, System, Table
 from orchestrator.fmu import FMUInstance
 from scenarios import Option, Scenario
+from scenarios.figures import fault_text, faults_of, title_lines
 from scenarios.plant import save_figure
 
 RATE = 20.0  # Hz, the sensor's
@@ -264,13 +265,38 @@ def report(result, o, out) -> dict:
     slope, intercept = np.polyfit(r, ir, 1)
     metrics["flight"] = {"ir_mean": float(ir.mean()), "ir_std": float(ir.std()), "turn_rate_mean": float(r.mean()),
                          "turn_rate_std": float(r.std()), "ir_fit": {"a": float(slope), "b": float(intercept)}}
-    figures = [_calibration_figure(result, o, truth, windows, out), _innovations_figure(result, o, windows, out),
-               _errors_figure(t, truth, estimates, metrics["turn_rate_error_deg_s"], out)]
+    title = run_title(result, o)
+    figures = [_calibration_figure(result, o, truth, windows, out, title),
+               _innovations_figure(result, o, windows, out, title),
+               _errors_figure(t, truth, estimates, metrics["turn_rate_error_deg_s"], out, title)]
     metrics["figures"] = [f for f in figures if f]
     return metrics
 
 
-def _calibration_figure(result, o, truth, windows, out):
+def run_title(result, o: dict) -> str:
+    """Title of the scenario's figures: the sensor model, the faults, the filter's settings.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        The run (its injected faults, if any, are named too).
+    o : dict
+        The scenario's options.
+
+    Returns
+    -------
+    str
+        Two lines or more.
+    """
+    gps = "GPS fused all flight" if o["gps_resetting"] else f"GPS fused until {o['calibration_s']:g} s"
+    faults = {"none": "no sensor fault", "ir": "IR fault", "gps": "GPS fault", "both": "IR and GPS faults"}
+    return title_lines(f"ir-calibration: {o['duration']:g} s of banked flight, a and b drift "
+                       f"{'on' if o['drift'] else 'off'}, sensor noise {'on' if o['noise'] else 'off'}",
+                       f"{faults[o['faults']]}, innovation gating {'on' if o['gating'] else 'off'}, {gps}",
+                       fault_text(faults_of(result)))
+
+
+def _calibration_figure(result, o, truth, windows, out, title):
     """a, b and the turn rate against time, with their truth."""
     import matplotlib.pyplot as plt
 
@@ -298,13 +324,12 @@ def _calibration_figure(result, o, truth, windows, out):
         ax.grid(alpha=0.3)
     axes[0].legend(loc="upper right", fontsize=8, ncol=3)
     axes[2].legend(loc="upper right", fontsize=8, ncol=3)
-    gps = "all flight" if o["gps_resetting"] else f"until {o['calibration_s']:g} s"
-    axes[0].set_title(f"IR calibration: drift {'on' if o['drift'] else 'off'}, faults {o['faults']}, "
-                      f"gating {'on' if o['gating'] else 'off'}, GPS {gps}")
+    axes[0].set_title("a and b: the three estimators against the truth (axes centred on the truth)", fontsize=8)
+    fig.suptitle(title, fontsize=9)
     return save_figure(fig, out, "calibration.png")
 
 
-def _innovations_figure(result, o, windows, out):
+def _innovations_figure(result, o, windows, out, title):
     """The Kalman filter's innovations with their gates: GPS, paired IR, present IR."""
     import matplotlib.pyplot as plt
 
@@ -330,12 +355,14 @@ def _innovations_figure(result, o, windows, out):
         _shade(ax, windows)
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize=8, ncol=4)
-    axes[0].set_title("Kalman innovations: GPS and paired IR (fused when inside the gate), present IR (checked)")
+    axes[0].set_title("Kalman innovations: GPS and paired IR (fused when inside the gate), present IR (checked)",
+                      fontsize=8)
     axes[2].set_xlabel("time (s)")
+    fig.suptitle(title, fontsize=9)
     return save_figure(fig, out, "innovations.png")
 
 
-def _errors_figure(t, truth, estimates, stats, out):
+def _errors_figure(t, truth, estimates, stats, out, title):
     """Histograms of the turn-rate error of each method."""
     import matplotlib.pyplot as plt
 
@@ -351,6 +378,8 @@ def _errors_figure(t, truth, estimates, stats, out):
     ax.set_ylabel("samples")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
+    ax.set_title("turn-rate error of each estimator, after the first 2 s", fontsize=8)
+    fig.suptitle(title, fontsize=9)
     return save_figure(fig, out, "errors.png")
 
 

@@ -32,6 +32,7 @@ from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_d
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
+from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
 PAPER_TABLE1 = {"none": {"set1": 11.142, "set2": 10.623, "free": 55.853},
@@ -270,6 +271,27 @@ def table1(cals: dict, rig1: RigSet, rig2: RigSet, rate: float) -> dict:
     return {"table": table, "whole": whole, "dynamic_free": dynamic_free, "series": series}
 
 
+PAPER = ("Metge et al., \"Compensation dynamique des perturbations magnétiques pour l'estimation "
+         "d'attitude d'un micro-drone\", 2013")
+
+
+def run_line(o: dict) -> str:
+    """The calibration runs in words, for the figures' titles.
+
+    Parameters
+    ----------
+    o : dict
+        The scenario's options.
+
+    Returns
+    -------
+    str
+    """
+    return (f"K = {o['levels']} command levels of {o['hold']:g} s per motor, free set {o['free']:g} s, "
+            f"magnetometer {o['mag_rate']:g} Hz, IMU noise {'on' if o['noise'] else 'off'}, battery states "
+            f"{o['soc1']} (set 1) and {o['soc2']} (set 2)")
+
+
 def figure3(first: RigRun, numbers: dict, o: dict, out):
     """The paper's Figure 3: angular error against time on the free set, before and after
     compensation, above the four commands. ``first``: the first run of set 1; ``numbers``: as
@@ -289,8 +311,8 @@ def figure3(first: RigRun, numbers: dict, o: dict, out):
     axes[0].set_yscale("log")
     axes[0].legend(fontsize=8)
     axes[0].grid(True, alpha=0.3, which="both")
-    axes[0].set_title("Free set, drone clamped: field error before and after compensation (cf. Metge et al., Fig. 3)",
-                      fontsize=10)
+    fig.suptitle(title_lines("metge: free set, drone clamped: angular error of the measured field before and after "
+                             "compensation, as in Fig. 3 of " + PAPER, run_line(o)), fontsize=9)
     for n in range(4):
         axes[1].plot(t, first.commands[rows, n], lw=0.8, label=f"c{n + 1}")
     axes[1].set_ylabel("ESC command (1)")
@@ -301,13 +323,14 @@ def figure3(first: RigRun, numbers: dict, o: dict, out):
     return save_figure(fig, out, "figure3_free_set.png")
 
 
-def table1_figure(numbers: dict, orders, out):
+def table1_figure(numbers: dict, orders, o: dict, out):
     """Table 1 as a figure, each cell beside the paper's value; ``numbers`` as :func:`table1`
-    returns, ``orders`` the model's ``(I, J)``, ``out`` the folder of the figure (None: no file)."""
+    returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's options (named in the
+    title), ``out`` the folder of the figure (None: no file)."""
     import matplotlib.pyplot as plt
 
     table, dynamic = numbers["table"], numbers["dynamic_free"]
-    fig, ax = plt.subplots(figsize=(9, 2.2))
+    fig, ax = plt.subplots(figsize=(9, 2.6))
     ax.axis("off")
     cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")]
              for r in ("none", "calibration1", "calibration2")]
@@ -315,7 +338,8 @@ def table1_figure(numbers: dict, orders, out):
     ax.table(cellText=cells, rowLabels=["no dynamic calibration", "calibration 1", "calibration 2",
                                         "motor dynamics (cal. 1 / 2)"],
              colLabels=["set 1", "set 2", "free set"], loc="center")
-    ax.set_title(f"Mean angular error (deg), simulated (paper), orders I = {orders[0]}, J = {orders[1]}")
+    fig.suptitle(title_lines(f"metge: mean angular error (deg), simulated (paper's value), Table 1 of {PAPER}",
+                             f"orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}", width=100), fontsize=9)
     return save_figure(fig, out, "table1.png")
 
 
@@ -343,7 +367,7 @@ def report(result, o, out) -> dict:
     ed_free = numbers["series"]["calibration1_dynamic"][first.free]
     true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
     true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
-    figures = [figure3(first, numbers, o, out), table1_figure(numbers, orders, out)]
+    figures = [figure3(first, numbers, o, out), table1_figure(numbers, orders, o, out)]
     return {
         "table1_deg": table,
         "free_set_dynamic_deg": dynamic_free["calibration1"],

@@ -16,6 +16,7 @@ from calibration import Calibration, fit_static
 from fmus import vehicle
 from orchestrator import FMUBlock, System, Table
 from scenarios import Option, Scenario
+from scenarios.figures import title_lines
 from scenarios.plant import angle_between, imu_parameters, save_figure
 
 SOFT_IRON = ((1.06, 0.04, -0.03), (0.04, 0.95, 0.05), (-0.03, 0.05, 1.02))  # 1, symmetric
@@ -138,6 +139,11 @@ def report(result, o, out) -> dict:
     ax2.grid(True, alpha=0.3)
     ax2.legend(fontsize=8)
     ax2.set_title("level yaw turn, noise-free readings", fontsize=10)
+    fig.suptitle(title_lines(f"static-cal: hand-held rotation sweep, {o['duration']:g} s at ({o['rates']}) rev/s "
+                             "about x, y, z, motors off",
+                             f"magnetometer {o['mag_rate']:g} Hz, IMU noise {'on' if o['noise'] else 'off'}, "
+                             + ("soft and hard iron on" if o["iron"] else "no soft or hard iron")
+                             + f"; fitted to |m| = {vehicle.EARTH_FIELD_NORM * 1e6:.1f} µT"), fontsize=9)
     figure = save_figure(fig, out, "static_calibration.png")
     truth = result["IMU.magneto"]  # the angle of every corrected reading to the true body field
     t, R = attitude(o)

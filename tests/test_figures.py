@@ -111,10 +111,11 @@ def test_open_loop_and_rig_figures_name_the_run(monkeypatch, name, options, file
 
 
 def test_result_plot_labels_the_unit(tmp_path):
-    result = Result(np.arange(3.0), ["IMU.acc_x", "IMU.acc_y", "Setpoint.c1"], np.ones((3, 3)),
-                    {"units": {"IMU.acc_x": "m/s2", "IMU.acc_y": "m/s2", "Setpoint.c1": ""}})
+    result = Result(np.arange(3.0), ["IMU.acc_x", "IMU.acc_y", "Setpoint.c1", "Probe.y"], np.ones((3, 4)),
+                    {"units": {"IMU.acc_x": "m/s2", "IMU.acc_y": "m/s2", "Setpoint.c1": "1", "Probe.y": ""}})
     assert result.plot("IMU.acc").get_ylabel() == "IMU.acc (m/s2)"
     assert result.plot("Setpoint.c").get_ylabel() == "Setpoint.c (1)"
+    assert result.plot("Probe.y").get_ylabel() == "Probe.y (unit unknown)"
     assert result.plot("IMU.acc_x", "Setpoint.c1").get_ylabel() == "IMU.acc_x (m/s2), Setpoint.c1 (1)"
     assert result.plot("IMU.acc", scale=100.0, unit="cm/s2").get_ylabel() == "IMU.acc (cm/s2)"
     with pytest.raises(ValueError, match="give the unit of the scaled values"):
@@ -175,3 +176,23 @@ def test_fold_names_vectors_and_renamed_components():
     assert fold([f"omega_r{n}" for n in range(1, 5)]) == "omega_r[1-4]"
     assert fold([f"q_est{n}→q{n}" for n in range(4)]) == "q_est[0-3]→q[0-3]"
     assert fold(["u_batt"]) == "u_batt"
+
+
+def test_sweep_plot_axes_carry_units(tmp_path):
+    """The metric's unit from the end of its name, the option's from its help; the title names
+    the sweep and what it held fixed (from sweep.json)."""
+    import json
+
+    from scenarios.sweep import figure
+    from scenarios.sweep.command import _plot_context
+
+    assert figure.metric_unit("rms_error_deg[0]") == "deg" and figure.metric_unit("bias_convergence_s") == "s"
+    assert figure.metric_unit("real_time_factor") == ""
+    (tmp_path / "sweep.json").write_text(json.dumps({"scenario": "tp", "name": None, "varied": ["k"],
+                                                     "description": {"set": ["duration=3"]}, "members": []}))
+    units, subtitle = _plot_context(tmp_path)
+    assert units["k"] == "1/s" and units["duration"] == "s" and subtitle == "tp sweep; duration=3"
+    columns = {"status": ["ok"] * 3, "k": [0.05, 0.2, 1.0], "rms_error_deg[0]": [0.04, 0.01, 0.1]}
+    ax = figure.plot(columns, "rms_error_deg[0]", "k", units=units, subtitle=subtitle).axes[0]
+    assert ax.get_xlabel() == "k (1/s)" and ax.get_ylabel() == "rms_error_deg[0] (deg)"
+    assert ax.get_title().endswith("tp sweep; duration=3")

@@ -108,6 +108,22 @@ def sweep(args) -> int:
     return summary.exit_code()
 
 
+def _plot_context(folder: Path) -> tuple[dict, str]:
+    """Units of the swept scenario's options (from their help) and a line naming the scenario
+    and the options held fixed, from the sweep's ``sweep.json`` (nothing without one)."""
+    import scenarios
+    from scenarios.sweep.figure import option_unit
+
+    try:
+        stored = json.loads((folder / "sweep.json").read_text())
+        scenario = scenarios.get(stored["scenario"])
+    except (OSError, ValueError, KeyError):
+        return {}, ""
+    units = {key: option_unit(option.help) for key, option in scenario.options.items()}
+    fixed = stored.get("description", {}).get("set") or []
+    return units, f"{stored.get('name') or stored['scenario']} sweep" + (f"; {', '.join(fixed)}" if fixed else "")
+
+
 def sweep_plot(args) -> int:
     """Run ``quadcosim sweep-plot`` from parsed arguments ``args``; print the figure's path.
 
@@ -123,8 +139,9 @@ def sweep_plot(args) -> int:
         source = Path(args.table)
         folder = source if source.is_dir() else source.parent
         safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in f"{args.metric}-vs-{args.x}")
+        units, subtitle = _plot_context(folder)
         path = figure.plot(columns, args.metric, args.x, by=args.by, logy=args.logy,
-                           out=args.out or folder / f"{safe}.png")
+                           out=args.out or folder / f"{safe}.png", units=units, subtitle=subtitle)
     except FileNotFoundError as error:
         print(f"quadcosim sweep-plot: no sweep table at {error.filename}: give a sweep folder (--out of "
               "quadcosim sweep) or its sweep.parquet / sweep.csv", file=sys.stderr)

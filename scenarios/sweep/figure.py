@@ -8,6 +8,7 @@ faint point. Failed members are left out and counted in the title.
 from __future__ import annotations
 
 import math
+import re
 from collections import defaultdict
 from pathlib import Path
 
@@ -24,8 +25,51 @@ def _number(value) -> float | None:
     return number if math.isfinite(number) else None
 
 
+# unit of a metric, from the end of its name (``rms_error_deg[0]``, ``bias_convergence_s``)
+_SUFFIX_UNITS = (("_deg_s", "deg/s"), ("_rad_s", "rad/s"), ("_rad2", "rad²"), ("_deg", "deg"), ("_rad", "rad"),
+                 ("_uT", "µT"), ("_m", "m"), ("_s", "s"), ("_A", "A"), ("_T", "T"))
+
+
+def metric_unit(name: str) -> str:
+    """The unit a metric's name ends with (``rms_error_deg[0]`` -> ``deg``); empty if none.
+
+    Parameters
+    ----------
+    name : str
+        A metric column of a sweep table.
+
+    Returns
+    -------
+    str
+        The unit, or ``""``.
+    """
+    stem = name.split("[", 1)[0]
+    return next((unit for suffix, unit in _SUFFIX_UNITS if stem.endswith(suffix)), "")
+
+
+def option_unit(help_text: str) -> str:
+    """The unit an option's help ends with, in parentheses (``"... gain (1/s)"`` -> ``1/s``).
+
+    Parameters
+    ----------
+    help_text : str
+        An option's help.
+
+    Returns
+    -------
+    str
+        The unit, or ``""``.
+    """
+    match = re.search(r"\(([^()]*)\)\s*$", help_text)
+    return match.group(1) if match and len(match.group(1)) <= 12 else ""
+
+
+def _labelled(name: str, unit: str) -> str:
+    return f"{name} ({unit})" if unit else name
+
+
 def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, out=None, logy: bool = False,
-         ax=None):
+         ax=None, units: dict | None = None, subtitle: str = ""):
     """Draw ``metric`` against option ``x``, grouped by option ``by``.
 
     Parameters
@@ -42,6 +86,11 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
         and spans more than a decade.
     ax : matplotlib Axes, optional
         Draw into it instead of a new figure.
+    units : dict, optional
+        Unit of a column by name (the options'); a metric's unit is read from the end of its
+        name (:func:`metric_unit`) unless given here.
+    subtitle : str
+        A second line of the title (e.g. the scenario and the options held fixed).
 
     Returns
     -------
@@ -64,12 +113,13 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
         ax.set_yscale("log")
     if categories:
         ax.set_xticks(range(len(categories)), categories)
-    ax.set_xlabel(x)
-    ax.set_ylabel(metric)
+    units = units or {}
+    ax.set_xlabel(_labelled(x, units.get(x, "")))
+    ax.set_ylabel(_labelled(metric, units.get(metric) or metric_unit(metric)))
     title = f"{metric} against {x}" + (f", by {by}" if by else "")
     if failed:
         title += f" ({failed} failed member{'s' * (failed > 1)} not shown)"
-    ax.set_title(title)
+    ax.set_title(title + (f"\n{subtitle}" if subtitle else ""), fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     if out is None:
