@@ -228,6 +228,7 @@ class MagCompensator(Block):
     """
 
     outputs = ("magneto_x", "magneto_y", "magneto_z")
+    units = dict.fromkeys(outputs, "T")
 
     def __init__(self, calibration, mode: str = "metge", sample_rate: float = 0.0, name: str = "MagCompensator",
                  period: int = 1):

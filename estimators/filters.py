@@ -99,6 +99,8 @@ OUTPUT_NAMES = tuple(name for name, _ in core.OUTPUT_LAYOUT)
 OUTPUTS = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "theta_est3",
            "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z",
            "acc_weight", "mag_weight", "at_rest")
+UNITS = {name: "1" if name.startswith("q_est") or name in ("acc_weight", "mag_weight", "at_rest")
+         else "rad" if name.startswith("theta_est") else "rad/s" for name in OUTPUTS}  # as the variable tables
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")
 R_REEL = tuple(f"R_reel_{i}{j}" for i in range(1, 4) for j in range(1, 4))
 assert len(OUTPUTS) == core.OUTPUT_SIZE and len(MEASUREMENTS) + len(R_REEL) == core.INPUT_SIZE
@@ -306,6 +308,7 @@ class QuaternionEstim(Block):
     """
 
     outputs = OUTPUTS
+    units = UNITS
 
     def __init__(self, kind: str = "explicit", gains: dict | None = None, *, name: str = "Quaternion_estim",
                  period: int = 1, q0=None, b0=(0.0, 0.0, 0.0), initial=None, corrections=None,

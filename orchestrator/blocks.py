@@ -130,13 +130,17 @@ class Table(Block):
         Runs every ``period`` macro steps.
     chunk : int
         Rows evaluated at once from a callable.
+    units : dict, optional
+        Unit of each output by name, as the variable tables write them (``"rad"``, ``"1"``);
+        they label the results and plots.
     """
 
     feedthrough = False
 
-    def __init__(self, name: str, outputs, values, period: int = 1, chunk: int = 4096):
+    def __init__(self, name: str, outputs, values, period: int = 1, chunk: int = 4096, units: dict | None = None):
         super().__init__(name, period)
         self.outputs = tuple(outputs)
+        self.units = dict(units or {})
         self.function = values if callable(values) else None
         self.chunk = int(chunk)
         if self.function is None:

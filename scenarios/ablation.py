@@ -42,6 +42,7 @@ class GravityOnly(Block):
 
     inputs = ("q0", "q1", "q2", "q3")
     outputs = ("f_x", "f_y", "f_z")
+    units = dict.fromkeys(outputs, "m/s2")
 
     def __init__(self, name: str = "GravityOnly", g: float = vehicle.GRAVITY):
         super().__init__(name)

@@ -192,7 +192,7 @@ def build(o: dict) -> System:
     samples = int(round(o["duration"] * RATE))
     system = System(dt=1.0 / RATE)
     # the profile of samples rows (the last is held), the same as simulate_flight flies
-    system.add(Table("Bank", ["phi"], bank_profile(samples, o["seed"])[:, None]))
+    system.add(Table("Bank", ["phi"], bank_profile(samples, o["seed"])[:, None], units={"phi": "rad"}))
     system.add(FMUBlock("InfraredSensor", parameters=sensor_parameters(o["seed"], o["drift"], o["noise"])))
     system.add(SensorFaults("Faults", fault_windows(o["faults"])))
     system.connect("Bank.phi", "InfraredSensor.phi")

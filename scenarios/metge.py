@@ -127,7 +127,7 @@ def system_for(o: dict, set_number: int, run: int) -> System:
     """Run ``run`` of calibration set ``set_number``; the first run of set 1 ends with the free set."""
     c, _, _ = commands(o, set_number, free=(set_number, run) == (1, 0))
     system = System(dt=o["dt"])
-    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], c))
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], c, units=dict.fromkeys(("c1", "c2", "c3", "c4"), "1")))
     seed = o[f"seed{set_number}"] + 10 * run
     add_plant(system, quadrotor={"clamped": True}, motors={"soc0": socs(o, set_number)[run]},
               imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"],

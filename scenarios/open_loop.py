@@ -66,7 +66,8 @@ def build(o: dict) -> System:
         Blocks ``Setpoint``, ``MotorMagnetics``, ``Quadrotor`` and ``IMU``.
     """
     system = System(dt=o["dt"])
-    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], partial(commands_at, pulse=o["pulse"])))
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], partial(commands_at, pulse=o["pulse"]),
+                     units=dict.fromkeys(("c1", "c2", "c3", "c4"), "1")))
     add_plant(system, imu=imu_parameters(o["noise"], o["bias"], o["seed"]), magnetic=o["magnetic"])
     system.connect("Setpoint.c", "MotorMagnetics.c")
     return system

@@ -107,7 +107,8 @@ def build(o: dict) -> System:
         Blocks ``Setpoint``, ``MotorMagnetics``, ``Quadrotor`` (clamped) and ``IMU``.
     """
     system = System(dt=o["dt"])
-    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], commands(o)))
+    system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], commands(o),
+                     units=dict.fromkeys(("c1", "c2", "c3", "c4"), "1")))
     add_plant(system, quadrotor={"clamped": True, "theta1_0": o["roll"], "theta2_0": o["pitch"],
                                  "theta3_0": o["yaw"]},
               imu=imu_parameters(o["noise"], False, o["seed"]))

@@ -86,7 +86,8 @@ def build(o: dict) -> System:
         raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     system = System(dt=o["dt"])
     names = ["q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "f_x", "f_y", "f_z"]
-    system.add(Table("Hand", names, np.column_stack([q, omega, force])))
+    system.add(Table("Hand", names, np.column_stack([q, omega, force]),
+                     units={name: "1" if name[0] == "q" else "rad/s" if name[0] == "o" else "m/s2" for name in names}))
     parameters = imu_parameters(o["noise"], False, o["seed"], sample_rate=o["mag_rate"],
                                 mag_sample_rate=o["mag_rate"])
     parameters |= {f"A_{i + 1}{j + 1}": A[i, j] for i in range(3) for j in range(3)}

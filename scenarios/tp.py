@@ -21,6 +21,7 @@ from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
 from scenarios.figures import fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
+from scenarios.flight.controller import SETPOINT_UNITS
 from scenarios.metge import add_compensator
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
@@ -114,7 +115,7 @@ def build(o: dict) -> System:
         raise ValueError(f"imu_rate = {o['imu_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     system = System(dt=o["dt"])
     setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
-    system.add(Table("Setpoint", SETPOINT, setpoint))
+    system.add(Table("Setpoint", SETPOINT, setpoint, units=SETPOINT_UNITS))
     if o["accelerometer"] == "gravity":
         system.add(GravityOnly())
     start = initial_state(o["flight"])  # the estimator starts from the vehicle's initial attitude

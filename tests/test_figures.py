@@ -196,3 +196,20 @@ def test_sweep_plot_axes_carry_units(tmp_path):
     ax = figure.plot(columns, "rms_error_deg[0]", "k", units=units, subtitle=subtitle).axes[0]
     assert ax.get_xlabel() == "k (1/s)" and ax.get_ylabel() == "rms_error_deg[0] (deg)"
     assert ax.get_title().endswith("tp sweep; duration=3")
+
+
+@pytest.mark.parametrize("name, options", [("tp", {"accelerometer": "gravity"}), ("rig", {}), ("open-loop", {}),
+                                           ("static-cal", {}), ("ir-calibration", {})])
+def test_every_python_block_states_the_unit_of_each_output(name, options):
+    """The Python blocks of the scenarios (setpoint tables, controller, estimator, ablations)
+    give a unit to every output, as the FMUs' variable tables do: plots and result files
+    label them."""
+    from orchestrator import Constant, FMUBlock
+
+    scenario = scenarios.get(name)
+    system = scenario.build(scenario.parse(options))
+    for block in system.blocks.values():
+        if isinstance(block, (FMUBlock, Constant)) or block.name in ("Kalman", "Regression", "Rls", "Faults"):
+            continue
+        assert set(getattr(block, "units", {})) == set(block.outputs), block.name
+        assert all(getattr(block, "units")[output] for output in block.outputs), block.name

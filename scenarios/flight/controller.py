@@ -51,6 +51,11 @@ SETPOINT = ("theta_d1", "theta_d2", "theta_d3", "x_d", "y_d", "z_d", "hold")
 INPUTS = SETPOINT + ("q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "p_x", "p_y", "p_z",
                      "v_x", "v_y", "v_z", "u_batt")
 OUTPUTS = ("c1", "c2", "c3", "c4", "thrust", "tau_x", "tau_y", "tau_z", "theta_d1", "theta_d2")
+#: Units of the outputs and of the setpoint, as the variable tables write them.
+UNITS = {"c1": "1", "c2": "1", "c3": "1", "c4": "1", "thrust": "N", "tau_x": "N.m", "tau_y": "N.m", "tau_z": "N.m",
+         "theta_d1": "rad", "theta_d2": "rad"}
+SETPOINT_UNITS = {"theta_d1": "rad", "theta_d2": "rad", "theta_d3": "rad", "x_d": "m", "y_d": "m", "z_d": "m",
+                  "hold": "1"}
 
 #: Gains: name -> (default, unit, meaning). Only these names are accepted.
 GAINS = {
@@ -206,6 +211,7 @@ class Controller(Block):
 
     inputs = INPUTS
     outputs = OUTPUTS
+    units = UNITS
 
     def __init__(self, name: str = "Controller", period: int = 1, gains: dict | None = None):
         super().__init__(name, period)
