@@ -147,9 +147,10 @@ class ChunkRunner:
         if len(compiled.inputs) < len(slots) or compiled.inputs.dtype != np.float64:
             raise ValueError(f"{block.name}: its compiled step's input buffer holds {len(compiled.inputs)} "
                              f"values for {len(slots)} inputs")
-        gather = _gathers(_runs(slots))
+        runs = _runs(slots)
+        gather = _gathers(runs)
         op = _Op(kind=OP_BLOCK, period=period, step=compiled.address, u=compiled.inputs.ctypes.data, y=y,
-                 data=compiled.data.ctypes.data, gather=ctypes.addressof(gather), gathers=len(_runs(slots)))
+                 data=compiled.data.ctypes.data, gather=ctypes.addressof(gather), gathers=len(runs))
         self.items.append(_Item(op, owner=block, keep=(compiled, gather)))
 
     def _python(self, period: int, run, owner):

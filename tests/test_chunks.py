@@ -125,6 +125,21 @@ def test_a_nan_made_by_a_compiled_block_inside_a_chunk_names_it_and_keeps_the_re
     assert len(errors[1].result) == 251 and errors[1].result["Ratio.y"][249] == 0.5
 
 
+def test_callable_tables_are_refilled_between_chunks_at_their_own_rate():
+    def build():
+        system = System()
+        system.add(Table("Slow", ["a"], lambda t: np.sin(7.0 * t)[:, None], period=3, chunk=50))
+        system.add(Table("Fast", ["b", "c"], lambda t: np.column_stack([t, np.cos(t)]), chunk=1000))
+        system.add(Ratio("Ratio"))
+        system.connect("Slow.a", "Ratio.a")
+        system.connect("Fast.c", "Ratio.b")
+        return system
+
+    step, chunk = both(build, 9.0, decimation=4)  # over two chunks of steps, many rows of tables
+    assert_identical(step, chunk)
+    assert chunk["Fast.b"][-1] == 9.0 and len(np.unique(chunk["Slow.a"])) > 700
+
+
 def test_an_unknown_master_is_refused():
     system = System()
     system.add(Table("Source", ["a"], [[1.0]]))
