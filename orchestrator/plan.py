@@ -26,7 +26,9 @@ Building a plan (:class:`Plan`), in order:
 
 Running (:meth:`Plan.run`), per macro step ``n`` at ``t_n``: the :class:`Phase` entries of
 phase A, due at ``n``, in order; the bus is recorded (every ``decimation`` steps) and checked for
-NaN and Inf; the phase B entries due at ``n``.
+NaN and Inf; the phase B entries due at ``n``. The same plan, read from :attr:`Plan.program`, is
+run either by the chunk runner (:class:`orchestrator.chunks.ChunkRunner`, compiled, the default)
+or one step at a time by :meth:`Plan._run_steps`.
 """
 
 from __future__ import annotations

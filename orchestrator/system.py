@@ -4,8 +4,11 @@ Signals live in one float64 vector, the bus. Each block's outputs occupy a conti
 slice of it. Before a run everything is resolved once: value references, the slices each
 FMU reads its inputs from (one ``fmi2SetReal`` per contiguous run, straight from the bus,
 no copy), the views each Python block reads and writes, faults, recording. The loop then
-makes only the FMI calls and the Python block steps, with no name look-up and no
-allocation per step.
+makes only the FMI calls and the block steps, with no name look-up and no allocation per
+step. It runs in C for whole chunks of steps (:mod:`orchestrator.chunks`: FMI calls, compiled
+block steps, tables, recording, checks), returning to Python per chunk, for blocks without a
+compiled form and for faults; ``run(..., master="step")`` runs it from Python one step at a
+time, with bit-identical results.
 
 Per macro step ``n`` (time ``t_n``), in dependency order:
 1. every block due at ``n`` produces its outputs at ``t_n`` (FMU: set inputs, get outputs;
