@@ -212,4 +212,4 @@ def test_every_python_block_states_the_unit_of_each_output(name, options):
         if isinstance(block, (FMUBlock, Constant)) or block.name in ("Kalman", "Regression", "Rls", "Faults"):
             continue
         assert set(getattr(block, "units", {})) == set(block.outputs), block.name
-        assert all(getattr(block, "units")[output] for output in block.outputs), block.name
+        assert all(block.units[output] for output in block.outputs), block.name
