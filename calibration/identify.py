@@ -22,7 +22,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from calibration.compensator import _compensate
 from calibration.static import CalibrationError
@@ -120,6 +119,8 @@ def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> Motor
         unit = _predicted(np.r_[start[:3], np.ones(len(v))], *data[0][:3], v, exponent, freewheel,
                           sample_rate)[data[0][4]]
         start[3:] = np.linalg.norm(data[0][3], axis=1).mean() / max(np.linalg.norm(unit, axis=1).mean(), 1e-30)
+        from scipy.optimize import least_squares  # imported where used: start-up
+
         result = least_squares(residual, np.clip(start, lower, upper), args=(exponent, freewheel), x_scale="jac",
                                max_nfev=evaluations, bounds=(lower, upper), ftol=1e-6, xtol=1e-6)
         return float(np.sqrt(np.mean(result.fun**2))) * scale, result.x, exponent, freewheel

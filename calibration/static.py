@@ -30,7 +30,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import least_squares
 
 
 class CalibrationError(ValueError):
@@ -222,6 +221,8 @@ def fit_static(samples, field_norm: float | None = None, bounds: Bounds | None =
 
     def residual(p):
         return np.linalg.norm((y - p[6:]) @ _sym(p[:6]), axis=1) - 1.0
+
+    from scipy.optimize import least_squares  # imported where used: start-up
 
     fit = least_squares(residual, start, method="lm", x_scale="jac")
     S = _sym(fit.x[:6])

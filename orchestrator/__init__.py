@@ -1,11 +1,18 @@
 """The co-simulation orchestrator: blocks, connections, a fixed-step master, results."""
 
-from orchestrator.blocks import Block, Constant, FMUBlock, Table
-from orchestrator.errors import AlgebraicLoopError, RunInterrupted, SimulationError
-from orchestrator.faults import Fault
-from orchestrator.fmu import FMUError, FMUInstance
-from orchestrator.result import Result
-from orchestrator.system import System
+import importlib
 
-__all__ = ["AlgebraicLoopError", "Block", "Constant", "FMUBlock", "FMUError", "FMUInstance", "Fault",
-           "Result", "RunInterrupted", "SimulationError", "System", "Table"]
+# Imported on first use, so that a command that needs one name (the command line's signal
+# handling, a scenario's option table) does not load fmpy and the master.
+_EXPORTS = {
+    "Block": "blocks", "Constant": "blocks", "FMUBlock": "blocks", "Table": "blocks",
+    "AlgebraicLoopError": "errors", "RunInterrupted": "errors", "SimulationError": "errors",
+    "Fault": "faults", "FMUError": "fmu", "FMUInstance": "fmu", "Result": "result", "System": "system",
+}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'orchestrator' has no attribute {name!r}")
+    return getattr(importlib.import_module(f"orchestrator.{_EXPORTS[name]}"), name)

@@ -13,9 +13,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from orchestrator.fmu import nearest
-
-_MODULES = ("open_loop", "rig", "tp", "gain_study", "static_cal", "metge", "ir_calibration")
+# scenario name -> module of scenarios declaring it: a look-up imports that module alone
+_MODULES = {"open-loop": "open_loop", "rig": "rig", "tp": "tp", "gain-study": "gain_study",
+            "static-cal": "static_cal", "metge": "metge", "ir-calibration": "ir_calibration"}
 
 
 @dataclass
@@ -106,6 +106,8 @@ class Scenario:
         pairs = settings.items() if isinstance(settings, dict) else [_split(s) for s in settings or []]
         for key, text in pairs:
             if key not in self.options:
+                from orchestrator.fmu import nearest
+
                 raise ValueError(f"unknown option {key!r} for scenario {self.name}.{nearest(key, self.options)} "
                                  f"Options: {', '.join(self.options)} (see `quadcosim list`).")
             values[key] = self.options[key].parse(key, text)
@@ -119,21 +121,43 @@ def _split(text: str) -> tuple[str, str]:
     return key.strip(), value.strip()
 
 
+def names() -> tuple[str, ...]:
+    """The scenarios' names, without importing any scenario module."""
+    return tuple(_MODULES)
+
+
 def registry() -> dict[str, Scenario]:
-    """Every scenario, by name. A module listed here that is missing is an error, not a gap."""
-    scenarios = {}
-    for module in _MODULES:
-        scenario = importlib.import_module(f"scenarios.{module}").SCENARIO
-        scenarios[scenario.name] = scenario
-    return scenarios
+    """Every scenario, by name (imports every scenario module; :func:`get` imports one)."""
+    return {name: get(name) for name in _MODULES}
 
 
 def get(name: str) -> Scenario:
-    """The scenario called ``name``; a :class:`KeyError` naming the nearest otherwise."""
-    scenarios = registry()
-    if name not in scenarios:
-        raise KeyError(f"unknown scenario {name!r}.{nearest(name, scenarios)} Scenarios: {', '.join(scenarios)}.")
-    return scenarios[name]
+    """The scenario called ``name``, importing its module only.
+
+    Parameters
+    ----------
+    name : str
+        Scenario name, e.g. ``"tp"`` (see :func:`names`).
+
+    Returns
+    -------
+    Scenario
+        The scenario's declaration.
+
+    Raises
+    ------
+    KeyError
+        Unknown name; the message names the nearest. A listed module that is missing, or
+        that declares another name, is an error, not a gap.
+    """
+    if name not in _MODULES:
+        from orchestrator.fmu import nearest
+
+        raise KeyError(f"unknown scenario {name!r}.{nearest(name, _MODULES)} Scenarios: {', '.join(_MODULES)}.")
+    scenario = importlib.import_module(f"scenarios.{_MODULES[name]}").SCENARIO
+    if scenario.name != name:
+        raise RuntimeError(f"scenarios.{_MODULES[name]} declares {scenario.name!r}, registered as {name!r}")
+    return scenario
 
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,

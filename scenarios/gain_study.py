@@ -27,7 +27,6 @@ from pathlib import Path
 
 import numpy as np
 
-from estimators import analysis, estimate
 from scenarios import Option, Scenario
 from scenarios.figures import fault_text, faults_of, title_lines
 from scenarios.plant import save_figure
@@ -123,6 +122,8 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
     """Roll and pitch error variances (rad^2, pooled) and their relative standard errors, of the
     linear filter run by the batch path at each of ``gains`` (1/s) on the stream of ``result``
     (the recorded hover), after ``o["burn_in"]``."""
+    from estimators import estimate
+
     dt = 1.0 / o["imu_rate"]
     truth = np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])
     start = int(round(o["burn_in"] / dt))
@@ -217,6 +218,8 @@ def report(result, o, out) -> dict:
         variances, failures and tracking RMS (deg), and the figures written.
     """
     import matplotlib.pyplot as plt
+
+    from estimators import analysis  # python-control: imported by the report only
 
     gains = grid(o)
     dt = 1.0 / o["imu_rate"]

@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import math
 
-from scipy.optimize import brentq
-
 from fmus import vehicle
 
 THRUST_ITERATIONS = 50  # fixed-point iterations of the vertical balance (they converge: drag << weight)
@@ -103,5 +101,7 @@ def wind_hover_tilt(wind_speed: float, mass: float = vehicle.MASS, thrust_coeff:
 
     if w == 0.0:
         return 0.0, mass * g
+    from scipy.optimize import brentq  # imported where used: start-up
+
     tilt = brentq(horizontal, 0.0, LARGEST_TRIM_TILT, xtol=1e-14)
     return tilt, thrust_of(tilt)

@@ -1,0 +1,107 @@
+"""Start-up time of the command line: wall time of ``quadcosim list``, ``quadcosim --help`` and others.
+
+Each command runs in a fresh interpreter (``python -m scenarios.cli ...``) ``repeats`` times;
+the median and the spread (min, max) of the wall times are printed, and the modules among
+:data:`HEAVY` that the command imported::
+
+    python -m benchmarks.startup                      # list and --help, 5 runs each
+    python -m benchmarks.startup --repeats 3 -- run tp --out /tmp/tp --overwrite
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+# packages a command should import only when it uses them
+HEAVY = ("control", "dask", "distributed", "matplotlib", "pyarrow", "scipy", "scipy.optimize", "scipy.io",
+         "numba", "fmpy", "vqf", "ahrs", "calibration", "estimators.analysis")
+
+_REPORT = ("import atexit, os, sys, json\n"
+           "def _report():\n"
+           "    with open(os.environ['QUADCOSIM_IMPORTED'], 'w') as f:\n"
+           "        json.dump(sorted(m for m in sys.modules), f)\n"
+           "atexit.register(_report)\n"
+           "from scenarios.cli import main\n"
+           "sys.argv[0] = 'quadcosim'\n"
+           "sys.exit(main())\n")
+
+
+def imported_modules(args: list[str], env: dict | None = None) -> set[str]:
+    """Names in ``sys.modules`` at the exit of ``quadcosim ARGS`` run in a fresh interpreter.
+
+    Parameters
+    ----------
+    args : list of str
+        Arguments after ``quadcosim``, e.g. ``["list"]``.
+    env : dict, optional
+        Environment of the subprocess (default: this process's).
+
+    Returns
+    -------
+    set of str
+        Module names imported by the command (including the interpreter's own).
+    """
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "modules.json")
+        subprocess.run([sys.executable, "-c", _REPORT, *args], check=True, capture_output=True,
+                       env=(env or os.environ) | {"QUADCOSIM_IMPORTED": path})
+        with open(path) as f:
+            return set(json.load(f))
+
+
+def wall_times(args: list[str], repeats: int) -> list[float]:
+    """Wall times (s) of ``repeats`` runs of ``quadcosim ARGS``, each in a fresh interpreter.
+
+    Parameters
+    ----------
+    args : list of str
+        Arguments after ``quadcosim``.
+    repeats : int
+        Number of runs.
+
+    Returns
+    -------
+    list of float
+        One wall time per run, s.
+    """
+    times = []
+    for _ in range(repeats):
+        started = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "scenarios.cli", *args], check=True, stdout=subprocess.DEVNULL)
+        times.append(time.perf_counter() - started)
+    return times
+
+
+def main(argv=None) -> int:
+    """Print the median wall time and the heavy imports of each command; returns 0."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.startup", description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5, help="runs per command")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("command", nargs="*", help="one quadcosim command (default: list, then --help)")
+    args = parser.parse_args(argv)
+    commands = [args.command] if args.command else [["list"], ["--help"]]
+    figures = {}
+    for command in commands:
+        times = wall_times(command, args.repeats)
+        heavy = sorted(m for m in HEAVY if m in imported_modules(command))
+        figures[" ".join(command)] = {"median_s": statistics.median(times), "min_s": min(times),
+                                      "max_s": max(times), "heavy_imports": heavy}
+    if args.json:
+        print(json.dumps(figures))
+    else:
+        for command, f in figures.items():
+            print(f"quadcosim {command}: median {f['median_s']:.2f} s (min {f['min_s']:.2f}, max {f['max_s']:.2f}, "
+                  f"{args.repeats} runs); heavy imports: {', '.join(f['heavy_imports']) or 'none'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,30 @@
+"""Start-up: the command line imports heavy packages only where it uses them (not a timed test)."""
+
+import ast
+import subprocess
+import sys
+
+import pytest
+
+import scenarios
+from benchmarks.startup import imported_modules
+
+NOT_FOR_LISTING = ("control", "dask", "distributed", "matplotlib", "pyarrow", "scipy.optimize", "scipy.signal")
+
+
+@pytest.mark.parametrize("command", [["list"], ["--help"]])
+def test_listing_and_help_import_no_heavy_package(command):
+    imported = imported_modules(command)
+    if command == ["list"]:
+        assert "scenarios.gain_study" in imported  # the hook saw the options of every scenario
+    assert [m for m in NOT_FOR_LISTING if m in imported] == []
+
+
+def test_a_scenario_look_up_imports_that_scenario_alone():
+    code = ("import sys, scenarios; scenarios.get('open-loop'); "
+            "print(sorted(m for m in sys.modules if m.startswith('scenarios.')))")
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout
+    assert ast.literal_eval(out) == ["scenarios.open_loop", "scenarios.plant"]
+    assert scenarios.names() == tuple(scenarios.registry())
+    with pytest.raises(KeyError, match="Did you mean tp"):
+        scenarios.get("tpp")
