@@ -2,8 +2,13 @@
 
 - ``rtf_closed_loop``: real-time factor of the ``tp`` scenario at 1 kHz (three FMUs, the
   estimator, the controller), stepping loop only;
-- ``batch_updates_per_s``: filter updates per second of the batch path (explicit filter,
-  256 gain sets evaluated in one call);
+- the batch path of the explicit filter (``estimators.estimate``, 256 gain sets in one call,
+  attitude kept) against its C reference (``benchmarks/c/batch_explicit.c``, the same update
+  operation for operation, compiled by ``quadcosim build``), both single-threaded, for the
+  exponential map and the Euler step: ``batch_updates_per_s``, ``batch_c_updates_per_s``,
+  ``batch_over_c`` (numba time / C time, exponential map), ``batch_over_c_euler``, and
+  ``batch_identical_to_c`` (the two give the same attitude to the last bit, checked in the run);
+- ``parallel_batch_updates_per_s``: the batch path on every core (``parallel_threads``);
 - ``ahrs_samples_per_s``: samples per second of the ``ahrs`` package's Mahony filter
   (``updateIMU``) on the same data, measured in the same run, for the ratio.
 """
@@ -36,20 +41,122 @@ def _data(samples: int):
     return acc, gyro, mag
 
 
-def batch_updates_per_s(gain_sets: int = 256, samples: int = 4000, repeats: int = 3) -> float:
-    """Filter updates per second of the explicit filter's batch path over ``gain_sets`` gain
-    sets and ``samples`` samples, best of ``repeats``."""
-    from estimators import estimate
+# slot numbers the C reference uses, in the order of its batch_explicit_slots()
+_C_SLOTS = ("ACC", "GYRO", "MAG", "INPUT_SIZE", "GRAVITY", "FIELD", "DISCRETE", "K1", "K2", "KP", "KI", "HEADING_ONLY",
+            "ACC_TOL", "MAG_NORM_TOL", "MAG_DIP_TOL", "REST_GYRO", "REST_ACC", "REST_MIN_TIME", "REST_GAIN",
+            "GAIN_SIZE", "EULER")
+
+
+def _batch_case(gain_sets: int, samples: int, discretisation: str) -> dict:
+    """The arrays of one batch run: the explicit filter's defaults (every correction on), kI = 0.1 (1/s^2)
+    and k1 from 0.01 to 10 over the gain sets."""
+    from estimators import core
+    from estimators.filters import check_measurements, config_vector, gain_table
 
     acc, gyro, mag = _data(samples)
+    config = config_vector(discretisation)
+    inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[core.GRAVITY:core.GRAVITY + 3])), True)
+    inputs = np.ascontiguousarray(np.column_stack([inputs, np.zeros((samples, 9))]))
     gains = {"k1": np.geomspace(0.01, 10, gain_sets), "kI": 0.1}
-    estimate("explicit", acc=acc[:10], gyro=gyro[:10], mag=mag[:10], dt=1e-3, gains=gains)  # compile
+    return {"acc": acc, "gyro": gyro, "mag": mag, "inputs": inputs, "gains": gains, "config": config,
+            "table": np.ascontiguousarray(gain_table("explicit", gains)), "discretisation": discretisation}
+
+
+def _numba_batch(case: dict) -> np.ndarray:
+    """The attitude (G, N, 4) of the batch path, through the public ``estimate``."""
+    from estimators import estimate
+
+    return estimate("explicit", acc=case["acc"], gyro=case["gyro"], mag=case["mag"], dt=1e-3, gains=case["gains"],
+                    discretisation=case["discretisation"], outputs=("q",))["q"]
+
+
+def _c_batch(case: dict) -> np.ndarray:
+    """The attitude (G, N, 4) of the C reference, after checking its slot numbers against
+    :mod:`estimators.core`'s layouts."""
+    import ctypes
+
+    from benchmarks import reference_library
+    from estimators import core
+
+    library = reference_library("batch_explicit")
+    slots = np.zeros(len(_C_SLOTS), dtype=np.int64)
+    library.batch_explicit_slots(slots.ctypes.data_as(ctypes.c_void_p))
+    expected = [getattr(core, name) for name in _C_SLOTS]
+    if slots.tolist() != expected:
+        raise RuntimeError(f"benchmarks/c/batch_explicit.c numbers its slots {slots.tolist()}, estimators.core "
+                           f"{expected} ({', '.join(_C_SLOTS)}): update the C reference")
+    table, inputs = case["table"], case["inputs"]
+    q = np.empty((len(table), len(inputs), 4))
+    pointer = ctypes.c_void_p
+    library.batch_explicit(ctypes.c_long(len(table)), ctypes.c_long(len(inputs)), pointer(inputs.ctypes.data),
+                           pointer(table.ctypes.data), pointer(case["config"].ctypes.data), ctypes.c_double(1e-3),
+                           pointer(np.array([1.0, 0.0, 0.0, 0.0]).ctypes.data), pointer(np.zeros(3).ctypes.data),
+                           pointer(q.ctypes.data))
+    return q
+
+
+def _best_time(run, case: dict, repeats: int, clock=time.process_time) -> tuple[float, np.ndarray]:
+    """Best time (s, of ``clock``: the process's CPU time by default) of ``repeats`` calls of
+    ``run(case)``, and its result."""
     best = np.inf
     for _ in range(repeats):
-        started = time.perf_counter()
-        estimate("explicit", acc=acc, gyro=gyro, mag=mag, dt=1e-3, gains=gains)
-        best = min(best, time.perf_counter() - started)
-    return gain_sets * samples / best
+        started = clock()
+        result = run(case)
+        best = min(best, clock() - started)
+    return best, result
+
+
+def batch_figures(gain_sets: int = 256, samples: int = 4000, repeats: int = 3) -> dict:
+    """The batch path against its C reference, single-threaded, and on every core.
+
+    Single-threaded figures are of the process's CPU time (the C reference and numba's one
+    thread both run on the calling thread), so that other jobs on the machine change them
+    little; the parallel figure is of wall time.
+
+    Parameters
+    ----------
+    gain_sets : int
+        Filters evaluated in one call (G).
+    samples : int
+        Samples per filter (N), at 1 kHz.
+    repeats : int
+        Timed calls of each, the best kept.
+
+    Returns
+    -------
+    dict
+        ``batch_updates_per_s`` (numba, one thread), ``batch_c_updates_per_s`` (C, one thread),
+        ``batch_over_c`` (numba time / C time, exponential map), ``batch_over_c_euler``,
+        ``batch_identical_to_c`` (same attitude to the last bit, both discretisations),
+        ``batch_max_difference_to_c`` (largest absolute difference of a quaternion component),
+        ``parallel_batch_updates_per_s`` and ``parallel_threads``; updates are filter steps
+        (samples x gain sets) per second.
+    """
+    import numba
+
+    threads = numba.get_num_threads()
+    updates = gain_sets * samples
+    figures, difference = {}, 0.0
+    for discretisation, suffix in (("exp", ""), ("euler", "_euler")):
+        case = _batch_case(gain_sets, samples, discretisation)
+        _numba_batch(_batch_case(2, 10, discretisation))  # compiled (or loaded from the cache) before timing
+        numba.set_num_threads(1)
+        try:
+            numba_time, q_numba = _best_time(_numba_batch, case, repeats)
+        finally:
+            numba.set_num_threads(threads)
+        c_time, q_c = _best_time(_c_batch, case, repeats)
+        difference = max(difference, float(np.max(np.abs(q_numba - q_c))))
+        figures[f"batch_over_c{suffix}"] = numba_time / c_time
+        if not suffix:
+            figures["batch_updates_per_s"] = updates / numba_time
+            figures["batch_c_updates_per_s"] = updates / c_time
+            wall = _best_time(_numba_batch, case, repeats, time.perf_counter)[0]
+            figures["parallel_batch_updates_per_s"] = updates / wall
+            figures["parallel_threads"] = threads
+    figures["batch_identical_to_c"] = difference == 0.0
+    figures["batch_max_difference_to_c"] = difference
+    return figures
 
 
 def ahrs_samples_per_s(samples: int = 4000) -> float:
@@ -67,7 +174,7 @@ def ahrs_samples_per_s(samples: int = 4000) -> float:
 
 def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
     """The estimator figures as a dict, runs of ``seconds`` simulated, best of ``repeats``."""
-    figures = {"rtf_closed_loop": rtf_closed_loop(seconds, repeats), "batch_updates_per_s": batch_updates_per_s()}
+    figures = {"rtf_closed_loop": rtf_closed_loop(seconds, repeats)} | batch_figures(repeats=repeats)
     try:
         figures["ahrs_samples_per_s"] = ahrs_samples_per_s()
         figures["batch_over_ahrs"] = figures["batch_updates_per_s"] / figures["ahrs_samples_per_s"]

@@ -20,6 +20,12 @@ Discretisation of the nonlinear filters, chosen by the configuration's ``discret
 - ``EULER`` (1): ``q <- q + dt 0.5 q (x) (0, Omega)``, then normalised (Mahony's and the
   ``ahrs`` package's form).
 In both the bias is updated first and the new bias is used in ``Omega``.
+
+Speed: ``update`` and the helpers of its explicit and passive steps are compiled inline
+(numba's ``inline="always"``) and work on scalars and tuples, not array views, so that the
+batch path's inner loop is straight code that allocates nothing. ``benchmarks/c/batch_explicit.c``
+is a C transcription of the explicit step; ``quadcosim bench`` checks that both give the
+same estimates to the last bit and prints their speed ratio.
 """
 
 from __future__ import annotations
@@ -100,19 +106,21 @@ def quaternion_multiply(p, q, out):
     out[3] = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _rotation(q0, q1, q2, q3):
+    """R(q) = I + 2 q0 S(qv) + 2 S(qv)^2, row-major, as a 9-tuple."""
+    return (1.0 - 2.0 * (q2 * q2 + q3 * q3), 2.0 * (q1 * q2 - q0 * q3), 2.0 * (q1 * q3 + q0 * q2),
+            2.0 * (q1 * q2 + q0 * q3), 1.0 - 2.0 * (q1 * q1 + q3 * q3), 2.0 * (q2 * q3 - q0 * q1),
+            2.0 * (q1 * q3 - q0 * q2), 2.0 * (q2 * q3 + q0 * q1), 1.0 - 2.0 * (q1 * q1 + q2 * q2))
+
+
 @njit(cache=True, error_model="numpy")
 def rotation(q, r):
     """r = R(q) = I + 2 q0 S(qv) + 2 S(qv)^2, row-major 3x3."""
-    q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
-    r[0, 0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3)
-    r[0, 1] = 2.0 * (q1 * q2 - q0 * q3)
-    r[0, 2] = 2.0 * (q1 * q3 + q0 * q2)
-    r[1, 0] = 2.0 * (q1 * q2 + q0 * q3)
-    r[1, 1] = 1.0 - 2.0 * (q1 * q1 + q3 * q3)
-    r[1, 2] = 2.0 * (q2 * q3 - q0 * q1)
-    r[2, 0] = 2.0 * (q1 * q3 - q0 * q2)
-    r[2, 1] = 2.0 * (q2 * q3 + q0 * q1)
-    r[2, 2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2)
+    m = _rotation(q[0], q[1], q[2], q[3])
+    for i in range(3):
+        for j in range(3):
+            r[i, j] = m[3 * i + j]
 
 
 @njit(cache=True, error_model="numpy")
@@ -137,14 +145,19 @@ def quaternion_from_rotation(r, q):
     _normalise(q)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _euler(q0, q1, q2, q3):
+    """Z-Y-X Euler angles (roll, pitch, yaw) of q, rad."""
+    roll = math.atan2(2.0 * (q2 * q3 + q0 * q1), 1.0 - 2.0 * (q1 * q1 + q2 * q2))
+    s = 2.0 * (q0 * q2 - q1 * q3)
+    pitch = math.asin(min(1.0, max(-1.0, s)))
+    return roll, pitch, math.atan2(2.0 * (q1 * q2 + q0 * q3), 1.0 - 2.0 * (q2 * q2 + q3 * q3))
+
+
 @njit(cache=True, error_model="numpy")
 def euler_from_quaternion(q, theta):
     """Z-Y-X Euler angles (roll, pitch, yaw) of q, rad."""
-    q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
-    theta[0] = math.atan2(2.0 * (q2 * q3 + q0 * q1), 1.0 - 2.0 * (q1 * q1 + q2 * q2))
-    s = 2.0 * (q0 * q2 - q1 * q3)
-    theta[1] = math.asin(min(1.0, max(-1.0, s)))
-    theta[2] = math.atan2(2.0 * (q1 * q2 + q0 * q3), 1.0 - 2.0 * (q2 * q2 + q3 * q3))
+    theta[0], theta[1], theta[2] = _euler(q[0], q[1], q[2], q[3])
 
 
 @njit(cache=True, error_model="numpy")
@@ -176,23 +189,25 @@ def _normalise(q):
         q[i] /= n
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
+def _norm(v0, v1, v2):
+    return math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _norm3(v):
-    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    return _norm(v[0], v[1], v[2])
 
 
-@njit(cache=True, error_model="numpy")
-def _integrate(q, wx, wy, wz, dt, discretisation):
-    """Advance q by the body rate (wx, wy, wz) over dt."""
+@njit(cache=True, error_model="numpy", inline="always")
+def _advance(q0, q1, q2, q3, wx, wy, wz, dt, discretisation):
+    """q advanced by the body rate (wx, wy, wz) over dt, then normalised, as a 4-tuple."""
     if discretisation == EULER:
-        d0 = 0.5 * (-q[1] * wx - q[2] * wy - q[3] * wz)
-        d1 = 0.5 * (q[0] * wx + q[2] * wz - q[3] * wy)
-        d2 = 0.5 * (q[0] * wy + q[3] * wx - q[1] * wz)
-        d3 = 0.5 * (q[0] * wz + q[1] * wy - q[2] * wx)
-        q[0] += dt * d0
-        q[1] += dt * d1
-        q[2] += dt * d2
-        q[3] += dt * d3
+        d0 = 0.5 * (-q1 * wx - q2 * wy - q3 * wz)
+        d1 = 0.5 * (q0 * wx + q2 * wz - q3 * wy)
+        d2 = 0.5 * (q0 * wy + q3 * wx - q1 * wz)
+        d3 = 0.5 * (q0 * wz + q1 * wy - q2 * wx)
+        p0, p1, p2, p3 = q0 + dt * d0, q1 + dt * d1, q2 + dt * d2, q3 + dt * d3
     else:
         angle = math.sqrt(wx * wx + wy * wy + wz * wz) * dt
         if angle > SMALL_ANGLE:
@@ -201,32 +216,51 @@ def _integrate(q, wx, wy, wz, dt, discretisation):
         else:
             s, c = 0.5 * dt, 1.0
         e1, e2, e3 = s * wx, s * wy, s * wz
-        q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
-        q[0] = q0 * c - q1 * e1 - q2 * e2 - q3 * e3
-        q[1] = q0 * e1 + q1 * c + q2 * e3 - q3 * e2
-        q[2] = q0 * e2 - q1 * e3 + q2 * c + q3 * e1
-        q[3] = q0 * e3 + q1 * e2 - q2 * e1 + q3 * c
-    _normalise(q)
+        p0 = q0 * c - q1 * e1 - q2 * e2 - q3 * e3
+        p1 = q0 * e1 + q1 * c + q2 * e3 - q3 * e2
+        p2 = q0 * e2 - q1 * e3 + q2 * c + q3 * e1
+        p3 = q0 * e3 + q1 * e2 - q2 * e1 + q3 * c
+    n = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
+    return p0 / n, p1 / n, p2 / n, p3 / n
+
+
+@njit(cache=True, error_model="numpy")
+def _integrate(q, wx, wy, wz, dt, discretisation):
+    """Advance q by the body rate (wx, wy, wz) over dt."""
+    q[0], q[1], q[2], q[3] = _advance(q[0], q[1], q[2], q[3], wx, wy, wz, dt, discretisation)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _direction(r, vx, vy, vz):
+    """R^T (vx, vy, vz) / |.| (``r`` row-major 9-tuple), an inertial direction seen in the body frame."""
+    o0 = r[0] * vx + r[3] * vy + r[6] * vz
+    o1 = r[1] * vx + r[4] * vy + r[7] * vz
+    o2 = r[2] * vx + r[5] * vy + r[8] * vz
+    n = _norm(o0, o1, o2)
+    return o0 / n, o1 / n, o2 / n
 
 
 @njit(cache=True, error_model="numpy")
 def _body(r, vx, vy, vz, out):
     """out = R^T (vx, vy, vz) / |.|, an inertial direction seen in the body frame."""
-    out[0] = r[0, 0] * vx + r[1, 0] * vy + r[2, 0] * vz
-    out[1] = r[0, 1] * vx + r[1, 1] * vy + r[2, 1] * vz
-    out[2] = r[0, 2] * vx + r[1, 2] * vy + r[2, 2] * vz
-    n = _norm3(out)
-    for i in range(3):
-        out[i] /= n
+    out[0], out[1], out[2] = _direction((r[0, 0], r[0, 1], r[0, 2], r[1, 0], r[1, 1], r[1, 2], r[2, 0], r[2, 1],
+                                         r[2, 2]), vx, vy, vz)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _cross(v, norm_v, vhat, gain):
+    """gain (v/|v|) x vhat (3-tuples), the correction of one reference direction (vhat unit)."""
+    scale = gain / norm_v
+    return (scale * (v[1] * vhat[2] - v[2] * vhat[1]), scale * (v[2] * vhat[0] - v[0] * vhat[2]),
+            scale * (v[0] * vhat[1] - v[1] * vhat[0]))
 
 
 @njit(cache=True, error_model="numpy")
 def _add_cross(v, norm_v, vhat, gain, w):
     """w += gain (v/|v|) x vhat, the correction of one reference direction (vhat unit)."""
-    scale = gain / norm_v
-    w[0] += scale * (v[1] * vhat[2] - v[2] * vhat[1])
-    w[1] += scale * (v[2] * vhat[0] - v[0] * vhat[2])
-    w[2] += scale * (v[0] * vhat[1] - v[1] * vhat[0])
+    c = _cross((v[0], v[1], v[2]), norm_v, (vhat[0], vhat[1], vhat[2]), gain)
+    for i in range(3):
+        w[i] += c[i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -271,7 +305,7 @@ def triad(acc, mag, config, r):
     return True
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _ramp(deviation, tolerance):
     """Weight 1 at no deviation, falling linearly to 0 at ``tolerance``; 1 when tolerance is 0 (off)."""
     if tolerance <= 0.0:
@@ -298,7 +332,7 @@ def _linear(x, u, gains, config, dt):
     quaternion_from_euler(theta, x[Q:Q + 4])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _rest(x, acc, gyro, gains, g, dt):
     """Rest detector on low-passed gyro and accelerometer; True once at rest for ``rest_time``."""
     alpha = dt / (REST_LOWPASS_TAU + dt)
@@ -311,21 +345,28 @@ def _rest(x, acc, gyro, gains, g, dt):
         x[ACC_LP + i] += alpha * (acc[i] - x[ACC_LP + i])
     if gains[REST_GYRO] <= 0.0:
         return False
-    still = (_norm3(x[GYRO_LP:GYRO_LP + 3]) < gains[REST_GYRO]
-             and abs(_norm3(x[ACC_LP:ACC_LP + 3]) - g) < gains[REST_ACC])
+    still = (_norm(x[GYRO_LP], x[GYRO_LP + 1], x[GYRO_LP + 2]) < gains[REST_GYRO]
+             and abs(_norm(x[ACC_LP], x[ACC_LP + 1], x[ACC_LP + 2]) - g) < gains[REST_ACC])
     x[REST_TIME] = x[REST_TIME] + dt if still else 0.0
     return x[REST_TIME] >= gains[REST_MIN_TIME]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _parts(w, vhat, tilt_weight, heading_weight):
+    """tilt_weight * (part of w normal to vhat) + heading_weight * (part along vhat), as a 3-tuple."""
+    along = w[0] * vhat[0] + w[1] * vhat[1] + w[2] * vhat[2]
+    return (tilt_weight * (w[0] - along * vhat[0]) + heading_weight * along * vhat[0],
+            tilt_weight * (w[1] - along * vhat[1]) + heading_weight * along * vhat[1],
+            tilt_weight * (w[2] - along * vhat[2]) + heading_weight * along * vhat[2])
 
 
 @njit(cache=True, error_model="numpy")
 def _split(w, vhat, tilt_weight, heading_weight):
     """w <- tilt_weight * (part of w normal to vhat) + heading_weight * (part along vhat)."""
-    along = w[0] * vhat[0] + w[1] * vhat[1] + w[2] * vhat[2]
-    for i in range(3):
-        w[i] = tilt_weight * (w[i] - along * vhat[i]) + heading_weight * along * vhat[i]
+    w[0], w[1], w[2] = _parts(w, vhat, tilt_weight, heading_weight)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _weights(acc, mag, gains, v_up, v_field, g, field):
     """Accelerometer and magnetometer weights (0..1) of the disturbance-aware corrections."""
     na, nm = _norm3(acc), _norm3(mag)
@@ -341,23 +382,20 @@ def _weights(acc, mag, gains, v_up, v_field, g, field):
     return acc_weight, mag_weight
 
 
-@njit(cache=True, error_model="numpy")
-def _explicit_correction(acc, mag, gains, acc_weight, mag_weight, work, w):
-    """w = sum k_i v_i x vhat_i, weighted; the magnetometer's part kept vertical when heading only."""
-    v_up, v_field = work[W_UP:W_UP + 3], work[W_FIELD:W_FIELD + 3]
+@njit(cache=True, error_model="numpy", inline="always")
+def _explicit_correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field):
+    """sum k_i v_i x vhat_i, weighted, as a 3-tuple; the magnetometer's part kept vertical when heading only."""
+    w0, w1, w2 = 0.0, 0.0, 0.0
     if acc_weight > 0.0:
-        _add_cross(acc, _norm3(acc), v_up, gains[K1] * acc_weight, w)
+        c = _cross(acc, _norm3(acc), v_up, gains[K1] * acc_weight)
+        w0, w1, w2 = w0 + c[0], w1 + c[1], w2 + c[2]
     if mag_weight > 0.0:
+        c = _cross(mag, _norm3(mag), v_field, gains[K2] * mag_weight)
         if gains[HEADING_ONLY] > 0.0:
             # the magnetometer's correction kept along the vertical: it turns the heading only
-            m = work[W_SCRATCH:W_SCRATCH + 3]
-            m[:] = 0.0
-            _add_cross(mag, _norm3(mag), v_field, gains[K2] * mag_weight, m)
-            _split(m, v_up, 0.0, 1.0)
-            for i in range(3):
-                w[i] += m[i]
-        else:
-            _add_cross(mag, _norm3(mag), v_field, gains[K2] * mag_weight, w)
+            c = _parts((0.0 + c[0], 0.0 + c[1], 0.0 + c[2]), v_up, 0.0, 1.0)
+        w0, w1, w2 = w0 + c[0], w1 + c[1], w2 + c[2]
+    return w0, w1, w2
 
 
 @njit(cache=True, error_model="numpy")
@@ -394,40 +432,56 @@ def _passive_correction(u, config, gains, acc_weight, mag_weight, r, work, w):
 
 
 @njit(cache=True, error_model="numpy")
-def _complementary(kind, x, u, gains, config, dt, work, flags):
-    """The explicit or passive filter's step; ``flags`` receives the weights and the rest flag."""
-    acc, gyro, mag = u[ACC:ACC + 3], u[GYRO:GYRO + 3], u[MAG:MAG + 3]
-    q, b = x[Q:Q + 4], x[B:B + 3]
-    r = work[W_R:W_R + 9].reshape((3, 3))
-    w = work[W_OMEGA:W_OMEGA + 3]
-    v_up, v_field = work[W_UP:W_UP + 3], work[W_FIELD:W_FIELD + 3]
-    rotation(q, r)
+def _passive(u, config, gains, acc_weight, mag_weight, r, v_up, work):
+    """The passive filter's correction (3-tuple), through the arrays of ``work``."""
+    rm, w = work[W_R:W_R + 9].reshape((3, 3)), work[W_OMEGA:W_OMEGA + 3]
+    for i in range(9):
+        rm[i // 3, i % 3] = r[i]
+    for i in range(3):
+        work[W_UP + i] = v_up[i]
+    w[:] = 0.0
+    _passive_correction(u, config, gains, acc_weight, mag_weight, rm, work, w)
+    return w[0], w[1], w[2]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _complementary(kind, x, u, gains, config, dt, work, y):
+    """The explicit or passive filter's step; writes the weights and the rest flag into ``y``.
+
+    Scalars and tuples throughout (no array views): this is the batch path's inner step."""
+    acc = (u[ACC], u[ACC + 1], u[ACC + 2])
+    gyro = (u[GYRO], u[GYRO + 1], u[GYRO + 2])
+    mag = (u[MAG], u[MAG + 1], u[MAG + 2])
+    r = _rotation(x[Q], x[Q + 1], x[Q + 2], x[Q + 3])
     gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
     mx, my, mz = config[FIELD], config[FIELD + 1], config[FIELD + 2]
     g = math.sqrt(gx * gx + gy * gy + gz * gz)
-    _body(r, -gx, -gy, -gz, v_up)  # estimated direction of the specific force at rest ("up")
-    _body(r, mx, my, mz, v_field)
+    v_up = _direction(r, -gx, -gy, -gz)  # estimated direction of the specific force at rest ("up")
+    v_field = _direction(r, mx, my, mz)
     acc_weight, mag_weight = _weights(acc, mag, gains, v_up, v_field, g, math.sqrt(mx * mx + my * my + mz * mz))
-    w[:] = 0.0
     if kind == EXPLICIT:
-        _explicit_correction(acc, mag, gains, acc_weight, mag_weight, work, w)
+        w = _explicit_correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field)
     else:
-        _passive_correction(u, config, gains, acc_weight, mag_weight, r, work, w)
+        w = _passive(u, config, gains, acc_weight, mag_weight, r, v_up, work)
         if config[RY] != TRIAD:
             acc_weight, mag_weight = 1.0, 1.0
     at_rest = _rest(x, acc, gyro, gains, g, dt)
     for i in range(3):
-        b[i] -= dt * gains[KI] * w[i]
+        x[B + i] -= dt * gains[KI] * w[i]
         if at_rest:
-            b[i] += dt * gains[REST_GAIN] * (gyro[i] - b[i])
+            x[B + i] += dt * gains[REST_GAIN] * (gyro[i] - x[B + i])
     kp = gains[KP]
-    _integrate(q, gyro[0] - b[0] + kp * w[0], gyro[1] - b[1] + kp * w[1], gyro[2] - b[2] + kp * w[2], dt,
-               int(config[DISCRETE]))
-    euler_from_quaternion(q, x[THETA:THETA + 3])
-    flags[0], flags[1], flags[2] = acc_weight, mag_weight, 1.0 if at_rest else 0.0
+    q = _advance(x[Q], x[Q + 1], x[Q + 2], x[Q + 3], gyro[0] - x[B] + kp * w[0], gyro[1] - x[B + 1] + kp * w[1],
+                 gyro[2] - x[B + 2] + kp * w[2], dt, int(config[DISCRETE]))
+    theta = _euler(q[0], q[1], q[2], q[3])
+    for i in range(4):
+        x[Q + i] = q[i]
+    for i in range(3):
+        x[THETA + i] = theta[i]
+    y[OUT_WEIGHTS], y[OUT_WEIGHTS + 1], y[OUT_WEIGHTS + 2] = acc_weight, mag_weight, 1.0 if at_rest else 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def update(kind, x, u, gains, config, dt, y, work):
     """One estimator step with the sample ``u``; writes the outputs ``y``.
 
@@ -435,24 +489,22 @@ def update(kind, x, u, gains, config, dt, y, work):
     gain vector and ``config`` the configuration, each in the layout declared above; ``work``
     is a scratch array of WORK_SIZE floats owned by the caller, so that nothing is allocated.
     """
-    gyro, q, b = u[GYRO:GYRO + 3], x[Q:Q + 4], x[B:B + 3]
     if x[PENDING] > 0.0:
         x[PENDING] = 0.0
         if triad(u[ACC:ACC + 3], u[MAG:MAG + 3], config, work[W_RY:W_RY + 9].reshape((3, 3))):
-            quaternion_from_rotation(work[W_RY:W_RY + 9].reshape((3, 3)), q)
-            euler_from_quaternion(q, x[THETA:THETA + 3])
-    flags = y[OUT_WEIGHTS:OUT_WEIGHTS + 3]
+            quaternion_from_rotation(work[W_RY:W_RY + 9].reshape((3, 3)), x[Q:Q + 4])
+            euler_from_quaternion(x[Q:Q + 4], x[THETA:THETA + 3])
     if kind == LINEAR:
         _linear(x, u, gains, config, dt)
-        flags[0], flags[1], flags[2] = 1.0, 1.0, 0.0
+        y[OUT_WEIGHTS], y[OUT_WEIGHTS + 1], y[OUT_WEIGHTS + 2] = 1.0, 1.0, 0.0
     else:
-        _complementary(kind, x, u, gains, config, dt, work, flags)
+        _complementary(kind, x, u, gains, config, dt, work, y)
     for i in range(4):
-        y[OUT_Q + i] = q[i]
+        y[OUT_Q + i] = x[Q + i]
     for i in range(3):
         y[OUT_THETA + i] = x[THETA + i]
-        y[OUT_B + i] = b[i]
-        y[OUT_OMEGA + i] = gyro[i] - b[i]
+        y[OUT_B + i] = x[B + i]
+        y[OUT_OMEGA + i] = u[GYRO + i] - x[B + i]
 
 
 @njit(cache=True, error_model="numpy")
