@@ -181,3 +181,24 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
     except ImportError:
         figures["ahrs_samples_per_s"] = None
     return figures
+
+
+def main(argv=None) -> int:
+    """Print the batch path's figures (``python -m benchmarks.estimators``); returns 0.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
+    import argparse
+    import json
+
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.estimators", description="the batch path against C")
+    parser.add_argument("--gain-sets", type=int, default=256, help="filters per call")
+    parser.add_argument("--samples", type=int, default=4000, help="samples per filter")
+    parser.add_argument("--repeats", type=int, default=3, help="timed calls, best kept")
+    args = parser.parse_args(argv)
+    print(json.dumps(batch_figures(args.gain_sets, args.samples, args.repeats)))
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())

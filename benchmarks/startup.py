@@ -57,8 +57,8 @@ def imported_modules(args: list[str], env: dict | None = None) -> set[str]:
             return set(json.load(f))
 
 
-def wall_times(args: list[str], repeats: int) -> list[float]:
-    """Wall times (s) of ``repeats`` runs of ``quadcosim ARGS``, each in a fresh interpreter.
+def wall_times(args: list[str], repeats: int) -> tuple[list[float], list[float]]:
+    """Wall and CPU times (s) of ``repeats`` runs of ``quadcosim ARGS``, each in a fresh interpreter.
 
     Parameters
     ----------
@@ -69,19 +69,25 @@ def wall_times(args: list[str], repeats: int) -> list[float]:
 
     Returns
     -------
-    list of float
-        One wall time per run, s.
+    walls, cpus : list of float
+        One wall time and one CPU time (user + system of the child) per run, s.
     """
-    times = []
+    import resource
+
+    walls, cpus = [], []
     for _ in range(repeats):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         started = time.perf_counter()
         subprocess.run([sys.executable, "-m", "scenarios.cli", *args], check=True, stdout=subprocess.DEVNULL)
-        times.append(time.perf_counter() - started)
-    return times
+        walls.append(time.perf_counter() - started)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return walls, cpus
 
 
 def main(argv=None) -> int:
-    """Print the median wall time and the heavy imports of each command; returns 0."""
+    """Print the median wall time and the heavy imports of each command; returns 0.
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks.startup", description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5, help="runs per command")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -90,16 +96,18 @@ def main(argv=None) -> int:
     commands = [args.command] if args.command else [["list"], ["--help"]]
     figures = {}
     for command in commands:
-        times = wall_times(command, args.repeats)
+        times, cpus = wall_times(command, args.repeats)
         heavy = sorted(m for m in HEAVY if m in imported_modules(command))
         figures[" ".join(command)] = {"median_s": statistics.median(times), "min_s": min(times),
-                                      "max_s": max(times), "heavy_imports": heavy}
+                                      "max_s": max(times), "median_cpu_s": statistics.median(cpus),
+                                      "heavy_imports": heavy}
     if args.json:
         print(json.dumps(figures))
     else:
         for command, f in figures.items():
             print(f"quadcosim {command}: median {f['median_s']:.2f} s (min {f['min_s']:.2f}, max {f['max_s']:.2f}, "
-                  f"{args.repeats} runs); heavy imports: {', '.join(f['heavy_imports']) or 'none'}")
+                  f"{args.repeats} runs; CPU {f['median_cpu_s']:.2f} s); heavy imports: "
+                  f"{', '.join(f['heavy_imports']) or 'none'}")
     return 0
 
 
