@@ -220,14 +220,12 @@ def report(result, o, out) -> dict:
     import matplotlib.pyplot as plt
 
     from estimators import analysis  # python-control: imported by the report only
-
     gains = grid(o)
     dt = 1.0 / o["imu_rate"]
     sigma_gyro, sigma_angle = analysis.imu_noise_per_sample(o["imu_rate"])
     predicted = analysis.linear_error_variance(gains, dt, sigma_gyro, sigma_angle)
     simulated, relative_se = simulated_variances(result, gains, o)
-    k_predicted = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle)
-    k_simulated = optimum_of(gains, simulated)
+    k_predicted, k_simulated = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle), optimum_of(gains, simulated)
     closed, tracking, failures = closed_loop_variances(gains, o, out) if o["closed_loop"] else (None, None, [])
 
     fig, ax = plt.subplots(figsize=(8, 5))
