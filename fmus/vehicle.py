@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import math
 
+from fmus.airframe import MOTORS
+
 GRAVITY = 9.81  # m/s^2, along +z of the NED frame {I}
 
 # Earth magnetic field in Paris, as in the lab's attitude-estimation report, NED frame.
@@ -39,6 +41,7 @@ EARTH_FIELD = (
 
 # Rigid body
 MASS = 1.0  # kg
+MOTOR_COUNT = len(MOTORS)  # rotors, each carrying an equal share in hover
 INERTIA = (0.010, 0.010, 0.018)  # kg m^2, diagonal in {B} (Jxx, Jyy, Jzz)
 ARM = 0.225  # m, centre to rotor axis
 THRUST_COEFF = 1.0e-5  # N/(rad/s)^2, k_f: thrust of one rotor = k_f omega^2
@@ -76,6 +79,7 @@ ESC_CURRENT_LIMIT = 18.0  # A
 BATTERY_CELLS = 3  # in series
 BATTERY_CAPACITY = 2.2 * 3600.0  # A s (2200 mAh)
 BATTERY_RESISTANCE = 0.02  # ohm, internal plus wiring
+HOVER_SAG_ITERATIONS = 30  # fixed-point iterations of the hover command under the battery's sag
 BATTERY_SOC0 = 0.9  # 1, initial state of charge
 # Open-circuit voltage of one cell against state of charge s in [0, 1]:
 # E_cell(s) = c0 + c1 s + c2 s^2 + c3 s^3, monotone, 4.20 V full, 3.71 V at half, 3.27 V empty.
@@ -101,7 +105,7 @@ def cell_voltage(soc: float) -> float:
 
 def hover_rotor_speed(mass: float = MASS, thrust_coeff: float = THRUST_COEFF) -> float:
     """Rotor speed (rad/s) at which four rotors carry ``mass`` (kg) with thrust coefficient ``thrust_coeff`` (N s^2)."""
-    return math.sqrt(mass * GRAVITY / (4.0 * thrust_coeff))
+    return math.sqrt(mass * GRAVITY / (MOTOR_COUNT * thrust_coeff))
 
 
 def steady_current(omega: float, drag_torque_coeff: float = DRAG_TORQUE_COEFF, ke: float = MOTOR_KE) -> float:
@@ -131,9 +135,9 @@ def hover_command(soc: float = BATTERY_SOC0) -> float:
     w = hover_rotor_speed()
     open_circuit = BATTERY_CELLS * cell_voltage(soc)
     u = open_circuit
-    for _ in range(30):
+    for _ in range(HOVER_SAG_ITERATIONS):
         c = steady_command(w, u)
-        u = open_circuit - BATTERY_RESISTANCE * 4 * c * steady_current(w)
+        u = open_circuit - BATTERY_RESISTANCE * MOTOR_COUNT * c * steady_current(w)
     return c
 
 
