@@ -156,13 +156,15 @@ def _euler(q0, q1, q2, q3):
 
 @njit(cache=True, error_model="numpy")
 def euler_from_quaternion(q, theta):
-    """Z-Y-X Euler angles (roll, pitch, yaw) of q, rad."""
+    """Z-Y-X Euler angles (roll, pitch, yaw; rad) of the unit quaternion ``q`` (body to inertial,
+    scalar first), written into ``theta`` (3,)."""
     theta[0], theta[1], theta[2] = _euler(q[0], q[1], q[2], q[3])
 
 
 @njit(cache=True, error_model="numpy")
 def euler_to_quaternion(roll, pitch, yaw):
-    """Quaternion (q0, q1, q2, q3) of Z-Y-X Euler angles (rad)."""
+    """Quaternion (q0, q1, q2, q3; body to inertial, scalar first) of the Z-Y-X Euler angles
+    ``roll``, ``pitch``, ``yaw`` (rad)."""
     c1, s1 = math.cos(0.5 * roll), math.sin(0.5 * roll)
     c2, s2 = math.cos(0.5 * pitch), math.sin(0.5 * pitch)
     c3, s3 = math.cos(0.5 * yaw), math.sin(0.5 * yaw)
@@ -178,7 +180,7 @@ def quaternion_from_euler(theta, q):
 
 @njit(cache=True, error_model="numpy")
 def wrap(angle):
-    """Angle wrapped to [-pi, pi)."""
+    """``angle`` (rad) wrapped to [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
@@ -270,7 +272,9 @@ def triad(acc, mag, config, r):
     Inertial triad ``(d_I, d_I x m_I, d_I x (d_I x m_I))`` with ``d_I = g_I/|g_I|``, matched with
     the body triad built the same way from ``d = -acc/|acc|`` and the measured field, so that
     ``R^T d_I = d`` exactly: the magnetometer sets the heading only. False, and ``r`` unset,
-    when the measurements or the references give no frame (null or parallel).
+    when the measurements or the references give no frame (null or parallel). ``acc`` (m/s^2)
+    and ``mag`` (any unit) are body-axis samples, ``config`` the configuration vector (its
+    ``gravity`` and ``earth_field`` references, inertial frame); ``r`` (9,) receives R row-major.
     """
     na = _norm3(acc)
     gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
@@ -488,6 +492,7 @@ def update(kind, x, u, gains, config, dt, y, work):
     ``kind`` is LINEAR, EXPLICIT or PASSIVE; ``x`` the state, ``u`` the sample, ``gains`` the
     gain vector and ``config`` the configuration, each in the layout declared above; ``work``
     is a scratch array of WORK_SIZE floats owned by the caller, so that nothing is allocated.
+    ``dt`` (s) is the time since the previous sample.
     """
     if x[PENDING] > 0.0:
         x[PENDING] = 0.0
@@ -509,7 +514,9 @@ def update(kind, x, u, gains, config, dt, y, work):
 
 @njit(cache=True, error_model="numpy")
 def initial_state(q0, b0, from_triad, x):
-    """State at the start: attitude ``q0`` (or TRIAD of the first sample), bias ``b0`` (rad/s)."""
+    """State at the start, written into ``x`` (STATE_LAYOUT): attitude ``q0`` (body to inertial,
+    scalar first), or, with ``from_triad``, the TRIAD attitude of the first sample; gyro bias
+    ``b0`` (rad/s, body axes)."""
     x[:] = 0.0
     for i in range(4):
         x[Q + i] = q0[i]
@@ -553,7 +560,10 @@ def error_angles(q, reference, gravity, heading_offset):
 
 @njit(cache=True, error_model="numpy")
 def accumulate_error(q, reference, gravity, heading_offset, sums):
-    """Add one sample's squared errors (and heading circular sums) to ``sums`` (ERROR_LAYOUT)."""
+    """Add one sample's squared errors (and heading circular sums) to ``sums`` (ERROR_LAYOUT): the
+    estimate ``q`` against ``reference`` (both body to inertial, scalar first), the vertical
+    along ``gravity`` (inertial frame), after turning by ``heading_offset`` (rad) about it (see
+    :func:`error_angles`)."""
     total, inclination, heading = error_angles(q, reference, gravity, heading_offset)
     sums[E_TOTAL] += total * total
     sums[E_INCL] += inclination * inclination
@@ -573,6 +583,9 @@ def run_batch(kind, inputs, gains, config, dt, q0, b0, from_triad, columns, outp
     (shape (G, 0, 0)). With a ``reference`` (N, 4), the errors of the samples where
     ``scored`` is true, after removing ``heading_offsets`` (G,), are summed into ``sums``
     (G, ERROR_SIZE): a gain study then keeps no time series at all.
+    ``kind`` is LINEAR, EXPLICIT or PASSIVE, ``config`` the configuration vector, ``dt`` (s) the
+    sample period; every filter starts from ``q0``/``b0`` (or TRIAD, ``from_triad``) as in
+    :func:`initial_state`.
     """
     keep = outputs.shape[1] > 0
     score = reference.shape[0] > 0
@@ -593,7 +606,9 @@ def run_batch(kind, inputs, gains, config, dt, q0, b0, from_triad, columns, outp
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def score_series(q, reference, scored, gravity, heading_offsets, sums):
-    """The reduction of :func:`run_batch` on stored estimates ``q`` (G, N, 4)."""
+    """The reduction of :func:`run_batch` on stored estimates ``q`` (G, N, 4): errors against
+    ``reference`` (N, 4) over the ``scored`` samples, the vertical along ``gravity``, after the
+    ``heading_offsets`` (G,) (rad), summed into ``sums`` (G, ERROR_SIZE)."""
     for g in prange(q.shape[0]):
         for n in range(q.shape[1]):
             if scored[n]:

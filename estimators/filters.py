@@ -186,7 +186,9 @@ def parse_corrections(text: str):
 
 
 def gain_table(kind: str, gains: dict | None = None, corrections=None) -> np.ndarray:
-    """(G, core.GAIN_SIZE) table of gain sets, each column placed by its name."""
+    """(G, core.GAIN_SIZE) table of gain sets of the filter ``kind``, each column placed by its
+    name: ``gains`` maps names to a value or a sequence of G values (None: the defaults), and
+    ``corrections`` sets the disturbance corrections, both as in :func:`check_gains`."""
     merged = check_gains(kind, gains, corrections)
     columns = {name: np.atleast_1d(np.asarray(v, dtype=float)) for name, v in merged.items()}
     sizes = {len(c) for c in columns.values() if len(c) > 1}
@@ -250,7 +252,9 @@ def config_vector(discretisation: str = "exp", ry: str = "reel", earth_field=Non
 
     ``discretisation`` ``"exp"`` (exponential map) or ``"euler"`` (Euler step plus
     renormalisation); ``ry`` ``"reel"`` or ``"triad"`` for the passive filter; references as in
-    :func:`references`.
+    :func:`references`: ``gravity`` (m/s^2, or a 3-vector in the inertial frame) and the Earth
+    field, given as ``earth_field`` (3, inertial frame) or by its ``dip`` and ``declination``
+    (rad).
     """
     if discretisation not in ("exp", "euler"):
         raise ValueError(f"discretisation {discretisation!r} must be 'exp' or 'euler'")
@@ -417,7 +421,7 @@ def check_measurements(gyro, acc, mag, gravity_norm: float, check_units: bool = 
     """(N, 9) samples ``acc, gyro, mag``, refused with a clear message when malformed.
 
     With ``check_units``, the median norm of ``acc`` must lie between half and twice the
-    gravity norm (m/s^2): a gyro in rad/s, or an accelerometer in g, does not.
+    gravity norm ``gravity_norm`` (m/s^2): a gyro in rad/s, or an accelerometer in g, does not.
     """
     parts = {}
     for label, value in (("acc", acc), ("gyro", gyro), ("mag", mag)):
@@ -609,6 +613,8 @@ def score(q, reference, scored=None, gravity=vehicle.GRAVITY, align_heading: boo
     The same reduction as :func:`estimate`'s ``reference`` (total, inclination and heading
     RMSE in degrees, over the ``scored`` samples; see :func:`estimators.core.error_angles`),
     taken a block of samples at a time so that it adds little memory to a long record.
+    ``gravity`` (m/s^2, or a 3-vector, inertial frame) gives the vertical; with
+    ``align_heading`` the constant heading offset between the two frames is removed first.
     """
     q = np.asarray(q)
     single = q.ndim == 2

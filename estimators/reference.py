@@ -36,7 +36,8 @@ def _vqf_parameters() -> dict:
 
 
 def check_gains(kind: str, gains: dict | None) -> dict:
-    """Scalar gains of a published filter by name, defaults filled in; unknown names refused."""
+    """Scalar gains of the published filter ``kind`` (``vqf`` or ``madgwick``) by name, defaults
+    filled in; unknown names refused."""
     known = _vqf_parameters() if kind == "vqf" else dict(DEFAULT_GAINS[kind])
     merged = dict(DEFAULT_GAINS[kind])
     for name, value in (gains or {}).items():
@@ -57,7 +58,8 @@ def _gain_sets(kind, gains) -> list[dict]:
 
 
 def frame_rotation(kind: str, config) -> np.ndarray:
-    """Quaternion of the rotation from the package's inertial frame to the configured one."""
+    """Quaternion of the rotation from the inertial frame of the package of ``kind`` to the one of
+    the configuration vector ``config``."""
     g = config[core.GRAVITY:core.GRAVITY + 3]
     m = config[core.FIELD:core.FIELD + 3]
     up = -g / np.linalg.norm(g)
@@ -133,7 +135,10 @@ def _write(runner, gyro, y):
 
 
 def streaming_step(kind, gains, config, dt, q0, b0, from_triad):
-    """A block's ``step(t, u, y)`` running the published filter on the inputs ``acc, gyro, mag``."""
+    """A block's ``step(t, u, y)`` running the published filter ``kind`` with ``gains`` on the
+    inputs ``acc, gyro, mag``, every ``dt`` (s), in the frame of ``config``, from ``q0`` (body to
+    inertial, scalar first; or TRIAD, ``from_triad``); ``b0`` is taken for the common signature
+    and not used."""
     runner = _Runner(kind, check_gains(kind, gains), config, dt, q0, from_triad)
     acc, gyro, mag = slice(core.ACC, core.ACC + 3), slice(core.GYRO, core.GYRO + 3), slice(core.MAG, core.MAG + 3)
 
@@ -145,7 +150,10 @@ def streaming_step(kind, gains, config, dt, q0, b0, from_triad):
 
 
 def estimate(kind, inputs, dt, gains, config, q0, b0, from_triad, outputs) -> dict:
-    """The published filter on recorded samples ``inputs`` (N, 9: acc, gyro, mag), per gain set.
+    """The published filter ``kind`` on recorded samples ``inputs`` (N, 9: acc, gyro, mag), every
+    ``dt`` (s), per gain set of ``gains``, in the frame of ``config``, from ``q0`` (or TRIAD,
+    ``from_triad``); ``b0`` is taken for the common signature and not used; ``outputs`` names
+    the outputs to keep.
 
     Returns the requested outputs (G, N, size) as :func:`estimators.estimate` does, and
     ``q_all`` (G, N, 4) for scoring.

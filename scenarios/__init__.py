@@ -101,7 +101,8 @@ class Scenario:
         return f"{self.name}: " + (", ".join(changed) if changed else "default options")
 
     def parse(self, settings: dict | list | None) -> dict:
-        """Options with defaults, from ``{"k": v}`` or ``["k=v", ...]``; refuses unknown keys."""
+        """Options with defaults, from ``settings`` ``{"k": v}`` or ``["k=v", ...]`` (None: all
+        defaults); refuses unknown keys."""
         values = {k: o.default for k, o in self.options.items()}
         pairs = settings.items() if isinstance(settings, dict) else [_split(s) for s in settings or []]
         for key, text in pairs:
@@ -162,7 +163,9 @@ def get(name: str) -> Scenario:
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
         record=None, formats=("npz", "mat"), overwrite: bool = False):
-    """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
+    """Run scenario ``name`` with the options ``settings`` (as :meth:`Scenario.parse` takes them);
+    write results, metrics and figures into ``out_dir`` if given. ``progress`` shows a progress
+    bar on long runs; ``faults`` are :class:`orchestrator.Fault` injected into the run.
 
     ``decimation`` keeps every N-th macro step; ``record`` lists the signals to keep (default:
     the scenario's choice, else all); ``formats`` are the result files written (``npz``,

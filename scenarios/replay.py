@@ -33,8 +33,9 @@ from estimators import estimate, parse_corrections, recording
 
 
 def field_from_data(acc, mag, samples: int) -> dict:
-    """Field references from the first ``samples``: dip (rad, below the horizontal, from the
-    angle between specific force and field) and norm (the magnetometer's unit)."""
+    """Field references from the first ``samples`` of ``acc`` (m/s^2) and ``mag`` (N, 3, body
+    axes): dip (rad, below the horizontal, from the angle between specific force and field) and
+    norm (the magnetometer's unit)."""
     a, m = np.asarray(acc[:samples]), np.asarray(mag[:samples])
     cos_up = np.einsum("ij,ij->i", a, m) / (np.linalg.norm(a, axis=1) * np.linalg.norm(m, axis=1))
     return {"dip": float(np.median(np.arcsin(np.clip(-cos_up, -1, 1)))),
@@ -42,7 +43,8 @@ def field_from_data(acc, mag, samples: int) -> dict:
 
 
 def references(frame: str, dip: float | None, norm: float | None) -> dict:
-    """Gravity and Earth field for ``frame`` ("ned": x north; "enu": y north), heading to magnetic north."""
+    """Gravity and Earth field for ``frame`` ("ned": x north; "enu": y north), heading to magnetic
+    north, the field of ``dip`` (rad, below the horizontal) and ``norm`` (None: the lab's)."""
     from fmus import vehicle
 
     dip = vehicle.EARTH_FIELD_INCLINATION if dip is None else dip
@@ -70,6 +72,12 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
     Settings not given come from the recording's ``meta`` (written by ``--from-tp``), then
     from the package's defaults. Returns the errors (degrees) when the recording has a
     reference, and the settings used.
+
+    ``data``: the recording; ``estimator``, ``gains``, ``corrections`` and ``initial``
+    (``"triad"`` or None): as :func:`estimators.estimate` takes them; ``frame``: ``"ned"`` or
+    ``"enu"``; ``field_from_data_s`` (s): take the field's dip and norm from that first stretch
+    of the data (0: the lab's field); ``align_heading``: remove the constant heading offset
+    before scoring.
     """
     meta = data["meta"].get("estimator", {})
     kind = estimator or meta.get("kind", "explicit")
@@ -99,7 +107,8 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
 
 
 def from_tp(results_dir, path) -> Path:
-    """Write the recording of a ``tp`` run's results folder (see the module docstring)."""
+    """Write the recording of the ``tp`` run in the results folder ``results_dir`` to ``path``
+    (see the module docstring)."""
     from estimators.core import euler_to_quaternion
     from orchestrator.result import Result
     from scenarios.tp import estimator_gains, initial_state
@@ -123,7 +132,8 @@ def from_tp(results_dir, path) -> Path:
 
 
 def main(argv=None) -> int:
-    """Command line (see the module docstring); returns the exit status (2 on bad input)."""
+    """Command line (see the module docstring); returns the exit status (2 on bad input).
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(prog="python -m scenarios.replay", description=__doc__.splitlines()[0])
     parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording")
     parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")

@@ -149,7 +149,8 @@ def parameters(gains: dict | None = None) -> np.ndarray:
 @njit(cache=True, error_model="numpy")
 def control_law(u, p, mixer_inverse, state, dt, y):
     """One sample of the law: inputs ``u`` (:data:`INPUTS`), parameters ``p`` (:data:`PARAMETERS`),
-    the inverse allocation matrix, the integral ``state`` (updated), the period ``dt`` (s);
+    the inverse allocation matrix ``mixer_inverse`` (each motor's thrust from the total thrust
+    and the three torques), the integral ``state`` (updated), the period ``dt`` (s);
     writes the outputs ``y`` (:data:`OUTPUTS`)."""
     roll_d, pitch_d, yaw = u[U_ROLL_D], u[U_PITCH_D], u[U_YAW_D]
     g = p[P_G]
@@ -219,7 +220,8 @@ class Controller(Block):
         self.mixer_inverse = np.linalg.inv(allocation_matrix())
 
     def start(self, t0, dt):
-        """Reset the integral; compile the law before the run. ``dt``: the block's period (s)."""
+        """Reset the integral; compile the law before the run. ``t0``: the start time (s);
+        ``dt``: the block's period (s)."""
         self.data = np.zeros(DATA_SIZE)
         self.data[D_PARAMETERS:D_MIXER] = self.parameters
         self.data[D_MIXER:D_STATE] = self.mixer_inverse.ravel()

@@ -58,8 +58,8 @@ def cruise_pitch(speed: float = CRUISE_SPEED) -> float:
 
 
 def initial_state(flight: str) -> dict:
-    """Initial condition of a profile, as Quadrotor FMU parameters: the trimmed cruise of
-    ``quasi`` (velocity m/s, pitch rad), rest otherwise."""
+    """Initial condition of the profile ``flight``, as Quadrotor FMU parameters: the trimmed
+    cruise of ``quasi`` (velocity m/s, pitch rad), rest otherwise."""
     if flight == "quasi":
         return {"v_x0": CRUISE_SPEED, "theta2_0": cruise_pitch()}
     return {}
@@ -70,7 +70,8 @@ def _sine(amplitude, frequency, t, phase=0.0):
 
 
 def profile(flight: str, duration: float, dt: float, tilt: float = 5.0 * DEG) -> np.ndarray:
-    """Setpoint table of a flight profile at 0, dt, ..., duration (s): see :func:`profile_at`.
+    """Setpoint table of the profile ``flight`` at 0, dt, ..., duration (s), the ``tilt`` profile
+    pitched by ``tilt`` (rad): see :func:`profile_at`.
 
     Returns
     -------
