@@ -171,7 +171,8 @@ def figure(system, title: str | None = None):
     for arrow in arrows:
         _draw_arrow(ax, arrow, column)
     heading = f"{len(order)} blocks, {len(system.connections)} connections, macro step {system.dt * 1e3:g} ms"
-    ax.set_title(f"{title}\n{heading}" if title else heading, fontsize=9, pad=8)
+    faults = [f"{f.kind} fault on the input {f.target}, {f.start:g}-{f.stop:g} s" for f in system.faults]
+    ax.set_title("\n".join([*([title] if title else []), heading, *faults]), fontsize=9, pad=8)
     return fig
 
 

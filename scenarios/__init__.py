@@ -188,12 +188,12 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         raise ValueError(f"--format {','.join(formats)}: choose among {', '.join(FORMATS)}")
     out = prepare_out_dir(out_dir, overwrite) if out_dir else None
     system = scenario.build(options)
+    for fault in faults:
+        system.inject(fault)
     if out is not None and scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs
         from orchestrator.diagram import draw
 
         draw(system, out / "diagram.png", scenario.title(options))
-    for fault in faults:
-        system.inject(fault)
     duration = scenario.duration(options) if scenario.duration else options["duration"]
     base = {"scenario": name, "options": options, "duration_s": duration, "decimation": decimation}
     try:

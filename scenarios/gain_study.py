@@ -243,6 +243,12 @@ def report(result, o, out) -> dict:
     ax.axvline(0.05, color="grey", ls=":", label="lab gain 0.05")
     ax.axvline(k_predicted, color="C0", ls="--", lw=0.8, label=f"predicted optimum {k_predicted:.2f}")
     ax.axvline(k_simulated, color="C1", ls="--", lw=0.8, label=f"simulated optimum {k_simulated:.2f}")
+    from matplotlib.ticker import FormatStrFormatter
+
+    # plain numbers, not powers of ten, on the log axes; the error axis spans less than a decade
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(FormatStrFormatter("%g"))
     ax.set_xlabel("gain k (1/s)")
     ax.set_ylabel("roll/pitch error, standard deviation (deg)")
     closed_text = (f"estimate-fed runs: {o['closed_duration']:g} s each, {o['closed_flight']}, rotor drag "
