@@ -142,8 +142,10 @@ def test_tp_diagram_reads_as_the_labs_loop(feedback):
     back = {(a.source, a.destination) for a in arrows if a.side < 0}
     fed_back = "Quaternion_estim" if feedback == "estimate" else "Quadrotor"
     assert {("MotorMagnetics", "Controller"), (fed_back, "Controller")} <= back
+    system.inject(Fault("IMU.omega_x", "offset", 1.0, 2.0, 0.2))
     figure = diagram.figure(system, tp.title(options))
     ax = figure.axes[0]
+    assert ax.title.get_text().endswith("offset fault on the input IMU.omega_x, 1-2 s")
     renderer = figure.canvas.get_renderer()
     canvas = ax.get_window_extent(renderer)
     texts = [t for t in ax.texts if t.get_text()]
