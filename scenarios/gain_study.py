@@ -243,21 +243,7 @@ def report(result, o, out) -> dict:
     ax.axvline(0.05, color="grey", ls=":", label="lab gain 0.05")
     ax.axvline(k_predicted, color="C0", ls="--", lw=0.8, label=f"predicted optimum {k_predicted:.2f}")
     ax.axvline(k_simulated, color="C1", ls="--", lw=0.8, label=f"simulated optimum {k_simulated:.2f}")
-    from matplotlib.ticker import FormatStrFormatter
-
-    # plain numbers, not powers of ten, on the log axes; the error axis spans less than a decade
-    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
-    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
-    ax.yaxis.set_minor_formatter(FormatStrFormatter("%g"))
-    ax.set_xlabel("gain k (1/s)")
-    ax.set_ylabel("roll/pitch error, standard deviation (deg)")
-    closed_text = (f"estimate-fed runs: {o['closed_duration']:g} s each, {o['closed_flight']}, rotor drag "
-                   f"{'on' if o['closed_drag'] else 'off'}" + (", gravity-only accelerometer"
-                                                                 if o["closed_accelerometer"] == "gravity" else "")
-                   if o["closed_loop"] else "no estimate-fed runs")
-    ax.set_title(title_lines(f"gain-study: linear filter's roll/pitch error against its gain k, {o['count']} gains",
-                             f"GT stream {o['duration']:g} s at {o['imu_rate']:g} Hz (first {o['burn_in']:g} s left "
-                             f"out), IMU noise on; {closed_text}", fault_text(faults_of(result)), width=90), fontsize=9)
+    _label(ax, result, o)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     figure = save_figure(fig, out, "gain_study.png")
@@ -282,6 +268,25 @@ def report(result, o, out) -> dict:
         "closed_loop_tracking_rms_deg": tracking,
         "figures": [figure] if figure else [],
     }
+
+
+def _label(ax, result, o: dict) -> None:
+    """Axis labels in plain numbers (not powers of ten: the error axis spans less than a
+    decade) and the title naming the stream, the estimate-fed runs and the faults."""
+    from matplotlib.ticker import FormatStrFormatter
+
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(FormatStrFormatter("%g"))
+    ax.set_xlabel("gain k (1/s)")
+    ax.set_ylabel("roll/pitch error, standard deviation (deg)")
+    closed_text = (f"estimate-fed runs: {o['closed_duration']:g} s each, {o['closed_flight']}, rotor drag "
+                   f"{'on' if o['closed_drag'] else 'off'}" + (", gravity-only accelerometer"
+                                                                 if o["closed_accelerometer"] == "gravity" else "")
+                   if o["closed_loop"] else "no estimate-fed runs")
+    ax.set_title(title_lines(f"gain-study: linear filter's roll/pitch error against its gain k, {o['count']} gains",
+                             f"GT stream {o['duration']:g} s at {o['imu_rate']:g} Hz (first {o['burn_in']:g} s left "
+                             f"out), IMU noise on; {closed_text}", fault_text(faults_of(result)), width=90), fontsize=9)
 
 
 def duration(o: dict) -> float:
