@@ -24,6 +24,7 @@ class Option:
     help: str
     choices: tuple | None = None
     minimum: float | None = None
+    classes: bool = False  # beside the choices, a block class of the user's, "module:Class"
 
     def parse(self, name: str, text):
         """The option's value from text, checked against its type, choices and minimum.
@@ -64,8 +65,9 @@ class Option:
                 value = str(text)
         except ValueError:
             raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}") from None
-        if self.choices and value not in self.choices:
-            raise ValueError(f"option {name}={text!r} must be one of {', '.join(map(str, self.choices))}")
+        if self.choices and value not in self.choices and not (self.classes and ":" in value):
+            other = " or module:Class (a block of your own)" if self.classes else ""
+            raise ValueError(f"option {name}={text!r} must be one of {', '.join(map(str, self.choices))}{other}")
         if self.minimum is not None and value < self.minimum:
             raise ValueError(f"option {name}={value} must be at least {self.minimum}")
         return value
@@ -97,15 +99,23 @@ class Scenario:
         """
         if "title" in self.extra:
             return self.extra["title"](options)
-        changed = [f"{key}={value}" for key, value in options.items() if value != self.options[key].default]
+        changed = [f"{key}={value}" for key, value in options.items()
+                   if key not in self.options or value != self.options[key].default]  # or Block.parameter
         return f"{self.name}: " + (", ".join(changed) if changed else "default options")
 
     def parse(self, settings: dict | list | None) -> dict:
         """Options with defaults, from ``settings`` ``{"k": v}`` or ``["k=v", ...]`` (None: all
-        defaults); refuses unknown keys."""
+        defaults); refuses unknown keys.
+
+        A key ``Block.parameter`` sets a block parameter (``IMU.gyro_noise_density``); it is
+        kept as given and checked against the block when :meth:`system` builds the system.
+        """
         values = {k: o.default for k, o in self.options.items()}
         pairs = settings.items() if isinstance(settings, dict) else [_split(s) for s in settings or []]
         for key, text in pairs:
+            if "." in key:
+                values[key] = text
+                continue
             if key not in self.options:
                 from orchestrator.fmu import nearest
 
@@ -113,6 +123,50 @@ class Scenario:
                                  f"Options: {', '.join(self.options)} (see `quadcosim list`).")
             values[key] = self.options[key].parse(key, text)
         return values
+
+
+    def system(self, options: dict, estimator=None):
+        """The system of these options: built, then its block parameters set.
+
+        Parameters
+        ----------
+        options : dict
+            From :meth:`parse`. Its ``Block.parameter`` entries are set on the built system
+            (checked against the FMU's variable table) and replaced by the values used.
+        estimator : Block or class, optional
+            A block of the user's in the place of ``Quaternion_estim`` (see
+            :mod:`estimators.contract`), for a scenario with an ``estimator`` option.
+
+        Raises
+        ------
+        KeyError, ValueError
+            An unknown block or parameter, a bad value, or a parameter the scenario sets from
+            one of its options (the message names that option).
+        """
+        from orchestrator.parameters import apply, resolve
+
+        if estimator is not None:
+            if "estimator" not in self.options:
+                raise ValueError(f"scenario {self.name} has no estimator to replace; {_with_estimator()}")
+            system = self.build(options, estimator=estimator)
+        else:
+            system = self.build(options)
+        settings = {k: v for k, v in options.items() if "." in k}
+        derived = self.extra.get("derived", {})
+        for key in settings:
+            block = key.partition(".")[0]
+            for name in resolve(system, key, settings[key]):
+                option = derived.get(f"{block}.{name}")
+                if option is not None:
+                    raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
+                                     f"use --set {option}=... instead of {key}")
+        options.update(apply(system, settings))
+        return system
+
+
+def _with_estimator() -> str:
+    names = [s.name for s in registry().values() if "estimator" in s.options]
+    return f"the scenarios with one: {', '.join(names)}"
 
 
 def _split(text: str) -> tuple[str, str]:
@@ -162,7 +216,7 @@ def get(name: str) -> Scenario:
 
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
-        record=None, formats=("npz", "mat"), overwrite: bool = False):
+        record=None, formats=("npz", "mat"), overwrite: bool = False, estimator=None):
     """Run scenario ``name`` with the options ``settings`` (as :meth:`Scenario.parse` takes them);
     write results, metrics and figures into ``out_dir`` if given. ``progress`` shows a progress
     bar on long runs; ``faults`` are :class:`orchestrator.Fault` injected into the run.
@@ -170,7 +224,9 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     ``decimation`` keeps every N-th macro step; ``record`` lists the signals to keep (default:
     the scenario's choice, else all); ``formats`` are the result files written (``npz``,
     ``mat``, ``csv``). ``out_dir`` is checked before the run: a folder holding earlier results
-    is refused unless ``overwrite``.
+    is refused unless ``overwrite``. ``settings`` may set block parameters
+    (``{"IMU.gyro_noise_density": 1e-3}``); ``estimator`` puts a block of the user's (an
+    instance or a class, see :mod:`estimators.contract`) in the place of ``Quaternion_estim``.
 
     Returns ``(result, metrics)``. On a failure or an interrupt, what was recorded is saved all
     the same, with a ``metrics.json`` saying where the run stopped, and
@@ -187,7 +243,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     if unknown or not formats:
         raise ValueError(f"--format {','.join(formats)}: choose among {', '.join(FORMATS)}")
     out = prepare_out_dir(out_dir, overwrite) if out_dir else None
-    system = scenario.build(options)
+    system = scenario.system(options, estimator=estimator)
     for fault in faults:
         system.inject(fault)
     if out is not None and scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs

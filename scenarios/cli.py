@@ -2,7 +2,8 @@
 
   quadcosim build                          build the plant FMUs and the master's call runner
   quadcosim list [--parameters MODEL]      scenarios and their options (or an FMU's parameters)
-  quadcosim run SCENARIO [--set k=v]... [--out DIR] [--fault ...]
+  quadcosim run SCENARIO [--set k=v k2=v2 ...] [--estimator module:Class] [--out DIR] [--fault ...]
+                                           (--set IMU.gyro_noise_density=0.001: an FMU parameter)
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
@@ -45,9 +46,18 @@ def _list(args) -> int:
         if args.parameters not in MODELS:
             print(f"unknown model {args.parameters!r}; models: {', '.join(MODELS)}", file=sys.stderr)
             return 2
+        from orchestrator.parameters import model_notes
+
+        print(f"{args.parameters} parameters (set one in any scenario with --set {args.parameters}.NAME=VALUE; "
+              "a vector as x,y,z):")
         for v in table(args.parameters).of("parameter"):
             unit = f" [{v.unit}]" if v.unit else ""
-            print(f"  {v.name:22s} = {v.start!r:24}{unit:12s} {v.description}")
+            print(f"  {v.name:22s} = {v.start!r:24}{unit:14s} {v.description}")
+        aliases, switched = model_notes(args.parameters)
+        for alias, name in aliases.items():
+            print(f"  {alias} stands for the vector {name}")
+        for switch, governed in switched.items():
+            print(f"  {', '.join(governed)} act only while {switch} is true")
         return 0
     import scenarios
 
@@ -57,6 +67,21 @@ def _list(args) -> int:
             choices = f" ({'|'.join(map(str, option.choices))})" if option.choices else ""
             print(f"    {key:16s} = {option.default!s:10s}{choices}  {option.help}")
     return 0
+
+
+def _settings(args) -> list[str]:
+    """The ``--set`` pairs, with ``--estimator`` as the option it stands for."""
+    settings = list(args.set)
+    if getattr(args, "estimator", None):
+        import scenarios
+
+        if "estimator" not in scenarios.get(args.scenario).options:
+            raise ValueError(f"--estimator: scenario {args.scenario} has no estimator; "
+                             f"{scenarios._with_estimator()}")
+        if ":" not in args.estimator:
+            raise ValueError(f"--estimator {args.estimator!r}: write module:Class or file.py:Class")
+        settings.append(f"estimator={args.estimator}")
+    return settings
 
 
 def _parse_fault(text: str):
@@ -88,7 +113,7 @@ def _run(args) -> int:
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
     try:
         faults = [_parse_fault(f) for f in args.fault or []]
-        _, metrics = scenarios.run(args.scenario, args.set, out, progress=True, faults=faults,
+        _, metrics = scenarios.run(args.scenario, _settings(args), out, progress=True, faults=faults,
                                    decimation=args.decimation, record=args.record, formats=formats,
                                    overwrite=args.overwrite)
     except RunInterrupted as error:
@@ -128,8 +153,8 @@ def _diagram(args) -> int:
 
     try:
         scenario = scenarios.get(args.scenario)
-        options = scenario.parse(args.set)
-        system = scenario.build(options)
+        options = scenario.parse(_settings(args))
+        system = scenario.system(options)
     except (KeyError, ValueError) as error:
         print(error.args[0] if error.args else error, file=sys.stderr)
         return 2
@@ -166,7 +191,13 @@ def parser() -> argparse.ArgumentParser:
     listing.set_defaults(func=_list)
     run = sub.add_parser("run", help="run a scenario")
     run.add_argument("scenario")
-    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario option")
+    run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
+                     help="scenario options, several after one flag (estimator=explicit k1=0.2), or block "
+                          "parameters: IMU.gyro_noise_density=0.001, IMU.gyro_bias=0.01,0,0 (units: quadcosim list "
+                          "--parameters IMU)")
+    run.add_argument("--estimator", metavar="MODULE:CLASS",
+                     help="your own attitude estimator block in the place of Quaternion_estim (a module, or "
+                          "a file.py, and a class; see estimators/contract.py)")
     run.add_argument("--out", help="output folder (default results/SCENARIO)")
     run.add_argument("--fault", action="append", metavar="TARGET:KIND:START:STOP[:VALUE]",
                      help="fault on the connection into TARGET; KIND is offset, scale, stuck, noise or dropout")
@@ -180,7 +211,8 @@ def parser() -> argparse.ArgumentParser:
     run.set_defaults(func=_run)
     diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
     diagram.add_argument("scenario")
-    diagram.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
+    diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
     diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
     diagram.set_defaults(func=_diagram)
     bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")

@@ -28,7 +28,8 @@ from scenarios.plant import add_plant, imu_parameters, save_figure
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
 
 OPTIONS = {
-    "estimator": Option("linear", "attitude estimator", choices=("linear", "explicit", "passive", "vqf", "madgwick")),
+    "estimator": Option("linear", "attitude estimator, or module:Class (a block of your own: estimators/contract.py)",
+                        choices=("linear", "explicit", "passive", "vqf", "madgwick"), classes=True),
     "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py)", choices=FLIGHTS),
     "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
@@ -64,7 +65,8 @@ def estimator_gains(o: dict) -> dict:
     """The estimator's gains from the options: ``k`` for the three axes of the linear filter
     (1/s); ``k1``, ``k2`` (weights of gravity and field), ``kP`` (1/s) and ``kI`` (1/s^2) for the
     explicit filter; ``kP`` and ``kI`` for the passive one; none for ``vqf`` and ``madgwick``
-    (their packages' defaults). ``kI = -1`` takes the lab's value.
+    (their packages' defaults) and for a user's block (``module:Class``, its gains its own).
+    ``kI = -1`` takes the lab's value.
 
     Parameters
     ----------
@@ -79,15 +81,15 @@ def estimator_gains(o: dict) -> dict:
     kind = o["estimator"]
     if kind == "linear":
         return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
-    if kind in ("vqf", "madgwick"):
-        return {}  # the packages' defaults
+    if kind in ("vqf", "madgwick") or ":" in kind:
+        return {}  # the packages' defaults; a user's block holds its own
     ki = o["kI"] if o["kI"] >= 0 else LAB_GAINS[kind]["kI"]
     if kind == "explicit":
         return {"k1": o["k1"], "k2": o["k2"], "kP": o["kP"], "kI": ki}
     return {"kP": o["kP"], "kI": ki}
 
 
-def build(o: dict) -> System:
+def build(o: dict, estimator=None) -> System:
     """The lab's closed loop: setpoint profile, controller, motors and battery, rigid body, IMU
     (at ``imu_rate``, a divisor of the macro step rate) and the attitude estimator, the
     controller fed by the truth or by the estimate (``feedback``), with the optional
@@ -97,6 +99,10 @@ def build(o: dict) -> System:
     ----------
     o : dict
         Parsed options (``quadcosim list`` shows them with their units).
+    estimator : orchestrator.Block or class, optional
+        An estimator of the user's in the place of ``Quaternion_estim`` (see
+        :mod:`estimators.contract`); ``o["estimator"]`` then names it, ``module:Class``.
+        ``o["estimator"] = "module:Class"`` does the same from the options.
 
     Returns
     -------
@@ -106,7 +112,8 @@ def build(o: dict) -> System:
     Raises
     ------
     ValueError
-        ``kI`` negative (but -1), or ``imu_rate`` not a divisor of ``1 / dt``.
+        ``kI`` negative (but -1), ``imu_rate`` not a divisor of ``1 / dt``, or a user's
+        estimator that cannot be loaded or breaks the contract.
     """
     if o["kI"] < 0 and o["kI"] != -1.0:
         raise ValueError(f"option kI={o['kI']} must be non-negative (or -1 for the default)")
@@ -127,10 +134,18 @@ def build(o: dict) -> System:
               specific_force="GravityOnly.f" if o["accelerometer"] == "gravity" else "Quadrotor.f")
     if o["accelerometer"] == "gravity":
         system.connect("Quadrotor.q", "GravityOnly.q")
-    estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
-                                           discretisation=o["discretisation"], ry=o["ry"],
-                                           corrections=parse_corrections(o["corrections"]),
-                                           q0=euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)))
+    q0 = euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)
+    if estimator is not None or ":" in o["estimator"]:
+        from estimators import contract
+
+        if estimator is not None:
+            o["estimator"] = contract.label(estimator)
+        estimator = system.add(contract.adopt(estimator if estimator is not None else o["estimator"], period,
+                                              q0=q0, available=system.blocks["IMU"].outputs))
+    else:
+        estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
+                                               discretisation=o["discretisation"], ry=o["ry"],
+                                               corrections=parse_corrections(o["corrections"]), q0=q0))
     for name in estimator.inputs:
         if not (o["compensation"] != "none" and name.startswith("magneto")):  # else from MagCompensator
             system.connect(f"IMU.{name}", f"Quaternion_estim.{name}")
@@ -252,8 +267,8 @@ def estimator_text(o: dict, name: str | None = None) -> str:
     str
         ``"explicit filter (k1 = 0.2, k2 = 0.2, kP = 1 1/s, kI = 0.1 1/s^2)"``.
     """
-    if name:
-        return f"estimator {name}"
+    if name or ":" in o["estimator"]:  # a user's block, module:Class
+        return f"estimator {name or o['estimator']}"
     kind = o["estimator"]
     gains = estimator_gains(o)
     if kind == "linear":
@@ -296,6 +311,7 @@ def describe(o: dict, estimator: str | None = None) -> list[str]:
         sensors.append(f"{o['compensation']} compensation")
     defaults = {key: option.default for key, option in OPTIONS.items()}
     others = [f"{key}={o[key]}" for key in OPTIONS if key not in _TITLED and o[key] != defaults[key]]
+    others += [f"{key}={o[key]}" for key in o if "." in key]  # block parameters set by name
     return [f"tp: {estimator_text(o, estimator)}", f"{flight}, {FEEDBACK_NAMES[o['feedback']]}",
             ", ".join(sensors) + ("; " + ", ".join(others) if others else "")]
 
@@ -420,5 +436,7 @@ def diagram_title(o: dict) -> str:
     return title_lines(*describe(o))
 
 
+# IMU parameters the options set: --set IMU.seed=... would contradict the option seed
+DERIVED = {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed", "IMU.sample_rate": "imu_rate"}
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    extra={"diagram": True, "title": diagram_title})
+                    extra={"diagram": True, "title": diagram_title, "derived": DERIVED})

@@ -72,3 +72,12 @@ TABLE = Table(
           for a in _AXES],
     ],
 )
+
+# Other names a user may give a parameter vector (``--set IMU.gyro_bias=0.01,0,0``): the outputs
+# ``gyro_bias_x..z`` are the true bias as it walks, the parameters ``b_g_x..z`` its initial value
+ALIASES = {"gyro_bias": "b_g", "acc_bias": "b_a"}
+# Parameters that act only while a Boolean switch is true (setting one while it is off is refused)
+SWITCHED = {
+    "noise_enabled": ("gyro_noise_density", "acc_noise_density", "mag_noise_density"),
+    "bias_enabled": ("b_g", "b_a", "gyro_bias_walk", "acc_bias_walk"),
+}

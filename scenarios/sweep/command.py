@@ -20,7 +20,8 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
     p.add_argument("scenario", help="a scenario (quadcosim list) or a named sweep (lab-matrix)")
     p.add_argument("--grid", action="append", default=[], metavar="NAME=SPEC",
                    help="vary an option: a,b,c | start:stop:logN | start:stop:linN | start:stop (integers)")
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="fix an option")
+    p.add_argument("--set", action="extend", nargs="+", default=[], metavar="NAME=VALUE",
+                   help="fix options (several after one flag) or block parameters (IMU.gyro_noise_density=0.001)")
     p.add_argument("--seeds", metavar="N|A:B", help="Monte Carlo: the seed option over 1..N (or A..B)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="use a running Dask scheduler (tcp://host:8786)")

@@ -1,0 +1,216 @@
+"""Block parameters set by name, checked against the FMU's variable table.
+
+``"IMU.gyro_noise_density"`` names one FMU parameter; ``"IMU.b_g"`` a parameter vector
+(``b_g_x, b_g_y, b_g_z``), given as three numbers (``"0.01,0,0"`` or a sequence). A model's
+variable module may declare ``ALIASES`` (another name for a parameter vector, such as
+``gyro_bias`` for ``b_g``) and ``SWITCHED`` (a Boolean parameter and the parameters that act only
+while it is true: setting a noise density while the noise is off is refused rather than ignored).
+
+A value given as text may carry the variable's unit after it (``"0.002 rad/s/Hz0.5"``); another
+unit is refused with the expected one named. A Python block's parameters are its public numeric
+attributes (``Quaternion_estim.beta``), set before the run starts it.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import numbers
+import re
+
+from orchestrator.fmu import nearest
+from orchestrator.result import expand
+
+_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(.*)", re.IGNORECASE)
+_NOT_PARAMETERS = ("name", "period", "feedthrough", "inputs", "outputs")
+
+
+def fmu_parameters(model: str) -> dict:
+    """The parameters of a built FMU, by name: fmpy's variables (``type``, ``start``, ``unit``,
+    ``description``)."""
+    from fmpy import read_model_description
+
+    from fmus import fmu_path
+
+    description = read_model_description(str(fmu_path(model)))
+    return {v.name: v for v in description.modelVariables if v.causality == "parameter"}
+
+
+def model_notes(model: str) -> tuple[dict, dict]:
+    """``ALIASES`` and ``SWITCHED`` of ``fmus/<model>/variables.py`` (empty if none)."""
+    try:
+        module = importlib.import_module(f"fmus.{model}.variables")
+    except ImportError:
+        return {}, {}
+    return dict(getattr(module, "ALIASES", {})), dict(getattr(module, "SWITCHED", {}))
+
+
+def resolve(system, target: str, value) -> dict:
+    """Parameter values that ``target = value`` stands for, checked.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+        The system holding the block.
+    target : str
+        ``"Block.parameter"``: an FMU parameter or parameter vector (or an alias of one), or a
+        numeric attribute of a Python block.
+    value : str, number, bool or sequence
+        Text (``"0.01"``, ``"true"``, ``"0.01,0,0"``, optionally followed by the unit) or values.
+
+    Returns
+    -------
+    dict
+        Parameter name (within the block) to its value, one entry per component.
+
+    Raises
+    ------
+    KeyError
+        Unknown block or parameter; the message names the nearest names.
+    ValueError
+        A value of the wrong type, count or unit.
+    """
+    block_name, dot, name = target.partition(".")
+    if not dot or not name:
+        raise ValueError(f"{target!r}: write Block.parameter=value, e.g. IMU.gyro_noise_density=0.001")
+    block = system.blocks.get(block_name)
+    if block is None:
+        raise KeyError(f"unknown block {block_name!r} in {target!r}.{nearest(block_name, system.blocks)} "
+                       f"Blocks: {', '.join(system.blocks)}.")
+    if not hasattr(block, "parameter_names"):
+        return {name: _python_value(block, name, value)}
+    variables = fmu_parameters(block.model)
+    aliases, _ = model_notes(block.model)
+    members = expand(aliases.get(name, name), variables)
+    if not members:
+        listed = list(variables) + list(aliases)
+        raise KeyError(f"{block_name} has no parameter {name!r}.{nearest(name, listed)} Its parameters are listed, "
+                       f"with their units, by `quadcosim list --parameters {block.model}`.")
+    texts = _components(target, value, len(members))
+    return {m: _parse(f"{block_name}.{m}", variables[m], t) for m, t in zip(members, texts, strict=True)}
+
+
+def apply(system, settings: dict) -> dict:
+    """Set block parameters ``{"Block.parameter": value}`` on ``system`` before its run.
+
+    Returns the values set, as they will be used: a number, or a list for a vector.
+
+    Raises
+    ------
+    KeyError, ValueError
+        As :func:`resolve`; or a parameter set while the switch it needs is off.
+    """
+    resolved = {}
+    for target, value in settings.items():
+        block_name = target.partition(".")[0]
+        values = resolve(system, target, value)
+        block = system.blocks[block_name]
+        if hasattr(block, "parameter_names"):
+            block.parameters.update(values)
+        else:
+            for name, v in values.items():
+                setattr(block, name, v)
+        resolved[target] = list(values.values()) if len(values) > 1 else next(iter(values.values()))
+    for target in settings:
+        _check_switch(system, target)
+    return resolved
+
+
+def _check_switch(system, target: str):
+    block_name, _, name = target.partition(".")
+    block = system.blocks[block_name]
+    if not hasattr(block, "parameter_names"):
+        return
+    aliases, switched = model_notes(block.model)
+    name = aliases.get(name, name)
+    variables = None
+    for switch, governed in switched.items():
+        if any(expand(g, [name]) for g in governed):
+            variables = variables or fmu_parameters(block.model)
+            on = block.parameters.get(switch, variables[switch].start)
+            if str(on).lower() not in ("true", "1"):
+                raise ValueError(f"{target} has no effect while {block_name}.{switch} is false: turn it on "
+                                 f"(the scenario's option that sets {switch}, or --set {block_name}.{switch}=true)")
+
+
+def _components(target: str, value, count: int) -> list:
+    if isinstance(value, str):
+        parts = [p.strip() for p in value.strip().strip("()[]").split(",")]
+    elif isinstance(value, (list, tuple)) or hasattr(value, "__array__"):
+        parts = list(value)
+    else:
+        parts = [value]
+    if len(parts) != count:
+        raise ValueError(f"{target} has {count} component{'s' * (count > 1)}: give {count} value"
+                         f"{'s' * (count > 1)}{', comma-separated' if count > 1 else ''}, not {len(parts)}")
+    return parts
+
+
+def _parse(label: str, variable, value):
+    """The value of one FMU parameter from text or a number, checked against its type and unit."""
+    kind = variable.type
+    if kind == "Boolean":
+        text = str(value).strip().lower()
+        if text in ("1", "true", "on", "yes"):
+            return True
+        if text in ("0", "false", "off", "no"):
+            return False
+        raise ValueError(f"{label} = {value!r}: give true or false")
+    if isinstance(value, str):
+        match = _NUMBER.fullmatch(value)
+        if not match:
+            raise ValueError(f"{label} = {value!r} is not a number{_unit_hint(variable)}")
+        number, unit = match.group(1), match.group(2).strip()
+        expected = variable.unit or ""
+        if unit and unit != expected:
+            raise ValueError(f"{label} = {value!r}: the unit is {expected or 'none (a pure number)'}, not {unit!r}; "
+                             f"give the value in {expected or 'no unit'}")
+        value = number
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{label} = {value!r} is not a number{_unit_hint(variable)}") from None
+    if not math.isfinite(number):
+        raise ValueError(f"{label} = {value!r} must be a finite number{_unit_hint(variable)}")
+    if kind == "Integer":
+        if number != int(number):
+            raise ValueError(f"{label} = {value!r} must be an integer")
+        return int(number)
+    return number
+
+
+def _unit_hint(variable) -> str:
+    return f" (in {variable.unit})" if variable.unit else ""
+
+
+def python_parameters(block) -> list[str]:
+    """A Python block's settable parameters: its public numeric attributes."""
+    return sorted(k for k, v in vars(block).items()
+                  if not k.startswith("_") and k not in _NOT_PARAMETERS
+                  and isinstance(v, numbers.Real))
+
+
+def _python_value(block, name: str, value):
+    settable = python_parameters(block)
+    if name not in settable:
+        raise KeyError(f"{block.name} has no parameter {name!r}.{nearest(name, settable)} "
+                       f"{'Its parameters: ' + ', '.join(settable) if settable else 'It has no numeric parameter'}"
+                       " (a Python block's parameters are its public numeric attributes).")
+    present = getattr(block, name)
+    label = f"{block.name}.{name}"
+    if isinstance(present, bool):
+        text = str(value).strip().lower()
+        if text not in ("1", "true", "on", "yes", "0", "false", "off", "no"):
+            raise ValueError(f"{label} = {value!r}: give true or false")
+        return text in ("1", "true", "on", "yes")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{label} = {value!r} is not a number") from None
+    if not math.isfinite(number):
+        raise ValueError(f"{label} = {value!r} must be a finite number")
+    if isinstance(present, numbers.Integral):
+        if number != int(number):
+            raise ValueError(f"{label} = {value!r} must be an integer")
+        return int(number)
+    return number
