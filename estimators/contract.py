@@ -34,9 +34,9 @@ Construction and parameters
     Given as a class (``--estimator module:Class``), the block is built as
     ``Class(period=..., q0=...)``: the IMU's period and the vehicle's initial attitude (body to
     NED, scalar first), each if the constructor takes it (a plain :class:`orchestrator.Block`
-    subclass is built as ``Class(name, period=...)``). Given as an instance, the scenario sets its ``period`` to the IMU's. A
-    Python block's parameters are its public numeric attributes: ``--set Quaternion_estim.beta=0.1``
-    sets ``beta`` before the run.
+    subclass is built as ``Class(name, period=...)``). Given as an instance, the scenario sets
+    its ``period`` to the IMU's. A Python block's parameters are its public numeric attributes:
+    ``--set Quaternion_estim.beta=0.1`` sets ``beta`` before the run.
 
 :class:`AttitudeEstimator` fills in everything but the filter: a subclass implements
 :meth:`AttitudeEstimator.update` on ``self.q`` (and ``self.bias``); the README's Madgwick
