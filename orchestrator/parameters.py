@@ -26,8 +26,18 @@ _NOT_PARAMETERS = ("name", "period", "feedthrough", "inputs", "outputs")
 
 
 def fmu_parameters(model: str) -> dict:
-    """The parameters of a built FMU, by name: fmpy's variables (``type``, ``start``, ``unit``,
-    ``description``)."""
+    """The parameters of a built FMU, by name.
+
+    Parameters
+    ----------
+    model : str
+        FMU model name (``"IMU"``).
+
+    Returns
+    -------
+    dict
+        Name to fmpy's variable (``type``, ``start``, ``unit``, ``description``).
+    """
     from fmpy import read_model_description
 
     from fmus import fmu_path
@@ -91,9 +101,18 @@ def resolve(system, target: str, value) -> dict:
 
 
 def apply(system, settings: dict) -> dict:
-    """Set block parameters ``{"Block.parameter": value}`` on ``system`` before its run.
+    """Set block parameters on ``system`` before its run.
 
-    Returns the values set, as they will be used: a number, or a list for a vector.
+    Parameters
+    ----------
+    system : orchestrator.System
+    settings : dict
+        ``{"Block.parameter": value}``, each as :func:`resolve` takes it.
+
+    Returns
+    -------
+    dict
+        The values set, as they will be used: a number, or a list for a vector.
 
     Raises
     ------

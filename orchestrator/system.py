@@ -143,70 +143,26 @@ class System:
                 raise ValueError(f"{d} is already connected to {self.connections[d]}; an input has one source")
 
     def set_parameter(self, target: str, value):
-        """Set a block parameter before the run, checked against the FMU's variable table.
+        """Set a block parameter before the run; returns the value set.
 
         Parameters
         ----------
         target : str
-            ``"Block.parameter"``: an FMU parameter (``"IMU.gyro_noise_density"``), a parameter
-            vector (``"IMU.gyro_bias"``: ``b_g_x..z``), or a public numeric attribute of a Python
-            block (``"Quaternion_estim.beta"``). ``quadcosim list --parameters MODEL`` lists an
-            FMU's parameters with their units.
+            ``"Block.parameter"``: an FMU parameter, vector or alias, checked against the FMU's
+            variable table, or a Python block's numeric attribute.
         value : number, bool, str or sequence
-            In the parameter's unit; text may end with that unit (``"0.002 rad/s/Hz0.5"``); a
-            vector takes one value per component.
-
-        Returns
-        -------
-        object
-            The value set (a list for a vector).
-
-        Raises
-        ------
-        KeyError
-            Unknown block or parameter (the message names the nearest ones).
-        ValueError
-            A value of the wrong type, count or unit, or a parameter whose switch is off.
+            In the parameter's unit (see :func:`orchestrator.parameters.resolve`).
         """
         from orchestrator.parameters import apply
 
         return apply(self, {target: value})[target]
 
     def replace(self, name: str, block):
-        """Put ``block`` in the place of the block called ``name``, keeping its connections.
+        """Put ``block`` in the place of block ``name`` (it takes that name), keeping the wiring;
+        see :func:`orchestrator.replace.replace`. Returns ``block``."""
+        from orchestrator.replace import replace
 
-        ``block`` takes the name ``name``. Connections into inputs the new block does not have
-        are dropped; inputs it adds are left for :meth:`connect` (a run refuses unconnected
-        inputs). Every output of the old block that feeds another block must exist on the new one.
-
-        Returns
-        -------
-        The new block.
-
-        Raises
-        ------
-        KeyError
-            No block ``name``, or the new block lacks an output that is connected or an input
-            where a fault is injected.
-        """
-        if name not in self.blocks:
-            raise KeyError(f"unknown block {name!r}.{nearest(name, self.blocks)} Blocks: {', '.join(self.blocks)}.")
-        used = sorted({s.split(".", 1)[1] for s in self.connections.values() if s.split(".", 1)[0] == name})
-        missing = [y for y in used if y not in block.outputs]
-        if missing:
-            raise KeyError(f"the block replacing {name} lacks the output{'s' * (len(missing) > 1)} "
-                           f"{', '.join(missing)}, which other blocks read")
-        lost = [f.target for f in self.faults if f.target.split(".", 1)[0] == name
-                and f.target.split(".", 1)[1] not in block.inputs]
-        if lost:
-            raise KeyError(f"the block replacing {name} lacks the input{'s' * (len(lost) > 1)} {', '.join(lost)}, "
-                           "where a fault is injected")
-        block.name = name
-        for destination in [d for d in self.connections if d.split(".", 1)[0] == name]:
-            if destination.split(".", 1)[1] not in block.inputs:
-                del self.connections[destination]
-        self.blocks[name] = block
-        return block
+        return replace(self, name, block)
 
     def inject(self, fault: Fault) -> Fault:
         """Add a fault on the connection into ``fault.target``."""
