@@ -124,3 +124,50 @@ def apply_faults(taps: list[FaultTap], bus: np.ndarray, t: float) -> None:
     """
     for tap in taps:
         bus[tap.slot] = tap.fault.apply(t, bus[tap.source])
+
+
+def suspects(faults: list[Fault], connections: dict[str, str], block: str,
+             t: float) -> list[tuple[Fault, list[str]]]:
+    """The faults that may have made ``block`` fail at time ``t``: those started by then on an
+    input of ``block`` or of a block that feeds it, directly or through others.
+
+    Parameters
+    ----------
+    faults : list of Fault
+        The injected faults (targets resolved, ``"Block.input"``).
+    connections : dict
+        Destination ``"B.u"`` to source ``"A.y"``, as :class:`orchestrator.System` holds them.
+    block : str
+        The block whose output failed.
+    t : float
+        Time of the failure (s).
+
+    Returns
+    -------
+    list of (Fault, list of str)
+        Each suspect and the path of blocks from its target to ``block``.
+    """
+    feeders: dict[str, set[str]] = {}
+    for destination, source in connections.items():
+        feeders.setdefault(destination.split(".", 1)[0], set()).add(source.split(".", 1)[0])
+    paths, frontier = {block: [block]}, [block]
+    while frontier:  # breadth first, upstream: the shortest path from each block to ``block``
+        following = []
+        for name in frontier:
+            for feeder in sorted(feeders.get(name, ())):
+                if feeder not in paths:
+                    paths[feeder] = [feeder] + paths[name]
+                    following.append(feeder)
+        frontier = following
+    found = []
+    for fault in faults:
+        target = fault.target.split(".", 1)[0]
+        if fault.start <= t and target in paths:
+            found.append((fault, paths[target]))
+    return found
+
+
+def describe(fault: Fault) -> str:
+    """``"the offset fault on IMU.omega_x (value 0.05, from 0.5 s to 1 s)"``."""
+    value = "" if fault.value is None else f"value {fault.value:g}, "
+    return f"the {fault.kind} fault on {fault.target} ({value}from {fault.start:g} s to {fault.stop:g} s)"

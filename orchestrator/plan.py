@@ -44,7 +44,7 @@ import numpy as np
 from orchestrator.blocks import Block, FMUBlock
 from orchestrator.calls import DoStep, FMICall, GetOutputs, SetInputs, batch
 from orchestrator.errors import RunInterrupted, SimulationError
-from orchestrator.faults import FaultTap, apply_faults
+from orchestrator.faults import FaultTap, apply_faults, describe, suspects
 from orchestrator.fmu import FMUError
 from orchestrator.interrupts import signal_name, signal_number
 from orchestrator.result import Result, check_record_fits
@@ -376,7 +376,7 @@ class Plan:
                 value = bus[self.slot[name]]
                 if not math.isfinite(value):
                     return (f"{name} became {value} at t = {t:.6g} s (the first non-finite signal in the block "
-                            f"order). Check the block {block.name} and its inputs.")
+                            f"order). " + _cause(self.system, block.name, t))
         return f"a signal became non-finite at t = {t:.6g} s"
 
     def result(self, error: str | None = None) -> Result:
@@ -412,6 +412,23 @@ class Plan:
         for block in self.system.blocks.values():
             if isinstance(block, Block):
                 block.close()
+
+
+def _cause(system, block: str, t: float) -> str:
+    """The injected fault most likely to have made ``block`` fail at ``t``: among those that feed
+    it and had started, one active at ``t`` first, then the nearest, then the latest started.
+    Without one, the block to check."""
+    found = suspects(system.faults, system.connections, block, t)
+    if not found:
+        return f"Check the block {block} and its inputs."
+    found.sort(key=lambda item: (not item[0].start <= t < item[0].stop, len(item[1]), -item[0].start))
+    (fault, path), others = found[0], found[1:]
+    where = f"on an input of {block}" if len(path) == 1 else f"feeding it through {' -> '.join(path)}"
+    state = "active at that time" if fault.start <= t < fault.stop else "over by then"
+    text = f"Likely cause: {describe(fault)}, {state}, {where}. Remove it or lower its value."
+    if others:
+        text += f" Other faults that had started and feed {block}: " + "; ".join(describe(f) for f, _ in others) + "."
+    return text
 
 
 def _warn_if_idle(fault, t0: float, steps: int, dt: float):

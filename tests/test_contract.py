@@ -161,3 +161,18 @@ def test_set_parameter_in_python_with_units_and_the_list_shows_them(capsys):
     listing = capsys.readouterr().out
     assert re.search(r"gyro_noise_density\s+= 0.000174\d*\s+\[rad/s/Hz0.5\]", listing)
     assert "gyro_bias stands for the vector b_g" in listing
+
+
+def test_a_nan_caused_by_a_fault_names_the_fault_not_the_block(tmp_path, capsys):
+    """A gyro offset of 1e300 rad/s into the estimator makes its quaternion NaN: the message
+    names that fault as the cause (active, on the failing block's input) before the others."""
+    code = cli(["run", "tp", "--set", "duration=1", "feedback=estimate", "estimator=explicit",
+                "--fault", "Controller.p_x:offset:0:1:1", "--fault", "Quaternion_estim.gyro_x:offset:0.5:1:1e300",
+                "--out", str(tmp_path / "run"), "--format", "npz"])
+    message = capsys.readouterr().err
+    assert code == 1
+    assert ("Quaternion_estim.q_est0 became nan at t = 0.5 s (the first non-finite signal in the block order). "
+            "Likely cause: the offset fault on Quaternion_estim.gyro_x (value 1e+300, from 0.5 s to 1 s), active "
+            "at that time, on an input of Quaternion_estim.") in message
+    assert "Other faults that had started and feed Quaternion_estim: the offset fault on Controller.p_x" in message
+    assert "Check the block" not in message
