@@ -100,7 +100,7 @@ def resolve(system, target: str, value) -> dict:
     return {m: _parse(f"{block_name}.{m}", variables[m], t) for m, t in zip(members, texts, strict=True)}
 
 
-def apply(system, settings: dict) -> dict:
+def apply(system, settings: dict, options: dict | None = None) -> dict:
     """Set block parameters on ``system`` before its run.
 
     Parameters
@@ -108,6 +108,9 @@ def apply(system, settings: dict) -> dict:
     system : orchestrator.System
     settings : dict
         ``{"Block.parameter": value}``, each as :func:`resolve` takes it.
+    options : dict, optional
+        ``{"Block.parameter": "option"}``: the scenario option that sets a parameter, named in
+        messages (``IMU.noise_enabled`` is set by ``tp``'s option ``noise``).
 
     Returns
     -------
@@ -131,11 +134,11 @@ def apply(system, settings: dict) -> dict:
                 setattr(block, name, v)
         resolved[target] = list(values.values()) if len(values) > 1 else next(iter(values.values()))
     for target in settings:
-        _check_switch(system, target)
+        _check_switch(system, target, options or {})
     return resolved
 
 
-def _check_switch(system, target: str):
+def _check_switch(system, target: str, options: dict):
     block_name, _, name = target.partition(".")
     block = system.blocks[block_name]
     if not hasattr(block, "parameter_names"):
@@ -148,8 +151,9 @@ def _check_switch(system, target: str):
             variables = variables or fmu_parameters(block.model)
             on = block.parameters.get(switch, variables[switch].start)
             if str(on).lower() not in ("true", "1"):
-                raise ValueError(f"{target} has no effect while {block_name}.{switch} is false: turn it on "
-                                 f"(the scenario's option that sets {switch}, or --set {block_name}.{switch}=true)")
+                option = options.get(f"{block_name}.{switch}")
+                fix = f"--set {option}=true" if option else f"--set {block_name}.{switch}=true"
+                raise ValueError(f"{target} has no effect while {block_name}.{switch} is false: turn it on ({fix})")
 
 
 def _components(target: str, value, count: int) -> list:

@@ -160,7 +160,7 @@ class Scenario:
                 if option is not None:
                     raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
                                      f"use --set {option}=... instead of {key}")
-        options.update(apply(system, settings))
+        options.update(apply(system, settings, derived))
         return system
 
 

@@ -138,7 +138,7 @@ def test_several_settings_after_one_set_flag_and_vector_parameters(tmp_path):
     ("IMU.gyro_noise_density=fast", "is not a number (in rad/s/Hz0.5)"),
     ("IMU.gyro_bias=0.01,0", "has 3 components: give 3 values, comma-separated, not 2"),
     ("IMU.seed=3", "IMU.seed is set by scenario tp's option seed: use --set seed=..."),
-    ("IMU.acc_noise_density=0.01", "has no effect while IMU.noise_enabled is false"),
+    ("IMU.acc_noise_density=0.01", "has no effect while IMU.noise_enabled is false: turn it on (--set noise=true)"),
     ("Imu.seed=1", "unknown block 'Imu'"),
     ("Quaternion_estim.beta=1", "Quaternion_estim has no parameter 'beta'"),
 ])
