@@ -53,6 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
+from estimators.core import euler_from_quaternion
 from orchestrator.blocks import Block
 
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")
@@ -60,8 +61,12 @@ R_REEL = tuple(f"R_reel_{i}{j}" for i in range(1, 4) for j in range(1, 4))
 INPUTS = MEASUREMENTS + R_REEL
 REQUIRED = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "theta_est3",
             "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z")
-UNITS = {**dict.fromkeys(REQUIRED[:4], "1"), **dict.fromkeys(REQUIRED[4:7], "rad"),
-         **dict.fromkeys(REQUIRED[7:], "rad/s")}
+# where AttitudeEstimator reads its inputs and writes its outputs (the order of the names above)
+ACC, GYRO, MAG = slice(0, 3), slice(3, 6), slice(6, 9)
+Q, THETA, BIAS, OMEGA = slice(0, 4), slice(4, 7), slice(7, 10), slice(10, 13)
+UNITS = {**dict.fromkeys(REQUIRED[Q], "1"), **dict.fromkeys(REQUIRED[THETA], "rad"),
+         **dict.fromkeys(REQUIRED[BIAS] + REQUIRED[OMEGA], "rad/s")}
+assert MEASUREMENTS[GYRO] == ("gyro_x", "gyro_y", "gyro_z") and REQUIRED[OMEGA][0] == "omega_est_x"
 
 
 class AttitudeEstimator(Block):
@@ -90,7 +95,15 @@ class AttitudeEstimator(Block):
         self.q0 = None if q0 is None else _unit_quaternion(q0)
 
     def start(self, t0, dt):
-        """Reset: ``self.q`` to ``q0``, ``self.bias`` to zero; ``dt`` (s) is the block's step."""
+        """Reset: ``self.q`` to ``q0``, ``self.bias`` to zero.
+
+        Parameters
+        ----------
+        t0 : float
+            Start time (s).
+        dt : float
+            The block's step (s), kept as ``self.dt``.
+        """
         self.dt = dt
         self.q = np.array((1.0, 0.0, 0.0, 0.0)) if self.q0 is None else self.q0.copy()
         self.bias = np.zeros(3)
@@ -110,14 +123,11 @@ class AttitudeEstimator(Block):
         raise NotImplementedError(f"{type(self).__name__} must implement update(acc, gyro, mag)")
 
     def step(self, t, u, y):
-        self.update(u[0:3], u[3:6], u[6:9])
-        q = self.q
-        y[0:4] = q
-        y[4] = np.arctan2(2.0 * (q[2] * q[3] + q[0] * q[1]), 1.0 - 2.0 * (q[1] ** 2 + q[2] ** 2))
-        y[5] = np.arcsin(np.clip(2.0 * (q[0] * q[2] - q[1] * q[3]), -1.0, 1.0))
-        y[6] = np.arctan2(2.0 * (q[1] * q[2] + q[0] * q[3]), 1.0 - 2.0 * (q[2] ** 2 + q[3] ** 2))
-        y[7:10] = self.bias
-        y[10:13] = u[3:6] - self.bias
+        self.update(u[ACC], u[GYRO], u[MAG])
+        y[Q] = self.q
+        euler_from_quaternion(self.q, y[THETA])
+        y[BIAS] = self.bias
+        y[OMEGA] = u[GYRO] - self.bias
 
 
 def _unit_quaternion(q) -> np.ndarray:
@@ -244,6 +254,13 @@ def _arguments(cls, offered: dict) -> dict:
 
 def check(block, available=INPUTS) -> None:
     """Refuse a block that breaks the contract, naming what is missing.
+
+    Parameters
+    ----------
+    block : orchestrator.Block
+        The estimator.
+    available : sequence of str
+        The inputs the scenario can wire.
 
     Raises
     ------
