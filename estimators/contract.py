@@ -23,7 +23,9 @@ Outputs (:data:`REQUIRED`, in any order, each written at every step)
     ``omega_est_x..z``  angular rate for the controller, ``gyro - b_est`` (rad/s, body).
     With ``feedback=estimate`` the controller flies on ``q_est`` and ``omega_est``; the report
     scores ``theta_est`` against the truth and ``b_est`` against the IMU's true bias. Other
-    outputs (``acc_weight, mag_weight, at_rest``, anything else) are recorded as well.
+    outputs (``acc_weight, mag_weight, at_rest``, anything else) are recorded as well. A
+    ``units`` attribute, ``{output: unit}`` (:data:`UNITS` for these), labels the outputs in
+    plots and result files.
 
 Rate and timing
     The scenario runs the block at the IMU's rate: its ``period`` is the IMU's, in macro steps,
@@ -89,6 +91,7 @@ class AttitudeEstimator(Block):
 
     inputs = MEASUREMENTS
     outputs = REQUIRED
+    units = UNITS  # of the outputs, for plots and result files
 
     def __init__(self, name: str = "Quaternion_estim", period: int = 1, q0=None):
         super().__init__(name, period)

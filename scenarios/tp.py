@@ -34,7 +34,7 @@ OPTIONS = {
     "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
     "noise": Option(False, "IMU white noise"),
-    "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s"),
+    "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s, or IMU.gyro_bias=x,y,z"),
     "rotor_drag": Option(True, "rotor drag (H-force) on the airspeed, the Quadrotor's k_d; off: k_d = 0"),
     "wind_n": Option(0.0, "steady wind towards the north (m/s)"),
     "wind_e": Option(0.0, "steady wind towards the east (m/s)"),
@@ -305,7 +305,8 @@ def describe(o: dict, estimator: str | None = None) -> list[str]:
     """
     flight = FLIGHT_NAMES[o["flight"]] + (f" {o['tilt_deg']:g} deg" if o["flight"] == "tilt" else "")
     sensors = [f"IMU noise {'on' if o['noise'] else 'off'}",
-               "gyro bias (0.02, -0.01, 0.015) rad/s" if o["bias"] else "no gyro bias",
+               ("gyro bias on" if any(k.startswith(("IMU.gyro_bias", "IMU.b_g")) for k in o)  # its value in others
+                else "gyro bias (0.02, -0.01, 0.015) rad/s") if o["bias"] else "no gyro bias",
                "motor-current field " + ("on" if o["magnetic"] else "off")]
     if o["compensation"] != "none":
         sensors.append(f"{o['compensation']} compensation")
