@@ -258,6 +258,8 @@ class FMUBlock:
         self.inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
         self.outputs = tuple(v.name for v in variables if v.causality == "output" and v.type == "Real")
         self.parameter_names = tuple(v.name for v in variables if v.causality == "parameter")
+        self.units = {v.name: v.unit or getattr(v.declaredType, "unit", None) or ""  # labels the results
+                      for v in variables if v.name in self.outputs}
         unknown = set(self.parameters) - set(self.parameter_names)
         if unknown:
             from orchestrator.fmu import nearest

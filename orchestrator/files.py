@@ -89,7 +89,7 @@ def prepare_out_dir(out, overwrite: bool = False) -> Path:
         raise ValueError(f"--out {out}: cannot create the folder ({error.strerror}); choose another place") from None
     if not os.access(out, os.W_OK | os.X_OK):
         raise ValueError(f"--out {out}: the folder is not writable; choose another place")
-    earlier = [name for name in RESULT_FILES if (out / name).exists()]
+    earlier = holds_results(out)
     if earlier:
         if not overwrite:
             raise ValueError(f"--out {out} already holds results ({', '.join(earlier)}); give another folder "
@@ -97,6 +97,23 @@ def prepare_out_dir(out, overwrite: bool = False) -> Path:
         for name in {*earlier, *_listed_files(out)}:
             (out / name).unlink(missing_ok=True)
     return out
+
+
+def holds_results(out) -> list[str]:
+    """The result files of an earlier run in folder ``out`` (empty if none, or no folder)."""
+    out = Path(out)
+    return [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
+
+
+def free_folder(base) -> Path:
+    """``base`` if it holds no results, else the first of ``base-2``, ``base-3``, ... that
+    holds none: a default output folder never replaces earlier results."""
+    base = Path(base)
+    candidate, number = base, 1
+    while holds_results(candidate) or (candidate.exists() and not candidate.is_dir()):
+        number += 1
+        candidate = base.with_name(f"{base.name}-{number}")
+    return candidate
 
 
 def _listed_files(out: Path) -> list[str]:

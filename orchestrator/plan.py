@@ -47,7 +47,8 @@ from orchestrator.errors import RunInterrupted, SimulationError
 from orchestrator.faults import FaultTap, apply_faults, describe, suspects
 from orchestrator.fmu import FMUError
 from orchestrator.interrupts import signal_name, signal_number
-from orchestrator.result import Result, check_record_fits
+from orchestrator.progress import Progress
+from orchestrator.result import Result, check_record_fits, signal_units
 
 
 class Copy(NamedTuple):
@@ -177,12 +178,18 @@ class Plan:
         self.bus = np.zeros(len(self.slot) + len(self.system.faults))
 
     def _plan_recording(self, record):
-        if record is None:
-            slots = list(range(len(self.slot)))
+        ties = {f"{b.name}.{y}": float(value) for b in self.system.blocks.values() if getattr(b, "ties", None)
+                for y, value in zip(b.outputs, b.values, strict=True)}
+        self.constant_inputs = {into: ties[source] for into, source in self.system.connections.items()
+                                if source in ties}
+        if record is None:  # every output but the tie-offs of System.set_input (in meta as constant_inputs)
+            hidden = set(ties)
+            slots = [s for name, s in self.slot.items() if name not in hidden]
         else:
             slots = sorted({self.slot[name] for signal in record for name in self.system._resolve(signal, "output")})
         by_slot = {v: k for k, v in self.slot.items()}
         self.names = [by_slot[s] for s in slots]
+        self.units = signal_units(self.system.blocks, self.names)
         self.record_copies = copies(slots)
         rows = self.steps // self.decimation + 1
         check_record_fits(rows, len(slots), self.decimation)
@@ -287,7 +294,8 @@ class Plan:
         Parameters
         ----------
         progress : bool
-            Show a progress bar on runs longer than a few seconds of wall time.
+            Show the run's progress on standard error (:class:`orchestrator.progress.Progress`:
+            a bar on a terminal, a few plain lines otherwise).
         master : {"chunk", "step"}
             ``"chunk"``: the compiled chunk runner (:mod:`orchestrator.chunks`) runs whole chunks
             of steps in C; ``"step"``: this loop, in Python, one step at a time. Both give
@@ -301,7 +309,7 @@ class Plan:
         from orchestrator.chunks import ChunkRunner
 
         runner = ChunkRunner(self) if master == "chunk" else None  # compiled steps loaded here, not timed
-        bar = _progress(self.steps * self.dt) if progress else None
+        bar = Progress(self.steps * self.dt, "run") if progress else None
         self.n = 0
         started, cpu = time.perf_counter(), time.process_time()
         try:
@@ -309,6 +317,8 @@ class Plan:
                 runner.run(bar)
             else:
                 self._run_steps(bar)
+            if bar is not None:  # both return only when the run reached its end
+                bar.complete()
         except _Failure as failure:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
@@ -355,7 +365,7 @@ class Plan:
                     if period == 1 or n % period == 0:
                         fn(t)
                 if bar is not None and n % chunk == 0 and n:
-                    bar.update(n * dt - bar.n)  # respects the bar's delay, unlike refresh()
+                    bar.update(n * dt - bar.n)
         finally:
             self.n = n
 
@@ -402,7 +412,8 @@ class Plan:
         meta = {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
                 "loop_cpu_seconds": getattr(self, "loop_cpu_seconds", None),
                 "order": [b.name for b in self.order],
-                "connections": dict(self.system.connections), "fmu_warnings": warnings}
+                "connections": dict(self.system.connections), "fmu_warnings": warnings, "units": self.units,
+                "constant_inputs": self.constant_inputs}
         return Result(times, self.names, self.record[:rows], meta, error)
 
     def close(self):
@@ -439,11 +450,3 @@ def _warn_if_idle(fault, t0: float, steps: int, dt: float):
         warnings.warn(f"the {fault.kind} fault on {fault.target} acts for {fault.start} s <= t < {fault.stop} s, "
                       f"when no step of the run ({t0:g} s to {t0 + steps * dt:g} s, every {dt:g} s) falls: "
                       "it has no effect", RuntimeWarning, stacklevel=4)
-
-
-def _progress(total_seconds: float):
-    from tqdm import tqdm
-
-    # shown only when a run lasts more than a few seconds of wall time
-    return tqdm(total=total_seconds, unit="s sim", delay=3.0,
-                bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]")

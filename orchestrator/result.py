@@ -1,9 +1,16 @@
-"""Recorded signals of a run, indexed by name, with exports to .npz, .csv and MATLAB .mat."""
+"""Recorded signals of a run, indexed by name, with exports to .npz, .csv and MATLAB .mat.
+
+The ``.npz`` and ``.mat`` files are compressed and carry the signals' units and the run's
+options; vector signals (``IMU.acc``, ``Quadrotor.q``) are stored as N x k arrays and the
+rotation matrix ``IMU.R_reel`` as N x 3 x 3.
+"""
 
 from __future__ import annotations
 
 import csv
 import json
+import re
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +20,74 @@ from orchestrator.fmu import nearest
 
 #: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.
 FORMATS = ("npz", "mat", "csv")
+
+#: What a run writes when no format is asked for: the compressed NumPy archive alone.
+DEFAULT_FORMATS = ("npz",)
+
+# a component: "acc_x" (axis after an underscore), "q0", "omega_r1", "R_reel_11" (index)
+_COMPONENT = re.compile(r"^(?P<base>.+?)(?:_(?P<axis>[xyz])|_?(?P<index>\d+))$")
+
+
+def vector_groups(names) -> dict[str, list[str]]:
+    """The vectors among signal names, each with its components in order.
+
+    Components are ``NAME_x``, ``NAME_y``, ``NAME_z`` or ``NAME0``, ``NAME1``, ... (``NAME_1``
+    too) of one block; at least two make a vector. A vector whose name is itself a signal is
+    left out.
+
+    Parameters
+    ----------
+    names : sequence of str
+        ``"Block.signal"`` names.
+
+    Returns
+    -------
+    dict of str to list of str
+        ``{"IMU.acc": ["IMU.acc_x", "IMU.acc_y", "IMU.acc_z"], "IMU.R_reel": [...9 names], ...}``
+        in the order of first appearance.
+    """
+    groups: dict[str, list[tuple]] = {}
+    for name in names:
+        block, dot, signal = name.partition(".")
+        match = _COMPONENT.match(signal)
+        if dot and match:
+            key = "xyz".index(match["axis"]) if match["axis"] else int(match["index"])
+            groups.setdefault(f"{block}.{match['base']}", []).append((key, name))
+    taken = set(names)
+    return {vector: [name for _, name in sorted(members)] for vector, members in groups.items()
+            if len(members) > 1 and vector not in taken}
+
+
+def matrix_shape(components: list[str]) -> tuple[int, ...]:
+    """``(3, 3)`` for the nine components ``_11`` to ``_33`` of a rotation matrix, row by row;
+    ``(k,)`` for any other vector of ``k`` components."""
+    indices = [_COMPONENT.match(c.partition(".")[2])["index"] for c in components]
+    if len(components) == 9 and indices == [f"{i}{j}" for i in "123" for j in "123"]:
+        return (3, 3)
+    return (len(components),)
+
+
+def signal_units(blocks, names) -> dict[str, str]:
+    """The unit of each recorded signal, from its block: an FMU's model description, or the
+    ``units`` dictionary a Python block declares (``""`` where none is known).
+
+    Parameters
+    ----------
+    blocks : dict of str to block
+        The system's blocks by name (``System.blocks``).
+    names : sequence of str
+        Recorded ``"Block.signal"`` names.
+
+    Returns
+    -------
+    dict of str to str
+        Unit of each name, e.g. ``{"IMU.acc_x": "m/s2"}``.
+    """
+    units = {}
+    for name in names:
+        block, _, signal = name.partition(".")
+        units[name] = str(getattr(blocks.get(block), "units", {}).get(signal, "") or "")
+    return units
 
 
 def available_memory() -> int | None:
@@ -158,6 +233,17 @@ class Result:
     def __len__(self):
         return len(self.time)
 
+    @property
+    def units(self) -> dict[str, str]:
+        """Unit of each signal (``"m/s2"``, ``"rad"``; ``""`` where none is known), with
+        ``"time": "s"``."""
+        return {"time": "s", **{n: "" for n in self.names}, **self.meta.get("units", {})}
+
+    @property
+    def options(self) -> dict:
+        """The options of the scenario that made this result (empty for a bare run)."""
+        return dict(self.meta.get("scenario", {}).get("options", {}))
+
     def __contains__(self, name):
         return name in self._index or bool(expand(name, self.names))
 
@@ -194,32 +280,76 @@ class Result:
     # ------------------------------------------------------------------ exports
     # Each export writes a temporary file beside the target and renames it when complete, so
     # an interrupt while saving never leaves a truncated file over earlier results.
-    def to_npz(self, path) -> Path:
-        """Write a NumPy archive: ``time``, one array per signal, and ``_meta`` (JSON).
+    def _chosen(self, signals) -> list[str]:
+        """The recorded names ``signals`` stand for (vector names allowed), in record order; all if None."""
+        if signals is None:
+            return self.names
+        chosen = {member for name in signals for member in self.columns(name)}
+        return [n for n in self.names if n in chosen]
+
+    def _arrays(self, names):
+        """``(name, array)`` to store, one at a time: each vector as one N x k array (a
+        rotation matrix N x 3 x 3), every other signal as a vector of N values."""
+        groups = vector_groups(names)
+        grouped = {c for members in groups.values() for c in members}
+        for name in names:
+            if name not in grouped:
+                yield name, self.data[:, self._index[name]]
+        for vector, members in groups.items():
+            stacked = self.data[:, [self._index[m] for m in members]]
+            yield vector, stacked.reshape(len(self.time), *matrix_shape(members))
+
+    def _description(self, names) -> dict:
+        """The meta data written into the files: units, options, names and vectors included."""
+        units = self.units
+        return self.meta | {"error": self.error, "names": names, "units": {n: units[n] for n in ["time", *names]},
+                            "options": self.options, "vectors": vector_groups(names)}
+
+    def to_npz(self, path, signals=None) -> Path:
+        """Write a compressed NumPy archive.
+
+        It holds ``time`` (s), one array per scalar signal, one N x k array per vector signal
+        (``"IMU.acc"``; ``"IMU.R_reel"`` is N x 3 x 3), and ``_meta``: JSON with ``units``
+        (each signal's unit), ``options`` (the scenario's options), ``names`` and ``vectors``
+        (the components of each vector). :meth:`from_npz` reads it back. The arrays are
+        compressed one at a time: no copy of the whole record is made.
 
         Parameters
         ----------
         path : str or pathlib.Path
             The file, written atomically.
+        signals : list of str, optional
+            The signals to write (vector names allowed); all by default.
 
         Returns
         -------
         pathlib.Path
             ``path``.
         """
+        from orchestrator.progress import Every
+
         path = Path(path)
-        with atomic_path(path) as temporary:
-            np.savez(temporary, time=self.time, **{n: self.data[:, i] for i, n in enumerate(self.names)},
-                     _meta=json.dumps(self.meta | {"error": self.error}, default=float))
+        every = Every(1.5)  # a status line now and then while a long record is written
+        # level 1: as small as the default level 6 on these signals (8.59 against 8.65 MB), twice as fast
+        with atomic_path(path) as temporary, zipfile.ZipFile(temporary, "w", zipfile.ZIP_DEFLATED, allowZip64=True,
+                                                            compresslevel=1) as archive:
+            _write_array(archive, "time", self.time)
+            names = self._chosen(signals)
+            for k, (name, values) in enumerate(self._arrays(names)):
+                _write_array(archive, name, values)
+                every.status(lambda k=k: f"writing {path.name}: {k + 1} arrays written")
+            _write_array(archive, "_meta", np.array(json.dumps(self._description(names), default=_plain_json)))
         return path
 
-    def to_csv(self, path) -> Path:
+    def to_csv(self, path, signals=None) -> Path:
         """Write one row per sample: ``time`` (s) then every signal, full precision.
 
         Parameters
         ----------
         path : str or pathlib.Path
             The file, written atomically.
+        signals : list of str, optional
+            The signals to write (vector names allowed); all by default.
 
         Returns
         -------
@@ -229,18 +359,28 @@ class Result:
         path = Path(path)
         with atomic_path(path) as temporary, temporary.open("w", newline="") as handle:
             writer = csv.writer(handle)
-            writer.writerow(["time", *self.names])
+            names = self._chosen(signals)
+            columns = [self._index[n] for n in names]
+            writer.writerow(["time", *names])
             for t, row in zip(self.time, self.data, strict=True):
-                writer.writerow([repr(float(t)), *(repr(float(v)) for v in row)])
+                writer.writerow([repr(float(t)), *(repr(float(row[c])) for c in columns)])
         return path
 
-    def to_mat(self, path) -> Path:
-        """Write a MATLAB file: one struct per block (``IMU.acc_x`` reads ``IMU.acc_x`` in MATLAB).
+    def to_mat(self, path, signals=None) -> Path:
+        """Write a compressed MATLAB file.
+
+        One struct per block, each signal an N x 1 column (``IMU.acc_x`` reads ``IMU.acc_x`` in
+        MATLAB) and each vector also an N x k array (``IMU.acc``; ``IMU.R_reel`` N x 3 x 3);
+        ``time`` (s); ``units``, a struct per block giving each field's unit
+        (``units.IMU.acc_x`` is ``'m/s2'``); ``options``, the scenario's options; ``meta``,
+        the run's step, decimation, scenario and error message.
 
         Parameters
         ----------
         path : str or pathlib.Path
             The file, written atomically.
+        signals : list of str, optional
+            The signals to write (vector names allowed); all by default.
 
         Returns
         -------
@@ -250,16 +390,31 @@ class Result:
         from scipy.io import savemat
 
         blocks: dict[str, dict[str, np.ndarray]] = {}
-        for i, name in enumerate(self.names):
+        units: dict[str, dict[str, str]] = {}
+        every_unit = self.units
+        names = self._chosen(signals)
+        groups = vector_groups(names)
+        for name in names:
             block, _, signal = name.partition(".")
-            blocks.setdefault(block, {})[signal] = self.data[:, i]
+            blocks.setdefault(block, {})[signal] = self.data[:, self._index[name]]
+            units.setdefault(block, {})[signal] = every_unit[name]
+        for vector, members in groups.items():
+            block, _, signal = vector.partition(".")
+            blocks[block][signal] = self[vector].reshape(len(self.time), *matrix_shape(members))
+            units[block][signal] = every_unit[members[0]]
+        scenario = self.meta.get("scenario", {})
+        meta = {"scenario": scenario.get("name", ""), "dt_s": self.meta.get("dt", np.nan),
+                "decimation": self.meta.get("decimation", 1), "error": self.error or "",
+                "faults": [json.dumps(f, default=_plain_json) for f in self.meta.get("faults", [])]}
         with atomic_path(path) as temporary:
-            savemat(temporary, {"time": self.time, **blocks}, long_field_names=True)
+            savemat(temporary, {"time": self.time, **blocks, "units": units | {"time": "s"},
+                                "options": _matlab_values(self.options), "meta": _matlab_values(meta)},
+                    long_field_names=True, do_compression=True, oned_as="column")
         return Path(path)
 
     @classmethod
     def from_npz(cls, path) -> Result:
-        """Read a result written by :meth:`to_npz`.
+        """Read a result written by :meth:`to_npz` (or by earlier versions, one array per signal).
 
         Parameters
         ----------
@@ -269,17 +424,44 @@ class Result:
         Returns
         -------
         Result
-            With its meta data and error message.
+            With its meta data (units and options included) and error message.
         """
         with np.load(path) as archive:
-            names = [n for n in archive.files if n not in ("time", "_meta")]
             meta = json.loads(str(archive["_meta"]))
-            data = np.column_stack([archive[n] for n in names]) if names else np.empty((len(archive["time"]), 0))
-            return cls(archive["time"], names, data, meta, meta.pop("error", None))
+            time = archive["time"]
+            vectors = meta.pop("vectors", {})
+            names = meta.pop("names", None) or [n for n in archive.files if n not in ("time", "_meta")]
+            data = np.empty((len(time), len(names)))
+            column = {n: i for i, n in enumerate(names)}
+            for stored in archive.files:
+                if stored in vectors:
+                    values = archive[stored].reshape(len(time), -1)
+                    for k, member in enumerate(vectors[stored]):
+                        data[:, column[member]] = values[:, k]
+                elif stored in column:
+                    data[:, column[stored]] = archive[stored]
+            meta.pop("options", None)
+            return cls(time, names, data, meta, meta.pop("error", None))
 
-    def save(self, out_dir, csv: bool = False, formats=("npz", "mat")) -> list[Path]:
-        """Write ``results.<format>`` into ``out_dir`` for each of ``formats`` (a subset of
-        :data:`FORMATS`; ``csv=True`` adds ``"csv"``). Returns the paths written."""
+    def save(self, out_dir, csv: bool = False, formats=DEFAULT_FORMATS, signals=None) -> list[Path]:
+        """Write ``results.<format>`` into ``out_dir`` for each of ``formats``.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The folder (created if missing).
+        csv : bool
+            Add ``"csv"`` to ``formats``.
+        formats : sequence of str
+            A subset of :data:`FORMATS`; default :data:`DEFAULT_FORMATS` (the ``.npz`` alone).
+        signals : list of str, optional
+            The signals to write (vector names allowed); all by default.
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files written.
+        """
         formats = list(dict.fromkeys([*formats, *(["csv"] if csv else [])]))
         unknown = [f for f in formats if f not in FORMATS]
         if unknown:
@@ -287,7 +469,7 @@ class Result:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         writers = {"npz": self.to_npz, "mat": self.to_mat, "csv": self.to_csv}
-        return [writers[f](out / f"results.{f}") for f in formats]
+        return [writers[f](out / f"results.{f}", signals) for f in formats]
 
     # ------------------------------------------------------------------ plots
     def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = "", unit: str | None = None):
@@ -346,3 +528,32 @@ class Result:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="best")
         return ax
+
+
+def _write_array(archive: zipfile.ZipFile, name: str, values: np.ndarray):
+    """One ``name.npy`` member of a NumPy archive, written as ``numpy.savez_compressed`` does."""
+    with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+        np.lib.format.write_array(member, np.asanyarray(values), allow_pickle=False)
+
+
+def _plain_json(value):
+    try:
+        return value.item()  # NumPy scalars
+    except AttributeError:
+        return str(value)  # a fault, a path
+
+
+def _matlab_values(values: dict) -> dict:
+    """``values`` as MATLAB can hold them: None as an empty string, lists of text as cell
+    arrays, ``IMU.gyro_bias`` keys as ``IMU_gyro_bias`` (a field name holds no dot)."""
+    plain = {}
+    for key, value in values.items():
+        key = str(key).replace(".", "_")
+        if value is None:
+            value = ""
+        elif isinstance(value, dict):
+            value = _matlab_values(value)
+        elif isinstance(value, list | tuple) and any(isinstance(v, str) for v in value):
+            value = np.array([str(v) for v in value], dtype=object)
+        plain[key] = value
+    return plain

@@ -26,6 +26,13 @@ class Option:
     minimum: float | None = None
     classes: bool = False  # beside the choices, a block class of the user's, "module:Class"
 
+    @property
+    def unit(self) -> str | None:
+        """The option's unit, the first parenthesised unit of its help (``"(s)"``), or None."""
+        from scenarios.metrics import option_unit
+
+        return option_unit(self.help)
+
     def parse(self, name: str, text):
         """The option's value from text, checked against its type, choices and minimum.
 
@@ -82,6 +89,11 @@ class Scenario:
     report: object  # (result, options, out_dir) -> metrics dict
     duration: object = None  # (options) -> seconds
     extra: dict = field(default_factory=dict)
+    resolve: object = None  # (options) -> the options as used: a default marker (kI = -1) replaced by its value
+
+    def used(self, options: dict) -> dict:
+        """``options`` as the run uses them: every default marker replaced by the value it stands for."""
+        return self.resolve(options) if self.resolve else dict(options)
 
     def title(self, options: dict) -> str:
         """The scenario's name and its options off their defaults, as a figure title names a run.
@@ -216,64 +228,92 @@ def get(name: str) -> Scenario:
 
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
-        record=None, formats=("npz", "mat"), overwrite: bool = False, estimator=None):
-    """Run scenario ``name`` with the options ``settings`` (as :meth:`Scenario.parse` takes them);
-    write results, metrics and figures into ``out_dir`` if given. ``progress`` shows a progress
-    bar on long runs; ``faults`` are :class:`orchestrator.Fault` injected into the run.
+        record=None, formats=("npz",), overwrite: bool = False, estimator=None):
+    """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
 
-    ``decimation`` keeps every N-th macro step; ``record`` lists the signals to keep (default:
-    the scenario's choice, else all); ``formats`` are the result files written (``npz``,
-    ``mat``, ``csv``). ``out_dir`` is checked before the run: a folder holding earlier results
-    is refused unless ``overwrite``. ``settings`` may set block parameters
-    (``{"IMU.gyro_noise_density": 1e-3}``); ``estimator`` puts a block of the user's (an
-    instance or a class, see :mod:`estimators.contract`) in the place of ``Quaternion_estim``.
+    Parameters
+    ----------
+    name : str
+        A scenario of :func:`registry`.
+    settings : dict or list of str, optional
+        Option values, ``{"duration": 5}`` or ``["duration=5"]``, and block parameters
+        (``{"IMU.gyro_noise_density": 1e-3}``).
+    out_dir : str or pathlib.Path, optional
+        Folder of the results, ``metrics.json`` and figures; checked before the run: a folder
+        holding earlier results is refused unless ``overwrite``.
+    progress : bool
+        Progress and status lines on standard error.
+    faults : sequence of orchestrator.Fault
+        Faults injected; recorded in ``metrics.json``.
+    decimation : int
+        Keep every N-th macro step.
+    record : list of str, optional
+        Signals to keep; ``["all"]`` keeps every output; default: the scenario's choice
+        (``extra["record"]``, or every output but ``extra["unrecorded"]``), else all.
+    formats : sequence of str
+        Result files written (``npz``, ``mat``, ``csv``); the compressed ``.npz`` alone by default.
+    overwrite : bool
+        Replace the results already in ``out_dir``.
+    estimator : orchestrator.Block or class, optional
+        A block of the user's (an instance or a class, see :mod:`estimators.contract`) in the
+        place of ``Quaternion_estim``.
 
-    Returns ``(result, metrics)``. On a failure or an interrupt, what was recorded is saved all
-    the same, with a ``metrics.json`` saying where the run stopped, and
-    :class:`orchestrator.SimulationError` (:class:`orchestrator.RunInterrupted`) is raised.
+    Returns
+    -------
+    (orchestrator.Result, dict)
+        The result and the metrics. ``metrics["options"]`` holds every option's value as
+        used (no default markers), ``metrics["units"]`` the units of the metrics and options,
+        ``metrics["injected_faults"]`` the faults (:func:`fault_record`).
+
+    Raises
+    ------
+    orchestrator.SimulationError
+        The run failed (:class:`orchestrator.RunInterrupted`: it was interrupted); what was
+        recorded is saved all the same, with a ``metrics.json`` saying where the run stopped.
     """
-    from orchestrator import RunInterrupted, SimulationError
+    from orchestrator import SimulationError
     from orchestrator.files import prepare_out_dir
-    from orchestrator.interrupts import signal_name
+    from orchestrator.progress import status
     from orchestrator.result import FORMATS
+    from scenarios.metrics import metric_units
 
+    status(f"{name}: loading the scenario")
     scenario = get(name)
     options = scenario.parse(settings)
     unknown = [f for f in formats if f not in FORMATS]
     if unknown or not formats:
         raise ValueError(f"--format {','.join(formats)}: choose among {', '.join(FORMATS)}")
     out = prepare_out_dir(out_dir, overwrite) if out_dir else None
+    status(f"{name}: building the system")
     system = scenario.system(options, estimator=estimator)
     for fault in faults:
         system.inject(fault)
     if out is not None and scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs
         from orchestrator.diagram import draw
 
+        status(f"{name}: wiring diagram")
         draw(system, out / "diagram.png", scenario.title(options))
+    used = scenario.used(options)
     duration = scenario.duration(options) if scenario.duration else options["duration"]
-    base = {"scenario": name, "options": options, "duration_s": duration, "decimation": decimation}
+    option_units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
+    base = {"scenario": name, "options": used, "injected_faults": [fault_record(f) for f in faults],
+            "duration_s": duration, "decimation": decimation}
+    kept, saved = _signals_kept(scenario, system, record, base)
+    status(f"{name}: starting {duration:g} s of simulated time ({len(system.blocks)} blocks)")
     try:
-        result = system.run(duration, decimation=decimation, progress=progress,
-                            record=record if record else scenario.extra.get("record"))
+        result = system.run(duration, decimation=decimation, progress=progress, record=kept)
     except SimulationError as error:
-        partial = error.result
-        if out is not None and partial is not None:
-            partial.meta["scenario"] = {"name": name, "options": options}
-            partial.meta["faults"] = [fault_record(f) for f in faults]
-            written = partial.save(out, formats=formats)
-            stopped = {"status": "interrupted" if isinstance(error, RunInterrupted) else "failed",
-                       "error": str(error),
-                       "recorded_until_s": float(partial.time[-1]) if len(partial) else None,
-                       "samples": len(partial),
-                       "fmu_warnings": _warning_counts(partial)}
-            if isinstance(error, RunInterrupted):
-                stopped["interrupted_by"] = signal_name(error.signal_number)
-            _write_metrics(out, base | stopped | {"files": sorted(p.name for p in written)})
+        if out is not None and error.result is not None:
+            _save_stopped(error, out, formats, base, option_units, saved)
         raise
-    result.meta["scenario"] = {"name": name, "options": options}
-    result.meta["faults"] = [fault_record(f) for f in faults]
-    metrics = base | {"status": "completed", "samples": len(result), "fmu_warnings": _warning_counts(result)}
-    written = result.save(out, formats=formats) if out is not None else []
+    result.meta |= {"scenario": {"name": name, "options": used}, "faults": base["injected_faults"]}
+    metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
+                      "fmu_warnings": _warning_counts(result)}
+    if out is not None:
+        status(f"{name}: writing {', '.join(f'results.{f}' for f in formats)} "
+               f"({len(saved) if saved else len(result.names)} signals, {len(result)} samples)")
+    written = result.save(out, formats=formats, signals=saved) if out is not None else []
+    status(f"{name}: report" + (" (metrics and figures)" if out is not None else " (metrics)"))
     try:
         metrics |= scenario.report(result, options, out)
     except KeyError as error:
@@ -281,6 +321,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
             raise
         # the report needs a signal the user chose not to record: the results stand alone
         metrics["report"] = f"report skipped: {error.args[0]} (add it to --record for the report)"
+    metrics["units"] = metric_units(metrics, metrics.get("units") or {}) | option_units | \
+        {"injected_faults": FAULT_UNITS}
     if out is not None:
         figures = sorted(p.name for p in out.iterdir() if p.suffix in (".png", ".svg", ".pdf"))
         _write_metrics(out, metrics | {"files": sorted([p.name for p in written] + figures)})
@@ -288,7 +330,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
 
 
 def fault_record(fault) -> dict:
-    """A fault as recorded with a run: target, kind, start and stop (s), value (the signal's unit).
+    """A fault as recorded with a run (``metrics.json``, the result files' meta, figure titles).
 
     Parameters
     ----------
@@ -297,9 +339,58 @@ def fault_record(fault) -> dict:
     Returns
     -------
     dict
+        ``target``, ``kind``, ``start`` and ``stop`` (s), ``value`` (the target's unit; a factor
+        for ``scale``; None for a held value or a dropout), ``seed`` (of a noise fault).
     """
     return {"target": fault.target, "kind": fault.kind, "start": fault.start, "stop": fault.stop,
-            "value": fault.value}
+            "value": fault.value, "seed": fault.seed}
+
+
+#: The units of :func:`fault_record`'s fields, as ``metrics.json`` states them.
+FAULT_UNITS = "start, stop: s; value: the target's unit (scale: a factor)"
+
+
+def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | None, list[str] | None]:
+    """The signals to record and those to write into the result files (None: all).
+
+    ``record`` chooses (``["all"]``: every output, recorded and written); else the scenario:
+    ``extra["record"]`` lists what it records, ``extra["unrecorded"]`` what its files leave out
+    (recorded all the same, for the report and for Python callers), listed in
+    ``base["signals_not_saved"]``.
+    """
+    from scenarios.metrics import recorded_outputs
+
+    if record == ["all"]:
+        return None, None
+    if record:
+        return record, None
+    if "unrecorded" in scenario.extra:
+        every = recorded_outputs(system)
+        saved = recorded_outputs(system, scenario.extra["unrecorded"])
+        base["signals_not_saved"] = [n for n in every if n not in set(saved)]
+        return None, saved
+    return scenario.extra.get("record"), None
+
+
+def _save_stopped(error, out: Path, formats, base: dict, option_units: dict, saved):
+    """Save what a failed or interrupted run recorded, with a ``metrics.json`` saying where it stopped."""
+    from orchestrator import RunInterrupted
+    from orchestrator.interrupts import signal_name
+    from scenarios.metrics import metric_units
+
+    partial = error.result
+    partial.meta |= {"scenario": {"name": base["scenario"], "options": base["options"]},
+                     "faults": base["injected_faults"]}
+    written = partial.save(out, formats=formats, signals=saved)
+    stopped = {"status": "interrupted" if isinstance(error, RunInterrupted) else "failed",
+               "error": str(error),
+               "recorded_until_s": float(partial.time[-1]) if len(partial) else None,
+               "samples": len(partial),
+               "fmu_warnings": _warning_counts(partial)}
+    if isinstance(error, RunInterrupted):
+        stopped["interrupted_by"] = signal_name(error.signal_number)
+    metrics = base | stopped | {"files": sorted(p.name for p in written)}
+    _write_metrics(out, metrics | {"units": metric_units(metrics) | option_units | {"injected_faults": FAULT_UNITS}})
 
 
 def _warning_counts(result) -> dict:

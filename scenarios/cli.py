@@ -106,10 +106,20 @@ def _positive_int(text: str) -> int:
 
 
 def _run(args) -> int:
+    from orchestrator.progress import reporting
+
+    with reporting(True):
+        return _run_reporting(args)
+
+
+def _run_reporting(args) -> int:
+    from orchestrator.progress import status
+
+    status(f"quadcosim run {args.scenario}: loading the packages")
     import scenarios
     from orchestrator import RunInterrupted, SimulationError
 
-    out = Path(args.out) if args.out else Path("results") / args.scenario
+    out = Path(args.out) if args.out else _default_out(args.scenario, args.overwrite)
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
     try:
         faults = [_parse_fault(f) for f in args.fault or []]
@@ -129,12 +139,27 @@ def _run(args) -> int:
         print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
     warnings = metrics.pop("fmu_warnings", {})
-    shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario")}
+    shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario", "units", "signals_not_saved")}
     for key, value in shown.items():
         print(f"  {key}: {value}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
     return 0
+
+
+def _default_out(scenario: str, overwrite: bool) -> Path:
+    """``results/SCENARIO``, or with earlier results there (and no --overwrite) the next free
+    ``results/SCENARIO-N``, said on standard error: a run never replaces results unasked."""
+    from orchestrator.files import free_folder, holds_results
+
+    base = Path("results") / scenario
+    if overwrite:
+        return base
+    out = free_folder(base)
+    if out != base:
+        print(f"quadcosim run {scenario}: {base}/ holds earlier results ({', '.join(holds_results(base))}); "
+              f"writing to {out}/ (--out DIR chooses the folder, --overwrite replaces {base}/)", file=sys.stderr)
+    return out
 
 
 def _print_warnings(warnings: dict, shown: int = 3):
@@ -198,16 +223,21 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--estimator", metavar="MODULE:CLASS",
                      help="your own attitude estimator block in the place of Quaternion_estim (a module, or "
                           "a file.py, and a class; see estimators/contract.py)")
-    run.add_argument("--out", help="output folder (default results/SCENARIO)")
+    run.add_argument("--out", help="output folder (default results/SCENARIO, or results/SCENARIO-N when that "
+                                   "holds earlier results); a given folder holding results is refused without "
+                                   "--overwrite")
     run.add_argument("--fault", action="append", metavar="TARGET:KIND:START:STOP[:VALUE]",
                      help="fault on the connection into TARGET; KIND is offset, scale, stuck, noise or dropout")
     run.add_argument("--overwrite", action="store_true", help="replace the results already in the --out folder")
     run.add_argument("--decimation", type=_positive_int, default=1, metavar="N",
                      help="record every N-th macro step (default 1)")
     run.add_argument("--record", nargs="+", metavar="SIGNAL",
-                     help="record only these signals (Block.signal; a vector name such as IMU.acc is allowed)")
-    run.add_argument("--format", default="npz,mat", metavar="npz,mat,csv",
-                     help="result files to write, comma-separated (default npz,mat)")
+                     help="record only these signals (Block.signal; a vector name such as IMU.acc is allowed); "
+                          "'all' records and writes every output (by default a scenario's files may leave out signals "
+                          "that follow from others, listed in metrics.json)")
+    run.add_argument("--format", default="npz", metavar="npz,mat,csv",
+                     help="result files to write, comma-separated: npz (compressed NumPy, the default), mat "
+                          "(compressed MATLAB), csv")
     run.set_defaults(func=_run)
     diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
     diagram.add_argument("scenario")

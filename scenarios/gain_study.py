@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.progress import active, status
 from scenarios import Option, Scenario
 from scenarios.figures import fault_text, faults_of, title_lines
 from scenarios.plant import save_figure
@@ -129,6 +130,7 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
     start = int(round(o["burn_in"] / dt))
     variances, errors = [], []
     for chunk in np.array_split(gains, max(1, len(gains) // 2)):
+        status(f"gain-study: linear filter over the recorded stream, k = {', '.join(f'{k:.3g}' for k in chunk)} 1/s")
         out = estimate("linear", acc=result["IMU.acc"], gyro=result["IMU.gyro"], mag=result["IMU.magneto"], dt=dt,
                        gains={"k1": chunk, "k2": chunk, "k3": chunk}, outputs=("theta",))
         for g in range(len(chunk)):
@@ -166,7 +168,11 @@ def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
     plan = grid.plan_of_cases("tp", {f"k={k:.6g}": closed_loop_options(float(k), o) for k in gains})
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(out) / "closed-loop" if out is not None else Path(scratch)
-        settings = {"workers": o["workers"] or None, "scheduler": o["scheduler"] or None, "progress": False}
+        # the sweep's own progress (a bar on a terminal, lines to a pipe) when the command line reports
+        settings = {"workers": o["workers"] or None, "scheduler": o["scheduler"] or None,
+                    "progress": None if active() else False}
+        status(f"gain-study: {len(gains)} estimate-fed closed loops of {o['closed_duration']:g} s on Dask "
+               "(starting the cluster)")
         try:  # the same runs left by an interrupted study are kept
             summary = engine.run(plan, folder, resume=(folder / "sweep.json").exists(), **settings)
         except engine.SweepError:  # another study's runs: this one replaces them, as it replaces its figures
@@ -227,6 +233,7 @@ def report(result, o, out) -> dict:
     simulated, relative_se = simulated_variances(result, gains, o)
     k_predicted, k_simulated = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle), optimum_of(gains, simulated)
     closed, tracking, failures = closed_loop_variances(gains, o, out) if o["closed_loop"] else (None, None, [])
+    status("gain-study: figure")
 
     fig, ax = plt.subplots(figsize=(8, 5))
     fine = np.geomspace(gains[0], gains[-1], 200)
@@ -267,6 +274,10 @@ def report(result, o, out) -> dict:
         else closed_loop_relative_standard_error(gains, o).tolist(),
         "closed_loop_tracking_rms_deg": tracking,
         "figures": [figure] if figure else [],
+        "units": {"gains": "1/s", "predicted_optimal_gain": "1/s", "simulated_optimal_gain": "1/s",
+                  "relative_difference": "1", "max_abs_relative_difference": "1", "optimum_ratio": "1",
+                  "simulated_relative_standard_error": "1", "max_relative_standard_error": "1",
+                  "closed_loop_relative_difference": "1", "closed_loop_relative_standard_error": "1"},
     }
 
 
@@ -305,5 +316,13 @@ def duration(o: dict) -> float:
     return o["duration"]
 
 
+def resolve(o: dict) -> dict:
+    """The options as used: ``workers = 0`` replaced by the worker count a local cluster starts
+    (one per CPU), or None when a running scheduler's workers run the closed loops."""
+    import os
+
+    return o | {"workers": None if o["scheduler"] else (o["workers"] or os.cpu_count() or 1)}
+
+
 SCENARIO = Scenario("gain-study", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD})
+                    duration=duration, extra={"record": RECORD}, resolve=resolve)

@@ -143,6 +143,7 @@ def report(result, o, out) -> dict:
         "us_per_step": None if loop is None else loop / (len(result) - 1) * 1e6,
         "real_time_factor": None if loop is None else o["duration"] / loop,
         "figures": [f for f in figures if f],
+        "units": {"us_per_step": "us", "real_time_factor": "1"},
     }
 
 

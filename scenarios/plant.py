@@ -106,7 +106,10 @@ def save_figure(figure, out_dir, name: str):
 
         plt.close(figure)
         return None
+    from orchestrator.progress import status
+
     path = out_dir / name
+    status(f"figure {name}")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
     import matplotlib.pyplot as plt

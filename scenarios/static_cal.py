@@ -160,6 +160,7 @@ def report(result, o, out) -> dict:
         "heading_error_uncorrected_max_deg": float(np.abs(heading_raw).max()),
         "field_angle_error_mean_deg": float(angle.mean()),
         "figures": [figure] if figure else [],
+        "units": {"A": "1", "A_true": "1", "A_error_max": "1"},
     }
 
 

@@ -89,6 +89,28 @@ def estimator_gains(o: dict) -> dict:
     return {"kP": o["kP"], "kI": ki}
 
 
+def resolve(o: dict) -> dict:
+    """The options as used: ``kI = -1`` replaced by the bias gain the estimator uses (1/s^2), or
+    None for an estimator without one (linear, vqf, madgwick)."""
+    kind = o["estimator"]
+    return o | {"kI": estimator_gains(o).get("kI") if kind in ("explicit", "passive") else None}
+
+
+#: Signals tp's result files leave out by default (recorded all the same; ``--record all``
+#: writes them; ``metrics.json`` lists them): each follows from signals kept. Quadrotor.R and
+#: IMU.R_reel are the rotation matrix of Quadrotor.q; each motor's field b_dN sums to
+#: MotorMagnetics.b_d; domega_r is the derivative of omega_r; the supply currents i_s are the
+#: commands times i. A 20 s run then writes < 10 MB.
+UNRECORDED = ["Quadrotor.R", "IMU.R_reel", "MotorMagnetics.b_d1", "MotorMagnetics.b_d2", "MotorMagnetics.b_d3",
+              "MotorMagnetics.b_d4", "MotorMagnetics.domega_r", "MotorMagnetics.i_s"]
+
+#: Tolerance of ``bias_convergence_s``: every axis of the bias estimate within it of the true bias.
+BIAS_TOLERANCE = 1e-3  # rad/s
+
+#: ``steady_error_deg`` and ``steady_tracking_error_deg`` average the last quarter of the run.
+STEADY_SHARE = 0.25
+
+
 def build(o: dict, estimator=None) -> System:
     """The lab's closed loop: setpoint profile, controller, motors and battery, rigid body, IMU
     (at ``imu_rate``, a divisor of the macro step rate) and the attitude estimator, the
@@ -215,17 +237,31 @@ def report(result, o, out) -> dict:
         real-time factor, and the figures written.
     """
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
-    metrics = {"settle_s": settle, **_error_statistics(result, settle), "bias_error_final": None,
-               "figures": _figures(result, o, out)}
+    metrics = {"settle_s": settle, **_error_statistics(result, settle), **steady_errors(result),
+               "bias_error_final": None, "figures": _figures(result, o, out),
+               "units": {"bias_error_final": "rad/s", "real_time_factor": "1"}}
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
         metrics["bias_error_final"] = [
             float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]
         metrics["bias_convergence_s"] = bias_convergence_time(
-            result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"), 1e-3)
+            result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"),
+            BIAS_TOLERANCE)
+        metrics["bias_convergence_tolerance_rad_s"] = BIAS_TOLERANCE
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
     return metrics
+
+
+def steady_errors(result) -> dict:
+    """Mean estimation and tracking errors over the last :data:`STEADY_SHARE` of the run
+    (deg; roll, pitch, yaw): the steady error a filter without bias estimate keeps."""
+    late = slice(np.searchsorted(result.time, result.time[0] + (1 - STEADY_SHARE) * (result.time[-1] - result.time[0])),
+                 None)
+    estimation = [math.degrees(float(_error(result, "Quaternion_estim.theta_est", k)[late].mean())) for k in range(3)]
+    tracking = [math.degrees(float(_error(result, _SETPOINTS[k], k)[late].mean())) for k in range(3)]
+    return {"steady_error_deg": estimation, "steady_tracking_error_deg": tracking,
+            "steady_window_s": [float(result.time[late][0]), float(result.time[-1])]}
 
 
 def _error_statistics(result, settle: float) -> dict:
@@ -440,4 +476,5 @@ def diagram_title(o: dict) -> str:
 # IMU parameters the options set: --set IMU.seed=... would contradict the option seed
 DERIVED = {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed", "IMU.sample_rate": "imu_rate"}
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    extra={"diagram": True, "title": diagram_title, "derived": DERIVED})
+                    extra={"diagram": True, "title": diagram_title, "derived": DERIVED, "unrecorded": UNRECORDED},
+                    resolve=resolve)

@@ -151,7 +151,7 @@ def test_no_allocation_grows_with_the_number_of_steps():
 def test_exports_load_back_equal(tmp_path):
     _, metrics = scenarios.run("open-loop", {"duration": 0.2})
     result, _ = scenarios.run("open-loop", {"duration": 0.2})
-    result.save(tmp_path, csv=True)
+    result.save(tmp_path, formats=("npz", "mat", "csv"))
     back = Result.from_npz(tmp_path / "results.npz")
     assert back.names == result.names and np.array_equal(back.data, result.data)
     assert np.array_equal(back.time, result.time)

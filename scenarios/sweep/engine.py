@@ -41,7 +41,7 @@ from scenarios.sweep import table
 from scenarios.sweep.grid import Member, Plan
 
 #: Keys of a scenario's metrics that are not metrics of a member.
-NOT_METRICS = ("scenario", "options", "figures")
+NOT_METRICS = ("scenario", "options", "figures", "units", "injected_faults")
 _members_run = 0  # members run by this process (reported by worker_state)
 
 

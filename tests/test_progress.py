@@ -1,0 +1,79 @@
+"""What a run shows while it works: a bar on a terminal, a few plain lines to a pipe, status
+lines around the run."""
+
+from __future__ import annotations
+
+import io
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+from orchestrator.progress import PIPE_LINES, Progress, reporting, status
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_on_a_terminal_the_bar_ends_at_100_percent_on_its_own_line():
+    screen = Terminal()
+    bar = Progress(20.0, "run", stream=screen)
+    for _ in range(199):  # the run loop's chunks stop short of the end
+        bar.update(0.1)
+    bar.complete()
+    bar.close()
+    text = screen.getvalue()
+    last = text.split("\r")[-1]
+    assert "100%" in last and "20.0/20.0 s" in last and text.endswith("\n")
+    assert "99%" not in last
+
+
+def test_to_a_pipe_a_few_plain_lines_and_after_a_failure_no_100_percent():
+    pipe = io.StringIO()
+    bar = Progress(120.0, "run", stream=pipe)
+    for _ in range(1000):
+        bar.update(0.12)
+    bar.complete()
+    bar.close()
+    lines = pipe.getvalue().splitlines()
+    assert len(lines) == 1 + PIPE_LINES and "\r" not in pipe.getvalue()
+    assert lines[0].startswith("run:   0 % (0.1/120 s simulated")  # the loop runs
+    assert lines[-1].startswith("run: 100 % (120.0/120 s simulated")
+    stopped = io.StringIO()
+    bar = Progress(120.0, "run", stream=stopped)
+    bar.update(70.0)
+    bar.close()
+    assert [line.split(" (")[0] for line in stopped.getvalue().splitlines()] == ["run:  58 %", "run:  25 %",
+                                                                                  "run:  50 %"]
+
+
+def test_status_lines_only_while_reporting():
+    quiet, told = io.StringIO(), io.StringIO()
+    with reporting(False, stream=quiet):
+        status("nothing")
+    with reporting(True, stream=told):
+        status("tp: building the system")
+    status("after")
+    assert quiet.getvalue() == "" and told.getvalue().endswith("] tp: building the system\n")
+
+
+def test_a_120_s_run_writes_at_most_15_lines_to_a_pipe(tmp_path):
+    """Acceptance 5, on the open loop (the cheapest 120 s run): every line of standard error, status
+    lines included, and no carriage return."""
+    process = subprocess.run([sys.executable, "-m", "scenarios.cli", "run", "open-loop", "--set", "duration=120",
+                              "--out", str(tmp_path / "run")], capture_output=True, text=True, cwd=ROOT,
+                             env=os.environ | {"COLUMNS": "80"}, timeout=600)
+    assert process.returncode == 0, process.stderr
+    lines = process.stderr.splitlines()
+    assert len(lines) <= 15, process.stderr
+    assert "\r" not in process.stderr
+    progress = [line for line in lines if line.startswith("run: ")]
+    assert [line.split(" (")[0] for line in progress] == ["run:   0 %", "run:  25 %", "run:  50 %", "run:  75 %",
+                                                          "run: 100 %"]
+    assert any("open-loop: building the system" in line for line in lines)
+    assert any("open-loop: report" in line for line in lines)
+    print(f"{len(lines)} lines on standard error:\n{process.stderr}")
