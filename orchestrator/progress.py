@@ -114,6 +114,8 @@ class Progress:
         if self.bar is not None:
             self.bar.update(self.n - self.bar.n)
             return
+        if self.next_line == 0 and self.n >= self.total / PIPE_LINES:
+            self.next_line = 1  # past the first quarter already: its line says the loop runs
         while self.next_line <= PIPE_LINES and self.n >= self.total * self.next_line / PIPE_LINES - 1e-9:
             elapsed = time.perf_counter() - self.started
             percent = 100 * self.n / self.total if self.next_line == 0 else 100 * self.next_line / PIPE_LINES

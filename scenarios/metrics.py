@@ -36,6 +36,16 @@ def option_unit(help_text: str) -> str | None:
     ``"macro step (s)"`` -> ``"s"``; ``"bias gain (1/s^2); -1 for the default"`` -> ``"1/s^2"``;
     ``"accelerometer weight (1; Mahony's Kp = kP k1)"`` -> ``"1"``; None when no parentheses
     hold a unit (prose, a file name, a list of values).
+
+    Parameters
+    ----------
+    help_text : str
+        The option's help.
+
+    Returns
+    -------
+    str or None
+        The unit, as written there.
     """
     for match in _PARENTHESES.finditer(help_text):
         unit = match[1].split(";")[0].strip()

@@ -254,8 +254,20 @@ def report(result, o, out) -> dict:
 
 
 def steady_errors(result) -> dict:
-    """Mean estimation and tracking errors over the last :data:`STEADY_SHARE` of the run
-    (deg; roll, pitch, yaw): the steady error a filter without bias estimate keeps."""
+    """Mean estimation and tracking errors over the last :data:`STEADY_SHARE` of the run: the
+    steady error a filter without bias estimate keeps.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A tp run's record.
+
+    Returns
+    -------
+    dict
+        ``steady_error_deg`` and ``steady_tracking_error_deg`` (deg; roll, pitch, yaw, wrapped
+        to +-180), ``steady_window_s`` (its first and last time, s).
+    """
     late = slice(np.searchsorted(result.time, result.time[0] + (1 - STEADY_SHARE) * (result.time[-1] - result.time[0])),
                  None)
     estimation = [math.degrees(float(_error(result, "Quaternion_estim.theta_est", k)[late].mean())) for k in range(3)]
