@@ -162,7 +162,7 @@ class ChunkRunner:
 
         Parameters
         ----------
-        bar : tqdm progress bar, optional
+        bar : orchestrator.progress.Progress, optional
             Updated at the end of each chunk.
 
         Raises
