@@ -321,7 +321,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
             raise
         # the report needs a signal the user chose not to record: the results stand alone
         metrics["report"] = f"report skipped: {error.args[0]} (add it to --record for the report)"
-    metrics["units"] = metric_units(metrics, metrics.get("units") or {}) | option_units | \
+    declared = scenario.extra.get("units", {}) | (metrics.get("units") or {})  # for names that carry none
+    metrics["units"] = metric_units(metrics, declared) | option_units | \
         {"injected_faults": FAULT_UNITS}
     if out is not None:
         figures = sorted(p.name for p in out.iterdir() if p.suffix in (".png", ".svg", ".pdf"))

@@ -203,6 +203,13 @@ def optimum_of(gains, values) -> float:
     return float(np.exp(-b / (2 * a))) if a > 0 else float(gains[np.argmin(values)])
 
 
+#: Units of the report's metrics whose names carry none (``metrics.json``'s ``units``).
+METRIC_UNITS = {"gains": "1/s", "predicted_optimal_gain": "1/s", "simulated_optimal_gain": "1/s",
+                "relative_difference": "1", "max_abs_relative_difference": "1", "optimum_ratio": "1",
+                "simulated_relative_standard_error": "1", "max_relative_standard_error": "1",
+                "closed_loop_relative_difference": "1", "closed_loop_relative_standard_error": "1"}
+
+
 def report(result, o, out) -> dict:
     """Error variance against gain: python-control's prediction, the batch path on the recorded
     stream, and (option ``closed_loop``) one estimate-fed run per gain on Dask.
@@ -233,7 +240,6 @@ def report(result, o, out) -> dict:
     simulated, relative_se = simulated_variances(result, gains, o)
     k_predicted, k_simulated = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle), optimum_of(gains, simulated)
     closed, tracking, failures = closed_loop_variances(gains, o, out) if o["closed_loop"] else (None, None, [])
-    status("gain-study: figure")
 
     fig, ax = plt.subplots(figsize=(8, 5))
     fine = np.geomspace(gains[0], gains[-1], 200)
@@ -274,10 +280,6 @@ def report(result, o, out) -> dict:
         else closed_loop_relative_standard_error(gains, o).tolist(),
         "closed_loop_tracking_rms_deg": tracking,
         "figures": [figure] if figure else [],
-        "units": {"gains": "1/s", "predicted_optimal_gain": "1/s", "simulated_optimal_gain": "1/s",
-                  "relative_difference": "1", "max_abs_relative_difference": "1", "optimum_ratio": "1",
-                  "simulated_relative_standard_error": "1", "max_relative_standard_error": "1",
-                  "closed_loop_relative_difference": "1", "closed_loop_relative_standard_error": "1"},
     }
 
 
@@ -325,4 +327,4 @@ def resolve(o: dict) -> dict:
 
 
 SCENARIO = Scenario("gain-study", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD}, resolve=resolve)
+                    duration=duration, extra={"record": RECORD, "units": METRIC_UNITS}, resolve=resolve)
