@@ -308,8 +308,14 @@ class Plan:
         """
         from orchestrator.chunks import ChunkRunner
 
-        runner = ChunkRunner(self) if master == "chunk" else None  # compiled steps loaded here, not timed
+        # the bar first: on a terminal it shows while the compiled steps load (compiled at the first run after a change)
         bar = Progress(self.steps * self.dt, "run") if progress else None
+        try:
+            runner = ChunkRunner(self) if master == "chunk" else None  # compiled steps loaded here, not timed
+        except BaseException:
+            if bar is not None:
+                bar.close()
+            raise
         self.n = 0
         started, cpu = time.perf_counter(), time.process_time()
         try:
