@@ -57,7 +57,18 @@ def stamped_lines(command: list[str]) -> tuple[list[tuple[float, str, str]], flo
 
 
 def main(argv=None) -> int:
-    """Command line (see the module docstring); returns the command's exit code."""
+    """Command line (see the module docstring).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (the process's if None).
+
+    Returns
+    -------
+    int
+        The timed command's exit code.
+    """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--show", action="store_true", help="print every stamped line")
     parser.add_argument("command", nargs=argparse.REMAINDER, help="the command, after --")

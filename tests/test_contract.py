@@ -11,7 +11,7 @@ import pytest
 
 import scenarios
 from estimators.contract import REQUIRED, AttitudeEstimator
-from orchestrator import Block, System
+from orchestrator import Block, Result, System
 from scenarios.cli import main as cli
 
 README = Path(__file__).resolve().parent.parent / "README.md"
@@ -111,7 +111,7 @@ def test_a_gyro_noise_density_set_from_the_command_line_is_the_noise_in_the_resu
     out = tmp_path / "run"
     assert cli(["run", "static-cal", "--set", "duration=333.33", f"IMU.gyro_noise_density={density}",
                 "--record", "IMU.gyro", "Hand.omega", "IMU.magneto", "--format", "npz", "--out", str(out)]) == 0
-    data = np.load(out / "results.npz")
+    data = Result.from_npz(out / "results.npz")  # the archive holds IMU.gyro as one N x 3 array
     noise = np.concatenate([data[f"IMU.gyro_{a}"] - data[f"Hand.omega_{a}"] for a in "xyz"])
     expected = density * np.sqrt(100.0)  # the IMU samples at the macro rate of static-cal, 100 Hz
     print(f"{noise.size} samples: noise {noise.std():.6g} rad/s, expected {expected:.6g} "
@@ -128,7 +128,7 @@ def test_several_settings_after_one_set_flag_and_vector_parameters(tmp_path):
     options = json.loads((out / "metrics.json").read_text())["options"]
     assert options["estimator"] == "explicit" and options["k1"] == 0.3
     assert options["IMU.gyro_bias"] == [0.01, 0.0, -0.02]
-    data = np.load(out / "results.npz")
+    data = Result.from_npz(out / "results.npz")
     assert data["IMU.gyro_bias_x"][-1] == 0.01 and data["IMU.gyro_bias_z"][-1] == -0.02
 
 
