@@ -386,16 +386,17 @@ def _compiled_step():
     if _COMPILED is None:
         from numba import carray, cfunc
 
-        from orchestrator.blocks import COMPILED_SIGNATURE
+        from orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
 
         (s0, s1), (g0, g1), (c0, c1), (w0, w1) = _D_PARTS
+        sources = source_fingerprint(core)  # the update's file: in numba's cache key with the layout above
 
         @cfunc(COMPILED_SIGNATURE, cache=True, error_model="numpy")
         def step(t, u, y, data):
             memory = carray(data, _DATA_SIZE)
             core.update(int(memory[_D_KIND]), memory[s0:s1], carray(u, core.INPUT_SIZE), memory[g0:g1],
                         memory[c0:c1], memory[_D_DT], carray(y, core.OUTPUT_SIZE), memory[w0:w1])
-            return 0
+            return sources & 0  # 0: done
 
         _COMPILED = step
     return _COMPILED

@@ -145,3 +145,18 @@ def test_an_unknown_master_is_refused():
     system.add(Table("Source", ["a"], [[1.0]]))
     with pytest.raises(ValueError, match="master = 'fast' must be 'chunk' or 'step'"):
         system.run(0.1, master="fast")
+
+
+def test_the_cached_compiled_steps_follow_the_files_they_call_into():
+    """numba reuses a cached function while its own file is unchanged; the compiled steps hold a
+    fingerprint of the files they call into (estimators/core.py, ...) in their cache key."""
+    from estimators import core, filters
+    from fmus import vehicle
+    from orchestrator.blocks import source_fingerprint
+    from scenarios.flight import controller, mixer
+
+    for function, modules in ((filters._compiled_step(), (core,)),
+                              (controller._compiled_step(), (core, mixer, vehicle))):
+        closure = [cell.cell_contents for cell in function._pyfunc.__closure__]
+        assert source_fingerprint(*modules) in closure
+    assert source_fingerprint(core) != source_fingerprint(core, mixer)

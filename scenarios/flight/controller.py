@@ -251,7 +251,11 @@ def _compiled_step():
     if _COMPILED is None:
         from numba import carray, cfunc
 
-        from orchestrator.blocks import COMPILED_SIGNATURE
+        from estimators import core
+        from orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
+        from scenarios.flight import mixer
+
+        sources = source_fingerprint(core, mixer, vehicle)  # the files the law calls into: in the cache key
 
         @cfunc(COMPILED_SIGNATURE, cache=True, error_model="numpy")
         def step(t, u, y, data):
@@ -259,7 +263,7 @@ def _compiled_step():
             control_law(carray(u, len(INPUTS)), memory[D_PARAMETERS:D_MIXER],
                         memory[D_MIXER:D_STATE].reshape((MOTORS, 4)), memory[D_STATE:D_DT], memory[D_DT],
                         carray(y, len(OUTPUTS)))
-            return 0
+            return sources & 0  # 0: done
 
         _COMPILED = step
     return _COMPILED
