@@ -90,6 +90,8 @@ class ReferenceLoop:
 
         blocks = system.blocks
         self.closed = "Controller" in blocks
+        if self.closed:  # refused here, before any FMU is instantiated
+            self.control, self.filter = _control(blocks["Controller"]), _explicit(blocks["Quaternion_estim"])
         self.steps, self.dt = int(round(seconds / system.dt)), system.dt
         self.keep = []  # arrays the C loop points into
         self.fmus = {name: FMUInstance(blocks[name].model, blocks[name].parameters, name=name)
@@ -107,7 +109,6 @@ class ReferenceLoop:
                           wind=wind.ctypes.data, field=field.ctypes.data, steps=self.steps, dt=self.dt,
                           record=self.record.ctypes.data, width=len(self.names))
         if self.closed:
-            self.control, self.filter = _control(blocks["Controller"]), _explicit(blocks["Quaternion_estim"])
             self.loop.control, self.loop.filter = ctypes.addressof(self.control), ctypes.addressof(self.filter)
 
     def _kept(self, values) -> np.ndarray:
