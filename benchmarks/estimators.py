@@ -32,19 +32,26 @@ _C_SLOTS = ("ACC", "GYRO", "MAG", "INPUT_SIZE", "GRAVITY", "FIELD", "DISCRETE", 
             "GAIN_SIZE", "EULER")
 
 
+# corrections benchmarks/c/batch_explicit.c does not transcribe: off in its case
+_NOT_IN_C = ("acc_lowpass", "mag_lowpass", "mag_reference_time")
+
+
 def _batch_case(gain_sets: int, samples: int, discretisation: str) -> dict:
-    """The arrays of one batch run: the explicit filter's defaults (every correction on), kI = 0.1 (1/s^2)
-    and k1 from 0.01 to 10 over the gain sets."""
+    """The arrays of one batch run: the explicit filter's defaults with the corrections the C reference
+    transcribes on (the low-passes and the magnetic reference tracking off), kI = 0.1 (1/s^2) and k1
+    from 0.01 to 10 over the gain sets."""
     from estimators import core
-    from estimators.filters import check_measurements, config_vector, gain_table
+    from estimators.filters import CORRECTIONS, check_measurements, config_vector, gain_table
 
     acc, gyro, mag = _data(samples)
     config = config_vector(discretisation)
     inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[core.GRAVITY:core.GRAVITY + 3])), True)
     inputs = np.ascontiguousarray(np.column_stack([inputs, np.zeros((samples, 9))]))
     gains = {"k1": np.geomspace(0.01, 10, gain_sets), "kI": 0.1}
-    return {"acc": acc, "gyro": gyro, "mag": mag, "inputs": inputs, "gains": gains, "config": config,
-            "table": np.ascontiguousarray(gain_table("explicit", gains)), "discretisation": discretisation}
+    corrections = {name: (0.0 if name in _NOT_IN_C else True) for name in CORRECTIONS}
+    return {"acc": acc, "gyro": gyro, "mag": mag, "inputs": inputs, "gains": gains, "corrections": corrections,
+            "config": config, "table": np.ascontiguousarray(gain_table("explicit", gains, corrections)),
+            "discretisation": discretisation}
 
 
 def _numba_batch(case: dict) -> np.ndarray:
@@ -52,7 +59,7 @@ def _numba_batch(case: dict) -> np.ndarray:
     from estimators import estimate
 
     return estimate("explicit", acc=case["acc"], gyro=case["gyro"], mag=case["mag"], dt=1e-3, gains=case["gains"],
-                    discretisation=case["discretisation"], outputs=("q",))["q"]
+                    corrections=case["corrections"], discretisation=case["discretisation"], outputs=("q",))["q"]
 
 
 def _c_batch(case: dict) -> np.ndarray:

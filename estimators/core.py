@@ -59,12 +59,18 @@ CONFIG_SLOTS, CONFIG_SIZE = _offsets(CONFIG_LAYOUT)
 GRAVITY, FIELD, DISCRETE, RY = (CONFIG_SLOTS[n][0] for n in ("gravity", "earth_field", "discretisation", "ry"))
 
 # "pending" is 1 until the first sample has set the attitude from TRIAD (initial="triad");
-# "started" is 0 until the first sample has set the rest detector's low-pass filters
+# "started" is 0 until the first sample has set the low-pass filters (rest detector, specific force);
+# "acc_filter", "mag_filter": the two delay vectors of the low-passes of specific force and field,
+# body coordinates; "field_reference" and "field_candidate": (norm, dip) of the accepted field
+# and of the candidate one, "candidate_time" how long the candidate has held (s)
 STATE_LAYOUT = (("q", 4), ("b", 3), ("theta", 3), ("gyro_lowpass", 3), ("acc_lowpass", 3), ("rest_time", 1),
-                ("pending", 1), ("started", 1))
+                ("pending", 1), ("started", 1), ("acc_filter", 6), ("mag_filter", 6), ("field_reference", 2),
+                ("field_candidate", 2), ("candidate_time", 1))
 STATE_SLOTS, STATE_SIZE = _offsets(STATE_LAYOUT)
-Q, B, THETA, GYRO_LP, ACC_LP, REST_TIME, PENDING, STARTED = (STATE_SLOTS[n][0] for n in (
-    "q", "b", "theta", "gyro_lowpass", "acc_lowpass", "rest_time", "pending", "started"))
+Q, B, THETA, GYRO_LP, ACC_LP, REST_TIME, PENDING, STARTED, ACC_FILTER, MAG_FILTER = (STATE_SLOTS[n][0] for n in (
+    "q", "b", "theta", "gyro_lowpass", "acc_lowpass", "rest_time", "pending", "started", "acc_filter", "mag_filter"))
+FIELD_REF, FIELD_CANDIDATE, CANDIDATE_TIME = (STATE_SLOTS[n][0] for n in ("field_reference", "field_candidate",
+                                                                          "candidate_time"))
 
 # weights: accelerometer weight, magnetometer weight (0..1), at rest (0 or 1)
 OUTPUT_LAYOUT = (("q", 4), ("theta", 3), ("b", 3), ("omega", 3), ("weights", 3))
@@ -73,7 +79,8 @@ OUT_Q, OUT_THETA, OUT_B, OUT_OMEGA, OUT_WEIGHTS = (OUTPUT_SLOTS[n][0] for n in (
 
 # Gains and correction settings, one vector per gain set; see estimators.filters for meanings.
 GAIN_NAMES = ("k1", "k2", "k3", "kP", "kI", "heading_only", "acc_tolerance", "mag_norm_tolerance",
-              "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain")
+              "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain",
+              "acc_lowpass", "mag_lowpass", "mag_reference_time")
 GAIN_SLOTS = {name: i for i, name in enumerate(GAIN_NAMES)}
 GAIN_SIZE = len(GAIN_NAMES)
 K1, K2, K3, KP, KI = (GAIN_SLOTS[n] for n in ("k1", "k2", "k3", "kP", "kI"))
@@ -81,13 +88,16 @@ HEADING_ONLY, ACC_TOL, MAG_NORM_TOL, MAG_DIP_TOL = (GAIN_SLOTS[n] for n in (
     "heading_only", "acc_tolerance", "mag_norm_tolerance", "mag_dip_tolerance"))
 REST_GYRO, REST_ACC, REST_MIN_TIME, REST_GAIN = (GAIN_SLOTS[n] for n in ("rest_gyro", "rest_acc", "rest_time",
                                                                           "rest_gain"))
+ACC_LOWPASS, MAG_LOWPASS, MAG_REF_TIME = (GAIN_SLOTS[n] for n in ("acc_lowpass", "mag_lowpass",
+                                                                  "mag_reference_time"))
 
 REST_LOWPASS_TAU = 0.5  # s, time constant of the low-pass filters of the rest detector
 SMALL_ANGLE = 1e-12  # rad: a smaller rotation in one step is integrated to first order (sin x = x)
-WORK_LAYOUT = (("R", 9), ("omega", 3), ("R_y", 9), ("v_up", 3), ("v_field", 3), ("scratch", 3))
+WORK_LAYOUT = (("R", 9), ("omega", 3), ("R_y", 9), ("v_up", 3), ("v_field", 3), ("scratch", 3), ("acc", 3),
+               ("mag", 3))
 WORK_SLOTS, WORK_SIZE = _offsets(WORK_LAYOUT)
-W_R, W_OMEGA, W_RY, W_UP, W_FIELD, W_SCRATCH = (WORK_SLOTS[n][0] for n in ("R", "omega", "R_y", "v_up", "v_field",
-                                                                          "scratch"))
+W_R, W_OMEGA, W_RY, W_UP, W_FIELD, W_SCRATCH, W_ACC, W_MAG = (WORK_SLOTS[n][0] for n in (
+    "R", "omega", "R_y", "v_up", "v_field", "scratch", "acc", "mag"))
 # error sums of the in-loop reduction, per gain set
 ERROR_LAYOUT = (("total2", 1), ("inclination2", 1), ("heading2", 1), ("heading_sin", 1), ("heading_cos", 1),
                 ("count", 1))
@@ -337,11 +347,10 @@ def _linear(x, u, gains, config, dt):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _rest(x, acc, gyro, gains, g, dt):
+def _rest(x, acc, gyro, gains, g, dt, first):
     """Rest detector on low-passed gyro and accelerometer; True once at rest for ``rest_time``."""
     alpha = dt / (REST_LOWPASS_TAU + dt)
-    if x[STARTED] == 0.0:
-        x[STARTED] = 1.0
+    if first:
         for i in range(3):
             x[GYRO_LP + i], x[ACC_LP + i] = gyro[i], acc[i]
     for i in range(3):
@@ -371,18 +380,107 @@ def _split(w, vhat, tilt_weight, heading_weight):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _weights(acc, mag, gains, v_up, v_field, g, field):
+def _rotate_back(v, wx, wy, wz, dt):
+    """v <- exp(-S(omega dt)) v: a vector fixed in the inertial frame, seen from the body after it
+    turned by ``omega dt`` (Rodrigues)."""
+    angle = math.sqrt(wx * wx + wy * wy + wz * wz) * dt
+    if angle < SMALL_ANGLE:
+        return
+    ux, uy, uz = wx * dt / angle, wy * dt / angle, wz * dt / angle
+    c, s = math.cos(angle), -math.sin(angle)
+    along = (1.0 - c) * (ux * v[0] + uy * v[1] + uz * v[2])
+    v0, v1, v2 = v[0], v[1], v[2]
+    v[0] = c * v0 + s * (uy * v2 - uz * v1) + along * ux
+    v[1] = c * v1 + s * (uz * v0 - ux * v2) + along * uy
+    v[2] = c * v2 + s * (ux * v1 - uy * v0) + along * uz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lowpass_in_gyro_frame(z, v, wx, wy, wz, tau, dt, first):
+    """The body-frame measurement ``v`` low-passed in the frame that turns with the corrected gyro (3-tuple).
+
+    A second-order Butterworth low-pass of cut-off ``sqrt(2) / (2 pi tau)`` (the choice of
+    VQF, Laidig and Seel, "VQF: highly accurate IMU orientation estimation with bias estimation
+    and magnetic disturbance rejection", 2023) whose two delay vectors ``z`` (6) are kept in
+    body coordinates and turned with the body by ``omega = gyro - b`` each sample: the filter
+    runs in an almost inertial frame, where linear accelerations average out and gravity does not.
+    """
+    z1, z2 = z[0:3], z[3:6]
+    c = math.tan(math.pi * math.sqrt(2.0) / (2.0 * math.pi * tau) * dt)
+    d = c * c + math.sqrt(2.0) * c + 1.0
+    b0 = c * c / d
+    a1, a2 = 2.0 * (c * c - 1.0) / d, (1.0 - math.sqrt(2.0) * c + c * c) / d
+    if first:  # steady state of a constant input
+        for i in range(3):
+            z1[i], z2[i] = (1.0 - b0) * v[i], (b0 - a2) * v[i]
+    else:
+        _rotate_back(z1, wx, wy, wz, dt)
+        _rotate_back(z2, wx, wy, wz, dt)
+    out0 = b0 * v[0] + z1[0]
+    out1 = b0 * v[1] + z1[1]
+    out2 = b0 * v[2] + z1[2]
+    for i, out in ((0, out0), (1, out1), (2, out2)):  # transposed direct form II, b1 = 2 b0, b2 = b0
+        z1[i] = 2.0 * b0 * v[i] - a1 * out + z2[i]
+        z2[i] = b0 * v[i] - a2 * out
+    return out0, out1, out2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _field_weight(norm, dip, reference_norm, reference_dip, gains):
+    """Magnetometer weight (0..1): ramps on the relative norm and on the dip against the reference."""
+    return _ramp(norm / reference_norm - 1.0, gains[MAG_NORM_TOL]) * _ramp(dip - reference_dip, gains[MAG_DIP_TOL])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
+    """Magnetic reference tracking, after VQF (Laidig and Seel, 2023): the reference (norm, dip)
+    follows the field slowly while the field agrees with it (weight over 0.5); a candidate
+    field that has held its own norm and dip (within the tolerances) for ``mag_reference_time``
+    while the reference is rejected becomes the reference. A short disturbance stays rejected,
+    a lasting new field (an uncompensated motor field, a room's iron) is accepted instead of
+    being rejected for ever."""
+    if first:
+        x[FIELD_REF], x[FIELD_REF + 1] = field, field_dip
+        x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
+    span = gains[MAG_REF_TIME]
+    k = min(1.0, dt / span)
+    accepted = _field_weight(norm, dip, x[FIELD_REF], x[FIELD_REF + 1], gains) > 0.5
+    if accepted:
+        x[FIELD_REF] += k * (norm - x[FIELD_REF])
+        x[FIELD_REF + 1] += k * (dip - x[FIELD_REF + 1])
+    if _field_weight(norm, dip, x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], gains) > 0.0:
+        x[FIELD_CANDIDATE] += k * (norm - x[FIELD_CANDIDATE])
+        x[FIELD_CANDIDATE + 1] += k * (dip - x[FIELD_CANDIDATE + 1])
+        x[CANDIDATE_TIME] += dt
+    else:
+        x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
+    if not accepted and x[CANDIDATE_TIME] >= span:
+        x[FIELD_REF], x[FIELD_REF + 1] = x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _asin(s):
+    return math.asin(min(1.0, max(-1.0, s)))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _weights(acc, mag, gains, v_up, v_field, g, field, x, dt, first):
     """Accelerometer and magnetometer weights (0..1) of the disturbance-aware corrections."""
     na, nm = _norm3(acc), _norm3(mag)
     # a null measurement (free fall, a dropped sensor) carries no direction: weight 0
     acc_weight = _ramp(na - g, gains[ACC_TOL]) if na > 0.0 else 0.0
-    mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL]) if nm > 0.0 else 0.0
-    if nm > 0.0 and gains[MAG_DIP_TOL] > 0.0:
-        # dip: angle of the field below the horizontal plane, measured against the estimate's vertical
-        sin_dip = -(mag[0] * v_up[0] + mag[1] * v_up[1] + mag[2] * v_up[2]) / nm
+    if nm == 0.0:
+        return acc_weight, 0.0
+    # dip: angle of the field below the horizontal plane, measured against the estimate's vertical
+    sin_dip = -(mag[0] * v_up[0] + mag[1] * v_up[1] + mag[2] * v_up[2]) / nm
+    if gains[MAG_REF_TIME] > 0.0:
+        field_dip = _asin(-(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2]))
+        _track_field(x, nm, _asin(sin_dip), gains, dt, first, field, field_dip)
+        return acc_weight, _field_weight(nm, _asin(sin_dip), x[FIELD_REF], x[FIELD_REF + 1], gains)
+    mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL])
+    if gains[MAG_DIP_TOL] > 0.0:
         sin_ref = -(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2])
-        mag_weight *= _ramp(math.asin(min(1.0, max(-1.0, sin_dip))) - math.asin(min(1.0, max(-1.0, sin_ref))),
-                            gains[MAG_DIP_TOL])
+        mag_weight *= _ramp(_asin(sin_dip) - _asin(sin_ref), gains[MAG_DIP_TOL])
     return acc_weight, mag_weight
 
 
@@ -403,9 +501,9 @@ def _explicit_correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field)
 
 
 @njit(cache=True, error_model="numpy")
-def _passive_correction(u, config, gains, acc_weight, mag_weight, r, work, w):
-    """w = vex(Pa(R^T R_y)), R_y from R_reel or TRIAD, split into tilt and heading when asked."""
-    acc, mag, v_up = u[ACC:ACC + 3], u[MAG:MAG + 3], work[W_UP:W_UP + 3]
+def _passive_correction(acc, mag, u, config, gains, acc_weight, mag_weight, r, work, w):
+    """w = vex(Pa(R^T R_y)), R_y from R_reel or TRIAD, split into tilt (weight k1) and heading (k2)."""
+    v_up = work[W_UP:W_UP + 3]
     ry = work[W_RY:W_RY + 9].reshape((3, 3))
     if config[RY] == TRIAD:
         if not triad(acc, mag, config, ry):
@@ -428,23 +526,24 @@ def _passive_correction(u, config, gains, acc_weight, mag_weight, r, work, w):
         v_meas = work[W_SCRATCH:W_SCRATCH + 3]
         _body(ry, -config[GRAVITY], -config[GRAVITY + 1], -config[GRAVITY + 2], v_meas)
         w[:] = 0.0
-        _add_cross(v_meas, 1.0, v_up, acc_weight, w)
+        _add_cross(v_meas, 1.0, v_up, gains[K1] * acc_weight, w)
         for i in range(3):
-            w[i] += mag_weight * along * v_up[i]
-    elif acc_weight < 1.0 or mag_weight < 1.0:
-        _split(w, v_up, acc_weight, mag_weight)
+            w[i] += gains[K2] * mag_weight * along * v_up[i]
+    elif gains[K1] * acc_weight != 1.0 or gains[K2] * mag_weight != 1.0:
+        _split(w, v_up, gains[K1] * acc_weight, gains[K2] * mag_weight)
 
 
 @njit(cache=True, error_model="numpy")
-def _passive(u, config, gains, acc_weight, mag_weight, r, v_up, work):
+def _passive(acc, mag, u, config, gains, acc_weight, mag_weight, r, v_up, work):
     """The passive filter's correction (3-tuple), through the arrays of ``work``."""
     rm, w = work[W_R:W_R + 9].reshape((3, 3)), work[W_OMEGA:W_OMEGA + 3]
     for i in range(9):
         rm[i // 3, i % 3] = r[i]
     for i in range(3):
-        work[W_UP + i] = v_up[i]
+        work[W_UP + i], work[W_ACC + i], work[W_MAG + i] = v_up[i], acc[i], mag[i]
     w[:] = 0.0
-    _passive_correction(u, config, gains, acc_weight, mag_weight, rm, work, w)
+    _passive_correction(work[W_ACC:W_ACC + 3], work[W_MAG:W_MAG + 3], u, config, gains, acc_weight, mag_weight, rm,
+                        work, w)
     return w[0], w[1], w[2]
 
 
@@ -456,20 +555,29 @@ def _complementary(kind, x, u, gains, config, dt, work, y):
     acc = (u[ACC], u[ACC + 1], u[ACC + 2])
     gyro = (u[GYRO], u[GYRO + 1], u[GYRO + 2])
     mag = (u[MAG], u[MAG + 1], u[MAG + 2])
+    first = x[STARTED] == 0.0
+    x[STARTED] = 1.0
+    wx, wy, wz = gyro[0] - x[B], gyro[1] - x[B + 1], gyro[2] - x[B + 2]
+    filtered, field = acc, mag
+    if gains[ACC_LOWPASS] > 0.0:
+        filtered = _lowpass_in_gyro_frame(x[ACC_FILTER:ACC_FILTER + 6], acc, wx, wy, wz, gains[ACC_LOWPASS], dt, first)
+    if gains[MAG_LOWPASS] > 0.0:
+        field = _lowpass_in_gyro_frame(x[MAG_FILTER:MAG_FILTER + 6], mag, wx, wy, wz, gains[MAG_LOWPASS], dt, first)
     r = _rotation(x[Q], x[Q + 1], x[Q + 2], x[Q + 3])
     gx, gy, gz = config[GRAVITY], config[GRAVITY + 1], config[GRAVITY + 2]
     mx, my, mz = config[FIELD], config[FIELD + 1], config[FIELD + 2]
     g = math.sqrt(gx * gx + gy * gy + gz * gz)
     v_up = _direction(r, -gx, -gy, -gz)  # estimated direction of the specific force at rest ("up")
     v_field = _direction(r, mx, my, mz)
-    acc_weight, mag_weight = _weights(acc, mag, gains, v_up, v_field, g, math.sqrt(mx * mx + my * my + mz * mz))
+    acc_weight, mag_weight = _weights(filtered, field, gains, v_up, v_field, g, math.sqrt(mx * mx + my * my + mz * mz),
+                                      x, dt, first)
     if kind == EXPLICIT:
-        w = _explicit_correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field)
+        w = _explicit_correction(filtered, field, gains, acc_weight, mag_weight, v_up, v_field)
     else:
-        w = _passive(u, config, gains, acc_weight, mag_weight, r, v_up, work)
+        w = _passive(filtered, field, u, config, gains, acc_weight, mag_weight, r, v_up, work)
         if config[RY] != TRIAD:
             acc_weight, mag_weight = 1.0, 1.0
-    at_rest = _rest(x, acc, gyro, gains, g, dt)
+    at_rest = _rest(x, acc, gyro, gains, g, dt, first)
     for i in range(3):
         x[B + i] -= dt * gains[KI] * w[i]
         if at_rest:

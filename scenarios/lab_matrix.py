@@ -10,6 +10,10 @@ A named sweep: its members run on Dask like any sweep (``--workers``, ``--schedu
   prediction (estimators.analysis.explicit_bias_steady_error);
 - the passive filter: bias-convergence time against the linearised prediction for
   kP = kI in {0.1, 1, 10, 100}, with R_reel and with TRIAD;
+- the published filters beside the lab's: VQF (``vqf``) and Madgwick (``ahrs``) with the
+  linear, explicit and passive (TRIAD) filters at the lab's gains, estimate-fed, noise and
+  gyro bias, on both flight profiles; quaternion-error RMSE (total, inclination, heading)
+  and the estimation and tracking RMS;
 - the lab's findings as checks, each with its measured figures: the linear filter accurate in
   quasi-stationary flight (a non-zero error below 1 degree on every axis) and degraded in
   non-stationary flight; the explicit filter below 2 degrees RMS in both; the bias cases as
@@ -25,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from estimators import analysis
+from estimators import analysis, score
 from fmus.IMU.variables import LAB_GYRO_BIAS
 
 CASES = {
@@ -53,6 +57,11 @@ CASES = {
     "passive-triad-hover-estimate-noise-bias": {"estimator": "passive", "ry": "triad", "bias": True, "noise": True,
                                                 "feedback": "estimate", "flight": "hover"},
 }
+# the published filters beside the lab's, in the same closed loop (estimate-fed, noise, gyro bias)
+COMPARED = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+COMPARISON = {f"compare-{kind}-{flight}": {"estimator": kind, "flight": flight, "feedback": "estimate", "noise": True,
+                                           "bias": True, **options}
+              for flight in ("quasi", "nonstationary") for kind, options in COMPARED.items()}
 EXPLICIT_GAINS = (0.2, 1.0, 2.0)
 EXPLICIT_WITHOUT_BIAS = ("explicit-0.002-quasi-gt", "explicit-0.002-nonstationary-gt", "explicit-0.002-quasi-estimate",
                          "explicit-0.2-nonstationary-estimate", "explicit-nonstationary-estimate-noise")
@@ -64,7 +73,7 @@ PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
 
 def cases() -> dict[str, dict]:
     """Every member: the matrix's cases, then the runs the checks against analysis rest on."""
-    members = dict(CASES)
+    members = dict(CASES) | COMPARISON
     for k in EXPLICIT_GAINS:  # the explicit filter's steady error without bias estimate
         members[f"explicit-steady-k{k:g}-hover-bias"] = {"estimator": "explicit", "flight": "hover", "bias": True,
                                                         "k1": k, "k2": k, "kI": 0.0, "duration": 60.0}
@@ -82,12 +91,16 @@ def _passive_prediction(gain: float) -> float:
 
 def late_mean_error(result, options) -> dict:
     """Mean estimation error over the last quarter of the run (deg; roll, pitch, yaw): the
-    steady error of a filter that does not estimate the gyro bias (after 45 s of 60), from a
+    steady error of a filter that does not estimate the gyro bias (after 45 s of 60), and the
+    quaternion-error RMSE after the settling time (deg; total, inclination, heading), from a
     member's ``result`` and its tp ``options``."""
     late = result.time > 0.75 * options["duration"]
     error = np.column_stack([result[f"Quaternion_estim.theta_est{i}"] - result[f"Quadrotor.theta{i}"]
                              for i in (1, 2, 3)])[late].mean(axis=0)
-    return {"late_mean_error_deg": np.degrees(error).tolist()}
+    settle = min(options["settle"], 0.5 * options["duration"])
+    quaternion = score(result["Quaternion_estim.q_est"], result["Quadrotor.q"], result.time >= settle)
+    return {"late_mean_error_deg": np.degrees(error).tolist(),
+            "quaternion_rmse_deg": [quaternion[f"{k}_rmse_deg"] for k in ("total", "inclination", "heading")]}
 
 
 def summary_of(records: list[dict]) -> dict:
@@ -100,6 +113,9 @@ def summary_of(records: list[dict]) -> dict:
             {"k1=k2": k, "simulated": by_label[f"explicit-steady-k{k:g}-hover-bias"]["late_mean_error_deg"],
              "predicted": np.degrees(analysis.explicit_bias_steady_error(k, k, 1.0, LAB_GYRO_BIAS)).tolist()}
             for k in EXPLICIT_GAINS],
+        "comparison": {name: {k: by_label[name][k] for k in ("quaternion_rmse_deg", "rms_error_deg",
+                                                               "tracking_rms_deg")}
+                       for name in COMPARISON},
         "passive_bias_convergence_s": [
             {"ry": ry, "kP=kI": g,
              "simulated": by_label[f"passive-{ry}-{g:g}-hover-bias-convergence"]["bias_convergence_s"],
@@ -167,6 +183,12 @@ def markdown(summary: dict) -> str:
     lines = ["| case | estimation RMS (deg, roll/pitch/yaw) | tracking RMS (deg) |", "|---|---|---|"]
     for name, m in summary["cases"].items():
         lines.append(f"| {name} | {deg(m['rms_error_deg'])} | {deg(m['tracking_rms_deg'])} |")
+    lines += ["", "| flight | estimator (estimate-fed, noise, bias) | quaternion RMSE total / inclination / heading "
+              "(deg) | estimation RMS (deg, roll/pitch/yaw) | tracking RMS (deg) |", "|---|---|---|---|---|"]
+    for name, m in summary["comparison"].items():
+        options = COMPARISON[name]
+        lines.append(f"| {options['flight']} | {options['estimator']} | {deg(m['quaternion_rmse_deg'])} | "
+                     f"{deg(m['rms_error_deg'])} | {deg(m['tracking_rms_deg'])} |")
     lines += ["", "| explicit, no bias estimate, k1 = k2 | simulated steady error (deg) | predicted (deg) |",
               "|---|---|---|"]
     for row in summary["explicit_steady_bias_error_deg"]:

@@ -86,7 +86,7 @@ def estimator_gains(o: dict) -> dict:
     ki = o["kI"] if o["kI"] >= 0 else LAB_GAINS[kind]["kI"]
     if kind == "explicit":
         return {"k1": o["k1"], "k2": o["k2"], "kP": o["kP"], "kI": ki}
-    return {"kP": o["kP"], "kI": ki}
+    return {"k1": LAB_GAINS[kind]["k1"], "k2": LAB_GAINS[kind]["k2"], "kP": o["kP"], "kI": ki}
 
 
 def resolve(o: dict) -> dict:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import scenarios
-from estimators import analysis, core, estimate, filters, gain_grid, score
+from estimators import analysis, core, estimate, filters, gain_grid, parse_corrections, score
 from fmus import vehicle
 
 
@@ -33,6 +33,7 @@ def angle(q1, q2):
 
 @pytest.mark.parametrize("kind, options", [
     ("linear", {"k": 0.05}), ("explicit", {"kI": 0.3}), ("passive", {"ry": "reel"}), ("passive", {"ry": "triad"}),
+    ("explicit", {"kI": 0.3, "corrections": "on"}), ("passive", {"ry": "triad", "corrections": "on"}),
 ])
 def test_batch_path_equals_streaming_block(kind, options):
     result, _ = scenarios.run("tp", {"estimator": kind, "noise": True, "bias": True, "duration": 1.0,
@@ -42,7 +43,7 @@ def test_batch_path_equals_streaming_block(kind, options):
         {"estimator": kind, **options}))
     batch = estimate(kind, acc=result["IMU.acc"], gyro=result["IMU.gyro"], mag=result["IMU.magneto"], dt=1e-3,
                      gains=gains, R_reel=result["IMU.R_reel"], ry=options.get("ry", "reel"), q0=(1, 0, 0, 0),
-                     corrections=False if kind != "linear" else None)
+                     corrections=parse_corrections(options.get("corrections", "off")) if kind != "linear" else None)
     streamed = result["Quaternion_estim.q_est"]
     print(f"{kind} {options}: largest |batch - streaming| = {np.abs(batch['q'][0] - streamed).max():.3g}")
     assert np.abs(batch["q"][0] - streamed).max() <= 1e-12

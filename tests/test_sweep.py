@@ -249,8 +249,11 @@ def test_lab_matrix_is_a_named_sweep_of_every_case():
 
     plan = named.get("lab-matrix").plan(["noise=on"])
     labels = [m.label for m in plan.members]
-    assert labels[:len(lab_matrix.CASES)] == list(lab_matrix.CASES)
-    assert len(labels) == len(lab_matrix.CASES) + len(lab_matrix.EXPLICIT_GAINS) + 2 * len(lab_matrix.PASSIVE_GAINS)
+    assert labels[:len(lab_matrix.CASES) + 10] == list(lab_matrix.CASES) + list(lab_matrix.COMPARISON)
+    assert {m.options["estimator"] for m in plan.members if m.label in lab_matrix.COMPARISON} == {
+        "linear", "explicit", "passive", "vqf", "madgwick"}
+    assert len(labels) == (len(lab_matrix.CASES) + len(lab_matrix.COMPARISON) + len(lab_matrix.EXPLICIT_GAINS)
+                           + 2 * len(lab_matrix.PASSIVE_GAINS))
     assert all(m.options["noise"] is True for m in plan.members)
     passive = plan.members[-1].options  # TRIAD, kP = kI = 100: 1.5 times the predicted convergence, at least 10 s
     assert passive["ry"] == "triad" and passive["kP"] == 100.0 and passive["duration"] == 10.0
