@@ -147,4 +147,5 @@ def report(result, o, out) -> dict:
     }
 
 
-SCENARIO = Scenario("open-loop", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report)
+SCENARIO = Scenario("open-loop", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
+                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed"}})

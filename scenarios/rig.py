@@ -192,4 +192,5 @@ def report(result, o, out) -> dict:
     }
 
 
-SCENARIO = Scenario("rig", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report, duration=duration)
+SCENARIO = Scenario("rig", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report, duration=duration,
+                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.seed": "seed"}})

@@ -176,3 +176,11 @@ def test_a_nan_caused_by_a_fault_names_the_fault_not_the_block(tmp_path, capsys)
             "at that time, on an input of Quaternion_estim.") in message
     assert "Other faults that had started and feed Quaternion_estim: the offset fault on Controller.p_x" in message
     assert "Check the block" not in message
+
+
+@pytest.mark.parametrize("scenario, setting, option", [
+    ("open-loop", "IMU.seed=2", "seed"), ("rig", "IMU.noise_enabled=false", "noise"),
+    ("static-cal", "IMU.sample_rate=50", "mag_rate")])
+def test_a_parameter_a_scenario_sets_from_an_option_names_the_option(scenario, setting, option, capsys, tmp_path):
+    assert run_cli(["run", scenario, "--set", setting, "--out", str(tmp_path / "run")]) == 2
+    assert f"is set by scenario {scenario}'s option {option}: use --set {option}=..." in capsys.readouterr().err
