@@ -215,3 +215,9 @@ def test_every_python_block_states_the_unit_of_each_output(name, options):
             continue
         assert set(getattr(block, "units", {})) == set(block.outputs), block.name
         assert all(block.units[output] for output in block.outputs), block.name
+
+
+def test_result_plot_of_a_real_run_labels_the_units_of_the_variable_tables():
+    result, _ = scenarios.run("open-loop", {"duration": 0.05})
+    assert result.plot("IMU.acc").get_ylabel() == "IMU.acc (m/s2)"
+    assert result.plot("MotorMagnetics.omega_r1").get_ylabel() == "MotorMagnetics.omega_r1 (rad/s)"
