@@ -34,7 +34,8 @@ def build_references() -> list[Path]:
 
 
 def reference_library(name: str):
-    """The compiled reference ``benchmarks/c/<name>.c``, compiled first if missing or stale.
+    """The compiled reference ``benchmarks/c/<name>.c``, compiled first if missing or older than
+    its source or a shared header.
 
     Parameters
     ----------
@@ -51,6 +52,7 @@ def reference_library(name: str):
     from orchestrator.calls import compile_shared
 
     source, library = SOURCES / f"{name}.c", LIBRARIES / f"lib{name}.so"
-    if not library.is_file() or library.stat().st_mtime < source.stat().st_mtime:
+    newest = max(path.stat().st_mtime for path in [source, *SOURCES.glob("*.h")])
+    if not library.is_file() or library.stat().st_mtime < newest:
         compile_shared(source, library)
     return ctypes.CDLL(str(library))

@@ -12,6 +12,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include "rotation.h"
 
 /* input sample */
 enum { ACC = 0, GYRO = 3, MAG = 6, INPUT_SIZE = 18 };
@@ -117,15 +118,7 @@ static void update(State *x, const double *u, const double *gains, const double 
     double *q = x->q, *b = x->b;
     double r[3][3], v_up[3], v_field[3], w[3] = {0.0, 0.0, 0.0};
     double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3];
-    r[0][0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
-    r[0][1] = 2.0 * (q1 * q2 - q0 * q3);
-    r[0][2] = 2.0 * (q1 * q3 + q0 * q2);
-    r[1][0] = 2.0 * (q1 * q2 + q0 * q3);
-    r[1][1] = 1.0 - 2.0 * (q1 * q1 + q3 * q3);
-    r[1][2] = 2.0 * (q2 * q3 - q0 * q1);
-    r[2][0] = 2.0 * (q1 * q3 - q0 * q2);
-    r[2][1] = 2.0 * (q2 * q3 + q0 * q1);
-    r[2][2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2);
+    rotation_of_quaternion(q0, q1, q2, q3, r);
     double gx = config[GRAVITY], gy = config[GRAVITY + 1], gz = config[GRAVITY + 2];
     double mx = config[FIELD], my = config[FIELD + 1], mz = config[FIELD + 2];
     double g = sqrt(gx * gx + gy * gy + gz * gz);

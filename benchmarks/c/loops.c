@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
+#include "rotation.h"
 
 typedef int (*SetReal)(void *, const unsigned int *, size_t, const double *);
 typedef int (*GetReal)(void *, const unsigned int *, size_t, double *);
@@ -92,15 +93,7 @@ static void add_cross(const double *v, double norm_v, const double *vhat, double
 static void explicit_filter(const Explicit *f, double *q, double *b, const double *imu, double dt, double *y) {
     const double *acc = imu + I_ACC, *gyro = imu + I_GYRO, *mag = imu + I_MAG;
     double q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3], r[3][3], up[3], field[3], w[3] = {0.0, 0.0, 0.0};
-    r[0][0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3);
-    r[0][1] = 2.0 * (q1 * q2 - q0 * q3);
-    r[0][2] = 2.0 * (q1 * q3 + q0 * q2);
-    r[1][0] = 2.0 * (q1 * q2 + q0 * q3);
-    r[1][1] = 1.0 - 2.0 * (q1 * q1 + q3 * q3);
-    r[1][2] = 2.0 * (q2 * q3 - q0 * q1);
-    r[2][0] = 2.0 * (q1 * q3 - q0 * q2);
-    r[2][1] = 2.0 * (q2 * q3 + q0 * q1);
-    r[2][2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2);
+    rotation_of_quaternion(q0, q1, q2, q3, r);
     body_direction(r, -f->gravity[0], -f->gravity[1], -f->gravity[2], up);
     body_direction(r, f->field[0], f->field[1], f->field[2], field);
     double acc_weight = norm3(acc) > 0.0 ? 1.0 : 0.0, mag_weight = norm3(mag) > 0.0 ? 1.0 : 0.0;
