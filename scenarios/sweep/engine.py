@@ -67,9 +67,11 @@ class Preload(WorkerPlugin):
         matplotlib.use("Agg")
         import scenarios
         from fmus import MODELS, FMUNotFoundError
+        from orchestrator import pool
         from orchestrator.fmu import FMUInstance
 
         scenarios.get(self.scenario)
+        pool.reuse(True)  # members reset the worker's FMU instances rather than make new ones
         for model in MODELS:
             try:
                 FMUInstance(model).close()
@@ -131,7 +133,8 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
     -------
     dict
         ``status`` ("ok" or "failed"), ``error``, ``traceback``, ``metrics``, ``wall_s`` (s),
-        ``cpu_s`` (s of this process's CPU time), ``worker``, ``files``.
+        ``cpu_s`` (s of this process's CPU time), ``stepping_cpu_s`` (s of CPU in the stepping
+        loop alone), ``worker``, ``files``.
     """
     global _members_run
     import scenarios
@@ -153,6 +156,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
                     record["files"] = {p.name: p.read_bytes() for p in Path(folder).iterdir() if p.is_file()}
         else:
             result, metrics = scenarios.run(scenario, options)
+        record["stepping_cpu_s"] = result.meta.get("loop_cpu_seconds")
         if extra_metrics:
             metrics = metrics | _resolve(extra_metrics)(result, options)
         record["metrics"] = _plain({k: v for k, v in metrics.items() if k not in NOT_METRICS})
@@ -278,6 +282,7 @@ def _save_member(out: Path, member: Member, record: dict, attempts: int, scenari
         (folder / "error.txt").write_text(record["traceback"])
     saved = {"member": member.index, "label": member.label, "status": record["status"], "error": record["error"],
              "attempts": attempts, "wall_s": record.get("wall_s"), "cpu_s": record.get("cpu_s"),
+             "stepping_cpu_s": record.get("stepping_cpu_s"),
              "worker": record.get("worker"), "scenario": scenario, "options": member.options,
              "metrics": record.get("metrics") or {}}
     # metrics.json is written last: its presence means the member finished (well or not).
