@@ -107,3 +107,17 @@ def test_infrared_gps_delay_or_window_beyond_the_history_is_refused_not_wrapped(
     assert status == ERROR, f"{parameter} = {seconds:g} s accepted; gps_valid = {fmu.get_real([fmu.refs['gps_valid']])}"
     assert "more than the 4095 kept" in fmu.messages()
     fmu.free()
+
+
+def test_the_long_fuzz_reports_calls_on_freed_instances_and_double_frees():
+    import json
+    import subprocess
+
+    done = subprocess.run([sys.executable, "-m", "benchmarks.fuzz", "--calls", "600", "--models", "Quadrotor", "IMU",
+                           "--json"], capture_output=True, text=True, timeout=300,
+                          cwd=Path(__file__).resolve().parents[2])
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    report = json.loads(done.stdout)
+    assert report["failed"] == []
+    assert report["totals"]["calls"] >= 1200
+    assert report["totals"]["calls_after_free"] > 0 and report["totals"]["double_frees"] > 0
