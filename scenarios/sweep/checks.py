@@ -17,7 +17,7 @@ import math
 from scenarios.sweep.grid import GridMembers, Plan
 
 #: Dimensions with up to this many values are probed value by value.
-PROBED_VALUES = 256
+PROBED_VALUES = 32
 
 
 class MemberRefused(ValueError):
@@ -34,7 +34,8 @@ def _extremes(values: list) -> set[int]:
 
 
 def probes(plan: Plan) -> list[int]:
-    """Indices of the members to check (see the module documentation), first member first."""
+    """Indices of the members of ``plan`` to check (see the module documentation), the first
+    member first: every member of a list of cases, probes of a grid."""
     members = plan.members
     if not isinstance(members, GridMembers):
         return list(range(len(members)))
