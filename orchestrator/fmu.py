@@ -103,6 +103,27 @@ class FMUError(RuntimeError):
         )
 
 
+class ParameterRefused(FMUError, ValueError):
+    """An FMU refused the parameter values it was given, at instantiation or initialisation.
+
+    A ``ValueError`` too: it is refused input, which the command line answers with exit 2.
+    The message names the block, the call, the values set and what the FMU logged.
+    """
+
+    def __init__(self, error: FMUError, overrides: dict):
+        self.block, self.function, self.status, self.time, self.log = (
+            error.block, error.function, error.status, error.time, error.log)
+        given = ", ".join(f"{name}={value!r}" for name, value in overrides.items()) or "none (the defaults)"
+        logged = "\n  ".join(error.log[-10:]) if error.log else "(the FMU logged nothing)"
+        model = error.block
+        ValueError.__init__(
+            self, f"{model} refused its parameters at initialisation ({error.function} returned "
+                  f"{STATUS[error.status] if 0 <= error.status < 6 else error.status}). Values set: {given}.\n"
+                  f"  FMU log:\n  {logged}\n"
+                  f"Give a value in the range the log names (`quadcosim list --parameters MODEL` lists each "
+                  f"parameter's default and unit).")
+
+
 def _unzip(path: Path) -> str:
     key = (str(path), path.stat().st_mtime)
     if key not in _extracted:
@@ -160,6 +181,15 @@ class FMUInstance:
             modelIdentifier=description.coSimulation.modelIdentifier,
             instanceName=self._instance_name,
         )
+        try:
+            self._initialise(start_time, overrides)
+        except FMUError as error:
+            self._free_after_failure()
+            raise ParameterRefused(error, overrides) from None
+        self.closed = False
+
+    def _initialise(self, start_time: float, overrides: dict):
+        """Instantiate, set up, enter initialisation, set ``overrides``, leave initialisation."""
         self._call(lambda: self._slave.instantiate(callbacks=_CALLBACKS), "fmi2Instantiate")
         self.component = self._slave.component
         # One set of handles for every path: fresh function objects without argtypes, called
@@ -176,7 +206,16 @@ class FMUInstance:
         for name, value in overrides.items():
             self._set_any(name, value)
         self._call(self._slave.exitInitializationMode, "fmi2ExitInitializationMode")
-        self.closed = False
+
+    def _free_after_failure(self):
+        """Free an instance whose set-up failed (FMI allows fmi2FreeInstance in any state)."""
+        if getattr(self._slave, "component", None):
+            try:
+                self._slave.freeInstance()
+            except Exception:  # the instance is gone either way; the refusal is what to report
+                pass
+        _logs.pop(self._instance_name.encode(), None)
+        self.closed = True
 
     # ------------------------------------------------------------------ set-up helpers
     def _call(self, function, label: str):
