@@ -49,17 +49,26 @@ class DiskFull(OSError):
     path : pathlib.Path
         The file that was being written.
     needed : int or None
-        Bytes the file needed (an estimate, or at least what was written when it failed).
+        Bytes the file needs, when known before it is written.
     free : int or None
         Bytes free in its folder after the partial file was removed.
+    reached : int
+        Bytes written when the disk filled.
     """
 
-    def __init__(self, path: Path, needed: int | None, free: int | None):
-        self.path, self.needed, self.free = Path(path), needed, free
-        need = f"about {megabytes(needed)}" if needed else "more room"
+    def __init__(self, path: Path, needed: int | None, free: int | None, reached: int = 0):
+        self.path, self.needed, self.free, self.reached = Path(path), needed, free, reached
+        if needed and needed > reached:
+            need = f"about {megabytes(needed)}"
+        else:
+            need = f"more than the {megabytes(reached)} written when the disk filled"
         room = f"{megabytes(free)} free" if free is not None else "free space unknown"
-        super().__init__(errno.ENOSPC, f"no space left in {self.path.parent}/ to write {self.path.name}: it needs "
-                                       f"{need} ({room}). Free space there or choose another --out folder")
+        self.message = (f"no space left in {self.path.parent}/ to write {self.path.name}: it needs {need} ({room}). "
+                        "Free space there or choose another --out folder")
+        super().__init__(errno.ENOSPC, self.message)
+
+    def __str__(self):
+        return self.message
 
 
 def megabytes(count: int | None) -> str:
@@ -117,7 +126,7 @@ def _no_room(error: OSError, path: Path, reached: int, size: int | None) -> OSEr
     """``error`` as :class:`DiskFull` when it says the disk is full, else unchanged."""
     if getattr(error, "errno", None) not in _NO_ROOM:
         return error
-    return DiskFull(path, max(size or 0, reached) or None, free_bytes(path.parent))
+    return DiskFull(path, size, free_bytes(path.parent), reached)
 
 
 def _note_written(path: Path):

@@ -108,19 +108,27 @@ class ParameterRefused(FMUError, ValueError):
 
     A ``ValueError`` too: it is refused input, which the command line answers with exit 2.
     The message names the block, the call, the values set and what the FMU logged.
+
+    Parameters
+    ----------
+    error : FMUError
+        The refused call.
+    overrides : dict
+        The parameter values that were set, by variable name.
+    model : str
+        The FMU's model name, for the command that lists its parameters.
     """
 
-    def __init__(self, error: FMUError, overrides: dict):
+    def __init__(self, error: FMUError, overrides: dict, model: str):
         self.block, self.function, self.status, self.time, self.log = (
             error.block, error.function, error.status, error.time, error.log)
         given = ", ".join(f"{name}={value!r}" for name, value in overrides.items()) or "none (the defaults)"
         logged = "\n  ".join(error.log[-10:]) if error.log else "(the FMU logged nothing)"
-        model = error.block
         ValueError.__init__(
             self, f"{model} refused its parameters at initialisation ({error.function} returned "
                   f"{STATUS[error.status] if 0 <= error.status < 6 else error.status}). Values set: {given}.\n"
                   f"  FMU log:\n  {logged}\n"
-                  f"Give a value in the range the log names (`quadcosim list --parameters MODEL` lists each "
+                  f"Give a value in the range the log names (`quadcosim list --parameters {model}` lists each "
                   f"parameter's default and unit).")
 
 
@@ -185,7 +193,7 @@ class FMUInstance:
             self._initialise(start_time, overrides)
         except FMUError as error:
             self._free_after_failure()
-            raise ParameterRefused(error, overrides) from None
+            raise ParameterRefused(error, overrides, path.stem) from None
         self.closed = False
 
     def _initialise(self, start_time: float, overrides: dict):

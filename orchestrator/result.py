@@ -592,10 +592,33 @@ class Result:
         return ax
 
 
+#: Rows gathered at a time when a column of the record is written (a few MB at most).
+WRITE_ROWS = 2 ** 16
+
+
 def _write_array(archive: zipfile.ZipFile, name: str, values: np.ndarray):
-    """One ``name.npy`` member of a NumPy archive, written as ``numpy.savez_compressed`` does."""
+    """One ``name.npy`` member of a NumPy archive, the bytes ``numpy.save`` writes.
+
+    A column of the record is strided: it is gathered :data:`WRITE_ROWS` rows at a time into
+    one contiguous block handed to the archive as it is (``numpy.lib.format.write_array``
+    copies each block twice).
+    """
+    values = np.asanyarray(values)
+    if values.dtype.hasobject or values.dtype.kind not in "fiub":  # the JSON meta: numpy's own writer
+        with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+            np.lib.format.write_array(member, values, allow_pickle=False)
+        return
+    header = np.lib.format.header_data_from_array_1_0(values)
     with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
-        np.lib.format.write_array(member, np.asanyarray(values), allow_pickle=False)
+        try:
+            np.lib.format.write_array_header_1_0(member, header)
+        except ValueError:  # a header too long for format 1.0, as numpy.save falls back
+            np.lib.format.write_array_header_2_0(member, header)
+        if values.flags.c_contiguous:
+            member.write(values.data if values.ndim else values.tobytes())
+            return
+        for first in range(0, len(values), WRITE_ROWS):
+            member.write(np.ascontiguousarray(values[first:first + WRITE_ROWS]).data)
 
 
 def _matlab_values(values: dict) -> dict:

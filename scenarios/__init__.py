@@ -347,6 +347,8 @@ def _run_phases(scenario, options, base, files, given, progress):
         status(f"{name}: writing {', '.join(f'results.{f}' for f in files.formats)} "
                f"({len(saved) if saved else len(result.names)} signals, {len(result)} samples)")
         files.keep_record(result, saved, files.stream)
+        if files.not_written:  # a full disk, or no memory left for a writer: metrics.json says which
+            raise files.failed("; ".join(f"{name} not written: {why}" for name, why in files.not_written.items()))
         files.phase = "reporting (metrics and figures)"
     status(f"{name}: report" + (" (metrics and figures)" if files else " (metrics)"))
     metrics |= _report(scenario, result, options, files, record)
@@ -439,7 +441,10 @@ def _report(scenario, result, options, files, record) -> dict:
     except Exception as error:
         if files is None:
             raise
-        raise files.failed(f"the report failed: {type(error).__name__}: {error}") from error
+        from orchestrator.files import DiskFull
+
+        what = str(error) if isinstance(error, DiskFull) else f"{type(error).__name__}: {error}"
+        raise files.failed(f"the report failed: {what}") from error
 
 
 def fault_record(fault) -> dict:
@@ -460,7 +465,7 @@ def fault_record(fault) -> dict:
 
 
 #: The units of :func:`fault_record`'s fields, as ``metrics.json`` states them.
-FAULT_UNITS = "start, stop: s; value: the target's unit (scale: a factor)"
+FAULT_UNITS = "start, stop: s (stop null: no end); value: the target's unit (scale: a factor)"
 
 
 def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | None, list[str] | None]:
