@@ -99,6 +99,10 @@ def available() -> tuple[int | None, str]:
     return min(known) if known else (None, "unknown")
 
 
+#: Bytes the writers hold whatever the record (buffers, compressor state).
+WRITER_BUFFERS = 16 * 2 ** 20
+
+
 def writers_peak(rows: int, widest: int, formats=("npz",), compress: bool = False, largest_block: int = 0) -> int:
     """Bytes the record's writers take beside the record at their peak.
 
@@ -119,14 +123,14 @@ def writers_peak(rows: int, widest: int, formats=("npz",), compress: bool = Fals
     Returns
     -------
     int
-        Bytes: a copy of the widest vector, twice for safety (the ``.npz`` gathers a vector's
-        columns, the ``.mat`` writer lays out each array once more); for a ``.mat`` three
-        times the largest block, twelve times when compressed (the block's serialised bytes
-        with its vectors, their copy and its compressed form: 6.7 to 11.3 times measured).
+        Bytes: twice the widest vector (measured once: the ``.mat`` writer lays it out, a
+        compressed ``.npz`` buffers it), :data:`WRITER_BUFFERS`, and for a compressed ``.mat``
+        ten times the largest block (its serialised bytes with its vectors, their copy and
+        its compressed form: 7.1 to 8.9 times measured).
     """
-    peak = 2 * 8 * rows * max(widest, 1)
-    if "mat" in formats:  # scipy lays out a block's struct whole: measured up to 1.4 times a block
-        peak += (12 if compress else 3) * 8 * rows * largest_block  # compressed: measured 6.7 to 11.3 times
+    peak = 2 * 8 * rows * max(widest, 1) + WRITER_BUFFERS
+    if compress and "mat" in formats:
+        peak += 10 * 8 * rows * largest_block
     return peak
 
 

@@ -12,6 +12,7 @@ import contextlib
 import importlib
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 # scenario name -> module of scenarios declaring it: a look-up imports that module alone
 _MODULES = {"open-loop": "open_loop", "rig": "rig", "tp": "tp", "gain-study": "gain_study",
@@ -288,21 +289,31 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     from scenarios.outputs import RunFiles
 
     status(f"{name}: loading the scenario")
-    scenario = get(name)
-    options = scenario.parse(settings)
     _check_formats(formats, stream, out_dir)
+    if name not in _MODULES:
+        get(name)  # refused (the nearest names given) before any folder is made
+    made = out_dir is not None and not Path(out_dir).exists()
     out = prepare_out_dir(out_dir, overwrite) if out_dir else None
-    base = {"scenario": name, "options": dict(options), "injected_faults": [fault_record(f) for f in faults],
+    given = dict(settings) if isinstance(settings, dict) else dict(_split(s) for s in settings or [] if "=" in s)
+    base = {"scenario": name, "options": given, "injected_faults": [fault_record(f) for f in faults],
             "decimation": decimation}
-    option_units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
-    files = RunFiles(out, formats, base, option_units, compress) if out is not None else None
+    files = RunFiles(out, formats, base, {}, compress) if out is not None else None
     with first_only(), (files.tracking() if files else contextlib.nullcontext()):
         try:
+            scenario = get(name)
+            options = scenario.parse(settings)
+            base["options"] = dict(options)
+            if files:
+                files.units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
             return _run_phases(scenario, options, base, files, (faults, estimator, record, stream), progress)
-        except KeyboardInterrupt as interrupt:  # outside the loop: building, drawing, saving, reporting
+        except KeyboardInterrupt as interrupt:  # outside the loop: loading, building, drawing, saving, reporting
             if files is None:
                 raise
             raise files.interrupted(interrupt, files.saved, files.stream) from None
+        except (KeyError, ValueError):  # refused before the run: the folder is left as it was
+            if files is not None and files.result is None:
+                files.refused(remove_folder=made)
+            raise
 
 
 def _check_formats(formats, stream: bool, out_dir):

@@ -163,15 +163,23 @@ class RunFiles:
         self.stopped(error, complete=True)
         return error
 
-    def refused(self):
+    def refused(self, remove_folder: bool = False):
         """Remove what this run wrote: it was refused before it started (a value an FMU
-        refused, a record too large), and the folder is left as it was."""
+        refused, a record too large), and the folder is left as it was.
+
+        Parameters
+        ----------
+        remove_folder : bool
+            The run made the folder: remove it too, if nothing else is in it.
+        """
         import shutil
 
         for name in self.names:
             (self.out / name).unlink(missing_ok=True)
         if self.stream is not None and self.stream.path.is_dir():
             shutil.rmtree(self.stream.path)
+        if remove_folder and self.out.is_dir() and not any(self.out.iterdir()):
+            self.out.rmdir()
 
     # ------------------------------------------------------------------ room, before the run
     def check_room(self, rows: int, recorded: list[str], saved: list[str], decimation: int, stream: bool):

@@ -58,19 +58,21 @@ def test_a_run_beyond_ulimit_v_is_refused_before_it_starts_naming_the_limit(tmp_
     assert done.returncode == 2, done.stderr[-2000:]
     assert "this run would record 3600001 samples of 126 signals, 3.63 GB" in done.stderr
     assert "(bound by ulimit -v)" in done.stderr and "--stream" in done.stderr
-    assert "MemoryError" not in done.stderr and list(out.iterdir()) == []
+    assert "MemoryError" not in done.stderr and not out.exists()
 
 
-@pytest.mark.parametrize("formats, compress, share", [(("npz",), False, 0.1), (("mat",), False, 0.6),
-                                                     (("npz", "mat"), True, 0.6)])
+@pytest.mark.parametrize("formats, compress, share", [(("npz",), False, 0.05), (("mat",), False, 0.25),
+                                                     (("npz", "mat"), True, 0.5)])
 def test_the_writers_peak_stays_within_its_estimate(tmp_path, formats, compress, share):
     """The estimate bounds what the writers allocate at their peak, and is not far above it
-    (measured here: 0.8 of it for a .mat file)."""
+    (measured: 0.11, 0.32 and 0.63 of it)."""
+    import scipy.io  # noqa: F401 (imported before the memory is traced)
+
     blocks = {"IMU": ["acc", "gyro", "magneto"], "Quadrotor": ["q", "omega", "p", "v", "R"]}
     names = [f"{block}.{vector}{axis}" for block, vectors in blocks.items() for vector in vectors
              for axis in (["_11", "_12", "_13", "_21", "_22", "_23", "_31", "_32", "_33"] if vector == "R"
                           else ["_x", "_y", "_z"])]
-    rows = 20001
+    rows = 200001
     record = Result(np.arange(float(rows)), names, np.random.default_rng(0).random((rows, len(names))))
     widest = max(len(m) for m in vector_groups(names).values())
     largest = max(Counter(n.partition(".")[0] for n in names).values())
