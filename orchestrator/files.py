@@ -123,8 +123,11 @@ def atomic_path(path, size: int | None = None):
 
 
 def _no_room(error: OSError, path: Path, reached: int, size: int | None) -> OSError:
-    """``error`` as :class:`DiskFull` when it says the disk is full, else unchanged."""
-    if getattr(error, "errno", None) not in _NO_ROOM:
+    """``error`` as :class:`DiskFull` when it says the disk is full, else unchanged (NumPy's
+    ``tofile`` reports a short write without an error number: "N requested and M written")."""
+    code = getattr(error, "errno", None)
+    short_write = code is None and "requested and" in str(error) and "written" in str(error)
+    if code not in _NO_ROOM and not short_write:
         return error
     return DiskFull(path, size, free_bytes(path.parent), reached)
 

@@ -20,6 +20,13 @@ from orchestrator import Result, RunInterrupted, SimulationError
 from orchestrator.files import DiskFull, free_bytes, megabytes, note_written, tracking, write_json
 from orchestrator.interrupts import held, signal_name, signal_number, stopping
 
+#: The file that keeps room for ``metrics.json`` on a disk that fills during the run (named as
+#: a temporary file: ``--overwrite`` removes one a killed run left).
+RESERVE = ".metrics.reserve.part"
+
+#: Bytes kept for ``metrics.json`` (a run's is 3 to 10 kB).
+RESERVE_BYTES = 64 * 1024
+
 
 def empty_result(meta: dict | None = None) -> Result:
     """A record of no sample and no signal: what a run stopped before its loop leaves."""
@@ -53,6 +60,11 @@ class RunFiles:
         self.save_cpu_seconds = 0.0
         self.saved = None  # the signals the files hold (None: all recorded)
         self.stream = None  # the record's stream writer, with --stream
+        self.reserve = out / RESERVE
+        try:  # room kept for metrics.json, given back if the disk fills before it is written
+            self.reserve.write_bytes(bytes(RESERVE_BYTES))
+        except OSError:
+            self.reserve.unlink(missing_ok=True)
 
     @contextlib.contextmanager
     def tracking(self):
@@ -124,7 +136,15 @@ class RunFiles:
         declared = metrics.get("units") or {}
         metrics = metrics | {"units": metric_units(metrics, declared) | self.units | {"injected_faults": FAULT_UNITS}}
         with held():
-            write_json(self.out / "metrics.json", metrics)
+            try:
+                write_json(self.out / "metrics.json", metrics)
+            except DiskFull:
+                if not self.reserve.exists():
+                    raise
+                self.reserve.unlink()  # the room kept for this file
+                write_json(self.out / "metrics.json", metrics)
+            finally:
+                self.reserve.unlink(missing_ok=True)
 
     def stopped(self, error: SimulationError, signals=None, stream=None, complete: bool = False):
         """Keep what a failed or interrupted run recorded, and a ``metrics.json`` saying where
@@ -178,6 +198,7 @@ class RunFiles:
             (self.out / name).unlink(missing_ok=True)
         if self.stream is not None and self.stream.path.is_dir():
             shutil.rmtree(self.stream.path)
+        self.reserve.unlink(missing_ok=True)
         if remove_folder and self.out.is_dir() and not any(self.out.iterdir()):
             self.out.rmdir()
 
