@@ -114,9 +114,15 @@ def _uninstall():
 
 
 @contextlib.contextmanager
-def first_only():
+def first_only(final: bool = False):
     """Within the block, the first SIGINT or SIGTERM raises (as :func:`interrupt_for` makes
     it); every later one is noted and ignored: the run it stopped is being saved.
+
+    Parameters
+    ----------
+    final : bool
+        The process ends with the block: when a signal stopped it, both signals stay ignored
+        after it, so that the exit code is the first signal's (a command line's last block).
 
     Outside the main thread the block changes nothing.
     """
@@ -128,6 +134,8 @@ def first_only():
         yield
     finally:
         _state.regions -= 1
+        if final and _state.raised is not None and not _state.regions:
+            _state.previous = dict.fromkeys(_HELD, signal.SIG_IGN)
         _uninstall()
 
 

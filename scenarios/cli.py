@@ -120,10 +120,17 @@ def _positive_int(text: str) -> int:
 
 
 def _run(args) -> int:
+    from orchestrator.interrupts import exit_code, first_only
     from orchestrator.progress import reporting
 
-    with reporting(True):
-        return _run_reporting(args)
+    # the first signal stops the run; later ones wait until its record is safe, then (when this
+    # is the process's command line) are ignored while the process ends with the first one's code
+    with first_only(final=getattr(args, "final", False)), reporting(True):
+        try:
+            return _run_reporting(args)
+        except KeyboardInterrupt as interrupt:  # before the run began: nothing was written
+            print("quadcosim: interrupted", file=sys.stderr)
+            return exit_code(interrupt)
 
 
 def _run_reporting(args) -> int:
@@ -293,6 +300,7 @@ def main(argv=None) -> int:
             warnings.simplefilter("default")
             warnings.showwarning = _show_warning
             args = parser().parse_args(argv)
+            args.final = argv is None  # the process's own command line, not a call from Python
             return args.func(args)
     except KeyboardInterrupt as interrupt:  # before or after a run: nothing half-written is left
         print("quadcosim: interrupted", file=sys.stderr)
