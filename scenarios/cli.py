@@ -11,6 +11,7 @@
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
 """
 
 from __future__ import annotations
@@ -256,6 +257,9 @@ def parser() -> argparse.ArgumentParser:
         .set_defaults(func=sweep.sweep)
     sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
         .set_defaults(func=sweep.sweep_plot)
+    from scenarios.flightlog import command as flightlog
+
+    flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
     return p
 
 
