@@ -119,7 +119,8 @@ def _compasses(rows: dict, params: dict) -> list[Compass]:
         flag = params.get("COMPASS_EXTERNAL" if k == 0 else f"COMPASS_EXTERN{k + 1}")
         out.append(Compass(name, _time(group), mag, raw, -np.median(ofs, axis=0),
                            None if flag is None else bool(flag),
-                           "logged field with the logged offsets, soft iron and motor offsets undone"))
+                           "logged field with the logged offsets, soft iron and motor offsets undone",
+                           np.linalg.inv(matrix)))
     return out
 
 

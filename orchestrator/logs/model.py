@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as _default
 
 import numpy as np
 
@@ -34,6 +35,8 @@ class Compass:
     raw_source : str
         How ``raw`` was obtained (logged raw topic, or the logged field with the logged
         corrections undone).
+    soft_iron : (3, 3) array
+        The autopilot's soft-iron correction in our convention, ``raw = soft_iron m + offsets``.
     """
 
     name: str
@@ -43,6 +46,7 @@ class Compass:
     offsets: np.ndarray
     external: bool | None = None
     raw_source: str = ""
+    soft_iron: np.ndarray = _default(default_factory=lambda: np.eye(3))
 
 
 @dataclass(frozen=True)
@@ -131,13 +135,13 @@ class FlightLog:
     firmware: str
     vehicle: str
     simulator: bool
-    compasses: list[Compass] = field(default_factory=list)
-    imus: list[Imu] = field(default_factory=list)
+    compasses: list[Compass] = _default(default_factory=list)
+    imus: list[Imu] = _default(default_factory=list)
     motors: Motors | None = None
     battery: Battery | None = None
     attitude: Attitude | None = None
-    params: dict = field(default_factory=dict)
-    warnings: list[str] = field(default_factory=list)
+    params: dict = _default(default_factory=dict)
+    warnings: list[str] = _default(default_factory=list)
 
     @property
     def start(self) -> float:

@@ -49,7 +49,7 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
         scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
         out.append(Compass(f"sensor_mag[{k}]", d.data["timestamp"] * MICRO, (raw - offsets) * scale, raw, offsets,
-                           None, "sensor_mag (logged before calibration)"))
+                           None, "sensor_mag (logged before calibration)", np.diag(1.0 / scale)))
     if out:
         return out
     calibrated = _topics(ulog, "vehicle_magnetometer")
@@ -70,8 +70,8 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
         scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
         field = field * GAUSS
-        out.append(Compass(name, time, field, field / scale + offsets, offsets, None,
-                           f"{name} with CAL_MAG{k}_*OFF and *SCALE undone (no raw topic logged)"))
+        undone = f"{name} with CAL_MAG{k}_*OFF and *SCALE undone (no raw topic logged)"
+        out.append(Compass(name, time, field, field / scale + offsets, offsets, None, undone, np.diag(1.0 / scale)))
     return out
 
 
