@@ -12,6 +12,7 @@
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
   quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
+  quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
 """
 
 from __future__ import annotations
@@ -260,6 +261,10 @@ def parser() -> argparse.ArgumentParser:
     from scenarios.flightlog import command as flightlog
 
     flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
+    from scenarios.flightlog import calibrate
+
+    calibrate.add_arguments(sub.add_parser("calibrate", help="calibrate a magnetometer and its motor interference "
+                                           "from real flights; ArduPilot and PX4 parameters"))
     return p
 
 

@@ -27,7 +27,9 @@ DELAYS = np.round(np.arange(0.0, 0.301, 0.02), 3)  # s
 MIN_CURRENT_SPREAD_A = 1.0  # standard deviation of the current needed to identify the current model
 MIN_COMMAND_SPREAD = 0.02  # standard deviation of a command (or the throttle) needed to identify a model
 MAX_CONDITION = 1e3  # column-normalised design: above it, coefficients cannot be told apart
-METGE_ORDERS = (2, 1)  # command to the 2nd power, voltage to the 1st (see the README)
+# (I, J) tried in turn, the richest first: the first the training flights identify is kept
+METGE_ORDERS = ((2, 1), (2, 0))
+METGE_EVALUATIONS = 2000  # residual evaluations, finite differences included
 DYNAMIC_MIN_RATE_HZ = 50.0  # motor time constants of tens of ms need both records faster than this
 
 
@@ -108,7 +110,8 @@ def _unit(angles: np.ndarray) -> np.ndarray:
 
 
 class MetgeModel:
-    """Eqs. 3 and 4 of Metge et al. fitted on a flight (orders :data:`METGE_ORDERS`)."""
+    """Eqs. 3 and 4 of Metge et al. fitted on a flight, with the richest orders of
+    :data:`METGE_ORDERS` the training flights identify."""
 
     name = "metge"
 
@@ -122,12 +125,26 @@ class MetgeModel:
         return None
 
     def fit(self, parts) -> Fitted:
-        """Fit directions and amplitude polynomials with the Earth field and offset of each part."""
+        """Fit directions and amplitude polynomials with the Earth field and offset of each part,
+        trying the orders of :data:`METGE_ORDERS` in turn."""
+        reasons = []
+        for orders in METGE_ORDERS:
+            try:
+                fitted = self._fit(parts, orders)
+            except Refused as error:
+                reasons.append(f"orders (I, J) = {orders}: {error}")
+                continue
+            if reasons:
+                fitted.coefficients["richer_orders_refused"] = reasons
+            return fitted
+        raise Refused("; ".join(reasons))
+
+    def _fit(self, parts, orders) -> Fitted:
         from scipy.optimize import least_squares
 
         delay = self.motors.delay
         K = self.motors.extra["K"]
-        N, (I, J) = len(K), METGE_ORDERS
+        N, (I, J) = len(K), orders
         width = I * (J + 1)
         inputs = [(p.commands(delay), p.voltage(delay)) for p in parts]
         angles0 = np.column_stack([np.arctan2(K[:, 1], K[:, 0]), np.arcsin(K[:, 2] / np.linalg.norm(K, axis=1))])
@@ -139,7 +156,7 @@ class MetgeModel:
 
         def model(x):
             return MotorFieldModel(_unit(x[NUISANCE * P:NUISANCE * P + 2 * N].reshape(N, 2)),
-                                   x[NUISANCE * P + 2 * N:].reshape(N, width), METGE_ORDERS)
+                                   x[NUISANCE * P + 2 * N:].reshape(N, width), orders)
 
         def residual(x):
             field_model = model(x)
@@ -150,13 +167,13 @@ class MetgeModel:
                 out.append((predicted - p.raw).ravel())
             return np.concatenate(out)
 
-        fit = least_squares(residual, x0, x_scale=scale, method="trf")
+        fit = least_squares(residual, x0, x_scale=scale, method="lm", max_nfev=METGE_EVALUATIONS)
         columns = fit.jac / np.maximum(np.linalg.norm(fit.jac, axis=0), 1e-300)
         singular = np.linalg.svd(columns, compute_uv=False)
         condition = float(singular[0] / max(singular[-1], 1e-300))
         if condition > MAX_CONDITION:
-            raise Refused(f"its per-motor directions and polynomial coefficients cannot be told apart on this flight "
-                          f"(condition number {condition:.3g} > {MAX_CONDITION:g})")
+            raise Refused(f"its per-motor directions and polynomial coefficients cannot be told apart on these "
+                          f"flights (condition number {condition:.3g} > {MAX_CONDITION:g})")
         found = model(fit.x)
         return Fitted("metge", delay, {"orders": {"I": I, "J": J}, "v": found.v.tolist(),
                                        "theta": found.theta.tolist()},
