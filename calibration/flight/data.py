@@ -97,7 +97,9 @@ class FlightData:
         return None if b is None or b.current is None else np.interp(self.time - delay, b.time, b.current)
 
     def voltage(self, delay: float = 0.0) -> np.ndarray:
-        """Battery voltage (T,) (V) at ``time - delay`` (s)."""
+        """Battery voltage (T,) (V) at ``time - delay`` (s); NaN when the log has no battery."""
+        if self.battery is None:
+            return np.full(len(self.time), np.nan)
         return np.interp(self.time - delay, self.battery.time, self.battery.voltage)
 
     def part(self, rows) -> FlightData:
@@ -133,13 +135,13 @@ def flight_data(log, compass: int, attitude: str = "gyro") -> FlightData:
     except LogError as error:
         raise CalibrationError(str(error)) from None
     missing = [name for name, part in (("motor outputs", log.motors), ("attitude", log.attitude),
-                                       ("battery voltage", log.battery), ("IMU", log.imus or None)) if part is None]
+                                       ("IMU", log.imus or None)) if part is None]
     if missing:
         raise CalibrationError(f"{log.path}: the log has no {', '.join(missing)}; a flight calibration needs "
-                               "them all (log RCOU, ATT, BAT/CURR and IMU, or PX4's actuator_outputs, "
-                               "vehicle_attitude, battery_status and sensor_combined)")
-    lo = max(log.attitude.time[0], log.motors.time[0], log.battery.time[0])
-    hi = min(log.attitude.time[-1], log.motors.time[-1], log.battery.time[-1])
+                               "them all (log RCOU, ATT and IMU, or PX4's actuator_outputs, vehicle_attitude and "
+                               "sensor_combined)")
+    series = [s for s in (log.attitude, log.motors, log.battery) if s is not None]
+    lo, hi = max(s.time[0] for s in series), min(s.time[-1] for s in series)
     rows = (chosen.time >= lo) & (chosen.time <= hi)
     time = chosen.time[rows]
     euler_log = euler_of(log.attitude.q)

@@ -47,6 +47,8 @@ class DynamicModel:
                     f"{motors:.1f} Hz, both must exceed {DYNAMIC_MIN_RATE_HZ:g} Hz (log them faster)")
         if self.metge is None:
             return "it takes the field directions of the metge model, which was refused"
+        if any(p.battery is None for p in parts):
+            return "no battery voltage in the log to drive the motor model"
         return None
 
     def fit(self, parts) -> Fitted:

@@ -72,7 +72,8 @@ class LinearModel:
         """Why the training ``parts`` cannot identify the model, or None."""
         if self.name == "current":
             if any(p.current() is None for p in parts):
-                return "no current sensor in the log (" + parts[0].battery.current_sensor + ")"
+                why = "no battery logged" if parts[0].battery is None else parts[0].battery.current_sensor
+                return f"no current sensor in the log ({why})"
             spread = _spread(parts, lambda p: p.current())
             if spread < MIN_CURRENT_SPREAD_A:
                 return f"the current varies too little ({spread:.2f} A standard deviation < {MIN_CURRENT_SPREAD_A} A)"
@@ -142,6 +143,8 @@ class MetgeModel:
     def _fit(self, parts, orders) -> Fitted:
         from scipy.optimize import least_squares
 
+        if orders[1] > 0 and any(p.battery is None for p in parts):
+            raise Refused("no battery voltage in the log for the voltage terms")
         delay = self.motors.delay
         K = self.motors.extra["K"]
         N, (I, J) = len(K), orders

@@ -108,6 +108,11 @@ def run(args) -> int:
         return 2
     print("\n".join(_report(metrics)))
     print(f"exported model: {metrics['exported_model'] or 'none identified'}; {', '.join(files)} in {out}/")
+    if not fitted:
+        sources = ", ".join(sorted({str(Path(p.source).parent / Path(p.source).name) for p in train}))
+        print(f"quadcosim calibrate: no interference model could be identified from {sources} (reasons above); "
+              "the parameter files keep the log's offsets", file=sys.stderr)
+        return 2
     return 0
 
 
