@@ -63,4 +63,12 @@ def add_arguments(parser):
     drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
     drawn.add_argument("--out", help="PNG to write (default results/logs/NAME-overview.png)")
     drawn.set_defaults(func=plot)
+    from scenarios.flightlog import replay
+
+    replayed = sub.add_parser("replay", help="the project's estimators on the log, without and with the "
+                              "compensation, against the autopilot's attitude (a reference, not the truth)")
+    replayed.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
+    replayed.add_argument("--compass", type=int, default=0, help="compass to use, from 0 in the log's order")
+    replayed.add_argument("--json", help="also write the result to this JSON file")
+    replayed.set_defaults(func=replay.run)
     return parser
