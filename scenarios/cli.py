@@ -258,14 +258,18 @@ def parser() -> argparse.ArgumentParser:
         .set_defaults(func=sweep.sweep)
     sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
         .set_defaults(func=sweep.sweep_plot)
+    _add_flight_logs(sub)
+    return p
+
+
+def _add_flight_logs(sub):
+    """The ``log`` and ``calibrate`` verbs (:mod:`scenarios.flightlog`) on the sub-parsers ``sub``."""
+    from scenarios.flightlog import calibrate
     from scenarios.flightlog import command as flightlog
 
     flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
-    from scenarios.flightlog import calibrate
-
     calibrate.add_arguments(sub.add_parser("calibrate", help="calibrate a magnetometer and its motor interference "
                                            "from real flights; ArduPilot and PX4 parameters"))
-    return p
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):

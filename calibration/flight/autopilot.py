@@ -65,8 +65,9 @@ def apply_ardupilot(params: dict, compass: int, raw, x) -> np.ndarray:
 
 
 def px4_parameters(compass: int, static, model: str | None, K) -> dict:
-    """PX4 parameters (name: value, in PX4's units) of compass ``compass`` (0-based); arguments as
-    for :func:`ardupilot_parameters`."""
+    """PX4 parameters (name: value, in PX4's units) of compass ``compass`` (0-based): ``static`` a
+    :class:`calibration.StaticCalibration` (T), ``model`` ``"current"``, ``"throttle"`` or None,
+    ``K`` its field vector (T/A or T per unit throttle)."""
     prefix = f"CAL_MAG{compass}_"
     correction = np.linalg.inv(static.A)
     params = {f"{prefix}{a}OFF": float(static.b_s[i] / GAUSS) for i, a in enumerate(AXES)}

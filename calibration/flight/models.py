@@ -40,7 +40,8 @@ class Refused(Exception):
 @dataclass
 class Fitted:
     """A fitted interference model: ``name``, ``delay`` (s), ``coefficients`` (SI, JSON-ready),
-    ``predict`` (FlightData -> (T, 3) field, T) and ``condition`` (the design's condition number)."""
+    ``predict`` (FlightData -> (T, 3) field, T), ``condition`` (the design's condition number) and
+    ``extra`` (the fit's arrays: ``K``, ``nuisance``, ``field``, ``dynamics``, as the model has them)."""
 
     name: str
     delay: float
@@ -55,7 +56,7 @@ def _spread(parts, values) -> float:
 
 
 class LinearModel:
-    """A model linear in its regressors (``current``, ``throttle``, ``motors``)."""
+    """A model linear in its regressors; ``name`` is ``current``, ``throttle`` or ``motors``."""
 
     def __init__(self, name: str):
         self.name = name
@@ -112,7 +113,8 @@ def _unit(angles: np.ndarray) -> np.ndarray:
 
 class MetgeModel:
     """Eqs. 3 and 4 of Metge et al. fitted on a flight, with the richest orders of
-    :data:`METGE_ORDERS` the training flights identify."""
+    :data:`METGE_ORDERS` the training flights identify; ``motors`` is the fitted ``motors`` model
+    it starts from (None when refused)."""
 
     name = "metge"
 
@@ -126,8 +128,8 @@ class MetgeModel:
         return None
 
     def fit(self, parts) -> Fitted:
-        """Fit directions and amplitude polynomials with the Earth field and offset of each part,
-        trying the orders of :data:`METGE_ORDERS` in turn."""
+        """Fit directions and amplitude polynomials with the Earth field and offset of each of the
+        training ``parts`` (FlightData), trying the orders of :data:`METGE_ORDERS` in turn."""
         reasons = []
         for orders in METGE_ORDERS:
             try:

@@ -40,8 +40,8 @@ def _split(args):
 
 
 def exported_model(fitted: dict) -> str | None:
-    """The model the autopilots' parameters carry: the current model when identified (both
-    autopilots recommend it), else the throttle model, else none."""
+    """The model the autopilots' parameters carry, of the ``fitted`` models (name: Fitted): the
+    current model when identified (both autopilots recommend it), else the throttle model, else none."""
     return next((name for name in ("current", "throttle") if name in fitted), None)
 
 

@@ -49,7 +49,7 @@ def residual_figure(parts, fitted, name: str, path, title: str):
 def heading_figure(data, fitted, name: str, cut: float, path, title: str):
     """Tilt-compensated heading error (deg) against the log's heading, the constant offset
     removed, without and with the model ``fitted`` (named ``name``), over the whole flight
-    ``data`` (FlightData); the held-out part after ``cut`` (s) shaded; into ``path``."""
+    ``data`` (FlightData); the held-out part after ``cut`` (s) shaded; into ``path`` under ``title``."""
     plt = _pyplot()
     base = earth_and_offset(data.rotation, data.raw)
     predicted = fitted.predict(data)
