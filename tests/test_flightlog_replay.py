@@ -4,15 +4,15 @@ flight calibration flown in simulation."""
 import pytest
 
 from scenarios.flightlog.replay import ESTIMATORS, replay_log
-from tests.flightlog_data import ERLE, PX4, QUAD, path
+from tests.flightlog_data import ERLE, PX4, QUAD, log, path
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("name", "compass"), [(QUAD[0], 0), (QUAD[1], 1), (QUAD[2], 1), (ERLE, 0), (PX4, 0)])
-def test_the_estimators_run_on_every_shared_log(name, compass):
-    result = replay_log(path(name), compass)
+@pytest.mark.parametrize(("name", "compass"), [(QUAD[1], 1), (ERLE, 0), (PX4, 0)])  # one log of each format
+def test_the_estimators_run_on_shared_logs_of_every_format(name, compass):
+    result = replay_log(log(name), compass, kinds=("explicit", "vqf"))
     assert "not the truth" in result["note"]
-    assert set(result["estimators"]) == set(ESTIMATORS)
+    assert set(result["estimators"]) == {"explicit", "vqf"} <= set(ESTIMATORS)
     for kind in ("explicit", "vqf"):
         for label in ("without", "with"):
             r = result["estimators"][kind][label]

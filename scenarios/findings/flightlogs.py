@@ -97,7 +97,7 @@ def _replays() -> list[dict]:
 
     found = []
     for key, compass in REPLAYS:
-        result = replay_log(_path(key), compass)
+        result = replay_log(_path(key), compass, kinds=REPLAYED)
         command = f"quadcosim log replay {_shown(key)} --compass {compass}"
         for kind in REPLAYED:
             for label in ("without", "with"):

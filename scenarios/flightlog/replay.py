@@ -63,14 +63,16 @@ def _fields(log, compass: int, time):
     return without, with_model, model
 
 
-def replay_log(path, compass: int = 0, settle_s: float = 5.0) -> dict:
-    """Run every estimator of :data:`ESTIMATORS` on the log at ``path`` with compass ``compass``,
-    without and with the compensation; heading and inclination RMS differences (deg) from the
-    log's attitude over the second half of the flight (at least ``settle_s`` (s) after the start)."""
+def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMATORS)) -> dict:
+    """Run every estimator of :data:`ESTIMATORS` on the log at ``path`` (or an already read
+    :class:`orchestrator.logs.FlightLog`) with compass ``compass``, without and with the
+    compensation; heading and inclination RMS differences (deg) from the log's attitude over the
+    second half of the flight (at least ``settle_s`` (s) after the start); ``kinds``: the
+    estimators run (names of :data:`ESTIMATORS`)."""
     from estimators import estimate
-    from orchestrator.logs import read_log
+    from orchestrator.logs import FlightLog, read_log
 
-    log = read_log(path)
+    log = path if isinstance(path, FlightLog) else read_log(path)
     time, dt, gyro, acc, reference = _uniform(log)
     without, with_model, model = _fields(log, compass, time)
     half = time[0] + 0.5 * (time[-1] - time[0])
@@ -82,13 +84,14 @@ def replay_log(path, compass: int = 0, settle_s: float = 5.0) -> dict:
 
         R = Rotation.from_quat(reference[first], scalar_first=True).as_matrix()
         earth = np.einsum("tij,tj->i", R, mag[first]) / first.sum()
-        for kind, settings in ESTIMATORS.items():
+        for kind in kinds:
+            settings = ESTIMATORS[kind]
             out = estimate(kind, gyro=gyro, acc=acc, mag=mag, dt=dt, earth_field=earth, initial="triad",
                            outputs=(), reference=reference, scored=scored, **settings)
             errors = out["errors"]
             results.setdefault(kind, {})[label] = {"heading_rms_deg": float(errors["heading_rmse_deg"][0]),
                                                    "inclination_rms_deg": float(errors["inclination_rmse_deg"][0])}
-    return {"file": str(path), "compass": log.compasses[compass].name, "compensation_model": model,
+    return {"file": log.path, "compass": log.compasses[compass].name, "compensation_model": model,
             "note": REFERENCE_NOTE, "scored_s": float(scored.sum() * dt), "estimators": results}
 
 
