@@ -113,3 +113,11 @@ def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, 
     parameters = readme.split("ends with the motor compensation (milligauss per ampere):\n\n```text\n", 1)[1]
     written = (tmp_path / "b" / "ardupilot.parm").read_text().strip().splitlines()[-4:]
     assert parameters.split("\n```", 1)[0].splitlines() == written
+
+
+def test_the_command_lines_defaults_are_the_calibrations_names():
+    from calibration.flight import MODELS
+    from scenarios.cli import parser
+
+    args = parser().parse_args(["calibrate", "flight.log", "--out", "out"])
+    assert tuple(args.models) == MODELS and args.attitude == "gyro"

@@ -99,6 +99,7 @@ def run(args) -> int:
     from orchestrator.logs import LogError
 
     try:
+        _check_choices(args)
         out = prepare_out_dir(args.out, args.overwrite)
         train, test = _split(args)
         metrics, calibration, fitted = calibrate(train, test, tuple(args.models), args.attitude)
@@ -116,10 +117,20 @@ def run(args) -> int:
     return 0
 
 
-def add_arguments(parser):
-    """The ``calibrate`` verb's options on ``parser`` (an argparse parser); returns it."""
+def _check_choices(args):
+    """--attitude and --models against the calibration's own names (checked here rather than by
+    argparse, so that the command line's help does not import the calibration package)."""
     from calibration.flight import ATTITUDES, MODELS
 
+    if args.attitude not in ATTITUDES:
+        raise ValueError(f"--attitude {args.attitude!r} must be one of {', '.join(ATTITUDES)}")
+    unknown = [m for m in args.models if m not in MODELS]
+    if unknown:
+        raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
+
+
+def add_arguments(parser):
+    """The ``calibrate`` verb's options on ``parser`` (an argparse parser); returns it."""
     parser.add_argument("files", nargs="*", metavar="FILE", help="PX4 .ulg, ArduPilot .bin or .log flights")
     parser.add_argument("--compass", type=int, default=0, help="compass to calibrate, from 0 in the log's order")
     parser.add_argument("--out", required=True, help="folder for the results")
@@ -127,10 +138,11 @@ def add_arguments(parser):
                         help="last fraction of each flight kept for testing (default 0.5)")
     parser.add_argument("--train", nargs="+", metavar="FILE", help="flights to fit on (with --test)")
     parser.add_argument("--test", nargs="+", metavar="FILE", help="flights of the same vehicle to score on")
-    parser.add_argument("--attitude", choices=ATTITUDES, default="gyro",
+    parser.add_argument("--attitude", default="gyro",
                         help="attitude removing the Earth field: gyro (default: roll and pitch from the log, heading "
                              "integrated from the gyro, so not from the compass being calibrated) or log")
-    parser.add_argument("--models", nargs="+", choices=MODELS, default=list(MODELS), help="models to fit")
+    parser.add_argument("--models", nargs="+", default=["current", "throttle", "motors", "metge", "dynamic"],
+                        help="models to fit: current, throttle, motors, metge, dynamic (default all)")
     parser.add_argument("--overwrite", action="store_true", help="replace the results already in --out")
     parser.set_defaults(func=run)
     return parser
