@@ -19,10 +19,13 @@ FORMATS = [
 ]
 
 
-def _euler(t):
-    """Roll, pitch, yaw (rad) and their rates: two slow turns, gentle rocking."""
-    roll, pitch, yaw = 0.12 * np.sin(0.9 * t), 0.1 * np.sin(0.6 * t + 1.0), 0.2 * t
-    rates = np.column_stack([0.108 * np.cos(0.9 * t), 0.06 * np.cos(0.6 * t + 1.0), np.full_like(t, 0.2)])
+def _euler(t, tumble: float):
+    """Roll, pitch, yaw (rad) and their rates: two slow turns, rocking of ``tumble`` times a
+    gentle amplitude (1: a multirotor's flight; 10: the sensor turned through most orientations)."""
+    a_roll, a_pitch = 0.12 * tumble, min(0.1 * tumble, 1.2)
+    roll, pitch, yaw = a_roll * np.sin(0.9 * t), a_pitch * np.sin(0.6 * t + 1.0), 0.2 * t
+    rates = np.column_stack([0.9 * a_roll * np.cos(0.9 * t), 0.6 * a_pitch * np.cos(0.6 * t + 1.0),
+                             np.full_like(t, 0.2)])
     return np.column_stack([roll, pitch, yaw]), rates
 
 
@@ -35,8 +38,9 @@ def _commands(t):
     return np.column_stack([base + 0.05 * np.sin(0.8 * t + n) for n in range(4)])
 
 
-def write_log(path, duration=60.0, simulator=True, seed=1):
-    """Write the synthetic flight to ``path`` (text DataFlash) and return its truth as a dict."""
+def write_log(path, duration=60.0, simulator=True, seed=1, tumble=1.0):
+    """Write the synthetic flight to ``path`` (text DataFlash) and return its truth as a dict;
+    ``tumble`` scales the rocking (see :func:`_euler`)."""
     rng = np.random.default_rng(seed)
     lines = ["FMT, 128, 89, FMT, BBnNZ, Type,Length,Name,Format,Columns"]
     lines += [f"FMT, {129 + k}, 64, {name}, {fmt}, {cols}" for k, (name, fmt, cols) in enumerate(FORMATS)]
@@ -48,7 +52,7 @@ def write_log(path, duration=60.0, simulator=True, seed=1):
     lines += ["MSG, 1100, ArduCopter V4.5.0 (test)" + (" SITL" if simulator else ""), "MSG, 1200, Frame: QUAD"]
     rows = []
     t_imu = np.arange(1.0, duration, 0.02)
-    euler, rates = _euler(t_imu)
+    euler, rates = _euler(t_imu, tumble)
     R = Rotation.from_euler("ZYX", euler[:, ::-1]).as_matrix()
     roll, pitch = euler[:, 0], euler[:, 1]
     p = rates[:, 0] - rates[:, 2] * np.sin(pitch)

@@ -121,3 +121,20 @@ def test_the_command_lines_defaults_are_the_calibrations_names():
 
     args = parser().parse_args(["calibrate", "flight.log", "--out", "out"])
     assert tuple(args.models) == MODELS and args.attitude == "gyro"
+
+
+def test_rotations_covering_the_sphere_give_hard_and_soft_iron_and_flights_cross_validate(synthetic, capsys):
+    folder, truth = synthetic
+    write_log(folder / "tumbling.log", seed=3, tumble=20.0)  # rolled and pitched through most orientations
+    out = folder / "cross"
+    assert main(["calibrate", "--train", str(folder / "tumbling.log"), "--test", str(folder / "sitl.log"),
+                 "--out", str(out), "--models", "current"]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["static"]["source"] == "flight" and metrics["static"]["coverage"] >= 0.5
+    assert metrics["test"] == [f"{folder / 'sitl.log'}:MAG[0]"]
+    assert metrics["models"]["current"]["explained_test"] > 0.995  # another flight, measured 0.998
+    static = Calibration.load(out / "calibration.json").static
+    assert np.abs(static.b_s - truth["hard_iron"]).max() < 0.1e-6  # measured 0.04 uT
+    assert np.abs(static.A - np.eye(3)).max() < 2e-3  # no soft iron in the data; measured 5e-4
+    params = autopilot.read_parameters(out / "ardupilot.parm")
+    assert [params[f"COMPASS_OFS_{a}"] for a in "XYZ"] == pytest.approx(-static.b_s / 1e-7, rel=1e-6)

@@ -83,7 +83,6 @@ def calibrate(train, test, names=MODELS, attitude: str = "gyro") -> tuple[dict, 
     fitted, refused = _fit_models(train, names)
     compass = train[0].log.compasses[train[0].compass]
     chosen, field = _field_model(fitted, train[0].motors.commands.shape[1])
-    static, static_notes = _static(train, fitted.get(chosen), compass.offsets, compass.soft_iron)
     models = {}
     for name in names:
         if name in refused:
@@ -96,6 +95,10 @@ def calibrate(train, test, names=MODELS, attitude: str = "gyro") -> tuple[dict, 
                         "heading_rms_change_deg": on_test["heading_rms_change_deg"],
                         "heading_error_rms_deg": on_test["heading_error_rms_deg"], "delay_s": f.delay,
                         "condition_number": f.condition}
+    # the ellipsoid is fitted on the field with the interference removed that explains most in training
+    best = max(fitted, key=lambda name: models[name]["explained_train"], default=None)
+    static, static_notes = _static(train, fitted.get(best), compass.offsets, compass.soft_iron)
+    static_notes["interference_removed"] = best
     baseline = score(None, test)
     metrics = {"train": sorted({p.source for p in train}), "test": sorted({p.source for p in test}),
                "attitude": attitude,
