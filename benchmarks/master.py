@@ -15,7 +15,8 @@ Measures, in one run, per macro step at 1 kHz, CPU time of the stepping loop onl
   trajectories are compared bit for bit: every recorded signal of the C loop must equal the
   orchestrator's (``*_identical``).
 
-The keys of :func:`benchmarks.estimators.measure` (the batch path) join the same JSON object.
+The keys of :func:`benchmarks.estimators.measure` (the batch path) and of
+:func:`benchmarks.save.figures` (``save_fraction``) join the same JSON object.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ import time
 
 import numpy as np
 
-from benchmarks import estimators, reference_library
+from benchmarks import estimators, fmu_steps, reference_library
+from benchmarks.save import figures as save_figures
 
 CLOSED_LOOP = {"estimator": "explicit", "noise": True, "bias": True}  # tp options of the closed loop
 
@@ -148,9 +150,9 @@ class ReferenceLoop:
         """
         function = getattr(reference_library("loops"), "closed_loop" if self.closed else "open_loop")
         function.restype = ctypes.c_int
-        started = time.process_time()
+        started = time.thread_time()
         status = function(ctypes.byref(self.loop))
-        seconds = time.process_time() - started
+        seconds = time.thread_time() - started
         if status:
             raise RuntimeError(f"the C reference loop failed at step {self.loop.failed_step} (status {status})")
         return seconds
@@ -229,7 +231,8 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
         ``open_loop_over_c`` and ``closed_loop_over_c`` (median ratio of CPU times), their
         ``*_spread`` (lowest, highest), the µs per step of each loop, ``rtf_open_loop``,
         ``rtf_closed_loop`` and ``rtf_closed_loop_c`` (simulated over CPU seconds, best run),
-        ``*_identical``, then the batch-path figures of :func:`benchmarks.estimators.measure`.
+        ``*_identical``, then the batch-path figures of :func:`benchmarks.estimators.measure` and
+        the FMI shell's cost, :func:`benchmarks.fmu_steps.measure` (``fmu_step_over_equations``).
     """
     figures = {}
     for key, scenario, settings in (("open_loop", "open-loop", {}), ("closed_loop", "tp", CLOSED_LOOP)):
@@ -239,7 +242,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
                     f"{key}_us_per_step": run["us_per_step"], f"{key}_c_us_per_step": run["c_us_per_step"],
                     f"rtf_{key}": 1e3 / run["us_per_step"], f"rtf_{key}_c": 1e3 / run["c_us_per_step"],
                     f"{key}_identical": run["identical"]}
-    return estimators.measure(seconds, repeats) | figures
+    return estimators.measure(seconds, repeats) | fmu_steps.measure(seconds, repeats) | figures | save_figures()
 
 
 def main(argv=None) -> int:

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from estimators import estimate, parse_corrections, recording
+from orchestrator.files import write_text
 
 FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
 
@@ -180,7 +181,7 @@ def main(argv=None) -> int:
     text = json.dumps(result, indent=2, default=float)
     print(text)
     if args.json:
-        Path(args.json).write_text(text + "\n")
+        write_text(args.json, text + "\n")
     return 0
 
 
