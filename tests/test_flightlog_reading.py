@@ -118,3 +118,26 @@ def test_log_info_and_plot_commands(tmp_path, capsys):
     (tmp_path / "flight.csv").write_text("time,roll\n0,0\n")
     assert main(["log", "info", str(tmp_path / "flight.csv")]) == 2
     assert "unknown log format" in capsys.readouterr().err
+
+
+def test_a_ulog_with_current_px4_topics(tmp_path):
+    from calibration.flight import calibrate, flight_data
+    from tests.flightlog_ulog_synthetic import write_ulog
+
+    truth = write_ulog(tmp_path / "sitl.ulg")
+    flight = read_log(tmp_path / "sitl.ulg")
+    info = summary(flight)
+    assert info["simulator"] is True and info["firmware"] == "v1.15.0 on PX4_SITL"
+    assert [c["name"] for c in info["compasses"]] == ["sensor_mag[0]", "sensor_mag[1]"]
+    assert [c["rate_hz"] for c in info["compasses"]] == pytest.approx([50.0, 50.0])
+    assert info["imus"][0]["acc_norm_m_s2"] == pytest.approx(GRAVITY, abs=1e-4)
+    compass = flight.compasses[0]
+    assert compass.offsets == pytest.approx(truth["hard_iron"], abs=1e-12)  # CAL_MAG0_*OFF, gauss to tesla
+    assert np.abs(compass.field - (compass.raw - truth["hard_iron"])).max() < 1e-12
+    assert flight.motors.limits_from == "PWM_MAIN_MIN/PWM_MAIN_MAX" and 0.3 < flight.motors.throttle.mean() < 0.6
+    assert flight.battery.current is not None
+    train, test = flight_data(flight, 0).split(0.5)
+    metrics, _, _ = calibrate([train], [test], ("current",))
+    current = metrics["models"]["current"]
+    assert np.abs(np.array(current["coefficients"]["K_T_per_A"]) - truth["K"]).max() < 0.01 * np.linalg.norm(truth["K"])
+    assert current["delay_s"] == pytest.approx(truth["delay"], abs=1e-9)
