@@ -138,3 +138,12 @@ def test_rotations_covering_the_sphere_give_hard_and_soft_iron_and_flights_cross
     assert np.abs(static.A - np.eye(3)).max() < 2e-3  # no soft iron in the data; measured 5e-4
     params = autopilot.read_parameters(out / "ardupilot.parm")
     assert [params[f"COMPASS_OFS_{a}"] for a in "XYZ"] == pytest.approx(-static.b_s / 1e-7, rel=1e-6)
+
+
+def test_a_log_without_a_magnetometer_is_refused_naming_it(synthetic, tmp_path, capsys):
+    folder, _ = synthetic
+    lines = (folder / "sitl.log").read_text().splitlines()
+    (tmp_path / "nomag.log").write_text("\n".join(line for line in lines if not line.startswith("MAG,")) + "\n")
+    assert main(["calibrate", str(tmp_path / "nomag.log"), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'nomag.log'}: the log holds no magnetometer" in err
