@@ -11,6 +11,8 @@
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
+  quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
 """
 
 from __future__ import annotations
@@ -287,7 +289,18 @@ def parser() -> argparse.ArgumentParser:
         .set_defaults(func=sweep.sweep)
     sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
         .set_defaults(func=sweep.sweep_plot)
+    _add_flight_logs(sub)
     return p
+
+
+def _add_flight_logs(sub):
+    """The ``log`` and ``calibrate`` verbs (:mod:`scenarios.flightlog`) on the sub-parsers ``sub``."""
+    from scenarios.flightlog import calibrate
+    from scenarios.flightlog import command as flightlog
+
+    flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
+    calibrate.add_arguments(sub.add_parser("calibrate", help="calibrate a magnetometer and its motor interference "
+                                           "from real flights; ArduPilot and PX4 parameters"))
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
