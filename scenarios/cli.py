@@ -11,6 +11,7 @@
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim findings [GROUP...] [--quick] [--check]   the README's numbers, measured into findings.json
 """
 
 from __future__ import annotations
@@ -202,6 +203,12 @@ def _bench(args) -> int:
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
 
 
+def _findings(args) -> int:
+    from scenarios.findings.__main__ import main as findings
+
+    return findings(args.rest)
+
+
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
@@ -250,6 +257,11 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
+    findings = sub.add_parser("findings", add_help=False,
+                              help="run the README's findings, write findings.json, rewrite the README's numbers "
+                                   "(quadcosim findings --help)")
+    findings.add_argument("rest", nargs=argparse.REMAINDER)
+    findings.set_defaults(func=_findings)
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\

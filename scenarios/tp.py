@@ -247,10 +247,25 @@ def report(result, o, out) -> dict:
             result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"),
             BIAS_TOLERANCE)
         metrics["bias_convergence_tolerance_rad_s"] = BIAS_TOLERANCE
+    metrics |= _flight_findings(result, o)
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
     return metrics
+
+
+def _flight_findings(result, o) -> dict:
+    """What the flight shows of the drag model: the tilt step's lag and speed (``flight=tilt``),
+    the tilt into a steady wind and the position held (a wind on a position-holding flight)."""
+    from scenarios.flight import measured
+
+    found = {}
+    if o["flight"] == "tilt":
+        found |= measured.tilt_step(result, math.radians(o["tilt_deg"]), o["rotor_drag"])
+    wind = math.hypot(o["wind_n"], o["wind_e"])
+    if wind > 0 and o["flight"] == "hover":
+        found |= measured.wind_hold(result, wind)
+    return found
 
 
 def steady_errors(result) -> dict:
