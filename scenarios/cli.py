@@ -203,12 +203,6 @@ def _bench(args) -> int:
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
 
 
-def _findings(args) -> int:
-    from scenarios.findings.__main__ import main as findings
-
-    return findings(args.rest)
-
-
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
@@ -260,8 +254,7 @@ def parser() -> argparse.ArgumentParser:
     findings = sub.add_parser("findings", add_help=False,
                               help="run the README's findings, write findings.json, rewrite the README's numbers "
                                    "(quadcosim findings --help)")
-    findings.add_argument("rest", nargs=argparse.REMAINDER)
-    findings.set_defaults(func=_findings)
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
@@ -283,6 +276,11 @@ def main(argv=None) -> int:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")
             warnings.showwarning = _show_warning
+            argv = sys.argv[1:] if argv is None else list(argv)
+            if argv[:1] == ["findings"]:  # its own parser: its options, --help included, are its own
+                from scenarios.findings.__main__ import main as findings
+
+                return findings(argv[1:])
             args = parser().parse_args(argv)
             return args.func(args)
     except KeyboardInterrupt as interrupt:  # before or after a run: nothing half-written is left
