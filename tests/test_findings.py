@@ -168,3 +168,12 @@ def test_a_findings_command_run_as_written_prints_its_findings(command, tmp_path
     shown = [float(x) for x in PRINTED_NUMBER.findall(capsys.readouterr().out)]
     for f in (f for f in COMMITTED.values() if f["command"] == command):
         assert any(abs(x - f["value"]) <= f["tolerance"] for x in shown), f"{f['name']} not printed by {command}"
+
+
+def test_the_readme_states_the_default_result_format():
+    from scenarios.cli import parser
+
+    default = parser().parse_args(["run", "tp"]).format
+    stated = re.search(r"`--format npz,mat,csv` the files written \(default `([^`]*)` alone\)",
+                       (findings.ROOT / "README.md").read_text())
+    assert stated is not None and stated.group(1) == default
