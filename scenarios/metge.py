@@ -31,6 +31,7 @@ import numpy as np
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
 from orchestrator import System, Table
+from orchestrator.parameters import apply
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
@@ -59,6 +60,47 @@ OPTIONS = {
     "static": Option("", "static calibration file (JSON) for A, b_s; empty: the IMU's identity"),
 }
 RECORD = ["Setpoint.c", "MotorMagnetics.u_batt", "IMU.magneto"]
+#: Block parameters the rig sets from its options (``--set`` on one of them is refused, naming the option).
+DERIVED = {"IMU.noise_enabled": "noise", "IMU.seed": "seed1 and seed2", "IMU.sample_rate": "mag_rate",
+           "IMU.mag_sample_rate": "mag_rate", "MotorMagnetics.soc0": "soc1 and soc2", "Quadrotor.clamped": "(the rig)"}
+# a flight's IMU settings the clamped rig does not take: its biases are off and its rates its own
+_NOT_ON_THE_RIG = ("IMU.bias_enabled", "IMU.b_g", "IMU.b_a", "IMU.gyro_bias", "IMU.acc_bias", "IMU.gyro_bias_walk",
+                   "IMU.acc_bias_walk")
+
+
+def block_settings(o: dict) -> dict:
+    """The ``Block.parameter`` settings of options ``o`` (``--set MotorMagnetics.kappa1=8e-6``).
+
+    Parameters
+    ----------
+    o : dict
+        A scenario's options.
+
+    Returns
+    -------
+    dict
+        ``{"Block.parameter": value}``; every rig run of the scenario takes them.
+    """
+    return {k: v for k, v in o.items() if "." in k}
+
+
+def vehicle_settings(o: dict) -> tuple[tuple[str, str], ...]:
+    """The settings of a flight's options ``o`` that the clamped rig of the same vehicle takes:
+    its motors, airframe and magnetometer, not the rig's own (:data:`DERIVED`) nor the IMU's
+    biases; as sorted ``(name, text)`` pairs (hashable, for :func:`rig_calibration`'s cache).
+
+    Parameters
+    ----------
+    o : dict
+        A flight scenario's options (``tp``).
+
+    Returns
+    -------
+    tuple of (str, str)
+    """
+    rig_blocks = ("MotorMagnetics.", "Quadrotor.", "IMU.")
+    return tuple(sorted((k, str(v)) for k, v in block_settings(o).items()
+                        if k.startswith(rig_blocks) and k not in DERIVED and not k.startswith(_NOT_ON_THE_RIG)))
 
 
 def schedule(o: dict, set_number: int) -> tuple[list[tuple[str, float, float, int, float]], float]:
@@ -133,6 +175,9 @@ def system_for(o: dict, set_number: int, run: int) -> System:
               imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"],
                                  mag_sample_rate=o["mag_rate"]))
     system.connect("Setpoint.c", "MotorMagnetics.c")
+    settings = block_settings(o)
+    if settings:  # every run of the rig is the same vehicle: the parameters set reach them all
+        apply(system, settings, DERIVED)
     return system
 
 
@@ -398,7 +443,7 @@ def duration(o: dict) -> float:
 
 
 SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD})
+                    duration=duration, extra={"record": RECORD, "derived": DERIVED})
 
 
 # --- the compensation in the closed loop (``tp --set compensation=...``) ----------------
@@ -407,11 +452,21 @@ COMPENSATIONS = ("none", "static", "metge", "dynamic")
 
 
 @functools.lru_cache(maxsize=4)
-def rig_calibration(orders: str = "4,1", levels: int = 8) -> Calibration:
+def rig_calibration(orders: str = "4,1", levels: int = 8, settings: tuple = ()) -> Calibration:
     """Calibration 1 of this scenario with ``levels`` command levels, made on the clamped rig
     (about 30 s of simulated rig time); cached for the process. The tp vehicle has no soft or
-    hard iron, so the static part is the identity."""
-    o = SCENARIO.parse({"orders": orders, "levels": levels})
+    hard iron, so the static part is the identity.
+
+    Parameters
+    ----------
+    orders : str
+        ``"I,J"`` of eq. 4.
+    levels : int
+        Command levels per motor.
+    settings : tuple of (str, str)
+        Block parameters of the vehicle (:func:`vehicle_settings`), set on every rig run.
+    """
+    o = SCENARIO.parse({"orders": orders, "levels": levels} | dict(settings))
     runs = []
     for run in range(len(socs(o, 1))):
         recorded = system_for(o, 1, run).run(commands(o, 1)[2], record=RECORD)
@@ -433,16 +488,21 @@ def magnetometer_rate(system: System) -> float:
     raise KeyError("the IMU declares no magnetometer rate (mag_sample_rate or sample_rate)")
 
 
-def add_compensator(system: System, mode: str, path: str, estimator: str = "Quaternion_estim"):
+def add_compensator(system: System, mode: str, path: str, estimator: str = "Quaternion_estim",
+                    settings: tuple = ()):
     """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
     ``mode = "none"``): commands from the controller, voltage from the battery, ``b_d``
     refreshed at the magnetometer's sample instants. ``path``: a calibration file, or empty for
-    :func:`rig_calibration`. ``system``: the tp system; ``estimator``: the name of its block."""
+    :func:`rig_calibration` of the vehicle of ``settings`` (:func:`vehicle_settings`).
+    ``system``: the tp system; ``estimator``: the name of its block."""
     from calibration import MagCompensator
 
     if mode == "none":
+        if path:
+            raise ValueError(f"calibration={path} is given with compensation=none, which uses no calibration: "
+                             "choose compensation=static, metge or dynamic, or leave calibration empty")
         return None
-    calibration = Calibration.load(path, motors=4) if path else rig_calibration()
+    calibration = Calibration.load(path, motors=4) if path else rig_calibration(settings=settings)
     block = system.add(MagCompensator(calibration, mode, sample_rate=magnetometer_rate(system)))
     system.connect("IMU.magneto", "MagCompensator.magneto")
     system.connect("Controller.c", "MagCompensator.c")
@@ -472,7 +532,8 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
             for magnetic, mode in cases:
                 settings = {"estimator": estimator, "flight": flight, "noise": noise, "duration": duration,
                             "magnetic": magnetic == "on", "compensation": mode,
-                            "calibration": calibration_path, **STUDY_ESTIMATORS[estimator]}
+                            "calibration": calibration_path if mode != "none" else "",
+                            **STUDY_ESTIMATORS[estimator]}
                 _, m = scenarios.run("tp", settings)
                 key = "magnetic_off" if magnetic == "off" else mode
                 table.setdefault(flight, {}).setdefault(estimator, {})[key] = m["rms_error_deg"][2]

@@ -22,7 +22,7 @@ from scenarios.ablation import GravityOnly
 from scenarios.figures import fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.flight.controller import SETPOINT_UNITS
-from scenarios.metge import add_compensator
+from scenarios.metge import add_compensator, vehicle_settings
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
@@ -184,7 +184,7 @@ def build(o: dict, estimator=None) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
-    add_compensator(system, o["compensation"], o["calibration"])
+    add_compensator(system, o["compensation"], o["calibration"], settings=vehicle_settings(o))
     return system
 
 
