@@ -388,6 +388,25 @@ def table1_figure(numbers: dict, orders, o: dict, out):
     return save_figure(fig, out, "table1.png")
 
 
+def fast_third(run: RigRun, o: dict) -> np.ndarray:
+    """Which rows of the free set of ``run`` fall in its middle, fast third (options ``o``).
+
+    Parameters
+    ----------
+    run : RigRun
+        The run holding the free set (the first of set 1).
+    o : dict
+        The scenario's options (``free``, s).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        One per row of the free set.
+    """
+    t_free = run.time[run.free] - run.end
+    return (t_free >= o["free"] / 3) & (t_free < 2 * o["free"] / 3)
+
+
 def report(result, o, out) -> dict:
     """Record set 2 and the second battery state, calibrate on each set, and return Table 1,
     the dynamics-aware free-set error, the order study and the identified motor dynamics;
@@ -406,8 +425,7 @@ def report(result, o, out) -> dict:
             cal.save(out / f"{name}.json")
     numbers = table1({"none": Calibration(4, static), **cals}, rig1, rig2, rate)
     table, dynamic_free, first = numbers["table"], numbers["dynamic_free"], rig1.runs[0]
-    t_free = first.time[first.free] - first.end
-    fast = (t_free >= o["free"] / 3) & (t_free < 2 * o["free"] / 3)
+    fast = fast_third(first, o)
     e_free = numbers["series"]["calibration1"][first.free]
     ed_free = numbers["series"]["calibration1_dynamic"][first.free]
     true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
@@ -421,6 +439,7 @@ def report(result, o, out) -> dict:
         "improvement_factor_sets": {f"{r}_{c}": table["none"][c] / table[r][c]
                                     for r in ("calibration1", "calibration2") for c in ("set1", "set2")},
         "dynamic_gain_free": table["calibration1"]["free"] / dynamic_free["calibration1"],
+        **_ranges(table, study["scores"]),
         "sets_with_transients_deg": numbers["whole"],
         "free_eq9_slow_fast_deg": {"slow": float(e_free[~fast].mean()), "fast": float(e_free[fast].mean())},
         "free_dynamic_slow_fast_deg": {"slow": float(ed_free[~fast].mean()), "fast": float(ed_free[fast].mean())},
@@ -435,6 +454,21 @@ def report(result, o, out) -> dict:
         "motor_dynamics": {name: c.to_dict()["dynamics"] for name, c in cals.items()},
         "figures": [f for f in figures if f],
     }
+
+
+def _ranges(table: dict, scores: dict) -> dict:
+    """The figures the findings quote from Table 1 and the order study: the range over both
+    calibrations and both sets after eq. 9 (deg), of the improvement on the sets (1), and the
+    order study's scores of (3, 1) and of the best (I, 0) over that of (4, 1) (1)."""
+    after = [table[r][c] for r in ("calibration1", "calibration2") for c in ("set1", "set2")]
+    gains = [table["none"][c] / table[r][c] for r in ("calibration1", "calibration2") for c in ("set1", "set2")]
+    reference = scores.get((4, 1))
+    ratios = {}
+    if reference:
+        ratios = {"order_study_3_1_over_4_1": scores[(3, 1)] / reference if (3, 1) in scores else None,
+                  "order_study_best_j0_over_4_1": min(v for (_, j), v in scores.items() if j == 0) / reference}
+    return {"sets_calibrated_range_deg": [min(after), max(after)], "improvement_range": [min(gains), max(gains)],
+            **ratios}
 
 
 def duration(o: dict) -> float:
@@ -551,16 +585,31 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
 
 
 def main(argv=None):
-    """Command line of the yaw study: ``python -m scenarios.metge --calibration FILE --out DIR``.
+    """Command line of the studies: ``python -m scenarios.metge --calibration FILE --out DIR``
+    (the yaw study) or ``--robustness --out DIR`` (:mod:`scenarios.metge_robustness`).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
-    parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated.")
-    parser.add_argument("--calibration", required=True, help="calibration file, e.g. from quadcosim run metge")
+    parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated "
+                                                 "(--calibration), or the compensation on perturbed plants "
+                                                 "(--robustness).")
+    parser.add_argument("--calibration", help="calibration file, e.g. from quadcosim run metge (the yaw study)")
+    parser.add_argument("--robustness", nargs="*", metavar="CASE",
+                        help="the robustness study (every case, or those named)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
     parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
     args = parser.parse_args(argv)
+    if args.robustness is not None:
+        from scenarios import metge_robustness
+
+        unknown = set(args.robustness) - set(metge_robustness.cases())
+        if unknown:
+            parser.error(f"unknown case {', '.join(sorted(unknown))}; cases: {', '.join(metge_robustness.cases())}")
+        metge_robustness.study(args.out, args.robustness or None)
+        return
+    if not args.calibration:
+        parser.error("give --calibration FILE (the yaw study) or --robustness")
     yaw_study(args.out, args.calibration, estimators=tuple(args.estimators.split(",")), duration=args.duration)
 
 
