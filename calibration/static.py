@@ -135,6 +135,9 @@ def _check_samples(samples, min_samples: int) -> np.ndarray:
         raise CalibrationError(f"too few samples: {len(x)} < {min_samples}; record a longer sweep "
                                "(turn the sensor through all orientations)")
     _, spread, axes = np.linalg.svd(x - x.mean(axis=0), full_matrices=False)
+    if not spread[0] > 0:
+        raise CalibrationError(f"the {len(x)} samples are all equal ({x[0].tolist()}): the sensor did not turn, or "
+                               "reads a constant (zeros: is it connected?); record a sweep through all orientations")
     missing = _axis_name(axes[2])
     if spread[2] < PLANAR_RATIO * spread[0]:
         raise CalibrationError(

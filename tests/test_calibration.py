@@ -217,6 +217,11 @@ def test_calibration_file_round_trip(tmp_path):
     (lambda d: d["static"].update(A=[[1, 0, 0], [0, 1, 0], [0, 0, "x"]]), {}, "static.A must be numbers"),
     (lambda d: d["dynamics"].update(exponent=2), {}, "dynamics.exponent must be 0 or 1"),
     (lambda d: d.update(motors=0), {}, "motors = 0 must be a positive integer"),
+    (lambda d: d.update(notes=5), {}, "notes = 5 must be a JSON object"),
+    (lambda d: d["static"].update(A=[[0, 0, 0]] * 3), {}, "static.A is singular (all zeros"),
+    (lambda d: d["static"].update(field_norm=0.0), {}, "static.field_norm = 0.0 must be positive"),
+    (lambda d: d["static"].update(field_norm=-4.7e-5), {}, "must be positive"),
+    (lambda d: d["static"].update(A=[[[[[1.0]]]]]), {}, "static.A must have shape (3, 3)"),
 ])
 def test_calibration_file_refusals(tmp_path, edit, kwargs, message):
     data = calibration().to_dict()
@@ -234,6 +239,22 @@ def test_calibration_file_not_json(tmp_path):
     path.write_text("{ motors: 4")
     with pytest.raises(CalibrationError, match="not valid JSON"):
         Calibration.load(path)
+
+
+def test_calibration_file_nested_too_deeply_or_not_utf8(tmp_path):
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100000 + "]" * 100000)
+    with pytest.raises(CalibrationError, match="nested too deeply"):
+        Calibration.load(deep)
+    latin = tmp_path / "latin.json"
+    latin.write_bytes('{"notes": "étalonnage"}'.encode("latin-1"))
+    with pytest.raises(CalibrationError, match=r"not UTF-8 text \(byte 0xe9 at offset 11\)"):
+        Calibration.load(latin)
+
+
+def test_static_fit_of_constant_samples_is_a_calibration_error():
+    with pytest.raises(CalibrationError, match="the 200 samples are all equal"):
+        fit_static(np.zeros((200, 3)))
 
 
 def test_eq9_removes_the_modelled_field():
