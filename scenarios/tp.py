@@ -247,11 +247,31 @@ def report(result, o, out) -> dict:
             result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"),
             BIAS_TOLERANCE)
         metrics["bias_convergence_tolerance_rad_s"] = BIAS_TOLERANCE
+    metrics |= _predictions(result, o)
     metrics |= _flight_findings(result, o)
+    metrics["attitude_span_deg"] = [math.degrees(float(np.ptp(result[f"Quadrotor.theta{k}"]))) for k in (1, 2, 3)]
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
     return metrics
+
+
+def _predictions(result, o) -> dict:
+    """What the linearised analyses (:mod:`estimators.analysis`) predict for this run's gyro bias:
+    the passive filter's bias-convergence time (s), the explicit filter's steady error without
+    bias estimate (deg, roll, pitch, yaw); nothing without a bias or for the other filters."""
+    if not o["bias"] or o["estimator"] not in ("explicit", "passive"):
+        return {}
+    from estimators import analysis
+
+    gains, bias = estimator_gains(o), result["IMU.gyro_bias"][0]
+    if o["estimator"] == "passive" and gains["kI"] > 0:
+        return {"bias_convergence_predicted_s": analysis.passive_bias_convergence_time(
+            gains["kP"], gains["kI"], float(np.abs(bias).max()), BIAS_TOLERANCE)}
+    if o["estimator"] == "explicit" and gains["kI"] == 0:
+        predicted = analysis.explicit_bias_steady_error(gains["k1"], gains["k2"], gains["kP"], bias)
+        return {"steady_error_predicted_deg": np.degrees(predicted).tolist()}
+    return {}
 
 
 def _flight_findings(result, o) -> dict:

@@ -29,6 +29,10 @@ from pathlib import Path
 #: Every group of findings, in the order they are run and listed; one line a group.
 GROUPS = (
     "flight",
+    "lab",
+    "rig",
+    "metge",
+    "infrared",
 )
 
 ROOT = Path(__file__).resolve().parents[2]

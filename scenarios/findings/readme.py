@@ -140,11 +140,42 @@ def problems(path, findings: dict[str, dict]) -> list[str]:
                 lines.append(f"{passage.path.name}:{line}: {token} is no finding of {', '.join(passage.scope)} "
                              "(a measured number: add it to its group in scenarios/findings/ and run "
                              "`python -m scenarios.findings`; an input: put it in a code span)")
-        for f in scoped:
-            if not any(matches(token, f) for _, token in shown):
-                lines.append(f"{where}: {f['name']} = {printed(f)} {f['unit']} is not printed in the passage "
-                             f"{', '.join(passage.scope)} (its command: {f['command']})")
+        for f in unprinted(scoped, [token for _, token in shown]):
+            lines.append(f"{where}: {f['name']} = {printed(f)} {f['unit']} is not printed in the passage "
+                         f"{', '.join(passage.scope)} (its command: {f['command']})")
     return lines
+
+
+def unprinted(scoped: list[dict], tokens: list[str]) -> list[dict]:
+    """The findings that get no printed number of their own: a maximum matching of findings to
+    the numbers that print them (Kuhn's augmenting paths), so that two findings of one value
+    need two numbers, and a finding moved onto another's value is still missed.
+
+    Parameters
+    ----------
+    scoped : list of dict
+        The passage's findings.
+    tokens : list of str
+        The passage's numbers, as printed.
+
+    Returns
+    -------
+    list of dict
+        The findings left without a number.
+    """
+    candidates = [[j for j, token in enumerate(tokens) if matches(token, f)] for f in scoped]
+    owner: dict[int, int] = {}
+
+    def assign(i: int, seen: set) -> bool:
+        for j in candidates[i]:
+            if j not in seen:
+                seen.add(j)
+                if j not in owner or assign(owner[j], seen):
+                    owner[j] = i
+                    return True
+        return False
+
+    return [f for i, f in enumerate(scoped) if not assign(i, set())]
 
 
 def pages(root) -> list[Path]:
