@@ -8,6 +8,9 @@ downwards the same on ``-z``; a fault is declared when a statistic exceeds ``h``
 small offsets the gate lets through (and that the filter would otherwise absorb into ``b`` or
 ``r``), and the large ones at their first samples.
 
+- Only while both sensors are in use: with the GPS alone gone (not valid, or not used after a
+  calibration phase) an offset of the IR cannot be told from a drift of ``b``, and nothing
+  would replace the IR.
 - Attribution: an IR fault shows first in the IR's innovations (the present IR at once, the
   paired IR when the faulty samples reach the GPS window), a GPS fault first in the GPS's. The
   first statistic over its threshold names the sensor; at the same sample, the one furthest
@@ -243,6 +246,8 @@ def detect(s, c, gps_seen, pair_seen):
     if s[HOLD] > 0.0:
         s[HOLD] -= 1.0
         pair_seen = False
+    if not gps_seen:  # one sensor alone: a drift and a fault look alike, and nothing would replace it
+        return
     gps = cusum(s, CUSUM_GPS, s[NU_GPS], s[GATE_GPS], c[CUSUM_K], c[CUSUM_H]) if gps_seen else -1.0
     pair = cusum(s, CUSUM_PAIR, s[NU_IR], s[GATE_IR], c[CUSUM_K], c[CUSUM_H]) if pair_seen else -1.0
     now = cusum(s, CUSUM_NOW, s[NU_NOW], s[GATE_NOW], c[NOW_K], c[NOW_H])
