@@ -33,6 +33,8 @@ GROUPS = (
     "rig",
     "metge",
     "infrared",
+    "gain_study",
+    "gain_ablation",
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -106,6 +108,29 @@ def finding(name: str, value: float, unit: str, command: str, tolerance: float, 
     """
     return {"name": name, "value": float(value), "unit": unit, "command": command, "tolerance": float(tolerance),
             "digits": int(digits)}
+
+
+def command(prefix: str, settings: dict) -> str:
+    """The command line of a finding: ``prefix`` and ``--set`` of ``settings`` as a user types them.
+
+    Parameters
+    ----------
+    prefix : str
+        ``"quadcosim run tp"``.
+    settings : dict
+        Options; booleans as ``on``/``off``, floats without trailing zeros.
+
+    Returns
+    -------
+    str
+        ``"quadcosim run tp --set flight=tilt tilt_deg=5"`` (``prefix`` alone without settings).
+    """
+    def text(value) -> str:
+        if isinstance(value, bool):
+            return "on" if value else "off"
+        return f"{value:g}" if isinstance(value, float) else str(value)
+
+    return prefix + (" --set " + " ".join(f"{k}={text(v)}" for k, v in settings.items()) if settings else "")
 
 
 def compute_group(group: str, quick: bool = False) -> list[dict]:

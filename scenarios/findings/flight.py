@@ -9,21 +9,14 @@ from __future__ import annotations
 
 import math
 
-from scenarios.findings import finding
+from scenarios.findings import command, finding
 
 TILT = {"flight": "tilt", "tilt_deg": 5.0, "duration": 30.0}
 WIND = {"flight": "hover", "wind_n": 3.0, "duration": 40.0}
-RUN = "quadcosim run tp --set "
-
-
-def _text(value) -> str:
-    if isinstance(value, bool):
-        return "on" if value else "off"
-    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def _command(options: dict) -> str:
-    return RUN + " ".join(f"{k}={_text(v)}" for k, v in options.items())
+    return command("quadcosim run tp", options)
 
 
 def _run(options: dict) -> dict:

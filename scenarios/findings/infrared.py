@@ -8,7 +8,7 @@ acceptance names (IR +400 counts, GPS +0.3 rad/s).
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from scenarios.findings import command, finding
 
 RUN = "quadcosim run ir-calibration"
 DETECTION = "python -m scenarios.ir_detection"
@@ -18,12 +18,8 @@ CASES = {"drift": {}, "no_drift": {"drift": False}, "no_gps_resetting": {"gps_re
 METHODS = {"kalman": "Kalman", "regression": "regression", "rls": "RLS"}
 
 
-def _text(value) -> str:
-    return ("on" if value else "off") if isinstance(value, bool) else str(value)
-
-
 def _command(settings: dict) -> str:
-    return RUN + (" --set " + " ".join(f"{k}={_text(v)}" for k, v in settings.items()) if settings else "")
+    return command(RUN, settings)
 
 
 def errors() -> list[dict]:

@@ -6,7 +6,7 @@ scenarios.ablation`` (it prints it). The quick subset: the default ``tp`` run (a
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from scenarios.findings import command, finding
 
 RUN = "quadcosim run tp"
 ABLATION = "python -m scenarios.ablation"
@@ -14,14 +14,8 @@ AXES = ("roll", "pitch", "yaw")
 PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
 
 
-def _text(value) -> str:
-    if isinstance(value, bool):
-        return "on" if value else "off"
-    return f"{value:g}" if isinstance(value, float) else str(value)
-
-
 def _command(settings: dict) -> str:
-    return RUN + (" --set " + " ".join(f"{k}={_text(v)}" for k, v in settings.items()) if settings else "")
+    return command(RUN, settings)
 
 
 def _tp(settings: dict) -> dict:
