@@ -13,6 +13,7 @@
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
   quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
   quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
+  quadcosim findings [GROUP...] [--quick] [--check]   the README's numbers, measured into findings.json
 """
 
 from __future__ import annotations
@@ -283,6 +284,10 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
+    findings = sub.add_parser("findings", add_help=False,
+                              help="run the README's findings, write findings.json, rewrite the README's numbers "
+                                   "(quadcosim findings --help)")
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
@@ -315,8 +320,14 @@ def main(argv=None) -> int:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")
             warnings.showwarning = _show_warning
+            final = argv is None  # the process's own command line, not a call from Python
+            argv = sys.argv[1:] if argv is None else list(argv)
+            if argv[:1] == ["findings"]:  # its own parser: its options, --help included, are its own
+                from scenarios.findings.__main__ import main as findings
+
+                return findings(argv[1:])
             args = parser().parse_args(argv)
-            args.final = argv is None  # the process's own command line, not a call from Python
+            args.final = final
             if args.command in ("run", "sweep", "bench", "build"):
                 from scenarios.compiled import announce_compiles
 
