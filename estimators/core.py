@@ -507,7 +507,12 @@ def _passive_correction(acc, mag, u, config, gains, acc_weight, mag_weight, r, w
     ry = work[W_RY:W_RY + 9].reshape((3, 3))
     if config[RY] == TRIAD:
         if not triad(acc, mag, config, ry):
-            return
+            # no field (a missing magnetometer): the field the estimate predicts, so that R_y
+            # carries the accelerometer's tilt and the estimate's own heading
+            v_field = work[W_FIELD:W_FIELD + 3]
+            _body(r, config[FIELD], config[FIELD + 1], config[FIELD + 2], v_field)
+            if not triad(acc, v_field, config, ry):
+                return
     else:
         for i in range(3):
             for j in range(3):
@@ -604,7 +609,9 @@ def update(kind, x, u, gains, config, dt, y, work):
     """
     if x[PENDING] > 0.0:
         x[PENDING] = 0.0
-        if triad(u[ACC:ACC + 3], u[MAG:MAG + 3], config, work[W_RY:W_RY + 9].reshape((3, 3))):
+        # without a field (no magnetometer) the heading is the Earth field's: TRIAD on the configured field
+        field = u[MAG:MAG + 3] if _norm3(u[MAG:MAG + 3]) > 0.0 else config[FIELD:FIELD + 3]
+        if triad(u[ACC:ACC + 3], field, config, work[W_RY:W_RY + 9].reshape((3, 3))):
             quaternion_from_rotation(work[W_RY:W_RY + 9].reshape((3, 3)), x[Q:Q + 4])
             euler_from_quaternion(x[Q:Q + 4], x[THETA:THETA + 3])
     if kind == LINEAR:
