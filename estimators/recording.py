@@ -29,6 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
+# A small real recording shipped with the package: 24 s of BROAD's trial "01_undisturbed_slow_rotation_A"
+# (Laidig, Caruso, Cereatti, Seel, "BROAD - A Benchmark for Robust Inertial Orientation Estimation",
+# Data, 2021; CC BY 4.0, cut and stored in single precision, otherwise unchanged): 286 Hz, ENU, mag in uT,
+# 7.8 s at rest then slow rotations, with its optical reference and movement phases.
+EXAMPLE = Path(__file__).parent / "data" / "broad_excerpt.npz"
+
 ALIASES = {
     "gyro": ("gyro", "gyr", "imu_gyr"),
     "acc": ("acc", "imu_acc"),
