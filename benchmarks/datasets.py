@@ -25,6 +25,7 @@ Each dataset sits in its own sub-folder of the data folder, as its authors publi
     Capture Systems", ICCVG 2016): its pendulum recordings (``Pendulum_*.csv``), an IMU on a
     swinging pendulum with a Vicon reference. Aligned as the smartphones.
 
+A recording whose reference does not turn as its gyro does (:func:`usable`) is left out.
 Every loader gives recordings as :func:`estimators.recording.load` does (``gyro``, ``acc``,
 ``mag``, ``rate``, ``quat``, ``scored``, ``meta``), with ``meta["align"]`` saying whether the
 heading offset is removed when scoring.
@@ -40,6 +41,7 @@ from estimators import alignment, recording
 
 PHONE_RATE = 100.0  # Hz, the grid the phones' unevenly timed sensors are resampled to
 TIME_SEARCH_S = 4.0  # s, span searched for the phones' clock offset
+MISMATCH_LIMIT = 0.3  # a recording whose gyro and reference rates differ by more (relative median) is not used
 
 
 def broad(folder: Path):
@@ -53,7 +55,8 @@ def broad(folder: Path):
 def _aligned(gyro, acc, mag, rate, quat):
     quat = alignment.align(gyro, acc, quat, 1.0 / rate)
     return {"gyro": gyro, "acc": acc, "mag": mag, "rate": rate, "quat": quat,
-            "scored": np.isfinite(quat).all(axis=1), "meta": {"frame": "enu", "align": True}}
+            "scored": np.isfinite(quat).all(axis=1),
+            "meta": {"frame": "enu", "align": True, "rate_mismatch": alignment.rate_mismatch(gyro, quat, 1.0 / rate)}}
 
 
 def _csv_with_comments(path: Path) -> tuple[dict, float]:
@@ -152,6 +155,13 @@ def smartphones(folder: Path):
         yield phone.name, data
 
 
+def usable(data: dict) -> bool:
+    """Whether the recording ``data`` can score a filter: its reference turns as its gyro does
+    (:func:`estimators.alignment.rate_mismatch` under :data:`MISMATCH_LIMIT`). A recording whose
+    reference lost track of its body, or whose clocks could not be matched, is left out."""
+    return data["meta"].get("rate_mismatch", 0.0) < MISMATCH_LIMIT
+
+
 LOADERS = {"broad": broad, "smartphones": smartphones, "diodem": diodem, "repoimu": repoimu}
 
 
@@ -161,4 +171,4 @@ def load(data_folder, name: str):
     folder = Path(data_folder) / name
     if not folder.is_dir():
         return []
-    return list(LOADERS[name](folder))
+    return [(label, data) for label, data in LOADERS[name](folder) if usable(data)]

@@ -79,6 +79,19 @@ def body_rotation(gyro, quat, dt: float) -> np.ndarray:
     return _quaternion(rotation)
 
 
+def rate_mismatch(gyro, quat, dt: float) -> float:
+    """How far the reference ``quat`` (N, 4, the IMU's attitude) turns otherwise than the gyro
+    (N, 3, rad/s) says, sampled every ``dt`` (s): the median of ``|omega_ref - gyro|`` over the
+    median of ``|gyro|``, over the samples turning faster than :data:`MOVING_RATE` (0 for a
+    perfect match; 1 for no relation)."""
+    rates = body_rates(quat, dt)
+    use = np.isfinite(rates).all(axis=1) & (np.linalg.norm(gyro, axis=1) > MOVING_RATE)
+    if use.sum() < 3:
+        return float("inf")
+    return float(np.median(np.linalg.norm(rates[use] - gyro[use], axis=1)) /
+                 np.median(np.linalg.norm(gyro[use], axis=1)))
+
+
 def vertical_rotation(acc, quat) -> np.ndarray:
     """Quaternion ``q_e`` turning the reference's inertial frame so that its vertical is ENU's up
     (+z), the smallest such turn: ``q_e (x) quat`` is then in an Earth frame up to a heading.

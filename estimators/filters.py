@@ -58,6 +58,10 @@ or tunes each:
     within the tolerances for this long while rejected. A short disturbance (a fault, a magnet
     passed by) stays rejected; a lasting one (an uncompensated motor field) is accepted, so
     the heading keeps its correction. 0: the configured field, for ever.
+``bias_clip`` (rad/s)
+    Each axis of the bias estimate is kept within this bound (VQF's choice too): a slow
+    rotation taken for rest, or a lasting disturbance, cannot leave a bias estimate larger than
+    a MEMS gyro's.
 ``rest_gyro`` (rad/s), ``rest_acc`` (m/s^2), ``rest_time`` (s), ``rest_gain`` (1/s)
     Rest detection: once the low-passed gyro norm stays under ``rest_gyro`` and the low-passed
     specific force within ``rest_acc`` of g for ``rest_time``, the bias follows the gyro,
@@ -114,6 +118,7 @@ CORRECTIONS = {
     "acc_lowpass": 1.0,  # s
     "mag_lowpass": 1.0,  # s
     "mag_reference_time": 2.0,  # s
+    "bias_clip": math.radians(2.0),  # rad/s
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 OUTPUT_NAMES = tuple(name for name, _ in core.OUTPUT_LAYOUT)
