@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup fmus demo test lint bench clean
+.PHONY: setup fmus demo test lint bench fuzz clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,6 +30,9 @@ lint: $(STAMP)
 
 bench: fmus
 	$(BIN)/quadcosim bench
+
+fuzz: fmus
+	$(BIN)/python -m benchmarks.fuzz
 
 clean:
 	rm -rf build results

@@ -16,6 +16,9 @@ from pathlib import Path
 MODELS = ("Quadrotor", "MotorMagnetics", "IMU", "InfraredSensor")
 
 
+_BUILD = Path(__file__).resolve().parent.parent / "build" / "fmus"  # resolved once: runs look FMUs up often
+
+
 class FMUNotFoundError(FileNotFoundError):
     """A built FMU is missing."""
 
@@ -29,7 +32,7 @@ def default_fmu_dir() -> Path:
         ``$QUADCOSIM_FMU_DIR`` if set, else ``build/fmus`` beside the package.
     """
     env = os.environ.get("QUADCOSIM_FMU_DIR")
-    return Path(env) if env else Path(__file__).resolve().parent.parent / "build" / "fmus"
+    return Path(env) if env else _BUILD
 
 
 def fmu_path(name: str) -> Path:

@@ -395,7 +395,10 @@ ANGLE_SPAN_DEG, ERROR_SPAN_DEG, BIAS_SPAN = 1.0, 0.05, 2e-3
 
 def _figures(result, o, out) -> list[str]:
     """Roll and pitch, yaw, and (when estimated) the gyro bias: truth and estimate, then the
-    estimate's error, fault windows shaded; the files written."""
+    estimate's error, fault windows shaded; the files written (none, and nothing drawn, without
+    a folder ``out``)."""
+    if out is None:
+        return []
     import matplotlib.pyplot as plt
 
     t = result.time

@@ -13,8 +13,9 @@ member is refused before any run.
 
 from __future__ import annotations
 
-import itertools
+import math
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,6 +28,25 @@ def _number(text: str, where: str) -> float:
         return float(text)
     except ValueError:
         raise ValueError(f"{where}: {text!r} is not a number") from None
+
+
+#: The most members a plan may have unless asked for more (``max_members``, ``--max-members``).
+MAX_MEMBERS = 1_000_000
+
+
+def count_of(spec: str, where: str = "--grid") -> int:
+    """How many values the grid specification ``spec`` stands for, found without making them (a
+    range of 10^8 values is counted, not built); ``where`` names it in error messages."""
+    match = _RANGE.match(spec)
+    if match is None or "," in spec:
+        return len(spec.split(","))
+    start, stop = _number(match[1], where), _number(match[2], where)
+    if match[3] is None:
+        if not (math.isfinite(start) and math.isfinite(stop)) or start != int(start) or stop != int(stop) \
+                or stop < start:
+            return 1  # refused, with its reason, by values_of
+        return int(stop) - int(start) + 1
+    return int(match[4])
 
 
 def values_of(spec: str, where: str = "--grid") -> list:
@@ -79,26 +99,90 @@ class Member:
     label: str = ""
 
 
+class GridMembers(Sequence):
+    """The members of a grid, made when asked for, never all held: member ``i`` is the
+    ``i``-th combination of the dimensions, the last varying fastest, over the options
+    ``base`` (every option typed, as the scenario parses them). A plan of a million members
+    takes the memory of its dimensions.
+
+    Parameters
+    ----------
+    base : dict
+        The options every member shares (defaults and ``--set``).
+    dimensions : dict of str to list
+        Each varied option's typed values, slowest first.
+    """
+
+    def __init__(self, base: dict, dimensions: dict[str, list]):
+        self.base, self.dimensions = base, dimensions
+        self._sizes = [len(values) for values in dimensions.values()]
+        self._count = math.prod(self._sizes)
+
+    def __len__(self) -> int:
+        return self._count
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(self._count))]
+        if index < 0:
+            index += self._count
+        if not 0 <= index < self._count:
+            raise IndexError(f"member {index} of a plan of {self._count}")
+        picked, rest = [], index
+        for size in reversed(self._sizes):
+            rest, position = divmod(rest, size)
+            picked.append(position)
+        values = {name: values[k] for (name, values), k in zip(self.dimensions.items(), reversed(picked), strict=True)}
+        return Member(index, self.base | values, " ".join(f"{k}={v}" for k, v in values.items()))
+
+
 @dataclass
 class Plan:
     """What a sweep runs: a scenario and its members, with the command-line description kept;
-    ``varied`` are the options the grid varies, ``name`` a named sweep's name (else None)."""
+    ``varied`` are the options the grid varies, ``name`` a named sweep's name (else None).
+    ``members`` is a list, or a :class:`GridMembers` for a grid (made as they are read)."""
 
     scenario: str
-    members: list[Member]
+    members: Sequence
     varied: list[str] = field(default_factory=list)
     description: dict = field(default_factory=dict)
     name: str | None = None  # a named sweep's name
 
     def to_json(self) -> dict:
-        """The plan as stored in ``sweep.json`` (every member's options)."""
-        return {"scenario": self.scenario, "name": self.name, "varied": self.varied,
-                "description": self.description,
-                "members": [{"label": m.label, "options": m.options} for m in self.members]}
+        """The plan as stored in ``sweep.json``: a grid by its shared options and dimensions,
+        named cases one by one (:func:`stored_members` reads either back)."""
+        stored = {"scenario": self.scenario, "name": self.name, "varied": self.varied,
+                  "description": self.description, "count": len(self.members)}
+        if isinstance(self.members, GridMembers):
+            return stored | {"base": self.members.base, "dimensions": self.members.dimensions}
+        return stored | {"members": [{"label": m.label, "options": m.options} for m in self.members]}
 
 
-def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None) -> Plan:
+def stored_members(stored: dict) -> Sequence:
+    """The members of a plan as :meth:`Plan.to_json` stored it (``sweep.json``, read back)."""
+    if "members" in stored:
+        return [Member(i, m["options"], m["label"]) for i, m in enumerate(stored["members"])]
+    return GridMembers(stored["base"], stored["dimensions"])
+
+
+def _typed(scenario, name: str, values: list) -> list:
+    """``values`` of option ``name`` typed and checked as :meth:`scenarios.Scenario.parse` does it
+    (a block parameter, ``Block.name``, is kept as text and checked when a system is built)."""
+    if "." in name:
+        return [_text(v) for v in values]
+    if name not in scenario.options:
+        scenario.parse({name: _text(values[0])})  # refuses the unknown name, naming the nearest
+    option = scenario.options[name]
+    return [option.parse(name, _text(v)) for v in values]
+
+
+def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None,
+         max_members: int = MAX_MEMBERS) -> Plan:
     """Expand ``--grid`` and ``--set`` strings (and ``--seeds``) into typed members.
+
+    The members are counted from the specifications before any value is made, and a plan of
+    more than ``max_members`` is refused with its count; the members themselves are made
+    when read (:class:`GridMembers`).
 
     Parameters
     ----------
@@ -111,39 +195,49 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None) ->
     seeds : str, optional
         ``N`` (seeds 1 to N) or ``start:stop``: the scenario's ``seed`` option as the last,
         fastest-varying dimension (Monte Carlo).
+    max_members : int
+        The most members accepted.
+
+    Raises
+    ------
+    ValueError
+        A bad specification or value (the message names it), or too many members.
     """
     import scenarios
 
     scenario = scenarios.get(scenario_name)
     fixed = dict(split_assignment(s, "--set") for s in settings)
-    dimensions: dict[str, list] = {}
+    specs: dict[str, tuple[str, str]] = {}
     for text in grids:
         name, spec = split_assignment(text, "--grid")
-        if name in dimensions:
+        if name in specs:
             raise ValueError(f"--grid {name} is given twice; put all its values in one --grid")
-        dimensions[name] = values_of(spec, f"--grid {name}")
+        specs[name] = (spec, f"--grid {name}")
     if seeds is not None:
         if "seed" not in scenario.options:
             raise ValueError(f"scenario {scenario_name} has no seed option; --seeds does not apply to it")
-        if "seed" in dimensions or "seed" in fixed:
+        if "seed" in specs or "seed" in fixed:
             raise ValueError("--seeds and a seed in --grid or --set: give the seeds once")
-        spec = seeds if ":" in str(seeds) else f"1:{int(seeds)}"
-        dimensions["seed"] = values_of(spec, "--seeds")
-    for name in dimensions:
+        try:
+            specs["seed"] = (seeds if ":" in str(seeds) else f"1:{int(seeds)}", "--seeds")
+        except ValueError:
+            raise ValueError(f"--seeds {seeds!r}: give a count N or a range A:B") from None
+    for name in specs:
         if name in fixed:
             raise ValueError(f"option {name} is both varied (--grid) and fixed (--set); keep one")
+    counts = {name: count_of(spec, where) for name, (spec, where) in specs.items()}
+    total = math.prod(counts.values())
+    if total > max_members:
+        sizes = " x ".join(f"{counts[name]:,} {name}" for name in counts)
+        raise ValueError(f"the plan has {total:,} members ({sizes}), more than the {max_members:,} allowed: "
+                         "narrow the grid, or raise the limit (--max-members)")
     # Type and check every value once, through the scenario's own options.
-    scenario.parse(fixed)
-    typed = {name: [scenario.parse({name: _text(v)})[name] for v in values] for name, values in dimensions.items()}
+    base = scenario.parse(fixed)
+    typed = {name: _typed(scenario, name, values_of(spec, where)) for name, (spec, where) in specs.items()}
     for name, values in typed.items():
         if len(set(map(repr, values))) != len(values):
             raise ValueError(f"--grid {name}: repeated values {values}")
-    members = []
-    for index, combination in enumerate(itertools.product(*typed.values())):
-        options = scenario.parse(fixed | dict(zip(typed, combination, strict=True)))
-        label = " ".join(f"{k}={v}" for k, v in zip(typed, combination, strict=True))
-        members.append(Member(index, options, label))
-    return Plan(scenario_name, members, list(typed),
+    return Plan(scenario_name, GridMembers(base, typed), list(typed),
                 {"grid": list(grids), "set": list(settings), "seeds": seeds})
 
 
