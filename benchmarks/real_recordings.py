@@ -43,10 +43,10 @@ OURS = ("explicit", "passive")
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 FIELD_SECONDS = 1.0  # s, start of each recording the field references are taken from
 GRID = {
-    "explicit": {"kP": [0.5, 1.0, 2.0], "kI": [0.001, 0.003, 0.01], "k2": [0.1, 0.3, 1.0],
-                 "rest_gain": [0.1, 0.3, 1.0]},
-    "passive": {"kP": [0.5, 1.0, 2.0], "kI": [0.001, 0.003, 0.01], "k2": [0.01, 0.03, 0.1],
-                "rest_gain": [0.1, 0.3, 1.0]},
+    "explicit": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.1, 0.3, 1.0],
+                 "rest_gain": [0.03, 0.1, 0.3, 1.0]},
+    "passive": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.01, 0.03, 0.1],
+                "rest_gain": [0.03, 0.1, 0.3, 1.0]},
 }
 
 
