@@ -36,6 +36,7 @@ GROUPS = (
     "gain_study",
     "gain_ablation",
     "flightlogs",
+    "real_recordings",
 )
 
 ROOT = Path(__file__).resolve().parents[2]
