@@ -20,6 +20,7 @@ fmus: $(STAMP)
 
 demo: fmus
 	$(BIN)/quadcosim run tp --out results/tp --overwrite
+	@echo "quadcosim is installed in $(VENV): activate it with  . $(VENV)/bin/activate  (or call $(BIN)/quadcosim)"
 
 test: fmus
 	$(BIN)/ruff check .

@@ -207,9 +207,10 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus), the master's C runner and "
-                           "the benchmark's C references")
-    build.add_argument("--out", default=None, help="output folder (default build/fmus)")
+    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
+                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
+                           "builds what it needs on first use)")
+    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
