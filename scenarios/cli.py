@@ -5,6 +5,8 @@
   quadcosim run SCENARIO [--set k=v k2=v2 ...] [--estimator module:Class] [--out DIR] [--fault ...]
                                            (--set IMU.gyro_noise_density=0.001: an FMU parameter)
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
+  quadcosim plot RUN SIGNAL...             signals of a finished run (its folder) against time
+  quadcosim compare RUN RUN... SIGNAL      one signal of several finished runs on one figure
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
@@ -50,9 +52,11 @@ def _list(args) -> int:
 
         print(f"{args.parameters} parameters (set one in any scenario with --set {args.parameters}.NAME=VALUE; "
               "a vector as x,y,z):")
+        from scenarios.shown import PARAMETER_DIGITS, shown
+
         for v in table(args.parameters).of("parameter"):
             unit = f" [{v.unit}]" if v.unit else ""
-            print(f"  {v.name:22s} = {v.start!r:24}{unit:14s} {v.description}")
+            print(f"  {v.name:22s} = {shown(v.start, PARAMETER_DIGITS):24}{unit:14s} {v.description}")
         aliases, switched = model_notes(args.parameters)
         for alias, name in aliases.items():
             print(f"  {alias} stands for the vector {name}")
@@ -140,8 +144,10 @@ def _run_reporting(args) -> int:
         return 2
     warnings = metrics.pop("fmu_warnings", {})
     shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario", "units", "signals_not_saved")}
+    from scenarios.shown import shown as text
+
     for key, value in shown.items():
-        print(f"  {key}: {value}")
+        print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
     return 0
@@ -251,6 +257,9 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
+    from scenarios import run_plots
+
+    run_plots.add_arguments(sub)
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\

@@ -323,24 +323,28 @@ def figure3(first: RigRun, numbers: dict, o: dict, out):
     return save_figure(fig, out, "figure3_free_set.png")
 
 
-def table1_figure(numbers: dict, orders, o: dict, out):
-    """Table 1 as a figure, each cell beside the paper's value; ``numbers`` as :func:`table1`
-    returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's options (named in the
-    title), ``out`` the folder of the figure (None: no file)."""
-    import matplotlib.pyplot as plt
+def table1_text(numbers: dict, orders, o: dict, out):
+    """Table 1 as a Markdown table (``table1.md``), each cell beside the paper's value;
+    ``numbers`` as :func:`table1` returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's
+    options (named in the heading), ``out`` the folder of the file (None: no file). Returns the
+    file name written, or None."""
+    if out is None:
+        return None
+    from orchestrator.files import atomic_path
 
     table, dynamic = numbers["table"], numbers["dynamic_free"]
-    fig, ax = plt.subplots(figsize=(9, 2.6))
-    ax.axis("off")
-    cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")]
-             for r in ("none", "calibration1", "calibration2")]
-    cells.append(["", "", f"{dynamic['calibration1']:.3f} / {dynamic['calibration2']:.3f}"])
-    ax.table(cellText=cells, rowLabels=["no dynamic calibration", "calibration 1", "calibration 2",
-                                        "motor dynamics (cal. 1 / 2)"],
-             colLabels=["set 1", "set 2", "free set"], loc="center")
-    fig.suptitle(title_lines(f"metge: mean angular error (deg), simulated (paper's value), Table 1 of {PAPER}",
-                             f"orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}", width=100), fontsize=9)
-    return save_figure(fig, out, "table1.png")
+    names = {"none": "no dynamic calibration", "calibration1": "calibration 1", "calibration2": "calibration 2"}
+    lines = [f"Mean angular error (deg) of the measured field, simulated (the paper's value), Table 1 of {PAPER}.",
+             f"Orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}.", "",
+             "| | set 1 | set 2 | free set |", "|---|---|---|---|"]
+    for row, name in names.items():
+        cells = [f"{table[row][c]:.3f} ({PAPER_TABLE1[row][c]:.3f})" for c in ("set1", "set2", "free")]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    lines.append(f"| motor dynamics (cal. 1 / 2) | | | {dynamic['calibration1']:.3f} / "
+                 f"{dynamic['calibration2']:.3f} |")
+    with atomic_path(out / "table1.md") as temporary:
+        Path(temporary).write_text("\n".join(lines) + "\n")
+    return "table1.md"
 
 
 def report(result, o, out) -> dict:
@@ -367,7 +371,7 @@ def report(result, o, out) -> dict:
     ed_free = numbers["series"]["calibration1_dynamic"][first.free]
     true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
     true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
-    figures = [figure3(first, numbers, o, out), table1_figure(numbers, orders, o, out)]
+    figures = [figure3(first, numbers, o, out), table1_text(numbers, orders, o, out)]
     return {
         "table1_deg": table,
         "free_set_dynamic_deg": dynamic_free["calibration1"],

@@ -138,13 +138,47 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None) ->
     for name, values in typed.items():
         if len(set(map(repr, values))) != len(values):
             raise ValueError(f"--grid {name}: repeated values {values}")
-    members = []
-    for index, combination in enumerate(itertools.product(*typed.values())):
-        options = scenario.parse(fixed | dict(zip(typed, combination, strict=True)))
-        label = " ".join(f"{k}={v}" for k, v in zip(typed, combination, strict=True))
-        members.append(Member(index, options, label))
+    members = _distinct_members(scenario, fixed, typed, seeds is not None)
     return Plan(scenario_name, members, list(typed),
                 {"grid": list(grids), "set": list(settings), "seeds": seeds})
+
+
+def _shown(value) -> str:
+    """An option value as a user writes it: on/off for a switch."""
+    return ("on" if value else "off") if isinstance(value, bool) else str(value)
+
+
+def _distinct_members(scenario, fixed: dict, typed: dict, seeds_given: bool) -> list[Member]:
+    """The grid's members, each distinct run once: a varied option that acts on nothing in a
+    member (``k`` with ``estimator=explicit``, ``seed`` with ``noise=off``; the options'
+    ``applies``) makes duplicates of that member: the first is kept, the others dropped, and a
+    warning says which option, for which members, and how many runs it saved."""
+    import warnings
+
+    members, seen, dropped = [], {}, {}
+    for combination in itertools.product(*typed.values()):
+        chosen = dict(zip(typed, combination, strict=True))
+        options = scenario.parse(fixed | chosen)
+        inert = [name for name in scenario.inert(options) if name in typed]
+        key = repr(sorted((k, "inert" if k in inert else v) for k, v in options.items()))
+        if key in seen:
+            for name in inert:
+                other = scenario.options[name].applies.partition("=")[0]
+                values, count, kept = dropped.get(name, (set(), 0, seen[key][name]))
+                dropped[name] = (values | {_shown(options[other])}, count + 1, kept)
+            continue
+        seen[key] = options
+        label = " ".join(f"{k}={v}" for k, v in chosen.items() if k not in inert)
+        members.append(Member(len(members), options, label))
+    total = int(np.prod([len(v) for v in typed.values()])) if typed else 1
+    for name, (values, count, kept) in dropped.items():
+        condition = scenario.options[name].applies
+        flag = "--seeds" if name == "seed" and seeds_given else f"--grid {name}"
+        warnings.warn(f"{flag}: {name} acts only when {condition}; with {condition.partition('=')[0]}="
+                      f"{'/'.join(sorted(values))} it varies nothing, so those members run once, at {name}={kept} "
+                      f"({count} duplicate members of {total} dropped)",
+                      stacklevel=3)
+    return members
 
 
 def plan_of_cases(scenario_name: str, cases: dict[str, dict], name: str | None = None) -> Plan:
