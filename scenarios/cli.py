@@ -179,17 +179,23 @@ def _print_warnings(warnings: dict, shown: int = 3):
 
 
 def _diagram(args) -> int:
-    import scenarios
-    from orchestrator.diagram import draw
+    from orchestrator.progress import reporting, status
 
-    try:
-        scenario = scenarios.get(args.scenario)
-        options = scenario.parse(_settings(args))
-        system = scenario.system(options)
-    except (KeyError, ValueError) as error:
-        print(error.args[0] if error.args else error, file=sys.stderr)
-        return 2
-    path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+    with reporting(True):
+        status(f"quadcosim diagram {args.scenario}: loading the packages")
+        import scenarios
+        from orchestrator.diagram import draw
+
+        try:
+            scenario = scenarios.get(args.scenario)
+            options = scenario.parse(_settings(args))
+            status(f"{args.scenario}: building the system (its FMUs loaded)")
+            system = scenario.system(options)
+        except (KeyError, ValueError) as error:
+            print(error.args[0] if error.args else error, file=sys.stderr)
+            return 2
+        status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
+        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
     print(path)
     return 0
 

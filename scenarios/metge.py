@@ -31,6 +31,7 @@ import numpy as np
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
 from orchestrator import System, Table
+from orchestrator.progress import status
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
@@ -217,7 +218,7 @@ def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Cal
     """
     model = fit_dynamic(rig.reference, rig.sweeps(), orders)
     dynamics = fit_motor_dynamics([r.record() for r in rig.runs], [r.reference for r in rig.runs], model.v,
-                                  sample_rate)
+                                  sample_rate, progress=status)
     return Calibration(4, static, model, dynamics, rig.reference, {"made_by": f"quadcosim run metge ({name})"})
 
 
@@ -242,6 +243,7 @@ def record_sets(result, o: dict, out) -> dict[int, list[RigRun]]:
     runs = {1: [RigRun(result, o, 1)], 2: []}
     for set_number in (1, 2):
         for run in range(len(runs[set_number]), len(socs(o, set_number))):
+            status(f"metge: rig run {run + 1} of set {set_number} ({commands(o, set_number)[2]:.0f} s simulated)")
             recorded = system_for(o, set_number, run).run(commands(o, set_number)[2], record=RECORD)
             if out is not None:
                 recorded.save(out / f"set{set_number}_run{run}")
@@ -356,13 +358,16 @@ def report(result, o, out) -> dict:
     static = load_static(o)
     runs = record_sets(result, o, out)
     rig1, rig2 = RigSet(runs[1]), RigSet(runs[2])
+    status("metge: cross-validating the orders (I, J) between the sets")
     study = order_study([(rig1.reference, rig1.sweeps()), (rig2.reference, rig2.sweeps())])
     orders = orders or study["best"]
+    status("metge: calibrating on each set (eqs. 5 to 8, then the motors' dynamics)")
     cals = {"calibration1": calibrate(rig1, orders, static, rate, "set 1"),
             "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
     if out is not None:
         for name, cal in cals.items():
             cal.save(out / f"{name}.json")
+    status("metge: Table 1 (every run compensated by each calibration)")
     numbers = table1({"none": Calibration(4, static), **cals}, rig1, rig2, rate)
     table, dynamic_free, first = numbers["table"], numbers["dynamic_free"], rig1.runs[0]
     t_free = first.time[first.free] - first.end
@@ -416,10 +421,13 @@ def rig_calibration(orders: str = "4,1", levels: int = 8) -> Calibration:
     (about 30 s of simulated rig time); cached for the process. The tp vehicle has no soft or
     hard iron, so the static part is the identity."""
     o = SCENARIO.parse({"orders": orders, "levels": levels})
-    runs = []
-    for run in range(len(socs(o, 1))):
+    runs, count = [], len(socs(o, 1))
+    for run in range(count):
+        status(f"calibrating the motor-current field on the clamped rig: run {run + 1} of {count} "
+               f"({commands(o, 1)[2]:.0f} s simulated)")
         recorded = system_for(o, 1, run).run(commands(o, 1)[2], record=RECORD)
         runs.append(RigRun(recorded, o, 1))
+    status("identifying the field model (eqs. 5 to 8) and the motors' dynamics")
     return calibrate(RigSet(runs), parse_orders(orders), None, o["mag_rate"], "set 1, made for tp")
 
 
