@@ -5,12 +5,12 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup fmus demo test lint bench clean
+.PHONY: setup fmus demo test lint bench docs clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e ".[dev]"
+	$(BIN)/pip install --quiet -e ".[dev,docs]"
 	touch $(STAMP)
 
 setup: $(STAMP)
@@ -24,7 +24,12 @@ demo: fmus
 
 test: fmus
 	$(BIN)/ruff check .
+	$(MAKE) docs
 	$(BIN)/python -m pytest -q
+
+# The documentation site, warnings as errors; its lab figures are made by the commands it shows.
+docs: fmus
+	$(BIN)/python -m sphinx -W --keep-going -q -b html docs docs/_build/html
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
@@ -33,4 +38,4 @@ bench: fmus
 	$(BIN)/quadcosim bench
 
 clean:
-	rm -rf build results
+	rm -rf build results docs/_build docs/_generated

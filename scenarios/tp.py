@@ -456,6 +456,11 @@ def _figures(result, o, out) -> list[str]:
     axes[1].set_ylabel("estimate - truth (deg)")
     figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "yaw.png"))
 
+    if o["flight"] == "tilt":  # the tilt finding: what the accelerometer reads, and the speed
+        from scenarios.tilt_figure import tilt_figure
+
+        figures.append(save_figure(tilt_figure(result, o, title), out, "tilt.png"))
+
     # the bias figure only for an estimator that estimates one (the linear filter does not)
     if any(np.any(result[f"Quaternion_estim.b_est_{axis}"]) for axis in "xyz"):
         fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))

@@ -114,3 +114,13 @@ def test_a_wrapping_yaw_is_drawn_with_a_gap_not_a_vertical_line():
     assert values[finite].max() == pytest.approx(180.0, abs=0.2)
     assert values[finite].min() == pytest.approx(-180, abs=0.2)
     assert math.isclose(values[-1], -60.0, abs_tol=1e-6)
+
+
+def test_a_tilt_run_draws_the_accelerometer_s_tilt_and_the_speed(tmp_path):
+    from scenarios.tilt_figure import accelerometer_tilt_deg
+
+    _, metrics = run_scenario("tp", {"flight": "tilt", "duration": 3.0}, tmp_path)
+    assert "tilt.png" in metrics["figures"] and imread(tmp_path / "tilt.png").shape[1] > 900
+    level, pitched = [0.0, 0.0, -9.81], [9.81 * math.sin(0.1), 0.0, -9.81 * math.cos(0.1)]
+    roll, pitch = accelerometer_tilt_deg(np.array([level, pitched]))
+    assert np.allclose(roll, 0.0) and np.allclose(pitch, [0.0, math.degrees(0.1)])
