@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup fmus demo test lint bench docs clean
+.PHONY: setup fmus demo test lint bench fuzz docs clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -36,6 +36,9 @@ lint: $(STAMP)
 
 bench: fmus
 	$(BIN)/quadcosim bench
+
+fuzz: fmus
+	$(BIN)/python -m benchmarks.fuzz
 
 clean:
 	rm -rf build results docs/_build docs/_generated

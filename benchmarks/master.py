@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from benchmarks import estimators, reference_library
+from benchmarks import estimators, fmu_steps, reference_library
 
 CLOSED_LOOP = {"estimator": "explicit", "noise": True, "bias": True}  # tp options of the closed loop
 
@@ -148,9 +148,9 @@ class ReferenceLoop:
         """
         function = getattr(reference_library("loops"), "closed_loop" if self.closed else "open_loop")
         function.restype = ctypes.c_int
-        started = time.process_time()
+        started = time.thread_time()
         status = function(ctypes.byref(self.loop))
-        seconds = time.process_time() - started
+        seconds = time.thread_time() - started
         if status:
             raise RuntimeError(f"the C reference loop failed at step {self.loop.failed_step} (status {status})")
         return seconds
@@ -229,7 +229,8 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
         ``open_loop_over_c`` and ``closed_loop_over_c`` (median ratio of CPU times), their
         ``*_spread`` (lowest, highest), the µs per step of each loop, ``rtf_open_loop``,
         ``rtf_closed_loop`` and ``rtf_closed_loop_c`` (simulated over CPU seconds, best run),
-        ``*_identical``, then the batch-path figures of :func:`benchmarks.estimators.measure`.
+        ``*_identical``, then the batch-path figures of :func:`benchmarks.estimators.measure` and
+        the FMI shell's cost, :func:`benchmarks.fmu_steps.measure` (``fmu_step_over_equations``).
     """
     figures = {}
     for key, scenario, settings in (("open_loop", "open-loop", {}), ("closed_loop", "tp", CLOSED_LOOP)):
@@ -239,7 +240,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
                     f"{key}_us_per_step": run["us_per_step"], f"{key}_c_us_per_step": run["c_us_per_step"],
                     f"rtf_{key}": 1e3 / run["us_per_step"], f"rtf_{key}_c": 1e3 / run["c_us_per_step"],
                     f"{key}_identical": run["identical"]}
-    return estimators.measure(seconds, repeats) | figures
+    return estimators.measure(seconds, repeats) | fmu_steps.measure(seconds, repeats) | figures
 
 
 def main(argv=None) -> int:

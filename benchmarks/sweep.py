@@ -50,8 +50,10 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
     Returns
     -------
     dict
-        Rates (members/s), start-up (s), CPU and wall time per member (s), disk per member
-        (bytes), the 10 000-member extrapolation (h, MB), load averages.
+        Rates (members/s), start-up (s), CPU and wall time per member (s) and of its stepping
+        loop, ``member_over_stepping`` (the median over the 1-worker members of their CPU over
+        their stepping loop's CPU), disk per member (bytes), the 10 000-member extrapolation (h,
+        MB), load averages.
     """
     from scenarios.sweep import engine, grid, table
 
@@ -81,7 +83,12 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
                 "first_member_extra_s": statistics.mean(firsts.values()) - typical,
                 "median_member_s": typical,
                 "median_member_cpu_s": statistics.median(columns["cpu_s"]),
+                "median_stepping_cpu_s": statistics.median(columns["stepping_cpu_s"]),
             }
+            if workers == 1:
+                # a member's CPU against its stepping loop's alone: what the rest of the member costs
+                figures["member_over_stepping"] = statistics.median(
+                    cpu / stepping for cpu, stepping in zip(columns["cpu_s"], columns["stepping_cpu_s"], strict=True))
             if workers == 1:
                 files = list((out / "members").glob("*/metrics.json"))
                 apparent, allocated = _disk(files)
@@ -116,6 +123,8 @@ def report(f: dict) -> str:
         f"  2 workers: {two['members_per_s']:6.2f} members/s   (median member {two['median_member_s']:.3f} s, "
         f"{two['median_member_cpu_s']:.3f} s of CPU)",
         f"  speed-up with 2 workers: {f['speed_up_2_workers']:.2f}",
+        f"  a member's CPU over its stepping loop's (median, 1 worker): {f['member_over_stepping']:.2f} "
+        f"(stepping {one['median_stepping_cpu_s'] * 1e3:.1f} ms of {one['median_member_cpu_s'] * 1e3:.1f} ms)",
         f"  start-up per worker: cluster and preparation {one['start_s']:.2f} s (1 worker), {two['start_s']:.2f} s "
         f"(2 workers at once); first member {one['first_member_extra_s']:.2f} s longer than the others; "
         f"shut-down {one['shutdown_s']:.2f} s (1 worker), {two['shutdown_s']:.2f} s (2 workers)",

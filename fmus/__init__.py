@@ -14,6 +14,7 @@ folder for an installed package, so that an installation never writes into ``sit
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -53,14 +54,17 @@ def build_root() -> Path:
         imported from; else, for an installed package, the per-user cache
         ``$XDG_CACHE_HOME/quadcosim/<version>`` (``~/.cache/quadcosim/<version>``).
     """
-    env = os.environ.get("QUADCOSIM_BUILD_DIR")
+    return _build_root(os.environ.get("QUADCOSIM_BUILD_DIR"), os.environ.get("XDG_CACHE_HOME"))
+
+
+@functools.lru_cache(maxsize=8)  # resolved once per setting: runs look FMUs up often
+def _build_root(env: str | None, cache: str | None) -> Path:
     if env:
         return Path(env)
     checkout = _checkout()
     if checkout is not None:
         return checkout / "build"
-    cache = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(cache) / "quadcosim" / _version()
+    return Path(cache or Path.home() / ".cache") / "quadcosim" / _version()
 
 
 def default_fmu_dir() -> Path:
@@ -93,6 +97,9 @@ def fmu_sources(name: str) -> list[Path]:
     shared = [here / f"{module}.py" for module in ("build", "variables", "airframe", "vehicle")]
     own = [here / name / "model.c", here / name / "variables.py"]
     return [path for path in [*sorted((here / "c").glob("*")), *shared, *own] if path.is_file()]
+
+
+_checked: set[Path] = set()  # FMUs found up to date by this process: checked once, not at every look-up
 
 
 def _stale(path: Path, name: str) -> bool:
@@ -141,8 +148,10 @@ def fmu_path(name: str) -> Path:
         folder); the message says how to build it.
     """
     path = default_fmu_dir() / f"{name}.fmu"
-    if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and _stale(path, name):
-        _build_on_first_use(name, path)
+    if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
+        if _stale(path, name):
+            _build_on_first_use(name, path)
+        _checked.add(path)
     if not path.is_file():
         known = ", ".join(MODELS)
         hint = "" if name in MODELS else f" ({name!r} is not one of the plant models: {known})"

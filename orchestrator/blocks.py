@@ -265,9 +265,8 @@ class FMUBlock:
     """
 
     def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
-        from fmpy import read_model_description
-
         from fmus import fmu_path
+        from orchestrator.fmu import model_description
 
         if int(period) != period or period < 1:
             raise ValueError(f"{name}: period must be a positive integer number of macro steps, not {period}")
@@ -275,7 +274,7 @@ class FMUBlock:
         self.model = model or name
         self.parameters = dict(parameters or {})
         self.period = int(period)
-        description = read_model_description(str(fmu_path(self.model)))
+        description = model_description(fmu_path(self.model))
         variables = description.modelVariables
         self.inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
         self.outputs = tuple(v.name for v in variables if v.causality == "output" and v.type == "Real")
@@ -307,13 +306,16 @@ class FMUBlock:
         orchestrator.fmu.FMUInstance
             The live instance, also kept as ``self.instance``.
         """
-        from orchestrator.fmu import FMUInstance
+        from orchestrator import pool
 
-        self.instance = FMUInstance(self.model, self.parameters, name=self.name, start_time=t0)
+        self.instance = pool.acquire(self.model, self.parameters, name=self.name, start_time=t0)
         return self.instance
 
     def close(self):
-        """Free the FMU instance after a run."""
+        """Free the FMU instance after a run (or keep it for the next run, when this process
+        reuses instances: :mod:`orchestrator.pool`)."""
         if self.instance is not None:
-            self.instance.close()
+            from orchestrator import pool
+
+            pool.release(self.instance)
             self.instance = None

@@ -103,6 +103,31 @@ class FMUError(RuntimeError):
         )
 
 
+_descriptions: dict[tuple, object] = {}
+
+
+def model_description(path):
+    """fmpy's model description of the FMU file ``path``, parsed once per version of the file
+    (its path, modification time and size): a sweep's members share it rather than each
+    parsing the XML again. Callers read it and never change it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An ``.fmu`` file.
+
+    Returns
+    -------
+    fmpy.model_description.ModelDescription
+    """
+    stat = Path(path).stat()
+    key = (str(path), stat.st_mtime_ns, stat.st_size)
+    description = _descriptions.get(key)
+    if description is None:
+        description = _descriptions[key] = read_model_description(str(path))
+    return description
+
+
 def _unzip(path: Path) -> str:
     key = (str(path), path.stat().st_mtime)
     if key not in _extracted:
@@ -141,10 +166,11 @@ class FMUInstance:
     def __init__(self, model: str, parameters: dict | None = None, name: str | None = None,
                  start_time: float = 0.0):
         path = Path(model) if str(model).endswith(".fmu") else fmu_path(model)
+        self.path = path
         self.name = name or path.stem
         self.time = start_time
         self.log = FMULog()
-        description = read_model_description(str(path))
+        description = model_description(path)
         self.description = description
         self.variables = {v.name: v for v in description.modelVariables}
         self.parameters = [v.name for v in description.modelVariables if v.causality == "parameter"]
@@ -171,12 +197,53 @@ class FMUInstance:
         for function in (self.raw_set_real, self.raw_get_real, self.raw_do_step):
             function.restype = ctypes.c_int
         self.component_arg = ctypes.c_void_p(self.component)
+        self.closed = False
+        try:
+            self._initialize(overrides, start_time)
+        except Exception:
+            self.close()
+            raise
+
+    def _initialize(self, overrides: dict, start_time: float):
         self._call(lambda: self._slave.setupExperiment(startTime=start_time), "fmi2SetupExperiment")
         self._call(self._slave.enterInitializationMode, "fmi2EnterInitializationMode")
-        for name, value in overrides.items():
-            self._set_any(name, value)
+        for kind in ("Real", "Integer", "Boolean"):  # one call per type, in the order given
+            names = [name for name in overrides if self.variables[name].type == kind]
+            if names:
+                self._set_many(kind, names, [overrides[name] for name in names])
         self._call(self._slave.exitInitializationMode, "fmi2ExitInitializationMode")
-        self.closed = False
+
+    def reset(self, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0):
+        """Make this instance what a new one with these arguments would be: ``fmi2Reset`` (every
+        variable back to its start value, the model's state cleared), then the set-up and
+        initialization of :class:`FMUInstance`, and an empty log. The FMUs' reset reproduces a
+        fresh instance bit for bit (``tests/test_fmu_reset.py``).
+
+        Parameters
+        ----------
+        parameters : dict, optional
+            Overrides of parameter start values, by variable name.
+        name : str, optional
+            Instance (block) name used in messages; the model name by default.
+        start_time : float
+            Start time (s).
+
+        Raises
+        ------
+        FMUError
+            The FMU refused the reset or the new parameters; the instance is then closed.
+        """
+        overrides = self._check_parameters(parameters or {})
+        self.name = name or self.path.stem
+        self.time = start_time
+        self.log.clear()
+        self.log.warnings, self.log.first_warnings = 0, []
+        try:
+            self._call(self._slave.reset, "fmi2Reset")
+            self._initialize(overrides, start_time)
+        except Exception:
+            self.close()
+            raise
 
     # ------------------------------------------------------------------ set-up helpers
     def _call(self, function, label: str):
@@ -218,11 +285,12 @@ class FMUInstance:
             checked[name] = value
         return checked
 
-    def _set_any(self, name: str, value):
-        variable = self.variables[name]
+    def _set_many(self, kind: str, names: list[str], values: list):
         setter = {"Real": self._slave.setReal, "Integer": self._slave.setInteger,
-                  "Boolean": self._slave.setBoolean}[variable.type]
-        self._call(lambda: setter([variable.valueReference], [value]), f"fmi2Set{variable.type}({name})")
+                  "Boolean": self._slave.setBoolean}[kind]
+        refs = [self.variables[name].valueReference for name in names]
+        label = f"fmi2Set{kind}({', '.join(names)})"
+        self._call(lambda: setter(refs, values), label)
 
     def vr(self, names) -> np.ndarray:
         """Value references of Real variables ``names``, as a ctypes-ready uint32 array."""

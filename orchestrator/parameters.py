@@ -41,11 +41,10 @@ def fmu_parameters(model: str) -> dict:
     dict
         Name to fmpy's variable (``type``, ``start``, ``unit``, ``description``).
     """
-    from fmpy import read_model_description
-
     from fmus import fmu_path
+    from orchestrator.fmu import model_description
 
-    description = read_model_description(str(fmu_path(model)))
+    description = model_description(fmu_path(model))
     return {v.name: v for v in description.modelVariables if v.causality == "parameter"}
 
 

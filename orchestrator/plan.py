@@ -317,7 +317,7 @@ class Plan:
                 bar.close()
             raise
         self.n = 0
-        started, cpu = time.perf_counter(), time.process_time()
+        started, cpu = time.perf_counter(), time.thread_time()
         try:
             if runner is not None:
                 runner.run(bar)
@@ -341,7 +341,7 @@ class Plan:
             raise RunInterrupted(message, self.result(error=message), number) from None
         finally:
             self.loop_seconds = time.perf_counter() - started
-            self.loop_cpu_seconds = time.process_time() - cpu
+            self.loop_cpu_seconds = time.thread_time() - cpu
             if bar is not None:
                 bar.close()
 

@@ -34,6 +34,9 @@ def _build(args) -> int:
 
         for library in build_references():
             print(f"built {library}")
+        from scenarios.compiled import compile_all
+
+        print(f"compiled the numba steps in {compile_all():.1f} s")
     except (BuildError, RunnerBuildError) as error:
         print(error, file=sys.stderr)
         return 1
@@ -288,6 +291,10 @@ def main(argv=None) -> int:
             warnings.simplefilter("default")
             warnings.showwarning = _show_warning
             args = parser().parse_args(argv)
+            if args.command in ("run", "sweep", "bench", "build"):
+                from scenarios.compiled import announce_compiles
+
+                announce_compiles()
             return args.func(args)
     except KeyboardInterrupt as interrupt:  # before or after a run: nothing half-written is left
         print("quadcosim: interrupted", file=sys.stderr)

@@ -298,6 +298,8 @@ def run_title(result, o: dict) -> str:
 
 def _calibration_figure(result, o, truth, windows, out, title):
     """a, b and the turn rate against time, with their truth."""
+    if out is None:  # nothing would keep it
+        return None
     import matplotlib.pyplot as plt
 
     t, a, b, truth_r = result.time, truth["a"], truth["b"], truth["r"]
@@ -331,6 +333,8 @@ def _calibration_figure(result, o, truth, windows, out, title):
 
 def _innovations_figure(result, o, windows, out, title):
     """The Kalman filter's innovations with their gates: GPS, paired IR, present IR."""
+    if out is None:  # nothing would keep it
+        return None
     import matplotlib.pyplot as plt
 
     t = result.time
@@ -364,6 +368,8 @@ def _innovations_figure(result, o, windows, out, title):
 
 def _errors_figure(t, truth, estimates, stats, out, title):
     """Histograms of the turn-rate error of each method."""
+    if out is None:  # nothing would keep it
+        return None
     import matplotlib.pyplot as plt
 
     valid = t >= 2.0

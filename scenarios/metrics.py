@@ -7,6 +7,7 @@ An option's unit is the first parenthesised unit of its help text (``"simulated 
 
 from __future__ import annotations
 
+import functools
 import re
 
 #: Name endings and the unit they stand for, longest first.
@@ -78,8 +79,14 @@ def metric_units(metrics: dict, declared: dict | None = None) -> dict[str, str]:
 def recorded_outputs(system, left_out=()) -> list[str]:
     """Every output of ``system`` but the tie-offs of ``System.set_input`` and ``left_out``
     (names or vector names such as ``"Quadrotor.R"``)."""
+    names = tuple(f"{b.name}.{y}" for b in system.blocks.values() if not getattr(b, "ties", None) for y in b.outputs)
+    return list(_kept(names, tuple(left_out)))
+
+
+@functools.lru_cache(maxsize=64)
+def _kept(names: tuple[str, ...], left_out: tuple[str, ...]) -> tuple[str, ...]:
+    """``names`` but the members of ``left_out``; the same systems come back run after run."""
     from orchestrator.result import expand
 
-    names = [f"{b.name}.{y}" for b in system.blocks.values() if not getattr(b, "ties", None) for y in b.outputs]
     dropped = {member for name in left_out for member in expand(name, names)}
-    return [n for n in names if n not in dropped]
+    return tuple(n for n in names if n not in dropped)

@@ -93,6 +93,24 @@ def report(result, o, out) -> dict:
         ``hover_current_A`` (motor 1 at 0.7 s), ``us_per_step`` and ``real_time_factor`` of the
         loop, and the figures written.
     """
+    loop = result.meta.get("loop_seconds")
+    return {
+        "final_position_m": result["Quadrotor.p"][-1].tolist(),
+        "max_abs_attitude_deg": np.degrees(np.abs(np.column_stack(
+            [result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])).max(axis=0)).tolist(),
+        "hover_current_A": float(result["MotorMagnetics.i1"][np.searchsorted(result.time, min(0.7, o["duration"]))]
+                                 if result.time[-1] >= 0.7 else np.nan),
+        "us_per_step": None if loop is None else loop / (len(result) - 1) * 1e6,
+        "real_time_factor": None if loop is None else o["duration"] / loop,
+        "figures": _figures(result, o, out),
+        "units": {"us_per_step": "us", "real_time_factor": "1"},
+    }
+
+
+def _figures(result, o, out) -> list[str]:
+    """``open_loop.png`` and ``imu.png`` in ``out``; none, and nothing drawn, without a folder."""
+    if out is None:
+        return []
     import matplotlib.pyplot as plt
 
     faults = faults_of(result)
@@ -133,18 +151,7 @@ def report(result, o, out) -> dict:
     result.plot("IMU.magneto", ax=axes[2], scale=1e6, unit="µT")
     axes[2].set_ylabel("magnetometer (µT)")
     figures.append(finish(fig, axes, "imu.png"))
-    loop = result.meta.get("loop_seconds")
-    return {
-        "final_position_m": result["Quadrotor.p"][-1].tolist(),
-        "max_abs_attitude_deg": np.degrees(np.abs(np.column_stack(
-            [result[f"Quadrotor.theta{i}"] for i in (1, 2, 3)])).max(axis=0)).tolist(),
-        "hover_current_A": float(result["MotorMagnetics.i1"][np.searchsorted(result.time, min(0.7, o["duration"]))]
-                                 if result.time[-1] >= 0.7 else np.nan),
-        "us_per_step": None if loop is None else loop / (len(result) - 1) * 1e6,
-        "real_time_factor": None if loop is None else o["duration"] / loop,
-        "figures": [f for f in figures if f],
-        "units": {"us_per_step": "us", "real_time_factor": "1"},
-    }
+    return [f for f in figures if f]
 
 
 SCENARIO = Scenario("open-loop", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,

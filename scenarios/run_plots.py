@@ -140,7 +140,13 @@ def compare(runs, signal: str, out=None) -> Path:
 
 
 def plot_command(args) -> int:
-    """``quadcosim plot``: exit code 0, or 2 for a run or signal that is not there."""
+    """``quadcosim plot``: exit code 0, or 2 for a run or signal that is not there.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``run``, ``signals`` and ``out``, as :func:`add_arguments` declares them.
+    """
     import sys
 
     try:
@@ -152,7 +158,14 @@ def plot_command(args) -> int:
 
 
 def compare_command(args) -> int:
-    """``quadcosim compare``: exit code 0, or 2 for a run or signal that is not there."""
+    """``quadcosim compare``: exit code 0, or 2 for a run or signal that is not there.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``items`` (the runs, then the signal unless ``signal`` is given), ``signal`` and ``out``,
+        as :func:`add_arguments` declares them.
+    """
     import sys
 
     runs, signal = (args.items, args.signal) if args.signal else (args.items[:-1], args.items[-1])

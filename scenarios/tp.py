@@ -248,7 +248,7 @@ def report(result, o, out) -> dict:
     """
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
     metrics = {"settle_s": settle, **_error_statistics(result, settle), **steady_errors(result),
-               "bias_error_final": None, "figures": _figures(result, o, out),
+               "bias_error_final": None, "figures": _figures(result, o, out) + _tilt_figures(result, o, out),
                "units": {"bias_error_final": "rad/s", "real_time_factor": "1"}}
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
         metrics["bias_error_final"] = [
@@ -411,7 +411,10 @@ ANGLE_SPAN_DEG, ERROR_SPAN_DEG, BIAS_SPAN = 1.0, 0.05, 2e-3
 
 def _figures(result, o, out) -> list[str]:
     """Roll and pitch, yaw, and (when estimated) the gyro bias: truth and estimate, then the
-    estimate's error, fault windows shaded; the files written."""
+    estimate's error, fault windows shaded; the files written (none, and nothing drawn, without
+    a folder ``out``)."""
+    if out is None:
+        return []
     import matplotlib.pyplot as plt
 
     t = result.time
@@ -456,11 +459,6 @@ def _figures(result, o, out) -> list[str]:
     axes[1].set_ylabel("estimate - truth (deg)")
     figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "yaw.png"))
 
-    if o["flight"] == "tilt":  # the tilt finding: what the accelerometer reads, and the speed
-        from scenarios.tilt_figure import tilt_figure
-
-        figures.append(save_figure(tilt_figure(result, o, title), out, "tilt.png"))
-
     # the bias figure only for an estimator that estimates one (the linear filter does not)
     if any(np.any(result[f"Quaternion_estim.b_est_{axis}"]) for axis in "xyz"):
         fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
@@ -474,6 +472,16 @@ def _figures(result, o, out) -> list[str]:
         axes[1].set_ylabel("estimate - truth (rad/s)")
         figures.append(finish(fig, axes, (BIAS_SPAN, BIAS_SPAN), "bias.png"))
     return [f for f in figures if f]
+
+
+def _tilt_figures(result, o, out) -> list[str]:
+    """The tilt finding's figure for ``flight=tilt`` (what the accelerometer reads, the speed)."""
+    if o["flight"] != "tilt":
+        return []
+    from scenarios.tilt_figure import tilt_figure
+
+    written = save_figure(tilt_figure(result, o, figure_title(result, o)), out, "tilt.png")
+    return [written] if written else []
 
 
 def bias_convergence_time(t, error, tolerance) -> float | None:

@@ -28,6 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from raw_fmu import RawFMU  # noqa: E402
 
 CALLS_PER_SESSION = 40
+ERROR = 3  # fmi2Error
 EXTREMES = [0.0, -0.0, 1e-300, -1e-300, 1e-11, 1e-3, 1.0, 1e12, 1e300, -1e300,
             math.inf, -math.inf, math.nan, 2.0**31, -1.0]
 
@@ -57,7 +58,9 @@ def operations(fmu: RawFMU):
         st.tuples(st.just("set_boolean"), st.lists(st.tuples(references(n["Boolean"]), integers), max_size=2)),
         st.tuples(st.just("get_boolean"), ref_lists["Boolean"]),
         st.tuples(st.just("setup"), reals, st.one_of(st.none(), reals)),
-        st.tuples(st.sampled_from(["enter", "exit", "terminate", "reset", "status"])),
+        # now and then the master frees the instance and goes on calling it (FMI leaves that
+        # undefined; the FMUs answer every such call with fmi2Error)
+        st.tuples(st.sampled_from(["enter", "exit", "terminate", "reset", "status"] * 5 + ["free_keep"])),
     )
 
 
@@ -70,6 +73,9 @@ class Fuzzer:
         self.slowest = (0.0, "")  # CPU time (s) of the longest call, and the call
         self.slowest_wall = 0.0  # wall time (s) of the longest call: on a loaded machine, more
         self.statuses = Counter()
+        self.freed = False  # the component was freed and is still called
+        self.after_free = 0  # calls made on a freed component
+        self.double_frees = 0
         self.log = open(log_path, "w", buffering=1)  # noqa: SIM115 (lives as long as the process)
 
     def timed(self, label: str, function, *args, status_call: bool = True):
@@ -87,7 +93,17 @@ class Fuzzer:
         if status not in range(5):
             raise AssertionError(f"{label} returned {status!r}, not an FMI status")
         self.statuses[status] += 1
+        if self.freed:
+            self.after_free += 1
+            if status != ERROR:
+                raise AssertionError(f"{label} on a freed instance returned {status}, not fmi2Error")
         return result
+
+    def free_keeping_handle(self):
+        """fmi2FreeInstance, the handle kept (and used again by the calls that follow)."""
+        self.double_frees += self.freed
+        self.timed("free (handle kept)", self.fmu.f["fmi2FreeInstance"], self.fmu.component, status_call=False)
+        self.freed = True
 
     def check_outputs(self, label: str):
         """After a call that succeeded, every output the FMU delivers must be finite."""
@@ -102,6 +118,7 @@ class Fuzzer:
     def run(self, ops):
         fmu = self.fmu
         self.sessions += 1
+        self.freed = False
         self.timed("instantiate", fmu.instantiate, status_call=False)
         for op in ops:
             kind, args = op[0], op[1:]
@@ -139,6 +156,9 @@ class Fuzzer:
                 self.timed(label, fmu.call, "fmi2Reset")
             elif kind == "status":
                 self.timed(label, fmu.time, status_call=False)
+            elif kind == "free_keep":
+                self.free_keeping_handle()
+        self.double_frees += self.freed  # the session's last free frees it again
         self.timed("free", fmu.free, status_call=False)
 
 
@@ -172,6 +192,7 @@ def main(model: str, budget: int, log_path: str) -> dict:
     return {"model": model, "calls": fuzzer.calls, "sessions": fuzzer.sessions,
             "slowest_call_cpu_s": fuzzer.slowest[0], "slowest_call": fuzzer.slowest[1],
             "slowest_call_wall_s": fuzzer.slowest_wall,
+            "calls_after_free": fuzzer.after_free, "double_frees": fuzzer.double_frees,
             "statuses": {str(k): v for k, v in sorted(fuzzer.statuses.items())}}
 
 

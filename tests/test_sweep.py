@@ -181,7 +181,7 @@ def test_grid_values_and_members():
     (["k=1,2"], ["k=3"], None, "both varied (--grid) and fixed (--set)"),
     (["k=1,1"], [], None, "repeated values"),
     (["k"], [], None, "write NAME=VALUES"),
-    ([], [], "4", None),
+    ([], ["noise=on"], "4", None),
 ])
 def test_bad_grids_are_refused_before_any_run(grids, settings, seeds, message):
     if message is None:

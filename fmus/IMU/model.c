@@ -22,7 +22,6 @@
  */
 #include <math.h>
 #include <stdint.h>
-#include <stdio.h>
 
 #include "airframe.h"
 #include "noise.h"
@@ -157,9 +156,8 @@ fmi2Status model_initialize(ModelInstance *m) {
 /* Index one past the last instant of clock `rate` in [t, t + h), or -1 when too many. */
 static int64_t end_of_step(ModelInstance *m, const Clock *c, double rate, const char *name, double t, double h) {
     double last = ceil((t + h) * rate - SAMPLE_INSTANT_TOLERANCE);
-    char what[WORK_TEXT_SIZE];
-    snprintf(what, sizeof what, "samples at %s = %g Hz", name, rate);
-    if (!work_allowed(m, last - (double)c->next, h, what, "take shorter communication steps or a lower rate"))
+    if (!work_allowed(m, last - (double)c->next, h, "take shorter communication steps or a lower rate",
+                      "samples at %s = %g Hz", name, rate))
         return -1;
     return (int64_t)last;
 }

@@ -88,11 +88,12 @@ static void take_sample(ModelInstance *m, Data *d, int64_t k, double t, double p
     }
 }
 
-/* A whole number of samples in `seconds`, or -1. */
-static int samples(ModelInstance *m, double seconds) {
+/* A whole number of samples in `seconds`, or -1; a double, so that a huge duration is compared
+ * with the history before it is ever converted to an integer. */
+static double samples(ModelInstance *m, double seconds) {
     double n = seconds * R(sample_rate);
-    if (!(n >= 0.0) || fabs(n - floor(n + 0.5)) > WHOLE_SAMPLES_TOLERANCE * (1.0 + n)) return -1;
-    return (int)floor(n + 0.5);
+    if (!(n >= 0.0) || !isfinite(n) || fabs(n - floor(n + 0.5)) > WHOLE_SAMPLES_TOLERANCE * (1.0 + n)) return -1.0;
+    return floor(n + 0.5);
 }
 
 static int bank_ok(ModelInstance *m) {
@@ -124,19 +125,20 @@ fmi2Status model_initialize(ModelInstance *m) {
         log_error(m, "noise levels ir_noise and gps_heading_noise must be non-negative");
         return fmi2Error;
     }
-    d->delay = samples(m, R(gps_delay));
-    d->window = samples(m, R(gps_window));
-    if (d->delay < 0 || d->window < 1) {
+    double delay = samples(m, R(gps_delay)), window = samples(m, R(gps_window));
+    if (delay < 0.0 || window < 1.0) {
         log_error(m, "gps_delay = %g s and gps_window = %g s must be whole numbers of sample periods "
                      "(1 / sample_rate = %g s), the window at least one", R(gps_delay), R(gps_window),
                   1.0 / R(sample_rate));
         return fmi2Error;
     }
-    if (d->delay + d->window >= HISTORY) {
-        log_error(m, "gps_delay + gps_window = %g s spans more than %d samples; shorten them", 
-                  R(gps_delay) + R(gps_window), HISTORY - 1);
+    if (delay + window >= (double)HISTORY) {
+        log_error(m, "gps_delay + gps_window = %g s spans %.3g samples, more than the %d kept; shorten them",
+                  R(gps_delay) + R(gps_window), delay + window, HISTORY - 1);
         return fmi2Error;
     }
+    d->delay = (int)delay;
+    d->window = (int)window;
     if (!bank_ok(m)) return fmi2Error;
     d->psi = R(psi0);
     d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
@@ -149,12 +151,11 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     double r, tk, last = ceil((t + h) * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     int64_t end;
-    char what[WORK_TEXT_SIZE];
     /* instants in [t, t + h) become final, with phi held over the step */
     if (!bank_ok(m)) return fmi2Error;
-    snprintf(what, sizeof what, "samples at sample_rate = %g Hz", R(sample_rate));
-    if (!work_allowed(m, last - (double)d->next_sample, h, what,
-                      "take shorter communication steps or a lower sample_rate"))
+    if (!work_allowed(m, last - (double)d->next_sample, h,
+                      "take shorter communication steps or a lower sample_rate", "samples at sample_rate = %g Hz",
+                      R(sample_rate)))
         return fmi2Error;
     end = (int64_t)last;
     r = turn_rate(m);

@@ -2,6 +2,7 @@
  * No model-specific code lives here; see shell.h for what a model provides. */
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,6 +24,87 @@
 
 /* RK4 scratch: one vector per stage, sized by the model's state count. */
 #define RK4_CAPACITY (N_STATES > 0 ? N_STATES : 1)
+
+/* ---------------------------------------------------------------- live instances
+ * Instances live in slots that are never returned to the system. A handle that was freed, or
+ * never issued, therefore points either at a slot whose mark says it is not live or at none of
+ * the slots, and every call on it answers fmi2Error instead of touching freed memory (FMI 2.0
+ * leaves such calls undefined). A freed slot is reused only after SLOT_QUARANTINE later frees,
+ * so that a stale handle keeps failing for that long. Slots are taken and given back under a
+ * spin lock (instantiation is rare); the check itself reads only published memory. */
+#define SLOTS_PER_CHUNK 64
+#define SLOT_QUARANTINE 256
+#define LIVE_MARK 0x51C051D5u
+
+typedef struct Chunk {
+    ModelInstance slot[SLOTS_PER_CHUNK];
+    struct Chunk *next;
+} Chunk;
+
+static Chunk *chunks;                      /* newest first; a chunk is published whole */
+static int chunks_used;                    /* slots handed out from the newest chunk */
+static ModelInstance *freed_head, *freed_tail; /* freed slots, oldest first */
+static int freed_count;
+static char slot_lock;
+
+static void lock_slots(void) {
+    while (__atomic_test_and_set(&slot_lock, __ATOMIC_ACQUIRE)) {
+    }
+}
+
+static void unlock_slots(void) { __atomic_clear(&slot_lock, __ATOMIC_RELEASE); }
+
+static void index_checked(void);
+
+/* A zeroed slot: a quarantined one when enough have waited, else a new one; NULL when out of memory. */
+static ModelInstance *take_slot(void) {
+    ModelInstance *m = NULL;
+    lock_slots();
+    index_checked();
+    if (freed_count > SLOT_QUARANTINE) {
+        m = freed_head;
+        freed_head = m->next_free;
+        if (!freed_head) freed_tail = NULL;
+        freed_count--;
+    } else {
+        if (!chunks || chunks_used == SLOTS_PER_CHUNK) {
+            Chunk *chunk = (Chunk *)calloc(1, sizeof(Chunk));
+            if (chunk) {
+                chunk->next = chunks;
+                __atomic_store_n(&chunks, chunk, __ATOMIC_RELEASE);
+                chunks_used = 0;
+            }
+        }
+        if (chunks && chunks_used < SLOTS_PER_CHUNK) m = &chunks->slot[chunks_used++];
+    }
+    unlock_slots();
+    if (m) memset(m, 0, sizeof *m);
+    return m;
+}
+
+static void give_slot(ModelInstance *m) {
+    lock_slots();
+    m->next_free = NULL;
+    if (freed_tail) freed_tail->next_free = m;
+    else freed_head = m;
+    freed_tail = m;
+    freed_count++;
+    unlock_slots();
+}
+
+/* The instance behind handle c if it is live, else NULL. */
+static ModelInstance *live(fmi2Component c) {
+    const Chunk *chunk;
+    uintptr_t p = (uintptr_t)c;
+    for (chunk = __atomic_load_n(&chunks, __ATOMIC_ACQUIRE); chunk; chunk = chunk->next) {
+        uintptr_t base = (uintptr_t)chunk->slot;
+        if (p < base || p >= base + sizeof chunk->slot) continue;
+        if ((p - base) % sizeof(ModelInstance)) return NULL;
+        return __atomic_load_n(&((ModelInstance *)c)->live, __ATOMIC_ACQUIRE) == LIVE_MARK ? (ModelInstance *)c
+                                                                                           : NULL;
+    }
+    return NULL;
+}
 
 static void vlog(ModelInstance *m, fmi2Status status, const char *category, const char *format,
                  va_list args) {
@@ -66,20 +148,25 @@ void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, in
     for (i = 0; i < n; i++) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
 }
 
-int work_allowed(ModelInstance *m, double count, double h, const char *what, const char *fix) {
+int work_allowed(ModelInstance *m, double count, double h, const char *fix, const char *what, ...) {
+    char text[SHORT_TEXT_SIZE];
+    va_list args;
     if (count <= (double)MAX_SUBSTEPS_PER_STEP) return 1; /* false for NaN */
+    /* the description is formatted only here, on the refusal: a step that fits does no I/O */
+    va_start(args, what);
+    vsnprintf(text, sizeof text, what, args);
+    va_end(args);
     log_error(m, "fmi2DoStep: a step of %g s at t = %g would need %.3g %s, more than the %d allowed "
                  "per step; %s",
-              h, m->time, count, what, MAX_SUBSTEPS_PER_STEP, fix);
+              h, m->time, count, text, MAX_SUBSTEPS_PER_STEP, fix);
     return 0;
 }
 
 int substep_count(ModelInstance *m, double h, double max_step, const char *parameter) {
     double count = ceil(h / max_step - SUBSTEP_ROUNDING);
-    char what[SHORT_TEXT_SIZE];
     if (count < 1.0) return 1;
-    snprintf(what, sizeof what, "sub-steps of %s = %g s", parameter, max_step);
-    if (!work_allowed(m, count, h, what, "take shorter communication steps or a larger sub-step"))
+    if (!work_allowed(m, count, h, "take shorter communication steps or a larger sub-step",
+                      "sub-steps of %s = %g s", parameter, max_step))
         return 0;
     return (int)count;
 }
@@ -130,11 +217,30 @@ static int allowed(ModelInstance *m, const char *function, unsigned modes) {
 #define MASK_fmi2DoStep IN(MODE_STEPPING)
 #define ALLOWED(m, function) allowed((m), #function, MASK_##function)
 
-/* Index of the first non-finite Real variable, or -1. */
-static int first_non_finite(ModelInstance *m) {
+/* The Real variables a step can change: outputs and locals. Parameters and inputs are checked
+ * when set (fmi2SetReal refuses a non-finite value) and their start values are finite. Filled
+ * by the first fmi2Instantiate, under the slot lock, before any instance can step. */
+static int checked_index[N_REAL > 0 ? N_REAL : 1];
+static int checked_count = -1;
+
+static void index_checked(void) {
     int i;
+    if (checked_count >= 0) return;
+    checked_count = 0;
     for (i = 0; i < N_REAL; i++)
-        if (!isfinite(m->real[i])) return i;
+        if (REAL_INFO[i].causality == CAUSALITY_OUTPUT || REAL_INFO[i].causality == CAUSALITY_LOCAL)
+            checked_index[checked_count++] = i;
+}
+
+/* Index of the first non-finite output or local, or -1. x * 0 is 0 for a finite x and NaN
+ * otherwise, so the sum tells without a branch per variable; the search runs only on a NaN. */
+static int first_non_finite(ModelInstance *m) {
+    double probe = 0.0;
+    int k;
+    for (k = 0; k < checked_count; k++) probe += m->real[checked_index[k]] * 0.0;
+    if (probe == 0.0) return -1;
+    for (k = 0; k < checked_count; k++)
+        if (!isfinite(m->real[checked_index[k]])) return checked_index[k];
     return -1;
 }
 
@@ -154,12 +260,26 @@ const char *fmi2GetVersion(void) { return fmi2Version; }
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     UNUSED(nCategories);
     UNUSED(categories);
     if (!m) return fmi2Error;
     m->logging_on = loggingOn;
     return fmi2OK;
+}
+
+static void release(ModelInstance *m) {
+    free((void *)m->instance_name);
+    free(m->real);
+    free(m->integer);
+    free(m->boolean);
+    free(m->data);
+    m->instance_name = NULL;
+    m->real = NULL;
+    m->integer = NULL;
+    m->boolean = NULL;
+    m->data = NULL;
+    give_slot(m);
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
@@ -182,7 +302,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                           fmuGUID ? fmuGUID : "(null)", MODEL_GUID);
         return NULL;
     }
-    m = (ModelInstance *)calloc(1, sizeof(ModelInstance));
+    m = take_slot();
     if (!m) return NULL;
     m->instance_name = (char *)malloc(strlen(instanceName) + 1);
     if (m->instance_name) strcpy((char *)m->instance_name, instanceName);
@@ -193,28 +313,26 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     m->boolean = (fmi2Boolean *)calloc(N_BOOLEAN > 0 ? N_BOOLEAN : 1, sizeof(fmi2Boolean));
     m->data = calloc(1, MODEL_DATA_SIZE > 0 ? MODEL_DATA_SIZE : 1);
     if (!m->instance_name || !m->real || !m->integer || !m->boolean || !m->data) {
-        fmi2FreeInstance(m);
+        release(m);
         return NULL;
     }
     reset_values(m);
     m->mode = MODE_INSTANTIATED;
+    __atomic_store_n(&m->live, LIVE_MARK, __ATOMIC_RELEASE);
     return m;
 }
 
+/* A freed handle, freed again or never issued, is ignored: fmi2FreeInstance returns no status. */
 void fmi2FreeInstance(fmi2Component c) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!m) return;
-    free((void *)m->instance_name);
-    free(m->real);
-    free(m->integer);
-    free(m->boolean);
-    free(m->data);
-    free(m);
+    __atomic_store_n(&m->live, 0u, __ATOMIC_RELEASE);
+    release(m);
 }
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!ALLOWED(m, fmi2SetupExperiment)) return fmi2Error;
     if (!isfinite(startTime))
         return fail(m, "fmi2SetupExperiment", "startTime = %g is not a finite number", startTime);
@@ -228,14 +346,14 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!ALLOWED(m, fmi2EnterInitializationMode)) return fmi2Error;
     m->mode = MODE_INITIALIZATION;
     return fmi2OK;
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     fmi2Status status;
     int bad;
     if (!ALLOWED(m, fmi2ExitInitializationMode)) return fmi2Error;
@@ -257,14 +375,14 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!ALLOWED(m, fmi2Terminate)) return fmi2Error;
     m->mode = MODE_TERMINATED;
     return fmi2OK;
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!m) return fmi2Error;
     reset_values(m);
     m->mode = MODE_INSTANTIATED;
@@ -309,7 +427,7 @@ static fmi2Status refresh_outputs(ModelInstance *m, const char *function) {
 }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     size_t i;
     if (!ALLOWED(m, fmi2GetReal)) return fmi2Error;
     if (check_refs(m, "fmi2GetReal", vr, nvr, N_REAL, "Real") != fmi2OK) return fmi2Error;
@@ -321,7 +439,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     size_t i;
     if (!ALLOWED(m, fmi2GetInteger)) return fmi2Error;
     if (check_refs(m, "fmi2GetInteger", vr, nvr, N_INTEGER, "Integer") != fmi2OK) return fmi2Error;
@@ -332,7 +450,7 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     size_t i;
     if (!ALLOWED(m, fmi2GetBoolean)) return fmi2Error;
     if (check_refs(m, "fmi2GetBoolean", vr, nvr, N_BOOLEAN, "Boolean") != fmi2OK) return fmi2Error;
@@ -343,16 +461,17 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          fmi2String value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     UNUSED(vr);
     UNUSED(value);
+    if (!m) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     return fail(m, "fmi2GetString", "this model has no String variables");
 }
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     size_t i;
     if (!ALLOWED(m, fmi2SetReal)) return fmi2Error;
     if (check_refs(m, "fmi2SetReal", vr, nvr, N_REAL, "Real") != fmi2OK) return fmi2Error;
@@ -373,7 +492,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Integer value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     size_t i;
     if (!ALLOWED(m, fmi2SetInteger)) return fmi2Error;
     if (check_refs(m, "fmi2SetInteger", vr, nvr, N_INTEGER, "Integer") != fmi2OK) return fmi2Error;
@@ -387,7 +506,7 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           const fmi2Boolean value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     size_t i;
     if (!ALLOWED(m, fmi2SetBoolean)) return fmi2Error;
     if (check_refs(m, "fmi2SetBoolean", vr, nvr, N_BOOLEAN, "Boolean") != fmi2OK) return fmi2Error;
@@ -401,9 +520,10 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                          const fmi2String value[]) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     UNUSED(vr);
     UNUSED(value);
+    if (!m) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     return fail(m, "fmi2SetString", "this model has no String variables");
 }
@@ -411,33 +531,33 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 /* ---------------------------------------------------------------- unsupported capabilities */
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s) {
     UNUSED(s);
-    return fail((ModelInstance *)c, "fmi2GetFMUstate", "not supported");
+    return fail(live(c), "fmi2GetFMUstate", "not supported");
 }
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) {
     UNUSED(s);
-    return fail((ModelInstance *)c, "fmi2SetFMUstate", "not supported");
+    return fail(live(c), "fmi2SetFMUstate", "not supported");
 }
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s) {
     UNUSED(s);
-    return fail((ModelInstance *)c, "fmi2FreeFMUstate", "not supported");
+    return fail(live(c), "fmi2FreeFMUstate", "not supported");
 }
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *size) {
     UNUSED(s);
     UNUSED(size);
-    return fail((ModelInstance *)c, "fmi2SerializedFMUstateSize", "not supported");
+    return fail(live(c), "fmi2SerializedFMUstateSize", "not supported");
 }
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte bytes[], size_t size) {
     UNUSED(s);
     UNUSED(bytes);
     UNUSED(size);
-    return fail((ModelInstance *)c, "fmi2SerializeFMUstate", "not supported");
+    return fail(live(c), "fmi2SerializeFMUstate", "not supported");
 }
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
                                    fmi2FMUstate *s) {
     UNUSED(bytes);
     UNUSED(size);
     UNUSED(s);
-    return fail((ModelInstance *)c, "fmi2DeSerializeFMUstate", "not supported");
+    return fail(live(c), "fmi2DeSerializeFMUstate", "not supported");
 }
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
                                         const fmi2ValueReference z[], size_t nz,
@@ -448,7 +568,7 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
     UNUSED(nz);
     UNUSED(dv);
     UNUSED(dz);
-    return fail((ModelInstance *)c, "fmi2GetDirectionalDerivative", "not supported");
+    return fail(live(c), "fmi2GetDirectionalDerivative", "not supported");
 }
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
@@ -456,7 +576,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     UNUSED(nvr);
     UNUSED(order);
     UNUSED(value);
-    return fail((ModelInstance *)c, "fmi2SetRealInputDerivatives", "not supported");
+    return fail(live(c), "fmi2SetRealInputDerivatives", "not supported");
 }
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
@@ -464,16 +584,16 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     UNUSED(nvr);
     UNUSED(order);
     UNUSED(value);
-    return fail((ModelInstance *)c, "fmi2GetRealOutputDerivatives", "not supported");
+    return fail(live(c), "fmi2GetRealOutputDerivatives", "not supported");
 }
 fmi2Status fmi2CancelStep(fmi2Component c) {
-    return fail((ModelInstance *)c, "fmi2CancelStep", "doStep is synchronous; nothing to cancel");
+    return fail(live(c), "fmi2CancelStep", "doStep is synchronous; nothing to cancel");
 }
 
 /* ---------------------------------------------------------------- stepping */
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     double t = currentCommunicationPoint, h = communicationStepSize;
     fmi2Status status;
     int bad;
@@ -510,12 +630,13 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
     UNUSED(s);
-    if (!c || !value) return fmi2Error;
-    *value = ((ModelInstance *)c)->mode == MODE_ERROR ? fmi2Error : fmi2OK;
+    ModelInstance *m = live(c);
+    if (!m || !value) return fmi2Error;
+    *value = m->mode == MODE_ERROR ? fmi2Error : fmi2OK;
     return fmi2OK;
 }
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!m || !value) return fmi2Error;
     if (s == fmi2LastSuccessfulTime) {
         *value = m->time;
@@ -526,10 +647,10 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
     UNUSED(s);
     UNUSED(value);
-    return fail((ModelInstance *)c, "fmi2GetIntegerStatus", "not supported");
+    return fail(live(c), "fmi2GetIntegerStatus", "not supported");
 }
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    ModelInstance *m = (ModelInstance *)c;
+    ModelInstance *m = live(c);
     if (!m || !value) return fmi2Error;
     if (s == fmi2Terminated) {
         *value = fmi2False;
@@ -540,5 +661,5 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
     UNUSED(s);
     UNUSED(value);
-    return fail((ModelInstance *)c, "fmi2GetStringStatus", "not supported");
+    return fail(live(c), "fmi2GetStringStatus", "not supported");
 }

@@ -43,6 +43,8 @@ typedef struct ModelInstance {
     int outputs_stale; /* inputs changed since the outputs were last computed */
     int step_failed;   /* set by a shell helper that refused its work in this doStep */
     void *data;        /* the model's own state, MODEL_DATA_SIZE bytes */
+    unsigned live;     /* LIVE_MARK from fmi2Instantiate to fmi2FreeInstance (shell.c) */
+    struct ModelInstance *next_free; /* the next freed slot waiting for reuse */
 } ModelInstance;
 
 /* Member k of the Real vector `name` of the variable table (VEC_name, LEN_name in variables.h),
@@ -62,13 +64,10 @@ void log_warning(ModelInstance *m, const char *format, ...);
 /* Sample clocks of the sensor models: t * rate within this many sample periods of an integer k
  * is the instant k (it absorbs the rounding of t * rate, far below any step a caller takes). */
 #define SAMPLE_INSTANT_TOLERANCE 1e-6
-/* Size of the short description a model hands to work_allowed. */
-#define WORK_TEXT_SIZE 64
-
 /* Whether `count` sub-steps or samples (a real number: it may be huge or non-finite) fit in one
- * doStep of h seconds; if not, logs why, naming `what` (e.g. "sub-steps of sub_step = 0.01 s")
- * and the `fix`, and returns 0. */
-int work_allowed(ModelInstance *m, double count, double h, const char *what, const char *fix);
+ * doStep of h seconds; if not, logs why, naming what (the printf `what` and its arguments, e.g.
+ * "sub-steps of %s = %g s") and the `fix`, and returns 0. Nothing is formatted when it fits. */
+int work_allowed(ModelInstance *m, double count, double h, const char *fix, const char *what, ...);
 /* Number of equal sub-steps of at most max_step (the model's parameter `parameter`) covering a
  * step h, at least 1; or 0, with the reason logged, beyond MAX_SUBSTEPS_PER_STEP. */
 int substep_count(ModelInstance *m, double h, double max_step, const char *parameter);

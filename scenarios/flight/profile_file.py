@@ -31,6 +31,7 @@ from orchestrator.fmu import nearest
 TIME_COLUMN = "t"
 ANGLES = ("theta_d1", "theta_d2", "theta_d3")
 DEGREE_SUFFIX = "_deg"
+RAD_PER_DEG = math.pi / 180.0  # rad per degree, for the columns given in degrees
 
 
 def is_profile_file(flight: str) -> bool:
@@ -41,7 +42,7 @@ def is_profile_file(flight: str) -> bool:
 def _columns(setpoint: tuple) -> dict:
     """Accepted column name -> (setpoint index, factor to SI)."""
     columns = {name: (i, 1.0) for i, name in enumerate(setpoint)}
-    columns |= {name + DEGREE_SUFFIX: (setpoint.index(name), math.pi / 180.0) for name in ANGLES}
+    columns |= {name + DEGREE_SUFFIX: (setpoint.index(name), RAD_PER_DEG) for name in ANGLES}
     return columns
 
 

@@ -34,6 +34,10 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
                    help="also retry members that raised or gave a NaN (members are deterministic)")
     p.add_argument("--results", action="store_true", help="keep each member's results and figures (large)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    from scenarios.sweep.grid import MAX_MEMBERS
+
+    p.add_argument("--max-members", type=int, default=MAX_MEMBERS, metavar="N",
+                   help=f"refuse a plan of more members (default {MAX_MEMBERS:,}); counted before any is made")
     return p
 
 
@@ -49,11 +53,16 @@ def add_plot_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def _stored_plan(out: Path):
-    from scenarios.sweep.grid import Member, Plan
+    from scenarios.sweep.grid import Plan, stored_members
 
-    stored = json.loads((out / "sweep.json").read_text())
-    members = [Member(i, m["options"], m["label"]) for i, m in enumerate(stored["members"])]
-    return Plan(stored["scenario"], members, stored["varied"], stored["description"], stored.get("name"))
+    path = out / "sweep.json"
+    try:
+        stored = json.loads(path.read_text())
+        return Plan(stored["scenario"], stored_members(stored), stored["varied"], stored["description"],
+                    stored.get("name"))
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise ValueError(f"{path} is unreadable ({type(error).__name__}: {error}); its sweep cannot be resumed: "
+                         "run it again into another --out") from None
 
 
 def default_out(base: Path, resume: bool, label: str) -> Path:
@@ -94,7 +103,10 @@ def make_plan(args):
     out = Path(args.out) if args.out else default_out(Path("results") / f"sweep-{args.scenario}", args.resume,
                                                       f"quadcosim sweep {args.scenario}")
     args.out = str(out)
-    if args.resume and not (args.grid or args.set or args.seeds) and (out / "sweep.json").exists():
+    if args.resume and not (out / "sweep.json").exists():
+        raise ValueError(f"--resume: {out} holds no sweep (no sweep.json); run the sweep without --resume to "
+                         "start it, or give the --out of an earlier sweep")
+    if args.resume and not (args.grid or args.set or args.seeds):
         plan = _stored_plan(out)
         if args.scenario not in (plan.scenario, plan.name):
             raise ValueError(f"{out} holds a sweep of {plan.name or plan.scenario}, not {args.scenario}")
@@ -104,7 +116,7 @@ def make_plan(args):
         if args.grid or args.seeds:
             raise ValueError(f"{args.scenario} is a named sweep: its members are fixed; only --set applies")
         return sweeps[args.scenario].plan(args.set)
-    return grid.plan(args.scenario, args.grid, args.set, args.seeds)
+    return grid.plan(args.scenario, args.grid, args.set, args.seeds, max_members=args.max_members)
 
 
 def sweep(args) -> int:

@@ -38,11 +38,14 @@ from pathlib import Path
 from distributed import WorkerPlugin
 
 from scenarios.sweep import table
-from scenarios.sweep.grid import Member, Plan
+from scenarios.sweep.grid import Member, Plan, stored_members
 
 #: Keys of a scenario's metrics that are not metrics of a member.
 NOT_METRICS = ("scenario", "options", "figures", "units", "injected_faults")
 _members_run = 0  # members run by this process (reported by worker_state)
+#: Members submitted ahead per worker, and at least: enough to keep every worker busy while
+#: results come back, few enough that neither the client nor the scheduler grows with the plan.
+IN_FLIGHT_PER_WORKER, IN_FLIGHT_LEAST = 16, 32
 
 
 class SweepError(ValueError):
@@ -67,9 +70,11 @@ class Preload(WorkerPlugin):
         matplotlib.use("Agg")
         import scenarios
         from fmus import MODELS, FMUNotFoundError
+        from orchestrator import pool
         from orchestrator.fmu import FMUInstance
 
         scenarios.get(self.scenario)
+        pool.reuse(True)  # members reset the worker's FMU instances rather than make new ones
         for model in MODELS:
             try:
                 FMUInstance(model).close()
@@ -131,7 +136,9 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
     -------
     dict
         ``status`` ("ok" or "failed"), ``error``, ``traceback``, ``metrics``, ``wall_s`` (s),
-        ``cpu_s`` (s of this process's CPU time), ``worker``, ``files``.
+        ``cpu_s`` (s of CPU time of the thread that ran the member: a Dask worker's own threads
+        are not the member's), ``stepping_cpu_s`` (s of the same thread's CPU time in the
+        stepping loop alone), ``worker``, ``files``.
     """
     global _members_run
     import scenarios
@@ -142,7 +149,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
         worker = str(get_worker().name)
     except ValueError:
         worker = f"pid {os.getpid()}"
-    started, cpu = time.perf_counter(), time.process_time()
+    started, cpu = time.perf_counter(), time.thread_time()
     record = {"status": "ok", "error": None, "traceback": None, "metrics": {}, "files": {}}
     try:
         if keep_results:
@@ -153,6 +160,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
                     record["files"] = {p.name: p.read_bytes() for p in Path(folder).iterdir() if p.is_file()}
         else:
             result, metrics = scenarios.run(scenario, options)
+        record["stepping_cpu_s"] = result.meta.get("loop_cpu_seconds")
         if extra_metrics:
             metrics = metrics | _resolve(extra_metrics)(result, options)
         record["metrics"] = _plain({k: v for k, v in metrics.items() if k not in NOT_METRICS})
@@ -164,7 +172,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
                    "traceback": traceback.format_exc()}
     _members_run += 1
     record["wall_s"] = time.perf_counter() - started
-    record["cpu_s"] = time.process_time() - cpu
+    record["cpu_s"] = time.thread_time() - cpu
     record["worker"] = worker
     return record
 
@@ -236,36 +244,61 @@ def member_folder(out: Path, index: int) -> Path:
     return out / "members" / f"{index:06d}"
 
 
+def _check_stored(plan: Plan, out: Path, stored: dict, resume: bool) -> None:
+    """Refuse a folder whose stored plan is not ``plan`` (or any stored plan, without ``resume``)."""
+    count = stored.get("count", len(stored.get("members", ())))
+    if not resume:
+        finished = len(list((out / "members").glob("*/metrics.json")))
+        raise SweepError(f"{out} already holds a sweep of {stored['scenario']} ({count} members, "
+                         f"{finished} finished). Continue it with --resume, or choose another --out.")
+    if stored["scenario"] != plan.scenario or count != len(plan.members):
+        raise SweepError(f"{out} holds a sweep of {stored['scenario']} with {count} members; "
+                         f"this one is {plan.scenario} with {len(plan.members)}. Resume with the same grid, "
+                         "or choose another --out.")
+    # member by member, as JSON reads them back; one at a time, so that memory stays flat
+    for old, new in zip(stored_members(stored), plan.members, strict=True):
+        now = json.loads(json.dumps(new.options, default=float))
+        if old.options != now:
+            changed = {k: (old.options.get(k), v) for k, v in now.items() if old.options.get(k) != v}
+            raise SweepError(f"{out}: member {new.label or '?'} was run with other options "
+                             f"(stored, now: {changed}). Resume with the same grid and --set, "
+                             "or choose another --out.")
+
+
+def _finished_record(path: Path) -> dict | None:
+    """A member's ``metrics.json`` as written, or None (with a warning naming the file) when it
+    cannot be read: that member runs again."""
+    try:
+        record = json.loads(path.read_text())
+        if not isinstance(record, dict) or record.get("status") not in ("ok", "failed"):
+            raise ValueError("no status ok or failed")
+        return record
+    except (OSError, ValueError) as error:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+        print(f"quadcosim sweep: {path} is unreadable ({error}); that member runs again", file=sys.stderr)
+        return None
+
+
 def _prepare_folder(plan: Plan, out: Path, resume: bool) -> dict[int, dict]:
     """Check the sweep folder against the plan; the finished members' records when resuming."""
     stored_path = out / "sweep.json"
-    described = json.loads(json.dumps(plan.to_json(), default=float))
     if stored_path.exists():
-        stored = json.loads(stored_path.read_text())
-        if not resume:
-            finished = len(list((out / "members").glob("*/metrics.json")))
-            raise SweepError(f"{out} already holds a sweep of {stored['scenario']} ({len(stored['members'])} members, "
-                             f"{finished} finished). Continue it with --resume, or choose another --out.")
-        if stored["scenario"] != plan.scenario or len(stored["members"]) != len(plan.members):
-            raise SweepError(f"{out} holds a sweep of {stored['scenario']} with {len(stored['members'])} members; "
-                             f"this one is {plan.scenario} with {len(plan.members)}. Resume with the same grid, "
-                             "or choose another --out.")
-        for old, new in zip(stored["members"], described["members"], strict=True):
-            if old["options"] != new["options"]:
-                changed = {k: (old["options"].get(k), v) for k, v in new["options"].items()
-                           if old["options"].get(k) != v}
-                raise SweepError(f"{out}: member {new['label'] or '?'} was run with other options "
-                                 f"(stored, now: {changed}). Resume with the same grid and --set, "
-                                 "or choose another --out.")
+        try:
+            stored = json.loads(stored_path.read_text())
+        except (OSError, ValueError) as error:
+            raise SweepError(f"{stored_path} is unreadable ({error}); choose another --out") from None
+        _check_stored(plan, out, stored, resume)
+    elif resume:
+        raise SweepError(f"{out} holds no sweep to resume (no {stored_path.name}): run the sweep without "
+                         "--resume to start it, or give the --out of an earlier sweep.")
     out.mkdir(parents=True, exist_ok=True)
     (out / "members").mkdir(exist_ok=True)
-    _write_json(stored_path, described)
+    _write_json(stored_path, json.loads(json.dumps(plan.to_json(), default=float)))
     records = {}
     if resume:
-        for member in plan.members:
-            path = member_folder(out, member.index) / "metrics.json"
-            if path.exists():
-                records[member.index] = json.loads(path.read_text())
+        for path in sorted((out / "members").glob("*/metrics.json")):
+            index = int(path.parent.name) if path.parent.name.isdigit() else -1
+            if 0 <= index < len(plan.members) and (record := _finished_record(path)) is not None:
+                records[index] = record
     return records
 
 
@@ -278,6 +311,7 @@ def _save_member(out: Path, member: Member, record: dict, attempts: int, scenari
         (folder / "error.txt").write_text(record["traceback"])
     saved = {"member": member.index, "label": member.label, "status": record["status"], "error": record["error"],
              "attempts": attempts, "wall_s": record.get("wall_s"), "cpu_s": record.get("cpu_s"),
+             "stepping_cpu_s": record.get("stepping_cpu_s"),
              "worker": record.get("worker"), "scenario": scenario, "options": member.options,
              "metrics": record.get("metrics") or {}}
     # metrics.json is written last: its presence means the member finished (well or not).
@@ -383,11 +417,21 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     Returns
     -------
     Summary
+
+    Raises
+    ------
+    SweepError
+        The folder does not match the plan, or holds no sweep to resume.
+    scenarios.sweep.checks.MemberRefused
+        A member's values would fail (:func:`scenarios.sweep.checks.check`); nothing was run.
     """
     if retries < 0:
         raise SweepError(f"retries = {retries} must be zero or more")
+    from scenarios.sweep import checks
+
+    checks.check(plan)  # before the folder is written and the cluster started
     sweep = _Sweep(plan, Path(out), resume)
-    if sweep.todo:
+    if sweep.left:
         with ExitStack() as stack:
             client = _cluster(stack, workers, scheduler, retries, timeout)
             client.register_plugin(Preload(plan.scenario))
@@ -408,7 +452,7 @@ class _Sweep:
         records = _prepare_folder(plan, out, resume)
         self.finished = {i for i, r in records.items() if r["status"] == "ok"}
         self.rows = {i: table.row(r, plan.varied) for i, r in records.items()}
-        self.todo = [m for m in plan.members if m.index not in self.finished]
+        self.left = len(plan.members) - len(self.finished)
         self.started = time.perf_counter()
         self.interrupted, self.ran, self.workers, self.startup = 0, 0, 0, 0.0
         self.streamed, self.shutdown = 0.0, 0.0
@@ -427,7 +471,7 @@ class _Sweep:
 
         self.workers = len(client.scheduler_info(n_workers=-1)["workers"])
         self.startup = time.perf_counter() - self.started
-        bar = _Progress(len(self.todo), f"sweep {self.plan.name or self.plan.scenario}", progress)
+        bar = _Progress(self.left, f"sweep {self.plan.name or self.plan.scenario}", progress)
         token, by_key = uuid.uuid4().hex[:8], {}
 
         def submit(member: Member, attempt: int):
@@ -436,15 +480,25 @@ class _Sweep:
             return client.submit(run_member, self.plan.scenario, member.options, keep_results, extra_metrics,
                                  key=key, pure=False)
 
+        # Members go out in a bounded window, topped up as they finish: the client's futures and
+        # the scheduler's tasks stay as many however large the plan.
+        todo = (m for m in self.plan.members if m.index not in self.finished)
+        window = max(IN_FLIGHT_PER_WORKER * self.workers, IN_FLIGHT_LEAST)
+
+        def top_up():
+            while len(by_key) < window and (member := next(todo, None)) is not None:
+                pending.add(submit(member, 1))
+
         pending = as_completed()
         try:
-            pending.update([submit(m, 1) for m in self.todo])
+            top_up()
             for future in pending:
                 member, attempt = by_key.pop(future.key)
                 record, lost = _outcome(future)
                 if record["status"] != "ok" and attempt <= retries and (lost or retry_errors):
                     pending.add(submit(member, attempt + 1))
                     continue
+                top_up()
                 saved = _save_member(self.out, member, record, attempt, self.plan.scenario)
                 self.rows[member.index] = table.row(saved, self.plan.varied)
                 self.ran += 1

@@ -17,9 +17,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 #: Columns that come first, in this order; the options and then the metrics follow.
-LEADING = ("member", "label", "status", "error", "attempts", "wall_s", "cpu_s", "worker")
+LEADING = ("member", "label", "status", "error", "attempts", "wall_s", "cpu_s", "stepping_cpu_s", "worker")
 #: Columns that depend on the run (timing, placement), not on the member's options.
-VOLATILE = ("wall_s", "cpu_s", "worker", "attempts", "real_time_factor")
+VOLATILE = ("wall_s", "cpu_s", "stepping_cpu_s", "worker", "attempts", "real_time_factor")
 #: Lists of at most this many numbers are spread over columns ``name[0]``, ``name[1]``...
 SPREAD = 8
 

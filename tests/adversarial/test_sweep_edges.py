@@ -1,0 +1,104 @@
+"""Sweeps at their edges: a plan too large is refused by its count before any member is made,
+planning gives way to Ctrl-C, a value a member would fail on stops the sweep before its cluster
+starts, and --resume names a corrupt member file and runs that member again, or refuses a
+folder that holds no sweep."""
+
+import json
+import signal
+import subprocess
+import sys
+import time
+import tracemalloc
+
+import pytest
+
+from scenarios.sweep import command, grid, table
+
+
+def test_a_plan_over_the_limit_is_refused_by_its_count_before_any_value_is_made(capsys, tmp_path):
+    grid.plan("tp", ["k=1,2"])  # the scenario imported, so that only the refusal is timed
+    started = time.perf_counter()
+    tracemalloc.start()
+    with pytest.raises(ValueError, match=r"the plan has 100,000,000 members \(100,000,000 k\), more than the "
+                                         r"1,000,000 allowed"):
+        grid.plan("tp", ["k=0.1:1:log100000000"])
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert time.perf_counter() - started < 1.0 and peak < 2**20
+    out = tmp_path / "huge"
+    assert command.main(["tp", "--grid", "k=0.1:1:log100000000", "--out", str(out), "--quiet"]) == 2
+    assert "100,000,000 members" in capsys.readouterr().err and not out.exists()
+    assert command.main(["tp", "--grid", "k=0.1:1:log30", "--seeds", "40", "--max-members", "1000",
+                         "--out", str(out), "--quiet"]) == 2
+    assert "the plan has 1,200 members (30 k x 40 seed)" in capsys.readouterr().err
+
+
+def test_a_100000_member_plan_is_made_member_by_member_in_little_memory():
+    tracemalloc.start()
+    plan = grid.plan("tp", ["estimator=linear,explicit"], ["duration=5"], seeds="50000")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert len(plan.members) == 100_000
+    last = plan.members[-1]
+    assert (last.index, last.options["estimator"], last.options["seed"], last.options["duration"]) == \
+        (99_999, "explicit", 50_000, 5.0)
+    assert last.label == "estimator=explicit seed=50000"
+    assert plan.members[50_000].options["seed"] == 1
+    assert peak < 16 * 2**20  # the 100,000 members' options would take over 100 MB
+
+
+def test_planning_gives_way_to_ctrl_c(tmp_path):
+    process = subprocess.Popen([sys.executable, "-m", "scenarios.sweep", "tp", "--grid", "k=0.1:1:log990000",
+                                "--seeds", "1", "--out", str(tmp_path / "long"), "--quiet"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(4.0)  # imports, then making and checking 990,000 values
+    assert process.poll() is None, "planning ended before the signal: make the plan longer"
+    process.send_signal(signal.SIGINT)
+    sent = time.perf_counter()
+    _, err = process.communicate(timeout=30)
+    assert process.returncode == 130 and "interrupted" in err
+    assert time.perf_counter() - sent < 5.0
+    assert not (tmp_path / "long").exists()
+
+
+@pytest.mark.parametrize("arguments, refused", [
+    (["--grid", "IMU.gyro_noise_density=0.001,-1"], "member 1 (IMU.gyro_noise_density=-1) would fail"),
+    (["--set", "Quadrotor.m=-1"], "member 0 (the fixed options) would fail"),
+    (["--grid", "IMU.gyro_noise_dnsity=0.001,0.002"], "gyro_noise_density"),
+])
+def test_a_value_a_member_would_fail_on_stops_the_sweep_before_its_cluster(arguments, refused, capsys, tmp_path):
+    out = tmp_path / "refused"
+    started = time.perf_counter()
+    assert command.main(["tp", *arguments, "--set", "duration=0.2", "noise=on", "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert refused in err and "No member was run" in err
+    assert not out.exists()  # nothing written, and no cluster started (which alone takes seconds)
+    assert time.perf_counter() - started < 5.0
+
+
+def test_resume_names_a_corrupt_member_file_and_runs_that_member_again(capsys, tmp_path):
+    out = tmp_path / "sweep"
+    arguments = ["tp", "--grid", "k=0.05,0.1", "--set", "duration=0.2", "noise=on", "--workers", "1",
+                 "--out", str(out), "--quiet"]
+    assert command.main(arguments) == 0
+    before = table.read(out)
+    corrupt = out / "members" / "000001" / "metrics.json"
+    corrupt.write_text(corrupt.read_text()[:40])  # cut short, as by a full disk
+    untouched = (out / "members" / "000000" / "metrics.json").stat().st_mtime_ns
+    capsys.readouterr()
+    assert command.main(["tp", "--out", str(out), "--resume", "--workers", "1", "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert f"{corrupt} is unreadable" in err and "that member runs again" in err
+    assert json.loads(corrupt.read_text())["status"] == "ok"
+    assert (out / "members" / "000000" / "metrics.json").stat().st_mtime_ns == untouched
+    assert table.same(table.read(out), before)
+
+
+def test_resume_on_a_folder_without_a_plan_is_refused(capsys, tmp_path):
+    out = tmp_path / "never-run"
+    assert command.main(["tp", "--out", str(out), "--resume", "--quiet"]) == 2
+    assert "holds no sweep (no sweep.json)" in capsys.readouterr().err
+    assert not out.exists()
+    (out / "members").mkdir(parents=True)  # a folder, but no plan in it
+    assert command.main(["tp", "--grid", "k=0.05,0.1", "--out", str(out), "--resume", "--quiet"]) == 2
+    assert "holds no sweep" in capsys.readouterr().err
