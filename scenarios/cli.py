@@ -5,6 +5,8 @@
   quadcosim run SCENARIO [--set k=v k2=v2 ...] [--estimator module:Class] [--out DIR] [--fault ...]
                                            (--set IMU.gyro_noise_density=0.001: an FMU parameter)
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
+  quadcosim plot RUN SIGNAL...             signals of a finished run (its folder) against time
+  quadcosim compare RUN RUN... SIGNAL      one signal of several finished runs on one figure
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
@@ -57,9 +59,11 @@ def _list(args) -> int:
 
         print(f"{args.parameters} parameters (set one in any scenario with --set {args.parameters}.NAME=VALUE; "
               "a vector as x,y,z):")
+        from scenarios.shown import PARAMETER_DIGITS, shown
+
         for v in table(args.parameters).of("parameter"):
             unit = f" [{v.unit}]" if v.unit else ""
-            print(f"  {v.name:22s} = {v.start!r:24}{unit:14s} {v.description}")
+            print(f"  {v.name:22s} = {shown(v.start, PARAMETER_DIGITS):24}{unit:14s} {v.description}")
         aliases, switched = model_notes(args.parameters)
         for alias, name in aliases.items():
             print(f"  {alias} stands for the vector {name}")
@@ -170,8 +174,10 @@ def _run_reporting(args) -> int:
         return 1
     warnings = metrics.pop("fmu_warnings", {})
     shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario", "units", "signals_not_saved")}
+    from scenarios.shown import shown as text
+
     for key, value in shown.items():
-        print(f"  {key}: {value}")
+        print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
     return 0
@@ -203,17 +209,23 @@ def _print_warnings(warnings: dict, shown: int = 3):
 
 
 def _diagram(args) -> int:
-    import scenarios
-    from orchestrator.diagram import draw
+    from orchestrator.progress import reporting, status
 
-    try:
-        scenario = scenarios.get(args.scenario)
-        options = scenario.parse(_settings(args))
-        system = scenario.system(options)
-    except (KeyError, ValueError) as error:
-        print(error.args[0] if error.args else error, file=sys.stderr)
-        return 2
-    path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+    with reporting(True):
+        status(f"quadcosim diagram {args.scenario}: loading the packages")
+        import scenarios
+        from orchestrator.diagram import draw
+
+        try:
+            scenario = scenarios.get(args.scenario)
+            options = scenario.parse(_settings(args))
+            status(f"{args.scenario}: building the system (its FMUs loaded)")
+            system = scenario.system(options)
+        except (KeyError, ValueError) as error:
+            print(error.args[0] if error.args else error, file=sys.stderr)
+            return 2
+        status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
+        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
     print(path)
     return 0
 
@@ -237,9 +249,10 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus), the master's C runner and "
-                           "the benchmark's C references")
-    build.add_argument("--out", default=None, help="output folder (default build/fmus)")
+    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
+                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
+                           "builds what it needs on first use)")
+    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
@@ -288,6 +301,9 @@ def parser() -> argparse.ArgumentParser:
                               help="run the README's findings, write findings.json, rewrite the README's numbers "
                                    "(quadcosim findings --help)")
     findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
+    from scenarios import run_plots
+
+    run_plots.add_arguments(sub)
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
