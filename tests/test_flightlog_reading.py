@@ -50,7 +50,7 @@ def test_dataflash_rates_and_compass_location_as_logged(name):
         assert info["battery"]["current_range_A"] == pytest.approx([1.25, 25.38], abs=0.01)
 
 
-@pytest.mark.parametrize("name", [*QUAD, PX4])
+@pytest.mark.parametrize("name", [*QUAD, ERLE, PX4])
 def test_units_field_norm_is_the_local_earth_field_and_gravity_at_rest(name):
     flight = log(name)
     compass = flight.compasses[0]
@@ -62,7 +62,8 @@ def test_units_field_norm_is_the_local_earth_field_and_gravity_at_rest(name):
     imu = flight.imus[0]
     rest = np.interp(imu.time, flight.motors.time, flight.motors.throttle) < 0.15  # motors idle: on the ground
     assert rest.sum() > 20
-    assert np.linalg.norm(imu.acc[rest], axis=1).mean() == pytest.approx(GRAVITY, abs=0.15)
+    # m/s^2; the Erle-Brain's accelerometer reads 10.20 at rest (uncalibrated, 4 % high)
+    assert np.linalg.norm(imu.acc[rest], axis=1).mean() == pytest.approx(GRAVITY, abs=0.45 if name == ERLE else 0.15)
     assert np.abs(np.median(imu.gyro[rest], axis=0)).max() < 0.01  # rad/s, not deg/s
     assert imu.acc[rest, 2].mean() < -9.5  # FRD: level at rest reads -g on z
 
