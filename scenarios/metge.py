@@ -23,7 +23,6 @@ clamped, so the Earth field is constant in the sensor frame.
 from __future__ import annotations
 
 import functools
-import json
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +30,7 @@ import numpy as np
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
 from orchestrator import System, Table
+from orchestrator.files import write_json, write_text
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
@@ -358,7 +358,7 @@ def report(result, o, out) -> dict:
             "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
     if out is not None:
         for name, cal in cals.items():
-            cal.save(out / f"{name}.json")
+            write_json(out / f"{name}.json", cal.to_dict())  # atomically
     numbers = table1({"none": Calibration(4, static), **cals}, rig1, rig2, rate)
     table, dynamic_free, first = numbers["table"], numbers["dynamic_free"], rig1.runs[0]
     t_free = first.time[first.free] - first.end
@@ -478,14 +478,14 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
                 table.setdefault(flight, {}).setdefault(estimator, {})[key] = m["rms_error_deg"][2]
                 print(f"{flight:14s} {estimator:9s} {key:13s} yaw RMS {m['rms_error_deg'][2]:8.3f} deg", flush=True)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "yaw_study.json").write_text(json.dumps(table, indent=2) + "\n")
+    write_json(out / "yaw_study.json", table)
     columns = ["magnetic_off", *COMPENSATIONS]
     lines = []
     for flight, rows in table.items():
         lines += [f"### {flight}", "", "| estimator | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
         lines += [f"| {e} | " + " | ".join(f"{r[c]:.3f}" for c in columns) + " |" for e, r in rows.items()]
         lines.append("")
-    (out / "yaw_study.md").write_text("\n".join(lines))
+    write_text(out / "yaw_study.md", "\n".join(lines))
     return table
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from estimators import estimate, parse_corrections, recording
+from orchestrator.files import write_text
 
 
 def field_from_data(acc, mag, samples: int) -> dict:
@@ -168,7 +169,7 @@ def main(argv=None) -> int:
     text = json.dumps(result, indent=2, default=float)
     print(text)
     if args.json:
-        Path(args.json).write_text(text + "\n")
+        write_text(args.json, text + "\n")
     return 0
 
 
