@@ -17,7 +17,8 @@ UNLIMITED = 2 ** 60
 
 
 def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
-    """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown."""
+    """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown.
+    ``meminfo``: the file to read (``/proc/meminfo``)."""
     try:
         with open(meminfo) as lines:
             for line in lines:
@@ -30,7 +31,8 @@ def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
 
 def address_space_left(status: str = "/proc/self/status") -> int | None:
     """Bytes of address space left under ``ulimit -v`` (``RLIMIT_AS``) beyond what the process
-    maps already (``VmSize``); None without a limit."""
+    maps already (``VmSize``); None without a limit. ``status``: the file that gives ``VmSize``
+    (``/proc/self/status``)."""
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
         return None
@@ -49,7 +51,15 @@ def cgroup_left(membership: str = "/proc/self/cgroup", root: str = "/sys/fs/cgro
     """Bytes the process's control group (v2 ``memory.max``, or v1 ``memory.limit_in_bytes``)
     and each of its ancestors may still take; None without a limit. The process's own groups
     (the default paths) and their limits are read once per process, since a sweep checks every
-    member; their usage at every call. Other paths are read whole at every call."""
+    member; their usage at every call. Other paths are read whole at every call.
+
+    Parameters
+    ----------
+    membership : str
+        The process's groups, one ``id:controllers:path`` a line (``/proc/self/cgroup``).
+    root : str
+        Where the control-group hierarchies are mounted (``/sys/fs/cgroup``).
+    """
     if (membership, root) == _OWN:
         groups = _own_groups()
     else:
