@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.files import atomic_path, write_json
-from orchestrator.result import Result
+from orchestrator.result import Result, envelope, run_extremes
 
 #: Bytes of the window of rows held in memory before they go to disk.
 WINDOW_BYTES = 8 * 2 ** 20
@@ -139,3 +139,29 @@ class StreamedResult(Result):
         if len(members) == 1 and members[0] == name:
             return self._column(self._index[name])
         return np.stack([self._column(self._index[m]) for m in members], axis=1)
+
+    def windows(self):
+        """One :class:`Result` per chunk, read one at a time (see :meth:`Result.windows`)."""
+        for path in self.chunk_files:
+            block = np.load(path)
+            yield Result(block[0], self.names, block[1:].T, self.meta, self.error)
+
+    def envelope(self, of, points: int = 2000) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`orchestrator.result.envelope` of ``of(window)``, chunk by chunk: the runs
+        are those of the whole record, and a run that spans two chunks is carried over, so the
+        samples kept are those of the envelope of the whole curve."""
+        n = len(self.time)
+        if n <= 2 * points:
+            return envelope(self.time, of(self), points)
+        size = -(-n // points)
+        times, values = [], []
+        carry_t, carry_y = np.empty(0), np.empty(0)
+        for window in self.windows():
+            t, y = np.concatenate([carry_t, window.time]), np.concatenate([carry_y, of(window)])
+            full = len(y) // size * size
+            keep = run_extremes(y[:full], size)
+            keep.sort()
+            times.append(t[keep])
+            values.append(y[keep])
+            carry_t, carry_y = t[full:], y[full:]
+        return np.concatenate([*times, carry_t]), np.concatenate([*values, carry_y])
