@@ -101,8 +101,13 @@ class StreamedResult(Result):
         if meta.get("ended"):
             self.chunk_files = self.chunk_files[:meta["chunks"]]
         names = meta.pop("names")
-        time = np.concatenate([self._chunk(f)[0] for f in self.chunk_files]) if self.chunk_files else np.empty(0)
         error = meta.pop("error", None)
+        lengths = [self._chunk(path).shape[1] for path in self.chunk_files]  # from the headers alone
+        time = np.empty(sum(lengths))
+        at = 0
+        for path, length in zip(self.chunk_files, lengths, strict=True):  # one chunk mapped at a time
+            time[at:at + length] = self._chunk(path)[0]
+            at += length
         super().__init__(time, names, None, meta, error)
 
     @staticmethod
