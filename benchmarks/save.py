@@ -89,7 +89,13 @@ def stream_peak(durations=(60.0, 3600.0)) -> dict:
 
 
 def main(argv=None) -> int:
-    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked)."""
+    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (the process's by default).
+    """
     parser = argparse.ArgumentParser(prog="python -m benchmarks.save", description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=DURATION_S, help="simulated seconds (default 320)")
     parser.add_argument("--compressed", action="store_true", help="measure the compressed archive too")

@@ -16,7 +16,13 @@ UNLIMITED = 2 ** 60
 
 
 def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
-    """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown."""
+    """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown.
+
+    Parameters
+    ----------
+    meminfo : str
+        The kernel's memory table.
+    """
     try:
         with open(meminfo) as lines:
             for line in lines:
@@ -29,7 +35,13 @@ def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
 
 def address_space_left(status: str = "/proc/self/status") -> int | None:
     """Bytes of address space left under ``ulimit -v`` (``RLIMIT_AS``) beyond what the process
-    maps already (``VmSize``); None without a limit."""
+    maps already (``VmSize``); None without a limit.
+
+    Parameters
+    ----------
+    status : str
+        The process's status table (its ``VmSize``).
+    """
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
         return None
@@ -46,7 +58,16 @@ def address_space_left(status: str = "/proc/self/status") -> int | None:
 
 def cgroup_left(membership: str = "/proc/self/cgroup", root: str = "/sys/fs/cgroup") -> int | None:
     """Bytes the process's control group (v2 ``memory.max``, or v1 ``memory.limit_in_bytes``)
-    and each of its ancestors may still take; None without a limit."""
+    and each of its ancestors may still take; None without a limit.
+
+    Parameters
+    ----------
+    membership : str
+        The process's control groups (``/proc/self/cgroup``: ``0::/path`` for v2,
+        ``N:memory:/path`` for v1).
+    root : str
+        Where the control-group file systems are mounted.
+    """
     try:
         lines = Path(membership).read_text().splitlines()
     except OSError:

@@ -56,7 +56,15 @@ class StreamWriter:
         self.units: dict[str, str] = {}
 
     def start(self, names, units: dict):
-        """Create the folder and its first ``meta.json``, before the first row."""
+        """Create the folder and its first ``meta.json``, before the first row.
+
+        Parameters
+        ----------
+        names : sequence of str
+            The recorded signals, in the order of the rows' columns.
+        units : dict
+            Unit of each signal.
+        """
         self.names, self.units = list(names), dict(units)
         self.path.mkdir(parents=True, exist_ok=False)
         self._write_meta({}, None, ended=False)
@@ -74,7 +82,15 @@ class StreamWriter:
         self.samples += len(rows)
 
     def close(self, meta: dict, error: str | None = None):
-        """Write the final ``meta.json``: the run's meta data and the samples written."""
+        """Write the final ``meta.json``: the run's meta data and the samples written.
+
+        Parameters
+        ----------
+        meta : dict
+            The run's meta data (step, decimation, scenario, warnings).
+        error : str, optional
+            The message of the failure that ended the run.
+        """
         self._write_meta(meta, error, ended=True)
 
     def _write_meta(self, meta: dict, error: str | None, ended: bool):
@@ -154,7 +170,15 @@ class StreamedResult(Result):
     def envelope(self, of, points: int = 2000) -> tuple[np.ndarray, np.ndarray]:
         """:func:`orchestrator.result.envelope` of ``of(window)``, chunk by chunk: the runs
         are those of the whole record, and a run that spans two chunks is carried over, so the
-        samples kept are those of the envelope of the whole curve."""
+        samples kept are those of the envelope of the whole curve.
+
+        Parameters
+        ----------
+        of : callable
+            A window (one chunk, a :class:`Result`) to the values drawn at its samples.
+        points : int
+            Runs of samples (each keeps its minimum and maximum).
+        """
         n = len(self.time)
         if n <= 2 * points:
             return envelope(self.time, of(self), points)

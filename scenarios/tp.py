@@ -475,18 +475,21 @@ def _figures(result, o, out) -> list[str]:
 
     # the bias figure only for an estimator that estimates one (the linear filter does not)
     if any(np.any(w[f"Quaternion_estim.b_est_{axis}"]) for w in result.windows() for axis in "xyz"):
-        fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
-        for axis in "xyz":
-            line = curve(axes[0], lambda w, a=axis: w[f"Quaternion_estim.b_est_{a}"], label=f"b_{axis}, estimate")
-            curve(axes[0], lambda w, a=axis: w[f"IMU.gyro_bias_{a}"], ":", color=line.get_color(),
-                  label=f"b_{axis}, truth")
-            curve(axes[1], lambda w, a=axis: _bias_error(w, a), color=line.get_color(), label=f"b_{axis} error",
-                  lw=0.9)
-        axes[0].set_ylabel("gyro bias (rad/s)")
-        axes[1].axhline(0.0, color="k", lw=0.5)
-        axes[1].set_ylabel("estimate - truth (rad/s)")
-        figures.append(finish(fig, axes, (BIAS_SPAN, BIAS_SPAN), "bias.png"))
+        figures.append(finish(*_bias_axes(plt, curve), (BIAS_SPAN, BIAS_SPAN), "bias.png"))
     return [f for f in figures if f]
+
+
+def _bias_axes(plt, curve):
+    """The gyro bias figure's two axes drawn with ``curve``: estimate and truth, then the error."""
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
+    for axis in "xyz":
+        line = curve(axes[0], lambda w, a=axis: w[f"Quaternion_estim.b_est_{a}"], label=f"b_{axis}, estimate")
+        curve(axes[0], lambda w, a=axis: w[f"IMU.gyro_bias_{a}"], ":", color=line.get_color(), label=f"b_{axis}, truth")
+        curve(axes[1], lambda w, a=axis: _bias_error(w, a), color=line.get_color(), label=f"b_{axis} error", lw=0.9)
+    axes[0].set_ylabel("gyro bias (rad/s)")
+    axes[1].axhline(0.0, color="k", lw=0.5)
+    axes[1].set_ylabel("estimate - truth (rad/s)")
+    return fig, axes
 
 
 def bias_convergence_time(t, error, tolerance) -> float | None:
