@@ -27,11 +27,12 @@ import ctypes
 
 import numpy as np
 
-from orchestrator.blocks import Constant, Table
+from orchestrator.blocks import Block, Constant, Table
 from orchestrator.calls import _pack, runner_library
 from orchestrator.faults import apply_faults
 from orchestrator.fmu import FMUError
 from orchestrator.plan import RECORD
+from orchestrator.progress import status
 
 OP_BLOCK, OP_TABLE, OP_RECORD, OP_PYTHON = 3, 4, 5, 6
 CHUNK_DONE, PYTHON, FINISHED, NON_FINITE, FMI_FAILED, BLOCK_FAILED = range(6)
@@ -137,6 +138,9 @@ class ChunkRunner:
             self.items.append(_Item(op, owner=block, table=block if type(block) is Table else None,
                                     keep=[rows]))
             return
+        if type(block).compiled is not Block.compiled:
+            status(f"{block.name}: loading its compiled step (numba compiles it on the first run after an "
+                   "installation or a change of its source, which can take a minute)")
         compiled = block.compiled()
         if compiled is None:
             self._python(period, entry.phase.run, block)

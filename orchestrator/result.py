@@ -603,7 +603,7 @@ class Result:
         import matplotlib.pyplot as plt
 
         if ax is None:
-            _, ax = plt.subplots(figsize=(8, 3))
+            _, ax = plt.subplots(figsize=(8, 3), layout="constrained")  # savefig keeps the axis labels
         if unit is None and scale != 1.0:
             raise ValueError(f"plot of {', '.join(names)} scaled by {scale:g}: give the unit of the scaled values "
                              "(unit=...)")

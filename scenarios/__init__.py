@@ -26,6 +26,8 @@ class Option:
     choices: tuple | None = None
     minimum: float | None = None
     classes: bool = False  # beside the choices, a block class of the user's, "module:Class"
+    files: str | None = None  # beside the choices, a file of this suffix (".csv"), read by the scenario
+    applies: str | None = None  # "other=a,b": the option acts only when option `other` is a or b
 
     @property
     def unit(self) -> str | None:
@@ -73,8 +75,10 @@ class Option:
                 value = str(text)
         except ValueError:
             raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}") from None
-        if self.choices and value not in self.choices and not (self.classes and ":" in value):
+        file = self.files is not None and str(value).lower().endswith(self.files)
+        if self.choices and value not in self.choices and not (self.classes and ":" in value) and not file:
             other = " or module:Class (a block of your own)" if self.classes else ""
+            other += f" or a {self.files} file" if self.files else ""
             raise ValueError(f"option {name}={text!r} must be one of {', '.join(map(str, self.choices))}{other}")
         if self.minimum is not None and value < self.minimum:
             raise ValueError(f"option {name}={value} must be at least {self.minimum}")
@@ -95,6 +99,29 @@ class Scenario:
     def used(self, options: dict) -> dict:
         """``options`` as the run uses them: every default marker replaced by the value it stands for."""
         return self.resolve(options) if self.resolve else dict(options)
+
+    def inert(self, options: dict) -> list[str]:
+        """The options that act on nothing in a run with ``options`` (their ``applies`` condition
+        is not met: ``k`` with ``estimator=explicit``, ``seed`` with ``noise=off``).
+
+        Parameters
+        ----------
+        options : dict
+            Parsed options (:meth:`parse`).
+
+        Returns
+        -------
+        list of str
+            Option names, in declaration order.
+        """
+        inert = []
+        for key, option in self.options.items():
+            if option.applies:
+                other, _, values = option.applies.partition("=")
+                accepted = [self.options[other].parse(other, v) for v in values.split(",")]
+                if options[other] not in accepted:
+                    inert.append(key)
+        return inert
 
     def title(self, options: dict) -> str:
         """The scenario's name and its options off their defaults, as a figure title names a run.

@@ -5,12 +5,17 @@
   quadcosim run SCENARIO [--set k=v k2=v2 ...] [--estimator module:Class] [--out DIR] [--fault ...]
                                            (--set IMU.gyro_noise_density=0.001: an FMU parameter)
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
+  quadcosim plot RUN SIGNAL...             signals of a finished run (its folder) against time
+  quadcosim compare RUN RUN... SIGNAL      one signal of several finished runs on one figure
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
+  quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
+  quadcosim findings [GROUP...] [--quick] [--check]   the README's numbers, measured into findings.json
 """
 
 from __future__ import annotations
@@ -54,9 +59,11 @@ def _list(args) -> int:
 
         print(f"{args.parameters} parameters (set one in any scenario with --set {args.parameters}.NAME=VALUE; "
               "a vector as x,y,z):")
+        from scenarios.shown import PARAMETER_DIGITS, shown
+
         for v in table(args.parameters).of("parameter"):
             unit = f" [{v.unit}]" if v.unit else ""
-            print(f"  {v.name:22s} = {v.start!r:24}{unit:14s} {v.description}")
+            print(f"  {v.name:22s} = {shown(v.start, PARAMETER_DIGITS):24}{unit:14s} {v.description}")
         aliases, switched = model_notes(args.parameters)
         for alias, name in aliases.items():
             print(f"  {alias} stands for the vector {name}")
@@ -167,8 +174,10 @@ def _run_reporting(args) -> int:
         return 1
     warnings = metrics.pop("fmu_warnings", {})
     shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario", "units", "signals_not_saved")}
+    from scenarios.shown import shown as text
+
     for key, value in shown.items():
-        print(f"  {key}: {value}")
+        print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
     return 0
@@ -200,17 +209,23 @@ def _print_warnings(warnings: dict, shown: int = 3):
 
 
 def _diagram(args) -> int:
-    import scenarios
-    from orchestrator.diagram import draw
+    from orchestrator.progress import reporting, status
 
-    try:
-        scenario = scenarios.get(args.scenario)
-        options = scenario.parse(_settings(args))
-        system = scenario.system(options)
-    except (KeyError, ValueError) as error:
-        print(error.args[0] if error.args else error, file=sys.stderr)
-        return 2
-    path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+    with reporting(True):
+        status(f"quadcosim diagram {args.scenario}: loading the packages")
+        import scenarios
+        from orchestrator.diagram import draw
+
+        try:
+            scenario = scenarios.get(args.scenario)
+            options = scenario.parse(_settings(args))
+            status(f"{args.scenario}: building the system (its FMUs loaded)")
+            system = scenario.system(options)
+        except (KeyError, ValueError) as error:
+            print(error.args[0] if error.args else error, file=sys.stderr)
+            return 2
+        status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
+        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
     print(path)
     return 0
 
@@ -234,9 +249,10 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus), the master's C runner and "
-                           "the benchmark's C references")
-    build.add_argument("--out", default=None, help="output folder (default build/fmus)")
+    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
+                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
+                           "builds what it needs on first use)")
+    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
@@ -281,13 +297,31 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
+    findings = sub.add_parser("findings", add_help=False,
+                              help="run the README's findings, write findings.json, rewrite the README's numbers "
+                                   "(quadcosim findings --help)")
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
+    from scenarios import run_plots
+
+    run_plots.add_arguments(sub)
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
         .set_defaults(func=sweep.sweep)
     sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
         .set_defaults(func=sweep.sweep_plot)
+    _add_flight_logs(sub)
     return p
+
+
+def _add_flight_logs(sub):
+    """The ``log`` and ``calibrate`` verbs (:mod:`scenarios.flightlog`) on the sub-parsers ``sub``."""
+    from scenarios.flightlog import calibrate
+    from scenarios.flightlog import command as flightlog
+
+    flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
+    calibrate.add_arguments(sub.add_parser("calibrate", help="calibrate a magnetometer and its motor interference "
+                                           "from real flights; ArduPilot and PX4 parameters"))
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
@@ -302,8 +336,14 @@ def main(argv=None) -> int:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")
             warnings.showwarning = _show_warning
+            final = argv is None  # the process's own command line, not a call from Python
+            argv = sys.argv[1:] if argv is None else list(argv)
+            if argv[:1] == ["findings"]:  # its own parser: its options, --help included, are its own
+                from scenarios.findings.__main__ import main as findings
+
+                return findings(argv[1:])
             args = parser().parse_args(argv)
-            args.final = argv is None  # the process's own command line, not a call from Python
+            args.final = final
             if args.command in ("run", "sweep", "bench", "build"):
                 from scenarios.compiled import announce_compiles
 
