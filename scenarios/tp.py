@@ -18,7 +18,16 @@ from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
-from scenarios.figures import angle_curve, fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
+from scenarios.figures import (
+    angle_curve,
+    fault_text,
+    faults_of,
+    floor_span,
+    label_axes,
+    shade_faults,
+    title_lines,
+    wrapped_curve,
+)
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.flight.controller import SETPOINT_UNITS
 from scenarios.flight.profile_file import FileProfile, is_profile_file
@@ -524,8 +533,8 @@ def _figures(result, o, out) -> list[str]:
     figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "roll_pitch.png"))
 
     fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
-    axes[0].plot(*angle_curve(t, np.degrees(result["Quadrotor.theta3"])), label="yaw, truth")
-    axes[0].plot(*angle_curve(t, np.degrees(result["Quaternion_estim.theta_est3"])), "--", label="yaw, estimate")
+    axes[0].plot(*_angle_curve(result, "Quadrotor.theta3"), label="yaw, truth")
+    axes[0].plot(*_angle_curve(result, "Quaternion_estim.theta_est3"), "--", label="yaw, estimate")
     axes[0].set_ylabel("yaw (deg)")
     curve(axes[1], lambda w: _error(w, "Quaternion_estim.theta_est", 2), scale=180 / np.pi, label="yaw error",
           lw=0.9)
@@ -537,6 +546,28 @@ def _figures(result, o, out) -> list[str]:
     if any(np.any(w[f"Quaternion_estim.b_est_{axis}"]) for w in result.windows() for axis in "xyz"):
         figures.append(finish(*_bias_axes(plt, curve), (BIAS_SPAN, BIAS_SPAN), "bias.png"))
     return [f for f in figures if f]
+
+
+def _angle_curve(result, name: str):
+    """:func:`scenarios.figures.angle_curve` of signal ``name`` (rad); a streamed record is
+    unwrapped window by window, each window continuing from the last sample of the one before."""
+    windows = result.windows()
+    first = next(windows)
+    if next(windows, None) is None:  # a record in memory: one window
+        return angle_curve(result.time, np.degrees(result[name]))
+    carried = {}  # the last raw sample and the offset unwrapping added to it
+
+    def unwrapped(window):
+        raw = window[name]
+        if not carried:
+            turned = np.unwrap(raw)
+        else:
+            turned = np.unwrap(np.concatenate([[carried["raw"]], raw]))[1:] + carried["offset"]
+        carried["raw"], carried["offset"] = raw[-1], turned[-1] - raw[-1]
+        return np.degrees(turned)
+
+    del first
+    return wrapped_curve(*result.envelope(unwrapped))
 
 
 def _bias_axes(plt, curve):

@@ -81,3 +81,10 @@ def test_the_report_of_a_streamed_record_taken_chunk_by_chunk_equals_the_whole_r
         expected = envelope(kept.time, kept[name], points=700)
         assert np.array_equal(drawn[0], expected[0]) and np.array_equal(drawn[1], expected[1])
     assert by_chunk["figures"] == whole["figures"] == ["roll_pitch.png", "yaw.png", "bias.png"]
+    from scenarios.figures import angle_curve
+    from scenarios.tp import _angle_curve
+
+    drawn = _angle_curve(streamed, "Quadrotor.theta3")
+    expected = angle_curve(kept.time, np.degrees(kept["Quadrotor.theta3"]))
+    assert np.array_equal(drawn[0], expected[0], equal_nan=True)
+    assert np.allclose(drawn[1], expected[1], rtol=0, atol=1e-12, equal_nan=True)
