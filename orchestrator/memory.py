@@ -18,7 +18,12 @@ UNLIMITED = 2 ** 60
 
 def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
     """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown.
-    ``meminfo``: the file to read (``/proc/meminfo``)."""
+
+    Parameters
+    ----------
+    meminfo : str
+        The kernel's memory table.
+    """
     try:
         with open(meminfo) as lines:
             for line in lines:
@@ -31,8 +36,13 @@ def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
 
 def address_space_left(status: str = "/proc/self/status") -> int | None:
     """Bytes of address space left under ``ulimit -v`` (``RLIMIT_AS``) beyond what the process
-    maps already (``VmSize``); None without a limit. ``status``: the file that gives ``VmSize``
-    (``/proc/self/status``)."""
+    maps already (``VmSize``); None without a limit.
+
+    Parameters
+    ----------
+    status : str
+        The process's status table (its ``VmSize``).
+    """
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
         return None

@@ -244,20 +244,8 @@ def _bench(args) -> int:
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
 
 
-def parser() -> argparse.ArgumentParser:
-    """The ``quadcosim`` argument parser, one sub-command per action."""
-    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
-                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
-                           "builds what it needs on first use)")
-    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
-    build.set_defaults(func=_build)
-    listing = sub.add_parser("list", help="the scenarios and their options")
-    listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
-    listing.set_defaults(func=_list)
-    run = sub.add_parser("run", help="run a scenario")
+def _add_run_arguments(run: argparse.ArgumentParser):
+    """The options of ``quadcosim run``."""
     run.add_argument("scenario")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
                      help="scenario options, several after one flag (estimator=explicit k1=0.2), or block "
@@ -285,6 +273,23 @@ def parser() -> argparse.ArgumentParser:
     run.add_argument("--stream", action="store_true",
                      help="write the record to OUT/results.stream/ in chunks as the run goes: memory stays flat "
                           "however long the run (read it with Result.load(OUT))")
+
+
+def parser() -> argparse.ArgumentParser:
+    """The ``quadcosim`` argument parser, one sub-command per action."""
+    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
+                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
+                           "builds what it needs on first use)")
+    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
+    build.set_defaults(func=_build)
+    listing = sub.add_parser("list", help="the scenarios and their options")
+    listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
+    listing.set_defaults(func=_list)
+    run = sub.add_parser("run", help="run a scenario")
+    _add_run_arguments(run)
     run.set_defaults(func=_run)
     diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
     diagram.add_argument("scenario")
