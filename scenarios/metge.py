@@ -23,7 +23,6 @@ clamped, so the Earth field is constant in the sensor frame.
 from __future__ import annotations
 
 import functools
-import json
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +30,9 @@ import numpy as np
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
 from orchestrator import System, Table
+from orchestrator.files import write_json, write_text
 from orchestrator.parameters import apply
+from orchestrator.progress import status
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
@@ -262,7 +263,7 @@ def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Cal
     """
     model = fit_dynamic(rig.reference, rig.sweeps(), orders)
     dynamics = fit_motor_dynamics([r.record() for r in rig.runs], [r.reference for r in rig.runs], model.v,
-                                  sample_rate)
+                                  sample_rate, progress=status)
     return Calibration(4, static, model, dynamics, rig.reference, {"made_by": f"quadcosim run metge ({name})"})
 
 
@@ -287,6 +288,7 @@ def record_sets(result, o: dict, out) -> dict[int, list[RigRun]]:
     runs = {1: [RigRun(result, o, 1)], 2: []}
     for set_number in (1, 2):
         for run in range(len(runs[set_number]), len(socs(o, set_number))):
+            status(f"metge: rig run {run + 1} of set {set_number} ({commands(o, set_number)[2]:.0f} s simulated)")
             recorded = system_for(o, set_number, run).run(commands(o, set_number)[2], record=RECORD)
             if out is not None:
                 recorded.save(out / f"set{set_number}_run{run}")
@@ -368,24 +370,28 @@ def figure3(first: RigRun, numbers: dict, o: dict, out):
     return save_figure(fig, out, "figure3_free_set.png")
 
 
-def table1_figure(numbers: dict, orders, o: dict, out):
-    """Table 1 as a figure, each cell beside the paper's value; ``numbers`` as :func:`table1`
-    returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's options (named in the
-    title), ``out`` the folder of the figure (None: no file)."""
-    import matplotlib.pyplot as plt
+def table1_text(numbers: dict, orders, o: dict, out):
+    """Table 1 as a Markdown table (``table1.md``), each cell beside the paper's value;
+    ``numbers`` as :func:`table1` returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's
+    options (named in the heading), ``out`` the folder of the file (None: no file). Returns the
+    file name written, or None."""
+    if out is None:
+        return None
+    from orchestrator.files import atomic_path
 
     table, dynamic = numbers["table"], numbers["dynamic_free"]
-    fig, ax = plt.subplots(figsize=(9, 2.6))
-    ax.axis("off")
-    cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")]
-             for r in ("none", "calibration1", "calibration2")]
-    cells.append(["", "", f"{dynamic['calibration1']:.3f} / {dynamic['calibration2']:.3f}"])
-    ax.table(cellText=cells, rowLabels=["no dynamic calibration", "calibration 1", "calibration 2",
-                                        "motor dynamics (cal. 1 / 2)"],
-             colLabels=["set 1", "set 2", "free set"], loc="center")
-    fig.suptitle(title_lines(f"metge: mean angular error (deg), simulated (paper's value), Table 1 of {PAPER}",
-                             f"orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}", width=100), fontsize=9)
-    return save_figure(fig, out, "table1.png")
+    names = {"none": "no dynamic calibration", "calibration1": "calibration 1", "calibration2": "calibration 2"}
+    lines = [f"Mean angular error (deg) of the measured field, simulated (the paper's value), Table 1 of {PAPER}.",
+             f"Orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}.", "",
+             "| | set 1 | set 2 | free set |", "|---|---|---|---|"]
+    for row, name in names.items():
+        cells = [f"{table[row][c]:.3f} ({PAPER_TABLE1[row][c]:.3f})" for c in ("set1", "set2", "free")]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    lines.append(f"| motor dynamics (cal. 1 / 2) | | | {dynamic['calibration1']:.3f} / "
+                 f"{dynamic['calibration2']:.3f} |")
+    with atomic_path(out / "table1.md") as temporary:
+        Path(temporary).write_text("\n".join(lines) + "\n")
+    return "table1.md"
 
 
 def fast_third(run: RigRun, o: dict) -> np.ndarray:
@@ -416,13 +422,16 @@ def report(result, o, out) -> dict:
     static = load_static(o)
     runs = record_sets(result, o, out)
     rig1, rig2 = RigSet(runs[1]), RigSet(runs[2])
+    status("metge: cross-validating the orders (I, J) between the sets")
     study = order_study([(rig1.reference, rig1.sweeps()), (rig2.reference, rig2.sweeps())])
     orders = orders or study["best"]
+    status("metge: calibrating on each set (eqs. 5 to 8, then the motors' dynamics)")
     cals = {"calibration1": calibrate(rig1, orders, static, rate, "set 1"),
             "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
     if out is not None:
         for name, cal in cals.items():
-            cal.save(out / f"{name}.json")
+            write_json(out / f"{name}.json", cal.to_dict())  # atomically
+    status("metge: Table 1 (every run compensated by each calibration)")
     numbers = table1({"none": Calibration(4, static), **cals}, rig1, rig2, rate)
     table, dynamic_free, first = numbers["table"], numbers["dynamic_free"], rig1.runs[0]
     fast = fast_third(first, o)
@@ -430,7 +439,7 @@ def report(result, o, out) -> dict:
     ed_free = numbers["series"]["calibration1_dynamic"][first.free]
     true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
     true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
-    figures = [figure3(first, numbers, o, out), table1_figure(numbers, orders, o, out)]
+    figures = [figure3(first, numbers, o, out), table1_text(numbers, orders, o, out)]
     return {
         "table1_deg": table,
         "free_set_dynamic_deg": dynamic_free["calibration1"],
@@ -501,10 +510,13 @@ def rig_calibration(orders: str = "4,1", levels: int = 8, settings: tuple = ()) 
         Block parameters of the vehicle (:func:`vehicle_settings`), set on every rig run.
     """
     o = SCENARIO.parse({"orders": orders, "levels": levels} | dict(settings))
-    runs = []
-    for run in range(len(socs(o, 1))):
+    runs, count = [], len(socs(o, 1))
+    for run in range(count):
+        status(f"calibrating the motor-current field on the clamped rig: run {run + 1} of {count} "
+               f"({commands(o, 1)[2]:.0f} s simulated)")
         recorded = system_for(o, 1, run).run(commands(o, 1)[2], record=RECORD)
         runs.append(RigRun(recorded, o, 1))
+    status("identifying the field model (eqs. 5 to 8) and the motors' dynamics")
     return calibrate(RigSet(runs), parse_orders(orders), None, o["mag_rate"], "set 1, made for tp")
 
 
@@ -573,14 +585,14 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
                 table.setdefault(flight, {}).setdefault(estimator, {})[key] = m["rms_error_deg"][2]
                 print(f"{flight:14s} {estimator:9s} {key:13s} yaw RMS {m['rms_error_deg'][2]:8.3f} deg", flush=True)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "yaw_study.json").write_text(json.dumps(table, indent=2) + "\n")
+    write_json(out / "yaw_study.json", table)
     columns = ["magnetic_off", *COMPENSATIONS]
     lines = []
     for flight, rows in table.items():
         lines += [f"### {flight}", "", "| estimator | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
         lines += [f"| {e} | " + " | ".join(f"{r[c]:.3f}" for c in columns) + " |" for e, r in rows.items()]
         lines.append("")
-    (out / "yaw_study.md").write_text("\n".join(lines))
+    write_text(out / "yaw_study.md", "\n".join(lines))
     return table
 
 

@@ -29,7 +29,7 @@ def test_metge_table1_and_the_motor_dynamics(tmp_path):
     assert np.max(m["direction_error_deg"]["calibration1"]) < 1.0
     assert m["free_eq9_slow_fast_deg"]["fast"] > 2 * m["free_eq9_slow_fast_deg"]["slow"]
     assert m["free_set_dynamic_deg"] < table["calibration1"]["free"] / 2
-    assert {"calibration1.json", "calibration2.json", "figure3_free_set.png", "table1.png"} <= {
+    assert {"calibration1.json", "calibration2.json", "figure3_free_set.png", "table1.md"} <= {
         p.name for p in tmp_path.iterdir()}
 
 

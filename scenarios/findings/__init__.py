@@ -35,6 +35,8 @@ GROUPS = (
     "infrared",
     "gain_study",
     "gain_ablation",
+    "flightlogs",
+    "real_recordings",
 )
 
 ROOT = Path(__file__).resolve().parents[2]
