@@ -244,8 +244,50 @@ def _bench(args) -> int:
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
 
 
-def _add_run_arguments(run: argparse.ArgumentParser):
-    """The options of ``quadcosim run``."""
+def parser() -> argparse.ArgumentParser:
+    """The ``quadcosim`` argument parser, one sub-command per action."""
+    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
+                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
+                           "builds what it needs on first use)")
+    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
+    build.set_defaults(func=_build)
+    listing = sub.add_parser("list", help="the scenarios and their options")
+    listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
+    listing.set_defaults(func=_list)
+    _add_run(sub)
+    diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
+    diagram.add_argument("scenario")
+    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
+    diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
+    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
+    diagram.set_defaults(func=_diagram)
+    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))
+    bench.add_argument("--json", action="store_true")
+    bench.add_argument("--seconds", type=float, default=5.0)
+    bench.set_defaults(func=_bench)
+    sub.add_parser("findings", add_help=False,  # main() hands its arguments to scenarios.findings
+                   help="run the README's findings, write findings.json, rewrite the README's numbers "
+                        "(quadcosim findings --help)")
+    from scenarios import run_plots
+
+    run_plots.add_arguments(sub)
+    from scenarios.sweep import command as sweep
+
+    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
+        .set_defaults(func=sweep.sweep)
+    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
+        .set_defaults(func=sweep.sweep_plot)
+    _add_flight_logs(sub)
+    return p
+
+
+def _add_run(sub):
+    """The ``run`` sub-command's options."""
+    run = sub.add_parser("run", help="run a scenario")
     run.add_argument("scenario")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
                      help="scenario options, several after one flag (estimator=explicit k1=0.2), or block "
@@ -273,50 +315,7 @@ def _add_run_arguments(run: argparse.ArgumentParser):
     run.add_argument("--stream", action="store_true",
                      help="write the record to OUT/results.stream/ in chunks as the run goes: memory stays flat "
                           "however long the run (read it with Result.load(OUT))")
-
-
-def parser() -> argparse.ArgumentParser:
-    """The ``quadcosim`` argument parser, one sub-command per action."""
-    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
-                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
-                           "builds what it needs on first use)")
-    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
-    build.set_defaults(func=_build)
-    listing = sub.add_parser("list", help="the scenarios and their options")
-    listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
-    listing.set_defaults(func=_list)
-    run = sub.add_parser("run", help="run a scenario")
-    _add_run_arguments(run)
     run.set_defaults(func=_run)
-    diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
-    diagram.add_argument("scenario")
-    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
-    diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
-    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
-    diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))
-    bench.add_argument("--json", action="store_true")
-    bench.add_argument("--seconds", type=float, default=5.0)
-    bench.set_defaults(func=_bench)
-    findings = sub.add_parser("findings", add_help=False,
-                              help="run the README's findings, write findings.json, rewrite the README's numbers "
-                                   "(quadcosim findings --help)")
-    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
-    from scenarios import run_plots
-
-    run_plots.add_arguments(sub)
-    from scenarios.sweep import command as sweep
-
-    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
-        .set_defaults(func=sweep.sweep)
-    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
-        .set_defaults(func=sweep.sweep_plot)
-    _add_flight_logs(sub)
-    return p
 
 
 def _add_flight_logs(sub):
