@@ -1,21 +1,26 @@
-"""The estimators on real recordings with optical ground truth, against VQF and Madgwick.
+"""The estimators on public real recordings with optical ground truth, against VQF, Madgwick and Mahony.
 
-    python -m benchmarks.real_recordings FOLDER [--frame enu] [--json OUT]
+    python -m benchmarks.real_recordings DATA [--datasets broad,smartphones,...] [--choose]
+        [--cache DIR] [--json OUT]
 
-FOLDER holds recordings that :mod:`estimators.recording` reads (the ``.mat`` files of the
-BROAD benchmark, Laidig et al., "BROAD: a benchmark for robust inertial orientation
-estimation", Data, 2021, read as they are; ENU frame). Each is scored by the quaternion-error
-RMSE over its scored samples (BROAD: the movement phases), and the mean over the recordings
-is reported for:
-- ``explicit`` and ``passive`` (TRIAD) at their defaults (``estimators.DEFAULT_GAINS``,
-  corrections on) and at the gain set of a grid with the least mean error ("tuned", one set
-  for all recordings), with and without the disturbance-aware corrections; the tuning is
-  done on every other recording (the first, third, ...) and the means are given over all
-  recordings and over the held-out others (``held_out_mean_total_rmse_deg``), so that a
-  gain set fitted to the recordings shows itself;
-- ``vqf`` and ``madgwick`` at their packages' defaults.
-The filters start from the TRIAD attitude of the first sample; the field's dip and norm are
-taken from the first second. The data stay outside the repository.
+DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes (where each comes
+from, by title, and how it is read and aligned); the data stay outside the repository. Every
+recording is scored by the quaternion-error RMSE (total, heading, inclination; the BROAD
+benchmark's decomposition, :func:`estimators.score`) over its scored samples, after the
+alignment its dataset needs, and the mean over a dataset's recordings is reported for our
+``explicit`` and ``passive`` (TRIAD) filters at their defaults (``estimators.DEFAULT_GAINS``,
+corrections on) and for VQF, Madgwick and Mahony at their packages' defaults. Every filter
+starts from the TRIAD attitude of the first sample (VQF from its own first samples); the
+field's dip and norm are taken from the first second.
+
+``--choose`` runs the cross-validation that chose the defaults: over the grid :data:`GRID`, on
+the datasets of :data:`CHOOSING` only (never on :data:`HELD_OUT`), each gain set is scored by
+the mean over those datasets of its mean total RMSE divided by VQF's on the same dataset (so
+that each dataset counts alike, whatever its number of recordings); leaving each dataset out in
+turn, the set chosen on the others is scored on it (the cross-validated ratio), and the set
+chosen on all of them is the default.
+
+The published filters' results do not depend on our gains: ``--cache DIR`` keeps them.
 """
 
 from __future__ import annotations
@@ -27,93 +32,159 @@ from pathlib import Path
 
 import numpy as np
 
-from estimators import DEFAULT_GAINS, estimate, gain_grid, recording
+from benchmarks import datasets
+from estimators import DEFAULT_GAINS, estimate, gain_grid
 from scenarios.replay import field_from_data, references
 
-GRID = {"kP": [0.3, 0.5, 1.0, 2.0, 3.0], "kI": [0.0, 0.001, 0.003, 0.01, 0.03]}
+CHOOSING = ("broad", "smartphones", "diodem")  # the datasets the defaults were chosen on
+HELD_OUT = ("repoimu",)  # kept aside until the defaults were frozen
+PUBLISHED = ("vqf", "madgwick", "mahony")
+OURS = ("explicit", "passive")
+METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 FIELD_SECONDS = 1.0  # s, start of each recording the field references are taken from
+GRID = {
+    "explicit": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.1, 0.3, 1.0],
+                 "rest_gain": [0.03, 0.1, 0.3, 1.0]},
+    "passive": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.01, 0.03, 0.1],
+                "rest_gain": [0.03, 0.1, 0.3, 1.0]},
+}
 
 
-def _errors(kind, data, refs, gains=None, corrections=None):
-    options = {"corrections": corrections, "ry": "triad"} if kind in ("explicit", "passive") else {}
-    return estimate(kind, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], dt=1.0 / data["rate"],
-                    gains=gains, initial="triad", outputs=(), reference=data["quat"], scored=data["scored"],
-                    **options, **refs)["errors"]["total_rmse_deg"]
+def _options(kind: str, data: dict) -> dict:
+    field = field_from_data(data["acc"], data["mag"], max(1, int(FIELD_SECONDS * data["rate"])))
+    options = {"gyro": data["gyro"], "acc": data["acc"], "mag": data["mag"], "dt": 1.0 / data["rate"],
+               "initial": "triad", "outputs": (), "reference": data["quat"], "scored": data["scored"],
+               "align_heading": data["meta"]["align"], **references("enu", field["dip"], field["norm"])}
+    if kind in OURS:
+        options |= {"corrections": True, "ry": "triad"}
+    return options
 
 
-def evaluate(folder, frame: str = "enu", published: bool = True) -> dict:
-    """Total RMSE (deg) per recording and filter variant, and the tuned gain sets.
+def errors(kind: str, data: dict, gains: dict | None = None) -> dict:
+    """Total, heading and inclination RMSE (deg; (G,) arrays over the gain sets ``gains``) of the
+    filter ``kind`` on the recording ``data`` (as :mod:`benchmarks.datasets` loads it)."""
+    found = estimate(kind, gains=gains, **_options(kind, data))["errors"]
+    return {metric: np.asarray(found[metric]) for metric in METRICS}
+
+
+def _published(name: str, recordings: list, cache: Path | None) -> dict:
+    path = None if cache is None else cache / f"{name}.json"
+    if path is not None and path.exists():
+        return json.loads(path.read_text())
+    table = {}
+    for label, data in recordings:
+        table[label] = {kind: {m: float(v[0]) for m, v in errors(kind, data).items()} for kind in PUBLISHED}
+        print(name, label, {k: round(v["total_rmse_deg"], 2) for k, v in table[label].items()}, file=sys.stderr)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(table, indent=1) + "\n")
+    return table
+
+
+def evaluate(folder, names=CHOOSING + HELD_OUT, cache=None, grids: bool = False) -> dict:
+    """Per dataset, the mean total, heading and inclination RMSE (deg) of every filter at its
+    defaults; with ``grids``, also each gain set of :data:`GRID` (mean total RMSE per set).
 
     Parameters
     ----------
     folder : str or pathlib.Path
-        Folder of the recordings (``.mat``, ``.npz``, ``.csv``).
-    frame : {"enu", "ned"}
-        Navigation frame of the recordings' reference attitudes.
-    published : bool
-        Also run the published filters (VQF, Madgwick) at their packages' defaults.
+        The data folder (one sub-folder per dataset, see :mod:`benchmarks.datasets`).
+    names : sequence of str
+        Datasets to score; those absent from ``folder`` are skipped.
+    cache : str or pathlib.Path, optional
+        Folder keeping the published filters' results.
+    grids : bool
+        Also score the grid of :data:`GRID` (for :func:`choose`).
 
     Returns
     -------
     dict
-        ``recordings`` (name -> variant -> total RMSE, deg), ``mean_total_rmse_deg``,
-        ``tuned_gains`` (variant -> gain set) and the ``defaults``.
+        Dataset name -> ``{"recordings": count, "means": {filter: {metric: deg}}, "grid": {kind:
+        (G,) mean total RMSE}}``.
     """
-    paths = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in (".mat", ".npz", ".csv"))
-    if not paths:
-        raise ValueError(f"no recordings (.mat, .npz, .csv) in {folder}")
-    grid = gain_grid(**GRID)
-    rows, grids = {}, {}
-    for path in paths:
-        data = recording.load(path)
-        field = field_from_data(data["acc"], data["mag"], int(FIELD_SECONDS * data["rate"]))
-        refs = references(frame, field["dip"], field["norm"])
-        row = {}
-        for kind in ("explicit", "passive"):
-            row[f"{kind} default"] = float(_errors(kind, data, refs, corrections=True)[0])
-            for corrections in (False, True):
-                grids[(path.name, kind, corrections)] = _errors(kind, data, refs, grid, corrections)
-        if published:
-            for kind in ("vqf", "madgwick"):
-                row[kind] = float(_errors(kind, data, refs)[0])
-        rows[path.stem] = row
-        print(path.stem, {k: round(v, 2) for k, v in row.items()}, file=sys.stderr)
-    tuned = {}
-    for kind in ("explicit", "passive"):
-        for corrections in (False, True):
-            mean = np.mean([grids[(p.name, kind, corrections)] for p in paths[0::2]], axis=0)
-            best = int(np.argmin(mean))
-            label = f"{kind} tuned, corrections {'on' if corrections else 'off'}"
-            tuned[label] = {name: float(values[best]) for name, values in grid.items()}
-            for p in paths:
-                rows[p.stem][label] = float(grids[(p.name, kind, corrections)][best])
-    labels = next(iter(rows.values()))
-    means = {label: float(np.mean([r[label] for r in rows.values()])) for label in labels}
-    held_out = {label: float(np.mean([rows[p.stem][label] for p in paths[1::2]])) for label in labels}
-    return {"recordings": rows, "mean_total_rmse_deg": means, "held_out_mean_total_rmse_deg": held_out,
-            "tuning_recordings": [p.stem for p in paths[0::2]], "tuned_gains": tuned,
-            "defaults": {k: DEFAULT_GAINS[k] for k in ("explicit", "passive")}}
+    out = {}
+    for name in names:
+        recordings = datasets.load(folder, name)
+        if not recordings:
+            continue
+        published = _published(name, recordings, None if cache is None else Path(cache))
+        rows = {label: dict(published[label]) for label, _ in recordings}
+        grid_totals = {kind: [] for kind in OURS}
+        for label, data in recordings:
+            for kind in OURS:
+                rows[label][kind] = {m: float(v[0]) for m, v in errors(kind, data).items()}
+                if grids:
+                    grid_totals[kind].append(errors(kind, data, gain_grid(**GRID[kind]))["total_rmse_deg"])
+        means = {kind: {m: float(np.mean([rows[label][kind][m] for label in rows])) for m in METRICS}
+                 for kind in OURS + PUBLISHED}
+        out[name] = {"recordings": len(recordings), "means": means, "per_recording": rows}
+        if grids:
+            out[name]["grid"] = {kind: np.mean(grid_totals[kind], axis=0).tolist() for kind in OURS}
+        print(name, {k: round(v["total_rmse_deg"], 2) for k, v in means.items()}, file=sys.stderr)
+    return out
+
+
+def choose(results: dict) -> dict:
+    """The cross-validation of the module docstring on :func:`evaluate`'s ``results`` (with
+    grids): per filter, the gain set chosen on all the choosing datasets and, per left-out
+    dataset, the set chosen without it and its ratio to VQF there."""
+    names = [n for n in CHOOSING if n in results]
+    choice = {}
+    for kind in OURS:
+        axes = gain_grid(**GRID[kind])
+        ratios = {n: np.asarray(results[n]["grid"][kind]) / results[n]["means"]["vqf"]["total_rmse_deg"]
+                  for n in names}
+        best = int(np.argmin(np.mean([ratios[n] for n in names], axis=0)))
+        folds = {}
+        for left in names:
+            inner = int(np.argmin(np.mean([ratios[n] for n in names if n != left], axis=0)))
+            folds[left] = {"gains": {a: float(v[inner]) for a, v in axes.items()},
+                           "ratio_to_vqf": float(ratios[left][inner])}
+        choice[kind] = {"gains": {a: float(v[best]) for a, v in axes.items()},
+                        "ratios_to_vqf": {n: float(ratios[n][best]) for n in names}, "left_out": folds}
+    return choice
+
+
+def table(results: dict) -> str:
+    """The README's table: per dataset (its role), mean total RMSE (deg) of every filter, and our best
+    filter's ratio to VQF."""
+    lines = ["| dataset (recordings) | role | explicit | passive | VQF | Madgwick | Mahony | best / VQF |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, found in results.items():
+        m = {k: v["total_rmse_deg"] for k, v in found["means"].items()}
+        role = "held out" if name in HELD_OUT else "chose the defaults"
+        ratio = min(m["explicit"], m["passive"]) / m["vqf"]
+        lines.append(f"| {name} ({found['recordings']}) | {role} | {m['explicit']:.2f} | {m['passive']:.2f} | "
+                     f"{m['vqf']:.2f} | {m['madgwick']:.2f} | {m['mahony']:.2f} | {ratio:.2f} |")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> int:
-    """Command line (see the module docstring); prints the mean errors, returns 0.
+    """Command line (see the module docstring); prints the table, returns 0 (2 for a bad folder).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks.real_recordings", description=__doc__.splitlines()[0])
     parser.add_argument("folder")
-    parser.add_argument("--frame", default="enu", choices=("ned", "enu"))
+    parser.add_argument("--datasets", default=",".join(CHOOSING + HELD_OUT), help="comma-separated dataset names")
+    parser.add_argument("--choose", action="store_true", help="cross-validate the defaults on the choosing datasets")
+    parser.add_argument("--cache", help="folder keeping the published filters' results")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args(argv)
-    result = evaluate(args.folder, args.frame)
-    vqf = result["mean_total_rmse_deg"].get("vqf")
-    vqf_held = result["held_out_mean_total_rmse_deg"].get("vqf")
-    print(f"{'mean total RMSE (deg)':40s} {'all':>6s} {'x VQF':>6s} {'held-out':>9s} {'x VQF':>6s}")
-    for label, mean in result["mean_total_rmse_deg"].items():
-        held = result["held_out_mean_total_rmse_deg"][label]
-        ratios = (f"{mean / vqf:6.2f}", f"{held / vqf_held:6.2f}") if vqf else ("", "")
-        print(f"{label:40s} {mean:6.2f} {ratios[0]} {held:9.2f} {ratios[1]}")
-    print("tuned gain sets:", json.dumps(result["tuned_gains"]))
+    names = tuple(n.strip() for n in args.datasets.split(","))
+    unknown = [n for n in names if n not in datasets.LOADERS]
+    if unknown or not Path(args.folder).is_dir():
+        print(f"real_recordings: {args.folder} is not a folder, or unknown dataset {unknown}; datasets are "
+              f"{', '.join(datasets.LOADERS)}", file=sys.stderr)
+        return 2
+    if args.choose:
+        names = tuple(n for n in names if n in CHOOSING)  # the held-out dataset never enters the choice
+    results = evaluate(args.folder, names, args.cache, grids=args.choose)
+    print(table(results))
+    report = {"results": results, "defaults": {k: DEFAULT_GAINS[k] for k in OURS}}
+    if args.choose:
+        report["choice"] = choose(results)
+        print(json.dumps(report["choice"], indent=1))
     if args.json:
-        Path(args.json).write_text(json.dumps(result, indent=2) + "\n")
+        Path(args.json).write_text(json.dumps(report, indent=1) + "\n")
     return 0
 
 

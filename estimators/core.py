@@ -80,7 +80,7 @@ OUT_Q, OUT_THETA, OUT_B, OUT_OMEGA, OUT_WEIGHTS = (OUTPUT_SLOTS[n][0] for n in (
 # Gains and correction settings, one vector per gain set; see estimators.filters for meanings.
 GAIN_NAMES = ("k1", "k2", "k3", "kP", "kI", "heading_only", "acc_tolerance", "mag_norm_tolerance",
               "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain",
-              "acc_lowpass", "mag_lowpass", "mag_reference_time")
+              "acc_lowpass", "mag_lowpass", "mag_reference_time", "bias_clip")
 GAIN_SLOTS = {name: i for i, name in enumerate(GAIN_NAMES)}
 GAIN_SIZE = len(GAIN_NAMES)
 K1, K2, K3, KP, KI = (GAIN_SLOTS[n] for n in ("k1", "k2", "k3", "kP", "kI"))
@@ -88,8 +88,8 @@ HEADING_ONLY, ACC_TOL, MAG_NORM_TOL, MAG_DIP_TOL = (GAIN_SLOTS[n] for n in (
     "heading_only", "acc_tolerance", "mag_norm_tolerance", "mag_dip_tolerance"))
 REST_GYRO, REST_ACC, REST_MIN_TIME, REST_GAIN = (GAIN_SLOTS[n] for n in ("rest_gyro", "rest_acc", "rest_time",
                                                                           "rest_gain"))
-ACC_LOWPASS, MAG_LOWPASS, MAG_REF_TIME = (GAIN_SLOTS[n] for n in ("acc_lowpass", "mag_lowpass",
-                                                                  "mag_reference_time"))
+ACC_LOWPASS, MAG_LOWPASS, MAG_REF_TIME, BIAS_CLIP = (GAIN_SLOTS[n] for n in ("acc_lowpass", "mag_lowpass",
+                                                                             "mag_reference_time", "bias_clip"))
 
 REST_LOWPASS_TAU = 0.5  # s, time constant of the low-pass filters of the rest detector
 SMALL_ANGLE = 1e-12  # rad: a smaller rotation in one step is integrated to first order (sin x = x)
@@ -507,7 +507,12 @@ def _passive_correction(acc, mag, u, config, gains, acc_weight, mag_weight, r, w
     ry = work[W_RY:W_RY + 9].reshape((3, 3))
     if config[RY] == TRIAD:
         if not triad(acc, mag, config, ry):
-            return
+            # no field (a missing magnetometer): the field the estimate predicts, so that R_y
+            # carries the accelerometer's tilt and the estimate's own heading
+            v_field = work[W_FIELD:W_FIELD + 3]
+            _body(r, config[FIELD], config[FIELD + 1], config[FIELD + 2], v_field)
+            if not triad(acc, v_field, config, ry):
+                return
     else:
         for i in range(3):
             for j in range(3):
@@ -582,6 +587,8 @@ def _complementary(kind, x, u, gains, config, dt, work, y):
         x[B + i] -= dt * gains[KI] * w[i]
         if at_rest:
             x[B + i] += dt * gains[REST_GAIN] * (gyro[i] - x[B + i])
+        if gains[BIAS_CLIP] > 0.0:  # a slow rotation taken for rest, or a disturbance, leaves a bounded bias
+            x[B + i] = min(gains[BIAS_CLIP], max(-gains[BIAS_CLIP], x[B + i]))
     kp = gains[KP]
     q = _advance(x[Q], x[Q + 1], x[Q + 2], x[Q + 3], gyro[0] - x[B] + kp * w[0], gyro[1] - x[B + 1] + kp * w[1],
                  gyro[2] - x[B + 2] + kp * w[2], dt, int(config[DISCRETE]))
@@ -604,7 +611,9 @@ def update(kind, x, u, gains, config, dt, y, work):
     """
     if x[PENDING] > 0.0:
         x[PENDING] = 0.0
-        if triad(u[ACC:ACC + 3], u[MAG:MAG + 3], config, work[W_RY:W_RY + 9].reshape((3, 3))):
+        # without a field (no magnetometer) the heading is the Earth field's: TRIAD on the configured field
+        field = u[MAG:MAG + 3] if _norm3(u[MAG:MAG + 3]) > 0.0 else config[FIELD:FIELD + 3]
+        if triad(u[ACC:ACC + 3], field, config, work[W_RY:W_RY + 9].reshape((3, 3))):
             quaternion_from_rotation(work[W_RY:W_RY + 9].reshape((3, 3)), x[Q:Q + 4])
             euler_from_quaternion(x[Q:Q + 4], x[THETA:THETA + 3])
     if kind == LINEAR:

@@ -58,6 +58,10 @@ or tunes each:
     within the tolerances for this long while rejected. A short disturbance (a fault, a magnet
     passed by) stays rejected; a lasting one (an uncompensated motor field) is accepted, so
     the heading keeps its correction. 0: the configured field, for ever.
+``bias_clip`` (rad/s)
+    Each axis of the bias estimate is kept within this bound (VQF's choice too): a slow
+    rotation taken for rest, or a lasting disturbance, cannot leave a bias estimate larger than
+    a MEMS gyro's.
 ``rest_gyro`` (rad/s), ``rest_acc`` (m/s^2), ``rest_time`` (s), ``rest_gain`` (1/s)
     Rest detection: once the low-passed gyro norm stays under ``rest_gyro`` and the low-passed
     specific force within ``rest_acc`` of g for ``rest_time``, the bias follows the gyro,
@@ -83,6 +87,7 @@ import math
 import numpy as np
 
 from estimators import core
+from estimators.checks import check_finite, check_measurements, check_stability
 from fmus import vehicle
 from orchestrator.blocks import Block
 
@@ -113,6 +118,7 @@ CORRECTIONS = {
     "acc_lowpass": 1.0,  # s
     "mag_lowpass": 1.0,  # s
     "mag_reference_time": 2.0,  # s
+    "bias_clip": math.radians(2.0),  # rad/s
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 OUTPUT_NAMES = tuple(name for name, _ in core.OUTPUT_LAYOUT)
@@ -365,6 +371,7 @@ class QuaternionEstim(Block):
             self.step = reference.streaming_step(self.kind, self.gains, self.config, dt, self.q0, self.b0,
                                                  self.from_triad)
             return
+        check_stability(self.kind, self._gains[None], dt)
         self.data = np.zeros(_DATA_SIZE)  # shared by the Python step and the compiled step
         self.data[_D_KIND], self.data[_D_DT] = self._code, dt
         self.state, gains, config, self.work = (self.data[a:b] for a, b in _D_PARTS)
@@ -438,38 +445,6 @@ def _compile(code: int):
                 np.empty(core.WORK_SIZE))
 
 
-def check_measurements(gyro, acc, mag, gravity_norm: float, check_units: bool = True) -> np.ndarray:
-    """(N, 9) samples ``acc, gyro, mag``, refused with a clear message when malformed.
-
-    With ``check_units``, the median norm of ``acc`` must lie between half and twice the
-    gravity norm ``gravity_norm`` (m/s^2): a gyro in rad/s, or an accelerometer in g, does not.
-    """
-    parts = {}
-    for label, value in (("acc", acc), ("gyro", gyro), ("mag", mag)):
-        array = np.asarray(value, dtype=float)
-        if array.ndim != 2 or array.shape[1] != 3:
-            raise ValueError(f"{label} must be an (N, 3) array, not shape {array.shape}")
-        parts[label] = array
-    lengths = {len(p) for p in parts.values()}
-    if len(lengths) != 1 or lengths == {0}:
-        raise ValueError(f"acc, gyro and mag must hold the same number (> 0) of samples, not "
-                         f"{[len(p) for p in parts.values()]}")
-    if check_units:
-        norms = {label: float(np.median(np.linalg.norm(p, axis=1))) for label, p in parts.items()}
-        if not 0.5 * gravity_norm <= norms["acc"] <= 2.0 * gravity_norm:
-            hint = ""
-            if 0.5 * gravity_norm <= norms["gyro"] <= 2.0 * gravity_norm:
-                hint = " The gyro's norm is near g: were acc and gyro swapped?"
-            elif 0.5 <= norms["acc"] <= 2.0:
-                hint = " Is acc in g? Give it in m/s^2."
-            raise ValueError(f"acc has a median norm of {norms['acc']:.3g}, not near |g| = {gravity_norm:.3g} m/s^2."
-                             f"{hint} (check_units=False skips this check.)")
-    inputs = np.ascontiguousarray(np.column_stack([parts["acc"], parts["gyro"], parts["mag"]]))
-    if not np.isfinite(inputs).all():
-        raise ValueError("the recorded measurements hold NaN or Inf")
-    return inputs
-
-
 def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None, corrections=None, R_reel=None,
              q0=None, b0=(0.0, 0.0, 0.0), initial=None, discretisation: str = "exp", ry: str = "reel",
              gravity=vehicle.GRAVITY, earth_field=None, dip=None, declination=0.0, outputs=OUTPUT_NAMES,
@@ -483,7 +458,9 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
         filters of :mod:`estimators.reference`).
     gyro, acc, mag : (N, 3) arrays, keyword-only
         Body-frame measurements: rad/s, m/s^2 (specific force: ``-g`` rotated into the body at
-        rest), and T (or the unit of ``earth_field``); sample ``n`` at time ``n * dt``.
+        rest), and T (or the unit of ``earth_field``); sample ``n`` at time ``n * dt``. A
+        transposed (3, N) array is refused. ``mag=None`` or all zeros: a 6-axis estimate (tilt
+        corrected, heading from the gyro alone), with a ``NoMagnetometerWarning``.
     dt : float
         Sample period (s).
     gains : dict, optional
@@ -520,7 +497,8 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
         Remove each gain set's mean heading offset before scoring (for a reference whose
         inertial frame differs from the filter's by a constant heading); costs a second pass.
     check_units : bool
-        Refuse an ``acc`` whose median norm is far from g (see :func:`check_measurements`).
+        Refuse an ``acc`` whose specific force at rest is far from g, a unit error (see
+        :func:`estimators.checks.check_measurements`); running or vibrating recordings pass.
 
     Returns
     -------
@@ -532,10 +510,10 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
         ``heading_offset_deg`` (the offset removed).
     """
     config = config_vector(discretisation, ry, earth_field, gravity, dip, declination)
-    inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[core.GRAVITY:core.GRAVITY + 3])),
-                                check_units)
     if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt = {dt} s must be positive")
+    inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[core.GRAVITY:core.GRAVITY + 3])),
+                                check_units, dt)
     unknown = [name for name in outputs if name not in OUTPUT_NAMES]
     if unknown:
         raise ValueError(f"unknown output {unknown[0]!r}; the outputs are {', '.join(OUTPUT_NAMES)}")
@@ -552,6 +530,7 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
         return _with_errors(series, reference, scored, config, align_heading)
     table = gain_table(kind, gains, corrections)
     _check_frame(kind, config)
+    check_stability(kind, table, dt)
     if kind == "passive" and ry == "reel":
         if R_reel is None:
             raise ValueError("the passive filter with ry='reel' needs R_reel (N, 9); or use ry='triad'")
@@ -568,6 +547,7 @@ def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None,
     args = (core.KINDS[kind], inputs, table, config, dt, q_start, np.asarray(b0, dtype=float), from_triad,
             columns.astype(np.int64))
     core.run_batch(*args, stored, reference, scored, offsets, sums)
+    check_finite(kind, table, stored, sums)
     result, start = {}, 0
     for name in outputs:
         size = core.OUTPUT_SLOTS[name][1] - core.OUTPUT_SLOTS[name][0]

@@ -11,6 +11,9 @@ Names accepted when reading (first found wins):
   ``magneto``, ``imu_mag``;
 - ``quat``: ``quat``, ``q_ref``, ``opt_quat``; ``scored``: ``scored``, ``movement``;
 - ``rate``: ``rate``, ``sampling_rate``, or ``1/dt``.
+A recording without a magnetometer reads as zeros there (the filters then give a 6-axis
+estimate, with a warning). Arrays hold one sample per row: one stored transposed (3 x N) is
+refused, never reshaped.
 ``.mat`` files of the BROAD benchmark (Laidig et al., "BROAD: a benchmark for robust inertial
 orientation estimation", Data, 2021) read as they are. A ``.csv`` has a header row with the
 columns ``gyro_x, gyro_y, gyro_z, acc_x, ..., mag_z``, optionally ``quat_0 .. quat_3`` and
@@ -20,9 +23,17 @@ columns ``gyro_x, gyro_y, gyro_z, acc_x, ..., mag_z``, optionally ``quat_0 .. qu
 from __future__ import annotations
 
 import json
+import warnings
+import zipfile
 from pathlib import Path
 
 import numpy as np
+
+# A small real recording shipped with the package: 24 s of BROAD's trial "01_undisturbed_slow_rotation_A"
+# (Laidig, Caruso, Cereatti, Seel, "BROAD - A Benchmark for Robust Inertial Orientation Estimation",
+# Data, 2021; CC BY 4.0, cut and stored in single precision, otherwise unchanged): 286 Hz, ENU, mag in uT,
+# 7.8 s at rest then slow rotations, with its optical reference and movement phases.
+EXAMPLE = Path(__file__).parent / "data" / "broad_excerpt.npz"
 
 ALIASES = {
     "gyro": ("gyro", "gyr", "imu_gyr"),
@@ -43,12 +54,25 @@ def _first(data: dict, key: str):
 
 
 def _read_csv(path: Path) -> dict:
-    table = np.genfromtxt(path, delimiter=",", names=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # numpy warns on an empty file; refused below with its name
+        try:
+            table = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True))
+        except IndexError:  # numpy's answer to a file without a header row
+            table = np.zeros(0)
+        except (ValueError, UnicodeDecodeError) as error:
+            raise ValueError(f"{path} is not a readable CSV recording ({error}); write it with "
+                             "estimators.recording.save") from None
     names = table.dtype.names or ()
+    if not names or len(table) == 0:
+        raise ValueError(f"{path} holds no samples: a header row (gyro_x, ..., mag_z) and one row per sample are "
+                         "needed")
     data = {}
     for key in ("gyro", "acc", "mag"):
         columns = [f"{key}_{a}" for a in AXES]
         missing = [c for c in columns if c not in names]
+        if missing and key == "mag":
+            continue
         if missing:
             raise ValueError(f"{path}: the CSV header lacks {', '.join(missing)}; columns are {', '.join(names)}")
         data[key] = np.column_stack([table[c] for c in columns])
@@ -57,8 +81,84 @@ def _read_csv(path: Path) -> dict:
     if "scored" in names:
         data["scored"] = table["scored"]
     if "time" in names and len(table) > 1:
-        data["rate"] = 1.0 / float(np.median(np.diff(table["time"])))
+        data["rate"] = _rate_from_time(path, table["time"])
     return data
+
+
+def _rate_from_time(path, time) -> float:
+    """Sampling rate (Hz) from a time column (s), refusing one that does not increase."""
+    steps = np.diff(np.asarray(time, dtype=float))
+    bad = np.flatnonzero(~(steps > 0))
+    if len(bad):
+        k = int(bad[0]) + 1
+        raise ValueError(f"{path}: time is not increasing at sample {k} ({time[k - 1]:g} s then {time[k]:g} s); "
+                         "sort the samples by time and remove repeated ones")
+    return 1.0 / float(np.median(steps))
+
+
+def _read_raw(path: Path) -> dict:
+    suffix = path.suffix.lower()
+    if suffix == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as f:
+                return {k: f[k] for k in f.files}
+        except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
+            raise ValueError(f"{path} is not a readable .npz archive ({error}); write it with numpy.savez or "
+                             "estimators.recording.save") from None
+    if suffix == ".mat":
+        from scipy.io import loadmat
+
+        try:
+            return {k: v for k, v in loadmat(path, squeeze_me=False).items() if not k.startswith("__")}
+        except (OSError, ValueError, TypeError, NotImplementedError) as error:
+            raise ValueError(f"{path} is not a readable MATLAB file ({error}); save it with MATLAB's save "
+                             "(-v7 or older) or scipy.io.savemat") from None
+    if suffix == ".csv":
+        return _read_csv(path)
+    raise ValueError(f"{path}: unknown recording format {suffix!r}; use .npz, .mat or .csv")
+
+
+def _rows(path, key: str, value, width: int) -> np.ndarray:
+    """The array ``key`` as (N, width) samples in rows; a transposed (width, N) one is refused, not reshaped."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{path}: {key} is not numeric") from None
+    if array.ndim == 2 and array.shape[0] == width and array.shape[1] != width:
+        raise ValueError(f"{path}: {key} is stored {array.shape[0]} x {array.shape[1]}, transposed; store it with "
+                         f"one sample per row ({array.shape[1]} x {width})")
+    if array.ndim != 2 or array.shape[1] != width:
+        raise ValueError(f"{path}: {key} must be an (N, {width}) array, one sample per row, not shape {array.shape}")
+    return np.ascontiguousarray(array)
+
+
+def _meta(path, raw) -> dict:
+    meta = raw.get("meta")
+    if meta is None:
+        return {}
+    try:
+        value = json.loads(str(np.asarray(meta).reshape(-1)[0]))
+    except (ValueError, IndexError) as error:
+        raise ValueError(f"{path}: meta is not a JSON text ({error}); rewrite it with json.dumps or remove "
+                         "it") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"{path}: meta must be a JSON object ({{...}}), not {type(value).__name__}")
+    return value
+
+
+def _rate(path, raw, rate):
+    found = _first(raw, "rate")
+    if rate is None and found is None and "dt" in raw:
+        dt = np.asarray(raw["dt"], dtype=float).reshape(-1)
+        found = 1.0 / float(dt[0]) if dt.size and dt[0] != 0 else float("nan")
+    if rate is None and found is None and "time" in raw:
+        found = _rate_from_time(path, np.asarray(raw["time"], dtype=float).reshape(-1))
+    if rate is None and found is not None:
+        values = np.asarray(found, dtype=float).reshape(-1)
+        rate = float(values[0]) if values.size else None
+    if rate is None or not np.isfinite(rate) or rate <= 0:
+        raise ValueError(f"{path} gives no sampling rate: store 'rate' (Hz), 'dt' (s) or 'time' (s), or pass rate=")
+    return float(rate)
 
 
 def load(path, rate: float | None = None) -> dict:
@@ -68,43 +168,35 @@ def load(path, rate: float | None = None) -> dict:
     Returns
     -------
     dict
-        ``gyro``, ``acc``, ``mag`` (N, 3), ``rate`` (Hz), ``quat`` (N, 4) or None,
-        ``scored`` (N,) bool or None, ``meta`` (dict).
+        ``gyro``, ``acc``, ``mag`` (N, 3; zeros when the file has no magnetometer), ``rate``
+        (Hz), ``quat`` (N, 4) or None, ``scored`` (N,) bool or None, ``meta`` (dict).
+
+    Raises
+    ------
+    ValueError
+        A file that is not a recording, an array stored transposed (3 x N) or of another
+        shape, an empty CSV, a time column that does not increase, a ``meta`` that is not
+        JSON, or no sampling rate: each names the problem and the fix.
     """
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"no recording at {path}")
-    suffix = path.suffix.lower()
-    if suffix == ".npz":
-        with np.load(path, allow_pickle=False) as f:
-            raw = {k: f[k] for k in f.files}
-    elif suffix == ".mat":
-        from scipy.io import loadmat
-
-        raw = {k: v for k, v in loadmat(path, squeeze_me=False).items() if not k.startswith("__")}
-    elif suffix == ".csv":
-        raw = _read_csv(path)
-    else:
-        raise ValueError(f"{path}: unknown recording format {suffix!r}; use .npz, .mat or .csv")
+    raw = _read_raw(path)
     out = {}
     for key in ("gyro", "acc", "mag"):
         value = _first(raw, key)
+        if value is None and key == "mag" and out:
+            out[key] = np.zeros_like(out["gyro"])  # a 6-axis recording: the filters warn and correct the tilt only
+            continue
         if value is None:
             raise ValueError(f"{path} has no {key} array (looked for {', '.join(ALIASES[key])})")
-        out[key] = np.ascontiguousarray(np.asarray(value, dtype=float).reshape(-1, 3))
+        out[key] = _rows(path, key, value, 3)
     quat = _first(raw, "quat")
-    out["quat"] = None if quat is None else np.ascontiguousarray(np.asarray(quat, dtype=float).reshape(-1, 4))
+    out["quat"] = None if quat is None else _rows(path, "quat", quat, 4)
     scored = _first(raw, "scored")
     out["scored"] = None if scored is None else np.asarray(scored).reshape(-1).astype(bool)
-    found = _first(raw, "rate")
-    if rate is None and found is None and "dt" in raw:
-        found = 1.0 / float(np.asarray(raw["dt"]).reshape(-1)[0])
-    rate = rate if rate is not None else (None if found is None else float(np.asarray(found).reshape(-1)[0]))
-    if rate is None or not np.isfinite(rate) or rate <= 0:
-        raise ValueError(f"{path} gives no sampling rate: store 'rate' (Hz) or 'dt' (s), or pass rate=")
-    out["rate"] = rate
-    meta = raw.get("meta")
-    out["meta"] = json.loads(str(np.asarray(meta).reshape(-1)[0])) if meta is not None else {}
+    out["rate"] = _rate(path, raw, rate)
+    out["meta"] = _meta(path, raw)
     return out
 
 

@@ -11,9 +11,14 @@
     Madgwick's gradient-descent filter (Madgwick, Harrison, Vaidyanathan, "Estimation of
     IMU and MARG orientation using a gradient descent algorithm", 2011), from the ``ahrs``
     package (``Madgwick.updateMARG``). Gain ``beta`` (rad/s). No bias estimate.
+``mahony``
+    Mahony's explicit complementary filter with bias (Mahony, Hamel, Pflimlin, "Nonlinear
+    complementary filters on the special orthogonal group", 2008), from the ``ahrs`` package
+    (``Mahony.updateMARG``): gains ``k_P`` (1/s) and ``k_I`` (1/s^2) at the package's defaults
+    (1 and 0.3).
 
-Frames: both packages work in their own inertial frame (VQF: east, north, up; Madgwick: north,
-west, up, "north" being the horizontal Earth field) and take the accelerometer's specific
+Frames: the packages work in their own inertial frame (VQF and the ``ahrs`` Mahony: east,
+north, up; Madgwick: north, west, up; "north" being the horizontal Earth field) and take the accelerometer's specific
 force as "up", so the body frame needs no change. The estimate is turned into this package's
 inertial frame, the one of the ``gravity`` and ``earth_field`` references, by the constant
 rotation between the two frames built from those references.
@@ -25,8 +30,8 @@ import numpy as np
 
 from estimators import core
 
-KINDS = ("vqf", "madgwick")
-DEFAULT_GAINS = {"vqf": {}, "madgwick": {"beta": 0.041}}
+KINDS = ("vqf", "madgwick", "mahony")
+DEFAULT_GAINS = {"vqf": {}, "madgwick": {"beta": 0.041}, "mahony": {"k_P": 1.0, "k_I": 0.3}}
 
 
 def _vqf_parameters() -> dict:
@@ -65,7 +70,7 @@ def frame_rotation(kind: str, config) -> np.ndarray:
     up = -g / np.linalg.norm(g)
     north = m - (m @ up) * up
     north /= np.linalg.norm(north)
-    if kind == "vqf":
+    if kind in ("vqf", "mahony"):
         columns = (np.cross(north, up), north, up)
     else:
         columns = (north, np.cross(up, north), up)
@@ -93,9 +98,12 @@ class _Runner:
 
             self.filter = VQF(dt, **gains)
         else:
-            from ahrs.filters import Madgwick
+            from ahrs.filters import Madgwick, Mahony
 
-            self.filter = Madgwick(gain=gains["beta"], frequency=1.0 / dt)
+            if kind == "mahony":
+                self.filter = Mahony(frequency=1.0 / dt, k_P=gains["k_P"], k_I=gains["k_I"])
+            else:
+                self.filter = Madgwick(gain=gains["beta"], frequency=1.0 / dt)
             self.state = np.empty(4)
             core.quaternion_multiply(self.from_ours, q0, self.state)
         self.pending = from_triad
@@ -121,6 +129,8 @@ class _Runner:
             self.state = self.filter.updateMARG(self.state, gyr=np.asarray(gyro, float), acc=np.asarray(acc, float),
                                                 mag=np.asarray(mag, float), dt=self.dt)
             quaternion = self.state
+            if self.kind == "mahony":
+                self.bias[:] = self.filter.b
         core.quaternion_multiply(self.to_ours, quaternion, self.q)
         if self.q[0] < 0:
             self.q *= -1.0
@@ -149,6 +159,21 @@ def streaming_step(kind, gains, config, dt, q0, b0, from_triad):
     return step
 
 
+def _vqf_batch(gains, config, dt, inputs) -> np.ndarray:
+    """VQF's attitude (N, 4) over the samples ``inputs`` by the package's batch update, in the frame of
+    ``config``."""
+    from vqf import VQF
+
+    acc, gyro, mag = (np.ascontiguousarray(inputs[:, start:start + 3]) for start in (core.ACC, core.GYRO, core.MAG))
+    quat = VQF(dt, **gains).updateBatch(gyro, acc, mag)["quat9D"]
+    to_ours = frame_rotation("vqf", config)
+    out = np.empty_like(quat)
+    for n in range(len(quat)):
+        core.quaternion_multiply(to_ours, quat[n], out[n])
+    out *= np.where(out[:, :1] < 0, -1.0, 1.0)
+    return out
+
+
 def estimate(kind, inputs, dt, gains, config, q0, b0, from_triad, outputs) -> dict:
     """The published filter ``kind`` on recorded samples ``inputs`` (N, 9: acc, gyro, mag), every
     ``dt`` (s), per gain set of ``gains``, in the frame of ``config``, from ``q0`` (or TRIAD,
@@ -165,6 +190,11 @@ def estimate(kind, inputs, dt, gains, config, q0, b0, from_triad, outputs) -> di
             for name in outputs}
     y = np.empty(core.OUTPUT_SIZE)
     for g, gain_set in enumerate(sets):
+        if kind == "vqf" and set(outputs) <= {"q"}:
+            q_all[g] = _vqf_batch(gain_set, config, dt, inputs)  # the same updates, in one call into the package
+            for array in kept.values():
+                array[g] = q_all[g]
+            continue
         runner = _Runner(kind, gain_set, config, dt, q0, from_triad)
         for n in range(count):
             u = inputs[n]

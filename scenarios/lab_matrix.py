@@ -23,7 +23,6 @@ A named sweep: its members run on Dask like any sweep (``--workers``, ``--schedu
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -31,6 +30,7 @@ import numpy as np
 
 from estimators import analysis, score
 from fmus.IMU.variables import LAB_GYRO_BIAS
+from orchestrator.files import write_json, write_text
 
 CASES = {
     "linear-quasi-gt": {"estimator": "linear"},
@@ -131,8 +131,8 @@ def summarise(records: list[dict], out: Path) -> dict:
     ``records`` (their metrics.json)."""
     summary = summary_of(records)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    (out / "summary.md").write_text(markdown(summary))
+    write_json(out / "summary.json", summary)
+    write_text(out / "summary.md", markdown(summary))
     return summary
 
 

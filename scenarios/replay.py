@@ -1,22 +1,33 @@
 """Replay: any estimator on a recorded IMU file, scored against its reference attitude.
 
     python -m scenarios.replay RECORDING [--estimator explicit] [--set kP=0.5 ...]
-        [--corrections] [--initial triad] [--frame ned|enu] [--field-from-data]
-        [--align-heading] [--rate HZ] [--json OUT]
+        [--corrections on|off|NAMES] [--ry reel|triad] [--discretisation exp|euler]
+        [--initial triad] [--q0 Q0,Q1,Q2,Q3] [--b0 BX,BY,BZ] [--frame ned|enu]
+        [--field-from-data SECONDS] [--dip DEG] [--declination DEG] [--align-heading]
+        [--rate HZ] [--json OUT]
+    python -m scenarios.replay results/tp            # a tp run's results folder, as it is
     python -m scenarios.replay --from-tp RESULTS_DIR --write RECORDING
+    python -m scenarios.replay FLIGHT.ulg|.bin|.log [--compass N] [--json OUT]
+
+A flight log (PX4 ULog, ArduPilot DataFlash) is replayed by :mod:`scenarios.flightlog.replay`:
+every estimator, without and with the magnetometer compensation, against the autopilot's own
+attitude (a reference, not the truth).
 
 The recording is read by :mod:`estimators.recording` (``.npz``, ``.mat``, ``.csv``: gyro, acc,
 mag, rate, optional reference quaternion and scored samples). With a reference, the
 quaternion-error RMSE (total, inclination, heading; degrees) over the scored samples is
-printed, the metric of :func:`estimators.score`.
+printed, the metric of :func:`estimators.score`. The gains and correction settings in force
+(defaults filled in) are printed and written with the errors (``gains_in_force``).
 
-``--from-tp`` turns the results folder of a ``quadcosim run tp`` into a recording: the IMU's
-samples, the true attitude as reference, the samples after the run's settling time as
-scored, and the run's estimator settings in ``meta``; replaying it with no option runs that
-estimator again and reproduces the run's ``quaternion_rmse_deg`` (the block and the batch path
-share one compiled update). A run whose estimator ran slower than the macro step is refused;
-one whose estimator inputs carried a fault (``--fault``) does not reproduce: the IMU's record
-is not what the estimator saw.
+A ``tp`` run's results folder (or its ``results.npz``) is read as a recording directly: the
+IMU's samples, the true attitude as reference, the samples after the run's settling time as
+scored, and the run's estimator settings; with no option it runs that estimator again and
+reproduces the run's ``quaternion_rmse_deg`` (the block and the batch path share one compiled
+update). ``--from-tp`` writes that recording to a file. A run whose estimator ran slower than the
+macro step is refused; one whose estimator inputs carried a fault (``--fault``) does not
+reproduce: the IMU's record is not what the estimator saw.
+
+Exit status: 0, or 2 with a message naming the problem for a bad file or option.
 """
 
 from __future__ import annotations
@@ -25,11 +36,15 @@ import argparse
 import json
 import math
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from estimators import estimate, parse_corrections, recording
+from orchestrator.files import write_text
+
+FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
 
 
 def field_from_data(acc, mag, samples: int) -> dict:
@@ -42,18 +57,20 @@ def field_from_data(acc, mag, samples: int) -> dict:
             "norm": float(np.median(np.linalg.norm(m, axis=1)))}
 
 
-def references(frame: str, dip: float | None, norm: float | None) -> dict:
+def references(frame: str, dip: float | None, norm: float | None, declination: float = 0.0) -> dict:
     """Gravity and Earth field for ``frame`` ("ned": x north; "enu": y north), heading to magnetic
-    north, the field of ``dip`` (rad, below the horizontal) and ``norm`` (None: the lab's)."""
+    north (or to geographic north with the field's ``declination``, rad, east of north), the
+    field of ``dip`` (rad, below the horizontal) and ``norm`` (None: the lab's)."""
     from fmus import vehicle
 
     dip = vehicle.EARTH_FIELD_INCLINATION if dip is None else dip
     norm = vehicle.EARTH_FIELD_NORM if norm is None else norm
     horizontal, down = norm * math.cos(dip), norm * math.sin(dip)
+    north, east = horizontal * math.cos(declination), horizontal * math.sin(declination)
     if frame == "ned":
-        return {"gravity": (0.0, 0.0, vehicle.GRAVITY), "earth_field": (horizontal, 0.0, down)}
+        return {"gravity": (0.0, 0.0, vehicle.GRAVITY), "earth_field": (north, east, down)}
     if frame == "enu":
-        return {"gravity": (0.0, 0.0, -vehicle.GRAVITY), "earth_field": (0.0, horizontal, -down)}
+        return {"gravity": (0.0, 0.0, -vehicle.GRAVITY), "earth_field": (east, north, -down)}
     raise ValueError(f"frame {frame!r} must be 'ned' or 'enu'")
 
 
@@ -66,60 +83,94 @@ def _value(text: str):
 
 def replay(data: dict, estimator: str | None = None, gains: dict | None = None, corrections=None,
            initial: str | None = None, frame: str | None = None, field_from_data_s: float = 0.0,
-           align_heading: bool = False) -> dict:
+           align_heading: bool = False, **options) -> dict:
     """Run an estimator on a loaded recording (see :func:`estimators.recording.load`).
 
-    Settings not given come from the recording's ``meta`` (written by ``--from-tp``), then
-    from the package's defaults. Returns the errors (degrees) when the recording has a
-    reference, and the settings used.
+    Settings not given come from the recording's ``meta`` (a ``tp`` run's), then from the
+    package's defaults. Returns the errors (degrees) when the recording has a reference, the
+    settings used and the gains in force (``gains_in_force``, every gain and correction
+    setting with its value).
 
     ``data``: the recording; ``estimator``, ``gains``, ``corrections`` and ``initial``
     (``"triad"`` or None): as :func:`estimators.estimate` takes them; ``frame``: ``"ned"`` or
     ``"enu"``; ``field_from_data_s`` (s): take the field's dip and norm from that first stretch
     of the data (0: the lab's field); ``align_heading``: remove the constant heading offset
-    before scoring.
+    before scoring; ``options``: any other option of :func:`estimators.estimate` (``ry``,
+    ``discretisation``, ``q0``, ``b0``, ``dip``, ``declination``; angles in rad).
     """
     meta = data["meta"].get("estimator", {})
     kind = estimator or meta.get("kind", "explicit")
     settings = {
         "gains": gains if gains is not None else (meta.get("gains") if kind == meta.get("kind") else None),
         "corrections": corrections if corrections is not None else meta.get("corrections"),
-        "ry": meta.get("ry", "triad"),
-        "discretisation": meta.get("discretisation", "exp"),
+        "ry": options.pop("ry", None) or meta.get("ry", "triad"),
+        "discretisation": options.pop("discretisation", None) or meta.get("discretisation", "exp"),
         "initial": initial if initial is not None else meta.get("initial"),
-        "q0": meta.get("q0"),
+        "q0": options.pop("q0", None) or meta.get("q0"),
+        "b0": list(options.pop("b0", None) or meta.get("b0", (0.0, 0.0, 0.0))),
     }
     frame = frame or data["meta"].get("frame", "ned")
-    dip = norm = None
+    dip, declination = options.pop("dip", None), options.pop("declination", 0.0)
+    if options:
+        raise ValueError(f"unknown replay option {next(iter(options))!r}")
+    norm = None
     if field_from_data_s > 0:
         field = field_from_data(data["acc"], data["mag"], max(1, int(field_from_data_s * data["rate"])))
-        dip, norm = field["dip"], field["norm"]
-    refs = references(frame, dip, norm)
-    quat = data["quat"]
+        dip, norm = (field["dip"] if dip is None else dip), field["norm"]
+    refs = references(frame, dip, norm, declination)
+    filtered = kind in ("linear", "explicit", "passive")
+    corrections_used = settings["corrections"] if kind != "linear" and filtered else None
     out = estimate(kind, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], dt=1.0 / data["rate"],
-                   gains=settings["gains"], corrections=settings["corrections"] if kind in ("explicit", "passive")
-                   else None, ry=settings["ry"], discretisation=settings["discretisation"],
-                   initial=settings["initial"], q0=settings["q0"], outputs=(), reference=quat, scored=data["scored"],
+                   gains=settings["gains"], corrections=False if kind == "linear" else corrections_used,
+                   ry=settings["ry"], discretisation=settings["discretisation"], initial=settings["initial"],
+                   q0=settings["q0"], b0=settings["b0"], outputs=(), reference=data["quat"], scored=data["scored"],
                    align_heading=align_heading, **refs)
     errors = {k: float(v[0]) for k, v in out.get("errors", {}).items()}
     return {"estimator": kind, **settings, "frame": frame, "dip_deg": None if dip is None else math.degrees(dip),
-            "errors": errors}
+            "gains_in_force": gains_in_force(kind, settings["gains"], corrections_used), "errors": errors}
 
 
-def from_tp(results_dir, path) -> Path:
-    """Write the recording of the ``tp`` run in the results folder ``results_dir`` to ``path``
-    (see the module docstring)."""
+def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
+    """Every gain and correction setting the filter ``kind`` runs with, defaults filled in
+    (``gains`` and ``corrections`` as :func:`estimators.estimate` takes them)."""
+    from estimators import reference
+    from estimators.filters import check_gains
+
+    if kind in reference.KINDS:
+        merged = reference.check_gains(kind, gains)
+    else:
+        merged = check_gains(kind, gains, False if kind == "linear" else corrections)
+    return {name: float(np.asarray(value).reshape(-1)[0]) for name, value in merged.items()}
+
+
+def tp_recording(results_dir) -> dict:
+    """The recording of the ``tp`` run in the results folder ``results_dir``, as
+    :func:`estimators.recording.load` returns one (see the module docstring)."""
     from estimators.core import euler_to_quaternion
     from orchestrator.result import Result
     from scenarios.tp import estimator_gains, initial_state
 
     results_dir = Path(results_dir)
-    result = Result.from_npz(results_dir / "results.npz")
-    metrics = json.loads((results_dir / "metrics.json").read_text())
-    o = metrics["options"]
+    if not (results_dir / "metrics.json").exists() or not (results_dir / "results.npz").exists():
+        raise ValueError(f"{results_dir} is not a tp results folder (no metrics.json and results.npz)")
+    try:
+        metrics = json.loads((results_dir / "metrics.json").read_text())
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{results_dir}: metrics.json is not readable ({error}); run tp again") from None
+    metrics = metrics if isinstance(metrics, dict) else {"scenario": None}
+    o = metrics.get("options", {})
+    if metrics.get("scenario", "tp") != "tp" or "estimator" not in o:
+        raise ValueError(f"{results_dir} holds a {metrics.get('scenario')!r} run, not a tp run")
+    try:
+        result = Result.from_npz(results_dir / "results.npz")
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise ValueError(f"{results_dir}: the run's results.npz is not readable ({error}); run tp again") from None
     if round(1.0 / (o["imu_rate"] * o["dt"])) != 1:
         raise ValueError("the estimator of this run ran slower than the macro step: its samples are not the "
                          "recorded ones; run tp with imu_rate = 1/dt")
+    missing = [name for name in ("IMU.gyro", "IMU.acc", "IMU.magneto", "Quadrotor.q") if name not in result]
+    if missing:
+        raise ValueError(f"{results_dir}: the run did not record {', '.join(missing)}; run tp without --record")
     settle = min(o["settle"], 0.5 * o["duration"])
     meta = {"frame": "ned", "source": f"tp run {results_dir}",
             "estimator": {"kind": o["estimator"], "gains": estimator_gains(o) or None,
@@ -127,28 +178,87 @@ def from_tp(results_dir, path) -> Path:
                           "discretisation": o["discretisation"],
                           "q0": list(euler_to_quaternion(0.0, initial_state(o["flight"]).get("theta2_0", 0.0), 0.0))},
             "reported_quaternion_rmse_deg": metrics.get("quaternion_rmse_deg")}
-    return recording.save(path, gyro=result["IMU.gyro"], acc=result["IMU.acc"], mag=result["IMU.magneto"],
-                          rate=1.0 / o["dt"], quat=result["Quadrotor.q"], scored=result.time >= settle, meta=meta)
+    return {"gyro": result["IMU.gyro"], "acc": result["IMU.acc"], "mag": result["IMU.magneto"], "rate": 1.0 / o["dt"],
+            "quat": result["Quadrotor.q"], "scored": result.time >= settle, "meta": meta}
 
 
-def main(argv=None) -> int:
-    """Command line (see the module docstring); returns the exit status (2 on bad input).
-    ``argv``: the arguments (default ``sys.argv[1:]``)."""
+def from_tp(results_dir, path) -> Path:
+    """Write the recording of the ``tp`` run in the results folder ``results_dir`` to ``path``
+    (see the module docstring)."""
+    data = tp_recording(results_dir)
+    return recording.save(path, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], rate=data["rate"],
+                          quat=data["quat"], scored=data["scored"], meta=data["meta"])
+
+
+def load_any(path, rate: float | None = None) -> dict:
+    """The recording at ``path``: a recording file, or a ``tp`` run's results folder (or its
+    ``results.npz``), loaded (``rate`` (Hz) overrides the file's)."""
+    path = Path(path)
+    folder = path if path.is_dir() else path.parent if path.name == "results.npz" else None
+    if folder is not None and (folder / "metrics.json").exists():
+        return tp_recording(folder)
+    if path.is_dir():
+        raise ValueError(f"{path} is a folder without a tp run's metrics.json; give a recording file")
+    return recording.load(path, rate=rate)
+
+
+def _vector(text: str, size: int, label: str) -> list:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise ValueError(f"{label} {text!r} must be {size} comma-separated numbers") from None
+    if len(values) != size:
+        raise ValueError(f"{label} {text!r} must be {size} comma-separated numbers")
+    return values
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m scenarios.replay", description=__doc__.splitlines()[0])
-    parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording")
+    parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording, or a tp run's results folder")
     parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")
-    parser.add_argument("--set", action="append", default=[], metavar="GAIN=VALUE", help="a gain by name")
-    parser.add_argument("--corrections", action="store_true", default=None, help="disturbance-aware corrections on")
+    parser.add_argument("--set", action="append", default=[], metavar="GAIN=VALUE",
+                        help="a gain or correction setting by name")
+    parser.add_argument("--corrections", nargs="?", const="on", metavar="on|off|NAMES",
+                        help="disturbance-aware corrections: on, off, or names (a,b=value)")
+    parser.add_argument("--ry", choices=("reel", "triad"), help="passive filter's measured rotation")
+    parser.add_argument("--discretisation", choices=("exp", "euler"), help="quaternion update")
     parser.add_argument("--initial", choices=("triad",), help="start from the TRIAD attitude of the first sample")
+    parser.add_argument("--q0", metavar="Q0,Q1,Q2,Q3", help="initial attitude, body to inertial, scalar first")
+    parser.add_argument("--b0", metavar="BX,BY,BZ", help="initial gyro-bias estimate (rad/s)")
     parser.add_argument("--frame", choices=("ned", "enu"), help="inertial frame of the recording (default ned)")
     parser.add_argument("--field-from-data", type=float, default=0.0, metavar="SECONDS",
                         help="take the field's dip and norm from the first SECONDS of the recording")
+    parser.add_argument("--dip", type=float, metavar="DEG", help="the Earth field's dip below the horizontal")
+    parser.add_argument("--declination", type=float, default=0.0, metavar="DEG", help="the field's declination")
     parser.add_argument("--align-heading", action="store_true", help="remove a constant heading offset")
     parser.add_argument("--rate", type=float, help="sampling rate (Hz), if the file has none")
     parser.add_argument("--json", help="write the result here")
     parser.add_argument("--from-tp", metavar="RESULTS_DIR", help="write a recording from a tp run's results")
     parser.add_argument("--write", metavar="RECORDING", help="with --from-tp: the recording to write")
+    parser.add_argument("--compass", type=int, default=0, help="flight logs: the compass, from 0 in the log's order")
+    return parser
+
+
+def _options(args) -> dict:
+    options = {"ry": args.ry, "discretisation": args.discretisation, "declination": math.radians(args.declination)}
+    if args.q0:
+        options["q0"] = _vector(args.q0, 4, "--q0")
+    if args.b0:
+        options["b0"] = _vector(args.b0, 3, "--b0")
+    if args.dip is not None:
+        options["dip"] = math.radians(args.dip)
+    return options
+
+
+def main(argv=None) -> int:
+    """Command line (see the module docstring); returns the exit status (2 on bad input).
+    ``argv``: the arguments (default ``sys.argv[1:]``)."""
+    parser = _parser()
     args = parser.parse_args(argv)
+    if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
+        from scenarios.flightlog import replay as flight
+
+        return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json))
     try:
         if args.from_tp:
             if not args.write:
@@ -157,18 +267,23 @@ def main(argv=None) -> int:
             return 0
         if not args.recording:
             parser.error("give a RECORDING (or --from-tp with --write)")
-        gains = dict(item.split("=", 1) for item in args.set) if args.set else None
-        gains = None if gains is None else {k.strip(): _value(v) for k, v in gains.items()}
-        data = recording.load(args.recording, rate=args.rate)
-        result = replay(data, args.estimator, gains, args.corrections, args.initial, args.frame,
-                        args.field_from_data, args.align_heading)
-    except (ValueError, FileNotFoundError) as error:
+        pairs = [item.split("=", 1) for item in args.set]
+        if any(len(pair) != 2 for pair in pairs):
+            raise ValueError(f"--set takes GAIN=VALUE, not {args.set}")
+        gains = {k.strip(): _value(v) for k, v in pairs} if pairs else None
+        corrections = None if args.corrections is None else parse_corrections(args.corrections)
+        data = load_any(args.recording, rate=args.rate)
+        result = replay(data, args.estimator, gains, corrections, args.initial, args.frame, args.field_from_data,
+                        args.align_heading, **_options(args))
+    except (ValueError, FileNotFoundError, OSError) as error:
         print(f"replay: {error}", file=sys.stderr)
         return 2
+    print(f"{result['estimator']}: gains in force " + ", ".join(f"{k}={v:g}" for k, v in
+                                                                 result["gains_in_force"].items()), file=sys.stderr)
     text = json.dumps(result, indent=2, default=float)
     print(text)
     if args.json:
-        Path(args.json).write_text(text + "\n")
+        write_text(args.json, text + "\n")
     return 0
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from calibration import Calibration, fit_static
 from fmus import vehicle
 from orchestrator import FMUBlock, System, Table
+from orchestrator.files import write_json
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import angle_between, imu_parameters, save_figure
@@ -122,7 +123,7 @@ def report(result, o, out) -> dict:
     raw = level @ A.T + b
     heading_raw = np.degrees(np.angle(np.exp(1j * (np.arctan2(-raw[:, 1], raw[:, 0]) - yaw))))
     if out is not None:
-        Calibration(4, fit, notes={"made_by": "quadcosim run static-cal"}).save(out / "static.json")
+        write_json(out / "static.json", Calibration(4, fit, notes={"made_by": "quadcosim run static-cal"}).to_dict())
     fig = plt.figure(figsize=(14, 4.8))
     raw_uT, corrected_uT = samples * 1e6, fit.correct(samples) * 1e6
     reach = np.abs(np.vstack([raw_uT, corrected_uT])).max()

@@ -23,7 +23,7 @@ from scenarios.figures import angle_curve, fault_text, faults_of, floor_span, la
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.flight.controller import SETPOINT_UNITS
 from scenarios.flight.profile_file import FileProfile, is_profile_file
-from scenarios.metge import add_compensator
+from scenarios.metge import add_compensator, vehicle_settings
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
@@ -194,7 +194,7 @@ def build(o: dict, estimator=None) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
-    add_compensator(system, o["compensation"], o["calibration"])
+    add_compensator(system, o["compensation"], o["calibration"], settings=vehicle_settings(o))
     return system
 
 
@@ -257,10 +257,45 @@ def report(result, o, out) -> dict:
             result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"),
             BIAS_TOLERANCE)
         metrics["bias_convergence_tolerance_rad_s"] = BIAS_TOLERANCE
+    metrics |= _predictions(result, o)
+    metrics |= _flight_findings(result, o)
+    metrics["attitude_span_deg"] = [math.degrees(float(np.ptp(result[f"Quadrotor.theta{k}"]))) for k in (1, 2, 3)]
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
     return metrics
+
+
+def _predictions(result, o) -> dict:
+    """What the linearised analyses (:mod:`estimators.analysis`) predict for this run's gyro bias:
+    the passive filter's bias-convergence time (s), the explicit filter's steady error without
+    bias estimate (deg, roll, pitch, yaw); nothing without a bias or for the other filters."""
+    if not o["bias"] or o["estimator"] not in ("explicit", "passive"):
+        return {}
+    from estimators import analysis
+
+    gains, bias = estimator_gains(o), result["IMU.gyro_bias"][0]
+    if o["estimator"] == "passive" and gains["kI"] > 0:
+        return {"bias_convergence_predicted_s": analysis.passive_bias_convergence_time(
+            gains["kP"], gains["kI"], float(np.abs(bias).max()), BIAS_TOLERANCE)}
+    if o["estimator"] == "explicit" and gains["kI"] == 0:
+        predicted = analysis.explicit_bias_steady_error(gains["k1"], gains["k2"], gains["kP"], bias)
+        return {"steady_error_predicted_deg": np.degrees(predicted).tolist()}
+    return {}
+
+
+def _flight_findings(result, o) -> dict:
+    """What the flight shows of the drag model: the tilt step's lag and speed (``flight=tilt``),
+    the tilt into a steady wind and the position held (a wind on a position-holding flight)."""
+    from scenarios.flight import measured
+
+    found = {}
+    if o["flight"] == "tilt":
+        found |= measured.tilt_step(result, math.radians(o["tilt_deg"]), o["rotor_drag"])
+    wind = math.hypot(o["wind_n"], o["wind_e"])
+    if wind > 0 and o["flight"] == "hover":
+        found |= measured.wind_hold(result, wind)
+    return found
 
 
 def steady_errors(result) -> dict:

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import scenarios
-from estimators import recording, score
+from estimators import DEFAULT_GAINS, recording, score
+from orchestrator.result import Result
 from scenarios import replay
 
 
@@ -43,9 +44,11 @@ def test_a_recording_without_rate_or_sensor_is_refused_by_name(tmp_path):
     np.savez(tmp_path / "a.npz", gyro=np.zeros((5, 3)), acc=np.zeros((5, 3)), mag=np.zeros((5, 3)))
     with pytest.raises(ValueError, match="gives no sampling rate"):
         recording.load(tmp_path / "a.npz")
-    np.savez(tmp_path / "b.npz", gyro=np.zeros((5, 3)), acc=np.zeros((5, 3)), rate=100.0)
-    with pytest.raises(ValueError, match="has no mag array"):
+    np.savez(tmp_path / "b.npz", gyro=np.zeros((5, 3)), mag=np.zeros((5, 3)), rate=100.0)
+    with pytest.raises(ValueError, match="has no acc array"):
         recording.load(tmp_path / "b.npz")
+    np.savez(tmp_path / "c.npz", gyro=np.ones((5, 3)), acc=np.ones((5, 3)), rate=100.0)
+    assert not recording.load(tmp_path / "c.npz")["mag"].any()  # a 6-axis recording: zeros, the filters warn
 
 
 def test_replay_command_line(tmp_path, capsys):
@@ -55,6 +58,23 @@ def test_replay_command_line(tmp_path, capsys):
                         "--json", str(tmp_path / "out.json")]) == 0
     result = json.loads((tmp_path / "out.json").read_text())
     assert result["estimator"] == "explicit" and result["gains"] == {"kP": 0.5}
+    assert result["gains_in_force"]["kP"] == 0.5 and result["gains_in_force"]["kI"] == DEFAULT_GAINS["explicit"]["kI"]
+    # the results folder of the run itself, with no flag: its own estimator again, its own error
+    assert replay.main([str(tmp_path / "run"), "--json", str(tmp_path / "same.json")]) == 0
+    same = json.loads((tmp_path / "same.json").read_text())
+    run = Result.from_npz(tmp_path / "run" / "results.npz")
+    settle = json.loads((tmp_path / "run" / "metrics.json").read_text())["settle_s"]
+    reported = score(run["Quaternion_estim.q_est"], run["Quadrotor.q"], run.time >= min(settle, 0.5))
+    assert same["estimator"] == "madgwick" and same["gains_in_force"] == {"beta": 0.041}
+    assert abs(same["errors"]["total_rmse_deg"] - reported["total_rmse_deg"]) < 1e-9
+    # every estimator option by name, ry included
+    assert replay.main([str(tmp_path / "run" / "results.npz"), "--estimator", "passive", "--ry", "triad", "--set",
+                        "k2=0.1", "--corrections", "heading_only", "--discretisation", "euler", "--b0", "0,0,0.01",
+                        "--json", str(tmp_path / "passive.json")]) == 0
+    passive = json.loads((tmp_path / "passive.json").read_text())
+    assert passive["ry"] == "triad" and passive["discretisation"] == "euler" and passive["b0"] == [0, 0, 0.01]
+    assert passive["gains_in_force"]["k2"] == 0.1 and passive["gains_in_force"]["heading_only"] == 1.0
+    assert passive["gains_in_force"]["acc_tolerance"] == 0.0  # the corrections not named are off
     assert result["errors"]["total_rmse_deg"] < 2.5  # 1.94 deg measured: a 1 s run, the start of convergence
     assert replay.main([str(tmp_path / "missing.npz")]) == 2
     assert "no recording at" in capsys.readouterr().err

@@ -1,0 +1,72 @@
+"""Findings on public real recordings: our filters at their defaults against VQF, Madgwick and Mahony.
+
+The numbers need the datasets, which are not shipped (:mod:`benchmarks.datasets` says where each
+comes from): set ``QUADCOSIM_REAL_DATA`` to the data folder (and optionally
+``QUADCOSIM_REAL_CACHE`` to a folder keeping the published filters' results, which take tens of
+minutes). Without the data, :func:`compute` raises ``FileNotFoundError``: the group is skipped and
+its recorded values stay as they were, not reproducible on a machine without the data (CI).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+COMMAND = "python -m benchmarks.real_recordings DATA"
+FILTERS = {"explicit": "explicit", "passive": "passive", "vqf": "VQF", "madgwick": "Madgwick", "mahony": "Mahony"}
+METRICS = {"total_rmse_deg": "total", "heading_rmse_deg": "heading", "inclination_rmse_deg": "inclination"}
+TOLERANCE_DEG = 0.005  # deg: the figures are deterministic; printed to 2 decimals
+DIGITS = 2
+
+
+def _entry(name, value, unit, digits=DIGITS, tolerance=TOLERANCE_DEG) -> dict:
+    return {"name": f"real_recordings.{name}", "value": float(value), "unit": unit, "command": COMMAND,
+            "tolerance": tolerance, "digits": digits}
+
+
+def findings(results: dict) -> list[dict]:
+    """The findings of :func:`benchmarks.real_recordings.evaluate`'s ``results``: per dataset, its
+    number of recordings, every filter's mean total, heading and inclination RMSE (deg), and our
+    best filter's mean total RMSE over VQF's."""
+    out = []
+    for dataset, found in results.items():
+        out.append(_entry(f"{dataset}.recordings", found["recordings"], "1", 0, 0.0))
+        for kind in FILTERS:
+            for metric in METRICS:
+                out.append(_entry(f"{dataset}.{kind}.{metric}", found["means"][kind][metric], "deg"))
+        best = min(found["means"][k]["total_rmse_deg"] for k in ("explicit", "passive"))
+        out.append(_entry(f"{dataset}.best_over_vqf", best / found["means"]["vqf"]["total_rmse_deg"], "1"))
+    return out
+
+
+def compute(quick: bool = False) -> list[dict]:
+    """The group's findings, from the data folder named by ``QUADCOSIM_REAL_DATA``; ``quick`` runs the
+    same (the published filters' results come from ``QUADCOSIM_REAL_CACHE`` when kept there).
+    Raises ``FileNotFoundError`` when the data are absent."""
+    folder = os.environ.get("QUADCOSIM_REAL_DATA")
+    if not folder or not Path(folder).is_dir():
+        raise FileNotFoundError("the real recordings are not on this machine: set QUADCOSIM_REAL_DATA to their "
+                                "folder (see benchmarks/datasets.py); the recorded values are kept")
+    from benchmarks import real_recordings
+
+    return findings(real_recordings.evaluate(folder, cache=os.environ.get("QUADCOSIM_REAL_CACHE")))
+
+
+def readme_tables(results: dict) -> str:
+    """The README's two tables (mean total RMSE and best over VQF; heading and inclination) from
+    :func:`benchmarks.real_recordings.evaluate`'s ``results``."""
+    from benchmarks.real_recordings import HELD_OUT
+
+    head = "| dataset (recordings) | role | " + " | ".join(FILTERS.values()) + " | best / VQF |"
+    lines = [head, "|---" * (len(FILTERS) + 3) + "|"]
+    detail = ["| dataset | " + " | ".join(f"{label} heading / incl." for label in FILTERS.values()) + " |",
+              "|---" * (len(FILTERS) + 1) + "|"]
+    for dataset, found in results.items():
+        m = found["means"]
+        role = "held out" if dataset in HELD_OUT else "chose the defaults"
+        best = min(m["explicit"]["total_rmse_deg"], m["passive"]["total_rmse_deg"]) / m["vqf"]["total_rmse_deg"]
+        lines.append(f"| {dataset} ({found['recordings']}) | {role} | " +
+                     " | ".join(f"{m[k]['total_rmse_deg']:.2f}" for k in FILTERS) + f" | {best:.2f} |")
+        detail.append(f"| {dataset} | " + " | ".join(
+            f"{m[k]['heading_rmse_deg']:.2f} / {m[k]['inclination_rmse_deg']:.2f}" for k in FILTERS) + " |")
+    return "\n".join(lines) + "\n\n" + "\n".join(detail)
