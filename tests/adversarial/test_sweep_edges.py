@@ -35,7 +35,7 @@ def test_a_plan_over_the_limit_is_refused_by_its_count_before_any_value_is_made(
 
 def test_a_100000_member_plan_is_made_member_by_member_in_little_memory():
     tracemalloc.start()
-    plan = grid.plan("tp", ["estimator=linear,explicit"], ["duration=5"], seeds="50000")
+    plan = grid.plan("tp", ["estimator=linear,explicit"], ["duration=5", "noise=on"], seeds="50000")
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert len(plan.members) == 100_000
