@@ -257,6 +257,37 @@ def parser() -> argparse.ArgumentParser:
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
     listing.set_defaults(func=_list)
+    _add_run(sub)
+    diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
+    diagram.add_argument("scenario")
+    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
+    diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
+    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
+    diagram.set_defaults(func=_diagram)
+    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))
+    bench.add_argument("--json", action="store_true")
+    bench.add_argument("--seconds", type=float, default=5.0)
+    bench.set_defaults(func=_bench)
+    findings = sub.add_parser("findings", add_help=False,
+                              help="run the README's findings, write findings.json, rewrite the README's numbers "
+                                   "(quadcosim findings --help)")
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
+    from scenarios import run_plots
+
+    run_plots.add_arguments(sub)
+    from scenarios.sweep import command as sweep
+
+    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
+        .set_defaults(func=sweep.sweep)
+    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
+        .set_defaults(func=sweep.sweep_plot)
+    _add_flight_logs(sub)
+    return p
+
+
+def _add_run(sub):
+    """The ``run`` sub-command, added to the sub-parsers ``sub``."""
     run = sub.add_parser("run", help="run a scenario")
     run.add_argument("scenario")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
@@ -286,32 +317,6 @@ def parser() -> argparse.ArgumentParser:
                      help="write the record to OUT/results.stream/ in chunks as the run goes: memory stays flat "
                           "however long the run (read it with Result.load(OUT))")
     run.set_defaults(func=_run)
-    diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
-    diagram.add_argument("scenario")
-    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
-    diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
-    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
-    diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))
-    bench.add_argument("--json", action="store_true")
-    bench.add_argument("--seconds", type=float, default=5.0)
-    bench.set_defaults(func=_bench)
-    findings = sub.add_parser("findings", add_help=False,
-                              help="run the README's findings, write findings.json, rewrite the README's numbers "
-                                   "(quadcosim findings --help)")
-    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
-    from scenarios import run_plots
-
-    run_plots.add_arguments(sub)
-    from scenarios.sweep import command as sweep
-
-    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
-        .set_defaults(func=sweep.sweep)
-    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
-        .set_defaults(func=sweep.sweep_plot)
-    _add_flight_logs(sub)
-    return p
 
 
 def _add_flight_logs(sub):
