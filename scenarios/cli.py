@@ -269,9 +269,10 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
-    sub.add_parser("findings", add_help=False,  # main() hands its arguments to scenarios.findings
-                   help="run the README's findings, write findings.json, rewrite the README's numbers "
-                        "(quadcosim findings --help)")
+    findings = sub.add_parser("findings", add_help=False,
+                              help="run the README's findings, write findings.json, rewrite the README's numbers "
+                                   "(quadcosim findings --help)")
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
     from scenarios import run_plots
 
     run_plots.add_arguments(sub)
@@ -286,7 +287,7 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _add_run(sub):
-    """The ``run`` sub-command's options."""
+    """The ``run`` sub-command, added to the sub-parsers ``sub``."""
     run = sub.add_parser("run", help="run a scenario")
     run.add_argument("scenario")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
