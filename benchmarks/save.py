@@ -1,13 +1,17 @@
 """What saving costs in a long run: ``save_fraction``, the CPU of writing a 320 s ``tp``
 run's record over the CPU of the whole run (``quadcosim bench`` reports it).
 
-``python -m benchmarks.save [--duration 320] [--compressed] [--json]``
+``python -m benchmarks.save [--duration 320] [--compressed] [--stream-peak] [--json]``
 
 The run is ``scenarios.run("tp", duration=320)`` into a temporary folder, in this process,
 after a short run that loads the compiled steps. Its CPU time (``time.process_time``: the
 build, the loop, the save, the report and its figures) is measured around the call; the save's
 CPU is the time :class:`scenarios.outputs.RunFiles` spends writing the record
 (``metrics.json``'s ``save_cpu_s``). ``--compressed`` measures the compressed archive too.
+
+``--stream-peak`` measures how flat ``--stream`` keeps memory: the peak resident set of
+``quadcosim run tp --stream`` (bench supply on) for 60 s and 3600 s of flight, each in a child
+process (:func:`benchmarks.memory.peak_rss`), and their ratio.
 """
 
 from __future__ import annotations
@@ -60,19 +64,53 @@ def figures(duration: float = DURATION_S) -> dict:
             "save_run_cpu_s": measured["run_cpu_s"]}
 
 
+def stream_peak(durations=(60.0, 3600.0)) -> dict:
+    """Peak memory of streamed ``tp`` runs of each duration and the ratio of the last to the first.
+
+    Parameters
+    ----------
+    durations : sequence of float
+        Simulated seconds of each run.
+
+    Returns
+    -------
+    dict
+        ``peak_mb`` (duration to MB) and ``ratio`` (longest over shortest).
+    """
+    from benchmarks.memory import peak_rss
+
+    peaks = {}
+    for duration in durations:
+        with tempfile.TemporaryDirectory() as folder:
+            peaks[duration] = peak_rss([sys.executable, "-m", "scenarios.cli", "run", "tp", "--set",
+                                        f"duration={duration:g}", "bench_supply=on", "--stream", "--out",
+                                        str(Path(folder) / "run")]) / 1e6
+    return {"peak_mb": peaks, "ratio": peaks[durations[-1]] / peaks[durations[0]]}
+
+
 def main(argv=None) -> int:
-    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked)."""
+    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (the process's by default).
+    """
     parser = argparse.ArgumentParser(prog="python -m benchmarks.save", description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=DURATION_S, help="simulated seconds (default 320)")
     parser.add_argument("--compressed", action="store_true", help="measure the compressed archive too")
+    parser.add_argument("--stream-peak", action="store_true", help="peak memory of 60 s and 3600 s streamed runs")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
     found = {"uncompressed": save_fraction(args.duration)}
     if args.compressed:
         found["compressed"] = save_fraction(args.duration, compress=True)
+    peak = stream_peak() if args.stream_peak else None
     if args.json:
-        print(json.dumps(found))
+        print(json.dumps(found | ({"stream_peak": peak} if peak else {})))
     else:
+        if peak:
+            print(f"--stream peak memory: {peak['peak_mb']} MB, ratio {peak['ratio']:.3f}")
         for kind, measured in found.items():
             print(f"{kind:13s} save_fraction {measured['fraction']:.3f}: save {measured['save_cpu_s']:.3f} s of "
                   f"{measured['run_cpu_s']:.2f} s CPU, results.npz {measured['record_mb']:.0f} MB")

@@ -85,7 +85,18 @@ _state = _State()
 
 
 def interrupt_for(number: int) -> KeyboardInterrupt:
-    """The exception a signal raises: :class:`Terminated` for SIGTERM, else ``KeyboardInterrupt``."""
+    """The exception a signal raises.
+
+    Parameters
+    ----------
+    number : int
+        Signal number.
+
+    Returns
+    -------
+    KeyboardInterrupt
+        :class:`Terminated` for SIGTERM, else ``KeyboardInterrupt``.
+    """
     return Terminated() if number == signal.SIGTERM else KeyboardInterrupt()
 
 

@@ -8,6 +8,7 @@ largest), and a compressed ``.mat`` file holds a whole block in memory while it 
 
 from __future__ import annotations
 
+import functools
 import resource
 from pathlib import Path
 
@@ -16,7 +17,13 @@ UNLIMITED = 2 ** 60
 
 
 def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
-    """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown."""
+    """``MemAvailable`` (bytes): what the kernel can give without swapping; None if unknown.
+
+    Parameters
+    ----------
+    meminfo : str
+        The kernel's memory table.
+    """
     try:
         with open(meminfo) as lines:
             for line in lines:
@@ -29,7 +36,13 @@ def machine_available(meminfo: str = "/proc/meminfo") -> int | None:
 
 def address_space_left(status: str = "/proc/self/status") -> int | None:
     """Bytes of address space left under ``ulimit -v`` (``RLIMIT_AS``) beyond what the process
-    maps already (``VmSize``); None without a limit."""
+    maps already (``VmSize``); None without a limit.
+
+    Parameters
+    ----------
+    status : str
+        The process's status table (its ``VmSize``).
+    """
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
         return None
@@ -46,29 +59,57 @@ def address_space_left(status: str = "/proc/self/status") -> int | None:
 
 def cgroup_left(membership: str = "/proc/self/cgroup", root: str = "/sys/fs/cgroup") -> int | None:
     """Bytes the process's control group (v2 ``memory.max``, or v1 ``memory.limit_in_bytes``)
-    and each of its ancestors may still take; None without a limit."""
-    try:
-        lines = Path(membership).read_text().splitlines()
-    except OSError:
-        return None
-    left = []
-    for line in lines:
-        number, controllers, path = line.split(":", 2)
-        if number == "0" and controllers == "":  # v2, the unified hierarchy
-            left += _room(Path(root), path, "memory.max", "memory.current")
-        elif "memory" in controllers.split(","):  # v1
-            left += _room(Path(root) / "memory", path, "memory.limit_in_bytes", "memory.usage_in_bytes")
+    and each of its ancestors may still take; None without a limit. The process's own groups
+    (the default paths) and their limits are read once per process, since a sweep checks every
+    member; their usage at every call. Other paths are read whole at every call.
+
+    Parameters
+    ----------
+    membership : str
+        The process's groups, one ``id:controllers:path`` a line (``/proc/self/cgroup``).
+    root : str
+        Where the control-group hierarchies are mounted (``/sys/fs/cgroup``).
+    """
+    if (membership, root) == _OWN:
+        groups = _own_groups()
+    else:
+        groups = _limited_groups(membership, root)
+    left = [max(0, limit - (_number(usage) or 0)) for usage, limit in groups]
     return min(left) if left else None
 
 
-def _room(base: Path, path: str, limit_name: str, usage_name: str) -> list[int]:
-    """``limit - usage`` of the group at ``path`` and of each ancestor that has a limit."""
+_OWN = ("/proc/self/cgroup", "/sys/fs/cgroup")
+
+
+@functools.cache
+def _own_groups() -> tuple[tuple[Path, int], ...]:
+    return _limited_groups(*_OWN)
+
+
+def _limited_groups(membership: str, root: str) -> tuple[tuple[Path, int], ...]:
+    """(usage file, limit) of the control group in ``membership`` and of each ancestor with a limit."""
+    try:
+        lines = Path(membership).read_text().splitlines()
+    except OSError:
+        return ()
+    found = []
+    for line in lines:
+        number, controllers, path = line.split(":", 2)
+        if number == "0" and controllers == "":  # v2, the unified hierarchy
+            found += _limits(Path(root), path, "memory.max", "memory.current")
+        elif "memory" in controllers.split(","):  # v1
+            found += _limits(Path(root) / "memory", path, "memory.limit_in_bytes", "memory.usage_in_bytes")
+    return tuple(found)
+
+
+def _limits(base: Path, path: str, limit_name: str, usage_name: str) -> list[tuple[Path, int]]:
+    """(usage file, limit) of the group at ``path`` and of each ancestor that has a limit."""
     found = []
     group = base / path.strip("/")
     while True:
-        limit, usage = _number(group / limit_name), _number(group / usage_name)
+        limit = _number(group / limit_name)
         if limit is not None and limit < UNLIMITED:
-            found.append(max(0, limit - (usage or 0)))
+            found.append((group / usage_name, limit))
         if group == base or base not in group.parents:
             return found
         group = group.parent

@@ -124,6 +124,13 @@ def input_runs(refs: list[tuple[int, int]]) -> list[tuple[np.ndarray, int]]:
     return [(np.array([vr for vr, _ in refs[i:j]], dtype=np.uint32), slots[i]) for i, j in consecutive(slots)]
 
 
+#: A record this large (bytes) is touched once before the loop. A smaller one is served by the
+#: allocator from memory it recycles (glibc maps fresh pages only above its mmap threshold,
+#: which rises to 32 MB as large blocks are freed), so touching it would cost a run, such as a
+#: sweep member, more than the page faults it saves.
+PRE_TOUCH_BYTES = 32 * 2**20
+
+
 class Plan:
     """Everything resolved once for one run of ``system``: bus, recording, calls, phases.
 
@@ -202,7 +209,8 @@ class Plan:
             rows = window_rows(len(slots), rows)
         check_record_fits(rows, len(slots), self.decimation)
         self.record = np.empty((rows, len(slots)))
-        self.record.fill(0.0)  # touched once here: no first-touch page fault inside the loop
+        if self.record.nbytes >= PRE_TOUCH_BYTES:
+            self.record.fill(0.0)  # touched once here: no first-touch page fault inside the loop
         self.recorded = 0
         if self.stream is not None:
             self.stream.start(self.names, self.units)

@@ -166,17 +166,23 @@ def envelope(t: np.ndarray, y: np.ndarray, points: int = 2000) -> tuple[np.ndarr
         return t, y
     size = -(-n // points)
     full = n // size * size
-    runs = y[:full].reshape(-1, size)  # a view, even of a column of the record
+    keep = np.concatenate([run_extremes(y[:full], size), np.arange(full, n)])
+    keep.sort()
+    return t[keep], y[keep]
+
+
+def run_extremes(y: np.ndarray, size: int) -> np.ndarray:
+    """Indices of the minimum and of the maximum of each run of ``size`` samples of ``y``
+    (whose length is a multiple of ``size``): the lower index of each pair, then the higher."""
+    runs = y.reshape(-1, size)  # a view, even of a column of the record
     lows, highs = np.empty(len(runs), dtype=np.intp), np.empty(len(runs), dtype=np.intp)
     for first in range(0, len(runs), 64):  # a few runs at a time: a strided view is copied to reduce
         group = runs[first:first + 64]
         lows[first:first + 64], highs[first:first + 64] = group.argmin(axis=1), group.argmax(axis=1)
-    starts = np.arange(0, full, size)
+    starts = np.arange(0, len(y), size)
     lows += starts
     highs += starts
-    keep = np.concatenate([np.minimum(lows, highs), np.maximum(lows, highs), np.arange(full, n)])
-    keep.sort()
-    return t[keep], y[keep]
+    return np.concatenate([np.minimum(lows, highs), np.maximum(lows, highs)])
 
 
 def expand(name: str, available) -> list[str]:
@@ -285,6 +291,35 @@ class Result:
         members = self.columns(name)
         columns = [self._index[m] for m in members]
         return self.data[:, columns[0]] if len(columns) == 1 and members[0] == name else self.data[:, columns]
+
+    # ------------------------------------------------------------------ windows
+    def windows(self):
+        """The record as consecutive windows of rows, each a :class:`Result`: the record
+        itself when it is in memory (a streamed record gives one window per chunk, read one at
+        a time), so that a report can take its statistics window by window.
+
+        Yields
+        ------
+        Result
+        """
+        yield self
+
+    def envelope(self, of, points: int = 2000) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`envelope` of the curve ``of(window)`` against time, over the whole record.
+
+        Parameters
+        ----------
+        of : callable
+            A window (:meth:`windows`) to the values drawn at its samples.
+        points : int
+            Runs of samples (each keeps its minimum and maximum).
+
+        Returns
+        -------
+        (ndarray, ndarray)
+            Times (s) and values kept.
+        """
+        return envelope(self.time, of(self), points)
 
     # ------------------------------------------------------------------ exports
     # Each export writes a temporary file beside the target and renames it when complete, so

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.files import atomic_path, write_json
-from orchestrator.result import Result
+from orchestrator.result import Result, envelope, run_extremes
 
 #: Bytes of the window of rows held in memory before they go to disk.
 WINDOW_BYTES = 8 * 2 ** 20
@@ -56,7 +56,15 @@ class StreamWriter:
         self.units: dict[str, str] = {}
 
     def start(self, names, units: dict):
-        """Create the folder and its first ``meta.json``, before the first row."""
+        """Create the folder and its first ``meta.json``, before the first row.
+
+        Parameters
+        ----------
+        names : sequence of str
+            The recorded signals, in the order of the rows' columns.
+        units : dict
+            Unit of each signal.
+        """
         self.names, self.units = list(names), dict(units)
         self.path.mkdir(parents=True, exist_ok=False)
         self._write_meta({}, None, ended=False)
@@ -74,7 +82,15 @@ class StreamWriter:
         self.samples += len(rows)
 
     def close(self, meta: dict, error: str | None = None):
-        """Write the final ``meta.json``: the run's meta data and the samples written."""
+        """Write the final ``meta.json``: the run's meta data and the samples written.
+
+        Parameters
+        ----------
+        meta : dict
+            The run's meta data (step, decimation, scenario, warnings).
+        error : str, optional
+            The message of the failure that ended the run.
+        """
         self._write_meta(meta, error, ended=True)
 
     def _write_meta(self, meta: dict, error: str | None, ended: bool):
@@ -101,8 +117,13 @@ class StreamedResult(Result):
         if meta.get("ended"):
             self.chunk_files = self.chunk_files[:meta["chunks"]]
         names = meta.pop("names")
-        time = np.concatenate([self._chunk(f)[0] for f in self.chunk_files]) if self.chunk_files else np.empty(0)
         error = meta.pop("error", None)
+        lengths = [self._chunk(path).shape[1] for path in self.chunk_files]  # from the headers alone
+        time = np.empty(sum(lengths))
+        at = 0
+        for path, length in zip(self.chunk_files, lengths, strict=True):  # one chunk mapped at a time
+            time[at:at + length] = self._chunk(path)[0]
+            at += length
         super().__init__(time, names, None, meta, error)
 
     @staticmethod
@@ -139,3 +160,37 @@ class StreamedResult(Result):
         if len(members) == 1 and members[0] == name:
             return self._column(self._index[name])
         return np.stack([self._column(self._index[m]) for m in members], axis=1)
+
+    def windows(self):
+        """One :class:`Result` per chunk, read one at a time (see :meth:`Result.windows`)."""
+        for path in self.chunk_files:
+            block = np.load(path)
+            yield Result(block[0], self.names, block[1:].T, self.meta, self.error)
+
+    def envelope(self, of, points: int = 2000) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`orchestrator.result.envelope` of ``of(window)``, chunk by chunk: the runs
+        are those of the whole record, and a run that spans two chunks is carried over, so the
+        samples kept are those of the envelope of the whole curve.
+
+        Parameters
+        ----------
+        of : callable
+            A window (one chunk, a :class:`Result`) to the values drawn at its samples.
+        points : int
+            Runs of samples (each keeps its minimum and maximum).
+        """
+        n = len(self.time)
+        if n <= 2 * points:
+            return envelope(self.time, of(self), points)
+        size = -(-n // points)
+        times, values = [], []
+        carry_t, carry_y = np.empty(0), np.empty(0)
+        for window in self.windows():
+            t, y = np.concatenate([carry_t, window.time]), np.concatenate([carry_y, of(window)])
+            full = len(y) // size * size
+            keep = run_extremes(y[:full], size)
+            keep.sort()
+            times.append(t[keep])
+            values.append(y[keep])
+            carry_t, carry_y = t[full:], y[full:]
+        return np.concatenate([*times, carry_t]), np.concatenate([*values, carry_y])

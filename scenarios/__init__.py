@@ -386,7 +386,7 @@ def _run_phases(scenario, options, base, files, given, progress):
                f"({len(saved) if saved else len(result.names)} signals, {len(result)} samples)")
         files.keep_record(result, saved, files.stream)
         if files.not_written:  # a full disk, or no memory left for a writer: metrics.json says which
-            raise files.failed("; ".join(f"{name} not written: {why}" for name, why in files.not_written.items()))
+            raise files.failed("; ".join(f"{file} not written: {why}" for file, why in files.not_written.items()))
         files.phase = "reporting (metrics and figures)"
     status(f"{name}: report" + (" (metrics and figures)" if files else " (metrics)"))
     metrics |= _report(scenario, result, options, files, record)

@@ -287,7 +287,7 @@ def parser() -> argparse.ArgumentParser:
 
 
 def _add_run(sub):
-    """The ``run`` verb and its options on the sub-parsers ``sub``."""
+    """The ``run`` sub-command, added to the sub-parsers ``sub``."""
     run = sub.add_parser("run", help="run a scenario")
     run.add_argument("scenario")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",

@@ -172,7 +172,25 @@ def angle_curve(t, degrees, points: int = 2000):
     from orchestrator.result import envelope
 
     unwrapped = np.degrees(np.unwrap(np.radians(degrees)))
-    times, values = envelope(t, unwrapped, points)
+    return wrapped_curve(*envelope(t, unwrapped, points))
+
+
+def wrapped_curve(times, values):
+    """An unwrapped angle's envelope (deg) wrapped to (-180, 180] deg, with a gap (NaN) where it
+    wraps (see :func:`angle_curve`).
+
+    Parameters
+    ----------
+    times : ndarray
+        Times (s).
+    values : ndarray
+        The unwrapped angle (deg) at those times.
+
+    Returns
+    -------
+    times, values : ndarray
+        Ready for ``ax.plot``.
+    """
     wrapped = (values + 180.0) % 360.0 - 180.0
     breaks = np.flatnonzero(np.abs(np.diff(wrapped)) > WRAP_JUMP_DEG) + 1
     return np.insert(times.astype(float), breaks, np.nan), np.insert(wrapped, breaks, np.nan)

@@ -93,6 +93,7 @@ def report(result, o, out) -> dict:
         ``hover_current_A`` (motor 1 at 0.7 s), ``us_per_step`` and ``real_time_factor`` of the
         loop, and the figures written.
     """
+    figures = _figures(result, o, out)  # first: the figures need the most signals
     loop = result.meta.get("loop_seconds")
     return {
         "final_position_m": result["Quadrotor.p"][-1].tolist(),
@@ -102,7 +103,7 @@ def report(result, o, out) -> dict:
                                  if result.time[-1] >= 0.7 else np.nan),
         "us_per_step": None if loop is None else loop / (len(result) - 1) * 1e6,
         "real_time_factor": None if loop is None else o["duration"] / loop,
-        "figures": _figures(result, o, out),
+        "figures": figures,
         "units": {"us_per_step": "us", "real_time_factor": "1"},
     }
 

@@ -29,7 +29,13 @@ RESERVE_BYTES = 64 * 1024
 
 
 def empty_result(meta: dict | None = None) -> Result:
-    """A record of no sample and no signal: what a run stopped before its loop leaves."""
+    """A record of no sample and no signal: what a run stopped before its loop leaves.
+
+    Parameters
+    ----------
+    meta : dict, optional
+        The run's meta data.
+    """
     return Result(np.empty(0), [], np.empty((0, 0)), meta)
 
 
@@ -148,7 +154,19 @@ class RunFiles:
 
     def stopped(self, error: SimulationError, signals=None, stream=None, complete: bool = False):
         """Keep what a failed or interrupted run recorded, and a ``metrics.json`` saying where
-        it stopped, in which phase and what was kept."""
+        it stopped, in which phase and what was kept.
+
+        Parameters
+        ----------
+        error : orchestrator.SimulationError
+            What stopped the run; its ``result`` is what was recorded (None: nothing).
+        signals : list of str, optional
+            The signals the files hold.
+        stream : orchestrator.stream.StreamWriter, optional
+            The record's stream, with ``--stream``.
+        complete : bool
+            The loop had ended: the record is whole.
+        """
         partial = error.result if error.result is not None else empty_result()
         if not partial.names:  # stopped before the loop: an empty record, every format
             signals = None
@@ -169,7 +187,22 @@ class RunFiles:
 
     def interrupted(self, interrupt: BaseException, signals=None, stream=None) -> RunInterrupted:
         """Keep what was recorded when a signal stopped the run outside its loop (building,
-        drawing, reporting), and say so in ``metrics.json``; the error to raise."""
+        drawing, reporting), and say so in ``metrics.json``.
+
+        Parameters
+        ----------
+        interrupt : KeyboardInterrupt
+            The interrupt raised (:class:`orchestrator.interrupts.Terminated` for SIGTERM).
+        signals : list of str, optional
+            The signals the files hold.
+        stream : orchestrator.stream.StreamWriter, optional
+            The record's stream, with ``--stream``.
+
+        Returns
+        -------
+        orchestrator.RunInterrupted
+            The error to raise.
+        """
         number = stopping() or signal_number(interrupt)
         message = f"interrupted by {signal_name(number)} while {self.phase}"
         record = self.result if self.result is not None else empty_result()
@@ -178,7 +211,18 @@ class RunFiles:
         return error
 
     def failed(self, message: str) -> SimulationError:
-        """A complete record whose report failed: ``metrics.json`` says so; the error to raise."""
+        """A complete record whose report failed: ``metrics.json`` says so.
+
+        Parameters
+        ----------
+        message : str
+            What failed.
+
+        Returns
+        -------
+        orchestrator.SimulationError
+            The error to raise, with the record.
+        """
         error = SimulationError(message, self.result)
         self.stopped(error, complete=True)
         return error
@@ -245,7 +289,17 @@ class RunFiles:
 
     def disk_need(self, rows: int, signals: int, vector_members: int) -> int:
         """Bytes the uncompressed record files take (a compressed file is not counted: its size
-        is not known before it is written)."""
+        is not known before it is written).
+
+        Parameters
+        ----------
+        rows : int
+            Samples.
+        signals : int
+            Signals written (the time is counted besides).
+        vector_members : int
+            Signals that a ``.mat`` file also holds as members of a vector array.
+        """
         from orchestrator.result import CSV_BYTES_PER_VALUE
 
         values = rows * (signals + 1)

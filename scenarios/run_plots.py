@@ -23,7 +23,7 @@ def load(run) -> tuple:
     Parameters
     ----------
     run : str or pathlib.Path
-        The run's folder, or its ``results.npz``.
+        The run's folder, its ``results.npz``, or its streamed record (``--stream``).
 
     Returns
     -------
@@ -38,11 +38,12 @@ def load(run) -> tuple:
     from orchestrator import Result
 
     path = Path(run)
-    archive = path / RESULTS_FILE if path.is_dir() else path
-    if not archive.is_file() or archive.suffix != ".npz":
-        raise ValueError(f"{run}: no {RESULTS_FILE} there; give the folder of a finished run (the --out of "
-                         "`quadcosim run`, e.g. results/tp) or its results.npz")
-    return Result.from_npz(archive), archive.parent
+    folder = path if path.is_dir() else path.parent
+    try:
+        return Result.load(path), folder
+    except (FileNotFoundError, OSError, ValueError):
+        raise ValueError(f"{run}: no {RESULTS_FILE} or streamed record there; give the folder of a finished run "
+                         "(the --out of `quadcosim run`, e.g. results/tp) or its results.npz") from None
 
 
 def _check(result, folder: Path, signal: str):

@@ -16,10 +16,18 @@ from estimators import LAB_GAINS, QuaternionEstim, parse_corrections
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator import System, Table
-from orchestrator.result import envelope
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
-from scenarios.figures import angle_curve, fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
+from scenarios.figures import (
+    angle_curve,
+    fault_text,
+    faults_of,
+    floor_span,
+    label_axes,
+    shade_faults,
+    title_lines,
+    wrapped_curve,
+)
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.flight.controller import SETPOINT_UNITS
 from scenarios.flight.profile_file import FileProfile, is_profile_file
@@ -251,19 +259,37 @@ def report(result, o, out) -> dict:
                "bias_error_final": None, "figures": _figures(result, o, out) + _tilt_figures(result, o, out),
                "units": {"bias_error_final": "rad/s", "real_time_factor": "1"}}
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
-        metrics["bias_error_final"] = [
-            float(result[f"Quaternion_estim.b_est_{a}"][-1] - result[f"IMU.gyro_bias_{a}"][-1]) for a in "xyz"]
-        metrics["bias_convergence_s"] = bias_convergence_time(
-            result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"),
-            BIAS_TOLERANCE)
-        metrics["bias_convergence_tolerance_rad_s"] = BIAS_TOLERANCE
+        metrics |= _bias_statistics(result)
     metrics |= _predictions(result, o)
     metrics |= _flight_findings(result, o)
-    metrics["attitude_span_deg"] = [math.degrees(float(np.ptp(result[f"Quadrotor.theta{k}"]))) for k in (1, 2, 3)]
+    metrics["attitude_span_deg"] = [math.degrees(float(_span(result, f"Quadrotor.theta{k}"))) for k in (1, 2, 3)]
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
     return metrics
+
+
+def _bias_error(window, axis: str) -> np.ndarray:
+    """The gyro bias estimate's error on one axis (rad/s)."""
+    return window[f"Quaternion_estim.b_est_{axis}"] - window[f"IMU.gyro_bias_{axis}"]
+
+
+def _bias_statistics(result) -> dict:
+    """The final gyro bias error (rad/s) and its convergence time (s, :func:`bias_convergence_time`),
+    window by window (:meth:`orchestrator.Result.windows`)."""
+    last, offset, window = -1, 0, None  # index of the last sample outside the tolerance, over every axis
+    for window in result.windows():
+        found = bias_convergence_time(np.arange(len(window)), (_bias_error(window, a) for a in "xyz"),
+                                      BIAS_TOLERANCE)  # the first index inside, in this window
+        if found is None:
+            last = offset + len(window) - 1
+        elif found > 0:
+            last = offset + int(found) - 1
+        offset += len(window)
+    final = [float(_bias_error(window, a)[-1]) for a in "xyz"]
+    converged = None if last == len(result) - 1 else float(result.time[last + 1])
+    return {"bias_error_final": final, "bias_convergence_s": converged,
+            "bias_convergence_tolerance_rad_s": BIAS_TOLERANCE}
 
 
 def _predictions(result, o) -> dict:
@@ -274,7 +300,7 @@ def _predictions(result, o) -> dict:
         return {}
     from estimators import analysis
 
-    gains, bias = estimator_gains(o), result["IMU.gyro_bias"][0]
+    gains, bias = estimator_gains(o), next(result.windows())["IMU.gyro_bias"][0]  # the first sample
     if o["estimator"] == "passive" and gains["kI"] > 0:
         return {"bias_convergence_predicted_s": analysis.passive_bias_convergence_time(
             gains["kP"], gains["kI"], float(np.abs(bias).max()), BIAS_TOLERANCE)}
@@ -298,6 +324,15 @@ def _flight_findings(result, o) -> dict:
     return found
 
 
+def _span(result, name: str) -> float:
+    """``numpy.ptp`` of a signal, its largest minus its smallest value, window by window."""
+    lowest, highest = np.inf, -np.inf
+    for window in result.windows():
+        values = window[name]
+        lowest, highest = min(lowest, values.min()), max(highest, values.max())
+    return highest - lowest
+
+
 def steady_errors(result) -> dict:
     """Mean estimation and tracking errors over the last :data:`STEADY_SHARE` of the run: the
     steady error a filter without bias estimate keeps.
@@ -313,28 +348,40 @@ def steady_errors(result) -> dict:
         ``steady_error_deg`` and ``steady_tracking_error_deg`` (deg; roll, pitch, yaw, wrapped
         to +-180), ``steady_window_s`` (its first and last time, s).
     """
-    late = slice(np.searchsorted(result.time, result.time[0] + (1 - STEADY_SHARE) * (result.time[-1] - result.time[0])),
-                 None)
-    estimation = [math.degrees(float(_error(result, "Quaternion_estim.theta_est", k)[late].mean())) for k in range(3)]
-    tracking = [math.degrees(float(_error(result, _SETPOINTS[k], k)[late].mean())) for k in range(3)]
-    return {"steady_error_deg": estimation, "steady_tracking_error_deg": tracking,
-            "steady_window_s": [float(result.time[late][0]), float(result.time[-1])]}
+    start = result.time[0] + (1 - STEADY_SHARE) * (result.time[-1] - result.time[0])
+    sums, count = np.zeros(6), 0
+    for window in result.windows():  # sums of the errors after `start`, window by window
+        late = slice(np.searchsorted(window.time, start), None)
+        for k in range(3):
+            sums[k] += _error(window, "Quaternion_estim.theta_est", k)[late].sum()
+            sums[3 + k] += _error(window, _SETPOINTS[k], k)[late].sum()
+        count += len(window.time[late])
+    means = [math.degrees(float(total / count)) for total in sums]
+    first = result.time[np.searchsorted(result.time, start)]
+    return {"steady_error_deg": means[:3], "steady_tracking_error_deg": means[3:],
+            "steady_window_s": [float(first), float(result.time[-1])]}
 
 
 def _error_statistics(result, settle: float) -> dict:
     """RMS and largest estimation error, RMS tracking error (deg; roll, pitch, yaw) after
     ``settle`` seconds, one error column at a time."""
-    after = slice(np.searchsorted(result.time, settle), None)
-    rms, peak, tracking_rms = [], [], []
-    for k in range(3):
-        error = _error(result, "Quaternion_estim.theta_est", k)[after]
-        rms.append(math.degrees(math.sqrt(np.dot(error, error) / len(error))))
-        peak.append(math.degrees(max(error.max(), -error.min())))
-        del error
-        error = _error(result, _SETPOINTS[k], k)[after]
-        tracking_rms.append(math.degrees(math.sqrt(np.dot(error, error) / len(error))))
-        del error
-    return {"rms_error_deg": rms, "max_error_deg": peak, "tracking_rms_deg": tracking_rms}
+    squares, peaks, count = np.zeros(6), np.full(3, -np.inf), 0
+    for window in result.windows():
+        after = slice(np.searchsorted(window.time, settle), None)
+        if not len(window.time[after]):
+            continue
+        for k in range(3):
+            error = _error(window, "Quaternion_estim.theta_est", k)[after]
+            squares[k] += np.dot(error, error)
+            peaks[k] = max(peaks[k], error.max(), -error.min())
+            del error
+            error = _error(window, _SETPOINTS[k], k)[after]
+            squares[3 + k] += np.dot(error, error)
+            del error
+        count += len(window.time[after])
+    rms = [math.degrees(math.sqrt(total / count)) for total in squares]
+    return {"rms_error_deg": rms[:3], "max_error_deg": [math.degrees(p) for p in peaks],
+            "tracking_rms_deg": rms[3:]}
 
 
 #: What the components of a metric list are, for tables and figures (``rms_error_deg[0]`` is roll).
@@ -456,8 +503,8 @@ def _figures(result, o, out) -> list[str]:
     title = figure_title(result, o)
     faults = faults_of(result)
 
-    def curve(ax, values, style="-", scale=1.0, **options):
-        times, values = envelope(t, values)
+    def curve(ax, of, style="-", scale=1.0, **options):  # of: a window of the record -> the values drawn
+        times, values = result.envelope(of)
         return ax.plot(times, values * scale, style, **options)[0]
 
     def finish(fig, axes, spans, name):
@@ -475,38 +522,65 @@ def _figures(result, o, out) -> list[str]:
     figures = []
     fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True, height_ratios=(1, 1, 0.8))
     for k, name in enumerate(("roll", "pitch")):
-        curve(axes[k], result[f"Quadrotor.theta{k + 1}"], scale=180 / np.pi, label=f"{name}, truth")
-        curve(axes[k], result[f"Quaternion_estim.theta_est{k + 1}"], "--", scale=180 / np.pi,
+        curve(axes[k], lambda w, k=k: w[f"Quadrotor.theta{k + 1}"], scale=180 / np.pi, label=f"{name}, truth")
+        curve(axes[k], lambda w, k=k: w[f"Quaternion_estim.theta_est{k + 1}"], "--", scale=180 / np.pi,
               label=f"{name}, estimate")
         axes[k].set_ylabel(f"{name} (deg)")
-        curve(axes[2], _error(result, "Quaternion_estim.theta_est", k), scale=180 / np.pi, label=f"{name} error",
-              lw=0.9)
+        curve(axes[2], lambda w, k=k: _error(w, "Quaternion_estim.theta_est", k), scale=180 / np.pi,
+              label=f"{name} error", lw=0.9)
     axes[2].axhline(0.0, color="k", lw=0.5)
     axes[2].set_ylabel("estimate - truth (deg)")
     figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "roll_pitch.png"))
 
     fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
-    axes[0].plot(*angle_curve(t, np.degrees(result["Quadrotor.theta3"])), label="yaw, truth")
-    axes[0].plot(*angle_curve(t, np.degrees(result["Quaternion_estim.theta_est3"])), "--", label="yaw, estimate")
+    axes[0].plot(*_angle_curve(result, "Quadrotor.theta3"), label="yaw, truth")
+    axes[0].plot(*_angle_curve(result, "Quaternion_estim.theta_est3"), "--", label="yaw, estimate")
     axes[0].set_ylabel("yaw (deg)")
-    curve(axes[1], _error(result, "Quaternion_estim.theta_est", 2), scale=180 / np.pi, label="yaw error", lw=0.9)
+    curve(axes[1], lambda w: _error(w, "Quaternion_estim.theta_est", 2), scale=180 / np.pi, label="yaw error",
+          lw=0.9)
     axes[1].axhline(0.0, color="k", lw=0.5)
     axes[1].set_ylabel("estimate - truth (deg)")
     figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "yaw.png"))
 
     # the bias figure only for an estimator that estimates one (the linear filter does not)
-    if any(np.any(result[f"Quaternion_estim.b_est_{axis}"]) for axis in "xyz"):
-        fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
-        for axis in "xyz":
-            estimate, truth = result[f"Quaternion_estim.b_est_{axis}"], result[f"IMU.gyro_bias_{axis}"]
-            line = curve(axes[0], estimate, label=f"b_{axis}, estimate")
-            curve(axes[0], truth, ":", color=line.get_color(), label=f"b_{axis}, truth")
-            curve(axes[1], estimate - truth, color=line.get_color(), label=f"b_{axis} error", lw=0.9)
-        axes[0].set_ylabel("gyro bias (rad/s)")
-        axes[1].axhline(0.0, color="k", lw=0.5)
-        axes[1].set_ylabel("estimate - truth (rad/s)")
-        figures.append(finish(fig, axes, (BIAS_SPAN, BIAS_SPAN), "bias.png"))
+    if any(np.any(w[f"Quaternion_estim.b_est_{axis}"]) for w in result.windows() for axis in "xyz"):
+        figures.append(finish(*_bias_axes(plt, curve), (BIAS_SPAN, BIAS_SPAN), "bias.png"))
     return [f for f in figures if f]
+
+
+def _angle_curve(result, name: str):
+    """:func:`scenarios.figures.angle_curve` of signal ``name`` (rad); a streamed record is
+    unwrapped window by window, each window continuing from the last sample of the one before."""
+    windows = result.windows()
+    first = next(windows)
+    if next(windows, None) is None:  # a record in memory: one window
+        return angle_curve(result.time, np.degrees(result[name]))
+    carried = {}  # the last raw sample and the offset unwrapping added to it
+
+    def unwrapped(window):
+        raw = window[name]
+        if not carried:
+            turned = np.unwrap(raw)
+        else:
+            turned = np.unwrap(np.concatenate([[carried["raw"]], raw]))[1:] + carried["offset"]
+        carried["raw"], carried["offset"] = raw[-1], turned[-1] - raw[-1]
+        return np.degrees(turned)
+
+    del first
+    return wrapped_curve(*result.envelope(unwrapped))
+
+
+def _bias_axes(plt, curve):
+    """The gyro bias figure's two axes drawn with ``curve``: estimate and truth, then the error."""
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
+    for axis in "xyz":
+        line = curve(axes[0], lambda w, a=axis: w[f"Quaternion_estim.b_est_{a}"], label=f"b_{axis}, estimate")
+        curve(axes[0], lambda w, a=axis: w[f"IMU.gyro_bias_{a}"], ":", color=line.get_color(), label=f"b_{axis}, truth")
+        curve(axes[1], lambda w, a=axis: _bias_error(w, a), color=line.get_color(), label=f"b_{axis} error", lw=0.9)
+    axes[0].set_ylabel("gyro bias (rad/s)")
+    axes[1].axhline(0.0, color="k", lw=0.5)
+    axes[1].set_ylabel("estimate - truth (rad/s)")
+    return fig, axes
 
 
 def _tilt_figures(result, o, out) -> list[str]:

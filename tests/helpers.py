@@ -36,3 +36,14 @@ def exit_worker_on_large_gain(result, options):
     if options["k"] > 1000:
         os._exit(3)
     return {}
+
+
+def documentation() -> str:
+    """The README and the documentation's pages (``docs/**/*.md``, the built site and generated
+    pages left out), one after the other: the text whose examples the tests run as written."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    pages = [root / "README.md"] + sorted(p for p in (root / "docs").rglob("*.md")
+                                          if not {"_build", "_generated"} & set(p.parts))
+    return "\n".join(page.read_text() for page in pages)

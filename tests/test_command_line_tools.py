@@ -81,7 +81,7 @@ def test_plot_and_compare_draw_signals_of_finished_runs(tmp_path, capsys, monkey
     assert "no recorded signal 'IMU.gyr'. Did you mean IMU.gyro" in capsys.readouterr().err
     assert main(["compare", "a", "Quadrotor.q"]) == 2
     assert main(["plot", "nowhere", "IMU.acc"]) == 2
-    assert "no results.npz there" in capsys.readouterr().err
+    assert "no results.npz or streamed record there" in capsys.readouterr().err
 
 
 def test_numbers_are_printed_at_their_precision(capsys):

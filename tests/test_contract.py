@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import documentation
 
 import scenarios
 from estimators.contract import REQUIRED, AttitudeEstimator
@@ -19,7 +20,7 @@ README = Path(__file__).resolve().parent.parent / "README.md"
 
 def readme_estimator() -> tuple[str, str]:
     """The README's Madgwick file and the command that flies it."""
-    text = README.read_text()
+    text = documentation()
     section = text[text.index("### Your own estimator in the loop"):]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     command = re.search(r"```bash\n(quadcosim run tp --estimator .*?)\n```", section, re.S).group(1)

@@ -204,7 +204,7 @@ def test_sweep_plot_axes_carry_units(tmp_path):
     assert figure.metric_unit("real_time_factor") == ""
     (tmp_path / "sweep.json").write_text(json.dumps({"scenario": "tp", "name": None, "varied": ["k"],
                                                      "description": {"set": ["duration=3"]}, "members": []}))
-    units, subtitle = _plot_context(tmp_path)
+    units, subtitle, _ = _plot_context(tmp_path)
     assert units["k"] == "1/s" and units["duration"] == "s" and subtitle == "tp sweep; duration=3"
     columns = {"status": ["ok"] * 3, "k": [0.05, 0.2, 1.0], "rms_error_deg[0]": [0.04, 0.01, 0.1]}
     ax = figure.plot(columns, "rms_error_deg[0]", "k", units=units, subtitle=subtitle).axes[0]

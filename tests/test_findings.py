@@ -14,6 +14,7 @@ import sys
 import types
 
 import pytest
+from helpers import documentation
 
 import scenarios.findings as findings
 from scenarios.findings import readme
@@ -175,6 +176,5 @@ def test_the_readme_states_the_default_result_format():
     from scenarios.cli import parser
 
     default = parser().parse_args(["run", "tp"]).format
-    stated = re.search(r"`--format npz,mat,csv` the files written \(default `([^`]*)` alone\)",
-                       (findings.ROOT / "README.md").read_text())
+    stated = re.search(r"`--format\s+npz,mat,csv` the files written \(default `([^`]*)` alone\)", documentation())
     assert stated is not None and stated.group(1) == default

@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+from helpers import documentation
 
 from calibration import Calibration, StaticCalibration, compensate
 from calibration.flight import autopilot, calibrate, flight_data
@@ -98,9 +99,8 @@ def test_logs_without_a_current_sensor_or_throttle_variation_refuse_with_the_rea
 
 
 def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, capsys):
-    from pathlib import Path
 
-    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    readme = documentation()
     command = "quadcosim calibrate ../shared/data/flightlogs/quad_2015-10-11_19-59-09.log --compass 1 --out " \
               "results/flight-b-internal"
     assert command in readme

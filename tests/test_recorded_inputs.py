@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import documentation
 
 from estimators import checks, estimate, gain_grid, recording
 from estimators.filters import gain_table
@@ -129,9 +130,8 @@ def test_replay_refuses_a_folder_that_is_not_a_tp_run(tmp_path, capsys):
 
 
 def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(capsys):
-    from pathlib import Path
 
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    readme = documentation()
     start = readme.index("```python\nfrom estimators import estimate, gain_grid, recording")
     code = readme[start + len("```python\n"):readme.index("```", start + 10)]
     namespace = {}

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import documentation
 from scipy.io import loadmat
 
 import orchestrator.files
@@ -300,10 +301,10 @@ def test_a_non_finite_value_made_by_a_fault_names_the_fault():
 # ---------------------------------------------------------------------- the README's commands
 def readme_commands() -> list[str]:
     """Every ``quadcosim`` command in the README's shell blocks, comments removed."""
-    text = (ROOT / "README.md").read_text()
+    text = documentation()  # the README and the documentation's pages
     blocks = re.findall(r"```sh\n(.*?)```", text, flags=re.S)
     lines = [line.split(" #")[0].strip() for block in blocks for line in block.splitlines()]
-    return [line for line in lines if line.startswith("quadcosim ")]
+    return list(dict.fromkeys(line for line in lines if line.startswith("quadcosim ")))
 
 
 def test_the_readme_has_command_examples():

@@ -42,10 +42,10 @@ def _run(command: str) -> Path:
     return out
 
 
-def _shown(value) -> str:
-    from scenarios.shown import shown
+def _shown(value, digits: int | None = None) -> str:
+    from scenarios.shown import MEASURED_DIGITS, shown
 
-    return shown(value)
+    return shown(value, digits or MEASURED_DIGITS)
 
 
 class QuadcosimRun(Directive):
@@ -86,7 +86,9 @@ def _variable_tables(app):
     for model in MODELS:
         lines += [f"## {model}", "", "| name | causality | unit | start | description |", "|---|---|---|---|---|"]
         for variable in table(model).variables:
-            start = "" if variable.start is None else _shown(variable.start)
+            from scenarios.shown import PARAMETER_DIGITS
+
+            start = "" if variable.start is None else _shown(variable.start, PARAMETER_DIGITS)
             description = str(variable.description).replace("|", "\\|")
             lines.append(f"| `{variable.name}` | {variable.causality} | {variable.unit or ''} | {start} | "
                          f"{description} |")

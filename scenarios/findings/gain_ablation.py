@@ -17,7 +17,7 @@ def _command(settings: dict) -> str:
 
 def compute(quick: bool = False) -> list[dict]:
     """The closed loop's relative difference from the prediction: its range over every gain and
-    at the largest with gravity alone; at the largest without drag (a ratio)."""
+    at the largest with gravity alone; at the largest without drag (a ratio). ``quick``: none."""
     if quick:
         return []
     import scenarios

@@ -18,7 +18,8 @@ def _nearest(gains: list[float], k: float) -> int:
 
 
 def compute(quick: bool = False) -> list[dict]:
-    """The GT mode's agreement and optimum, the closed loop's parting from the prediction."""
+    """The GT mode's agreement and optimum, the closed loop's parting from the prediction;
+    ``quick``: none (the run takes minutes)."""
     if quick:
         return []
     import scenarios

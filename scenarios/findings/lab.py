@@ -31,7 +31,19 @@ def _triple(name: str, values, unit: str, command: str, digits: int) -> list[dic
 
 
 def rms(name: str, settings: dict, digits: int, key: str = "rms_error_deg") -> tuple[list[dict], dict]:
-    """The RMS errors (deg) of one ``tp`` run, and its metrics."""
+    """The errors (deg, roll, pitch, yaw) of one ``tp`` run as findings ``name.roll`` ..., and its metrics.
+
+    Parameters
+    ----------
+    name : str
+        Prefix of the findings' names.
+    settings : dict
+        The run's ``tp`` options.
+    digits : int
+        Decimals printed.
+    key : str
+        The metric (``rms_error_deg``).
+    """
     m = _tp(settings)
     return _triple(name, m[key], "deg", _command(settings), digits), m
 

@@ -35,13 +35,18 @@ def _extremes(values: list) -> set[int]:
 
 def probes(plan: Plan) -> list[int]:
     """Indices of the members of ``plan`` to check (see the module documentation), the first
-    member first: every member of a list of cases, probes of a grid."""
+    member first: every member of a list of cases, probes of a grid, and of each part of a
+    chain of grids."""
     members = plan.members
-    if isinstance(members, ChainedMembers):  # each part's probes, numbered on
-        return [start + k for start, part in zip(members.starts, members.parts, strict=False)
-                for k in probes(Plan(plan.scenario, part))]
-    if not isinstance(members, GridMembers):
-        return list(range(len(members)))
+    if isinstance(members, ChainedMembers):
+        return [start + k for start, part in zip(members.starts, members.parts, strict=False) for k in _grid(part)]
+    if isinstance(members, GridMembers):
+        return _grid(members)
+    return list(range(len(members)))
+
+
+def _grid(members: GridMembers) -> list[int]:
+    """Probe indices of one grid: its first member, then each dimension's values in turn."""
     sizes = [len(values) for values in members.dimensions.values()]
     picked = [0]
     for d, values in enumerate(members.dimensions.values()):

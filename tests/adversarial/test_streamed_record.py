@@ -58,3 +58,33 @@ def test_a_streamed_run_cut_short_keeps_its_whole_chunks(tmp_path, monkeypatch):
     kept = Result.load(tmp_path / "s")
     assert len(kept) == 2000 and kept.time[-1] == pytest.approx(1.999)
     assert np.isfinite(kept.data).all()
+
+
+def test_the_report_of_a_streamed_record_taken_chunk_by_chunk_equals_the_whole_records(tmp_path, monkeypatch):
+    """tp's statistics and envelopes read a streamed record one chunk at a time: the same
+    bias convergence time and figure samples, the same errors to rounding."""
+    import scenarios
+    from orchestrator.result import envelope
+
+    monkeypatch.setattr(orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 1500)  # 1500 rows a chunk
+    settings = {"duration": 6, "estimator": "passive", "bias": True, "flight": "hover", "kP": 10, "kI": 10}
+    streamed, by_chunk = scenarios.run("tp", settings, tmp_path / "s", stream=True)
+    kept, whole = scenarios.run("tp", settings, tmp_path / "m")
+    assert len(streamed.chunk_files) == 5
+    assert by_chunk["bias_convergence_s"] == whole["bias_convergence_s"] and 2 < whole["bias_convergence_s"] < 4
+    assert by_chunk["bias_error_final"] == whole["bias_error_final"]
+    assert by_chunk["steady_window_s"] == whole["steady_window_s"]
+    for key in ("rms_error_deg", "max_error_deg", "tracking_rms_deg", "steady_error_deg"):
+        assert by_chunk[key] == pytest.approx(whole[key], rel=1e-12, abs=1e-15), key
+    for name in ("Quadrotor.theta1", "Quaternion_estim.b_est_x"):
+        drawn = streamed.envelope(lambda w, name=name: w[name], points=700)
+        expected = envelope(kept.time, kept[name], points=700)
+        assert np.array_equal(drawn[0], expected[0]) and np.array_equal(drawn[1], expected[1])
+    assert by_chunk["figures"] == whole["figures"] == ["roll_pitch.png", "yaw.png", "bias.png"]
+    from scenarios.figures import angle_curve
+    from scenarios.tp import _angle_curve
+
+    drawn = _angle_curve(streamed, "Quadrotor.theta3")
+    expected = angle_curve(kept.time, np.degrees(kept["Quadrotor.theta3"]))
+    assert np.array_equal(drawn[0], expected[0], equal_nan=True)
+    assert np.allclose(drawn[1], expected[1], rtol=0, atol=1e-12, equal_nan=True)
