@@ -5,12 +5,12 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup fmus demo test lint bench fuzz clean
+.PHONY: setup fmus demo test lint bench fuzz docs clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e ".[dev]"
+	$(BIN)/pip install --quiet -e ".[dev,docs]"
 	touch $(STAMP)
 
 setup: $(STAMP)
@@ -20,10 +20,16 @@ fmus: $(STAMP)
 
 demo: fmus
 	$(BIN)/quadcosim run tp --out results/tp --overwrite
+	@echo "quadcosim is installed in $(VENV): activate it with  . $(VENV)/bin/activate  (or call $(BIN)/quadcosim)"
 
 test: fmus
 	$(BIN)/ruff check .
+	$(MAKE) docs
 	$(BIN)/python -m pytest -q
+
+# The documentation site, warnings as errors; its lab figures are made by the commands it shows.
+docs: fmus
+	$(BIN)/python -m sphinx -W --keep-going -q -b html docs docs/_build/html
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
@@ -35,4 +41,4 @@ fuzz: fmus
 	$(BIN)/python -m benchmarks.fuzz
 
 clean:
-	rm -rf build results
+	rm -rf build results docs/_build docs/_generated

@@ -7,9 +7,9 @@
 - :mod:`benchmarks.infrared`: operations per iteration and time per update of the IR
   calibration estimators against the slides' 300 operations at 20 Hz.
 
-The C references in ``benchmarks/c/`` are compiled by ``quadcosim build`` with the system C
-compiler into ``build/benchmarks`` beside the package (:func:`build_references`); they are not
-part of the installed package.
+The C references in ``benchmarks/c/`` ship with the package as sources; ``quadcosim build``
+(:func:`build_references`), or their first use, compiles them with the system C compiler into
+``benchmarks/`` under :func:`fmus.build_root`.
 """
 
 from __future__ import annotations
@@ -17,11 +17,23 @@ from __future__ import annotations
 from pathlib import Path
 
 SOURCES = Path(__file__).resolve().parent / "c"
-LIBRARIES = Path(__file__).resolve().parent.parent / "build" / "benchmarks"
+
+
+def libraries_dir() -> Path:
+    """Folder of the compiled C references: ``benchmarks/`` under :func:`fmus.build_root`.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder (it may not exist yet).
+    """
+    from fmus import build_root
+
+    return build_root() / "benchmarks"
 
 
 def build_references() -> list[Path]:
-    """Compile every ``benchmarks/c/*.c`` into ``build/benchmarks/lib<name>.so``.
+    """Compile every ``benchmarks/c/*.c`` into ``lib<name>.so`` in :func:`libraries_dir`.
 
     Returns
     -------
@@ -30,7 +42,7 @@ def build_references() -> list[Path]:
     """
     from orchestrator.calls import compile_shared
 
-    return [compile_shared(source, LIBRARIES / f"lib{source.stem}.so") for source in sorted(SOURCES.glob("*.c"))]
+    return [compile_shared(source, libraries_dir() / f"lib{source.stem}.so") for source in sorted(SOURCES.glob("*.c"))]
 
 
 def reference_library(name: str):
@@ -51,7 +63,7 @@ def reference_library(name: str):
 
     from orchestrator.calls import compile_shared
 
-    source, library = SOURCES / f"{name}.c", LIBRARIES / f"lib{name}.so"
+    source, library = SOURCES / f"{name}.c", libraries_dir() / f"lib{name}.so"
     newest = max(path.stat().st_mtime for path in [source, *SOURCES.glob("*.h")])
     if not library.is_file() or library.stat().st_mtime < newest:
         compile_shared(source, library)

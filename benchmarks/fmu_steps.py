@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks import LIBRARIES, SOURCES, reference_library
+from benchmarks import SOURCES, libraries_dir, reference_library
 
 MODELS = ("MotorMagnetics", "Quadrotor", "IMU")
 PARAMETERS = {"IMU": {"noise_enabled": True, "bias_enabled": True}}  # as in the closed-loop benchmark
@@ -52,7 +52,7 @@ def equations_library(model: str) -> ctypes.CDLL:
     sources = [staged / "shell.c", staged / "model.c", harness]
     if not staged.is_dir():
         raise RuntimeError(f"no staged sources for {model} in {staged}; run `quadcosim build` first")
-    library = LIBRARIES / f"libequations_{model}.so"
+    library = libraries_dir() / f"libequations_{model}.so"
     newest = max(path.stat().st_mtime for path in [*sources, *staged.glob("*.h")])
     if not library.is_file() or library.stat().st_mtime < newest:
         library.parent.mkdir(parents=True, exist_ok=True)

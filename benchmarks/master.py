@@ -15,7 +15,8 @@ Measures, in one run, per macro step at 1 kHz, CPU time of the stepping loop onl
   trajectories are compared bit for bit: every recorded signal of the C loop must equal the
   orchestrator's (``*_identical``).
 
-The keys of :func:`benchmarks.estimators.measure` (the batch path) join the same JSON object.
+The keys of :func:`benchmarks.estimators.measure` (the batch path) and of
+:func:`benchmarks.save.figures` (``save_fraction``) join the same JSON object.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import time
 import numpy as np
 
 from benchmarks import estimators, fmu_steps, reference_library
+from benchmarks.save import figures as save_figures
 
 CLOSED_LOOP = {"estimator": "explicit", "noise": True, "bias": True}  # tp options of the closed loop
 
@@ -240,7 +242,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
                     f"{key}_us_per_step": run["us_per_step"], f"{key}_c_us_per_step": run["c_us_per_step"],
                     f"rtf_{key}": 1e3 / run["us_per_step"], f"rtf_{key}_c": 1e3 / run["c_us_per_step"],
                     f"{key}_identical": run["identical"]}
-    return estimators.measure(seconds, repeats) | fmu_steps.measure(seconds, repeats) | figures
+    return estimators.measure(seconds, repeats) | fmu_steps.measure(seconds, repeats) | figures | save_figures()
 
 
 def main(argv=None) -> int:

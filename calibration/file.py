@@ -37,6 +37,9 @@ FORMAT = "quadcosim-magnetometer-calibration"
 VERSION = 1
 
 
+SINGULAR = 1e-12  # |det A| below this times its largest entry cubed: singular
+
+
 @dataclass
 class Calibration:
     """Static calibration, the paper's motor-field model and the identified motor dynamics.
@@ -127,8 +130,11 @@ class Calibration:
         if motors is not None and n != motors:
             reader.fail(f"the file calibrates {n} motors; this vehicle has {motors}. Calibrate this vehicle")
         reference = None if data["reference"] is None else reader.array(data["reference"], (3,), "reference")
+        notes = data.get("notes")
+        if notes is not None and not isinstance(notes, dict):
+            reader.fail(f"notes = {notes!r} must be a JSON object (or absent)")
         return cls(n, reader.static(data["static"]), reader.field(data["field"], n, orders),
-                   reader.dynamics(data["dynamics"], n), reference, dict(data.get("notes") or {}))
+                   reader.dynamics(data["dynamics"], n), reference, dict(notes or {}))
 
     @classmethod
     def load(cls, path, motors: int | None = None, orders: tuple[int, int] | None = None) -> Calibration:
@@ -137,13 +143,19 @@ class Calibration:
         naming the defect."""
         path = Path(path)
         try:
-            text = path.read_text()
+            text = path.read_text(encoding="utf-8")
         except OSError as error:
             raise CalibrationError(f"cannot read calibration file {path}: {error.strerror}") from None
+        except UnicodeDecodeError as error:
+            raise CalibrationError(f"{path}: not UTF-8 text (byte 0x{error.object[error.start]:02x} at offset "
+                                   f"{error.start}); a calibration file is JSON, as `quadcosim run metge` or "
+                                   "Calibration.save writes it") from None
         try:
             data = json.loads(text)
         except json.JSONDecodeError as error:
             raise CalibrationError(f"{path}: not valid JSON ({error.msg} at line {error.lineno})") from None
+        except RecursionError:
+            raise CalibrationError(f"{path}: JSON nested too deeply to be a calibration file") from None
         return cls.from_dict(data, motors, orders, where=str(path))
 
 
@@ -159,8 +171,8 @@ class _Reader:
     def array(self, value, shape: tuple, name: str) -> np.ndarray:
         try:
             out = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            self.fail(f"{name} must be numbers, not {value!r}")
+        except (TypeError, ValueError, RecursionError):
+            self.fail(f"{name} must be numbers, not {str(value)[:80]}")
         if out.shape != shape:
             self.fail(f"{name} must have shape {shape}, not {out.shape}")
         if not np.isfinite(out).all():
@@ -173,10 +185,13 @@ class _Reader:
         if not isinstance(s, dict) or not {"A", "b_s", "field_norm"} <= set(s):
             self.fail("static must hold A, b_s and field_norm")
         A = self.array(s["A"], (3, 3), "static.A")
-        if abs(np.linalg.det(A)) < 1e-12 * np.abs(A).max() ** 3:
-            self.fail("static.A is singular")
-        return StaticCalibration(A=A, b_s=self.array(s["b_s"], (3,), "static.b_s"),
-                                 field_norm=float(self.array(s["field_norm"], (), "static.field_norm")))
+        largest = np.abs(A).max()
+        if not largest > 0 or abs(np.linalg.det(A)) < SINGULAR * largest**3:
+            self.fail("static.A is singular (all zeros, or rows that depend on each other); it must be invertible")
+        field_norm = float(self.array(s["field_norm"], (), "static.field_norm"))
+        if not field_norm > 0:
+            self.fail(f"static.field_norm = {field_norm!r} must be positive (the corrected field's norm)")
+        return StaticCalibration(A=A, b_s=self.array(s["b_s"], (3,), "static.b_s"), field_norm=field_norm)
 
     def field(self, f, n: int, orders) -> MotorFieldModel | None:
         if f is None:

@@ -74,7 +74,7 @@ def _predicted(params, time, c, u, v, exponent, freewheel, sample_rate):
     return -out
 
 
-def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> MotorDynamics:
+def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0, progress=None) -> MotorDynamics:
     """Fit the motor dynamics and field gains to rig records.
 
     Parameters
@@ -88,6 +88,8 @@ def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> Motor
         Directions of eq. 6.
     sample_rate : float
         Magnetometer rate (Hz); only its sample instants are fitted. 0: every row.
+    progress : callable, optional
+        Called with a line of text before each of the least-squares fits (a few seconds each).
     """
     v = np.asarray(v, dtype=float)
     references = np.broadcast_to(np.asarray(reference, dtype=float), (len(records), 3))
@@ -121,6 +123,9 @@ def fit_motor_dynamics(records, reference, v, sample_rate: float = 0.0) -> Motor
         start[3:] = np.linalg.norm(data[0][3], axis=1).mean() / max(np.linalg.norm(unit, axis=1).mean(), 1e-30)
         from scipy.optimize import least_squares  # imported where used: start-up
 
+        if progress is not None:
+            progress(f"identifying the motors' dynamics: a fit from a {1e3 / rate0:.0f} ms time constant "
+                     f"(exponent {exponent}, {'free-wheeling' if freewheel else 'regenerative'} ESCs)")
         result = least_squares(residual, np.clip(start, lower, upper), args=(exponent, freewheel), x_scale="jac",
                                max_nfev=evaluations, bounds=(lower, upper), ftol=1e-6, xtol=1e-6)
         return float(np.sqrt(np.mean(result.fun**2))) * scale, result.x, exponent, freewheel

@@ -72,6 +72,12 @@ TESLA = Bounds()
 MIN_SAMPLES = 50
 PLANAR_RATIO = 0.02  # smallest over largest spread of the samples below which a sweep is planar
 COVERAGE_CELLS = 80
+# A recorded sweep must spread off its plane by more than its noise, by this many standard
+# errors: a sweep about one axis does not, whatever the noise (its samples' spread off the plane
+# is their noise); an ellipsoid as flat as ArduPilot's bounds allow, turned every way, does.
+OFF_PLANE_ERRORS = 5.0
+ORDERED_CORRELATION = 0.1  # lag-1 correlation above which samples are taken as a recorded sequence
+AXIS_COSINE = 0.9  # a direction this close to a sensor axis is named as that axis
 
 
 @dataclass(frozen=True)
@@ -128,13 +134,46 @@ def _check_samples(samples, min_samples: int) -> np.ndarray:
     if len(x) < min_samples:
         raise CalibrationError(f"too few samples: {len(x)} < {min_samples}; record a longer sweep "
                                "(turn the sensor through all orientations)")
-    spread = np.linalg.svd(x - x.mean(axis=0), compute_uv=False)
+    _, spread, axes = np.linalg.svd(x - x.mean(axis=0), full_matrices=False)
+    if not spread[0] > 0:
+        raise CalibrationError(f"the {len(x)} samples are all equal ({x[0].tolist()}): the sensor did not turn, or "
+                               "reads a constant (zeros: is it connected?); record a sweep through all orientations")
+    missing = _axis_name(axes[2])
     if spread[2] < PLANAR_RATIO * spread[0]:
         raise CalibrationError(
             f"planar or single-axis sweep: the samples span a plane (smallest/largest spread "
-            f"{spread[2] / spread[0]:.3f} < {PLANAR_RATIO}), which cannot determine an ellipsoid; "
-            "turn the sensor about all three axes (roll and pitch it as well as yaw)")
+            f"{spread[2] / spread[0]:.3f} < {PLANAR_RATIO}), which cannot determine an ellipsoid; they hardly "
+            f"move along the sensor's {missing}: turn the sensor about the other axes too (roll and pitch it as "
+            "well as yaw)")
+    if not _leaves_the_plane(x - x.mean(axis=0), spread / np.sqrt(len(x)), axes):
+        raise CalibrationError(
+            f"planar or single-axis sweep: off the plane of the sweep the samples spread no more than their noise; "
+            f"they never move along the sensor's {missing}, whatever the noise: the sweep turned the sensor about "
+            "one axis; turn it about the others too (roll and pitch it as well as yaw)")
     return x
+
+
+def _leaves_the_plane(centred: np.ndarray, spread: np.ndarray, axes: np.ndarray) -> bool:
+    """Whether the samples spread along their weakest principal axis by more than their noise.
+
+    The noise along that axis is half the variance of the differences of successive samples,
+    when they follow each other (a recorded sweep: successive positions correlated); its spread
+    beyond the noise must exceed :data:`OFF_PLANE_ERRORS` standard errors of the variances'
+    difference (``sqrt(2 / N)`` of the noise variance). Samples in no order pass (the relative
+    test of :data:`PLANAR_RATIO` is theirs)."""
+    first = centred @ axes[0]
+    if not np.corrcoef(first[:-1], first[1:])[0, 1] > ORDERED_CORRELATION:
+        return True
+    noise = np.var(np.diff(centred @ axes[2])) / 2.0
+    return bool(spread[2] ** 2 - noise > OFF_PLANE_ERRORS * noise * np.sqrt(2.0 / len(centred)))
+
+
+def _axis_name(direction: np.ndarray) -> str:
+    """A direction of the sensor frame in words: ``"z axis"``, or ``"axis (0.12, 0.70, 0.70)"``."""
+    k = int(np.argmax(np.abs(direction)))
+    if abs(direction[k]) > AXIS_COSINE:
+        return f"{'xyz'[k]} axis"
+    return "axis ({:.2f}, {:.2f}, {:.2f})".format(*(direction * np.sign(direction[k])))
 
 
 def _algebraic(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

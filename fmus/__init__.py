@@ -5,22 +5,66 @@
 - ``fmus/<Model>/variables.py``: each model's variable table; ``fmus/<Model>/model.c``: its
   equations; ``fmus/c/``: the FMI shell they share;
 - ``fmus/QuadCoSim/``: the Modelica twins;
-- :mod:`fmus.build`: builds ``build/fmus/<Model>.fmu`` (``quadcosim build``).
+- :mod:`fmus.build`: builds ``<build root>/fmus/<Model>.fmu`` (``quadcosim build``, or on first
+  use).
+
+The build root (:func:`build_root`) is ``build/`` in a source checkout and a per-user cache
+folder for an installed package, so that an installation never writes into ``site-packages``.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
 MODELS = ("Quadrotor", "MotorMagnetics", "IMU", "InfraredSensor")
 
 
-_BUILD = Path(__file__).resolve().parent.parent / "build" / "fmus"  # resolved once: runs look FMUs up often
-
-
 class FMUNotFoundError(FileNotFoundError):
     """A built FMU is missing."""
+
+
+def _checkout() -> Path | None:
+    """The source checkout this package is imported from (the folder holding quadcosim's
+    ``pyproject.toml`` beside the packages), or None for an installed package."""
+    root = Path(__file__).resolve().parent.parent
+    project = root / "pyproject.toml"
+    if project.is_file() and 'name = "quadcosim"' in project.read_text():
+        return root
+    return None
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("quadcosim")
+    except PackageNotFoundError:
+        return "unversioned"
+
+
+def build_root() -> Path:
+    """Where compiled artefacts (FMUs, the master's C runner, benchmark references) live.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$QUADCOSIM_BUILD_DIR`` if set; else ``build/`` in the source checkout the package is
+        imported from; else, for an installed package, the per-user cache
+        ``$XDG_CACHE_HOME/quadcosim/<version>`` (``~/.cache/quadcosim/<version>``).
+    """
+    return _build_root(os.environ.get("QUADCOSIM_BUILD_DIR"), os.environ.get("XDG_CACHE_HOME"))
+
+
+@functools.lru_cache(maxsize=8)  # resolved once per setting: runs look FMUs up often
+def _build_root(env: str | None, cache: str | None) -> Path:
+    if env:
+        return Path(env)
+    checkout = _checkout()
+    if checkout is not None:
+        return checkout / "build"
+    return Path(cache or Path.home() / ".cache") / "quadcosim" / _version()
 
 
 def default_fmu_dir() -> Path:
@@ -29,10 +73,57 @@ def default_fmu_dir() -> Path:
     Returns
     -------
     pathlib.Path
-        ``$QUADCOSIM_FMU_DIR`` if set, else ``build/fmus`` beside the package.
+        ``$QUADCOSIM_FMU_DIR`` if set, else ``fmus/`` under :func:`build_root`.
     """
     env = os.environ.get("QUADCOSIM_FMU_DIR")
-    return Path(env) if env else _BUILD
+    return Path(env) if env else build_root() / "fmus"
+
+
+def fmu_sources(name: str) -> list[Path]:
+    """The files an FMU is built from: its equations and variable table, the shared shell and
+    headers, and the modules that generate its description and constants.
+
+    Parameters
+    ----------
+    name : str
+        Model name (one of :data:`MODELS`).
+
+    Returns
+    -------
+    list of pathlib.Path
+        Existing files only.
+    """
+    here = Path(__file__).resolve().parent
+    shared = [here / f"{module}.py" for module in ("build", "variables", "airframe", "vehicle")]
+    own = [here / name / "model.c", here / name / "variables.py"]
+    return [path for path in [*sorted((here / "c").glob("*")), *shared, *own] if path.is_file()]
+
+
+_checked: set[Path] = set()  # FMUs found up to date by this process: checked once, not at every look-up
+
+
+def _stale(path: Path, name: str) -> bool:
+    if not path.is_file():
+        return True
+    built = path.stat().st_mtime
+    return any(source.stat().st_mtime > built for source in fmu_sources(name))
+
+
+def _build_on_first_use(name: str, path: Path) -> None:
+    """Build FMU ``name`` into its default folder, one process at a time (a lock file), said on
+    standard error: the first run after an installation or an edit of its sources compiles it."""
+    import fcntl
+    import sys
+
+    from fmus.build import build_fmu
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path.parent / ".build.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if _stale(path, name):  # another process may have built it meanwhile
+            print(f"quadcosim: building the FMU {name} into {path.parent} (its sources are newer, or it is "
+                  "not built yet)", file=sys.stderr, flush=True)
+            build_fmu(name, path.parent)
 
 
 def fmu_path(name: str) -> Path:
@@ -46,14 +137,21 @@ def fmu_path(name: str) -> Path:
     Returns
     -------
     pathlib.Path
-        ``<default_fmu_dir()>/<name>.fmu``.
+        ``<default_fmu_dir()>/<name>.fmu``. In the default folder a plant model is built on
+        first use, and rebuilt when one of its sources (:func:`fmu_sources`) is newer; in a
+        folder named by ``$QUADCOSIM_FMU_DIR`` it is used as found.
 
     Raises
     ------
     FMUNotFoundError
-        The FMU is not built; the message says how to build it.
+        The FMU is not built (and is not a plant model, or ``$QUADCOSIM_FMU_DIR`` names the
+        folder); the message says how to build it.
     """
     path = default_fmu_dir() / f"{name}.fmu"
+    if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
+        if _stale(path, name):
+            _build_on_first_use(name, path)
+        _checked.add(path)
     if not path.is_file():
         known = ", ".join(MODELS)
         hint = "" if name in MODELS else f" ({name!r} is not one of the plant models: {known})"

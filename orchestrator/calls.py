@@ -3,7 +3,7 @@
 A co-simulation step then costs one crossing from Python into C per group of FMU calls
 instead of one per call. The runner's source is ``orchestrator/c/calls.c``; it is compiled
 with the system C compiler into the runner folder, a setting: ``$QUADCOSIM_RUNNER_DIR`` or
-``build/orchestrator`` beside the package. :func:`runner_path` compiles it on first use when it
+``orchestrator/`` under :func:`fmus.build_root`. :func:`runner_path` compiles it on first use when it
 is missing or older than its source; ``quadcosim build`` compiles it with the FMUs.
 """
 
@@ -33,10 +33,13 @@ def runner_dir() -> Path:
     Returns
     -------
     pathlib.Path
-        ``$QUADCOSIM_RUNNER_DIR`` if set, else ``build/orchestrator`` beside the package.
+        ``$QUADCOSIM_RUNNER_DIR`` if set, else ``orchestrator/`` under :func:`fmus.build_root`
+        (``build/`` in a source checkout, a per-user cache for an installed package).
     """
+    from fmus import build_root
+
     env = os.environ.get("QUADCOSIM_RUNNER_DIR")
-    return Path(env) if env else SOURCE.parent.parent.parent / "build" / "orchestrator"
+    return Path(env) if env else build_root() / "orchestrator"
 
 
 def build_runner(out_dir: str | Path | None = None, compiler: str | None = None) -> Path:

@@ -27,11 +27,12 @@ import ctypes
 
 import numpy as np
 
-from orchestrator.blocks import Constant, Table
+from orchestrator.blocks import Block, Constant, Table
 from orchestrator.calls import _pack, runner_library
 from orchestrator.faults import apply_faults
 from orchestrator.fmu import FMUError
 from orchestrator.plan import RECORD
+from orchestrator.progress import status
 
 OP_BLOCK, OP_TABLE, OP_RECORD, OP_PYTHON = 3, 4, 5, 6
 CHUNK_DONE, PYTHON, FINISHED, NON_FINITE, FMI_FAILED, BLOCK_FAILED = range(6)
@@ -61,7 +62,7 @@ class _Program(ctypes.Structure):
                 ("record_gather", ctypes.c_void_p), ("record_gathers", ctypes.c_long),
                 ("decimation", ctypes.c_long), ("t0", ctypes.c_double), ("dt", ctypes.c_double),
                 ("last", ctypes.c_long), ("n", ctypes.c_long), ("op", ctypes.c_long), ("recorded", ctypes.c_long),
-                ("status", ctypes.c_int)]
+                ("status", ctypes.c_int), ("record_first", ctypes.c_long)]
 
 
 def _gathers(pairs: list[tuple[int, int, int]]):
@@ -103,7 +104,7 @@ class ChunkRunner:
         bus, record = plan.bus, plan.record
         self.program = _Program(ctypes.addressof(self.ops), len(self.items), bus.ctypes.data, len(bus),
                                 record.ctypes.data, record.shape[1], ctypes.addressof(self.record_gather),
-                                len(plan.record_copies), plan.decimation, plan.t0, plan.dt, plan.steps, 0, 0, 0, 0)
+                                len(plan.record_copies), plan.decimation, plan.t0, plan.dt, plan.steps, 0, 0, 0, 0, 0)
         self.tables = [k for k, item in enumerate(self.items) if item.table is not None
                        and item.table.function is not None]
 
@@ -137,6 +138,9 @@ class ChunkRunner:
             self.items.append(_Item(op, owner=block, table=block if type(block) is Table else None,
                                     keep=[rows]))
             return
+        if type(block).compiled is not Block.compiled:
+            status(f"{block.name}: loading its compiled step (numba compiles it on the first run after an "
+                   "installation or a change of its source, which can take a minute)")
         compiled = block.compiled()
         if compiled is None:
             self._python(period, entry.phase.run, block)
@@ -180,6 +184,9 @@ class ChunkRunner:
             end = self._chunk_end()
             code = run_chunk(pointer, end)
             plan.n, plan.recorded = program.n, program.recorded
+            if plan.stream is not None and plan.recorded - plan.record_first == len(plan.record):
+                plan.flush()  # the window is full: to disk, and the next rows start at record[0]
+                program.record_first = plan.record_first
             if code == CHUNK_DONE:
                 if bar is not None:
                     bar.update(program.n * dt - bar.n)
@@ -195,8 +202,10 @@ class ChunkRunner:
     def _chunk_end(self) -> int:
         """The step the next chunk stops before: a chunk ahead, and no further than the rows of
         the callable tables at hand (refilled here when the present step needs the next ones)."""
-        program = self.program
-        end = min(program.n + CHUNK_STEPS, self.plan.steps + 1)
+        program, plan = self.program, self.plan
+        end = min(program.n + CHUNK_STEPS, plan.steps + 1)
+        if plan.stream is not None:  # no further than the last step whose row fits in the window
+            end = min(end, (plan.record_first + len(plan.record) - 1) * plan.decimation + 1)
         for k in self.tables:
             op, table = self.ops[k], self.items[k].table
             row = -(-program.n // op.period)  # the table's next row due

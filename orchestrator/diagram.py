@@ -19,6 +19,7 @@ from functools import partial
 from pathlib import Path
 
 from orchestrator.blocks import Constant, FMUBlock
+from orchestrator.files import save_figure
 
 # Layout, in axis units (one unit is INCH inches on the page): a block's box, the spacing of the
 # columns, the spacing of the lanes above and below the row.
@@ -132,9 +133,11 @@ def draw(system, path, title: str | None = None) -> Path:
     fig = figure(system, title)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with matplotlib.rc_context({"svg.fonttype": "none"}):  # SVG text stays text
-        fig.savefig(path, dpi=130, bbox_inches="tight", pad_inches=0.15)
-    plt.close(fig)
+    try:
+        with matplotlib.rc_context({"svg.fonttype": "none"}):  # SVG text stays text
+            save_figure(fig, path, dpi=130, bbox_inches="tight", pad_inches=0.15)
+    finally:
+        plt.close(fig)
     return path
 
 

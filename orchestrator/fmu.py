@@ -103,6 +103,35 @@ class FMUError(RuntimeError):
         )
 
 
+class ParameterRefused(FMUError, ValueError):
+    """An FMU refused the parameter values it was given, at instantiation or initialisation.
+
+    A ``ValueError`` too: it is refused input, which the command line answers with exit 2.
+    The message names the block, the call, the values set and what the FMU logged.
+
+    Parameters
+    ----------
+    error : FMUError
+        The refused call.
+    overrides : dict
+        The parameter values that were set, by variable name.
+    model : str
+        The FMU's model name, for the command that lists its parameters.
+    """
+
+    def __init__(self, error: FMUError, overrides: dict, model: str):
+        self.block, self.function, self.status, self.time, self.log = (
+            error.block, error.function, error.status, error.time, error.log)
+        given = ", ".join(f"{name}={value!r}" for name, value in overrides.items()) or "none (the defaults)"
+        logged = "\n  ".join(error.log[-10:]) if error.log else "(the FMU logged nothing)"
+        ValueError.__init__(
+            self, f"{model} refused its parameters at initialisation ({error.function} returned "
+                  f"{STATUS[error.status] if 0 <= error.status < 6 else error.status}). Values set: {given}.\n"
+                  f"  FMU log:\n  {logged}\n"
+                  f"Give a value in the range the log names (`quadcosim list --parameters {model}` lists each "
+                  f"parameter's default and unit).")
+
+
 _descriptions: dict[tuple, object] = {}
 
 
@@ -200,6 +229,9 @@ class FMUInstance:
         self.closed = False
         try:
             self._initialize(overrides, start_time)
+        except FMUError as error:  # a value the model refuses: refused input, the instance freed
+            self.close()
+            raise ParameterRefused(error, overrides, path.stem) from None
         except Exception:
             self.close()
             raise
@@ -231,7 +263,8 @@ class FMUInstance:
         Raises
         ------
         FMUError
-            The FMU refused the reset or the new parameters; the instance is then closed.
+            The FMU refused the reset (:class:`ParameterRefused`: the new parameters); the
+            instance is then closed.
         """
         overrides = self._check_parameters(parameters or {})
         self.name = name or self.path.stem
@@ -240,7 +273,14 @@ class FMUInstance:
         self.log.warnings, self.log.first_warnings = 0, []
         try:
             self._call(self._slave.reset, "fmi2Reset")
+        except Exception:
+            self.close()
+            raise
+        try:
             self._initialize(overrides, start_time)
+        except FMUError as error:  # a value the model refuses: refused input, the instance freed
+            self.close()
+            raise ParameterRefused(error, overrides, self.path.stem) from None
         except Exception:
             self.close()
             raise

@@ -4,12 +4,17 @@ Ctrl-C raises ``KeyboardInterrupt``; :func:`terminate_as_interrupt` makes SIGTER
 :class:`Terminated`, a ``KeyboardInterrupt`` too. The master catches both between two steps,
 keeps what was recorded and frees the FMUs, so that a run stopped either way leaves its
 partial results and no extracted FMU behind.
+
+While a record is being made safe (saved, and its ``metrics.json`` written), :func:`held`
+holds both signals back: the save finishes, and the first signal held is raised when the
+block ends. A second Ctrl-C, pressed because the first seemed slow, cannot cut the save short.
 """
 
 from __future__ import annotations
 
 import contextlib
 import signal
+import threading
 
 
 class Terminated(KeyboardInterrupt):
@@ -59,3 +64,116 @@ def terminate_as_interrupt():
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+_HELD = (signal.SIGINT, signal.SIGTERM)
+
+
+class _State:
+    """Who handles SIGINT and SIGTERM: the handlers replaced, the depth of :func:`held` blocks,
+    the signal already raised by a :func:`first_only` region and the signals noted."""
+
+    def __init__(self):
+        self.previous: dict | None = None
+        self.regions = 0
+        self.depth = 0
+        self.raised: int | None = None
+        self.noted: list[int] = []
+
+
+_state = _State()
+
+
+def interrupt_for(number: int) -> KeyboardInterrupt:
+    """The exception a signal raises: :class:`Terminated` for SIGTERM, else ``KeyboardInterrupt``."""
+    return Terminated() if number == signal.SIGTERM else KeyboardInterrupt()
+
+
+def _handle(number, frame):
+    if _state.depth or _state.raised is not None:
+        _state.noted.append(number)  # a save is under way, or the run is already stopping
+        return
+    _state.raised = number
+    raise interrupt_for(number)
+
+
+def _install() -> bool:
+    """Take over both signals (main thread only); False where signals cannot be handled."""
+    if threading.current_thread() is not threading.main_thread():
+        return False
+    if _state.previous is None:
+        _state.previous = {number: signal.signal(number, _handle) for number in _HELD}
+    return True
+
+
+def _uninstall():
+    if _state.previous is not None and not _state.regions and not _state.depth:
+        for number, handler in _state.previous.items():
+            signal.signal(number, handler)
+        _state.previous, _state.raised, _state.noted = None, None, []
+
+
+@contextlib.contextmanager
+def first_only(final: bool = False):
+    """Within the block, the first SIGINT or SIGTERM raises (as :func:`interrupt_for` makes
+    it); every later one is noted and ignored: the run it stopped is being saved.
+
+    Parameters
+    ----------
+    final : bool
+        The process ends with the block: when a signal stopped it, both signals stay ignored
+        after it, so that the exit code is the first signal's (a command line's last block).
+
+    Outside the main thread the block changes nothing.
+    """
+    if not _install():
+        yield
+        return
+    _state.regions += 1
+    try:
+        yield
+    finally:
+        _state.regions -= 1
+        if final and _state.raised is not None and not _state.regions:
+            _state.previous = dict.fromkeys(_HELD, signal.SIG_IGN)
+        _uninstall()
+
+
+@contextlib.contextmanager
+def held():
+    """Within the block, SIGINT and SIGTERM are noted, not raised: a save under way finishes.
+
+    On leaving the block without an exception, the first signal noted is raised, unless an
+    enclosing :func:`first_only` region has raised one already (the run is then stopping, and
+    the later signals are ignored). Blocks nest. Outside the main thread (a worker of a sweep),
+    where signals cannot be handled, the block holds nothing back.
+
+    Yields
+    ------
+    list of int
+        The signals noted so far.
+    """
+    if not _install():
+        yield []
+        return
+    _state.depth += 1
+    try:
+        yield _state.noted
+    finally:
+        _state.depth -= 1
+        waiting = _state.noted[0] if not _state.depth and _state.raised is None and _state.noted else None
+        if waiting is not None:
+            _state.raised = waiting
+        _uninstall()
+    if waiting is not None:
+        raise interrupt_for(waiting)
+
+
+def pending() -> list[int]:
+    """The signals noted since the first :func:`held` block or :func:`first_only` region began."""
+    return list(_state.noted)
+
+
+def stopping() -> int | None:
+    """The signal that a :func:`first_only` region has raised, if any (it is ending the run)."""
+    return _state.raised

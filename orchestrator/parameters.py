@@ -8,7 +8,10 @@ while it is true: setting a noise density while the noise is off is refused rath
 
 A value given as text may carry the variable's unit after it (``"0.002 rad/s/Hz0.5"``); another
 unit is refused with the expected one named. A Python block's parameters are its public numeric
-attributes (``Quaternion_estim.beta``), set before the run starts it.
+attributes (``Quaternion_estim.beta``), set before the run starts it, and the named parameters it
+declares: a block with ``named_parameters()`` (name to present value) and
+``set_named_parameter(name, value)`` (which checks the value) exposes values it keeps elsewhere,
+such as the controller's gains (``Controller.kp_yaw``).
 """
 
 from __future__ import annotations
@@ -129,8 +132,12 @@ def apply(system, settings: dict, options: dict | None = None) -> dict:
         if hasattr(block, "parameter_names"):
             block.parameters.update(values)
         else:
+            named = block.named_parameters() if hasattr(block, "named_parameters") else {}
             for name, v in values.items():
-                setattr(block, name, v)
+                if name in named:
+                    block.set_named_parameter(name, v)
+                else:
+                    setattr(block, name, v)
         resolved[target] = list(values.values()) if len(values) > 1 else next(iter(values.values()))
     for target in settings:
         _check_switch(system, target, options or {})
@@ -205,20 +212,35 @@ def _unit_hint(variable) -> str:
     return f" (in {variable.unit})" if variable.unit else ""
 
 
-def python_parameters(block) -> list[str]:
-    """A Python block's settable parameters: its public numeric attributes."""
-    return sorted(k for k, v in vars(block).items()
-                  if not k.startswith("_") and k not in _NOT_PARAMETERS
-                  and isinstance(v, numbers.Real))
+def python_parameters(block) -> dict:
+    """A Python block's settable parameters and their present values.
+
+    Parameters
+    ----------
+    block : orchestrator.Block
+        A Python block.
+
+    Returns
+    -------
+    dict
+        Name to value, sorted by name: its public numeric attributes, and the named parameters it
+        declares (``named_parameters()``).
+    """
+    values = {k: v for k, v in vars(block).items()
+              if not k.startswith("_") and k not in _NOT_PARAMETERS and isinstance(v, numbers.Real)}
+    if hasattr(block, "named_parameters"):
+        values.update(block.named_parameters())
+    return dict(sorted(values.items()))
 
 
 def _python_value(block, name: str, value):
-    settable = python_parameters(block)
-    if name not in settable:
-        raise KeyError(f"{block.name} has no parameter {name!r}.{nearest(name, settable)} "
-                       f"{'Its parameters: ' + ', '.join(settable) if settable else 'It has no numeric parameter'}"
-                       " (a Python block's parameters are its public numeric attributes).")
-    present = getattr(block, name)
+    values = python_parameters(block)
+    if name not in values:
+        raise KeyError(f"{block.name} has no parameter {name!r}.{nearest(name, values)} "
+                       f"{'Its parameters: ' + ', '.join(values) if values else 'It has no numeric parameter'}"
+                       " (a Python block's parameters are its public numeric attributes and the named ones it "
+                       "declares).")
+    present = values[name]
     label = f"{block.name}.{name}"
     if isinstance(present, bool):
         text = str(value).strip().lower()

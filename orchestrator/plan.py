@@ -139,10 +139,14 @@ class Plan:
         Start time (s).
     record : list of str, optional
         Signals to record (vector names allowed); every output by default.
+    stream : orchestrator.stream.StreamWriter, optional
+        Write the record to disk in chunks as the run goes: memory then holds a window of
+        rows (:func:`orchestrator.stream.window_rows`), not the whole record.
     """
 
-    def __init__(self, system, duration: float, decimation: int, t0: float, record=None):
+    def __init__(self, system, duration: float, decimation: int, t0: float, record=None, stream=None):
         self.system, self.dt, self.t0, self.decimation = system, system.dt, t0, decimation
+        self.stream, self.record_first = stream, 0  # the row record[0] holds (streamed: a window)
         self.steps = int(round(duration / system.dt))
         if self.steps < 1:
             raise ValueError(f"duration {duration} s is shorter than one macro step ({system.dt} s)")
@@ -192,9 +196,26 @@ class Plan:
         self.units = signal_units(self.system.blocks, self.names)
         self.record_copies = copies(slots)
         rows = self.steps // self.decimation + 1
+        if self.stream is not None:
+            from orchestrator.stream import window_rows
+
+            rows = window_rows(len(slots), rows)
         check_record_fits(rows, len(slots), self.decimation)
-        self.record = np.empty((rows, len(slots)))  # its pages become resident as rows fill
+        self.record = np.empty((rows, len(slots)))
+        self.record.fill(0.0)  # touched once here: no first-touch page fault inside the loop
         self.recorded = 0
+        if self.stream is not None:
+            self.stream.start(self.names, self.units)
+
+    def flush(self):
+        """Write the rows of the window to the stream and empty the window."""
+        first, rows = self.record_first, self.recorded - self.record_first
+        times = np.arange(first, first + rows, dtype=np.float64)  # as result() computes them
+        times *= self.decimation
+        times *= self.dt
+        times += self.t0
+        self.stream.write(times, self.record[:rows])
+        self.record_first = self.recorded
 
     def _source(self, block_name: str, u: str) -> tuple[int, bool]:
         """Bus slot input ``u`` reads, and whether its source runs earlier in the order."""
@@ -359,10 +380,12 @@ class Plan:
                     if period == 1 or n % period == 0:
                         fn(t)
                 if n % dec == 0:
-                    row = record[n // dec]
+                    row = record[n // dec - self.record_first]
                     for into, source in gather:
                         row[into] = bus[source]
                     self.recorded = n // dec + 1
+                    if self.stream is not None and self.recorded - self.record_first == len(record):
+                        self.flush()
                     if not isfinite(reduce(bus)):
                         raise _Failure(self._non_finite(t))
                 if n == self.steps:
@@ -406,21 +429,35 @@ class Plan:
         Returns
         -------
         orchestrator.Result
-            Time in s from ``t0``, one column per recorded signal.
+            Time in s from ``t0``, one column per recorded signal; for a streamed record, read
+            back from its folder (:class:`orchestrator.stream.StreamedResult`).
         """
+        if self.stream is not None:
+            return self._streamed(error)
         rows = self.recorded
         times = np.arange(rows, dtype=np.float64)  # in place, one vector: the values of
         times *= self.decimation                   # t0 + arange(rows) * decimation * dt
         times *= self.dt
         times += self.t0
+        return Result(times, self.names, self.record[:rows], self._meta(), error)
+
+    def _meta(self) -> dict:
+        """The run's meta data: step, decimation, loop time, order, wiring, warnings, units."""
         warnings = {name: {"count": log.warnings, "first": list(log.first_warnings)}
                     for name, log in self.logs.items() if log.warnings}
-        meta = {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
+        return {"dt": self.dt, "decimation": self.decimation, "loop_seconds": getattr(self, "loop_seconds", None),
                 "loop_cpu_seconds": getattr(self, "loop_cpu_seconds", None),
                 "order": [b.name for b in self.order],
                 "connections": dict(self.system.connections), "fmu_warnings": warnings, "units": self.units,
                 "constant_inputs": self.constant_inputs}
-        return Result(times, self.names, self.record[:rows], meta, error)
+
+    def _streamed(self, error: str | None) -> Result:
+        from orchestrator.stream import StreamedResult
+
+        if self.recorded > self.record_first:
+            self.flush()
+        self.stream.close(self._meta(), error)
+        return StreamedResult(self.stream.path)
 
     def close(self):
         """Free the FMU instances and close the Python blocks."""

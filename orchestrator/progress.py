@@ -83,7 +83,9 @@ class Progress:
 
     On a terminal, a bar redrawn in place; :meth:`complete` takes it to 100 %, :meth:`close`
     ends its line. Elsewhere (a pipe, a file) plain lines: one at the first update (the loop
-    runs), then :data:`PIPE_LINES`, one per quarter of the run, the last at 100 %.
+    runs), then one each time the run crosses a quarter (:data:`PIPE_LINES`), the last at 100 %;
+    each line's percentage is the simulated time reached (an update that crosses several
+    quarters prints one line).
 
     Parameters
     ----------
@@ -114,14 +116,15 @@ class Progress:
         if self.bar is not None:
             self.bar.update(self.n - self.bar.n)
             return
-        if self.next_line == 0 and self.n >= self.total / PIPE_LINES:
-            self.next_line = 1  # past the first quarter already: its line says the loop runs
-        while self.next_line <= PIPE_LINES and self.n >= self.total * self.next_line / PIPE_LINES - 1e-9:
+        passed = 0  # quarters of the run reached by now (a chunk may cross several at once)
+        while passed < PIPE_LINES and self.n >= self.total * (passed + 1) / PIPE_LINES - 1e-9:
+            passed += 1
+        if self.next_line == 0 or passed >= self.next_line:
             elapsed = time.perf_counter() - self.started
-            percent = 100 * self.n / self.total if self.next_line == 0 else 100 * self.next_line / PIPE_LINES
-            print(f"{self.label}: {int(percent):3d} % ({self.n:.1f}/{self.total:g} s simulated, {elapsed:.1f} s)",
-                  file=self.stream, flush=True)
-            self.next_line += 1
+            # one line, whose percentage is the simulated time reached, however many quarters it crossed
+            print(f"{self.label}: {int(100 * self.n / self.total):3d} % ({self.n:.1f}/{self.total:g} s simulated, "
+                  f"{elapsed:.1f} s)", file=self.stream, flush=True)
+            self.next_line = passed + 1
 
     def complete(self) -> None:
         """The run reached its end: show 100 %."""

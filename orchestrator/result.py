@@ -15,13 +15,16 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.files import atomic_path
+from orchestrator.files import atomic_path, json_text
 from orchestrator.fmu import nearest
 
 #: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.
 FORMATS = ("npz", "mat", "csv")
 
-#: What a run writes when no format is asked for: the compressed NumPy archive alone.
+#: Bytes a value takes in a ``.csv`` file at most (``repr`` of a float64 and a comma).
+CSV_BYTES_PER_VALUE = 25
+
+#: What a run writes when no format is asked for: the NumPy archive alone.
 DEFAULT_FORMATS = ("npz",)
 
 # a component: "acc_x" (axis after an underscore), "q0", "omega_r1", "R_reel_11" (index)
@@ -91,23 +94,19 @@ def signal_units(blocks, names) -> dict[str, str]:
 
 
 def available_memory() -> int | None:
-    """Memory the kernel can give without swapping (bytes): ``MemAvailable`` of
-    ``/proc/meminfo``, or None where that is not known."""
-    try:
-        with open("/proc/meminfo") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
+    """Memory a run may take (bytes): the smallest of the machine's available memory, the
+    address space left under ``ulimit -v`` and the room left in the control group (see
+    :func:`orchestrator.memory.available`); None where none is known."""
+    from orchestrator.memory import available
+
+    return available()[0]
 
 
 #: Share of the available memory a record may take: the rest is for the scenario's report.
 RECORD_SHARE = 0.8
 
 
-def check_record_fits(rows: int, signals: int, decimation: int = 1) -> int:
+def check_record_fits(rows: int, signals: int, decimation: int = 1, writers: int = 0) -> int:
     """Bytes a record will take; refuses one that would not fit in memory.
 
     Parameters
@@ -118,6 +117,9 @@ def check_record_fits(rows: int, signals: int, decimation: int = 1) -> int:
         Recorded signals (float64 each).
     decimation : int
         The run's decimation, named in the message as a way out.
+    writers : int
+        Bytes the writers of the result files add at their peak
+        (:func:`orchestrator.memory.writers_peak`).
 
     Returns
     -------
@@ -127,18 +129,25 @@ def check_record_fits(rows: int, signals: int, decimation: int = 1) -> int:
     Raises
     ------
     MemoryError
-        The record exceeds :data:`RECORD_SHARE` of the available memory; the message gives
-        the figure and the way out.
+        The record and its writers exceed :data:`RECORD_SHARE` of the memory available
+        (the machine's, ``ulimit -v`` or the control group's, whichever is smallest); the
+        message gives the figures, the limit that binds and the way out.
     """
-    need = rows * signals * 8
-    available = available_memory()
-    if available is not None and need > RECORD_SHARE * available:
+    from orchestrator.memory import available, in_gigabytes
+
+    record = rows * signals * 8
+    need = record + writers
+    room, source = available()
+    if room is not None and need > RECORD_SHARE * room:
         count = rows if rows < 1e12 else f"{rows:.3g}"
+        saving = f" and {in_gigabytes(writers)} more while its files are written" if writers else ""
         raise RecordTooLarge(
-            f"this run would record {count} samples of {signals} signals, {need / 1e9:.3g} GB, more than "
-            f"{RECORD_SHARE:.0%} of the {available / 1e9:.3g} GB of memory available. Record less: every N-th "
-            f"step (--decimation N, now {decimation}), fewer signals (--record SIGNAL ...), or a shorter run.")
-    return need
+            f"this run would record {count} samples of {signals} signals, {in_gigabytes(record)}{saving}: more "
+            f"than {RECORD_SHARE:.0%} of the {in_gigabytes(room)} of memory available (bound by {source})"
+            ". Record less: every N-th "
+            f"step (--decimation N, now {decimation}), fewer signals (--record SIGNAL ...), a shorter run, or "
+            "--stream (the record goes to disk as the run goes).")
+    return record
 
 
 class RecordTooLarge(MemoryError, ValueError):
@@ -296,8 +305,15 @@ class Result:
             if name not in grouped:
                 yield name, self.data[:, self._index[name]]
         for vector, members in groups.items():
-            stacked = self.data[:, [self._index[m] for m in members]]
-            yield vector, stacked.reshape(len(self.time), *matrix_shape(members))
+            yield vector, self._stacked(members).reshape(len(self.time), *matrix_shape(members))
+
+    def _stacked(self, members) -> np.ndarray:
+        """The columns of ``members`` side by side: a view of the record when they are
+        consecutive in it (a vector's components are), else a copy."""
+        columns = [self._index[m] for m in members]
+        if columns == list(range(columns[0], columns[0] + len(columns))):
+            return self.data[:, columns[0]:columns[0] + len(columns)]
+        return self.data[:, columns]
 
     def _description(self, names) -> dict:
         """The meta data written into the files: units, options, names and vectors included."""
@@ -305,8 +321,8 @@ class Result:
         return self.meta | {"error": self.error, "names": names, "units": {n: units[n] for n in ["time", *names]},
                             "options": self.options, "vectors": vector_groups(names)}
 
-    def to_npz(self, path, signals=None) -> Path:
-        """Write a compressed NumPy archive.
+    def to_npz(self, path, signals=None, compress: bool = False) -> Path:
+        """Write a NumPy archive (uncompressed unless ``compress``).
 
         It holds ``time`` (s), one array per scalar signal, one N x k array per vector signal
         (``"IMU.acc"``; ``"IMU.R_reel"`` is N x 3 x 3), and ``_meta``: JSON with ``units``
@@ -320,6 +336,9 @@ class Result:
             The file, written atomically.
         signals : list of str, optional
             The signals to write (vector names allowed); all by default.
+        compress : bool
+            Deflate each array (level 1: as small as the default level 6 on these signals,
+            twice as fast); about a third smaller and twenty times slower to write.
 
         Returns
         -------
@@ -330,15 +349,16 @@ class Result:
 
         path = Path(path)
         every = Every(1.5)  # a status line now and then while a long record is written
-        # level 1: as small as the default level 6 on these signals (8.59 against 8.65 MB), twice as fast
-        with atomic_path(path) as temporary, zipfile.ZipFile(temporary, "w", zipfile.ZIP_DEFLATED, allowZip64=True,
-                                                            compresslevel=1) as archive:
+        names = self._chosen(signals)
+        method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED
+        with atomic_path(path, size=8 * len(self) * (len(names) + 1)) as temporary, \
+                zipfile.ZipFile(temporary, "w", method, allowZip64=True, compresslevel=1 if compress else None) \
+                as archive:
             _write_array(archive, "time", self.time)
-            names = self._chosen(signals)
             for k, (name, values) in enumerate(self._arrays(names)):
                 _write_array(archive, name, values)
                 every.status(lambda k=k: f"writing {path.name}: {k + 1} arrays written")
-            _write_array(archive, "_meta", np.array(json.dumps(self._description(names), default=_plain_json)))
+            _write_array(archive, "_meta", np.array(json_text(self._description(names), indent=None)))
         return path
 
     def to_csv(self, path, signals=None) -> Path:
@@ -357,17 +377,18 @@ class Result:
             ``path``.
         """
         path = Path(path)
-        with atomic_path(path) as temporary, temporary.open("w", newline="") as handle:
+        names = self._chosen(signals)
+        with atomic_path(path, size=CSV_BYTES_PER_VALUE * len(self) * (len(names) + 1)) as temporary, \
+                temporary.open("w", newline="") as handle:
             writer = csv.writer(handle)
-            names = self._chosen(signals)
             columns = [self._index[n] for n in names]
             writer.writerow(["time", *names])
             for t, row in zip(self.time, self.data, strict=True):
                 writer.writerow([repr(float(t)), *(repr(float(row[c])) for c in columns)])
         return path
 
-    def to_mat(self, path, signals=None) -> Path:
-        """Write a compressed MATLAB file.
+    def to_mat(self, path, signals=None, compress: bool = False) -> Path:
+        """Write a MATLAB file (uncompressed unless ``compress``).
 
         One struct per block, each signal an N x 1 column (``IMU.acc_x`` reads ``IMU.acc_x`` in
         MATLAB) and each vector also an N x k array (``IMU.acc``; ``IMU.R_reel`` N x 3 x 3);
@@ -381,6 +402,9 @@ class Result:
             The file, written atomically.
         signals : list of str, optional
             The signals to write (vector names allowed); all by default.
+        compress : bool
+            Compress each variable (a block's struct is then held in memory whole while it is
+            compressed).
 
         Returns
         -------
@@ -400,17 +424,46 @@ class Result:
             units.setdefault(block, {})[signal] = every_unit[name]
         for vector, members in groups.items():
             block, _, signal = vector.partition(".")
-            blocks[block][signal] = self[vector].reshape(len(self.time), *matrix_shape(members))
+            blocks[block][signal] = self._stacked(members).reshape(len(self.time), *matrix_shape(members))
             units[block][signal] = every_unit[members[0]]
         scenario = self.meta.get("scenario", {})
         meta = {"scenario": scenario.get("name", ""), "dt_s": self.meta.get("dt", np.nan),
                 "decimation": self.meta.get("decimation", 1), "error": self.error or "",
-                "faults": [json.dumps(f, default=_plain_json) for f in self.meta.get("faults", [])]}
-        with atomic_path(path) as temporary:
+                "faults": [json_text(f, indent=None) for f in self.meta.get("faults", [])]}
+        size = 8 * len(self) * (1 + len(names) + sum(len(m) for m in groups.values()))
+        with atomic_path(path, size=size) as temporary:
             savemat(temporary, {"time": self.time, **blocks, "units": units | {"time": "s"},
                                 "options": _matlab_values(self.options), "meta": _matlab_values(meta)},
-                    long_field_names=True, do_compression=True, oned_as="column")
+                    long_field_names=True, do_compression=compress, oned_as="column")
         return Path(path)
+
+    @classmethod
+    def load(cls, path) -> Result:
+        """Read a record in either format: a ``.npz`` file, a ``results.stream`` folder, or a
+        run's output folder holding one of them.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file or folder.
+
+        Returns
+        -------
+        Result
+            The record (read lazily, one signal at a time, from a stream folder).
+        """
+        from orchestrator.stream import FOLDER, StreamedResult
+
+        path = Path(path)
+        if path.is_dir() and (path / FOLDER).is_dir():
+            path = path / FOLDER
+        elif path.is_dir() and (path / "results.npz").is_file():
+            path = path / "results.npz"
+        if path.is_dir():
+            if not (path / "meta.json").is_file():
+                raise FileNotFoundError(f"{path}: neither a results.npz nor a record streamed by --stream")
+            return StreamedResult(path)
+        return cls.from_npz(path)
 
     @classmethod
     def from_npz(cls, path) -> Result:
@@ -443,7 +496,8 @@ class Result:
             meta.pop("options", None)
             return cls(time, names, data, meta, meta.pop("error", None))
 
-    def save(self, out_dir, csv: bool = False, formats=DEFAULT_FORMATS, signals=None) -> list[Path]:
+    def save(self, out_dir, csv: bool = False, formats=DEFAULT_FORMATS, signals=None,
+             compress: bool = False) -> list[Path]:
         """Write ``results.<format>`` into ``out_dir`` for each of ``formats``.
 
         Parameters
@@ -456,6 +510,8 @@ class Result:
             A subset of :data:`FORMATS`; default :data:`DEFAULT_FORMATS` (the ``.npz`` alone).
         signals : list of str, optional
             The signals to write (vector names allowed); all by default.
+        compress : bool
+            Compress the ``.npz`` and ``.mat`` files.
 
         Returns
         -------
@@ -468,8 +524,14 @@ class Result:
             raise ValueError(f"unknown result format {', '.join(unknown)}; formats: {', '.join(FORMATS)}")
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        writers = {"npz": self.to_npz, "mat": self.to_mat, "csv": self.to_csv}
-        return [writers[f](out / f"results.{f}", signals) for f in formats]
+        written = []
+        for kind in formats:
+            path = out / f"results.{kind}"
+            if kind == "csv":
+                written.append(self.to_csv(path, signals))
+            else:
+                written.append((self.to_npz if kind == "npz" else self.to_mat)(path, signals, compress))
+        return written
 
     # ------------------------------------------------------------------ plots
     def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = "", unit: str | None = None):
@@ -506,7 +568,7 @@ class Result:
         import matplotlib.pyplot as plt
 
         if ax is None:
-            _, ax = plt.subplots(figsize=(8, 3))
+            _, ax = plt.subplots(figsize=(8, 3), layout="constrained")  # savefig keeps the axis labels
         if unit is None and scale != 1.0:
             raise ValueError(f"plot of {', '.join(names)} scaled by {scale:g}: give the unit of the scaled values "
                              "(unit=...)")
@@ -530,17 +592,33 @@ class Result:
         return ax
 
 
+#: Rows gathered at a time when a column of the record is written (a few MB at most).
+WRITE_ROWS = 2 ** 16
+
+
 def _write_array(archive: zipfile.ZipFile, name: str, values: np.ndarray):
-    """One ``name.npy`` member of a NumPy archive, written as ``numpy.savez_compressed`` does."""
+    """One ``name.npy`` member of a NumPy archive, the bytes ``numpy.save`` writes.
+
+    A column of the record is strided: it is gathered :data:`WRITE_ROWS` rows at a time into
+    one contiguous block handed to the archive as it is (``numpy.lib.format.write_array``
+    copies each block twice).
+    """
+    values = np.asanyarray(values)
+    if values.dtype.hasobject or values.dtype.kind not in "fiub":  # the JSON meta: numpy's own writer
+        with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+            np.lib.format.write_array(member, values, allow_pickle=False)
+        return
+    header = np.lib.format.header_data_from_array_1_0(values)
     with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
-        np.lib.format.write_array(member, np.asanyarray(values), allow_pickle=False)
-
-
-def _plain_json(value):
-    try:
-        return value.item()  # NumPy scalars
-    except AttributeError:
-        return str(value)  # a fault, a path
+        try:
+            np.lib.format.write_array_header_1_0(member, header)
+        except ValueError:  # a header too long for format 1.0, as numpy.save falls back
+            np.lib.format.write_array_header_2_0(member, header)
+        if values.flags.c_contiguous:
+            member.write(values.data if values.ndim else values.tobytes())
+            return
+        for first in range(0, len(values), WRITE_ROWS):
+            member.write(np.ascontiguousarray(values[first:first + WRITE_ROWS]).data)
 
 
 def _matlab_values(values: dict) -> dict:

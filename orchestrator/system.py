@@ -208,7 +208,7 @@ class System:
 
     # ------------------------------------------------------------------ running
     def run(self, duration: float, decimation: int = 1, progress: bool = False, start_time: float = 0.0,
-            record=None, master: str | None = None) -> Result:
+            record=None, master: str | None = None, stream=None) -> Result:
         """Run the system and return what was recorded.
 
         Parameters
@@ -228,6 +228,9 @@ class System:
             ``"chunk"`` (the default, or ``$QUADCOSIM_MASTER``): compiled code runs whole chunks
             of steps (:mod:`orchestrator.chunks`); ``"step"``: one step at a time from Python.
             Both give bit-identical results.
+        stream : orchestrator.stream.StreamWriter, optional
+            Write the record to its folder in chunks as the run goes (memory stays flat);
+            the result is then read back from that folder.
 
         Returns
         -------
@@ -252,7 +255,7 @@ class System:
         if missing:
             raise ValueError(f"unconnected input{'s' * (len(missing) > 1)}: {', '.join(missing)}. Connect each "
                              "with system.connect(source, destination) or tie it with system.set_input(name, value).")
-        plan = Plan(self, duration, int(decimation), start_time, record)
+        plan = Plan(self, duration, int(decimation), start_time, record, stream)
         try:
             plan.run(progress, master)
         finally:

@@ -8,6 +8,7 @@ figures and returns its metrics. :func:`run` does the rest: results (``results.n
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import math
 from dataclasses import dataclass, field
@@ -25,6 +26,8 @@ class Option:
     choices: tuple | None = None
     minimum: float | None = None
     classes: bool = False  # beside the choices, a block class of the user's, "module:Class"
+    files: str | None = None  # beside the choices, a file of this suffix (".csv"), read by the scenario
+    applies: str | None = None  # "other=a,b": the option acts only when option `other` is a or b
 
     @property
     def unit(self) -> str | None:
@@ -72,8 +75,10 @@ class Option:
                 value = str(text)
         except ValueError:
             raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}") from None
-        if self.choices and value not in self.choices and not (self.classes and ":" in value):
+        file = self.files is not None and str(value).lower().endswith(self.files)
+        if self.choices and value not in self.choices and not (self.classes and ":" in value) and not file:
             other = " or module:Class (a block of your own)" if self.classes else ""
+            other += f" or a {self.files} file" if self.files else ""
             raise ValueError(f"option {name}={text!r} must be one of {', '.join(map(str, self.choices))}{other}")
         if self.minimum is not None and value < self.minimum:
             raise ValueError(f"option {name}={value} must be at least {self.minimum}")
@@ -94,6 +99,29 @@ class Scenario:
     def used(self, options: dict) -> dict:
         """``options`` as the run uses them: every default marker replaced by the value it stands for."""
         return self.resolve(options) if self.resolve else dict(options)
+
+    def inert(self, options: dict) -> list[str]:
+        """The options that act on nothing in a run with ``options`` (their ``applies`` condition
+        is not met: ``k`` with ``estimator=explicit``, ``seed`` with ``noise=off``).
+
+        Parameters
+        ----------
+        options : dict
+            Parsed options (:meth:`parse`).
+
+        Returns
+        -------
+        list of str
+            Option names, in declaration order.
+        """
+        inert = []
+        for key, option in self.options.items():
+            if option.applies:
+                other, _, values = option.applies.partition("=")
+                accepted = [self.options[other].parse(other, v) for v in values.split(",")]
+                if options[other] not in accepted:
+                    inert.append(key)
+        return inert
 
     def title(self, options: dict) -> str:
         """The scenario's name and its options off their defaults, as a figure title names a run.
@@ -228,7 +256,8 @@ def get(name: str) -> Scenario:
 
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
-        record=None, formats=("npz",), overwrite: bool = False, estimator=None):
+        record=None, formats=("npz",), overwrite: bool = False, estimator=None, compress: bool = False,
+        stream: bool = False):
     """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
 
     Parameters
@@ -246,17 +275,23 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     faults : sequence of orchestrator.Fault
         Faults injected; recorded in ``metrics.json``.
     decimation : int
-        Keep every N-th macro step.
+        Keep every N-th macro step; at most the run's number of steps.
     record : list of str, optional
         Signals to keep; ``["all"]`` keeps every output; default: the scenario's choice
         (``extra["record"]``, or every output but ``extra["unrecorded"]``), else all.
     formats : sequence of str
-        Result files written (``npz``, ``mat``, ``csv``); the compressed ``.npz`` alone by default.
+        Result files written (``npz``, ``mat``, ``csv``); the ``.npz`` alone by default.
     overwrite : bool
-        Replace the results already in ``out_dir``.
+        Replace the results already in ``out_dir``: every file of the earlier run is removed.
     estimator : orchestrator.Block or class, optional
         A block of the user's (an instance or a class, see :mod:`estimators.contract`) in the
         place of ``Quaternion_estim``.
+    compress : bool
+        Compress the ``.npz`` and ``.mat`` files (smaller, several times slower to write).
+    stream : bool
+        Write the record to ``results.stream/`` in chunks as the run goes, so that its memory
+        stays flat however long the run (:mod:`orchestrator.stream`); needs ``out_dir`` and
+        the ``npz`` format alone.
 
     Returns
     -------
@@ -267,67 +302,187 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
 
     Raises
     ------
+    ValueError, KeyError
+        A refused option, parameter or output folder, before the run starts; nothing is left
+        in ``out_dir``.
     orchestrator.SimulationError
-        The run failed (:class:`orchestrator.RunInterrupted`: it was interrupted); what was
-        recorded is saved all the same, with a ``metrics.json`` saying where the run stopped.
+        The run failed (:class:`orchestrator.RunInterrupted`: it was interrupted, in any
+        phase); what was recorded is saved all the same, with a ``metrics.json`` saying where
+        the run stopped and which files were kept.
     """
-    from orchestrator import SimulationError
     from orchestrator.files import prepare_out_dir
+    from orchestrator.interrupts import first_only
     from orchestrator.progress import status
-    from orchestrator.result import FORMATS
-    from scenarios.metrics import metric_units
+    from scenarios.outputs import RunFiles
 
     status(f"{name}: loading the scenario")
-    scenario = get(name)
-    options = scenario.parse(settings)
+    _check_formats(formats, stream, out_dir)
+    if name not in _MODULES:
+        get(name)  # refused (the nearest names given) before any folder is made
+    made = out_dir is not None and not Path(out_dir).exists()
+    out = prepare_out_dir(out_dir, overwrite) if out_dir else None
+    given = dict(settings) if isinstance(settings, dict) else dict(_split(s) for s in settings or [] if "=" in s)
+    base = {"scenario": name, "options": given, "injected_faults": [fault_record(f) for f in faults],
+            "decimation": decimation}
+    files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+    with first_only(), (files.tracking() if files else contextlib.nullcontext()):
+        try:
+            scenario = get(name)
+            options = scenario.parse(settings)
+            base["options"] = dict(options)
+            if files:
+                files.units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
+            return _run_phases(scenario, options, base, files, (faults, estimator, record, stream), progress)
+        except KeyboardInterrupt as interrupt:  # outside the loop: loading, building, drawing, saving, reporting
+            if files is None:
+                raise
+            raise files.interrupted(interrupt, files.saved, files.stream) from None
+        except (KeyError, ValueError):  # refused before the run: the folder is left as it was
+            if files is not None and files.result is None:
+                files.refused(remove_folder=made)
+            raise
+
+
+def _check_formats(formats, stream: bool, out_dir):
+    from orchestrator.result import FORMATS
+
     unknown = [f for f in formats if f not in FORMATS]
     if unknown or not formats:
         raise ValueError(f"--format {','.join(formats)}: choose among {', '.join(FORMATS)}")
-    out = prepare_out_dir(out_dir, overwrite) if out_dir else None
-    status(f"{name}: building the system")
-    system = scenario.system(options, estimator=estimator)
-    for fault in faults:
-        system.inject(fault)
-    if out is not None and scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs
-        from orchestrator.diagram import draw
+    if stream and (out_dir is None or list(formats) != ["npz"]):
+        raise ValueError("--stream writes the record as it goes into OUT/results.stream/: give --out and no "
+                         "--format (other formats can be written afterwards: Result.load(folder).save(...))")
 
-        status(f"{name}: wiring diagram")
-        draw(system, out / "diagram.png", scenario.title(options))
-    used = scenario.used(options)
-    duration = scenario.duration(options) if scenario.duration else options["duration"]
-    option_units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
-    base = {"scenario": name, "options": used, "injected_faults": [fault_record(f) for f in faults],
-            "duration_s": duration, "decimation": decimation}
-    kept, saved = _signals_kept(scenario, system, record, base)
+
+def _run_phases(scenario, options, base, files, given, progress):
+    """Build, draw, run, save and report, each phase named in ``files`` for ``metrics.json``;
+    ``given`` holds the faults, the user's estimator, the signals to record and ``stream``."""
+    from orchestrator import SimulationError
+    from orchestrator.progress import status
+    from scenarios.metrics import metric_units
+
+    name, (faults, estimator, record, stream) = scenario.name, given
+    system, duration, kept, saved = _build(scenario, options, base, files, faults, estimator, stream, record)
+    if files:
+        files.phase, files.stream = "running", _open_stream(files, stream)
     status(f"{name}: starting {duration:g} s of simulated time ({len(system.blocks)} blocks)")
     try:
-        result = system.run(duration, decimation=decimation, progress=progress, record=kept)
+        result = system.run(duration, decimation=base["decimation"], progress=progress, record=kept,
+                            stream=files.stream if files else None)
     except SimulationError as error:
-        if out is not None and error.result is not None:
-            _save_stopped(error, out, formats, base, option_units, saved)
+        if files is not None:
+            files.stopped(error, saved, files.stream)
         raise
-    result.meta |= {"scenario": {"name": name, "options": used}, "faults": base["injected_faults"]}
+    except (KeyError, ValueError):  # refused as the run was set up (a value an FMU refused, memory)
+        if files is not None:
+            files.refused()
+        raise
+    result.meta |= {"scenario": {"name": name, "options": base["options"]}, "faults": base["injected_faults"]}
     metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
                       "fmu_warnings": _warning_counts(result)}
-    if out is not None:
-        status(f"{name}: writing {', '.join(f'results.{f}' for f in formats)} "
+    if files is not None:
+        files.phase = "saving the record"
+        status(f"{name}: writing {', '.join(f'results.{f}' for f in files.formats)} "
                f"({len(saved) if saved else len(result.names)} signals, {len(result)} samples)")
-    written = result.save(out, formats=formats, signals=saved) if out is not None else []
-    status(f"{name}: report" + (" (metrics and figures)" if out is not None else " (metrics)"))
+        files.keep_record(result, saved, files.stream)
+        if files.not_written:  # a full disk, or no memory left for a writer: metrics.json says which
+            raise files.failed("; ".join(f"{name} not written: {why}" for name, why in files.not_written.items()))
+        files.phase = "reporting (metrics and figures)"
+    status(f"{name}: report" + (" (metrics and figures)" if files else " (metrics)"))
+    metrics |= _report(scenario, result, options, files, record)
+    declared = scenario.extra.get("units", {}) | (metrics.get("units") or {})  # for names that carry none
+    option_units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
+    metrics["units"] = metric_units(metrics, declared) | option_units | {"injected_faults": FAULT_UNITS}
+    if files is not None:
+        metrics["save_cpu_s"] = files.save_cpu_seconds
+        files.finish(metrics)
+    return result, metrics
+
+
+def _recorded_names(system, kept) -> list[str]:
+    """The signals a run records: ``kept`` resolved (vector names expanded), or every output."""
+    from scenarios.metrics import recorded_outputs
+
+    if kept is None:
+        return recorded_outputs(system)
+    return list(dict.fromkeys(name for signal in kept for name in system._resolve(signal, "output")))
+
+
+def _open_stream(files, stream: bool):
+    """The writer of ``results.stream/`` when the record is streamed, else None."""
+    if not stream:
+        return None
+    from orchestrator.stream import FOLDER, StreamWriter
+
+    return StreamWriter(files.out / FOLDER)
+
+
+def _build(scenario, options, base, files, faults, estimator, stream, record):
+    """The system, its duration (s), the signals recorded and those written (``base`` takes
+    the options as used and the duration); a refusal removes what this run wrote."""
+    from orchestrator.progress import status
+
+    if files:
+        files.phase = "building the system"
+    status(f"{scenario.name}: building the system")
     try:
-        metrics |= scenario.report(result, options, out)
+        system = scenario.system(options, estimator=estimator)
+        for fault in faults:
+            system.inject(fault)
+        duration = scenario.duration(options) if scenario.duration else options["duration"]
+        _check_decimation(base["decimation"], duration, system.dt)
+        base |= {"options": scenario.used(options), "duration_s": duration}
+        kept, saved = _signals_kept(scenario, system, record, base)
+        if files:
+            files.saved = saved
+            recorded = _recorded_names(system, kept)
+            rows = int(round(duration / system.dt)) // base["decimation"] + 1
+            files.check_room(rows, recorded, saved or recorded, base["decimation"], stream)
+            _draw(scenario, system, options, files)
+    except (KeyError, ValueError):
+        if files:
+            files.refused()
+        raise
+    return system, duration, kept, saved
+
+
+def _check_decimation(decimation: int, duration: float, dt: float):
+    steps = int(round(duration / dt))
+    if decimation > steps:
+        raise ValueError(f"--decimation {decimation} is more than the run's {steps} steps ({duration:g} s every "
+                         f"{dt:g} s): it would record the first sample alone. Give at most --decimation {steps}, "
+                         "or a longer run")
+
+
+def _draw(scenario, system, options, files):
+    from orchestrator.progress import status
+
+    if scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs
+        from orchestrator.diagram import draw
+
+        files.phase = "drawing the wiring diagram"
+        status(f"{scenario.name}: wiring diagram")
+        draw(system, files.out / "diagram.png", scenario.title(options))
+
+
+def _report(scenario, result, options, files, record) -> dict:
+    """The scenario's metrics (and figures); a report that fails keeps the saved record."""
+    try:
+        return scenario.report(result, options, files.out if files else None)
     except KeyError as error:
         if not record:
-            raise
+            if files is None:
+                raise
+            raise files.failed(f"the report failed: KeyError: {error}") from error
         # the report needs a signal the user chose not to record: the results stand alone
-        metrics["report"] = f"report skipped: {error.args[0]} (add it to --record for the report)"
-    declared = scenario.extra.get("units", {}) | (metrics.get("units") or {})  # for names that carry none
-    metrics["units"] = metric_units(metrics, declared) | option_units | \
-        {"injected_faults": FAULT_UNITS}
-    if out is not None:
-        figures = sorted(p.name for p in out.iterdir() if p.suffix in (".png", ".svg", ".pdf"))
-        _write_metrics(out, metrics | {"files": sorted([p.name for p in written] + figures)})
-    return result, metrics
+        return {"report": f"report skipped: {error.args[0]} (add it to --record for the report)"}
+    except Exception as error:
+        if files is None:
+            raise
+        from orchestrator.files import DiskFull
+
+        what = str(error) if isinstance(error, DiskFull) else f"{type(error).__name__}: {error}"
+        raise files.failed(f"the report failed: {what}") from error
 
 
 def fault_record(fault) -> dict:
@@ -348,7 +503,7 @@ def fault_record(fault) -> dict:
 
 
 #: The units of :func:`fault_record`'s fields, as ``metrics.json`` states them.
-FAULT_UNITS = "start, stop: s; value: the target's unit (scale: a factor)"
+FAULT_UNITS = "start, stop: s (stop null: no end); value: the target's unit (scale: a factor)"
 
 
 def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | None, list[str] | None]:
@@ -373,34 +528,6 @@ def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | Non
     return scenario.extra.get("record"), None
 
 
-def _save_stopped(error, out: Path, formats, base: dict, option_units: dict, saved):
-    """Save what a failed or interrupted run recorded, with a ``metrics.json`` saying where it stopped."""
-    from orchestrator import RunInterrupted
-    from orchestrator.interrupts import signal_name
-    from scenarios.metrics import metric_units
-
-    partial = error.result
-    partial.meta |= {"scenario": {"name": base["scenario"], "options": base["options"]},
-                     "faults": base["injected_faults"]}
-    written = partial.save(out, formats=formats, signals=saved)
-    stopped = {"status": "interrupted" if isinstance(error, RunInterrupted) else "failed",
-               "error": str(error),
-               "recorded_until_s": float(partial.time[-1]) if len(partial) else None,
-               "samples": len(partial),
-               "fmu_warnings": _warning_counts(partial)}
-    if isinstance(error, RunInterrupted):
-        stopped["interrupted_by"] = signal_name(error.signal_number)
-    metrics = base | stopped | {"files": sorted(p.name for p in written)}
-    _write_metrics(out, metrics | {"units": metric_units(metrics) | option_units | {"injected_faults": FAULT_UNITS}})
-
-
 def _warning_counts(result) -> dict:
     """Per FMU block that warned: ``{"count": n, "first": [the first few messages]}``."""
     return dict(result.meta.get("fmu_warnings", {}))
-
-
-def _write_metrics(out: Path, metrics: dict):
-    from orchestrator.files import write_json
-
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "metrics.json", metrics)

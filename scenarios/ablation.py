@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 
-from estimators import estimate
+from estimators import estimate, parse_corrections
 from estimators.core import euler_to_quaternion
 from fmus import vehicle
 from orchestrator.blocks import Block
@@ -102,7 +102,7 @@ def linear_ablation(settings: dict | None = None) -> dict:
     rms = {"streaming": metrics["rms_error_deg"]}
     for name, (a, w) in zip(VARIANTS, [(acc, gyro), (ideal_acc, gyro), (acc, rates), (ideal_acc, rates)],
                             strict=True):
-        theta = estimate("linear", gyro=w, acc=a, mag=mag, dt=dt, gains=gains,
+        theta = estimate("linear", gyro=w, acc=a, mag=mag, dt=dt, gains=gains, discretisation=o["discretisation"],
                          q0=euler_to_quaternion(*truth[0]))["theta"][0]
         error = (theta - truth + np.pi) % (2 * np.pi) - np.pi
         rms[name] = np.degrees(np.sqrt((error[after] ** 2).mean(axis=0))).tolist()
@@ -129,6 +129,7 @@ def triad_ablation(settings: dict | None = None) -> dict:
            "streaming": (result["Quaternion_estim.b_est"][-1] - true_bias).tolist()}
     for name, a in (("recorded", acc), ("ideal accelerometer", gravity_only(result["IMU.R_reel"][picked]))):
         b = estimate("passive", gyro=gyro, acc=a, mag=mag, dt=o["dt"] * step, gains=gains, ry="triad",
+                     corrections=parse_corrections(o["corrections"]), discretisation=o["discretisation"],
                      q0=euler_to_quaternion(*truth[0]), outputs=("b",))["b"][0]
         out[name] = (b[-1] - true_bias).tolist()
     return out

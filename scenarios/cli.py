@@ -5,17 +5,23 @@
   quadcosim run SCENARIO [--set k=v k2=v2 ...] [--estimator module:Class] [--out DIR] [--fault ...]
                                            (--set IMU.gyro_noise_density=0.001: an FMU parameter)
   quadcosim diagram SCENARIO [--out FILE]  picture of the wiring
+  quadcosim plot RUN SIGNAL...             signals of a finished run (its folder) against time
+  quadcosim compare RUN RUN... SIGNAL      one signal of several finished runs on one figure
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
+  quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
+  quadcosim findings [GROUP...] [--quick] [--check]   the README's numbers, measured into findings.json
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -53,9 +59,11 @@ def _list(args) -> int:
 
         print(f"{args.parameters} parameters (set one in any scenario with --set {args.parameters}.NAME=VALUE; "
               "a vector as x,y,z):")
+        from scenarios.shown import PARAMETER_DIGITS, shown
+
         for v in table(args.parameters).of("parameter"):
             unit = f" [{v.unit}]" if v.unit else ""
-            print(f"  {v.name:22s} = {v.start!r:24}{unit:14s} {v.description}")
+            print(f"  {v.name:22s} = {shown(v.start, PARAMETER_DIGITS):24}{unit:14s} {v.description}")
         aliases, switched = model_notes(args.parameters)
         for alias, name in aliases.items():
             print(f"  {alias} stands for the vector {name}")
@@ -87,15 +95,28 @@ def _settings(args) -> list[str]:
     return settings
 
 
+_FAULT_FORM = ("write TARGET:KIND:START:STOP[:VALUE], e.g. IMU.omega_x:offset:0.5:1:0.05 (a gyro offset of "
+               "0.05 rad/s from 0.5 s to 1 s, on the true rate into the IMU)")
+
+
 def _parse_fault(text: str):
     from orchestrator import Fault
 
     parts = text.split(":")
     if len(parts) not in (4, 5):
-        raise ValueError(f"--fault {text!r}: write TARGET:KIND:START:STOP[:VALUE], e.g. IMU.omega_x:offset:0.5:1:0.05 "
-                         "(a gyro offset of 0.05 rad/s from 0.5 s to 1 s, on the true rate into the IMU)")
-    value = float(parts[4]) if len(parts) == 5 else None
-    return Fault(parts[0], parts[1], float(parts[2]), float(parts[3]), value)
+        raise ValueError(f"--fault {text!r}: {_FAULT_FORM}")
+    fields = {"START": (parts[2], "s"), "STOP": (parts[3], "s; inf for no end")}
+    if len(parts) == 5:
+        fields["VALUE"] = (parts[4], "in the unit of the target, a factor for scale")
+    numbers = {}
+    for field, (given, unit) in fields.items():
+        try:
+            numbers[field] = float(given)
+        except ValueError:
+            raise ValueError(f"--fault {text!r}: {field} {given!r} is not a number ({unit}); {_FAULT_FORM}") from None
+    if math.isnan(numbers["START"]) or math.isnan(numbers["STOP"]) or math.isinf(numbers["START"]):
+        raise ValueError(f"--fault {text!r}: START must be a finite time (s) and STOP a time or inf; {_FAULT_FORM}")
+    return Fault(parts[0], parts[1], numbers["START"], numbers["STOP"], numbers.get("VALUE"))
 
 
 def _positive_int(text: str) -> int:
@@ -109,10 +130,17 @@ def _positive_int(text: str) -> int:
 
 
 def _run(args) -> int:
+    from orchestrator.interrupts import exit_code, first_only
     from orchestrator.progress import reporting
 
-    with reporting(True):
-        return _run_reporting(args)
+    # the first signal stops the run; later ones wait until its record is safe, then (when this
+    # is the process's command line) are ignored while the process ends with the first one's code
+    with first_only(final=getattr(args, "final", False)), reporting(True):
+        try:
+            return _run_reporting(args)
+        except KeyboardInterrupt as interrupt:  # before the run began: nothing was written
+            print("quadcosim: interrupted", file=sys.stderr)
+            return exit_code(interrupt)
 
 
 def _run_reporting(args) -> int:
@@ -128,7 +156,7 @@ def _run_reporting(args) -> int:
         faults = [_parse_fault(f) for f in args.fault or []]
         _, metrics = scenarios.run(args.scenario, _settings(args), out, progress=True, faults=faults,
                                    decimation=args.decimation, record=args.record, formats=formats,
-                                   overwrite=args.overwrite)
+                                   overwrite=args.overwrite, compress=args.compress, stream=args.stream)
     except RunInterrupted as error:
         print(f"quadcosim run {args.scenario}: {error}", file=sys.stderr)
         print(f"what was recorded ({len(error.result)} samples) and metrics.json are in {out}/", file=sys.stderr)
@@ -141,10 +169,15 @@ def _run_reporting(args) -> int:
     except (KeyError, ValueError) as error:
         print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
+    except OSError as error:  # the output folder failed under the run (removed, read-only, a disk error)
+        print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)
+        return 1
     warnings = metrics.pop("fmu_warnings", {})
     shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario", "units", "signals_not_saved")}
+    from scenarios.shown import shown as text
+
     for key, value in shown.items():
-        print(f"  {key}: {value}")
+        print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
     return 0
@@ -176,17 +209,23 @@ def _print_warnings(warnings: dict, shown: int = 3):
 
 
 def _diagram(args) -> int:
-    import scenarios
-    from orchestrator.diagram import draw
+    from orchestrator.progress import reporting, status
 
-    try:
-        scenario = scenarios.get(args.scenario)
-        options = scenario.parse(_settings(args))
-        system = scenario.system(options)
-    except (KeyError, ValueError) as error:
-        print(error.args[0] if error.args else error, file=sys.stderr)
-        return 2
-    path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+    with reporting(True):
+        status(f"quadcosim diagram {args.scenario}: loading the packages")
+        import scenarios
+        from orchestrator.diagram import draw
+
+        try:
+            scenario = scenarios.get(args.scenario)
+            options = scenario.parse(_settings(args))
+            status(f"{args.scenario}: building the system (its FMUs loaded)")
+            system = scenario.system(options)
+        except (KeyError, ValueError) as error:
+            print(error.args[0] if error.args else error, file=sys.stderr)
+            return 2
+        status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
+        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
     print(path)
     return 0
 
@@ -210,9 +249,10 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    build = sub.add_parser("build", help="build the plant FMUs (into build/fmus), the master's C runner and "
-                           "the benchmark's C references")
-    build.add_argument("--out", default=None, help="output folder (default build/fmus)")
+    build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
+                           "references (into build/ in a source checkout, a per-user cache when installed; a run "
+                           "builds what it needs on first use)")
+    build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
@@ -239,8 +279,12 @@ def parser() -> argparse.ArgumentParser:
                           "'all' records and writes every output (by default a scenario's files may leave out signals "
                           "that follow from others, listed in metrics.json)")
     run.add_argument("--format", default="npz", metavar="npz,mat,csv",
-                     help="result files to write, comma-separated: npz (compressed NumPy, the default), mat "
-                          "(compressed MATLAB), csv")
+                     help="result files to write, comma-separated: npz (NumPy, the default), mat (MATLAB), csv")
+    run.add_argument("--compress", action="store_true",
+                     help="compress the npz and mat files (about a third smaller, many times slower to write)")
+    run.add_argument("--stream", action="store_true",
+                     help="write the record to OUT/results.stream/ in chunks as the run goes: memory stays flat "
+                          "however long the run (read it with Result.load(OUT))")
     run.set_defaults(func=_run)
     diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
     diagram.add_argument("scenario")
@@ -253,13 +297,31 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
+    findings = sub.add_parser("findings", add_help=False,
+                              help="run the README's findings, write findings.json, rewrite the README's numbers "
+                                   "(quadcosim findings --help)")
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
+    from scenarios import run_plots
+
+    run_plots.add_arguments(sub)
     from scenarios.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
         .set_defaults(func=sweep.sweep)
     sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
         .set_defaults(func=sweep.sweep_plot)
+    _add_flight_logs(sub)
     return p
+
+
+def _add_flight_logs(sub):
+    """The ``log`` and ``calibrate`` verbs (:mod:`scenarios.flightlog`) on the sub-parsers ``sub``."""
+    from scenarios.flightlog import calibrate
+    from scenarios.flightlog import command as flightlog
+
+    flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
+    calibrate.add_arguments(sub.add_parser("calibrate", help="calibrate a magnetometer and its motor interference "
+                                           "from real flights; ArduPilot and PX4 parameters"))
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
@@ -274,7 +336,14 @@ def main(argv=None) -> int:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")
             warnings.showwarning = _show_warning
+            final = argv is None  # the process's own command line, not a call from Python
+            argv = sys.argv[1:] if argv is None else list(argv)
+            if argv[:1] == ["findings"]:  # its own parser: its options, --help included, are its own
+                from scenarios.findings.__main__ import main as findings
+
+                return findings(argv[1:])
             args = parser().parse_args(argv)
+            args.final = final
             if args.command in ("run", "sweep", "bench", "build"):
                 from scenarios.compiled import announce_compiles
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import textwrap
 
+import numpy as np
+
 FAULT_COLOUR = "#d62728"
 
 
@@ -140,3 +142,37 @@ def label_axes(axes) -> None:
             raise ValueError(f"an axis of figure {ax.figure.get_suptitle()!r} has no y label")
     if not axes[-1].get_xlabel():
         raise ValueError(f"the bottom axis of figure {axes[-1].figure.get_suptitle()!r} has no x label")
+
+
+#: Degrees of a jump between two samples of a wrapped angle that is a wrap, not a motion.
+WRAP_JUMP_DEG = 180.0
+
+
+def angle_curve(t, degrees, points: int = 2000):
+    """A curve of an angle wrapped to (-180, 180] deg, as drawn: reduced to its envelope, with a
+    gap (NaN) where it wraps, so that the plot shows no vertical line at +-180 deg.
+
+    The angle is unwrapped before the envelope (a run of samples across the wrap keeps its
+    true extremes) and wrapped again after it.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times (s).
+    degrees : ndarray
+        The angle (deg), wrapped or not.
+    points : int
+        Runs of the envelope (:func:`orchestrator.result.envelope`).
+
+    Returns
+    -------
+    times, values : ndarray
+        Ready for ``ax.plot``.
+    """
+    from orchestrator.result import envelope
+
+    unwrapped = np.degrees(np.unwrap(np.radians(degrees)))
+    times, values = envelope(t, unwrapped, points)
+    wrapped = (values + 180.0) % 360.0 - 180.0
+    breaks = np.flatnonzero(np.abs(np.diff(wrapped)) > WRAP_JUMP_DEG) + 1
+    return np.insert(times.astype(float), breaks, np.nan), np.insert(wrapped, breaks, np.nan)

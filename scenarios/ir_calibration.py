@@ -37,6 +37,8 @@ OPTIONS = {
     "duration": Option(400.0, "simulated time (s): 8000 samples at 20 Hz", minimum=5.0),
     "drift": Option(True, "a and b drift with time of day, temperature and cloud"),
     "faults": Option("none", "sensor faults of the slides", choices=("none", "ir", "gps", "both")),
+    "ir_fault": Option(IR_FAULT[1], "offset of the IR fault (count; the slides': 1200)"),
+    "gps_fault": Option(GPS_FAULT[1], "offset of the GPS fault (rad/s; the slides': 1.5)"),
     "gps_resetting": Option(True, "GPS fused all flight (the slides' 'with GPS resetting'); off: only until "
                                   "calibration_s (their 'real case')"),
     "calibration_s": Option(60.0, "end of the GPS calibration phase when gps_resetting is off (s)", minimum=0.0),
@@ -75,13 +77,24 @@ def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gra
     return np.arctan(r * airspeed / gravity)
 
 
-def fault_windows(faults: str) -> list[tuple[str, float, float, float]]:
-    """The injected faults: (sensor, onset s, end s, offset)."""
+def fault_windows(faults: str, ir_fault: float = IR_FAULT[1], gps_fault: float = GPS_FAULT[1]
+                  ) -> list[tuple[str, float, float, float]]:
+    """The injected faults: (sensor, onset s, end s, offset).
+
+    Parameters
+    ----------
+    faults : {"none", "ir", "gps", "both"}
+        Which sensors fail, at the slides' onsets, for 2000 samples.
+    ir_fault : float
+        Offset of the IR (count); the slides' 1200 by default.
+    gps_fault : float
+        Offset of the GPS turn rate (rad/s); the slides' 1.5 by default.
+    """
     windows = []
     if faults in ("ir", "both"):
-        windows.append(("ir", IR_FAULT[0], IR_FAULT[0] + FAULT_SAMPLES / RATE, IR_FAULT[1]))
+        windows.append(("ir", IR_FAULT[0], IR_FAULT[0] + FAULT_SAMPLES / RATE, float(ir_fault)))
     if faults in ("gps", "both"):
-        windows.append(("gps", GPS_FAULT[0], GPS_FAULT[0] + FAULT_SAMPLES / RATE, GPS_FAULT[1]))
+        windows.append(("gps", GPS_FAULT[0], GPS_FAULT[0] + FAULT_SAMPLES / RATE, float(gps_fault)))
     return windows
 
 
@@ -91,7 +104,8 @@ def sensor_parameters(seed: int, drift: bool, noise: bool) -> dict:
 
 
 def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, noise: bool = True,
-                    faults: str = "none", parameters: dict | None = None) -> dict[str, np.ndarray]:
+                    faults: str = "none", parameters: dict | None = None, ir_fault: float = IR_FAULT[1],
+                    gps_fault: float = GPS_FAULT[1]) -> dict[str, np.ndarray]:
     """The InfraredSensor FMU over a flight of :func:`bank_profile`, on arrays, without the master.
 
     Returns arrays of ``samples`` values at 20 Hz: ``time`` (s), the truth ``r`` (rad/s), ``a``,
@@ -99,7 +113,8 @@ def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, nois
     ``gps_turn_rate`` (rad/s), ``gps_valid``. ``parameters`` overrides the FMU's (for instance
     ``{"cloud_start": 100.0}`` to put the cloud inside the IR fault). ``seed`` draws the bank
     profile and the noise; ``drift`` (of a and b), ``noise`` and ``faults`` (``none``, ``ir``,
-    ``gps``, ``both``) switch the slides' effects.
+    ``gps``, ``both``) switch the slides' effects; ``ir_fault`` (count) and ``gps_fault``
+    (rad/s) are the faults' offsets.
     """
     phi = bank_profile(samples, seed)
     names = ["r", "a", "b", "ir", "gps_turn_rate", "gps_valid"]
@@ -114,7 +129,7 @@ def simulate_flight(samples: int = 8000, seed: int = 1, drift: bool = True, nois
         fmu.close()
     flight = {name: values[:, j] for j, name in enumerate(names)}
     flight["time"] = np.arange(samples) / RATE
-    for sensor, start, stop, offset in fault_windows(faults):
+    for sensor, start, stop, offset in fault_windows(faults, ir_fault, gps_fault):
         window = (flight["time"] >= start - 1e-9) & (flight["time"] < stop - 1e-9)
         flight["ir" if sensor == "ir" else "gps_turn_rate"][window] += offset
     return flight
@@ -194,7 +209,7 @@ def build(o: dict) -> System:
     # the profile of samples rows (the last is held), the same as simulate_flight flies
     system.add(Table("Bank", ["phi"], bank_profile(samples, o["seed"])[:, None], units={"phi": "rad"}))
     system.add(FMUBlock("InfraredSensor", parameters=sensor_parameters(o["seed"], o["drift"], o["noise"])))
-    system.add(SensorFaults("Faults", fault_windows(o["faults"])))
+    system.add(SensorFaults("Faults", fault_windows(o["faults"], o["ir_fault"], o["gps_fault"])))
     system.connect("Bank.phi", "InfraredSensor.phi")
     system.connect("InfraredSensor.ir", "Faults.ir")
     system.connect("InfraredSensor.gps_turn_rate", "Faults.gps_turn_rate")
@@ -256,7 +271,7 @@ def report(result, o, out) -> dict:
         Folder of the figures; none are written when ``None``.
     """
     t = result.time
-    windows = fault_windows(o["faults"])
+    windows = fault_windows(o["faults"], o["ir_fault"], o["gps_fault"])
     truth = {"r": result["InfraredSensor.r"], "a": result["InfraredSensor.a"], "b": result["InfraredSensor.b"]}
     estimates = {m: {k: result[f"{m.capitalize()}.{k}"] for k in ("turn_rate", "a", "b")} for m in METHODS}
     estimates["kalman"] |= {k: result[f"Kalman.{k}"] for k in ("ir_fault", "gps_fault")}

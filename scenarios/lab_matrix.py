@@ -23,7 +23,6 @@ A named sweep: its members run on Dask like any sweep (``--workers``, ``--schedu
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -31,6 +30,7 @@ import numpy as np
 
 from estimators import analysis, score
 from fmus.IMU.variables import LAB_GYRO_BIAS
+from orchestrator.files import write_json, write_text
 
 CASES = {
     "linear-quasi-gt": {"estimator": "linear"},
@@ -131,8 +131,8 @@ def summarise(records: list[dict], out: Path) -> dict:
     ``records`` (their metrics.json)."""
     summary = summary_of(records)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
-    (out / "summary.md").write_text(markdown(summary))
+    write_json(out / "summary.json", summary)
+    write_text(out / "summary.md", markdown(summary))
     return summary
 
 
@@ -223,11 +223,13 @@ def main(argv=None) -> int:
     from scenarios.sweep import command
 
     parser = argparse.ArgumentParser(prog="python -m scenarios.lab_matrix", description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="results/lab-matrix", help="output folder")
+    parser.add_argument("--out", help="output folder (default results/lab-matrix, or results/lab-matrix-N when that "
+                                      "holds an earlier matrix)")
     parser.add_argument("--workers", help="local Dask worker processes (default: the CPUs)")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler")
     parser.add_argument("--resume", action="store_true", help="continue the matrix in --out")
     args, rest = parser.parse_known_args(argv)
+    args.out = args.out or str(command.default_out(Path("results/lab-matrix"), args.resume, parser.prog))
     forwarded = ["lab-matrix", "--out", args.out, *rest]
     forwarded += ["--workers", args.workers] if args.workers else []
     forwarded += ["--scheduler", args.scheduler] if args.scheduler else []

@@ -23,7 +23,6 @@ clamped, so the Earth field is constant in the sensor frame.
 from __future__ import annotations
 
 import functools
-import json
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +30,9 @@ import numpy as np
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
 from orchestrator import System, Table
+from orchestrator.files import write_json, write_text
+from orchestrator.parameters import apply
+from orchestrator.progress import status
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
@@ -59,6 +61,47 @@ OPTIONS = {
     "static": Option("", "static calibration file (JSON) for A, b_s; empty: the IMU's identity"),
 }
 RECORD = ["Setpoint.c", "MotorMagnetics.u_batt", "IMU.magneto"]
+#: Block parameters the rig sets from its options (``--set`` on one of them is refused, naming the option).
+DERIVED = {"IMU.noise_enabled": "noise", "IMU.seed": "seed1 and seed2", "IMU.sample_rate": "mag_rate",
+           "IMU.mag_sample_rate": "mag_rate", "MotorMagnetics.soc0": "soc1 and soc2", "Quadrotor.clamped": "(the rig)"}
+# a flight's IMU settings the clamped rig does not take: its biases are off and its rates its own
+_NOT_ON_THE_RIG = ("IMU.bias_enabled", "IMU.b_g", "IMU.b_a", "IMU.gyro_bias", "IMU.acc_bias", "IMU.gyro_bias_walk",
+                   "IMU.acc_bias_walk")
+
+
+def block_settings(o: dict) -> dict:
+    """The ``Block.parameter`` settings of options ``o`` (``--set MotorMagnetics.kappa1=8e-6``).
+
+    Parameters
+    ----------
+    o : dict
+        A scenario's options.
+
+    Returns
+    -------
+    dict
+        ``{"Block.parameter": value}``; every rig run of the scenario takes them.
+    """
+    return {k: v for k, v in o.items() if "." in k}
+
+
+def vehicle_settings(o: dict) -> tuple[tuple[str, str], ...]:
+    """The settings of a flight's options ``o`` that the clamped rig of the same vehicle takes:
+    its motors, airframe and magnetometer, not the rig's own (:data:`DERIVED`) nor the IMU's
+    biases; as sorted ``(name, text)`` pairs (hashable, for :func:`rig_calibration`'s cache).
+
+    Parameters
+    ----------
+    o : dict
+        A flight scenario's options (``tp``).
+
+    Returns
+    -------
+    tuple of (str, str)
+    """
+    rig_blocks = ("MotorMagnetics.", "Quadrotor.", "IMU.")
+    return tuple(sorted((k, str(v)) for k, v in block_settings(o).items()
+                        if k.startswith(rig_blocks) and k not in DERIVED and not k.startswith(_NOT_ON_THE_RIG)))
 
 
 def schedule(o: dict, set_number: int) -> tuple[list[tuple[str, float, float, int, float]], float]:
@@ -133,6 +176,9 @@ def system_for(o: dict, set_number: int, run: int) -> System:
               imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"],
                                  mag_sample_rate=o["mag_rate"]))
     system.connect("Setpoint.c", "MotorMagnetics.c")
+    settings = block_settings(o)
+    if settings:  # every run of the rig is the same vehicle: the parameters set reach them all
+        apply(system, settings, DERIVED)
     return system
 
 
@@ -217,7 +263,7 @@ def calibrate(rig: RigSet, orders, static, sample_rate: float, name: str) -> Cal
     """
     model = fit_dynamic(rig.reference, rig.sweeps(), orders)
     dynamics = fit_motor_dynamics([r.record() for r in rig.runs], [r.reference for r in rig.runs], model.v,
-                                  sample_rate)
+                                  sample_rate, progress=status)
     return Calibration(4, static, model, dynamics, rig.reference, {"made_by": f"quadcosim run metge ({name})"})
 
 
@@ -242,6 +288,7 @@ def record_sets(result, o: dict, out) -> dict[int, list[RigRun]]:
     runs = {1: [RigRun(result, o, 1)], 2: []}
     for set_number in (1, 2):
         for run in range(len(runs[set_number]), len(socs(o, set_number))):
+            status(f"metge: rig run {run + 1} of set {set_number} ({commands(o, set_number)[2]:.0f} s simulated)")
             recorded = system_for(o, set_number, run).run(commands(o, set_number)[2], record=RECORD)
             if out is not None:
                 recorded.save(out / f"set{set_number}_run{run}")
@@ -323,24 +370,47 @@ def figure3(first: RigRun, numbers: dict, o: dict, out):
     return save_figure(fig, out, "figure3_free_set.png")
 
 
-def table1_figure(numbers: dict, orders, o: dict, out):
-    """Table 1 as a figure, each cell beside the paper's value; ``numbers`` as :func:`table1`
-    returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's options (named in the
-    title), ``out`` the folder of the figure (None: no file)."""
-    import matplotlib.pyplot as plt
+def table1_text(numbers: dict, orders, o: dict, out):
+    """Table 1 as a Markdown table (``table1.md``), each cell beside the paper's value;
+    ``numbers`` as :func:`table1` returns, ``orders`` the model's ``(I, J)``, ``o`` the scenario's
+    options (named in the heading), ``out`` the folder of the file (None: no file). Returns the
+    file name written, or None."""
+    if out is None:
+        return None
+    from orchestrator.files import atomic_path
 
     table, dynamic = numbers["table"], numbers["dynamic_free"]
-    fig, ax = plt.subplots(figsize=(9, 2.6))
-    ax.axis("off")
-    cells = [[f"{table[r][c]:.3f}  ({PAPER_TABLE1[r][c]:.3f})" for c in ("set1", "set2", "free")]
-             for r in ("none", "calibration1", "calibration2")]
-    cells.append(["", "", f"{dynamic['calibration1']:.3f} / {dynamic['calibration2']:.3f}"])
-    ax.table(cellText=cells, rowLabels=["no dynamic calibration", "calibration 1", "calibration 2",
-                                        "motor dynamics (cal. 1 / 2)"],
-             colLabels=["set 1", "set 2", "free set"], loc="center")
-    fig.suptitle(title_lines(f"metge: mean angular error (deg), simulated (paper's value), Table 1 of {PAPER}",
-                             f"orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}", width=100), fontsize=9)
-    return save_figure(fig, out, "table1.png")
+    names = {"none": "no dynamic calibration", "calibration1": "calibration 1", "calibration2": "calibration 2"}
+    lines = [f"Mean angular error (deg) of the measured field, simulated (the paper's value), Table 1 of {PAPER}.",
+             f"Orders I = {orders[0]}, J = {orders[1]}; {run_line(o)}.", "",
+             "| | set 1 | set 2 | free set |", "|---|---|---|---|"]
+    for row, name in names.items():
+        cells = [f"{table[row][c]:.3f} ({PAPER_TABLE1[row][c]:.3f})" for c in ("set1", "set2", "free")]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    lines.append(f"| motor dynamics (cal. 1 / 2) | | | {dynamic['calibration1']:.3f} / "
+                 f"{dynamic['calibration2']:.3f} |")
+    with atomic_path(out / "table1.md") as temporary:
+        Path(temporary).write_text("\n".join(lines) + "\n")
+    return "table1.md"
+
+
+def fast_third(run: RigRun, o: dict) -> np.ndarray:
+    """Which rows of the free set of ``run`` fall in its middle, fast third (options ``o``).
+
+    Parameters
+    ----------
+    run : RigRun
+        The run holding the free set (the first of set 1).
+    o : dict
+        The scenario's options (``free``, s).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        One per row of the free set.
+    """
+    t_free = run.time[run.free] - run.end
+    return (t_free >= o["free"] / 3) & (t_free < 2 * o["free"] / 3)
 
 
 def report(result, o, out) -> dict:
@@ -352,22 +422,24 @@ def report(result, o, out) -> dict:
     static = load_static(o)
     runs = record_sets(result, o, out)
     rig1, rig2 = RigSet(runs[1]), RigSet(runs[2])
+    status("metge: cross-validating the orders (I, J) between the sets")
     study = order_study([(rig1.reference, rig1.sweeps()), (rig2.reference, rig2.sweeps())])
     orders = orders or study["best"]
+    status("metge: calibrating on each set (eqs. 5 to 8, then the motors' dynamics)")
     cals = {"calibration1": calibrate(rig1, orders, static, rate, "set 1"),
             "calibration2": calibrate(rig2, orders, static, rate, "set 2")}
     if out is not None:
         for name, cal in cals.items():
-            cal.save(out / f"{name}.json")
+            write_json(out / f"{name}.json", cal.to_dict())  # atomically
+    status("metge: Table 1 (every run compensated by each calibration)")
     numbers = table1({"none": Calibration(4, static), **cals}, rig1, rig2, rate)
     table, dynamic_free, first = numbers["table"], numbers["dynamic_free"], rig1.runs[0]
-    t_free = first.time[first.free] - first.end
-    fast = (t_free >= o["free"] / 3) & (t_free < 2 * o["free"] / 3)
+    fast = fast_third(first, o)
     e_free = numbers["series"]["calibration1"][first.free]
     ed_free = numbers["series"]["calibration1_dynamic"][first.free]
     true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
     true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
-    figures = [figure3(first, numbers, o, out), table1_figure(numbers, orders, o, out)]
+    figures = [figure3(first, numbers, o, out), table1_text(numbers, orders, o, out)]
     return {
         "table1_deg": table,
         "free_set_dynamic_deg": dynamic_free["calibration1"],
@@ -376,6 +448,7 @@ def report(result, o, out) -> dict:
         "improvement_factor_sets": {f"{r}_{c}": table["none"][c] / table[r][c]
                                     for r in ("calibration1", "calibration2") for c in ("set1", "set2")},
         "dynamic_gain_free": table["calibration1"]["free"] / dynamic_free["calibration1"],
+        **_ranges(table, study["scores"]),
         "sets_with_transients_deg": numbers["whole"],
         "free_eq9_slow_fast_deg": {"slow": float(e_free[~fast].mean()), "fast": float(e_free[fast].mean())},
         "free_dynamic_slow_fast_deg": {"slow": float(ed_free[~fast].mean()), "fast": float(ed_free[fast].mean())},
@@ -392,13 +465,28 @@ def report(result, o, out) -> dict:
     }
 
 
+def _ranges(table: dict, scores: dict) -> dict:
+    """The figures the findings quote from Table 1 and the order study: the range over both
+    calibrations and both sets after eq. 9 (deg), of the improvement on the sets (1), and the
+    order study's scores of (3, 1) and of the best (I, 0) over that of (4, 1) (1)."""
+    after = [table[r][c] for r in ("calibration1", "calibration2") for c in ("set1", "set2")]
+    gains = [table["none"][c] / table[r][c] for r in ("calibration1", "calibration2") for c in ("set1", "set2")]
+    reference = scores.get((4, 1))
+    ratios = {}
+    if reference:
+        ratios = {"order_study_3_1_over_4_1": scores[(3, 1)] / reference if (3, 1) in scores else None,
+                  "order_study_best_j0_over_4_1": min(v for (_, j), v in scores.items() if j == 0) / reference}
+    return {"sets_calibrated_range_deg": [min(after), max(after)], "improvement_range": [min(gains), max(gains)],
+            **ratios}
+
+
 def duration(o: dict) -> float:
     """Length (s) of the scenario's own run: set 1's sweeps and the free set."""
     return commands(o, 1, free=True)[2]
 
 
 SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD})
+                    duration=duration, extra={"record": RECORD, "derived": DERIVED})
 
 
 # --- the compensation in the closed loop (``tp --set compensation=...``) ----------------
@@ -407,15 +495,28 @@ COMPENSATIONS = ("none", "static", "metge", "dynamic")
 
 
 @functools.lru_cache(maxsize=4)
-def rig_calibration(orders: str = "4,1", levels: int = 8) -> Calibration:
+def rig_calibration(orders: str = "4,1", levels: int = 8, settings: tuple = ()) -> Calibration:
     """Calibration 1 of this scenario with ``levels`` command levels, made on the clamped rig
     (about 30 s of simulated rig time); cached for the process. The tp vehicle has no soft or
-    hard iron, so the static part is the identity."""
-    o = SCENARIO.parse({"orders": orders, "levels": levels})
-    runs = []
-    for run in range(len(socs(o, 1))):
+    hard iron, so the static part is the identity.
+
+    Parameters
+    ----------
+    orders : str
+        ``"I,J"`` of eq. 4.
+    levels : int
+        Command levels per motor.
+    settings : tuple of (str, str)
+        Block parameters of the vehicle (:func:`vehicle_settings`), set on every rig run.
+    """
+    o = SCENARIO.parse({"orders": orders, "levels": levels} | dict(settings))
+    runs, count = [], len(socs(o, 1))
+    for run in range(count):
+        status(f"calibrating the motor-current field on the clamped rig: run {run + 1} of {count} "
+               f"({commands(o, 1)[2]:.0f} s simulated)")
         recorded = system_for(o, 1, run).run(commands(o, 1)[2], record=RECORD)
         runs.append(RigRun(recorded, o, 1))
+    status("identifying the field model (eqs. 5 to 8) and the motors' dynamics")
     return calibrate(RigSet(runs), parse_orders(orders), None, o["mag_rate"], "set 1, made for tp")
 
 
@@ -433,16 +534,21 @@ def magnetometer_rate(system: System) -> float:
     raise KeyError("the IMU declares no magnetometer rate (mag_sample_rate or sample_rate)")
 
 
-def add_compensator(system: System, mode: str, path: str, estimator: str = "Quaternion_estim"):
+def add_compensator(system: System, mode: str, path: str, estimator: str = "Quaternion_estim",
+                    settings: tuple = ()):
     """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
     ``mode = "none"``): commands from the controller, voltage from the battery, ``b_d``
     refreshed at the magnetometer's sample instants. ``path``: a calibration file, or empty for
-    :func:`rig_calibration`. ``system``: the tp system; ``estimator``: the name of its block."""
+    :func:`rig_calibration` of the vehicle of ``settings`` (:func:`vehicle_settings`).
+    ``system``: the tp system; ``estimator``: the name of its block."""
     from calibration import MagCompensator
 
     if mode == "none":
+        if path:
+            raise ValueError(f"calibration={path} is given with compensation=none, which uses no calibration: "
+                             "choose compensation=static, metge or dynamic, or leave calibration empty")
         return None
-    calibration = Calibration.load(path, motors=4) if path else rig_calibration()
+    calibration = Calibration.load(path, motors=4) if path else rig_calibration(settings=settings)
     block = system.add(MagCompensator(calibration, mode, sample_rate=magnetometer_rate(system)))
     system.connect("IMU.magneto", "MagCompensator.magneto")
     system.connect("Controller.c", "MagCompensator.c")
@@ -472,34 +578,50 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
             for magnetic, mode in cases:
                 settings = {"estimator": estimator, "flight": flight, "noise": noise, "duration": duration,
                             "magnetic": magnetic == "on", "compensation": mode,
-                            "calibration": calibration_path, **STUDY_ESTIMATORS[estimator]}
+                            "calibration": calibration_path if mode != "none" else "",
+                            **STUDY_ESTIMATORS[estimator]}
                 _, m = scenarios.run("tp", settings)
                 key = "magnetic_off" if magnetic == "off" else mode
                 table.setdefault(flight, {}).setdefault(estimator, {})[key] = m["rms_error_deg"][2]
                 print(f"{flight:14s} {estimator:9s} {key:13s} yaw RMS {m['rms_error_deg'][2]:8.3f} deg", flush=True)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "yaw_study.json").write_text(json.dumps(table, indent=2) + "\n")
+    write_json(out / "yaw_study.json", table)
     columns = ["magnetic_off", *COMPENSATIONS]
     lines = []
     for flight, rows in table.items():
         lines += [f"### {flight}", "", "| estimator | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
         lines += [f"| {e} | " + " | ".join(f"{r[c]:.3f}" for c in columns) + " |" for e, r in rows.items()]
         lines.append("")
-    (out / "yaw_study.md").write_text("\n".join(lines))
+    write_text(out / "yaw_study.md", "\n".join(lines))
     return table
 
 
 def main(argv=None):
-    """Command line of the yaw study: ``python -m scenarios.metge --calibration FILE --out DIR``.
+    """Command line of the studies: ``python -m scenarios.metge --calibration FILE --out DIR``
+    (the yaw study) or ``--robustness --out DIR`` (:mod:`scenarios.metge_robustness`).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
-    parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated.")
-    parser.add_argument("--calibration", required=True, help="calibration file, e.g. from quadcosim run metge")
+    parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated "
+                                                 "(--calibration), or the compensation on perturbed plants "
+                                                 "(--robustness).")
+    parser.add_argument("--calibration", help="calibration file, e.g. from quadcosim run metge (the yaw study)")
+    parser.add_argument("--robustness", nargs="*", metavar="CASE",
+                        help="the robustness study (every case, or those named)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
     parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
     args = parser.parse_args(argv)
+    if args.robustness is not None:
+        from scenarios import metge_robustness
+
+        unknown = set(args.robustness) - set(metge_robustness.cases())
+        if unknown:
+            parser.error(f"unknown case {', '.join(sorted(unknown))}; cases: {', '.join(metge_robustness.cases())}")
+        metge_robustness.study(args.out, args.robustness or None)
+        return
+    if not args.calibration:
+        parser.error("give --calibration FILE (the yaw study) or --robustness")
     yaw_study(args.out, args.calibration, estimators=tuple(args.estimators.split(",")), duration=args.duration)
 
 

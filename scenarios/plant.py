@@ -106,13 +106,16 @@ def save_figure(figure, out_dir, name: str):
 
         plt.close(figure)
         return None
+    import matplotlib.pyplot as plt
+
+    from orchestrator.files import save_figure as save_atomically
     from orchestrator.progress import status
 
     path = out_dir / name
     status(f"figure {name}")
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    import matplotlib.pyplot as plt
-
-    plt.close(figure)
+    try:
+        figure.tight_layout()
+        save_atomically(figure, path, dpi=120)  # a temporary name, fsync, rename: never a truncated figure
+    finally:
+        plt.close(figure)
     return str(path.name)

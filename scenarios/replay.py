@@ -7,6 +7,11 @@
         [--rate HZ] [--json OUT]
     python -m scenarios.replay results/tp            # a tp run's results folder, as it is
     python -m scenarios.replay --from-tp RESULTS_DIR --write RECORDING
+    python -m scenarios.replay FLIGHT.ulg|.bin|.log [--compass N] [--json OUT]
+
+A flight log (PX4 ULog, ArduPilot DataFlash) is replayed by :mod:`scenarios.flightlog.replay`:
+every estimator, without and with the magnetometer compensation, against the autopilot's own
+attitude (a reference, not the truth).
 
 The recording is read by :mod:`estimators.recording` (``.npz``, ``.mat``, ``.csv``: gyro, acc,
 mag, rate, optional reference quaternion and scored samples). With a reference, the
@@ -37,6 +42,9 @@ from pathlib import Path
 import numpy as np
 
 from estimators import estimate, parse_corrections, recording
+from orchestrator.files import write_text
+
+FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
 
 
 def field_from_data(acc, mag, samples: int) -> dict:
@@ -227,6 +235,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", help="write the result here")
     parser.add_argument("--from-tp", metavar="RESULTS_DIR", help="write a recording from a tp run's results")
     parser.add_argument("--write", metavar="RECORDING", help="with --from-tp: the recording to write")
+    parser.add_argument("--compass", type=int, default=0, help="flight logs: the compass, from 0 in the log's order")
     return parser
 
 
@@ -246,6 +255,10 @@ def main(argv=None) -> int:
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = _parser()
     args = parser.parse_args(argv)
+    if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
+        from scenarios.flightlog import replay as flight
+
+        return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json))
     try:
         if args.from_tp:
             if not args.write:
@@ -270,7 +283,7 @@ def main(argv=None) -> int:
     text = json.dumps(result, indent=2, default=float)
     print(text)
     if args.json:
-        Path(args.json).write_text(text + "\n")
+        write_text(args.json, text + "\n")
     return 0
 
 

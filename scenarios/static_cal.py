@@ -15,6 +15,7 @@ import numpy as np
 from calibration import Calibration, fit_static
 from fmus import vehicle
 from orchestrator import FMUBlock, System, Table
+from orchestrator.files import write_json
 from scenarios import Option, Scenario
 from scenarios.figures import title_lines
 from scenarios.plant import angle_between, imu_parameters, save_figure
@@ -122,17 +123,23 @@ def report(result, o, out) -> dict:
     raw = level @ A.T + b
     heading_raw = np.degrees(np.angle(np.exp(1j * (np.arctan2(-raw[:, 1], raw[:, 0]) - yaw))))
     if out is not None:
-        Calibration(4, fit, notes={"made_by": "quadcosim run static-cal"}).save(out / "static.json")
-    fig = plt.figure(figsize=(10, 4.5))
-    ax = fig.add_subplot(1, 2, 1, projection="3d")
-    ax.scatter(*(samples * 1e6).T, s=2, label="raw")
-    ax.scatter(*(fit.correct(samples) * 1e6).T, s=2, label="corrected")
-    ax.set_xlabel("x (µT)")
-    ax.set_ylabel("y (µT)")
-    ax.set_zlabel("z (µT)")
-    ax.legend(fontsize=8)
-    ax.set_title("readings of the sweep", fontsize=10)
-    ax2 = fig.add_subplot(1, 2, 2)
+        write_json(out / "static.json", Calibration(4, fit, notes={"made_by": "quadcosim run static-cal"}).to_dict())
+    fig = plt.figure(figsize=(14, 4.8))
+    raw_uT, corrected_uT = samples * 1e6, fit.correct(samples) * 1e6
+    reach = np.abs(np.vstack([raw_uT, corrected_uT])).max()
+    # raw and corrected on axes of their own, to the same scale: drawn on one axes, either hides the other
+    for panel, (points, colour, what) in enumerate(((raw_uT, "C0", "raw"), (corrected_uT, "C1", "corrected")),
+                                                   start=1):
+        norm = np.linalg.norm(points, axis=1)
+        ax = fig.add_subplot(1, 3, panel, projection="3d")
+        ax.scatter(*points.T, s=1, color=colour)
+        ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(-reach, reach))
+        ax.set_box_aspect((1.0, 1.0, 1.0))
+        ax.set_xlabel("x (µT)")
+        ax.set_ylabel("y (µT)")
+        ax.set_zlabel("z (µT)")
+        ax.set_title(f"{what} readings, |m| from {norm.min():.1f} to {norm.max():.1f} µT", fontsize=9)
+    ax2 = fig.add_subplot(1, 3, 3)
     ax2.plot(np.degrees(yaw), heading_raw, label="uncorrected")
     ax2.plot(np.degrees(yaw), heading, label="corrected")
     ax2.set_xlabel("true heading (deg)")

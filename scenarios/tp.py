@@ -19,10 +19,11 @@ from orchestrator import System, Table
 from orchestrator.result import envelope
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
-from scenarios.figures import fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
+from scenarios.figures import angle_curve, fault_text, faults_of, floor_span, label_axes, shade_faults, title_lines
 from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from scenarios.flight.controller import SETPOINT_UNITS
-from scenarios.metge import add_compensator
+from scenarios.flight.profile_file import FileProfile, is_profile_file
+from scenarios.metge import add_compensator, vehicle_settings
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
@@ -30,8 +31,9 @@ BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
 OPTIONS = {
     "estimator": Option("linear", "attitude estimator, or module:Class (a block of your own: estimators/contract.py)",
                         choices=("linear", "explicit", "passive", "vqf", "madgwick"), classes=True),
-    "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py)", choices=FLIGHTS),
-    "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)"),
+    "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py), or a setpoint profile in a CSV file "
+                              "(scenarios/flight/profile_file.py)", choices=FLIGHTS, files=".csv"),
+    "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)", applies="flight=tilt"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
     "noise": Option(False, "IMU white noise"),
     "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s, or IMU.gyro_bias=x,y,z"),
@@ -42,19 +44,24 @@ OPTIONS = {
                             choices=("measured", "gravity")),
     "bench_supply": Option(False, "battery capacity x1000, for hovers longer than the battery's ten minutes"),
     "magnetic": Option(False, "field of the motor currents at the magnetometer"),
-    "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad")),
+    "ry": Option("reel", "passive filter: R_y from the IMU's R_reel or TRIAD", choices=("reel", "triad"),
+                 applies="estimator=passive"),
     "discretisation": Option("exp", "quaternion update", choices=("exp", "euler")),
-    "k": Option(0.05, "linear filter gain, all three axes (1/s)", minimum=0.0),
-    "k1": Option(0.2, "explicit filter: accelerometer weight (1; Mahony's Kp = kP k1)", minimum=0.0),
-    "k2": Option(0.2, "explicit filter: magnetometer weight (1)", minimum=0.0),
-    "kP": Option(1.0, "explicit and passive: proportional gain (1/s)", minimum=0.0),
-    "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)"),
-    "corrections": Option("off", "explicit/passive: disturbance-aware corrections, on, off or names (a,b)"),
+    "k": Option(0.05, "linear filter gain, all three axes (1/s)", minimum=0.0, applies="estimator=linear"),
+    "k1": Option(0.2, "explicit filter: accelerometer weight (1; Mahony's Kp = kP k1)", minimum=0.0,
+                 applies="estimator=explicit"),
+    "k2": Option(0.2, "explicit filter: magnetometer weight (1)", minimum=0.0, applies="estimator=explicit"),
+    "kP": Option(1.0, "explicit and passive: proportional gain (1/s)", minimum=0.0,
+                 applies="estimator=explicit,passive"),
+    "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)",
+                 applies="estimator=explicit,passive"),
+    "corrections": Option("off", "explicit/passive: disturbance-aware corrections, on, off or names (a,b)",
+                          applies="estimator=explicit,passive"),
     "duration": Option(20.0, "simulated time (s)", minimum=0.01),
     "settle": Option(2.0, "time excluded from the error metrics (s)", minimum=0.0),
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
     "imu_rate": Option(1000.0, "IMU and estimator rate (Hz)", minimum=1.0),
-    "seed": Option(1, "IMU noise seed"),
+    "seed": Option(1, "IMU noise seed", applies="noise=true"),
     "compensation": Option("none", "field of the motor currents compensated (scenarios/metge.py)",
                            choices=("none", "static", "metge", "dynamic")),
     "calibration": Option("", "calibration file (JSON) for the compensation; empty: made on the clamped rig"),
@@ -143,7 +150,10 @@ def build(o: dict, estimator=None) -> System:
     if period < 1 or abs(period * o["dt"] * o["imu_rate"] - 1.0) > 1e-9:
         raise ValueError(f"imu_rate = {o['imu_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     system = System(dt=o["dt"])
-    setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
+    if is_profile_file(o["flight"]):
+        setpoint = FileProfile(o["flight"], SETPOINT)
+    else:
+        setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
     system.add(Table("Setpoint", SETPOINT, setpoint, units=SETPOINT_UNITS))
     if o["accelerometer"] == "gravity":
         system.add(GravityOnly())
@@ -184,7 +194,7 @@ def build(o: dict, estimator=None) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
-    add_compensator(system, o["compensation"], o["calibration"])
+    add_compensator(system, o["compensation"], o["calibration"], settings=vehicle_settings(o))
     return system
 
 
@@ -238,7 +248,7 @@ def report(result, o, out) -> dict:
     """
     settle = min(o["settle"], 0.5 * o["duration"])  # a short run keeps its second half
     metrics = {"settle_s": settle, **_error_statistics(result, settle), **steady_errors(result),
-               "bias_error_final": None, "figures": _figures(result, o, out),
+               "bias_error_final": None, "figures": _figures(result, o, out) + _tilt_figures(result, o, out),
                "units": {"bias_error_final": "rad/s", "real_time_factor": "1"}}
     if o["estimator"] != "linear" and estimator_gains(o).get("kI", 0) > 0:
         metrics["bias_error_final"] = [
@@ -247,10 +257,45 @@ def report(result, o, out) -> dict:
             result.time, (result[f"Quaternion_estim.b_est_{a}"] - result[f"IMU.gyro_bias_{a}"] for a in "xyz"),
             BIAS_TOLERANCE)
         metrics["bias_convergence_tolerance_rad_s"] = BIAS_TOLERANCE
+    metrics |= _predictions(result, o)
+    metrics |= _flight_findings(result, o)
+    metrics["attitude_span_deg"] = [math.degrees(float(np.ptp(result[f"Quadrotor.theta{k}"]))) for k in (1, 2, 3)]
     loop = result.meta.get("loop_seconds")
     if loop:
         metrics["real_time_factor"] = o["duration"] / loop
     return metrics
+
+
+def _predictions(result, o) -> dict:
+    """What the linearised analyses (:mod:`estimators.analysis`) predict for this run's gyro bias:
+    the passive filter's bias-convergence time (s), the explicit filter's steady error without
+    bias estimate (deg, roll, pitch, yaw); nothing without a bias or for the other filters."""
+    if not o["bias"] or o["estimator"] not in ("explicit", "passive"):
+        return {}
+    from estimators import analysis
+
+    gains, bias = estimator_gains(o), result["IMU.gyro_bias"][0]
+    if o["estimator"] == "passive" and gains["kI"] > 0:
+        return {"bias_convergence_predicted_s": analysis.passive_bias_convergence_time(
+            gains["kP"], gains["kI"], float(np.abs(bias).max()), BIAS_TOLERANCE)}
+    if o["estimator"] == "explicit" and gains["kI"] == 0:
+        predicted = analysis.explicit_bias_steady_error(gains["k1"], gains["k2"], gains["kP"], bias)
+        return {"steady_error_predicted_deg": np.degrees(predicted).tolist()}
+    return {}
+
+
+def _flight_findings(result, o) -> dict:
+    """What the flight shows of the drag model: the tilt step's lag and speed (``flight=tilt``),
+    the tilt into a steady wind and the position held (a wind on a position-holding flight)."""
+    from scenarios.flight import measured
+
+    found = {}
+    if o["flight"] == "tilt":
+        found |= measured.tilt_step(result, math.radians(o["tilt_deg"]), o["rotor_drag"])
+    wind = math.hypot(o["wind_n"], o["wind_e"])
+    if wind > 0 and o["flight"] == "hover":
+        found |= measured.wind_hold(result, wind)
+    return found
 
 
 def steady_errors(result) -> dict:
@@ -291,6 +336,11 @@ def _error_statistics(result, settle: float) -> dict:
         del error
     return {"rms_error_deg": rms, "max_error_deg": peak, "tracking_rms_deg": tracking_rms}
 
+
+#: What the components of a metric list are, for tables and figures (``rms_error_deg[0]`` is roll).
+COMPONENTS = {name: ("roll", "pitch", "yaw") for name in ("rms_error_deg", "max_error_deg", "tracking_rms_deg",
+                                                          "steady_error_deg", "steady_tracking_error_deg")}
+COMPONENTS["bias_error_final"] = ("x", "y", "z")
 
 FLIGHT_NAMES = {"quasi": "quasi-stationary flight", "nonstationary": "non-stationary flight", "hover": "hover",
                 "tilt": "tilt"}
@@ -351,7 +401,8 @@ def describe(o: dict, estimator: str | None = None) -> list[str]:
     -------
     list of str
     """
-    flight = FLIGHT_NAMES[o["flight"]] + (f" {o['tilt_deg']:g} deg" if o["flight"] == "tilt" else "")
+    flight = FLIGHT_NAMES.get(o["flight"], f"setpoints from {o['flight']}")
+    flight += f" {o['tilt_deg']:g} deg" if o["flight"] == "tilt" else ""
     sensors = [f"IMU noise {'on' if o['noise'] else 'off'}",
                ("gyro bias on" if any(k.startswith(("IMU.gyro_bias", "IMU.b_g")) for k in o)  # its value in others
                 else "gyro bias (0.02, -0.01, 0.015) rad/s") if o["bias"] else "no gyro bias",
@@ -414,7 +465,7 @@ def _figures(result, o, out) -> list[str]:
         for ax, span in zip(axes, spans, strict=True):
             floor_span(ax, span)
             ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=7, loc="upper left", ncol=4)
+            ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)  # off the curves
         axes[-1].set_xlabel("time (s)")
         axes[-1].set_xlim(t[0], t[-1])
         fig.suptitle(title, fontsize=9)
@@ -435,8 +486,8 @@ def _figures(result, o, out) -> list[str]:
     figures.append(finish(fig, axes, (ANGLE_SPAN_DEG, ANGLE_SPAN_DEG, ERROR_SPAN_DEG), "roll_pitch.png"))
 
     fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True, height_ratios=(1, 0.8))
-    curve(axes[0], result["Quadrotor.theta3"], scale=180 / np.pi, label="yaw, truth")
-    curve(axes[0], result["Quaternion_estim.theta_est3"], "--", scale=180 / np.pi, label="yaw, estimate")
+    axes[0].plot(*angle_curve(t, np.degrees(result["Quadrotor.theta3"])), label="yaw, truth")
+    axes[0].plot(*angle_curve(t, np.degrees(result["Quaternion_estim.theta_est3"])), "--", label="yaw, estimate")
     axes[0].set_ylabel("yaw (deg)")
     curve(axes[1], _error(result, "Quaternion_estim.theta_est", 2), scale=180 / np.pi, label="yaw error", lw=0.9)
     axes[1].axhline(0.0, color="k", lw=0.5)
@@ -456,6 +507,16 @@ def _figures(result, o, out) -> list[str]:
         axes[1].set_ylabel("estimate - truth (rad/s)")
         figures.append(finish(fig, axes, (BIAS_SPAN, BIAS_SPAN), "bias.png"))
     return [f for f in figures if f]
+
+
+def _tilt_figures(result, o, out) -> list[str]:
+    """The tilt finding's figure for ``flight=tilt`` (what the accelerometer reads, the speed)."""
+    if o["flight"] != "tilt":
+        return []
+    from scenarios.tilt_figure import tilt_figure
+
+    written = save_figure(tilt_figure(result, o, figure_title(result, o)), out, "tilt.png")
+    return [written] if written else []
 
 
 def bias_convergence_time(t, error, tolerance) -> float | None:
@@ -491,5 +552,6 @@ def diagram_title(o: dict) -> str:
 # IMU parameters the options set: --set IMU.seed=... would contradict the option seed
 DERIVED = {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed", "IMU.sample_rate": "imu_rate"}
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    extra={"diagram": True, "title": diagram_title, "derived": DERIVED, "unrecorded": UNRECORDED},
+                    extra={"diagram": True, "title": diagram_title, "derived": DERIVED, "unrecorded": UNRECORDED,
+                           "components": COMPONENTS},
                     resolve=resolve)

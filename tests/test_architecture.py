@@ -20,8 +20,9 @@ ALLOWED = {
     # to find built FMUs only: the package's locating functions, not its build or its models
     "orchestrator": ("fmus",),
     # the block contract, and the plant's constants (vehicle, sensor densities)
-    "estimators": ("orchestrator.blocks", "fmus.", "calibration."),
-    "calibration": ("orchestrator.blocks", "fmus.", "estimators."),
+    # and the flight-log reading layer (orchestrator.logs), which replay and calibration share
+    "estimators": ("orchestrator.blocks", "orchestrator.logs.", "fmus.", "calibration."),
+    "calibration": ("orchestrator.blocks", "orchestrator.logs.", "fmus.", "estimators."),
     "scenarios": tuple(f"{p}." for p in PACKAGES),
     "benchmarks": tuple(f"{p}." for p in PACKAGES),
 }
@@ -100,6 +101,8 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     ("fmus", "orchestrator.fmu", False),
     ("estimators", "orchestrator.blocks", True),
     ("estimators", "orchestrator.system", False),
+    ("calibration", "orchestrator.logs.model", True),
+    ("calibration", "orchestrator.fmu", False),
     ("estimators", "scenarios.plant", False),
     ("scenarios", "benchmarks.master", True),
 ])

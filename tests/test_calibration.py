@@ -81,6 +81,40 @@ def test_heading_after_static_correction_over_a_full_yaw_turn():
     assert np.abs(raw_error).max() > 40
 
 
+def _heading_error(field, yaw):
+    return np.degrees(np.angle(np.exp(1j * (np.arctan2(-field[:, 1], field[:, 0]) - yaw))))
+
+
+def test_a_non_symmetric_soft_iron_leaves_its_rotation_as_a_heading_error():
+    """A = P U (P symmetric, U a rotation of 3 deg about z): the ellipsoid sees P alone, so the
+    corrected field keeps U, and a level yaw turn reads a constant heading error of 3 deg: the
+    alignment a sweep of |m| cannot see (the module's convention)."""
+    from scipy.linalg import polar
+
+    A = A_TRUE @ rot_z(np.radians(3.0))
+    _, P = polar(A, side="left")
+    fit = fit_static(sweep(A=A, noise=0.0), field_norm=NORM)
+    assert np.abs(fit.A - P).max() < 1e-8 and not np.allclose(A, A.T)
+    yaw = np.linspace(-np.pi, np.pi, 361)
+    raw = np.array([rot_z(y).T @ EARTH for y in yaw]) @ A.T + B_TRUE
+    error = _heading_error(fit.correct(raw), yaw)
+    print(f"non-symmetric soft iron: heading error {error.mean():.3f} deg (spread {np.ptp(error):.2e} deg)")
+    assert error.mean() == pytest.approx(-3.0, abs=0.05) and np.ptp(error) < 0.1
+
+
+@pytest.mark.parametrize("noise", [0.0, NOISE, 10 * NOISE, 30 * NOISE])
+def test_a_yaw_only_sweep_is_refused_whatever_the_noise_and_the_bounds(noise):
+    """A sweep about z alone, as recorded (samples in order): refused, naming the axis it never
+    turned off, at the magnetometer's noise and far above it, even with bounds=None."""
+    yaw = np.linspace(0, 4 * np.pi, 3000)
+    samples = np.array([rot_z(y).T @ EARTH for y in yaw]) @ A_TRUE.T + B_TRUE
+    samples += np.random.default_rng(7).normal(scale=noise, size=samples.shape) if noise else 0.0
+    with pytest.raises(CalibrationError, match="planar or single-axis sweep") as error:
+        fit_static(samples, bounds=None)
+    print(error.value)
+    assert "along the sensor's z axis" in str(error.value)
+
+
 @pytest.mark.parametrize("samples, message", [
     (sweep(20), "too few samples: 20 < 50"),
     (np.vstack([sweep(200)[:-1], [[np.nan, 0, 0]]]), "hold NaN or Inf (first at row 199)"),
@@ -183,6 +217,11 @@ def test_calibration_file_round_trip(tmp_path):
     (lambda d: d["static"].update(A=[[1, 0, 0], [0, 1, 0], [0, 0, "x"]]), {}, "static.A must be numbers"),
     (lambda d: d["dynamics"].update(exponent=2), {}, "dynamics.exponent must be 0 or 1"),
     (lambda d: d.update(motors=0), {}, "motors = 0 must be a positive integer"),
+    (lambda d: d.update(notes=5), {}, "notes = 5 must be a JSON object"),
+    (lambda d: d["static"].update(A=[[0, 0, 0]] * 3), {}, "static.A is singular (all zeros"),
+    (lambda d: d["static"].update(field_norm=0.0), {}, "static.field_norm = 0.0 must be positive"),
+    (lambda d: d["static"].update(field_norm=-4.7e-5), {}, "must be positive"),
+    (lambda d: d["static"].update(A=[[[[[1.0]]]]]), {}, "static.A must have shape (3, 3)"),
 ])
 def test_calibration_file_refusals(tmp_path, edit, kwargs, message):
     data = calibration().to_dict()
@@ -200,6 +239,22 @@ def test_calibration_file_not_json(tmp_path):
     path.write_text("{ motors: 4")
     with pytest.raises(CalibrationError, match="not valid JSON"):
         Calibration.load(path)
+
+
+def test_calibration_file_nested_too_deeply_or_not_utf8(tmp_path):
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100000 + "]" * 100000)
+    with pytest.raises(CalibrationError, match="nested too deeply"):
+        Calibration.load(deep)
+    latin = tmp_path / "latin.json"
+    latin.write_bytes('{"notes": "étalonnage"}'.encode("latin-1"))
+    with pytest.raises(CalibrationError, match=r"not UTF-8 text \(byte 0xe9 at offset 11\)"):
+        Calibration.load(latin)
+
+
+def test_static_fit_of_constant_samples_is_a_calibration_error():
+    with pytest.raises(CalibrationError, match="the 200 samples are all equal"):
+        fit_static(np.zeros((200, 3)))
 
 
 def test_eq9_removes_the_modelled_field():

@@ -67,7 +67,7 @@ def test_tp_titles_tell_gains_and_faults_apart():
 
 def test_tp_figures_show_truth_estimate_error_and_the_fault(monkeypatch, tmp_path):
     figures = drawn(monkeypatch, "tp")
-    scenarios.run("tp", {"estimator": "explicit", "kI": 0.3, "bias": True, "duration": 1.0},
+    scenarios.run("tp", {"estimator": "explicit", "kI": 0.3, "bias": True, "duration": 1.0}, tmp_path / "run",
                   faults=[Fault("IMU.omega_x", "offset", 0.4, 0.6, 0.1)])
     assert set(figures) == {"roll_pitch.png", "yaw.png", "bias.png"}
     for figure in figures.values():
@@ -80,11 +80,11 @@ def test_tp_figures_show_truth_estimate_error_and_the_fault(monkeypatch, tmp_pat
     assert roll_pitch[2].get_ylabel() == "estimate - truth (deg)"
 
 
-def test_a_still_axis_keeps_a_floor_under_its_span(monkeypatch):
+def test_a_still_axis_keeps_a_floor_under_its_span(monkeypatch, tmp_path):
     """Hovering without noise, the attitude moves by under 1e-6 deg: the axes still span 1 deg
     (angles) and 0.05 deg (errors), and no bias figure is drawn for the linear filter."""
     figures = drawn(monkeypatch, "tp")
-    result, _ = scenarios.run("tp", {"flight": "hover", "duration": 0.5, "bias": True})
+    result, _ = scenarios.run("tp", {"flight": "hover", "duration": 0.5, "bias": True}, tmp_path / "run")
     assert np.degrees(np.ptp(result["Quadrotor.theta1"])) < 1e-3
     assert set(figures) == {"roll_pitch.png", "yaw.png"}  # the linear filter estimates no bias
     roll, pitch, error = figures["roll_pitch.png"].axes
@@ -98,9 +98,9 @@ def test_a_still_axis_keeps_a_floor_under_its_span(monkeypatch):
     ("open-loop", {"duration": 1.0}, {"open_loop.png", "imu.png"}),
     ("rig", {"reference": 0.2, "sweep": 0.3, "rest": 0.1, "free": 0.3}, {"rig_field.png"}),
 ])
-def test_open_loop_and_rig_figures_name_the_run(monkeypatch, name, options, files):
+def test_open_loop_and_rig_figures_name_the_run(monkeypatch, tmp_path, name, options, files):
     figures = drawn(monkeypatch, name.replace("-", "_"))
-    scenarios.run(name, options, faults=[Fault("IMU.omega_x", "offset", 0.3, 0.5, 0.1)])
+    scenarios.run(name, options, tmp_path / "run", faults=[Fault("IMU.omega_x", "offset", 0.3, 0.5, 0.1)])
     assert set(figures) == files
     for figure in figures.values():
         check_axes(figure)
@@ -108,6 +108,18 @@ def test_open_loop_and_rig_figures_name_the_run(monkeypatch, name, options, file
         assert title.startswith(f"{name}:") and "IMU noise on" in title
         assert "fault: offset +0.1 on IMU.omega_x, 0.3-0.5 s" in title
         assert "seed" not in title.lower() and "cf." not in title
+
+
+@pytest.mark.parametrize("name", ["tp", "open-loop"])
+def test_without_a_folder_no_figure_is_drawn(monkeypatch, name):
+    """A run that keeps no file (a sweep member, a Python caller) draws nothing: figures were
+    half of a short member's CPU time."""
+    import matplotlib.pyplot as plt
+
+    figures = drawn(monkeypatch, name.replace("-", "_"))
+    before = plt.get_fignums()
+    _, metrics = scenarios.run(name, {"duration": 0.3})
+    assert figures == {} and metrics["figures"] == [] and plt.get_fignums() == before
 
 
 def test_result_plot_labels_the_unit(tmp_path):

@@ -47,7 +47,27 @@ def test_to_a_pipe_a_few_plain_lines_and_after_a_failure_no_100_percent():
     bar = Progress(120.0, "run", stream=stopped)
     bar.update(70.0)
     bar.close()
-    assert [line.split(" (")[0] for line in stopped.getvalue().splitlines()] == ["run:  25 %", "run:  50 %"]
+    assert stopped.getvalue().splitlines()[0].startswith("run:  58 % (70.0/120 s simulated")
+
+
+def _percent_and_seconds(line: str) -> tuple[int, float, float]:
+    percent = int(line.split("%")[0].split(":")[1])
+    done, total = line.split("(")[1].split(" s simulated")[0].split("/")
+    return percent, float(done), float(total)
+
+
+def test_each_line_s_percentage_is_the_simulated_time_it_shows():
+    """A chunk that crosses a quarter, or several, prints the time reached, not the quarter:
+    never "25 % (8.2/17 s)"."""
+    pipe = io.StringIO()
+    bar = Progress(17.0, "run", stream=pipe)
+    for _ in range(4):
+        bar.update(4.096)  # the chunk runner's 4096 steps of 1 ms
+    bar.complete()
+    lines = pipe.getvalue().splitlines()
+    shown = [_percent_and_seconds(line) for line in lines]
+    assert [p for p, _, _ in shown] == [24, 48, 72, 96, 100]
+    assert all(p == int(100 * done / total) for p, done, total in shown)
 
 
 def test_status_lines_only_while_reporting():
@@ -73,7 +93,9 @@ def test_a_120_s_run_writes_at_most_15_lines_to_a_pipe(tmp_path):
     progress = [line for line in lines if line.startswith("run: ")]
     first = int(progress[0].split("%")[0].split(":")[1])  # the first chunk ran: the loop runs
     assert 0 <= first < 25 and "/120 s simulated" in progress[0]
-    assert [line.split(" (")[0] for line in progress[1:]] == ["run:  25 %", "run:  50 %", "run:  75 %", "run: 100 %"]
+    shown = [_percent_and_seconds(line) for line in progress]
+    assert all(p == int(100 * done / total) for p, done, total in shown)  # the percentage is the time shown
+    assert len(progress) == 1 + PIPE_LINES and shown[-1][0] == 100
     assert any("open-loop: building the system" in line for line in lines)
     assert any("open-loop: report" in line for line in lines)
     print(f"{len(lines)} lines on standard error:\n{process.stderr}")

@@ -167,7 +167,8 @@ def test_a_run_that_would_not_fit_in_memory_is_refused_with_the_figure_and_the_w
     assert cli(["run", "open-loop", "--set", "duration=1e7", "--out", str(tmp_path / "run")]) == 2
     err = capsys.readouterr().err
     assert "this run would record 10000000001 samples of" in err
-    assert "GB of memory available. Record less: every N-th step (--decimation N, now 1)" in err
+    assert "GB of memory available (bound by " in err
+    assert "Record less: every N-th step (--decimation N, now 1)" in err
     assert time.perf_counter() - start < 20
 
 

@@ -148,16 +148,26 @@ def test_a_dead_worker_is_retried_then_recorded(tmp_path):
 
 # ------------------------------------------------------------------ without a cluster
 def test_grid_values_and_members():
-    plan = sweep.plan("tp", ["k=0.01:10:log4", "estimator=linear,explicit"], ["duration=2", "noise=on"], seeds="2")
-    assert len(plan.members) == 4 * 2 * 2
+    with pytest.warns(UserWarning, match=r"--grid k: k acts only when estimator=linear; with estimator=explicit it "
+                                         r"varies nothing, so those members run once, at k=0.01 \(6 duplicate members "
+                                         r"of 16 dropped\)"):
+        plan = sweep.plan("tp", ["k=0.01:10:log4", "estimator=linear,explicit"], ["duration=2", "noise=on"],
+                          seeds="2")
+    assert len(plan.members) == 4 * 2 + 2  # the explicit filter's members, once per seed: k does not act on it
     assert plan.varied == ["k", "estimator", "seed"]
-    assert [m.options["k"] for m in plan.members[::4]] == [0.01, 0.1, 1.0, 10.0]
+    linear = [m for m in plan.members if m.options["estimator"] == "linear"]
+    assert [m.options["k"] for m in linear[::2]] == [0.01, 0.1, 1.0, 10.0]
+    assert [m.label for m in plan.members if m.options["estimator"] == "explicit"] == [
+        "estimator=explicit seed=1", "estimator=explicit seed=2"]
+    assert [m.index for m in plan.members] == list(range(10))
     first = plan.members[0]
     assert first.options | {} == first.options and first.options["duration"] == 2.0
     assert first.options["noise"] is True and first.label == "k=0.01 estimator=linear seed=1"
     assert [m.options["seed"] for m in plan.members[:4]] == [1, 2, 1, 2]
     assert sweep.plan("tp", ["k=0:1:lin5"]).members[2].options["k"] == 0.5
-    assert [m.options["seed"] for m in sweep.plan("tp", seeds="3:5").members] == [3, 4, 5]
+    assert [m.options["seed"] for m in sweep.plan("tp", seeds="3:5", settings=["noise=on"]).members] == [3, 4, 5]
+    with pytest.warns(UserWarning, match="--seeds: seed acts only when noise=true; with noise=off it varies nothing"):
+        assert [m.options["seed"] for m in sweep.plan("tp", seeds="3:5").members] == [3]
 
 
 @pytest.mark.parametrize("grids, settings, seeds, message", [
@@ -171,7 +181,7 @@ def test_grid_values_and_members():
     (["k=1,2"], ["k=3"], None, "both varied (--grid) and fixed (--set)"),
     (["k=1,1"], [], None, "repeated values"),
     (["k"], [], None, "write NAME=VALUES"),
-    ([], [], "4", None),
+    ([], ["noise=on"], "4", None),
 ])
 def test_bad_grids_are_refused_before_any_run(grids, settings, seeds, message):
     if message is None:

@@ -110,6 +110,7 @@ typedef struct {
     long op;       /* in/out: the next operation of the present step */
     long recorded; /* out: rows recorded */
     int status;    /* out: the FMI or block status of a failure */
+    long record_first; /* the row record[0] holds: a streamed record holds a window of rows */
 } Program;
 
 static void gather(double *into, const double *bus, const Gather *g, long count) {
@@ -152,7 +153,7 @@ static int run_op(Program *p, const Op *o, long n, double t) {
         return -1;
     case OP_RECORD:
         if (n % p->decimation == 0) {
-            gather(p->record + (n / p->decimation) * p->record_width, p->bus, p->record_gather,
+            gather(p->record + (n / p->decimation - p->record_first) * p->record_width, p->bus, p->record_gather,
                    p->record_gathers);
             p->recorded = n / p->decimation + 1;
             if (!finite_bus(p->bus, p->bus_size))

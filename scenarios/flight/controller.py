@@ -219,6 +219,29 @@ class Controller(Block):
         self.parameters = parameters(gains)
         self.mixer_inverse = np.linalg.inv(allocation_matrix())
 
+    def named_parameters(self) -> dict:
+        """The gains (:data:`GAINS`) by name, their present values; ``--set Controller.kp_yaw=50``
+        sets one.
+
+        Returns
+        -------
+        dict
+            Gain name to value (units in :data:`GAINS`).
+        """
+        return {name: float(self.parameters[PARAMETERS.index(name)]) for name in GAINS}
+
+    def set_named_parameter(self, name: str, value: float):
+        """Set gain ``name`` to ``value`` before the run, checked as :func:`parameters` checks.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`GAINS`.
+        value : float
+            The gain, in its unit (:data:`GAINS`).
+        """
+        self.parameters = parameters(self.named_parameters() | {name: float(value)})
+
     def start(self, t0, dt):
         """Reset the integral; compile the law before the run. ``t0``: the start time (s);
         ``dt``: the block's period (s)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from scenarios.sweep.grid import GridMembers, Plan
+from scenarios.sweep.grid import ChainedMembers, GridMembers, Plan
 
 #: Dimensions with up to this many values are probed value by value.
 PROBED_VALUES = 32
@@ -37,6 +37,9 @@ def probes(plan: Plan) -> list[int]:
     """Indices of the members of ``plan`` to check (see the module documentation), the first
     member first: every member of a list of cases, probes of a grid."""
     members = plan.members
+    if isinstance(members, ChainedMembers):  # each part's probes, numbered on
+        return [start + k for start, part in zip(members.starts, members.parts, strict=False)
+                for k in probes(Plan(plan.scenario, part))]
     if not isinstance(members, GridMembers):
         return list(range(len(members)))
     sizes = [len(values) for values in members.dimensions.values()]

@@ -25,7 +25,8 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
     p.add_argument("--seeds", metavar="N|A:B", help="Monte Carlo: the seed option over 1..N (or A..B)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="use a running Dask scheduler (tcp://host:8786)")
-    p.add_argument("--out", help="sweep folder (default results/sweep-SCENARIO)")
+    p.add_argument("--out", help="sweep folder (default results/sweep-SCENARIO, or results/sweep-SCENARIO-N when that "
+                                 "holds an earlier sweep)")
     p.add_argument("--resume", action="store_true", help="continue the sweep in --out; skip finished members")
     p.add_argument("--retries", type=int, default=2, metavar="N",
                    help="resubmissions of a member whose worker died (default 2)")
@@ -64,12 +65,43 @@ def _stored_plan(out: Path):
                          "run it again into another --out") from None
 
 
+def default_out(base: Path, resume: bool, label: str) -> Path:
+    """The folder a sweep writes into when ``--out`` is not given: ``base``, or, when that holds
+    an earlier sweep and this is not a ``--resume``, the next free ``base-2``, ``base-3``, ...,
+    said on standard error (as ``quadcosim run`` does: a sweep never meets an earlier one unasked).
+
+    Parameters
+    ----------
+    base : pathlib.Path
+        The default folder (``results/sweep-tp``).
+    resume : bool
+        A resumed sweep continues in ``base``.
+    label : str
+        The command, for the message.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    if resume:
+        return base
+    candidate, number = base, 1
+    while (candidate / "sweep.json").exists() or (candidate.exists() and not candidate.is_dir()):
+        number += 1
+        candidate = base.with_name(f"{base.name}-{number}")
+    if candidate != base:
+        print(f"{label}: {base}/ holds an earlier sweep; writing to {candidate}/ (--out DIR chooses the folder, "
+              f"--resume continues {base}/)", file=sys.stderr)
+    return candidate
+
+
 def make_plan(args):
     """The plan the parsed arguments ``args`` describe (a named sweep, a grid, or the stored one
     on --resume)."""
     from scenarios.sweep import grid, named
 
-    out = Path(args.out) if args.out else Path("results") / f"sweep-{args.scenario}"
+    out = Path(args.out) if args.out else default_out(Path("results") / f"sweep-{args.scenario}", args.resume,
+                                                      f"quadcosim sweep {args.scenario}")
     args.out = str(out)
     if args.resume and not (out / "sweep.json").exists():
         raise ValueError(f"--resume: {out} holds no sweep (no sweep.json); run the sweep without --resume to "
@@ -121,9 +153,10 @@ def sweep(args) -> int:
     return summary.exit_code()
 
 
-def _plot_context(folder: Path) -> tuple[dict, str]:
-    """Units of the swept scenario's options (from their help) and a line naming the scenario
-    and the options held fixed, from the sweep's ``sweep.json`` (nothing without one)."""
+def _plot_context(folder: Path) -> tuple[dict, str, dict]:
+    """Units of the swept scenario's options (from their help), a line naming the scenario and
+    the options held fixed, and what its metrics' components are (``rms_error_deg[0]``: roll),
+    from the sweep's ``sweep.json`` (nothing without one)."""
     import scenarios
     from scenarios.sweep.figure import option_unit
 
@@ -131,10 +164,13 @@ def _plot_context(folder: Path) -> tuple[dict, str]:
         stored = json.loads((folder / "sweep.json").read_text())
         scenario = scenarios.get(stored["scenario"])
     except (OSError, ValueError, KeyError):
-        return {}, ""
+        return {}, "", {}
     units = {key: option_unit(option.help) for key, option in scenario.options.items()}
     fixed = stored.get("description", {}).get("set") or []
-    return units, f"{stored.get('name') or stored['scenario']} sweep" + (f"; {', '.join(fixed)}" if fixed else "")
+    components = {f"{metric}[{i}]": name for metric, names in scenario.extra.get("components", {}).items()
+                  for i, name in enumerate(names)}
+    return (units, f"{stored.get('name') or stored['scenario']} sweep" + (f"; {', '.join(fixed)}" if fixed else ""),
+            components)
 
 
 def sweep_plot(args) -> int:
@@ -152,9 +188,10 @@ def sweep_plot(args) -> int:
         source = Path(args.table)
         folder = source if source.is_dir() else source.parent
         safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in f"{args.metric}-vs-{args.x}")
-        units, subtitle = _plot_context(folder)
+        units, subtitle, components = _plot_context(folder)
         path = figure.plot(columns, args.metric, args.x, by=args.by, logy=args.logy,
-                           out=args.out or folder / f"{safe}.png", units=units, subtitle=subtitle)
+                           out=args.out or folder / f"{safe}.png", units=units, subtitle=subtitle,
+                           components=components)
     except FileNotFoundError as error:
         print(f"quadcosim sweep-plot: no sweep table at {error.filename}: give a sweep folder (--out of "
               "quadcosim sweep) or its sweep.parquet / sweep.csv", file=sys.stderr)

@@ -68,8 +68,27 @@ def _labelled(name: str, unit: str) -> str:
     return f"{name} ({unit})" if unit else name
 
 
+def metric_label(metric: str, components: dict | None = None) -> str:
+    """A metric as an axis names it: ``roll: rms_error_deg[0]`` when ``components`` says what
+    its index is, else the column name.
+
+    Parameters
+    ----------
+    metric : str
+        A metric column (``rms_error_deg[0]``).
+    components : dict, optional
+        Column to the component it is (``{"rms_error_deg[0]": "roll"}``).
+
+    Returns
+    -------
+    str
+    """
+    component = (components or {}).get(metric)
+    return f"{component}: {metric}" if component else metric
+
+
 def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, out=None, logy: bool = False,
-         ax=None, units: dict | None = None, subtitle: str = ""):
+         ax=None, units: dict | None = None, subtitle: str = "", components: dict | None = None):
     """Draw ``metric`` against option ``x``, grouped by option ``by``.
 
     Parameters
@@ -91,6 +110,9 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
         name (:func:`metric_unit`) unless given here.
     subtitle : str
         A second line of the title (e.g. the scenario and the options held fixed).
+    components : dict, optional
+        What the metric's index is (``{"rms_error_deg[0]": "roll"}``), named on the axis and in
+        the title (:func:`metric_label`).
 
     Returns
     -------
@@ -115,8 +137,9 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
         ax.set_xticks(range(len(categories)), categories)
     units = units or {}
     ax.set_xlabel(_labelled(x, units.get(x, "")))
-    ax.set_ylabel(_labelled(metric, units.get(metric) or metric_unit(metric)))
-    title = f"{metric} against {x}" + (f", by {by}" if by else "")
+    named = metric_label(metric, components)
+    ax.set_ylabel(_labelled(named, units.get(metric) or metric_unit(metric)))
+    title = f"{named} against {x}" + (f", by {by}" if by else "")
     if failed:
         title += f" ({failed} failed member{'s' * (failed > 1)} not shown)"
     ax.set_title(title + (f"\n{subtitle}" if subtitle else ""), fontsize=10)

@@ -13,6 +13,8 @@ member is refused before any run.
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import math
 import re
 from collections.abc import Sequence
@@ -136,6 +138,35 @@ class GridMembers(Sequence):
         return Member(index, self.base | values, " ".join(f"{k}={v}" for k, v in values.items()))
 
 
+class ChainedMembers(Sequence):
+    """Several grids' members one after the other, numbered on: the distinct members of a grid in
+    which an option acts on nothing for some members (:func:`distinct_members`).
+
+    Parameters
+    ----------
+    parts : list of GridMembers
+        The grids, in order.
+    """
+
+    def __init__(self, parts: list[GridMembers]):
+        self.parts = parts
+        self.starts = list(itertools.accumulate([0] + [len(part) for part in parts]))
+
+    def __len__(self) -> int:
+        return self.starts[-1]
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        if index < 0:
+            index += len(self)
+        if not 0 <= index < len(self):
+            raise IndexError(f"member {index} of a plan of {len(self)}")
+        part = bisect.bisect_right(self.starts, index) - 1
+        member = self.parts[part][index - self.starts[part]]
+        return Member(index, member.options, member.label)
+
+
 @dataclass
 class Plan:
     """What a sweep runs: a scenario and its members, with the command-line description kept;
@@ -155,6 +186,8 @@ class Plan:
                   "description": self.description, "count": len(self.members)}
         if isinstance(self.members, GridMembers):
             return stored | {"base": self.members.base, "dimensions": self.members.dimensions}
+        if isinstance(self.members, ChainedMembers):
+            return stored | {"parts": [{"base": p.base, "dimensions": p.dimensions} for p in self.members.parts]}
         return stored | {"members": [{"label": m.label, "options": m.options} for m in self.members]}
 
 
@@ -162,6 +195,8 @@ def stored_members(stored: dict) -> Sequence:
     """The members of a plan as :meth:`Plan.to_json` stored it (``sweep.json``, read back)."""
     if "members" in stored:
         return [Member(i, m["options"], m["label"]) for i, m in enumerate(stored["members"])]
+    if "parts" in stored:
+        return ChainedMembers([GridMembers(p["base"], p["dimensions"]) for p in stored["parts"]])
     return GridMembers(stored["base"], stored["dimensions"])
 
 
@@ -237,8 +272,67 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None,
     for name, values in typed.items():
         if len(set(map(repr, values))) != len(values):
             raise ValueError(f"--grid {name}: repeated values {values}")
-    return Plan(scenario_name, GridMembers(base, typed), list(typed),
+    return Plan(scenario_name, distinct_members(scenario, base, typed, seeds is not None), list(typed),
                 {"grid": list(grids), "set": list(settings), "seeds": seeds})
+
+
+def _shown(value) -> str:
+    """An option value as a user writes it: on/off for a switch."""
+    return ("on" if value else "off") if isinstance(value, bool) else str(value)
+
+
+def distinct_members(scenario, base: dict, typed: dict, seeds_given: bool = False) -> Sequence:
+    """The grid's members, each distinct run once.
+
+    A varied option that acts on nothing in some members (``k`` with ``estimator=explicit``,
+    ``seed`` with ``noise=off``: the options' ``applies``) would make duplicates of them: there
+    it keeps its first value only, and a warning says which option, for which members, and how
+    many runs that saves. The grid is split by the values of the options such conditions name
+    (a few), each part a lazy :class:`GridMembers`, so a large plan is never held.
+
+    Parameters
+    ----------
+    scenario : scenarios.Scenario
+    base : dict
+        The options every member shares, typed.
+    typed : dict of str to list
+        The varied options' typed values, slowest first.
+    seeds_given : bool
+        The ``seed`` dimension came from ``--seeds`` (named so in the warning).
+
+    Returns
+    -------
+    GridMembers or ChainedMembers
+        The plain grid when every option acts in every member.
+    """
+    import warnings
+
+    rules = {name: scenario.options[name].applies for name in typed
+             if name in scenario.options and scenario.options[name].applies}
+    controllers = [name for name in typed if name in {rule.partition("=")[0] for rule in rules.values()}]
+    parts, dropped = [], {}
+    for combination in itertools.product(*(typed[name] for name in controllers)):
+        chosen = dict(zip(controllers, combination, strict=True))
+        inert = [name for name in scenario.inert(base | chosen) if name in rules and name not in controllers]
+        dimensions = {name: [chosen[name]] if name in chosen else values
+                      for name, values in typed.items() if name not in inert}
+        part = GridMembers(base | {name: typed[name][0] for name in inert}, dimensions)
+        saved = len(part) * math.prod(len(typed[name]) for name in inert) - len(part)
+        for name in inert:
+            other = rules[name].partition("=")[0]
+            values, count = dropped.get(name, (set(), 0))
+            dropped[name] = (values | {_shown((base | chosen)[other])}, count + saved)
+        parts.append(part)
+    if not dropped:
+        return GridMembers(base, typed)
+    total = math.prod(len(values) for values in typed.values())
+    for name, (values, count) in dropped.items():
+        condition = rules[name]
+        flag = "--seeds" if name == "seed" and seeds_given else f"--grid {name}"
+        warnings.warn(f"{flag}: {name} acts only when {condition}; with {condition.partition('=')[0]}="
+                      f"{'/'.join(sorted(values))} it varies nothing, so those members run once, at "
+                      f"{name}={typed[name][0]} ({count} duplicate members of {total} dropped)", stacklevel=3)
+    return ChainedMembers(parts)
 
 
 def plan_of_cases(scenario_name: str, cases: dict[str, dict], name: str | None = None) -> Plan:

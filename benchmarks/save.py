@@ -1,0 +1,83 @@
+"""What saving costs in a long run: ``save_fraction``, the CPU of writing a 320 s ``tp``
+run's record over the CPU of the whole run (``quadcosim bench`` reports it).
+
+``python -m benchmarks.save [--duration 320] [--compressed] [--json]``
+
+The run is ``scenarios.run("tp", duration=320)`` into a temporary folder, in this process,
+after a short run that loads the compiled steps. Its CPU time (``time.process_time``: the
+build, the loop, the save, the report and its figures) is measured around the call; the save's
+CPU is the time :class:`scenarios.outputs.RunFiles` spends writing the record
+(``metrics.json``'s ``save_cpu_s``). ``--compressed`` measures the compressed archive too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+#: Simulated seconds of the run whose save is measured.
+DURATION_S = 320.0
+
+
+def save_fraction(duration: float = DURATION_S, compress: bool = False) -> dict:
+    """CPU of a ``tp`` run's save over the CPU of the whole run.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated seconds of the run.
+    compress : bool
+        Write the compressed archive (``--compress``).
+
+    Returns
+    -------
+    dict
+        ``fraction``, ``save_cpu_s`` and ``run_cpu_s`` (s of CPU), ``record_mb`` (the
+        ``results.npz`` written, MB).
+    """
+    import scenarios
+
+    with tempfile.TemporaryDirectory() as folder:
+        scenarios.run("tp", {"duration": 1.0}, Path(folder) / "warm-up")  # compiled steps loaded
+        out = Path(folder) / "run"
+        started = time.process_time()
+        _, metrics = scenarios.run("tp", {"duration": duration, "bench_supply": True}, out, compress=compress)
+        run_cpu = time.process_time() - started
+        size = (out / "results.npz").stat().st_size
+    return {"fraction": metrics["save_cpu_s"] / run_cpu, "save_cpu_s": metrics["save_cpu_s"],
+            "run_cpu_s": run_cpu, "record_mb": size / 1e6}
+
+
+def figures(duration: float = DURATION_S) -> dict:
+    """The keys ``quadcosim bench --json`` adds: ``save_fraction`` (default, uncompressed
+    save), ``save_cpu_s`` and ``save_run_cpu_s`` of a ``duration`` s ``tp`` run."""
+    measured = save_fraction(duration)
+    return {"save_fraction": measured["fraction"], "save_cpu_s": measured["save_cpu_s"],
+            "save_run_cpu_s": measured["run_cpu_s"]}
+
+
+def main(argv=None) -> int:
+    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.save", description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=DURATION_S, help="simulated seconds (default 320)")
+    parser.add_argument("--compressed", action="store_true", help="measure the compressed archive too")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    found = {"uncompressed": save_fraction(args.duration)}
+    if args.compressed:
+        found["compressed"] = save_fraction(args.duration, compress=True)
+    if args.json:
+        print(json.dumps(found))
+    else:
+        for kind, measured in found.items():
+            print(f"{kind:13s} save_fraction {measured['fraction']:.3f}: save {measured['save_cpu_s']:.3f} s of "
+                  f"{measured['run_cpu_s']:.2f} s CPU, results.npz {measured['record_mb']:.0f} MB")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

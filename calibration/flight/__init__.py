@@ -1,0 +1,25 @@
+"""Magnetometer calibration from real flights (logs read by :mod:`orchestrator.logs`).
+
+For one compass, the raw field (before the autopilot's own corrections) is explained as the
+Earth field rotated into the body frame, an offset, and the field of the motor currents::
+
+    m_raw(t) = R(t)^T m_E + b + b_d(t)
+
+- :mod:`calibration.flight.data`: the compass aligned with the attitude that removes the Earth
+  field, the log's own or one whose heading is integrated from the gyro (the default: the log's
+  heading is steered by the compass being calibrated, so its interference leaks into it);
+- :mod:`calibration.flight.linear`: the Earth field and offset of each flight with the shared
+  coefficients, by least squares;
+- :mod:`calibration.flight.models`: the ``current``, ``throttle``, ``motors`` and ``metge``
+  models and :mod:`calibration.flight.dynamic`, each refused with its reason when the flight
+  cannot identify it;
+- :mod:`calibration.flight.evaluate`: out-of-sample scores;
+- :mod:`calibration.flight.calibrate`: all of it, and the :class:`calibration.Calibration`;
+- :mod:`calibration.flight.autopilot`: ArduPilot and PX4 parameters, and the corrections those
+  autopilots apply with them.
+"""
+
+from calibration.flight.calibrate import MODELS, calibrate
+from calibration.flight.data import ATTITUDES, FlightData, flight_data
+
+__all__ = ["ATTITUDES", "MODELS", "FlightData", "calibrate", "flight_data"]

@@ -1,0 +1,112 @@
+"""A magnetometer calibration from flights: hard and soft iron when the rotations allow, each
+interference model fitted on training flights and scored on held-out ones, and the result as a
+:class:`calibration.Calibration`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calibration.dynamic import MotorFieldModel
+from calibration.file import Calibration
+from calibration.flight.dynamic import DynamicModel
+from calibration.flight.evaluate import score
+from calibration.flight.linear import earth_and_offset
+from calibration.flight.models import LinearModel, MetgeModel, Refused
+from calibration.static import CalibrationError, StaticCalibration, fit_static, sphere_coverage
+
+MODELS = ("current", "throttle", "motors", "metge", "dynamic")
+MIN_COVERAGE = 0.5  # share of the 80 sphere cells the Earth field must visit in the body frame
+# the model the calibration file carries: the first of these the flights identify (an a-priori order,
+# richest first, not a choice on the scores)
+FILE_PREFERENCE = ("metge", "motors", "throttle")
+
+
+def _fit_models(train, names) -> tuple[dict, dict]:
+    fitted, refused = {}, {}
+    for name in names:
+        model = (LinearModel(name) if name in ("current", "throttle", "motors")
+                 else MetgeModel(fitted.get("motors")) if name == "metge" else DynamicModel(fitted.get("metge")))
+        reason = model.refusal(train)
+        if reason is None:
+            try:
+                fitted[name] = model.fit(train)
+            except (Refused, CalibrationError) as error:
+                reason = str(error)
+        if reason is not None:
+            refused[name] = reason
+    return fitted, refused
+
+
+def _static(train, best, offsets, soft_iron) -> tuple[StaticCalibration, dict]:
+    """Hard and soft iron from the flights' rotations when they cover enough of the sphere, else the log's."""
+    first = train[0]
+    base = earth_and_offset(first.rotation, first.raw - (0 if best is None else best.predict(first)))
+    m_E = base.nuisance[0, :3]
+    directions = np.einsum("tji,j->ti", first.rotation, m_E)
+    coverage = sphere_coverage(directions)
+    kept = StaticCalibration(A=soft_iron, b_s=offsets, field_norm=float(np.linalg.norm(m_E)), coverage=coverage)
+    if coverage < MIN_COVERAGE:
+        return kept, {"source": "log", "coverage": coverage,
+                      "reason": f"the flight's rotations cover {coverage:.2f} of the sphere (< {MIN_COVERAGE}): "
+                                "hard and soft iron cannot be fitted, the log's offsets are kept"}
+    samples = np.concatenate([p.raw - (0 if best is None else best.predict(p)) for p in train])
+    try:
+        static = fit_static(samples, field_norm=float(np.linalg.norm(m_E)))
+    except CalibrationError as error:
+        return kept, {"source": "log", "coverage": coverage, "reason": f"the ellipsoid fit was refused: {error}"}
+    return static, {"source": "flight", "coverage": coverage, "reason": "fitted on the flight's rotations"}
+
+
+def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel | None]:
+    """The preferred identified model in the file's form (eqs. 3, 4 of Metge et al.)."""
+    for name in FILE_PREFERENCE:
+        if name not in fitted:
+            continue
+        if name == "metge":
+            return name, fitted[name].extra["field"]
+        K = fitted[name].extra["K"]
+        vectors = np.repeat(K / motors, motors, axis=0) if name == "throttle" else K  # throttle = mean command
+        norms = np.linalg.norm(vectors, axis=1)
+        safe = np.where(norms > 0, norms, 1.0)
+        v = np.where(norms[:, None] > 0, vectors / safe[:, None], np.array([1.0, 0.0, 0.0]))
+        return name, MotorFieldModel(v, norms[:, None], (1, 0))
+    return None, None
+
+
+def calibrate(train, test, names=MODELS, attitude: str = "gyro") -> tuple[dict, Calibration, dict]:
+    """Fit on the ``train`` parts, score on the ``test`` parts (lists of FlightData of one compass);
+    ``names`` the models tried, ``attitude`` the attitude the parts were built with (recorded).
+
+    Returns the metrics (JSON-ready), the :class:`calibration.Calibration` for the file and the
+    fitted models by name (:class:`calibration.flight.models.Fitted`).
+    """
+    fitted, refused = _fit_models(train, names)
+    compass = train[0].log.compasses[train[0].compass]
+    chosen, field = _field_model(fitted, train[0].motors.commands.shape[1])
+    models = {}
+    for name in names:
+        if name in refused:
+            models[name] = {"refused": refused[name]}
+            continue
+        f = fitted[name]
+        on_test, on_train = score(f, test), score(f, train)
+        models[name] = {"explained_test": on_test["explained"], "explained_train": on_train["explained"],
+                        "coefficients": f.coefficients, "perturbation_at_hover_T": on_test["perturbation_at_hover_T"],
+                        "heading_rms_change_deg": on_test["heading_rms_change_deg"],
+                        "heading_error_rms_deg": on_test["heading_error_rms_deg"], "delay_s": f.delay,
+                        "condition_number": f.condition}
+    # the ellipsoid is fitted on the field with the interference removed that explains most in training
+    best = max(fitted, key=lambda name: models[name]["explained_train"], default=None)
+    static, static_notes = _static(train, fitted.get(best), compass.offsets, compass.soft_iron)
+    static_notes["interference_removed"] = best
+    baseline = score(None, test)
+    metrics = {"train": sorted({p.source for p in train}), "test": sorted({p.source for p in test}),
+               "attitude": attitude,
+               "baseline_rms_test_T": baseline["baseline_rms_T"],
+               "heading_error_rms_without_deg": baseline["heading_error_rms_deg"]["without"],
+               "static": {k: v for k, v in static_notes.items()}, "models": models, "calibration_model": chosen}
+    calibration = Calibration(train[0].motors.commands.shape[1], static, field,
+                              fitted["dynamic"].extra["dynamics"] if "dynamic" in fitted and chosen == "metge"
+                              else None, None,
+                              {"source": "flight calibration", "train": metrics["train"], "model": chosen})
+    return metrics, calibration, fitted

@@ -1,0 +1,153 @@
+"""One compass of one flight log, aligned for calibration: the raw field at its own sample
+instants, the attitude that removes the Earth field there, and the interference regressors
+(motor commands, throttle, battery current and voltage) that can be read at any instant, delayed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from calibration.static import CalibrationError
+
+ATTITUDES = ("gyro", "log")
+
+
+def euler_of(q: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (rad, Z-Y-X; yaw unwrapped) of body-to-NED quaternions ``q`` (T, 4), scalar first."""
+    from scipy.spatial.transform import Rotation
+
+    euler = Rotation.from_quat(q, scalar_first=True).as_euler("ZYX")[:, ::-1].copy()
+    euler[:, 2] = np.unwrap(euler[:, 2])
+    return euler
+
+
+def rotation_of(euler: np.ndarray) -> np.ndarray:
+    """Body-to-NED rotation matrices (T, 3, 3) of roll, pitch, yaw ``euler`` (T, 3) (rad, Z-Y-X)."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_euler("ZYX", euler[:, ::-1]).as_matrix()
+
+
+def gyro_heading(log, times: np.ndarray) -> np.ndarray:
+    """Heading (rad) at ``times`` (s) integrated from the first IMU's gyro, with the log's roll and
+    pitch; its constant and its linear drift are matched to the log's heading over the whole
+    flight, so no stretch shorter than the flight depends on the compass. ``log``: the FlightLog."""
+    imu = log.imus[0]
+    euler = euler_of(log.attitude.q)
+    roll = np.interp(imu.time, log.attitude.time, euler[:, 0])
+    pitch = np.interp(imu.time, log.attitude.time, euler[:, 1])
+    p, q, r = imu.gyro.T
+    rate = (q * np.sin(roll) + r * np.cos(roll)) / np.cos(pitch)  # Z-Y-X Euler kinematics
+    integrated = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(imu.time))])
+    logged = np.interp(imu.time, log.attitude.time, euler[:, 2])
+    trend = np.polyfit(imu.time - imu.time[0], logged - integrated, 1)
+    heading = integrated + np.polyval(trend, imu.time - imu.time[0])
+    return np.interp(times, imu.time, heading)
+
+
+@dataclass(frozen=True)
+class FlightData:
+    """One compass of one log, at its sample instants.
+
+    Attributes
+    ----------
+    source : str
+        ``FILE:COMPASS`` for messages and reports.
+    time : (T,) array
+        Magnetometer sample instants (s, the log's clock).
+    raw : (T, 3) array
+        Raw field, body FRD (T), before the autopilot's corrections.
+    rotation : (T, 3, 3) array
+        Body-to-NED rotation that carries the Earth field into the body frame (``R^T m_E``).
+    euler : (T, 3) array
+        The log's roll, pitch and yaw (rad) at ``time``: tilt compensation and the reference heading.
+    motors, battery :
+        The log's :class:`orchestrator.logs.Motors` and :class:`orchestrator.logs.Battery` (or None).
+    log : FlightLog
+        The log itself.
+    compass : int
+        The compass's index in the log.
+    """
+
+    source: str
+    time: np.ndarray
+    raw: np.ndarray
+    rotation: np.ndarray
+    euler: np.ndarray
+    motors: object
+    battery: object
+    log: object
+    compass: int
+
+    def commands(self, delay: float = 0.0) -> np.ndarray:
+        """Motor commands (T, N) (1) at ``time - delay`` (s)."""
+        m = self.motors
+        return np.column_stack([np.interp(self.time - delay, m.time, m.commands[:, n])
+                                for n in range(m.commands.shape[1])])
+
+    def throttle(self, delay: float = 0.0) -> np.ndarray:
+        """Collective throttle (T,) (1), the mean command, at ``time - delay`` (s)."""
+        return self.commands(delay).mean(axis=1)
+
+    def current(self, delay: float = 0.0) -> np.ndarray | None:
+        """Battery current (T,) (A) at ``time - delay`` (s); None without a current sensor."""
+        b = self.battery
+        return None if b is None or b.current is None else np.interp(self.time - delay, b.time, b.current)
+
+    def voltage(self, delay: float = 0.0) -> np.ndarray:
+        """Battery voltage (T,) (V) at ``time - delay`` (s); NaN when the log has no battery."""
+        if self.battery is None:
+            return np.full(len(self.time), np.nan)
+        return np.interp(self.time - delay, self.battery.time, self.battery.voltage)
+
+    def part(self, rows) -> FlightData:
+        """The same flight restricted to ``rows`` (a boolean mask or indices of samples)."""
+        return replace(self, time=self.time[rows], raw=self.raw[rows], rotation=self.rotation[rows],
+                       euler=self.euler[rows])
+
+    def split(self, test_fraction: float) -> tuple[FlightData, FlightData]:
+        """(training, test): the test part is the last ``test_fraction`` (0..1) of the flight's time."""
+        cut = self.time[0] + (1.0 - test_fraction) * (self.time[-1] - self.time[0])
+        return self.part(self.time < cut), self.part(self.time >= cut)
+
+
+def flight_data(log, compass: int, attitude: str = "gyro") -> FlightData:
+    """Align compass ``compass`` of the :class:`orchestrator.logs.FlightLog` ``log`` for calibration.
+
+    ``attitude`` chooses the rotation that removes the Earth field: ``"gyro"`` (default) takes roll
+    and pitch from the log and integrates the heading from the gyro (see :func:`gyro_heading`), so
+    the heading does not come from the compass being calibrated; ``"log"`` takes the autopilot's
+    attitude as it is, whose heading the compass itself steered.
+
+    Raises
+    ------
+    CalibrationError
+        No such compass, no motors, attitude or battery voltage in the log, or an unknown ``attitude``.
+    """
+    from orchestrator.logs import LogError
+
+    if attitude not in ATTITUDES:
+        raise CalibrationError(f"attitude {attitude!r} must be one of {', '.join(ATTITUDES)}")
+    try:
+        chosen = log.compass(compass)
+    except LogError as error:
+        raise CalibrationError(str(error)) from None
+    missing = [name for name, part in (("motor outputs", log.motors), ("attitude", log.attitude),
+                                       ("IMU", log.imus or None)) if part is None]
+    if missing:
+        raise CalibrationError(f"{log.path}: the log has no {', '.join(missing)}; a flight calibration needs "
+                               "them all (log RCOU, ATT and IMU, or PX4's actuator_outputs, vehicle_attitude and "
+                               "sensor_combined)")
+    series = [s for s in (log.attitude, log.motors, log.battery) if s is not None]
+    lo, hi = max(s.time[0] for s in series), min(s.time[-1] for s in series)
+    rows = (chosen.time >= lo) & (chosen.time <= hi)
+    time = chosen.time[rows]
+    euler_log = euler_of(log.attitude.q)
+    euler = np.column_stack([np.interp(time, log.attitude.time, euler_log[:, k]) for k in range(3)])
+    used = euler.copy()
+    if attitude == "gyro":
+        used[:, 2] = gyro_heading(log, time)
+    return FlightData(f"{log.path}:{chosen.name}", time, chosen.raw[rows], rotation_of(used), euler, log.motors,
+                      log.battery, log, compass)

@@ -1,0 +1,466 @@
+"""The estimators' settings, the :class:`Estimator` on arrays or sample by sample, and its streaming block.
+
+Units: turn rate rad/s, IR in counts, ``a`` in counts per rad/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from calibration.infrared.filters import ekf_joint_step, ekf_step, pair_at, push, regression_step, rls_step
+from calibration.infrared.layout import (
+    A_SAFE,
+    B_SAFE,
+    CUSUM_H,
+    CUSUM_K,
+    EKF_CONFIG_SIZE,
+    EKF_SIZE,
+    END_H,
+    FAULT_SIZE,
+    FIT_A,
+    FIT_B,
+    GAMMA2,
+    GATE_GPS,
+    GATE_IR,
+    GATE_NOW,
+    GPS_FAULT,
+    GPS_USED,
+    IR_FAULT,
+    IR_SUSPECT,
+    IR_USED,
+    LAG,
+    LOST_PD,
+    NOW_H,
+    NOW_K,
+    NU_GPS,
+    NU_IR,
+    NU_NOW,
+    PA0,
+    PAA,
+    PAB,
+    PAR,
+    PB0,
+    PBB,
+    PBR,
+    PRR,
+    QA,
+    QB,
+    QR,
+    RATE,
+    REG_RATE,
+    REG_SIZE,
+    REJECTED,
+    RG,
+    RI,
+    RI1,
+    RLS_A,
+    RLS_B,
+    RLS_RATE,
+    SIZE_GAIN,
+    STATUS,
+    WINDOW_SPAN,
+    ZERO_GAIN,
+    A,
+    B,
+    R,
+)
+from orchestrator.blocks import Block
+
+
+def _check_positive(name: str, value: float, unit: str, fix: str):
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"{name} = {value!r} {unit} must be positive and finite; {fix}")
+
+
+@dataclass(frozen=True)
+class EKFSettings:
+    """Settings of :class:`TurnRateEKF`; standard deviations, per sample of 1 / rate.
+
+    Attributes
+    ----------
+    a0, b0 : float
+        Initial ``a`` (count per rad/s) and ``b`` (count): the last calibration, by default the
+        slides' regression ``IR = -400 r + 990``.
+    sd_a0, sd_b0, sd_r0 : float
+        Their initial standard deviations (count/(rad/s), count, rad/s).
+    q_a, q_b, q_r : float
+        Random-walk standard deviations per sample of ``a``, ``b`` and the paired turn rate.
+    sd_gps : float
+        GPS turn-rate noise (rad/s). At the default 0.04 rad/s the filter trusts the GPS turn
+        rate less than the window-mean IR (``sd_ir / |a0|`` = 0.0125 rad/s).
+    sd_ir : float
+        Noise of the window-mean IR (count), inflated for the overlap of successive windows.
+    sd_ir_sample : float
+        Noise of one IR sample (count), for the check of the present IR.
+    sd_lag : float
+        How much the turn rate may change over the GPS lag (rad/s), for the check of the
+        present IR against the paired turn rate; it lets a fault of the IR be declared before
+        it reaches the paired window, 1 s later.
+    gate : float
+        Innovation gate gamma in standard deviations; 0 turns gating and fault detection off.
+    cusum_k, cusum_h : float
+        Allowance and threshold (standard deviations) of the CUSUMs on the GPS and the paired
+        IR innovations (:mod:`calibration.infrared.detection`). The defaults were set on the
+        fault-free flights of seeds 101 to 200 (drift on), whose largest statistics were 5.7 (GPS
+        and paired IR, at this allowance) and 15.7 (present IR), against the thresholds 10 and
+        25; the flights of seeds 1 to 100 score them (``python -m scenarios.ir_detection``).
+    now_k, now_h : float
+        The same for the present IR, whose variance includes the turn's change over the lag.
+    end_h : float
+        Threshold of the log-likelihood ratio that ends a fault.
+    size_gain : float
+        Weight per sample of the running estimate of a declared fault's offset (1 / samples).
+    form : str
+        ``"sequential"`` (two scalar updates, gated) or ``"joint"`` (the slides' 2x2 update,
+        never gated).
+    """
+
+    a0: float = -400.0
+    b0: float = 990.0
+    sd_a0: float = 25.0
+    sd_b0: float = 60.0
+    sd_r0: float = 0.3
+    q_a: float = 0.5
+    q_b: float = 1.0
+    q_r: float = 0.02
+    sd_gps: float = 0.04
+    sd_ir: float = 5.0
+    sd_ir_sample: float = 6.0
+    sd_lag: float = 0.3
+    gate: float = 5.0
+    cusum_k: float = 2.0
+    cusum_h: float = 10.0
+    now_k: float = 3.5
+    now_h: float = 25.0
+    end_h: float = 10.0
+    size_gain: float = 0.05
+    form: str = "sequential"
+
+    def __post_init__(self):
+        for name in ("sd_a0", "sd_b0", "sd_r0", "q_a", "q_b", "q_r", "sd_gps", "sd_ir", "sd_ir_sample", "sd_lag"):
+            _check_positive(name, getattr(self, name), "", "a covariance must be positive definite")
+        if not (math.isfinite(self.a0) and self.a0 != 0.0 and math.isfinite(self.b0)):
+            raise ValueError(f"a0 = {self.a0!r}, b0 = {self.b0!r}: a0 must be finite and non-zero, b0 finite")
+        if not (self.gate == 0.0 or (math.isfinite(self.gate) and self.gate > 0.0)):
+            raise ValueError(f"gate = {self.gate!r} standard deviations must be positive, or 0 for no gating")
+        for name in ("cusum_k", "cusum_h", "now_k", "now_h", "end_h", "size_gain"):
+            _check_positive(name, getattr(self, name), "", "the detector needs a positive allowance and threshold")
+        if self.form not in ("sequential", "joint"):
+            raise ValueError(f"form = {self.form!r} must be 'sequential' or 'joint'")
+        if self.form == "joint" and self.gate:
+            raise ValueError("the joint form is the slides' filter and is not gated: set gate=0 or form='sequential'")
+
+    def config(self) -> np.ndarray:
+        """The configuration vector of the step functions (variances per sample, gate, rules)."""
+        c = np.zeros(EKF_CONFIG_SIZE)
+        c[[QA, QB, QR, RG, RI]] = np.square([self.q_a, self.q_b, self.q_r, self.sd_gps, self.sd_ir])
+        c[GAMMA2] = self.gate**2
+        c[CUSUM_K], c[CUSUM_H], c[NOW_K], c[NOW_H] = self.cusum_k, self.cusum_h, self.now_k, self.now_h
+        c[END_H], c[SIZE_GAIN] = self.end_h, self.size_gain
+        c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
+        c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
+        return c
+
+    def initial_state(self, covariance=None) -> np.ndarray:
+        """The state vector before the first sample.
+
+        Parameters
+        ----------
+        covariance : (3, 3) array, optional
+            Covariance of (a, b, r) (count^2 s^2/rad^2, count^2, rad^2/s^2 on the diagonal);
+            default ``diag(sd_a0^2, sd_b0^2, sd_r0^2)``. Refused unless finite, symmetric and
+            positive definite.
+        """
+        s = np.zeros(EKF_SIZE)
+        s[A], s[B] = self.a0, self.b0
+        s[A_SAFE], s[B_SAFE] = self.a0, self.b0
+        P = np.diag(np.square([self.sd_a0, self.sd_b0, self.sd_r0])) if covariance is None else covariance
+        P = np.asarray(P, dtype=float)
+        if P.shape != (3, 3) or not np.isfinite(P).all() or not np.allclose(P, P.T):
+            raise ValueError(f"initial covariance must be a finite symmetric 3x3 matrix, not {P!r}")
+        if np.linalg.eigvalsh(P).min() <= 0.0:
+            raise ValueError(f"initial covariance is not positive definite (eigenvalues {np.linalg.eigvalsh(P)}); "
+                             "give positive variances")
+        s[[PAA, PAB, PAR, PBB, PBR, PRR]] = P[0, 0], P[0, 1], P[0, 2], P[1, 1], P[1, 2], P[2, 2]
+        return s
+
+
+@dataclass(frozen=True)
+class RegressionSettings:
+    """Settings of :class:`Regression` (the slides' baseline).
+
+    Attributes
+    ----------
+    a0, b0 : float
+        Line used until the first fit (count per rad/s, count).
+    period : int
+        Samples between refits (20: every second at 20 Hz).
+    max_rate : float
+        Largest realistic turn rate (rad/s).
+    reject : float
+        A pair further than this many residual deviations from the line is left out.
+    sd_floor : float
+        Floor of the residual deviation (count).
+    min_samples : int
+        Pairs needed before the first fit.
+    min_spread : float
+        Turn-rate standard deviation needed before the first fit (rad/s).
+    """
+
+    a0: float = -400.0
+    b0: float = 990.0
+    period: int = 20
+    max_rate: float = 1.5
+    reject: float = 4.0
+    sd_floor: float = 10.0
+    min_samples: int = 100
+    min_spread: float = 0.05
+
+    def config(self) -> np.ndarray:
+        """The configuration vector of :func:`regression_step`."""
+        _check_positive("period", self.period, "samples", "refit at least every sample")
+        _check_positive("max_rate", self.max_rate, "rad/s", "give the largest realistic turn rate")
+        return np.array([self.period, self.max_rate, self.reject, self.sd_floor, self.min_samples,
+                         self.min_spread], dtype=float)
+
+    def initial_state(self) -> np.ndarray:
+        """The state vector before the first sample: no data, the initial line."""
+        s = np.zeros(REG_SIZE)
+        s[FIT_A], s[FIT_B] = self.a0, self.b0
+        return s
+
+
+@dataclass(frozen=True)
+class RLSSettings:
+    """Settings of :class:`ForgettingRLS` (Paparazzi's flight code).
+
+    Attributes
+    ----------
+    a0, b0, sd_a0, sd_b0 : float
+        Initial line and its standard deviations (count per rad/s, count).
+    forgetting : float
+        Forgetting factor rho, in (0, 1].
+    airspeed, gravity : float
+        For the GPS bank angle ``atan(r V / g)`` (m/s, m/s^2).
+    bank_min, bank_max : float
+        The RLS updates only when the absolute GPS bank angle lies in this band (rad).
+    """
+
+    a0: float = -400.0
+    b0: float = 990.0
+    sd_a0: float = 60.0
+    sd_b0: float = 60.0
+    forgetting: float = 0.995
+    airspeed: float = 12.0
+    gravity: float = 9.81
+    bank_min: float = 0.05
+    bank_max: float = 1.0
+
+    def config(self) -> np.ndarray:
+        """The configuration vector of :func:`rls_step`."""
+        if not 0.0 < self.forgetting <= 1.0:
+            raise ValueError(f"forgetting factor {self.forgetting!r} must lie in (0, 1]")
+        _check_positive("airspeed", self.airspeed, "m/s", "the bank angle needs a flying aircraft")
+        return np.array([self.forgetting, self.airspeed, self.gravity, self.bank_min, self.bank_max])
+
+    def initial_state(self) -> np.ndarray:
+        """The state vector before the first sample: the initial line and its covariance."""
+        for name in ("sd_a0", "sd_b0"):
+            _check_positive(name, getattr(self, name), "", "a covariance must be positive definite")
+        return np.array([self.a0, self.b0, self.sd_a0**2, 0.0, self.sd_b0**2, 0.0])
+
+
+METHODS = ("kalman", "regression", "rls")
+_EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_gps": GATE_GPS, "nu_ir": NU_IR,
+               "S_ir": GATE_IR, "gps_fault": GPS_FAULT, "ir_fault": IR_FAULT, "gps_used": GPS_USED,
+               "ir_used": IR_USED, "ir_suspect": IR_SUSPECT, "nu_ir_now": NU_NOW,
+               "S_ir_now": GATE_NOW, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS,
+               "fault_size": FAULT_SIZE}
+_REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
+_RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
+_STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "
+                         "raise the process noise q_a, q_b, q_r or the measurement noise",
+                ZERO_GAIN: "the gain a reached zero, so the turn rate (IR - b) / a is undefined; "
+                           "check the initial a0 and the IR data"}
+
+
+class CalibrationError(ValueError):
+    """An estimator was given data or settings it cannot use."""
+
+
+@njit(cache=True)
+def _sample(step, s, c, buffer, k, ir, gps, gps_use, delay, window, suspect):
+    """One sample of any estimator: pair the IR with the GPS window, step, store the IR."""
+    step(s, c, pair_at(buffer, k, delay, window), gps, gps_use, ir)
+    push(buffer, k, ir, s[suspect] if suspect >= 0 else 0.0, delay, window)
+
+
+@njit(cache=True)
+def _run(step, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, suspect, out):
+    """The batch path: the step function over recorded arrays. Returns the samples done."""
+    for k in range(ir.shape[0]):
+        _sample(step, s, c, buffer, k, ir[k], gps[k], gps_use[k], delay, window, suspect)
+        for j in range(fields.shape[0]):
+            out[k, j] = s[fields[j]]
+        if status >= 0 and s[status] != 0.0:
+            return k + 1
+    return ir.shape[0]
+
+
+def _finite(name: str, values) -> np.ndarray:
+    values = np.ascontiguousarray(values, dtype=float)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise CalibrationError(f"{name} holds a non-finite value ({values[k]!r}) at sample {k}; "
+                               "the estimators take finite readings only: drop or repair that sample")
+    return values
+
+
+class Estimator:
+    """One estimator of ``(a, b)`` and of the present turn rate, on arrays or sample by sample.
+
+    Parameters
+    ----------
+    method : {"kalman", "regression", "rls"}
+        Which estimator.
+    settings : EKFSettings, RegressionSettings or RLSSettings, optional
+        Its settings; defaults for the method when omitted.
+    delay, window : int
+        GPS delay and window in samples (1 s each at 20 Hz).
+    covariance : (3, 3) array, optional
+        Initial covariance of the Kalman filter's (a, b, r), instead of the settings' diagonal.
+    """
+
+    def __init__(self, method: str = "kalman", settings=None, delay: int = 20, window: int = 20,
+                 covariance=None):
+        if method not in METHODS:
+            raise CalibrationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+        if int(delay) != delay or delay < 0 or int(window) != window or window < 1:
+            raise CalibrationError(f"delay = {delay!r} and window = {window!r} must be whole numbers of samples, "
+                                   "delay >= 0 and window >= 1")
+        self.method, self.delay, self.window = method, int(delay), int(window)
+        if method == "kalman":
+            self.settings = settings or EKFSettings()
+            self._step = ekf_step if self.settings.form == "sequential" else ekf_joint_step
+            self._fields, self._status = _EKF_FIELDS, STATUS
+            self._suspect = IR_SUSPECT if self.settings.form == "sequential" else -1
+            self._initial = self.settings.initial_state(covariance)
+        elif method == "regression":
+            self.settings = settings or RegressionSettings()
+            self._step, self._fields, self._status, self._suspect = regression_step, _REG_FIELDS, -1, -1
+            self._initial = self.settings.initial_state()
+        else:
+            self.settings = settings or RLSSettings()
+            self._step, self._fields, self._status, self._suspect = rls_step, _RLS_FIELDS, -1, -1
+            self._initial = self.settings.initial_state()
+        self.config = self.settings.config()
+        if method == "kalman":
+            self.config[WINDOW_SPAN] = self.delay + self.window
+        self.names = tuple(self._fields)
+        self._index = np.array(list(self._fields.values()), dtype=np.int64)
+        self.reset()
+
+    def reset(self):
+        """Back to the initial state, before any sample."""
+        self.state = self._initial.copy()
+        self.buffer = np.zeros(2 * (self.delay + self.window + 2) + 2)
+        self.k = 0
+
+    def update(self, ir: float, gps: float, gps_use: bool = True) -> np.ndarray:
+        """Take one sample: the IR ``ir`` (count), the GPS turn rate ``gps`` (rad/s) and whether to
+        use it, ``gps_use``.
+
+        Returns the state vector (see the module's index constants); ``state[...]`` holds
+        ``a``, ``b`` and the present turn rate.
+        """
+        if not (math.isfinite(ir) and math.isfinite(gps)):
+            raise CalibrationError(f"sample {self.k}: IR = {ir!r}, GPS turn rate = {gps!r}; the estimators take "
+                                   "finite readings only: drop or repair that sample")
+        _sample(self._step, self.state, self.config, self.buffer, self.k, float(ir), float(gps), bool(gps_use),
+                self.delay, self.window, self._suspect)
+        self.k += 1
+        if self._status >= 0 and self.state[self._status] != 0.0:
+            raise CalibrationError(f"{self.method} at sample {self.k - 1}: {_STATUS_TEXT[self.state[self._status]]}")
+        return self.state
+
+    def run(self, ir, gps, gps_use=None) -> dict[str, np.ndarray]:
+        """The estimator over recorded arrays, from its initial state.
+
+        Parameters
+        ----------
+        ir : (n,) array
+            IR readings (count), one per sample.
+        gps : (n,) array
+            GPS turn rate (rad/s), one per sample.
+        gps_use : (n,) bool array, optional
+            Samples whose GPS is valid and to be used (default: all).
+
+        Returns
+        -------
+        dict of (n,) arrays
+            ``a``, ``b``, ``turn_rate`` (the present turn rate ``(IR - b) / a``, rad/s) and, for
+            the Kalman filter, ``r`` (paired turn rate), innovations ``nu_gps``, ``nu_ir`` and
+            their variances ``S_gps``, ``S_ir``, fault flags ``gps_fault``, ``ir_fault``, and
+            whether each measurement was fused (``gps_used``, ``ir_used``).
+        """
+        ir = _finite("IR", ir)
+        gps = _finite("GPS turn rate", gps)
+        if gps.shape != ir.shape or ir.ndim != 1:
+            raise CalibrationError(f"IR {ir.shape} and GPS {gps.shape} must be 1-D arrays of the same length")
+        use = np.ones(ir.shape, dtype=np.bool_) if gps_use is None else np.asarray(gps_use, dtype=np.bool_)
+        if use.shape != ir.shape:
+            raise CalibrationError(f"gps_use {use.shape} must have the shape of IR {ir.shape}")
+        self.reset()
+        out = np.full((ir.shape[0], self._index.shape[0]), np.nan)
+        done = _run(self._step, self.state, self.config, self.buffer, self.delay, self.window, ir, gps, use,
+                    self._index, self._status, self._suspect, out)
+        self.k = done
+        if done < ir.shape[0]:
+            raise CalibrationError(f"{self.method} at sample {done - 1}: {_STATUS_TEXT[self.state[self._status]]}")
+        return {name: out[:, j] for j, name in enumerate(self.names)}
+
+
+class InfraredCalibration(Block):
+    """Streaming block around one :class:`Estimator`, at the sensor's rate.
+
+    Inputs ``ir`` (count), ``gps_turn_rate`` (rad/s), ``gps_valid`` (1 when valid); outputs
+    the estimator's named values (``a``, ``b``, ``turn_rate`` and, for the Kalman filter, the
+    innovations, their variances and the fault flags). The GPS is used until ``gps_until``
+    (s; the slides' "real case" stops it after a calibration phase).
+
+    Parameters
+    ----------
+    name : str
+        Block name.
+    estimator : Estimator
+        The estimator, shared with the batch path.
+    gps_until : float
+        Time after which the GPS is no longer used (s); ``inf`` for always.
+    period : int
+        Runs every ``period`` macro steps (one sample of the sensor).
+    """
+
+    inputs = ("ir", "gps_turn_rate", "gps_valid")
+    feedthrough = True
+
+    def __init__(self, name: str, estimator: Estimator, gps_until: float = math.inf, period: int = 1):
+        super().__init__(name, period)
+        self.estimator = estimator
+        self.gps_until = float(gps_until)
+        self.outputs = estimator.names
+        self._index = estimator._index
+
+    def start(self, t0, dt):
+        self.estimator.reset()
+
+    def step(self, t, u, y):
+        use = u[2] > 0.5 and t < self.gps_until
+        s = self.estimator.update(u[0], u[1], use)
+        y[:] = s[self._index]
+
+

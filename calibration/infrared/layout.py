@@ -1,0 +1,46 @@
+"""Layouts of the estimators' state and configuration vectors: one index per quantity.
+
+The step functions (:mod:`calibration.infrared.filters`, :mod:`calibration.infrared.detection`)
+work on flat float arrays so that numba compiles them and the batch path and the streaming
+block share them; these constants name the entries.
+"""
+
+# EKF state vector s: estimate, covariance (upper triangle), faults, last innovations, detectors.
+A, B, R = 0, 1, 2
+PAA, PAB, PAR, PBB, PBR, PRR = 3, 4, 5, 6, 7, 8
+GPS_FAULT, IR_FAULT, FAULT_SIZE, END_STAT = 9, 10, 11, 12
+END_PAIR = 42  # the end test on the paired IR (END_STAT: on the present IR, or the GPS)
+A_SAFE, B_SAFE = 43, 44  # a and b when no detector last saw anything: restored when a fault is declared
+HOLD = 45  # samples left before the paired IR is watched again after an IR fault (its window still holds it)
+NU_GPS, GATE_GPS, NU_IR, GATE_IR, RATE, STATUS = 13, 14, 15, 16, 17, 18
+GPS_USED, IR_USED, IR_SUSPECT, NU_NOW, GATE_NOW = 19, 20, 21, 22, 23
+# one two-sided CUSUM per innovation: the GPS, the paired IR, the present IR
+CUSUM_GPS, CUSUM_PAIR, CUSUM_NOW = 24, 30, 36
+# inside a CUSUM: statistic, sum of the raw innovations and count of its run, upwards then downwards
+G_UP, SUM_UP, N_UP, G_DOWN, SUM_DOWN, N_DOWN = range(6)
+CUSUM_SIZE = 6
+EKF_SIZE = 46
+# EKF configuration c: process noise variances per sample, measurement variances, gate, detectors.
+# WINDOW_SPAN: delay + window of the GPS pairing (samples), set by the estimator.
+QA, QB, QR, RG, RI, GAMMA2, LAG, RI1, PA0, PB0 = range(10)
+CUSUM_K, CUSUM_H, NOW_K, NOW_H, END_H, SIZE_GAIN, WINDOW_SPAN = range(10, 17)
+EKF_CONFIG_SIZE = 17
+# status codes
+OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
+
+# Regression state: sums of the accepted pairs, the fit and its residual spread.
+N, SR, SRR, SY, SRY, SYY, FIT_A, FIT_B, FIT_SD, COUNT, REG_RATE, REJECTED, FITTED = range(13)
+REG_SIZE = 13
+# Regression configuration: recompute period (samples), largest realistic turn rate (rad/s),
+# rejection threshold (residual standard deviations), floor of that deviation (count),
+# samples and turn-rate spread (rad/s) needed before the first fit.
+PERIOD, MAX_RATE, REJECT_K, SD_FLOOR, MIN_N, MIN_SPREAD = range(6)
+REG_CONFIG_SIZE = 6
+
+# RLS state: (a, b), its covariance (upper triangle), the present turn rate.
+RLS_A, RLS_B, RLS_P00, RLS_P01, RLS_P11, RLS_RATE = range(6)
+RLS_SIZE = 6
+# RLS configuration: forgetting factor, airspeed (m/s) and gravity (m/s^2) for the bank angle,
+# bank-angle band (rad) in which it updates.
+RHO, AIRSPEED, GRAVITY, BANK_MIN, BANK_MAX = range(5)
+RLS_CONFIG_SIZE = 5

@@ -1,0 +1,105 @@
+"""Sphinx extension of the quadcosim documentation.
+
+- ``quadcosim-run``: a directive that runs the ``quadcosim`` command it shows (in-process, into
+  ``docs/_generated/runs/<hash>/``, reused while its ``metrics.json`` is there) and shows the
+  command, the figure it wrote and the metrics named, so that every figure of the lab
+  walk-through is made by the command beside it.
+- the FMUs' variable tables, generated from ``fmus/<Model>/variables.py`` into
+  ``docs/_generated/fmu_variables.md`` when the build starts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import io
+import json
+import shlex
+from pathlib import Path
+
+from docutils import nodes
+from docutils.parsers.rst import Directive, directives
+
+HERE = Path(__file__).resolve().parent.parent
+GENERATED = HERE / "_generated"
+
+
+def _run(command: str) -> Path:
+    """The folder of ``quadcosim COMMAND``'s results, running it first if not done yet."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from scenarios.cli import main
+
+    out = GENERATED / "runs" / hashlib.sha256(command.encode()).hexdigest()[:16]
+    metrics = out / "metrics.json"
+    if not (metrics.is_file() and json.loads(metrics.read_text()).get("status") == "completed"):
+        told = io.StringIO()  # the run's lines go to the error only if it fails
+        with contextlib.redirect_stdout(told), contextlib.redirect_stderr(told):
+            code = main([*shlex.split(command), "--out", str(out), "--overwrite"])
+        if code != 0:
+            raise RuntimeError(f"quadcosim {command} exited {code}:\n{told.getvalue()[-2000:]}")
+    return out
+
+
+def _shown(value) -> str:
+    from scenarios.shown import shown
+
+    return shown(value)
+
+
+class QuadcosimRun(Directive):
+    """``quadcosim-run``: the argument is the command after ``quadcosim``; options ``figure`` (a
+    file the run writes, ``roll_pitch.png`` by default) and ``metrics`` (comma-separated names of
+    ``metrics.json`` to print)."""
+
+    required_arguments = 1
+    final_argument_whitespace = True
+    option_spec = {"figure": directives.unchanged, "metrics": directives.unchanged}
+
+    def run(self):
+        command = self.arguments[0]
+        out = _run(command)
+        shown = [nodes.literal_block(text=f"quadcosim {command}", language="sh")]
+        names = [n.strip() for n in self.options.get("metrics", "").split(",") if n.strip()]
+        if names:
+            metrics = json.loads((out / "metrics.json").read_text())
+            text = "; ".join(f"{name} = {_shown(metrics.get(name))}" for name in names)
+            shown.append(nodes.paragraph(text=f"Measured by this command: {text}."))
+        figure = self.options.get("figure", "roll_pitch.png")
+        path = out / figure
+        if not path.is_file():
+            raise self.error(f"quadcosim {command} wrote no {figure}")
+        shown.append(nodes.image(uri="/" + path.relative_to(HERE).as_posix(), alt=f"{figure} of quadcosim {command}",
+                                 width="100%"))
+        return shown
+
+
+def _variable_tables(app):
+    """``_generated/fmu_variables.md``: every FMU's variable table (from its ``variables.py``)."""
+    from fmus import MODELS
+    from fmus.build import table
+
+    lines = ["# The FMUs' variables", "",
+             "Generated from each model's `fmus/<Model>/variables.py` (the source of its "
+             "`modelDescription.xml` and C accessors).", ""]
+    for model in MODELS:
+        lines += [f"## {model}", "", "| name | causality | unit | start | description |", "|---|---|---|---|---|"]
+        for variable in table(model).variables:
+            start = "" if variable.start is None else _shown(variable.start)
+            description = str(variable.description).replace("|", "\\|")
+            lines.append(f"| `{variable.name}` | {variable.causality} | {variable.unit or ''} | {start} | "
+                         f"{description} |")
+        lines.append("")
+    GENERATED.mkdir(exist_ok=True)
+    target = GENERATED / "fmu_variables.md"
+    text = "\n".join(lines)
+    if not target.is_file() or target.read_text() != text:
+        target.write_text(text)
+
+
+def setup(app):
+    """Register the directive and the generated pages."""
+    app.add_directive("quadcosim-run", QuadcosimRun)
+    app.connect("builder-inited", _variable_tables)
+    return {"parallel_read_safe": False, "version": "1"}

@@ -1,0 +1,220 @@
+"""ArduPilot DataFlash logs, binary (``.bin``) and text (``.log``), read with pymavlink's
+``DFReader_binary`` and ``DFReader_text``.
+
+What ArduPilot logs, and how it is turned into the project's conventions:
+
+- ``MAG``, ``MAG2``, ``MAG3`` (or ``MAG`` with an instance column ``I``): the field in the body
+  frame, in milligauss, *after* the compass's corrections: ``MagX = M (raw + Ofs) + MOfs``,
+  with ``Ofs`` the offsets (``COMPASS_OFS*``), ``M`` the soft-iron matrix (``COMPASS_DIA*``,
+  ``COMPASS_ODI*``) and ``MOfs`` the motor compensation, both logged beside the field. The raw
+  field is recovered as ``M^-1 (Mag - MOfs) - Ofs``, sample by sample.
+- ``IMU``, ``IMU2``, ``IMU3`` (or ``IMU`` with ``I``): rad/s and m/s^2, body frame.
+- ``ATT``: roll, pitch, yaw (degrees, Z-Y-X), the attitude the vehicle flew on.
+- ``RCOU``: PWM (us) per output; motors are normalised with ``MOT_PWM_MIN``/``MOT_PWM_MAX``,
+  or, when those are 0 or absent (Copter 3.4 and earlier), the throttle channel's
+  ``RC3_MIN``/``RC3_MAX``.
+- ``BAT`` (float V, A) or the older ``CURR`` (whose integer ``Volt`` and ``Curr`` are in
+  hundredths of a volt and an ampere).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+
+from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors
+
+MILLIGAUSS = 1e-7  # T
+CENTI = 0.01
+WANTED = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT", "MSG"}
+INTEGER_FORMATS = "bBhHiI"
+# motors per frame: Copter's FRAME_CLASS, and the "Frame: NAME" message of older firmware
+FRAME_CLASS_MOTORS = {1: 4, 2: 6, 3: 8, 4: 8, 5: 6, 7: 3, 12: 4, 14: 4}
+FRAME_NAME_MOTORS = {"QUAD": 4, "HEXA": 6, "OCTA": 8, "OCTA_QUAD": 8, "Y6": 6, "TRI": 3}
+VOLTAGE_ONLY_MONITOR = 3
+MIN_CURRENT_A = 0.2  # a current sensor that never reads more than this is not wired
+
+
+def _reader(path: Path, text: bool):
+    from pymavlink import DFReader
+
+    try:
+        return DFReader.DFReader_text(str(path)) if text else DFReader.DFReader_binary(str(path))
+    except Exception as error:  # pymavlink raises bare exceptions on a malformed header
+        raise LogError(f"{path}: not a readable DataFlash log ({error}); check the file is a complete "
+                       "ArduPilot .bin or .log") from None
+
+
+def _collect(path: Path, text: bool):
+    """Rows of the wanted messages (type -> list of dicts), the formats, the parameters and
+    the complaints pymavlink printed about skipped bytes."""
+    rows: dict[str, list] = {}
+    complaints = io.StringIO()
+    with contextlib.redirect_stderr(complaints), contextlib.redirect_stdout(complaints):
+        reader = _reader(path, text)
+        try:
+            while (m := reader.recv_match(type=WANTED)) is not None:
+                rows.setdefault(m.get_type(), []).append(m.to_dict())
+        except Exception as error:
+            raise LogError(f"{path}: the log is corrupt ({type(error).__name__}: {error}); "
+                           "download it again from the vehicle") from None
+        finally:
+            reader.close()
+    formats = {f.name: f for f in reader.formats.values()}
+    trailing = 0 if text else _unfinished(reader)
+    return rows, formats, dict(reader.params), complaints.getvalue(), trailing
+
+
+def _unfinished(reader) -> int:
+    """Bytes the last message of a binary log lacks (0 when it is complete), from the reader's index."""
+    last = max(((offsets[-1], mtype) for mtype, offsets in enumerate(reader.offsets) if offsets), default=None)
+    if last is None or last[1] not in reader.formats:
+        return 0
+    return max(0, last[0] + reader.formats[last[1]].len - reader.data_len)
+
+
+def _columns(rows: list[dict], names) -> np.ndarray:
+    return np.array([[row[n] for n in names] for row in rows], dtype=float)
+
+
+def _time(rows: list[dict]) -> np.ndarray:
+    key = "TimeUS" if "TimeUS" in rows[0] else "TimeMS"
+    return _columns(rows, [key])[:, 0] * (1e-6 if key == "TimeUS" else 1e-3)
+
+
+def _instances(rows: dict, base: str, key: str = "I") -> list[tuple[str, list]]:
+    """(name, rows) per instance: ``BASE``, ``BASE2``, ``BASE3``, or ``BASE`` split by ``key``."""
+    found = []
+    for name in (base, f"{base}2", f"{base}3"):
+        group = rows.get(name, [])
+        if group and key in group[0]:
+            for instance in sorted({r[key] for r in group}):
+                found.append((f"{name}[{instance}]", [r for r in group if r[key] == instance]))
+        elif group:
+            found.append((name, group))
+    return found
+
+
+def _soft_iron(params: dict, suffix: str) -> np.ndarray:
+    dia = [params.get(f"COMPASS_DIA{suffix}_{a}", 0.0) for a in "XYZ"]
+    odi = [params.get(f"COMPASS_ODI{suffix}_{a}", 0.0) for a in "XYZ"]
+    if not any(dia):  # ArduPilot treats an all-zero diagonal as the identity
+        dia = [1.0, 1.0, 1.0]
+    return np.array([[dia[0], odi[0], odi[1]], [odi[0], dia[1], odi[2]], [odi[1], odi[2], dia[2]]])
+
+
+def _compasses(rows: dict, params: dict) -> list[Compass]:
+    out = []
+    for k, (name, group) in enumerate(_instances(rows, "MAG")):
+        suffix = "" if k == 0 else str(k + 1)
+        mag = _columns(group, ["MagX", "MagY", "MagZ"]) * MILLIGAUSS
+        ofs = _columns(group, ["OfsX", "OfsY", "OfsZ"]) * MILLIGAUSS
+        mofs = _columns(group, ["MOfsX", "MOfsY", "MOfsZ"]) * MILLIGAUSS
+        matrix = _soft_iron(params, suffix)
+        raw = np.linalg.solve(matrix, (mag - mofs).T).T - ofs
+        flag = params.get("COMPASS_EXTERNAL" if k == 0 else f"COMPASS_EXTERN{k + 1}")
+        out.append(Compass(name, _time(group), mag, raw, -np.median(ofs, axis=0),
+                           None if flag is None else bool(flag),
+                           "logged field with the logged offsets, soft iron and motor offsets undone",
+                           np.linalg.inv(matrix)))
+    return out
+
+
+def _imus(rows: dict) -> list[Imu]:
+    return [Imu(name, _time(group), _columns(group, ["GyrX", "GyrY", "GyrZ"]),
+                _columns(group, ["AccX", "AccY", "AccZ"])) for name, group in _instances(rows, "IMU")]
+
+
+def _attitude(rows: dict) -> Attitude | None:
+    group = rows.get("ATT")
+    if not group:
+        return None
+    from scipy.spatial.transform import Rotation
+
+    angles = np.radians(_columns(group, ["Yaw", "Pitch", "Roll"]))
+    q = Rotation.from_euler("ZYX", angles).as_quat(scalar_first=True)
+    return Attitude(_time(group), q * np.sign(q[:, :1] + 1e-300), "ATT")
+
+
+def _motor_count(params: dict, messages: list[str]) -> int:
+    if params.get("FRAME_CLASS") in FRAME_CLASS_MOTORS:
+        return FRAME_CLASS_MOTORS[int(params["FRAME_CLASS"])]
+    for text in messages:
+        match = re.match(r"Frame: (\w+)", text)
+        if match and match.group(1).upper() in FRAME_NAME_MOTORS:
+            return FRAME_NAME_MOTORS[match.group(1).upper()]
+    return 4
+
+
+def _motors(rows: dict, params: dict, messages: list[str], path: Path) -> Motors | None:
+    group = rows.get("RCOU")
+    if not group:
+        return None
+    n = _motor_count(params, messages)
+    names = [f"C{k}" if f"C{k}" in group[0] else f"Ch{k}" for k in range(1, n + 1)]
+    pwm = _columns(group, names)
+    low, high = params.get("MOT_PWM_MIN", 0.0), params.get("MOT_PWM_MAX", 0.0)
+    source = "MOT_PWM_MIN/MAX"
+    if not (low > 0 and high > low):
+        low, high, source = params.get("RC3_MIN", 0.0), params.get("RC3_MAX", 0.0), "RC3_MIN/MAX"
+    if not (low > 0 and high > low):
+        raise LogError(f"{path}: no PWM limits to normalise the motor outputs (MOT_PWM_MIN/MAX and RC3_MIN/MAX "
+                       "are absent or 0); the log's parameters are incomplete: log them (LOG_BITMASK) or fix them")
+    return Motors(_time(group), np.clip((pwm - low) / (high - low), 0.0, 1.0), pwm, float(low), float(high), source)
+
+
+def _battery(rows: dict, formats: dict, params: dict) -> Battery | None:
+    name = "BAT" if rows.get("BAT") else "CURR" if rows.get("CURR") else None
+    if name is None:
+        return None
+    group = rows[name]
+    if "Instance" in group[0] or "Inst" in group[0]:
+        key = "Instance" if "Instance" in group[0] else "Inst"
+        group = [r for r in group if r[key] == min(x[key] for x in group)]
+    fmt = formats.get(name)
+    scale = {}
+    for column in ("Volt", "Curr"):
+        char = fmt.format[fmt.columns.index(column)] if fmt is not None and column in fmt.columns else "f"
+        scale[column] = CENTI if char in INTEGER_FORMATS else 1.0
+    voltage = _columns(group, ["Volt"])[:, 0] * scale["Volt"]
+    current = _columns(group, ["Curr"])[:, 0] * scale["Curr"]
+    monitor = params.get("BATT_MONITOR")
+    if monitor == VOLTAGE_ONLY_MONITOR:
+        return Battery(_time(group), voltage, None, "none: BATT_MONITOR = 3 (voltage only)")
+    if np.abs(current).max() < MIN_CURRENT_A:
+        return Battery(_time(group), voltage, None,
+                       f"none: the current never exceeds {MIN_CURRENT_A} A (BATT_MONITOR = {monitor}): not wired")
+    return Battery(_time(group), voltage, current, f"{name}.Curr (BATT_MONITOR = {monitor})")
+
+
+def read_dataflash(path: Path, text: bool) -> FlightLog:
+    """Read an ArduPilot DataFlash log at ``path``: text form when ``text`` is true, else binary."""
+    rows, formats, params, complaints, trailing = _collect(path, text)
+    if not rows or not any(rows.get(k) for k in WANTED - {"MSG"}):
+        raise LogError(f"{path}: no sensor messages could be read (MAG, IMU, ATT, RCOU, BAT); the file is empty, "
+                       "truncated before its data or not a DataFlash log")
+    messages = [r["Message"] for r in rows.get("MSG", [])]
+    warnings = []
+    skipped = sum(int(n) for n in re.findall(r"Skipped (\d+) bad bytes", complaints))
+    skipped += complaints.count("bad header")
+    failed = complaints.count("Failed to parse")
+    if skipped or failed:
+        warnings.append(f"corrupt stretches skipped: {skipped} bytes, {failed} messages")
+    if trailing > 0:
+        warnings.append(f"truncated: the last message lacks {trailing} bytes")
+    firmware = next((m for m in messages if re.match(r"(APM:|Ardu)\w+ V", m)), "ArduPilot (version not logged)")
+    simulator = any(k.startswith("SIM_") for k in params) or any("SITL" in m for m in messages)
+    kind = re.search(r"(?:APM:|Ardu)(\w+)", firmware)
+    vehicle = kind.group(1) if kind else "unknown"
+    frame = next((m for m in messages if m.startswith("Frame:")), None)
+    if vehicle == "Copter":
+        vehicle = {3: "tricopter", 4: "quadrotor", 6: "hexarotor", 8: "octorotor"}[_motor_count(params, messages)]
+        vehicle += f" (Copter{', ' + frame if frame else ''})"
+    log = FlightLog(str(path), "dataflash-text" if text else "dataflash-binary", "ArduPilot", firmware, vehicle,
+                    simulator, _compasses(rows, params), _imus(rows), _motors(rows, params, messages, path),
+                    _battery(rows, formats, params), _attitude(rows), params, warnings)
+    return log

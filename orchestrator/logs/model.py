@@ -1,0 +1,172 @@
+"""What a flight log holds, in the project's conventions (NED, FRD body, SI units)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from dataclasses import field as _default
+
+import numpy as np
+
+
+class LogError(ValueError):
+    """A log that cannot be read or used; the message names the file, the defect and the fix."""
+
+
+@dataclass(frozen=True)
+class Compass:
+    """One magnetometer instance.
+
+    Attributes
+    ----------
+    name : str
+        The log's name for it (``MAG2``, ``sensor_mag[1]``).
+    time : (T,) array
+        Sample times on the log's clock (s).
+    field : (T, 3) array
+        Field as the autopilot logged it, after its own corrections, body FRD (T).
+    raw : (T, 3) array
+        Field before the autopilot's offsets, soft iron and motor compensation, body FRD (T);
+        what a calibration starts from.
+    offsets : (3,) array
+        Hard-iron offsets the autopilot used, in its own sign convention turned to ours:
+        ``raw = A b_true + offsets`` (T).
+    external : bool or None
+        True for an external compass, None when the log does not say.
+    raw_source : str
+        How ``raw`` was obtained (logged raw topic, or the logged field with the logged
+        corrections undone).
+    soft_iron : (3, 3) array
+        The autopilot's soft-iron correction in our convention, ``raw = soft_iron m + offsets``.
+    """
+
+    name: str
+    time: np.ndarray
+    field: np.ndarray
+    raw: np.ndarray
+    offsets: np.ndarray
+    external: bool | None = None
+    raw_source: str = ""
+    soft_iron: np.ndarray = _default(default_factory=lambda: np.eye(3))
+
+
+@dataclass(frozen=True)
+class Imu:
+    """One IMU instance: ``gyro`` (T, 3) body rates (rad/s) and ``acc`` (T, 3) specific force
+    (m/s^2), body FRD, at ``time`` (T,) (s); ``name`` is the log's name for it."""
+
+    name: str
+    time: np.ndarray
+    gyro: np.ndarray
+    acc: np.ndarray
+
+
+@dataclass(frozen=True)
+class Motors:
+    """Motor outputs: ``commands`` (T, N) normalised to 0..1 from the log's PWM limits
+    ``pwm_min`` and ``pwm_max`` (us, named by ``limits_from``), ``pwm`` (T, N) as logged (us),
+    at ``time`` (T,) (s)."""
+
+    time: np.ndarray
+    commands: np.ndarray
+    pwm: np.ndarray
+    pwm_min: float
+    pwm_max: float
+    limits_from: str
+
+    @property
+    def throttle(self) -> np.ndarray:
+        """Collective throttle: the mean of the normalised commands (1), shape (T,)."""
+        return self.commands.mean(axis=1)
+
+
+@dataclass(frozen=True)
+class Battery:
+    """Battery ``voltage`` (T,) (V) and ``current`` (T,) (A, None without a current sensor) at
+    ``time`` (T,) (s); ``current_sensor`` says why the current is or is not trusted."""
+
+    time: np.ndarray
+    voltage: np.ndarray
+    current: np.ndarray | None
+    current_sensor: str
+
+
+@dataclass(frozen=True)
+class Attitude:
+    """The autopilot's attitude estimate: quaternion ``q`` (T, 4), scalar first, body FRD to
+    NED, at ``time`` (T,) (s); ``source`` names the message or topic."""
+
+    time: np.ndarray
+    q: np.ndarray
+    source: str
+
+
+@dataclass
+class FlightLog:
+    """Everything quadcosim reads from one PX4 ULog or ArduPilot DataFlash log.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    format : str
+        ``ulog``, ``dataflash-binary`` or ``dataflash-text``.
+    autopilot : str
+        ``PX4`` or ``ArduPilot``.
+    firmware : str
+        Firmware name and version as the log states it.
+    vehicle : str
+        Vehicle type (``quadrotor``...).
+    simulator : bool
+        True for a simulator (SITL) log.
+    compasses, imus : list
+        Every :class:`Compass` and :class:`Imu` instance, in the log's order.
+    motors : Motors or None
+    battery : Battery or None
+    attitude : Attitude or None
+    params : dict
+        The log's parameters (name: value), as the autopilot names them.
+    warnings : list of str
+        What was found wrong but could be read past (corruption skipped, a truncated end).
+    """
+
+    path: str
+    format: str
+    autopilot: str
+    firmware: str
+    vehicle: str
+    simulator: bool
+    compasses: list[Compass] = _default(default_factory=list)
+    imus: list[Imu] = _default(default_factory=list)
+    motors: Motors | None = None
+    battery: Battery | None = None
+    attitude: Attitude | None = None
+    params: dict = _default(default_factory=dict)
+    warnings: list[str] = _default(default_factory=list)
+
+    @property
+    def start(self) -> float:
+        """First sample time of any sensor (s)."""
+        return min(s.time[0] for s in self._series() if len(s.time))
+
+    @property
+    def duration(self) -> float:
+        """Time from the first to the last sensor sample (s)."""
+        return max(s.time[-1] for s in self._series() if len(s.time)) - self.start
+
+    def _series(self):
+        return [*self.compasses, *self.imus, *(x for x in (self.motors, self.battery, self.attitude) if x)]
+
+    def compass(self, index: int) -> Compass:
+        """Compass ``index``, counted from 0 in the log's order; a clear error if absent."""
+        if not self.compasses:
+            raise LogError(f"{self.path}: the log holds no magnetometer; log one (ArduPilot: LOG_BITMASK with IMU "
+                           "and compass; PX4: the sensor_mag topic) to calibrate it")
+        if not 0 <= index < len(self.compasses):
+            names = ", ".join(f"{k}: {c.name}" for k, c in enumerate(self.compasses))
+            raise LogError(f"{self.path}: no compass {index}; the log holds {names}")
+        return self.compasses[index]
+
+
+def rate(time: np.ndarray) -> float:
+    """Mean sample rate (Hz) of increasing times ``time`` (s); 0 for fewer than two samples."""
+    return (len(time) - 1) / (time[-1] - time[0]) if len(time) > 1 and time[-1] > time[0] else 0.0

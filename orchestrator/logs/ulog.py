@@ -1,0 +1,157 @@
+"""PX4 ULog files, read with pyulog.
+
+How PX4's logged topics differ from ArduPilot's messages:
+
+- ``sensor_mag`` (one topic instance per compass) is the field *before* calibration, in
+  gauss, already rotated by the driver into the board frame; the calibrated field is
+  ``vehicle_magnetometer`` (newer firmware) or ``sensor_combined.magnetometer_ga`` (older),
+  ``(raw - CAL_MAGn_*OFF) * CAL_MAGn_*SCALE`` in the body frame. When only the calibrated field
+  is logged, the raw one is recovered by undoing ``CAL_MAGn_*OFF`` and ``*SCALE``.
+- No motor-compensation offsets are logged: PX4 adds ``CAL_MAGn_*COMP`` times the throttle or
+  the current inside the calibration step, so the raw topic is the field before it.
+- IMUs: ``sensor_accel`` and ``sensor_gyro`` per instance (newer), or ``sensor_combined``.
+- Motors: ``actuator_motors`` (already 0..1, newer) or ``actuator_outputs`` in us, normalised
+  with ``PWM_MAIN_MIN``/``PWM_MAIN_MAX`` (or ``PWM_MIN``/``PWM_MAX`` in older firmware).
+- Battery: ``battery_status.voltage_v`` and ``current_a`` (negative when not measured).
+- Attitude: ``vehicle_attitude.q``, scalar first, body FRD to NED: the project's convention.
+- Time stamps are microseconds since boot.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors
+
+GAUSS = 1e-4  # T
+MICRO = 1e-6
+INVALID_RELATIVE = 2147483647  # sensor_combined: no new sample of this sensor
+MAV_TYPE_MOTORS = {2: 4, 13: 6, 14: 8, 15: 3}
+MAV_TYPE_NAMES = {1: "fixed wing", 2: "quadrotor", 13: "hexarotor", 14: "octorotor", 15: "tricopter",
+                  19: "VTOL", 20: "VTOL", 21: "VTOL", 22: "VTOL"}
+
+
+def _topics(ulog, name: str) -> list:
+    return sorted((d for d in ulog.data_list if d.name == name), key=lambda d: d.multi_id)
+
+
+def _vector(data: dict, names) -> np.ndarray:
+    return np.column_stack([np.asarray(data[n], dtype=float) for n in names])
+
+
+def _compasses(ulog, params: dict) -> list[Compass]:
+    out = []
+    for d in _topics(ulog, "sensor_mag"):
+        raw = _vector(d.data, ["x", "y", "z"]) * GAUSS
+        k = d.multi_id
+        offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
+        scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
+        out.append(Compass(f"sensor_mag[{k}]", d.data["timestamp"] * MICRO, (raw - offsets) * scale, raw, offsets,
+                           None, "sensor_mag (logged before calibration)", np.diag(1.0 / scale)))
+    if out:
+        return out
+    calibrated = _topics(ulog, "vehicle_magnetometer")
+    if calibrated:
+        sources = [(f"vehicle_magnetometer[{d.multi_id}]", d.data["timestamp"] * MICRO,
+                    _vector(d.data, [f"magnetometer_ga[{a}]" for a in range(3)]), d.multi_id) for d in calibrated]
+    else:
+        combined = _topics(ulog, "sensor_combined")
+        if not combined or "magnetometer_ga[0]" not in combined[0].data:
+            return []
+        data = combined[0].data
+        valid = data["magnetometer_timestamp_relative"] != INVALID_RELATIVE
+        time = (data["timestamp"][valid] + data["magnetometer_timestamp_relative"][valid]) * MICRO
+        field = _vector(data, [f"magnetometer_ga[{a}]" for a in range(3)])[valid]
+        time, first = np.unique(time, return_index=True)  # each new sample once
+        sources = [("sensor_combined.magnetometer_ga", time, field[first], 0)]
+    for name, time, field, k in sources:
+        offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
+        scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
+        field = field * GAUSS
+        undone = f"{name} with CAL_MAG{k}_*OFF and *SCALE undone (no raw topic logged)"
+        out.append(Compass(name, time, field, field / scale + offsets, offsets, None, undone, np.diag(1.0 / scale)))
+    return out
+
+
+def _imus(ulog) -> list[Imu]:
+    accels, gyros = _topics(ulog, "sensor_accel"), _topics(ulog, "sensor_gyro")
+    out = []
+    for acc, gyro in zip(accels, gyros, strict=False):
+        t_gyro = gyro.data["timestamp"] * MICRO
+        t_acc = acc.data["timestamp"] * MICRO
+        a = _vector(acc.data, ["x", "y", "z"])
+        out.append(Imu(f"sensor_gyro/accel[{gyro.multi_id}]", t_gyro, _vector(gyro.data, ["x", "y", "z"]),
+                       np.column_stack([np.interp(t_gyro, t_acc, a[:, i]) for i in range(3)])))
+    if out:
+        return out
+    combined = _topics(ulog, "sensor_combined")
+    if not combined:
+        return []
+    data = combined[0].data
+    return [Imu("sensor_combined", data["timestamp"] * MICRO, _vector(data, [f"gyro_rad[{a}]" for a in range(3)]),
+                _vector(data, [f"accelerometer_m_s2[{a}]" for a in range(3)]))]
+
+
+def _motors(ulog, params: dict, path: Path) -> Motors | None:
+    n = MAV_TYPE_MOTORS.get(int(params.get("MAV_TYPE", 2)), 4)
+    motors = _topics(ulog, "actuator_motors")
+    if motors:
+        d = motors[0].data
+        commands = _vector(d, [f"control[{k}]" for k in range(n)])
+        return Motors(d["timestamp"] * MICRO, np.clip(np.nan_to_num(commands), 0.0, 1.0), commands, 0.0, 1.0,
+                      "actuator_motors (normalised by PX4)")
+    outputs = _topics(ulog, "actuator_outputs")
+    if not outputs:
+        return None
+    d = outputs[0].data
+    pwm = _vector(d, [f"output[{k}]" for k in range(n)])
+    for low_name, high_name in (("PWM_MAIN_MIN", "PWM_MAIN_MAX"), ("PWM_MIN", "PWM_MAX")):
+        low, high = params.get(low_name, 0.0), params.get(high_name, 0.0)
+        if low > 0 and high > low:
+            return Motors(d["timestamp"] * MICRO, np.clip((pwm - low) / (high - low), 0.0, 1.0), pwm, float(low),
+                          float(high), f"{low_name}/{high_name}")
+    raise LogError(f"{path}: no PWM limits to normalise actuator_outputs (PWM_MAIN_MIN/MAX, PWM_MIN/MAX absent); "
+                   "the log's parameters are incomplete")
+
+
+def _battery(ulog) -> Battery | None:
+    topics = _topics(ulog, "battery_status")
+    if not topics:
+        return None
+    d = topics[0].data
+    current = np.asarray(d["current_a"], dtype=float)
+    measured = (current >= 0).all() and current.max() > 0
+    return Battery(d["timestamp"] * MICRO, np.asarray(d["voltage_v"], dtype=float), current if measured else None,
+                   "battery_status.current_a" if measured else "none: battery_status.current_a is never measured")
+
+
+def _attitude(ulog) -> Attitude | None:
+    topics = _topics(ulog, "vehicle_attitude")
+    if not topics:
+        return None
+    d = topics[0].data
+    return Attitude(d["timestamp"] * MICRO, _vector(d, [f"q[{k}]" for k in range(4)]), "vehicle_attitude")
+
+
+def read_ulog(path: Path) -> FlightLog:
+    """Read the PX4 ULog at ``path``."""
+    from pyulog import ULog
+
+    try:
+        ulog = ULog(str(path))
+    except Exception as error:  # pyulog raises bare exceptions on a bad header or definitions
+        raise LogError(f"{path}: not a readable ULog ({type(error).__name__}: {error}); check the file is a "
+                       "complete PX4 .ulg") from None
+    if not ulog.data_list:
+        raise LogError(f"{path}: the ULog holds no logged topic; it is truncated before its data")
+    params = dict(ulog.initial_parameters)
+    info = ulog.msg_info_dict
+    hardware = str(info.get("ver_hw", ""))
+    firmware = f"{info.get('ver_sw_release', info.get('ver_sw', 'version not logged'))} on {hardware}"
+    simulator = "SITL" in hardware.upper() or hardware.upper().startswith("PX4_SITL") or "SIH" in hardware.upper()
+    vehicle = MAV_TYPE_NAMES.get(int(params.get("MAV_TYPE", 0)), f"MAV_TYPE {params.get('MAV_TYPE', '?')}")
+    warnings = ["corrupt stretches skipped (pyulog reports file corruption)"] if ulog.file_corruption else []
+    return FlightLog(str(path), "ulog", "PX4", firmware, vehicle, simulator, _compasses(ulog, params), _imus(ulog),
+                     _motors(ulog, params, path), _battery(ulog), _attitude(ulog), params, warnings)

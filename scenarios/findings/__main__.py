@@ -1,0 +1,98 @@
+"""``python -m scenarios.findings`` (or ``quadcosim findings``): run the README's findings.
+
+Runs every group of :data:`scenarios.findings.GROUPS` (or those named), prints each finding
+with its command, writes ``findings.json`` and rewrites the README's numbers from it. A
+skipped group (its data absent) keeps its committed values and is said so. ``--check``
+writes nothing and exits 1 when a value moved by more than its tolerance.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import scenarios.findings as findings
+from scenarios.findings import readme
+
+
+def parser() -> argparse.ArgumentParser:
+    """The command's argument parser."""
+    p = argparse.ArgumentParser(prog="quadcosim findings", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("groups", nargs="*", metavar="GROUP",
+                   help=f"groups to run (default all: {', '.join(findings.GROUPS)})")
+    p.add_argument("--quick", action="store_true", help="each group's fast subset (seconds to a minute)")
+    p.add_argument("--check", action="store_true",
+                   help="compare with the committed findings.json; write nothing; exit 1 on a difference")
+    p.add_argument("--out", type=Path, default=findings.FINDINGS_FILE, help="findings file (default: the repository's)")
+    p.add_argument("--no-readme", action="store_true", help="leave the README and docs/ as they are")
+    return p
+
+
+def run(groups, quick: bool) -> tuple[list[dict], dict[str, str]]:
+    """The findings of ``groups`` and the groups skipped (group -> reason), printed as they come.
+
+    Parameters
+    ----------
+    groups : sequence of str
+        Groups of :data:`scenarios.findings.GROUPS`.
+    quick : bool
+        Each group's fast subset.
+    """
+    computed, skipped = [], {}
+    for group in groups:
+        print(f"[{group}]", flush=True)
+        try:
+            found = findings.compute_group(group, quick=quick)
+        except findings.Skipped as reason:
+            skipped[group] = str(reason)
+            print(f"  skipped: {reason}", flush=True)
+            continue
+        for f in found:
+            print(f"  {f['name']} = {readme.printed(f)} {f['unit']}    ({f['command']})", flush=True)
+        computed += found
+    return computed, skipped
+
+
+def main(argv=None) -> int:
+    """Run the findings; returns the exit code (2: a bad command line, 1: ``--check`` found a
+    difference or the README could not be rewritten).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (the process's if None).
+    """
+    args = parser().parse_args(argv)
+    unknown = [g for g in args.groups if g not in findings.GROUPS]
+    if unknown:
+        print(f"quadcosim findings: unknown group {', '.join(unknown)}; groups: {', '.join(findings.GROUPS)}",
+              file=sys.stderr)
+        return 2
+    committed = findings.load(args.out)
+    computed, skipped = run(args.groups or findings.GROUPS, args.quick)
+    for group, reason in skipped.items():
+        kept = [n for n, f in committed.items() if f["group"] == group]
+        print(f"{group}: skipped ({reason}); its {len(kept)} committed values are kept", file=sys.stderr)
+    if args.check:
+        lines = findings.differences(computed, committed)
+        for line in lines:
+            print(line, file=sys.stderr)
+        print(f"{len(computed)} findings computed, {len(lines)} differences from {args.out}")
+        return 1 if lines else 0
+    new = committed | {f["name"]: f for f in computed}
+    findings.save(new, args.out)
+    print(f"{len(computed)} findings written to {args.out}")
+    if args.no_readme:
+        return 0
+    unresolved = []
+    for page in readme.pages(args.out.parent):
+        unresolved += readme.rewrite(page, committed, new)
+    for line in unresolved:
+        print(f"not rewritten: {line}", file=sys.stderr)
+    return 1 if unresolved else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,117 @@
+"""Findings of the real flights: the quad's two compasses calibrated from its three flights
+(each model's explained share of the held-out residual, the perturbation at hover and the
+heading change), and the estimators replayed on every shared log without and with the
+compensation, against the autopilot's attitude.
+
+The logs are read from the shared data folder beside the repository
+(``../shared/data/flightlogs``); without it the group is skipped (``FileNotFoundError``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+FOLDER = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "flightlogs"
+FLIGHTS = {"a": "quad_2015-10-11_19-53-46.log", "b": "quad_2015-10-11_19-59-09.log",
+           "c": "quad_2015-10-11_20-17-22.log"}
+COMPASSES = {0: "external", 1: "internal"}
+MODELS = ("current", "throttle", "motors", "metge")
+REPLAYS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebrain", 0), ("px4", 0)]
+OTHER_LOGS = {"erlebrain": "erlebrain_APM_22.bin", "px4": "px4_sample.ulg"}
+REPLAYED = ("explicit", "vqf")
+PERCENT = 100.0
+
+
+def _name(key: str) -> str:
+    return FLIGHTS.get(key) or OTHER_LOGS[key]
+
+
+def _shown(key: str) -> str:
+    """The log as a command names it, from the repository's root."""
+    return f"../shared/data/flightlogs/{_name(key)}"
+
+
+def _path(key: str) -> Path:
+    path = FOLDER / _name(key)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: the shared flight logs are absent")
+    return path
+
+
+def _finding(name, value, unit, command, tolerance, digits) -> dict:
+    return {"name": f"flightlogs.{name}", "value": float(value), "unit": unit, "command": command,
+            "tolerance": float(tolerance), "digits": int(digits)}
+
+
+def _calibrate_command(files, compass: int, cross: bool) -> str:
+    if cross:
+        return (f"quadcosim calibrate --train {' '.join(_shown(f) for f in files[:-1])} --test "
+                f"{_shown(files[-1])} --compass {compass} --out results/flightlogs")
+    return f"quadcosim calibrate {_shown(files[0])} --compass {compass} --out results/flightlogs"
+
+
+def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
+    """Each flight's last half scored on a fit to its first half (and, with ``cross``, each
+    flight scored on a fit to the two others)."""
+    from calibration.flight import calibrate, flight_data
+    from orchestrator.logs import read_log
+
+    logs = {k: read_log(_path(k)) for k in flights}
+    found = []
+    for compass in compasses:
+        data = {k: flight_data(log, compass) for k, log in logs.items()}
+        where = f"quad.{COMPASSES[compass]}"
+        hover, change = {m: [] for m in models}, {m: [] for m in models}
+        for key, flight in data.items():
+            train, test = flight.split(0.5)
+            metrics, _, _ = calibrate([train], [test], models)
+            for m in models:
+                result = metrics["models"][m]
+                if "refused" in result:
+                    continue
+                found.append(_finding(f"{where}.{m}.explained_half_{key}", PERCENT * result["explained_test"], "%",
+                                      _calibrate_command([key], compass, False), 0.5, 0))
+                hover[m].append(result["perturbation_at_hover_T"] * 1e6)
+                change[m].append(result["heading_rms_change_deg"])
+            if cross:
+                others = [k for k in data if k != key]
+                metrics, _, _ = calibrate([data[k] for k in others], [flight], models)
+                for m in models:
+                    if "refused" not in metrics["models"][m]:
+                        found.append(_finding(f"{where}.{m}.explained_cross_{key}",
+                                              PERCENT * metrics["models"][m]["explained_test"], "%",
+                                              _calibrate_command([*others, key], compass, True), 0.5, 0))
+        for m in models:
+            if hover[m]:
+                found.append(_finding(f"{where}.{m}.hover_uT", np.mean(hover[m]), "uT",
+                                      "python -m scenarios.findings flightlogs", 0.05, 1))
+                found.append(_finding(f"{where}.{m}.heading_change_deg", np.mean(change[m]), "deg",
+                                      "python -m scenarios.findings flightlogs", 0.05, 1))
+    return found
+
+
+def _replays() -> list[dict]:
+    from scenarios.flightlog.replay import replay_log
+
+    found = []
+    for key, compass in REPLAYS:
+        result = replay_log(_path(key), compass, kinds=REPLAYED)
+        command = f"quadcosim log replay {_shown(key)} --compass {compass}"
+        for kind in REPLAYED:
+            for label in ("without", "with"):
+                r = result["estimators"][kind][label]
+                name = f"replay.{key}{compass}.{kind}.{label}"
+                found.append(_finding(f"{name}.heading_deg", r["heading_rms_deg"], "deg", command, 0.05, 1))
+                found.append(_finding(f"{name}.inclination_deg", r["inclination_rms_deg"], "deg", command, 0.05, 1))
+    return found
+
+
+def compute(quick: bool = False) -> list[dict]:
+    """The group's findings (see the module docstring); ``quick``: flight b's internal compass,
+    current and throttle models, last half held out (a few seconds)."""
+    if quick:
+        return [f for f in _calibrations(["b"], [1], ("current", "throttle"), cross=False)
+                if ".explained_half_" in f["name"]]
+    return _calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _replays()

@@ -1,0 +1,101 @@
+"""What a flight shows of the drag model, measured on a ``tp`` run: the figures :mod:`trim` predicts.
+
+- :func:`tilt_step`: after the pitch step of ``flight=tilt``, the accelerometer's tilt against
+  the true tilt at the end, the speed reached, and the time constant of a first-order lag
+  fitted to the accelerometer's tilt (against ``m / (k_d sum|omega_n|)``, :func:`trim.drag_time_constant`);
+- :func:`wind_hold`: holding a position in a steady wind, the tilt into the wind against
+  :func:`trim.wind_hover_tilt`, the final position error and the largest drift on the way.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import curve_fit
+
+from scenarios.flight import profiles, trim
+
+SETTLED_AFTER_STEP = 1.0  # s after the step: the attitude loop has settled (0.3 s), the lag alone remains
+FIT_START_TAU = 4.0  # s, first guess of the fitted time constant (the default vehicle's is 4.25 s)
+FIT_PARAMETERS = 3
+MM_PER_M = 1e3  # final tilt, amplitude, time constant
+
+
+def accelerometer_tilt(result) -> tuple[np.ndarray, np.ndarray]:
+    """Roll and pitch (rad) of the specific force the IMU measures: ``atan2`` of its components.
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A run recording ``IMU.acc`` (m/s^2, body frame).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Roll ``atan2(-a_y, -a_z)`` and pitch ``atan2(a_x, hypot(a_y, a_z))`` (rad), one per sample.
+    """
+    a = result["IMU.acc"]
+    return np.arctan2(-a[:, 1], -a[:, 2]), np.arctan2(a[:, 0], np.hypot(a[:, 1], a[:, 2]))
+
+
+def tilt_step(result, tilt: float, rotor_drag: bool) -> dict:
+    """The accelerometer's view of a held pitch step (``flight=tilt``).
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A ``tp`` run with ``flight=tilt``.
+    tilt : float
+        The commanded pitch (rad).
+    rotor_drag : bool
+        Whether the plant has rotor drag (without it there is no lag to fit).
+
+    Returns
+    -------
+    dict
+        ``accelerometer_tilt_final_deg`` and ``true_tilt_final_deg`` (deg, pitch at the last
+        sample), ``speed_final_m_s`` (m/s, ground speed at the last sample); with drag,
+        ``tilt_lag_fitted_s`` (s, time constant of ``final - amplitude exp(-(t - t_step) / tau)``
+        fitted from 1 s after the step) and ``tilt_lag_predicted_s`` (s, ``m / (k_d sum|omega_n|)``
+        at the final thrust).
+    """
+    _, pitch = accelerometer_tilt(result)
+    found = {"accelerometer_tilt_final_deg": math.degrees(float(pitch[-1])),
+             "true_tilt_final_deg": math.degrees(float(result["Quadrotor.theta2"][-1])),
+             "speed_final_m_s": float(np.linalg.norm(result["Quadrotor.v"][-1]))}
+    window = result.time > profiles.STEP_TIME + SETTLED_AFTER_STEP
+    if rotor_drag and np.count_nonzero(window) > FIT_PARAMETERS:
+        def lag(t, final, amplitude, tau):
+            return final - amplitude * np.exp(-(t - profiles.STEP_TIME) / tau)
+
+        (_, _, tau), _ = curve_fit(lag, result.time[window], pitch[window], p0=(tilt, tilt, FIT_START_TAU))
+        found["tilt_lag_fitted_s"] = float(tau)
+        found["tilt_lag_predicted_s"] = trim.drag_time_constant(thrust=float(result["Quadrotor.thrust"][-1]))
+    return found
+
+
+def wind_hold(result, wind_speed: float) -> dict:
+    """The position hold in a steady horizontal wind (``flight=hover``, ``wind_n``, ``wind_e``).
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A ``tp`` run holding its position in the wind.
+    wind_speed : float
+        Horizontal wind speed (m/s).
+
+    Returns
+    -------
+    dict
+        ``wind_tilt_final_deg`` (deg, the tilt of the body's z axis from the vertical at the
+        last sample), ``wind_tilt_predicted_deg`` (deg, :func:`trim.wind_hover_tilt`),
+        ``position_error_final_mm`` (mm, horizontal distance from the held point at the last
+        sample), ``drift_max_m`` (m, the largest horizontal distance on the way).
+    """
+    predicted, _ = trim.wind_hover_tilt(wind_speed)
+    roll, pitch = result["Quadrotor.theta1"][-1], result["Quadrotor.theta2"][-1]
+    horizontal = np.hypot(result["Quadrotor.p"][:, 0], result["Quadrotor.p"][:, 1])
+    return {"wind_tilt_final_deg": math.degrees(math.acos(math.cos(roll) * math.cos(pitch))),
+            "wind_tilt_predicted_deg": math.degrees(predicted),
+            "position_error_final_mm": MM_PER_M * float(horizontal[-1]), "drift_max_m": float(horizontal.max())}

@@ -1,0 +1,72 @@
+"""The figures of ``quadcosim calibrate``: the field residual against the current or the
+throttle before and after the exported model, and the heading before and after over the flight."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calibration.flight.evaluate import tilt_compensated_heading, wrap
+from calibration.flight.linear import earth_and_offset
+from orchestrator.files import save_figure
+
+TESLA_TO_UT = 1e6
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def residual_figure(parts, fitted, name: str, path, title: str):
+    """Residual field (uT, body axes) after the Earth field and offset alone, and after the model
+    ``fitted`` (named ``name``), against its regressor, on the held-out ``parts``, into ``path``;
+    ``title`` heads the figure."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True, constrained_layout=True)
+    for p in parts:
+        x = p.current() if name == "current" else p.throttle()
+        before = earth_and_offset(p.rotation, p.raw).residual[0]
+        after = earth_and_offset(p.rotation, p.raw - fitted.predict(p)).residual[0]
+        for k, ax in enumerate(axes):
+            ax.plot(x, -before[:, k] * TESLA_TO_UT, ".", ms=2, color="0.6", label="Earth field and offset only")
+            ax.plot(x, -after[:, k] * TESLA_TO_UT, ".", ms=2, color="C3", label=f"with the {name} model")
+    for k, ax in enumerate(axes):
+        ax.set_xlabel("battery current (A)" if name == "current" else "collective throttle (1)")
+        ax.set_title(f"body {'xyz'[k]}")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("field left unexplained (uT)")
+    handles, labels = axes[0].get_legend_handles_labels()
+    axes[0].legend(handles[:2], labels[:2], markerscale=5, fontsize=8)
+    fig.suptitle(title, fontsize=10)
+    save_figure(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def heading_figure(data, fitted, name: str, cut: float, path, title: str):
+    """Tilt-compensated heading error (deg) against the log's heading, the constant offset
+    removed, without and with the model ``fitted`` (named ``name``), over the whole flight
+    ``data`` (FlightData); the held-out part after ``cut`` (s) shaded; into ``path`` under ``title``."""
+    plt = _pyplot()
+    base = earth_and_offset(data.rotation, data.raw)
+    predicted = fitted.predict(data)
+    fit = earth_and_offset(data.rotation, data.raw - predicted)
+    fig, ax = plt.subplots(figsize=(11, 4), constrained_layout=True)
+    t0 = data.time[0]
+    for field, label, colour in ((data.raw - base.nuisance[0, 3:], "Earth field and offset only", "0.5"),
+                                 (data.raw - predicted - fit.nuisance[0, 3:], f"with the {name} model", "C3")):
+        error = wrap(tilt_compensated_heading(field, data.euler) - data.euler[:, 2])
+        error = wrap(error - np.angle(np.mean(np.exp(1j * error))))
+        rms = np.degrees(np.sqrt(np.mean(error**2)))
+        ax.plot(data.time - t0, np.degrees(error), lw=0.8, color=colour, label=f"{label} (RMS {rms:.2f} deg)")
+    ax.axvspan(cut - t0, data.time[-1] - t0, color="C0", alpha=0.08, label="held out for testing")
+    ax.set_xlabel("time from the first sample (s)")
+    ax.set_ylabel("compass heading - log heading (deg)")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    save_figure(fig, path, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,74 @@
+"""``quadcosim log info FILE``, ``quadcosim log plot FILE``: what a flight log holds, in text and in
+one figure."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+
+def load(path, verb: str):
+    """The :class:`orchestrator.logs.FlightLog` at ``path``, with a simulator log and corruption read
+    past announced on standard error, prefixed by ``verb``; raises ``LogError``."""
+    from orchestrator.logs import read_log
+
+    log = read_log(path)
+    if log.simulator:
+        print(f"quadcosim {verb}: warning: {path} is a simulator (SITL) log; its sensors are simulated, not "
+              "a real vehicle's", file=sys.stderr)
+    for warning in log.warnings:
+        print(f"quadcosim {verb}: warning: {path}: {warning}", file=sys.stderr)
+    return log
+
+
+def info(args) -> int:
+    """``quadcosim log info FILE [--json]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
+    from orchestrator.logs import LogError
+    from orchestrator.logs.info import summary, text
+
+    try:
+        found = summary(load(args.file, "log info"))
+    except LogError as error:
+        print(f"quadcosim log info: {error}", file=sys.stderr)
+        return 2
+    print(json.dumps(found, indent=2) if args.json else text(found))
+    return 0
+
+
+def plot(args) -> int:
+    """``quadcosim log plot FILE [--out PNG]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
+    from orchestrator.logs import LogError
+    from scenarios.flightlog.overview import plot_overview
+
+    try:
+        log = load(args.file, "log plot")
+    except LogError as error:
+        print(f"quadcosim log plot: {error}", file=sys.stderr)
+        return 2
+    out = Path(args.out) if args.out else Path("results") / "logs" / f"{Path(args.file).stem}-overview.png"
+    print(plot_overview(log, out))
+    return 0
+
+
+def add_arguments(parser):
+    """The ``log`` verb's sub-commands on ``parser`` (an argparse parser); returns it."""
+    sub = parser.add_subparsers(dest="log_command", required=True)
+    shown = sub.add_parser("info", help="what the log holds: sensors, rates, duration, vehicle, firmware, "
+                           "simulator or not, current sensor or not")
+    shown.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
+    shown.add_argument("--json", action="store_true", help="print the summary as JSON")
+    shown.set_defaults(func=info)
+    drawn = sub.add_parser("plot", help="an overview figure: field, current, throttle and attitude")
+    drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
+    drawn.add_argument("--out", help="PNG to write (default results/logs/NAME-overview.png)")
+    drawn.set_defaults(func=plot)
+    from scenarios.flightlog import replay
+
+    replayed = sub.add_parser("replay", help="the project's estimators on the log, without and with the "
+                              "compensation, against the autopilot's attitude (a reference, not the truth)")
+    replayed.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
+    replayed.add_argument("--compass", type=int, default=0, help="compass to use, from 0 in the log's order")
+    replayed.add_argument("--json", help="also write the result to this JSON file")
+    replayed.set_defaults(func=replay.run)
+    return parser

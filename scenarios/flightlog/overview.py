@@ -1,0 +1,74 @@
+"""The overview figure of a flight log: field, current, throttle and attitude over time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+TESLA_TO_UT = 1e6
+
+
+def _euler_deg(q: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (deg, Z-Y-X) of quaternions ``q`` (T, 4), scalar first."""
+    from scipy.spatial.transform import Rotation
+
+    euler = Rotation.from_quat(q, scalar_first=True).as_euler("ZYX")[:, ::-1]
+    euler[:, 2] = np.unwrap(euler[:, 2])  # a turn through north stays one line
+    return np.degrees(euler)
+
+
+def plot_overview(log, out) -> Path:
+    """Draw the overview of ``log`` (:class:`orchestrator.logs.FlightLog`) into the PNG ``out``:
+    each compass's raw field (uT), battery current (A) and voltage (V), motor commands and
+    throttle (1), and the autopilot's roll, pitch and yaw (deg), on the log's clock (s)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t0 = log.start
+    panels = max(1, len(log.compasses)) + 3
+    fig, axes = plt.subplots(panels, 1, figsize=(11, 2.2 * panels), sharex=True, constrained_layout=True)
+    for ax, compass in zip(axes, log.compasses, strict=False):
+        for k, axis in enumerate("xyz"):
+            ax.plot(compass.time - t0, compass.raw[:, k] * TESLA_TO_UT, lw=0.8, label=f"raw {axis}")
+        ax.plot(compass.time - t0, np.linalg.norm(compass.field, axis=1) * TESLA_TO_UT, "k", lw=0.8,
+                label="|field| as logged")
+        where = {True: "external", False: "internal", None: ""}[compass.external]
+        ax.set_ylabel(f"{compass.name} {where}\n(uT, body FRD)")
+        ax.legend(loc="upper right", ncol=4, fontsize=7)
+    if not log.compasses:
+        axes[0].text(0.5, 0.5, "no magnetometer in this log", ha="center", transform=axes[0].transAxes)
+    ax = axes[-3]
+    if log.battery is not None and log.battery.current is not None:
+        ax.plot(log.battery.time - t0, log.battery.current, "C3", lw=0.8)
+        ax.set_ylabel("current (A)")
+    else:
+        ax.text(0.02, 0.8, "no current sensor", transform=ax.transAxes)
+    if log.battery is not None:
+        twin = ax.twinx()
+        twin.plot(log.battery.time - t0, log.battery.voltage, "C7", lw=0.8)
+        twin.set_ylabel("voltage (V)", color="C7")
+    ax = axes[-2]
+    if log.motors is not None:
+        for n in range(log.motors.commands.shape[1]):
+            ax.plot(log.motors.time - t0, log.motors.commands[:, n], lw=0.6, label=f"motor {n + 1}")
+        ax.plot(log.motors.time - t0, log.motors.throttle, "k", lw=1.0, label="throttle (mean)")
+        ax.legend(loc="upper right", ncol=5, fontsize=7)
+    ax.set_ylabel("command (1)")
+    ax = axes[-1]
+    if log.attitude is not None:
+        euler = _euler_deg(log.attitude.q)
+        for k, name in enumerate(("roll", "pitch", "yaw")):
+            ax.plot(log.attitude.time - t0, euler[:, k], lw=0.8, label=name)
+        ax.legend(loc="upper right", ncol=3, fontsize=7)
+    ax.set_ylabel(f"attitude (deg)\n{log.attitude.source if log.attitude else 'none logged'}")
+    ax.set_xlabel("time from the first sample (s)")
+    sim = ", SIMULATOR" if log.simulator else ""
+    fig.suptitle(f"{Path(log.path).name}: {log.autopilot} {log.firmware}, {log.vehicle}{sim}", fontsize=10)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out

@@ -1,0 +1,125 @@
+"""The project's estimators on a real flight log, without and with the magnetometer
+compensation, scored against the autopilot's own attitude.
+
+The autopilot's attitude is a reference, not the truth: it is another estimator's output (for
+ArduPilot's EKF, one that fuses the primary compass), so the differences reported are
+disagreements, not errors.
+
+How a log is replayed:
+
+- the first IMU, resampled to a uniform period (its median sample spacing), gives gyro and
+  specific force; the compass (``--compass``) is interpolated to the same instants;
+- the compensation is calibrated on the first half of the flight (:func:`calibration.flight.calibrate`)
+  and applied by :func:`calibration.compensate` (eq. 9 of Metge et al.); without it, only the
+  log's offsets are removed;
+- the Earth field in NED is the compass's field rotated by the log's attitude, averaged over the
+  first half; every estimator starts from the TRIAD attitude of the first sample;
+- the differences are scored over the second half, the part the compensation was not fitted on.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+REFERENCE_NOTE = ("differences from the autopilot's own attitude estimate, a reference and not the truth "
+                  "(it fuses the primary compass itself)")
+
+
+def _uniform(log):
+    from scipy.spatial.transform import Rotation, Slerp
+
+    imu = log.imus[0]
+    dt = float(np.median(np.diff(imu.time)))
+    lo = max(imu.time[0], log.attitude.time[0])
+    hi = min(imu.time[-1], log.attitude.time[-1])
+    time = np.arange(lo, hi, dt)
+    gyro = np.column_stack([np.interp(time, imu.time, imu.gyro[:, k]) for k in range(3)])
+    acc = np.column_stack([np.interp(time, imu.time, imu.acc[:, k]) for k in range(3)])
+    rotations = Rotation.from_quat(log.attitude.q, scalar_first=True)
+    reference = Slerp(log.attitude.time, rotations)(time).as_quat(scalar_first=True)
+    return time, dt, gyro, acc, reference
+
+
+def _fields(log, compass: int, time):
+    """The compass at ``time`` without and with the compensation fitted on the first half, and the notes."""
+    from calibration import compensate
+    from calibration.flight import calibrate, flight_data
+
+    data = flight_data(log, compass)
+    train, test = data.split(0.5)
+    metrics, calibration, _ = calibrate([train], [test], ("current", "throttle", "motors", "metge"))
+    raw = np.column_stack([np.interp(time, data.time, data.raw[:, k]) for k in range(3)])
+    motors = log.motors
+    commands = np.column_stack([np.interp(time, motors.time, motors.commands[:, n])
+                                for n in range(motors.commands.shape[1])])
+    voltage = (np.interp(time, log.battery.time, log.battery.voltage) if log.battery is not None
+               else np.full(len(time), np.nan))
+    without = compensate(calibration, time, raw, commands, voltage, "static")
+    model = metrics["calibration_model"]
+    with_model = without if model is None else compensate(calibration, time, raw, commands, voltage, "metge")
+    return without, with_model, model
+
+
+def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMATORS)) -> dict:
+    """Run every estimator of :data:`ESTIMATORS` on the log at ``path`` (or an already read
+    :class:`orchestrator.logs.FlightLog`) with compass ``compass``, without and with the
+    compensation; heading and inclination RMS differences (deg) from the log's attitude over the
+    second half of the flight (at least ``settle_s`` (s) after the start); ``kinds``: the
+    estimators run (names of :data:`ESTIMATORS`)."""
+    from estimators import estimate
+    from orchestrator.logs import FlightLog, read_log
+
+    log = path if isinstance(path, FlightLog) else read_log(path)
+    time, dt, gyro, acc, reference = _uniform(log)
+    without, with_model, model = _fields(log, compass, time)
+    half = time[0] + 0.5 * (time[-1] - time[0])
+    scored = time >= max(half, time[0] + settle_s)
+    first = time < half
+    results = {}
+    for label, mag in (("without", without), ("with", with_model)):
+        from scipy.spatial.transform import Rotation
+
+        R = Rotation.from_quat(reference[first], scalar_first=True).as_matrix()
+        earth = np.einsum("tij,tj->i", R, mag[first]) / first.sum()
+        for kind in kinds:
+            settings = ESTIMATORS[kind]
+            out = estimate(kind, gyro=gyro, acc=acc, mag=mag, dt=dt, earth_field=earth, initial="triad",
+                           outputs=(), reference=reference, scored=scored, **settings)
+            errors = out["errors"]
+            results.setdefault(kind, {})[label] = {"heading_rms_deg": float(errors["heading_rmse_deg"][0]),
+                                                   "inclination_rms_deg": float(errors["inclination_rmse_deg"][0])}
+    return {"file": log.path, "compass": log.compasses[compass].name, "compensation_model": model,
+            "note": REFERENCE_NOTE, "scored_s": float(scored.sum() * dt), "estimators": results}
+
+
+def text(result: dict) -> str:
+    """The replay ``result`` as a table."""
+    model = result["compensation_model"] or "none identified"
+    lines = [f"{result['file']} ({result['compass']}), compensation: {model}",
+             f"  {result['note']}; over the last {result['scored_s']:.0f} s",
+             "  estimator   heading RMS (deg) without / with   inclination RMS (deg) without / with"]
+    for kind, r in result["estimators"].items():
+        lines.append(f"  {kind:10s}  {r['without']['heading_rms_deg']:8.2f} / {r['with']['heading_rms_deg']:<8.2f}"
+                     f"            {r['without']['inclination_rms_deg']:8.2f} / {r['with']['inclination_rms_deg']:.2f}")
+    return "\n".join(lines)
+
+
+def run(args) -> int:
+    """``quadcosim log replay FILE [--compass N] [--json OUT]`` (``args`` from argparse); 2 on bad input."""
+    from calibration.static import CalibrationError
+    from orchestrator.logs import LogError
+
+    try:
+        result = replay_log(args.file, args.compass)
+    except (LogError, CalibrationError, ValueError) as error:
+        print(f"quadcosim log replay: {error}", file=sys.stderr)
+        return 2
+    print(text(result))
+    if args.json:
+        from orchestrator.files import write_json
+
+        write_json(args.json, result)
+    return 0

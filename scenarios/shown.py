@@ -1,0 +1,40 @@
+"""Numbers as the command line prints them: at the precision they carry, not as 17-digit floats
+(``metrics.json`` keeps every digit)."""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+#: Significant digits of a measured figure on the screen (a metric, a rate, an error).
+MEASURED_DIGITS = 4
+#: Significant digits of a parameter: enough for any value written by hand (7920, 1.19e-4,
+#: 0.028), few enough to drop the last bit of a product (7920.000000000001).
+PARAMETER_DIGITS = 12
+
+
+def shown(value, digits: int = MEASURED_DIGITS) -> str:
+    """``value`` as text, each real number at ``digits`` significant digits.
+
+    Parameters
+    ----------
+    value : object
+        A number, a bool, None, a string, or a list, tuple or dict of them.
+    digits : int
+        Significant digits of each real number.
+
+    Returns
+    -------
+    str
+        ``0.04806`` for 0.04806407807056596, ``[0.04806, 0.06078]`` for a list, ``7920`` for
+        7920.000000000001 at 12 digits; integers, bools and text as they are.
+    """
+    if isinstance(value, bool) or value is None or isinstance(value, numbers.Integral):
+        return str(value)
+    if isinstance(value, numbers.Real):
+        return f"{value:.{digits}g}" if math.isfinite(value) else str(float(value))
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {shown(v, digits)}" for k, v in value.items()) + "}"
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(shown(v, digits) for v in value) + "]"
+    return str(value)

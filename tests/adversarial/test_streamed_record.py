@@ -1,0 +1,60 @@
+"""``--stream``: the record goes to disk in chunks as the run goes; read back it equals, bit for
+bit, the record kept in memory, with either master; a run cut short keeps its whole chunks."""
+
+import numpy as np
+import pytest
+from conftest import assert_whole
+
+import orchestrator.stream
+from orchestrator import Result
+from orchestrator.stream import StreamWriter
+from scenarios import get
+from scenarios.cli import main as cli
+
+
+@pytest.mark.parametrize("master", ["chunk", "step"])
+def test_a_streamed_record_equals_the_record_in_memory_bit_for_bit(tmp_path, monkeypatch, master):
+    monkeypatch.setattr(orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 700)  # 700 rows: several chunks
+    monkeypatch.setenv("QUADCOSIM_MASTER", master)
+    scenario = get("tp")
+    options = ["duration=2", "noise=on", "bias=on", "estimator=explicit"]
+    kept = scenario.system(scenario.parse(options)).run(2.0, decimation=3)
+    streamed = scenario.system(scenario.parse(options)).run(2.0, decimation=3, stream=StreamWriter(tmp_path / "s"))
+    assert len(list((tmp_path / "s").glob("chunk-*.npy"))) == 1 + len(kept) // 700
+    assert streamed.names == kept.names and len(streamed) == len(kept) == 667
+    assert np.array_equal(streamed.time, kept.time)
+    assert np.array_equal(streamed.data, kept.data)
+    assert np.array_equal(streamed["IMU.acc"], kept["IMU.acc"])
+    assert streamed.units == kept.units
+
+
+def test_stream_on_the_command_line_writes_the_folder_and_result_load_reads_either(tmp_path):
+    assert cli(["run", "tp", "--set", "duration=1", "--stream", "--out", str(tmp_path / "s")]) == 0
+    assert cli(["run", "tp", "--set", "duration=1", "--out", str(tmp_path / "m")]) == 0
+    metrics = assert_whole(tmp_path / "s")
+    assert "results.stream" in metrics["files"] and not (tmp_path / "s" / "results.npz").exists()
+    streamed, kept = Result.load(tmp_path / "s"), Result.load(tmp_path / "m" / "results.npz")
+    assert np.array_equal(streamed["Quadrotor.q"], kept["Quadrotor.q"])
+    assert metrics["rms_error_deg"] == assert_whole(tmp_path / "m")["rms_error_deg"]
+    assert cli(["run", "tp", "--stream", "--format", "npz,mat", "--out", str(tmp_path / "x")]) == 2
+
+
+def test_a_streamed_run_cut_short_keeps_its_whole_chunks(tmp_path, monkeypatch):
+    monkeypatch.setattr(orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 1000)
+    writer = StreamWriter(tmp_path / "s")
+    chunks = []
+    write = writer.write
+
+    def killed_after_two(time, rows):  # the process dies while its third chunk is written
+        if len(chunks) == 2:
+            raise SystemExit("killed")
+        chunks.append(len(rows))
+        write(time, rows)
+
+    writer.write = killed_after_two
+    scenario = get("tp")
+    with pytest.raises(SystemExit):
+        scenario.system(scenario.parse(["duration=4"])).run(4.0, stream=writer)
+    kept = Result.load(tmp_path / "s")
+    assert len(kept) == 2000 and kept.time[-1] == pytest.approx(1.999)
+    assert np.isfinite(kept.data).all()

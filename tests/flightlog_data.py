@@ -1,0 +1,34 @@
+"""The shared real flight logs (``../shared/data/flightlogs`` beside the repository), read once
+per test session; tests that need them skip, saying why, when the folder is absent."""
+
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+FOLDER = ROOT.parent / "shared" / "data" / "flightlogs"
+QUAD = ("quad_2015-10-11_19-53-46.log", "quad_2015-10-11_19-59-09.log", "quad_2015-10-11_20-17-22.log")
+ERLE = "erlebrain_APM_22.bin"
+PX4 = "px4_sample.ulg"
+
+
+def path(name: str) -> Path:
+    """The shared log ``name``; skips the test when it is not there."""
+    found = FOLDER / name
+    if not found.exists():
+        pytest.skip(f"real flight logs not found at {FOLDER} (the shared data folder beside the repository)")
+    return found
+
+
+@cache
+def _read(name: str):
+    from orchestrator.logs import read_log
+
+    return read_log(FOLDER / name)
+
+
+def log(name: str):
+    """The :class:`orchestrator.logs.FlightLog` of the shared log ``name``, read once."""
+    path(name)
+    return _read(name)

@@ -1,0 +1,149 @@
+"""Magnetometer calibration from flights: a synthetic log with known interference, the real
+quad's flights, refusals, and the exported autopilot parameters against the project's correction."""
+
+import json
+
+import numpy as np
+import pytest
+
+from calibration import Calibration, StaticCalibration, compensate
+from calibration.flight import autopilot, calibrate, flight_data
+from calibration.flight.calibrate import _field_model
+from scenarios.cli import main
+from tests.flightlog_data import ERLE, PX4, QUAD, log, path
+from tests.flightlog_synthetic import write_log
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("synthetic")
+    truth = write_log(folder / "sitl.log")
+    return folder, truth
+
+
+def test_a_synthetic_flight_gives_back_its_current_interference_and_delay(synthetic, capsys):
+    folder, truth = synthetic
+    assert main(["calibrate", str(folder / "sitl.log"), "--compass", "0", "--out", str(folder / "out"),
+                 "--models", "current", "throttle"]) == 0
+    err = capsys.readouterr().err
+    assert "simulator (SITL) log" in err
+    metrics = json.loads((folder / "out" / "metrics.json").read_text())
+    current = metrics["models"]["current"]
+    K = np.array(current["coefficients"]["K_T_per_A"])
+    assert np.abs(K - truth["K"]).max() < 0.01 * np.linalg.norm(truth["K"])  # measured 0.5 %
+    assert current["delay_s"] == pytest.approx(truth["delay"], abs=1e-9)
+    assert current["explained_test"] > 0.995  # measured 0.998: the rest is 0.1 uT noise and mG rounding
+    assert current["heading_error_rms_deg"]["without"] > 5.0 > 0.4 > current["heading_error_rms_deg"]["with"]
+    assert metrics["exported_model"] == "current"
+    assert metrics["static"]["source"] == "log" and metrics["static"]["coverage"] < 0.5
+    params = autopilot.read_parameters(folder / "out" / "ardupilot.parm")
+    assert params["COMPASS_MOTCT"] == 2
+    assert [params[f"COMPASS_MOT_{a}"] for a in "XYZ"] == pytest.approx(-K / 1e-7, rel=1e-6)
+    assert Calibration.load(folder / "out" / "calibration.json", motors=4).field is not None
+    for figure in ("residual.png", "heading.png"):
+        assert (folder / "out" / figure).stat().st_size > 20_000
+
+
+def test_exported_parameters_applied_as_the_autopilots_do_reproduce_the_projects_correction():
+    data = flight_data(log(QUAD[1]), 1)
+    train, test = data.split(0.5)
+    metrics, _, fitted = calibrate([train], [test], ("current", "throttle"))
+    # a soft iron that is not the identity, so that the order of corrections matters
+    A = np.array([[1.05, 0.03, -0.02], [0.03, 0.97, 0.01], [-0.02, 0.01, 1.02]])
+    static = StaticCalibration(A=A, b_s=np.array([2e-6, -4.7e-5, 7e-6]), field_norm=5e-5)
+    for model, x in (("current", test.current(fitted["current"].delay)),
+                     ("throttle", test.throttle(fitted["throttle"].delay))):
+        K = fitted[model].extra["K"][0]
+        ours = np.linalg.solve(A, (test.raw - static.b_s - np.outer(x, K)).T).T
+        scale = np.abs(ours).max()
+        for build, apply in ((autopilot.ardupilot_parameters, autopilot.apply_ardupilot),
+                             (autopilot.px4_parameters, autopilot.apply_px4)):
+            params = build(1, static, model, K)
+            assert np.abs(apply(params, 1, test.raw, x) - ours).max() < 0.01 * scale
+    # the throttle model in the file's form, through the project's compensator (eq. 9)
+    _, field = _field_model({"throttle": fitted["throttle"]}, 4)
+    commands = test.commands(fitted["throttle"].delay)
+    compensated = compensate(Calibration(4, static, field), test.time, test.raw, commands, test.voltage(), "metge")
+    K = fitted["throttle"].extra["K"][0]
+    params = autopilot.ardupilot_parameters(1, static, "throttle", K)
+    applied = autopilot.apply_ardupilot(params, 1, test.raw, commands.mean(axis=1))
+    assert np.abs(applied - compensated).max() < 0.01 * np.abs(compensated).max()
+
+
+def test_the_quads_internal_compass_moves_with_the_current_and_the_external_barely():
+    flight = log(QUAD[0])
+    figures = {}
+    for compass in (0, 1):
+        train, test = flight_data(flight, compass).split(0.5)
+        metrics, _, _ = calibrate([train], [test], ("current",))
+        figures[compass] = metrics["models"]["current"]
+    internal, external = figures[1], figures[0]
+    K_internal = np.linalg.norm(internal["coefficients"]["K_T_per_A"])
+    K_external = np.linalg.norm(external["coefficients"]["K_T_per_A"])
+    assert K_internal > 1.5e-7 > K_external  # T/A: 1.5 mG/A
+    assert internal["explained_test"] > 0.1
+
+
+def test_logs_without_a_current_sensor_or_throttle_variation_refuse_with_the_reason(capsys, tmp_path):
+    train, test = flight_data(log(ERLE), 0).split(0.5)
+    metrics, _, fitted = calibrate([train], [test], ("current", "throttle"))
+    assert metrics["models"]["current"]["refused"].startswith("no current sensor in the log")
+    assert metrics["models"]["throttle"]["explained_test"] > 0.5  # the Erle-Brain's compass sits by its ESCs
+    assert main(["calibrate", str(path(PX4)), "--out", str(tmp_path / "px4"), "--models", "throttle"]) == 2
+    captured = capsys.readouterr()
+    assert "too little throttle variation" in captured.out
+    assert "px4_sample.ulg" in captured.err
+    assert main(["calibrate", str(path(QUAD[1])), "--compass", "2", "--out", str(tmp_path / "none")]) == 2
+    assert "no compass 2; the log holds 0: MAG, 1: MAG2" in capsys.readouterr().err
+
+
+def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, capsys):
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    command = "quadcosim calibrate ../shared/data/flightlogs/quad_2015-10-11_19-59-09.log --compass 1 --out " \
+              "results/flight-b-internal"
+    assert command in readme
+    shown = readme.split("$ " + command + "\n", 1)[1].split("\n```", 1)[0]
+    log = str(path(QUAD[1]))
+    assert main(["calibrate", log, "--compass", "1", "--out", str(tmp_path / "b")]) == 0
+    printed = capsys.readouterr().out.replace(log, "../shared/data/flightlogs/quad_2015-10-11_19-59-09.log")
+    printed = printed.replace(str(tmp_path / "b"), "results/flight-b-internal")
+    assert printed.strip() == shown.strip()
+    parameters = readme.split("ends with the motor compensation (milligauss per ampere):\n\n```text\n", 1)[1]
+    written = (tmp_path / "b" / "ardupilot.parm").read_text().strip().splitlines()[-4:]
+    assert parameters.split("\n```", 1)[0].splitlines() == written
+
+
+def test_the_command_lines_defaults_are_the_calibrations_names():
+    from calibration.flight import MODELS
+    from scenarios.cli import parser
+
+    args = parser().parse_args(["calibrate", "flight.log", "--out", "out"])
+    assert tuple(args.models) == MODELS and args.attitude == "gyro"
+
+
+def test_rotations_covering_the_sphere_give_hard_and_soft_iron_and_flights_cross_validate(synthetic, capsys):
+    folder, truth = synthetic
+    write_log(folder / "tumbling.log", seed=3, tumble=20.0)  # rolled and pitched through most orientations
+    out = folder / "cross"
+    assert main(["calibrate", "--train", str(folder / "tumbling.log"), "--test", str(folder / "sitl.log"),
+                 "--out", str(out), "--models", "current"]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["static"]["source"] == "flight" and metrics["static"]["coverage"] >= 0.5
+    assert metrics["test"] == [f"{folder / 'sitl.log'}:MAG[0]"]
+    assert metrics["models"]["current"]["explained_test"] > 0.995  # another flight, measured 0.998
+    static = Calibration.load(out / "calibration.json").static
+    assert np.abs(static.b_s - truth["hard_iron"]).max() < 0.1e-6  # measured 0.04 uT
+    assert np.abs(static.A - np.eye(3)).max() < 2e-3  # no soft iron in the data; measured 5e-4
+    params = autopilot.read_parameters(out / "ardupilot.parm")
+    assert [params[f"COMPASS_OFS_{a}"] for a in "XYZ"] == pytest.approx(-static.b_s / 1e-7, rel=1e-6)
+
+
+def test_a_log_without_a_magnetometer_is_refused_naming_it(synthetic, tmp_path, capsys):
+    folder, _ = synthetic
+    lines = (folder / "sitl.log").read_text().splitlines()
+    (tmp_path / "nomag.log").write_text("\n".join(line for line in lines if not line.startswith("MAG,")) + "\n")
+    assert main(["calibrate", str(tmp_path / "nomag.log"), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{tmp_path / 'nomag.log'}: the log holds no magnetometer" in err

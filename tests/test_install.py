@@ -1,0 +1,101 @@
+"""The package as a user installs it: a wheel built from this checkout (through its sdist),
+installed into a fresh virtual environment outside the checkout, runs a short scenario from an
+unrelated folder, builds its FMUs into the per-user cache (never into ``site-packages``) and
+compiles the benchmark's C references from the sources it ships.
+
+The environment is made with ``uv`` (a pinned development dependency) so that the install takes
+seconds; its dependencies are resolved from ``pyproject.toml`` with the development
+environment's versions as constraints, so that the test measures the package, not a new release
+of a dependency.
+"""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+TOP_LEVEL = {"fmus", "orchestrator", "estimators", "calibration", "scenarios", "benchmarks"}
+
+pytestmark = pytest.mark.slow
+
+
+def _uv() -> str:
+    uv = pytest.importorskip("uv", reason="uv (a development dependency) installs the fresh environment")
+    return uv.find_uv_bin()
+
+
+def _clean_env(cache: Path) -> dict:
+    """The process environment less anything pointing at this checkout or its environment."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith("QUADCOSIM_") and k not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")}
+    env.update(XDG_CACHE_HOME=str(cache), UV_PYTHON_DOWNLOADS="never", MPLBACKEND="Agg",
+               NUMBA_CACHE_DIR=str(cache / "numba"))
+    return env
+
+
+def _call(command, cwd, env, timeout=600):
+    done = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    assert done.returncode == 0, f"{' '.join(map(str, command))} exited {done.returncode}:\n{done.stderr[-3000:]}"
+    return done
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    """(python of the fresh environment, its site-packages, the user's cache, the environment)."""
+    uv = _uv()
+    work = tmp_path_factory.mktemp("install")
+    env = _clean_env(work / "cache")
+    base = getattr(sys, "_base_executable", sys.executable)
+    _call([uv, "build", "-q", "--python", base, "--out-dir", str(work / "dist"), str(ROOT)], work, env)
+    wheel = next((work / "dist").glob("quadcosim-*.whl"))
+    frozen = _call([uv, "pip", "freeze", "--python", sys.executable, "--exclude-editable"], work, env).stdout
+    constraints = work / "constraints.txt"
+    constraints.write_text("\n".join(line for line in frozen.splitlines() if not line.startswith("quadcosim")))
+    venv = work / "venv"
+    _call([uv, "venv", "-q", "--python", base, str(venv)], work, env)
+    python = venv / "bin" / "python"
+    _call([uv, "pip", "install", "-q", "--python", str(python), "-c", str(constraints), str(wheel)], work, env)
+    site = Path(_call([str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                      work, env).stdout.strip())
+    return python, site, work / "cache", env
+
+
+def test_the_wheel_holds_the_project_packages_and_their_c_sources(installed):
+    _, site, _, _ = installed
+    assert "build" not in {p.name for p in site.iterdir()}
+    record = next(site.glob("quadcosim-*.dist-info"))
+    assert (record / "licenses" / "LICENSE").read_text().startswith("MIT License")
+    files = [line.split(",")[0] for line in (record / "RECORD").read_text().splitlines()]
+    top = {name.split("/")[0] for name in files if not name.startswith("..")} - {record.name}
+    assert top == TOP_LEVEL, top  # no `build`, no `tests`, nothing else at the top level
+    for source in ("benchmarks/c/loops.c", "benchmarks/c/rotation.h", "orchestrator/c/calls.c",
+                   "fmus/c/shell.c", "fmus/Quadrotor/model.c", "fmus/QuadCoSim/package.order"):
+        assert (site / source).is_file(), source
+
+
+def test_quadcosim_run_tp_from_an_unrelated_folder(installed, tmp_path):
+    python, site, cache, env = installed
+    quadcosim = python.parent / "quadcosim"
+    located = _call([str(python), "-c", "import fmus, scenarios; print(fmus.__file__); print(fmus.build_root())"],
+                    tmp_path, env).stdout.split()
+    assert Path(located[0]).is_relative_to(site)
+    assert Path(located[1]) == cache / "quadcosim" / "0.1.0"
+    done = _call([str(quadcosim), "run", "tp", "--set", "duration=2"], tmp_path, env)
+    metrics = json.loads((tmp_path / "results" / "tp" / "metrics.json").read_text())
+    assert metrics["status"] == "completed" and metrics["samples"] == 2001
+    assert all(0 < e < 0.2 for e in metrics["rms_error_deg"]), metrics["rms_error_deg"]
+    assert "building the FMU Quadrotor" in done.stderr
+    built = {p.name for p in (cache / "quadcosim" / "0.1.0" / "fmus").glob("*.fmu")}
+    assert {"Quadrotor.fmu", "MotorMagnetics.fmu", "IMU.fmu"} <= built
+    assert not (site / "build").exists()
+
+
+def test_the_benchmark_references_compile_from_the_installed_sources(installed, tmp_path):
+    python, _, cache, env = installed
+    script = "from benchmarks import reference_library; print(reference_library('loops')._name)"
+    library = Path(_call([str(python), "-c", script], tmp_path, env).stdout.strip())
+    assert library == cache / "quadcosim" / "0.1.0" / "benchmarks" / "libloops.so" and library.is_file()
