@@ -137,7 +137,7 @@ def test_sweep_through_a_separately_started_scheduler(reference, tmp_path):
 
 @pytest.mark.slow
 def test_a_dead_worker_is_retried_then_recorded(tmp_path):
-    plan = sweep.plan("tp", ["k=0.05,2000"], ["duration=0.2"])
+    plan = sweep.plan("tp", ["k=0.05,1500"], ["duration=0.2"])
     summary = sweep.run(plan, tmp_path / "dead", workers=1, retries=1, progress=False,
                         extra_metrics="helpers:exit_worker_on_large_gain")
     columns = table.read(tmp_path / "dead")
