@@ -146,8 +146,8 @@ def choose(results: dict) -> dict:
 
 
 def table(results: dict) -> str:
-    """The README's table: per dataset (its role), mean total RMSE (deg) of every filter, and our best
-    filter's ratio to VQF."""
+    """The summary table of :func:`evaluate`'s ``results``: per dataset (its role), mean total RMSE
+    (deg) of every filter, and our best filter's ratio to VQF."""
     lines = ["| dataset (recordings) | role | explicit | passive | VQF | Madgwick | Mahony | best / VQF |",
              "|---|---|---|---|---|---|---|---|"]
     for name, found in results.items():

@@ -89,13 +89,14 @@ def test_check_units_judges_acc_at_rest_and_accepts_a_running_recording():
 
 @pytest.mark.parametrize("kind, options", [("explicit", {}), ("passive", {"ry": "triad"})])
 def test_a_missing_magnetometer_gives_a_tilt_estimate_with_a_warning(kind, options):
-    gyro, acc, mag, quat = _static(20.0)
-    late = np.arange(len(gyro)) >= 15 * RATE
+    gyro, acc, mag, quat = _static(60.0)
+    late = np.arange(len(gyro)) >= 50 * RATE
     for absent in (None, np.zeros_like(mag)):
         with pytest.warns(checks.NoMagnetometerWarning, match="6-axis estimate"):
             out = estimate(kind, gyro=gyro, acc=acc, mag=absent, dt=1 / RATE, outputs=("q",), reference=quat,
                            scored=late, **options)
-        # from level, the 22 deg tilt is corrected (kP = 1-2 1/s: within 15 s to a hundredth of a degree);
+        # from level, the 22 deg tilt is corrected (tilt time constant 2-4 s: within 50 s to a hundredth of a
+        # degree);
         # nothing corrects the heading: it stays near its start, 17.2 deg off (19.0 measured, the tilt
         # correction turning about a tilted axis)
         assert out["errors"]["inclination_rmse_deg"][0] < 0.01
@@ -118,7 +119,7 @@ def test_gains_that_make_a_filter_diverge_are_named():
     table = gain_table("explicit", {"kP": [1.0, 2.0]})
     stored = np.zeros((2, 3, 4))
     stored[1, 2, 0] = np.nan
-    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 1, kP = 2"):
+    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.3, kP = 2"):
         checks.check_finite("explicit", table, stored, np.zeros((2, 6)))
 
 
@@ -138,6 +139,6 @@ def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(ca
     exec(compile(code, "README.md", "exec"), namespace)
     errors = namespace["out"]["errors"]["total_rmse_deg"].reshape(4, 3)
     print(errors)
-    # 24 s of slow rotations from a TRIAD start: 3.68 to 4.91 deg measured, the least at kP = 1
-    assert np.all((errors > 3.5) & (errors < 5.0)) and np.argmin(errors.min(axis=1)) == 2
+    # 24 s of slow rotations from a TRIAD start: 0.99 to 1.25 deg measured, the least at kP = 1
+    assert np.all((errors > 0.95) & (errors < 1.3)) and np.argmin(errors.min(axis=1)) == 2
     assert "[[" in capsys.readouterr().out

@@ -9,6 +9,7 @@ its recorded values stay as they were, not reproducible on a machine without the
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -33,7 +34,9 @@ def findings(results: dict) -> list[dict]:
         out.append(_entry(f"{dataset}.recordings", found["recordings"], "1", 0, 0.0))
         for kind in FILTERS:
             for metric in METRICS:
-                out.append(_entry(f"{dataset}.{kind}.{metric}", found["means"][kind][metric], "deg"))
+                value = found["means"][kind][metric]
+                if not math.isnan(value):  # a filter not run on the dataset: no finding
+                    out.append(_entry(f"{dataset}.{kind}.{metric}", value, "deg"))
         best = min(found["means"][k]["total_rmse_deg"] for k in ("explicit", "passive"))
         out.append(_entry(f"{dataset}.best_over_vqf", best / found["means"]["vqf"]["total_rmse_deg"], "1"))
     return out
@@ -52,6 +55,10 @@ def compute(quick: bool = False) -> list[dict]:
     return findings(real_recordings.evaluate(folder, cache=os.environ.get("QUADCOSIM_REAL_CACHE")))
 
 
+def _deg(value) -> str:
+    return "—" if math.isnan(value) else f"{value:.2f}"
+
+
 def readme_tables(results: dict) -> str:
     """The README's two tables (mean total RMSE and best over VQF; heading and inclination) from
     :func:`benchmarks.real_recordings.evaluate`'s ``results``."""
@@ -66,7 +73,7 @@ def readme_tables(results: dict) -> str:
         role = "held out" if dataset in HELD_OUT else "chose the defaults"
         best = min(m["explicit"]["total_rmse_deg"], m["passive"]["total_rmse_deg"]) / m["vqf"]["total_rmse_deg"]
         lines.append(f"| {dataset} ({found['recordings']}) | {role} | " +
-                     " | ".join(f"{m[k]['total_rmse_deg']:.2f}" for k in FILTERS) + f" | {best:.2f} |")
+                     " | ".join(_deg(m[k]["total_rmse_deg"]) for k in FILTERS) + f" | {best:.2f} |")
         detail.append(f"| {dataset} | " + " | ".join(
-            f"{m[k]['heading_rmse_deg']:.2f} / {m[k]['inclination_rmse_deg']:.2f}" for k in FILTERS) + " |")
+            f"{_deg(m[k]['heading_rmse_deg'])} / {_deg(m[k]['inclination_rmse_deg'])}" for k in FILTERS) + " |")
     return "\n".join(lines) + "\n\n" + "\n".join(detail)
