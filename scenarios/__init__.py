@@ -311,36 +311,53 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         the run stopped and which files were kept.
     """
     from orchestrator.files import prepare_out_dir
-    from orchestrator.interrupts import first_only
+    from orchestrator.interrupts import first_only, held
     from orchestrator.progress import status
     from scenarios.outputs import RunFiles
 
     status(f"{name}: loading the scenario")
-    _check_formats(formats, stream, out_dir)
-    if name not in _MODULES:
-        get(name)  # refused (the nearest names given) before any folder is made
-    made = out_dir is not None and not Path(out_dir).exists()
-    out = prepare_out_dir(out_dir, overwrite) if out_dir else None
-    given = dict(settings) if isinstance(settings, dict) else dict(_split(s) for s in settings or [] if "=" in s)
-    base = {"scenario": name, "options": given, "injected_faults": [fault_record(f) for f in faults],
-            "decimation": decimation}
-    files = RunFiles(out, formats, base, {}, compress) if out is not None else None
-    with first_only(), (files.tracking() if files else contextlib.nullcontext()):
+    files = None
+    with first_only():
         try:
-            scenario = get(name)
-            options = scenario.parse(settings)
-            base["options"] = dict(options)
-            if files:
-                files.units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
-            return _run_phases(scenario, options, base, files, (faults, estimator, record, stream), progress)
-        except KeyboardInterrupt as interrupt:  # outside the loop: loading, building, drawing, saving, reporting
+            with held():  # a signal while the folder is made is raised once the run can record it
+                _check_formats(formats, stream, out_dir)
+                if name not in _MODULES:
+                    get(name)  # refused (the nearest names given) before any folder is made
+                made = out_dir is not None and not Path(out_dir).exists()
+                out = prepare_out_dir(out_dir, overwrite) if out_dir else None
+                given = dict(settings) if isinstance(settings, dict) else dict(
+                    _split(s) for s in settings or [] if "=" in s)
+                base = {"scenario": name, "options": given,
+                        "injected_faults": [fault_record(f) for f in faults], "decimation": decimation}
+                files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+            with (files.tracking() if files else contextlib.nullcontext()):
+                return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream), progress)
+        except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
                 raise
-            raise files.interrupted(interrupt, files.saved, files.stream) from None
-        except (KeyError, ValueError):  # refused before the run: the folder is left as it was
-            if files is not None and files.result is None:
-                files.refused(remove_folder=made)
+            with files.tracking():
+                raise files.interrupted(interrupt, files.saved, files.stream) from None
+
+
+def _run_tracked(name, settings, files, base, made, given, progress):
+    """The run of :func:`run` once its folder is made: load, then :func:`_run_phases`; an
+    interrupt in any phase becomes :class:`orchestrator.RunInterrupted`, a refusal leaves the
+    folder as it was."""
+    try:
+        scenario = get(name)
+        options = scenario.parse(settings)
+        base["options"] = dict(options)
+        if files:
+            files.units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
+        return _run_phases(scenario, options, base, files, given, progress)
+    except KeyboardInterrupt as interrupt:  # outside the loop: loading, building, drawing, saving, reporting
+        if files is None:
             raise
+        raise files.interrupted(interrupt, files.saved, files.stream) from None
+    except (KeyError, ValueError):  # refused before the run: the folder is left as it was
+        if files is not None and files.result is None:
+            files.refused(remove_folder=made)
+        raise
 
 
 def _check_formats(formats, stream: bool, out_dir):
@@ -477,6 +494,10 @@ def _report(scenario, result, options, files, record) -> dict:
         # the report needs a signal the user chose not to record: the results stand alone
         return {"report": f"report skipped: {error.args[0]} (add it to --record for the report)"}
     except Exception as error:
+        from orchestrator.interrupts import interrupt_for, stopping
+
+        if stopping() is not None:  # a signal surfaced as another error inside a C extension (a figure's)
+            raise interrupt_for(stopping()) from error
         if files is None:
             raise
         from orchestrator.files import DiskFull

@@ -86,7 +86,7 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     import tomllib
 
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    assert project["project"]["scripts"]["quadcosim"] == "scenarios.cli:main"
+    assert project["project"]["scripts"]["quadcosim"] == "scenarios.cli:entry"
     assert "benchmarks*" in project["tool"]["setuptools"]["packages"]["find"]["include"]
     assert not (ROOT / "orchestrator" / "cli.py").exists()
     assert not list((ROOT / "orchestrator").glob("bench*.py"))
