@@ -1,6 +1,13 @@
 """Shared fixtures: the FMUs are built once per session if they are missing."""
 
+import os
+from pathlib import Path
+
 import pytest
+
+# The real flight logs beside the repository, for the flight-log findings group.
+os.environ.setdefault("QUADCOSIM_FLIGHT_LOGS",
+                      str(Path(__file__).resolve().parents[1].parent / "shared" / "data" / "flightlogs"))
 
 from fmus import MODELS, default_fmu_dir
 

@@ -101,13 +101,13 @@ def test_logs_without_a_current_sensor_or_throttle_variation_refuse_with_the_rea
 def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, capsys):
 
     readme = documentation()
-    command = "quadcosim calibrate ../shared/data/flightlogs/quad_2015-10-11_19-59-09.log --compass 1 --out " \
+    command = "quadcosim calibrate logs/quad_2015-10-11_19-59-09.log --compass 1 --out " \
               "results/flight-b-internal"
     assert command in readme
     shown = readme.split("$ " + command + "\n", 1)[1].split("\n```", 1)[0]
     log = str(path(QUAD[1]))
     assert main(["calibrate", log, "--compass", "1", "--out", str(tmp_path / "b")]) == 0
-    printed = capsys.readouterr().out.replace(log, "../shared/data/flightlogs/quad_2015-10-11_19-59-09.log")
+    printed = capsys.readouterr().out.replace(log, "logs/quad_2015-10-11_19-59-09.log")
     printed = printed.replace(str(tmp_path / "b"), "results/flight-b-internal")
     assert printed.strip() == shown.strip()
     parameters = readme.split("ends with the motor compensation (milligauss per ampere):\n\n```text\n", 1)[1]

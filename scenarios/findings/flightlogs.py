@@ -3,17 +3,19 @@
 heading change), and the estimators replayed on every shared log without and with the
 compensation, against the autopilot's attitude.
 
-The logs are read from the shared data folder beside the repository
-(``../shared/data/flightlogs``); without it the group is skipped (``FileNotFoundError``).
+The logs (three flights of one quad, an Erle-Brain flight and a PX4 bench log) are read from
+the folder that ``$QUADCOSIM_FLIGHT_LOGS`` names; without it the group is skipped
+(``FileNotFoundError``). The commands name them as they sit in a folder ``logs/``.
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 
-FOLDER = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "flightlogs"
+FOLDER_VARIABLE = "QUADCOSIM_FLIGHT_LOGS"  # the folder holding the logs
 FLIGHTS = {"a": "quad_2015-10-11_19-53-46.log", "b": "quad_2015-10-11_19-59-09.log",
            "c": "quad_2015-10-11_20-17-22.log"}
 COMPASSES = {0: "external", 1: "internal"}
@@ -30,13 +32,16 @@ def _name(key: str) -> str:
 
 def _shown(key: str) -> str:
     """The log as a command names it, from the repository's root."""
-    return f"../shared/data/flightlogs/{_name(key)}"
+    return f"logs/{_name(key)}"
 
 
 def _path(key: str) -> Path:
-    path = FOLDER / _name(key)
+    folder = os.environ.get(FOLDER_VARIABLE)
+    if not folder:
+        raise FileNotFoundError(f"the flight logs are absent: set {FOLDER_VARIABLE} to their folder")
+    path = Path(folder) / _name(key)
     if not path.exists():
-        raise FileNotFoundError(f"{path}: the shared flight logs are absent")
+        raise FileNotFoundError(f"{path}: the flight log is absent from {FOLDER_VARIABLE}")
     return path
 
 
