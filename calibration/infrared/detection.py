@@ -38,11 +38,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from calibration.infrared.layout import (
     A_SAFE,
     B_SAFE,
+    CONS_H,
+    CONS_K,
+    CUSUM_CONS,
     CUSUM_GPS,
     CUSUM_H,
     CUSUM_K,
@@ -56,18 +60,23 @@ from calibration.infrared.layout import (
     G_DOWN,
     G_UP,
     GAMMA2,
+    GATE_CONS,
     GATE_GPS,
     GATE_IR,
     GATE_NOW,
     GPS_FAULT,
+    HELD_LAG,
+    HELD_SCALE,
     HOLD,
     IR_FAULT,
     IR_SUSPECT,
     LAG,
+    MARGIN,
     N_DOWN,
     N_UP,
     NOW_H,
     NOW_K,
+    NU_CONS,
     NU_GPS,
     NU_IR,
     NU_NOW,
@@ -75,11 +84,21 @@ from calibration.infrared.layout import (
     PAA,
     PAB,
     PAR,
+    PAST,
+    PAST_COUNT,
+    PAST_SIZE,
     PB0,
     PBB,
     PBR,
     PRR,
+    RAMP,
+    RG,
+    RI,
     RI1,
+    RING,
+    RING_COUNT,
+    RING_SIZE,
+    SCALE_GAIN,
     SIZE_GAIN,
     SUM_DOWN,
     SUM_UP,
@@ -130,9 +149,10 @@ def run_mean(s, base):
 @njit(cache=True)
 def restart(s):
     """Every CUSUM of the state ``s`` back to zero."""
-    for base in (CUSUM_GPS, CUSUM_PAIR, CUSUM_NOW):
+    for base in (CUSUM_GPS, CUSUM_PAIR, CUSUM_NOW, CUSUM_CONS):
         for j in range(CUSUM_SIZE):
             s[base + j] = 0.0
+    s[RING_COUNT] = 0.0  # the consistency residuals before the restart are no evidence after it
 
 
 @njit(cache=True)
@@ -147,6 +167,103 @@ def reopen(s, c):
     s[PAB] = 0.0
     s[PAR] = 0.0
     s[PBR] = 0.0
+
+
+@njit(cache=True)
+def consistency(s, c, ir_pair, gps):
+    """The paired IR ``ir_pair`` (count) against the GPS turn rate ``gps`` (rad/s) through the
+    calibration of ``c[HELD_LAG]`` samples before (:func:`remember_calibration`): the residual
+    ``ir_pair - (a gps + b)`` (count) and its variance (count^2) under the filter's noise model
+    and the covariance that calibration had, stored in the state ``s``. The filter itself
+    absorbs an offset into ``b`` (and ``a``) within a few seconds; the calibration held from
+    before the offset does not, and drifts by at most the drift of ``a`` and ``b`` over the lag."""
+    held = PAST + (int(s[PAST_COUNT]) - int(c[HELD_LAG])) % PAST_SIZE
+    a = s[held]
+    s[NU_CONS] = ir_pair - (a * gps + s[held + PAST_SIZE])
+    var_a, cov_ab, var_b = s[held + 2 * PAST_SIZE], s[held + 3 * PAST_SIZE], s[held + 4 * PAST_SIZE]
+    s[GATE_CONS] = a * a * c[RG] + c[RI] + gps * (gps * var_a + 2.0 * cov_ab) + var_b
+
+
+@njit(cache=True)
+def remember_calibration(s):
+    """Keep this sample's ``a``, ``b`` and their covariance in the ring of past calibrations."""
+    count = int(s[PAST_COUNT])
+    slot = PAST + count % PAST_SIZE
+    s[slot] = s[A]
+    s[slot + PAST_SIZE] = s[B]
+    s[slot + 2 * PAST_SIZE] = s[PAA]
+    s[slot + 3 * PAST_SIZE] = s[PAB]
+    s[slot + 4 * PAST_SIZE] = s[PBB]
+    s[PAST_COUNT] = count + 1
+
+
+@njit(cache=True)
+def _remember(s, z):
+    """Keep the normalised consistency residual ``z`` (``nan``: none at this sample) in the ring."""
+    count = int(s[RING_COUNT])
+    s[RING + count % RING_SIZE] = z
+    s[RING_COUNT] = count + 1
+
+
+@njit(cache=True)
+def _ring(s):
+    """The ring's residuals, oldest first (``nan`` where there was none)."""
+    count = int(s[RING_COUNT])
+    first = count - RING_SIZE if count > RING_SIZE else 0
+    values = np.empty(count - first)
+    for m in range(first, count):
+        values[m - first] = s[RING + m % RING_SIZE]
+    return values
+
+
+@njit(cache=True)
+def _fit(x, onset, ramp, sign):
+    """Log-likelihood ratio (unit variance) and size of the best offset ``d`` of sign ``sign``
+    with the signature ``f_m = min(1, (m - onset + 1) / ramp)`` from sample ``onset`` on, in the
+    residuals ``x``: ``d = sum f x / sum f^2`` and ``(sum f x)^2 / (2 sum f^2)``."""
+    fx, ff = 0.0, 0.0
+    for m in range(max(onset, 0), x.shape[0]):
+        if x[m] == x[m]:
+            f = min(1.0, (m - onset + 1) / ramp)
+            fx += f * x[m]
+            ff += f * f
+    if ff == 0.0 or fx * sign <= 0.0:
+        return 0.0, 0.0
+    return 0.5 * fx * fx / ff, fx / ff
+
+
+@njit(cache=True)
+def _best(x, ramp, sign):
+    """The generalised likelihood ratio over every onset in the ring (a ramp may have started
+    before it): the largest log-likelihood ratio and its offset."""
+    best, size = 0.0, 0.0
+    for onset in range(1 - int(ramp), x.shape[0]):
+        llr, d = _fit(x, onset, ramp, sign)
+        if llr > best:
+            best, size = llr, d
+    return best, size
+
+
+@njit(cache=True)
+def attribute(s, c):
+    """Which sensor the consistency CUSUM's alarm comes from, by the shape of the residual in
+    the ring: an offset of the GPS turn rate enters it as a step (the sample it starts), one of
+    the IR as a ramp over the GPS window (``c[RAMP]`` samples, as the faulty samples fill the
+    paired mean). A generalised likelihood ratio with each signature, the onset and size
+    free; the sensor whose signature is more likely by ``c[MARGIN]`` (log-likelihood, the
+    residuals scaled by their own spread while no offset showed, ``s[HELD_SCALE]``) is named.
+    Returns ``(sensor, size)``: 1 the GPS, 2 the IR, 0 not yet told apart; the size in
+    normalised units."""
+    sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
+    x = _ring(s)
+    step, step_size = _best(x, 1.0, sign)
+    ramp, ramp_size = _best(x, c[RAMP], sign)
+    evidence = (step - ramp) / s[HELD_SCALE]  # in units of the residual's own spread
+    if evidence > c[MARGIN]:
+        return 1, step_size
+    if evidence < -c[MARGIN]:
+        return 2, ramp_size
+    return 0, 0.0
 
 
 @njit(cache=True)
@@ -216,7 +333,7 @@ def _ended(s, c, flag):
 @njit(cache=True)
 def _quiet(s):
     """Whether every CUSUM statistic is zero: no sensor shows the start of an offset."""
-    for base in (CUSUM_GPS, CUSUM_PAIR, CUSUM_NOW):
+    for base in (CUSUM_GPS, CUSUM_PAIR, CUSUM_NOW, CUSUM_CONS):
         if s[base + G_UP] > 0.0 or s[base + G_DOWN] > 0.0:
             return False
     return True
@@ -251,11 +368,34 @@ def detect(s, c, gps_seen, pair_seen):
     gps = cusum(s, CUSUM_GPS, s[NU_GPS], s[GATE_GPS], c[CUSUM_K], c[CUSUM_H]) if gps_seen else -1.0
     pair = cusum(s, CUSUM_PAIR, s[NU_IR], s[GATE_IR], c[CUSUM_K], c[CUSUM_H]) if pair_seen else -1.0
     now = cusum(s, CUSUM_NOW, s[NU_NOW], s[GATE_NOW], c[NOW_K], c[NOW_H])
+    held = -1.0
+    if pair_seen:
+        z = s[NU_CONS] / math.sqrt(s[GATE_CONS])
+        _remember(s, z)
+        held = cusum(s, CUSUM_CONS, s[NU_CONS], s[GATE_CONS], c[CONS_K], c[CONS_H])
+        if held == -1.0:  # its statistic is zero: no offset shows, the residual is noise and drift
+            s[HELD_SCALE] += c[SCALE_GAIN] * (z * z - s[HELD_SCALE])
+    else:
+        _remember(s, math.nan)
     ir = pair if pair > now else now
     if gps <= 0.0 and ir <= 0.0:
-        if _quiet(s):
-            s[A_SAFE], s[B_SAFE] = s[A], s[B]
-        return
+        sensor, size = attribute(s, c) if held > 0.0 else (0, 0.0)
+        if sensor == 0:  # nothing, or a small offset whose sensor the residual does not tell yet
+            if _quiet(s):
+                s[A_SAFE], s[B_SAFE] = s[A], s[B]
+            return
+        _declare_held(s, c, sensor, size)
+    else:
+        _declare(s, gps, pair, now, ir)
+    s[END_STAT] = 0.0
+    s[END_PAIR] = -1.0  # not armed
+    restart(s)
+
+
+@njit(cache=True)
+def _declare(s, gps, pair, now, ir):
+    """A fault declared by the CUSUM of the GPS, the paired IR or the present IR (how far each
+    is over its threshold): the furthest names the sensor, its run the offset."""
     s[A], s[B] = s[A_SAFE], s[B_SAFE]  # what the faulty sensor pulled a and b by before the alarm, undone
     if gps > ir:
         s[GPS_FAULT] = 1.0
@@ -263,6 +403,19 @@ def detect(s, c, gps_seen, pair_seen):
     else:
         s[IR_FAULT] = 1.0
         s[FAULT_SIZE] = run_mean(s, CUSUM_PAIR) if pair > now else run_mean(s, CUSUM_NOW)
-    s[END_STAT] = 0.0
-    s[END_PAIR] = -1.0  # not armed
-    restart(s)
+
+
+@njit(cache=True)
+def _declare_held(s, c, sensor, size):
+    """A fault declared by the consistency CUSUM, on the ``sensor`` :func:`attribute` named
+    (1 the GPS, 2 the IR), of normalised ``size``: the offset in the units of that sensor's
+    end test (the GPS: rad/s, ``-d / a``; the IR: count)."""
+    offset = size * math.sqrt(s[GATE_CONS])
+    held = PAST + (int(s[PAST_COUNT]) - int(c[HELD_LAG])) % PAST_SIZE
+    s[A], s[B] = s[held], s[held + PAST_SIZE]  # the calibration from before the offset
+    if sensor == 1:
+        s[GPS_FAULT] = 1.0
+        s[FAULT_SIZE] = -offset / s[A]
+    else:
+        s[IR_FAULT] = 1.0
+        s[FAULT_SIZE] = offset

@@ -15,6 +15,9 @@ from calibration.infrared.filters import ekf_joint_step, ekf_step, pair_at, push
 from calibration.infrared.layout import (
     A_SAFE,
     B_SAFE,
+    CONS_H,
+    CONS_K,
+    CUSUM_CONS,
     CUSUM_H,
     CUSUM_K,
     EKF_CONFIG_SIZE,
@@ -23,19 +26,26 @@ from calibration.infrared.layout import (
     FAULT_SIZE,
     FIT_A,
     FIT_B,
+    G_DOWN,
+    G_UP,
     GAMMA2,
+    GATE_CONS,
     GATE_GPS,
     GATE_IR,
     GATE_NOW,
     GPS_FAULT,
     GPS_USED,
+    HELD_LAG,
+    HELD_SCALE,
     IR_FAULT,
     IR_SUSPECT,
     IR_USED,
     LAG,
     LOST_PD,
+    MARGIN,
     NOW_H,
     NOW_K,
+    NU_CONS,
     NU_GPS,
     NU_IR,
     NU_NOW,
@@ -43,6 +53,8 @@ from calibration.infrared.layout import (
     PAA,
     PAB,
     PAR,
+    PAST,
+    PAST_SIZE,
     PB0,
     PBB,
     PBR,
@@ -50,6 +62,7 @@ from calibration.infrared.layout import (
     QA,
     QB,
     QR,
+    RAMP,
     RATE,
     REG_RATE,
     REG_SIZE,
@@ -60,6 +73,7 @@ from calibration.infrared.layout import (
     RLS_A,
     RLS_B,
     RLS_RATE,
+    SCALE_GAIN,
     SIZE_GAIN,
     STATUS,
     WINDOW_SPAN,
@@ -110,6 +124,26 @@ class EKFSettings:
         25; the flights of seeds 1 to 100 score them (``python -m scenarios.ir_detection``).
     now_k, now_h : float
         The same for the present IR, whose variance includes the turn's change over the lag.
+    held_k, held_h : float
+        Allowance and threshold (standard deviations) of the two-sided CUSUM on the GPS-IR
+        consistency residual against the calibration held at the last quiet sample
+        (:func:`calibration.infrared.detection.consistency`), which finds the offsets the filter
+        absorbs into ``b`` before the other CUSUMs see them. The allowance is half the smallest
+        offset it is meant for (a GPS +0.1 rad/s, 40 counts, 2.3 standard deviations); the
+        threshold was set on the fault-free flights of seeds 101 to 200 (``python -m
+        scenarios.ir_detection --calibrate``).
+    held_lag : int
+        How old the calibration held for the consistency residual is (samples, fewer than
+        60): long enough for the detector to fire before an offset reaches it (an IR offset
+        enters the paired mean a GPS delay late, over a GPS window), short enough that the
+        drift of ``a`` and ``b`` over it stays small.
+    margin : float
+        Log-likelihood by which one sensor's signature in the consistency residual (the GPS:
+        a step; the IR: a ramp over the GPS window) must beat the other's before a fault is
+        declared on it, the residual scaled by its own spread: ``log 100``.
+    scale_gain : float
+        Weight per sample of the running mean square of the normalised consistency residual
+        while its CUSUM is zero (1 / samples): the spread the attribution scales by.
     end_h : float
         Threshold of the log-likelihood ratio that ends a fault.
     size_gain : float
@@ -136,6 +170,11 @@ class EKFSettings:
     cusum_h: float = 10.0
     now_k: float = 3.5
     now_h: float = 25.0
+    held_k: float = 1.15
+    held_h: float = 10.0
+    held_lag: int = 10
+    margin: float = 4.6
+    scale_gain: float = 0.01
     end_h: float = 10.0
     size_gain: float = 0.05
     form: str = "sequential"
@@ -147,8 +186,11 @@ class EKFSettings:
             raise ValueError(f"a0 = {self.a0!r}, b0 = {self.b0!r}: a0 must be finite and non-zero, b0 finite")
         if not (self.gate == 0.0 or (math.isfinite(self.gate) and self.gate > 0.0)):
             raise ValueError(f"gate = {self.gate!r} standard deviations must be positive, or 0 for no gating")
-        for name in ("cusum_k", "cusum_h", "now_k", "now_h", "end_h", "size_gain"):
+        for name in ("cusum_k", "cusum_h", "now_k", "now_h", "held_k", "held_h", "margin", "scale_gain", "end_h",
+                     "size_gain"):
             _check_positive(name, getattr(self, name), "", "the detector needs a positive allowance and threshold")
+        if int(self.held_lag) != self.held_lag or not 1 <= self.held_lag < PAST_SIZE:
+            raise ValueError(f"held_lag = {self.held_lag!r} must be a whole number of samples in [1, {PAST_SIZE})")
         if self.form not in ("sequential", "joint"):
             raise ValueError(f"form = {self.form!r} must be 'sequential' or 'joint'")
         if self.form == "joint" and self.gate:
@@ -161,6 +203,8 @@ class EKFSettings:
         c[GAMMA2] = self.gate**2
         c[CUSUM_K], c[CUSUM_H], c[NOW_K], c[NOW_H] = self.cusum_k, self.cusum_h, self.now_k, self.now_h
         c[END_H], c[SIZE_GAIN] = self.end_h, self.size_gain
+        c[CONS_K], c[CONS_H], c[MARGIN], c[HELD_LAG] = self.held_k, self.held_h, self.margin, self.held_lag
+        c[SCALE_GAIN] = self.scale_gain
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c
@@ -178,6 +222,7 @@ class EKFSettings:
         s = np.zeros(EKF_SIZE)
         s[A], s[B] = self.a0, self.b0
         s[A_SAFE], s[B_SAFE] = self.a0, self.b0
+        s[HELD_SCALE] = 1.0  # the filter's noise model, until the residuals say otherwise
         P = np.diag(np.square([self.sd_a0, self.sd_b0, self.sd_r0])) if covariance is None else covariance
         P = np.asarray(P, dtype=float)
         if P.shape != (3, 3) or not np.isfinite(P).all() or not np.allclose(P, P.T):
@@ -186,6 +231,8 @@ class EKFSettings:
             raise ValueError(f"initial covariance is not positive definite (eigenvalues {np.linalg.eigvalsh(P)}); "
                              "give positive variances")
         s[[PAA, PAB, PAR, PBB, PBR, PRR]] = P[0, 0], P[0, 1], P[0, 2], P[1, 1], P[1, 2], P[2, 2]
+        for j, value in enumerate((self.a0, self.b0, P[0, 0], P[0, 1], P[1, 1])):  # the held calibrations
+            s[PAST + j * PAST_SIZE:PAST + (j + 1) * PAST_SIZE] = value
         return s
 
 
@@ -279,7 +326,9 @@ _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_g
                "S_ir": GATE_IR, "gps_fault": GPS_FAULT, "ir_fault": IR_FAULT, "gps_used": GPS_USED,
                "ir_used": IR_USED, "ir_suspect": IR_SUSPECT, "nu_ir_now": NU_NOW,
                "S_ir_now": GATE_NOW, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS,
-               "fault_size": FAULT_SIZE}
+               "fault_size": FAULT_SIZE, "nu_held": NU_CONS, "S_held": GATE_CONS,
+               "held_up": CUSUM_CONS + G_UP, "held_down": CUSUM_CONS + G_DOWN,
+               "held_scale": HELD_SCALE}
 _REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
 _RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
 _STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "
@@ -361,6 +410,7 @@ class Estimator:
         self.config = self.settings.config()
         if method == "kalman":
             self.config[WINDOW_SPAN] = self.delay + self.window
+            self.config[RAMP] = self.window
         self.names = tuple(self._fields)
         self._index = np.array(list(self._fields.values()), dtype=np.int64)
         self.reset()

@@ -12,7 +12,7 @@ import math
 
 from numba import njit
 
-from calibration.infrared.detection import check_present, detect
+from calibration.infrared.detection import check_present, consistency, detect, remember_calibration
 from calibration.infrared.layout import (
     AIRSPEED,
     BANK_MAX,
@@ -174,7 +174,10 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     s[GPS_USED] = 1.0 if gps_pass else 0.0
     if gamma2 > 0.0:
         check_present(s, c, ir_now)
+        if have_pair and gps_available:
+            consistency(s, c, ir_pair, gps)
         detect(s, c, gps_available, have_pair)
+        remember_calibration(s)
     _finish(s, ir_now)
 
 
