@@ -65,6 +65,8 @@ from calibration.infrared.layout import (
     GATE_IR,
     GATE_NOW,
     GPS_FAULT,
+    HELD_GPS,
+    HELD_IR,
     HELD_LAG,
     HELD_SCALE,
     HOLD,
@@ -99,6 +101,8 @@ from calibration.infrared.layout import (
     RING_COUNT,
     RING_SIZE,
     SCALE_GAIN,
+    SD_A_HELD,
+    SIGNIFICANCE,
     SIZE_GAIN,
     SUM_DOWN,
     SUM_UP,
@@ -180,6 +184,8 @@ def consistency(s, c, ir_pair, gps):
     held = PAST + (int(s[PAST_COUNT]) - int(c[HELD_LAG])) % PAST_SIZE
     a = s[held]
     s[NU_CONS] = ir_pair - (a * gps + s[held + PAST_SIZE])
+    s[HELD_GPS] = gps
+    s[HELD_IR] = (ir_pair - s[held + PAST_SIZE]) / a
     var_a, cov_ab, var_b = s[held + 2 * PAST_SIZE], s[held + 3 * PAST_SIZE], s[held + 4 * PAST_SIZE]
     s[GATE_CONS] = a * a * c[RG] + c[RI] + gps * (gps * var_a + 2.0 * cov_ab) + var_b
 
@@ -198,47 +204,72 @@ def remember_calibration(s):
 
 
 @njit(cache=True)
-def _remember(s, z):
-    """Keep the normalised consistency residual ``z`` (``nan``: none at this sample) in the ring."""
+def _remember(s, z, gps, ir):
+    """Keep the normalised consistency residual ``z`` and the turn rates of the GPS ``gps`` and
+    of the IR ``ir`` over the residual's deviation (``nan``: none at this sample) in the ring."""
     count = int(s[RING_COUNT])
-    s[RING + count % RING_SIZE] = z
+    slot = RING + count % RING_SIZE
+    s[slot] = z
+    s[slot + RING_SIZE] = gps
+    s[slot + 2 * RING_SIZE] = ir
     s[RING_COUNT] = count + 1
 
 
 @njit(cache=True)
-def _ring(s):
-    """The ring's residuals, oldest first (``nan`` where there was none)."""
+def _ring(s, channel):
+    """One channel of the ring, oldest first (``nan`` where there was none): 0 the residuals,
+    1 the GPS turn rates, 2 the IR's."""
     count = int(s[RING_COUNT])
     first = count - RING_SIZE if count > RING_SIZE else 0
     values = np.empty(count - first)
     for m in range(first, count):
-        values[m - first] = s[RING + m % RING_SIZE]
+        values[m - first] = s[RING + channel * RING_SIZE + m % RING_SIZE]
     return values
 
 
 @njit(cache=True)
-def _fit(x, onset, ramp, sign):
+def _fit(x, u, onset, ramp, sign, ridge):
     """Log-likelihood ratio (unit variance) and size of the best offset ``d`` of sign ``sign``
     with the signature ``f_m = min(1, (m - onset + 1) / ramp)`` from sample ``onset`` on, in the
-    residuals ``x``: ``d = sum f x / sum f^2`` and ``(sum f x)^2 / (2 sum f^2)``."""
-    fx, ff = 0.0, 0.0
-    for m in range(max(onset, 0), x.shape[0]):
+    residuals ``x``, beyond an error of the held calibration: ``delta_b + delta_a u_m`` (``u``:
+    the turn rate, from the sensor the hypothesis holds healthy), fitted with it. The offset must be what the calibration's error, present
+    all along the ring, does not explain: a turn that exposes an error of ``a`` is no fault.
+    ``delta_a`` has a Gaussian prior (``ridge``: the noise variance over its variance), so that
+    a GPS offset, which changes ``u`` as much as ``x`` asks, is not taken for an error of ``a``
+    of the size of ``a`` itself."""
+    n, su, suu, sx, sux, sf, suf, sff, sfx = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for m in range(x.shape[0]):
         if x[m] == x[m]:
-            f = min(1.0, (m - onset + 1) / ramp)
-            fx += f * x[m]
-            ff += f * f
-    if ff == 0.0 or fx * sign <= 0.0:
+            f = 0.0 if m < onset else min(1.0, (m - onset + 1) / ramp)
+            n += 1.0
+            su += u[m]
+            suu += u[m] * u[m]
+            sx += x[m]
+            sux += u[m] * x[m]
+            sf += f
+            suf += u[m] * f
+            sff += f * f
+            sfx += f * x[m]
+    suu += ridge
+    det = n * suu - su * su
+    if det > 1e-9 * n * suu:  # project the offset's signature and the residuals off (1, u)
+        fx = sfx - (sf * (suu * sx - su * sux) + suf * (n * sux - su * sx)) / det
+        ff = sff - (sf * (suu * sf - su * suf) + suf * (n * suf - su * sf)) / det
+    else:  # a steady turn: u is a constant, the calibration's error one offset
+        fx = sfx - sf * sx / n if n > 0.0 else 0.0
+        ff = sff - sf * sf / n if n > 0.0 else 0.0
+    if ff <= 1e-9 * sff or fx * sign <= 0.0:
         return 0.0, 0.0
     return 0.5 * fx * fx / ff, fx / ff
 
 
 @njit(cache=True)
-def _best(x, ramp, sign):
+def _best(x, u, ramp, sign, ridge):
     """The generalised likelihood ratio over every onset in the ring (a ramp may have started
-    before it): the largest log-likelihood ratio and its offset."""
+    before it): the largest log-likelihood ratio and its offset (:func:`_fit`)."""
     best, size = 0.0, 0.0
     for onset in range(1 - int(ramp), x.shape[0]):
-        llr, d = _fit(x, onset, ramp, sign)
+        llr, d = _fit(x, u, onset, ramp, sign, ridge)
         if llr > best:
             best, size = llr, d
     return best, size
@@ -249,19 +280,24 @@ def attribute(s, c):
     """Which sensor the consistency CUSUM's alarm comes from, by the shape of the residual in
     the ring: an offset of the GPS turn rate enters it as a step (the sample it starts), one of
     the IR as a ramp over the GPS window (``c[RAMP]`` samples, as the faulty samples fill the
-    paired mean). A generalised likelihood ratio with each signature, the onset and size
-    free; the sensor whose signature is more likely by ``c[MARGIN]`` (log-likelihood, the
-    residuals scaled by their own spread while no offset showed, ``s[HELD_SCALE]``) is named.
-    Returns ``(sensor, size)``: 1 the GPS, 2 the IR, 0 not yet told apart; the size in
+    paired mean). A generalised likelihood ratio with each signature, the onset and size free,
+    beyond an error of the held calibration (:func:`_fit`); log-likelihoods in units of the
+    residual's own spread while no offset showed (``s[HELD_SCALE]``). A fault needs the better
+    signature to reach ``c[SIGNIFICANCE]`` and to beat the other by ``c[MARGIN]``. Returns
+    ``(sensor, size)``: 1 the GPS, 2 the IR, 0 none or not yet told apart; the size in
     normalised units."""
     sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
-    x = _ring(s)
-    step, step_size = _best(x, 1.0, sign)
-    ramp, ramp_size = _best(x, c[RAMP], sign)
-    evidence = (step - ramp) / s[HELD_SCALE]  # in units of the residual's own spread
-    if evidence > c[MARGIN]:
+    x = _ring(s, 0)
+    scale = s[HELD_SCALE]
+    ridge = scale / (c[SD_A_HELD] * c[SD_A_HELD])
+    # each hypothesis takes the turn rate from the sensor it holds healthy
+    step, step_size = _best(x, _ring(s, 2), 1.0, sign, ridge)
+    ramp, ramp_size = _best(x, _ring(s, 1), c[RAMP], sign, ridge)
+    if (step if step > ramp else ramp) < c[SIGNIFICANCE] * scale:
+        return 0, 0.0
+    if step - ramp > c[MARGIN] * scale:
         return 1, step_size
-    if evidence < -c[MARGIN]:
+    if ramp - step > c[MARGIN] * scale:
         return 2, ramp_size
     return 0, 0.0
 
@@ -370,13 +406,14 @@ def detect(s, c, gps_seen, pair_seen):
     now = cusum(s, CUSUM_NOW, s[NU_NOW], s[GATE_NOW], c[NOW_K], c[NOW_H])
     held = -1.0
     if pair_seen:
-        z = s[NU_CONS] / math.sqrt(s[GATE_CONS])
-        _remember(s, z)
+        root = math.sqrt(s[GATE_CONS])
+        z = s[NU_CONS] / root
+        _remember(s, z, s[HELD_GPS] / root, s[HELD_IR] / root)
         held = cusum(s, CUSUM_CONS, s[NU_CONS], s[GATE_CONS], c[CONS_K], c[CONS_H])
         if held == -1.0:  # its statistic is zero: no offset shows, the residual is noise and drift
             s[HELD_SCALE] += c[SCALE_GAIN] * (z * z - s[HELD_SCALE])
     else:
-        _remember(s, math.nan)
+        _remember(s, math.nan, math.nan, math.nan)
     ir = pair if pair > now else now
     if gps <= 0.0 and ir <= 0.0:
         sensor, size = attribute(s, c) if held > 0.0 else (0, 0.0)

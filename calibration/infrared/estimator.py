@@ -74,6 +74,8 @@ from calibration.infrared.layout import (
     RLS_B,
     RLS_RATE,
     SCALE_GAIN,
+    SD_A_HELD,
+    SIGNIFICANCE,
     SIZE_GAIN,
     STATUS,
     WINDOW_SPAN,
@@ -141,6 +143,14 @@ class EKFSettings:
         Log-likelihood by which one sensor's signature in the consistency residual (the GPS:
         a step; the IR: a ramp over the GPS window) must beat the other's before a fault is
         declared on it, the residual scaled by its own spread: ``log 100``.
+    significance : float
+        Log-likelihood (the residual scaled by its own spread) that an offset starting inside
+        the attribution ring must reach beyond an error of the held calibration (``delta_b +
+        delta_a r``, which a change of the turn exposes) before a fault is declared.
+    sd_a_held : float
+        Prior standard deviation of the held calibration's error of ``a`` (count per rad/s)
+        in that test: the largest error of the filter's ``a`` 10 samples old on the fault-free
+        flights of seeds 101 to 200 was 51.
     scale_gain : float
         Weight per sample of the running mean square of the normalised consistency residual
         while its CUSUM is zero (1 / samples): the spread the attribution scales by.
@@ -174,6 +184,8 @@ class EKFSettings:
     held_h: float = 10.0
     held_lag: int = 10
     margin: float = 4.6
+    significance: float = 25.0
+    sd_a_held: float = 50.0
     scale_gain: float = 0.01
     end_h: float = 10.0
     size_gain: float = 0.05
@@ -186,8 +198,8 @@ class EKFSettings:
             raise ValueError(f"a0 = {self.a0!r}, b0 = {self.b0!r}: a0 must be finite and non-zero, b0 finite")
         if not (self.gate == 0.0 or (math.isfinite(self.gate) and self.gate > 0.0)):
             raise ValueError(f"gate = {self.gate!r} standard deviations must be positive, or 0 for no gating")
-        for name in ("cusum_k", "cusum_h", "now_k", "now_h", "held_k", "held_h", "margin", "scale_gain", "end_h",
-                     "size_gain"):
+        for name in ("cusum_k", "cusum_h", "now_k", "now_h", "held_k", "held_h", "margin", "significance", "sd_a_held",
+                     "scale_gain", "end_h", "size_gain"):
             _check_positive(name, getattr(self, name), "", "the detector needs a positive allowance and threshold")
         if int(self.held_lag) != self.held_lag or not 1 <= self.held_lag < PAST_SIZE:
             raise ValueError(f"held_lag = {self.held_lag!r} must be a whole number of samples in [1, {PAST_SIZE})")
@@ -204,7 +216,7 @@ class EKFSettings:
         c[CUSUM_K], c[CUSUM_H], c[NOW_K], c[NOW_H] = self.cusum_k, self.cusum_h, self.now_k, self.now_h
         c[END_H], c[SIZE_GAIN] = self.end_h, self.size_gain
         c[CONS_K], c[CONS_H], c[MARGIN], c[HELD_LAG] = self.held_k, self.held_h, self.margin, self.held_lag
-        c[SCALE_GAIN] = self.scale_gain
+        c[SCALE_GAIN], c[SIGNIFICANCE], c[SD_A_HELD] = self.scale_gain, self.significance, self.sd_a_held
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c

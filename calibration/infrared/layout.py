@@ -21,11 +21,13 @@ G_UP, SUM_UP, N_UP, G_DOWN, SUM_DOWN, N_DOWN = range(6)
 CUSUM_SIZE = 6
 # the GPS-IR consistency residual against the calibration of HELD_LAG samples before, its
 # variance, its CUSUM, the running mean square of its normalised values while no offset shows,
-# the ring of those values that attributes a fault, and the ring of the past calibrations
-# (a, b, then their covariance PAA, PAB, PBB; one per sample)
-NU_CONS, GATE_CONS, CUSUM_CONS, RING_COUNT, HELD_SCALE, RING = 46, 47, 48, 54, 55, 56
+# the turn rates it was taken at (the GPS's, and the paired IR's through the held calibration),
+# the ring of those values (normalised residual, then the two turn rates over its deviation) that
+# attributes a fault, and the ring of the past calibrations (a, b, then their covariance PAA,
+# PAB, PBB; one per sample)
+NU_CONS, GATE_CONS, CUSUM_CONS, RING_COUNT, HELD_SCALE, HELD_GPS, HELD_IR, RING = 46, 47, 48, 54, 55, 56, 57, 58
 RING_SIZE = 60  # samples: 3 s at 20 Hz, the onset of the fault and the GPS window's ramp
-PAST_COUNT = RING + RING_SIZE
+PAST_COUNT = RING + 3 * RING_SIZE
 PAST = PAST_COUNT + 1
 PAST_SIZE = 60  # samples: the longest lag of the held calibration
 PAST_FIELDS = 5
@@ -34,9 +36,10 @@ EKF_SIZE = PAST + PAST_FIELDS * PAST_SIZE
 # WINDOW_SPAN: delay + window of the GPS pairing (samples), set by the estimator.
 QA, QB, QR, RG, RI, GAMMA2, LAG, RI1, PA0, PB0 = range(10)
 CUSUM_K, CUSUM_H, NOW_K, NOW_H, END_H, SIZE_GAIN, WINDOW_SPAN = range(10, 17)
-# the consistency detector: allowance and threshold, attribution margin (log-likelihood), GPS window (samples)
-CONS_K, CONS_H, MARGIN, RAMP, HELD_LAG, SCALE_GAIN = range(17, 23)
-EKF_CONFIG_SIZE = 23
+# the consistency detector: allowance and threshold, attribution margin (log-likelihood), GPS window (samples),
+# lag of the held calibration (samples), weight of its spread, significance, prior deviation of a's error
+CONS_K, CONS_H, MARGIN, RAMP, HELD_LAG, SCALE_GAIN, SIGNIFICANCE, SD_A_HELD = range(17, 25)
+EKF_CONFIG_SIZE = 25
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 
