@@ -185,7 +185,7 @@ def consistency(s, c, ir_pair, gps):
     a = s[held]
     s[NU_CONS] = ir_pair - (a * gps + s[held + PAST_SIZE])
     s[HELD_GPS] = gps
-    s[HELD_IR] = (ir_pair - s[held + PAST_SIZE]) / a
+    s[HELD_IR] = ir_pair
     var_a, cov_ab, var_b = s[held + 2 * PAST_SIZE], s[held + 3 * PAST_SIZE], s[held + 4 * PAST_SIZE]
     s[GATE_CONS] = a * a * c[RG] + c[RI] + gps * (gps * var_a + 2.0 * cov_ab) + var_b
 
@@ -204,39 +204,46 @@ def remember_calibration(s):
 
 
 @njit(cache=True)
-def _remember(s, z, gps, ir):
-    """Keep the normalised consistency residual ``z`` and the turn rates of the GPS ``gps`` and
-    of the IR ``ir`` over the residual's deviation (``nan``: none at this sample) in the ring."""
+def _remember(s, ir_pair, gps, S):
+    """Keep the paired IR ``ir_pair`` (count), the GPS turn rate ``gps`` (rad/s) and the
+    consistency residual's variance ``S`` (count^2) in the ring; ``nan`` for a sample without."""
     count = int(s[RING_COUNT])
     slot = RING + count % RING_SIZE
-    s[slot] = z
+    s[slot] = ir_pair
     s[slot + RING_SIZE] = gps
-    s[slot + 2 * RING_SIZE] = ir
+    s[slot + 2 * RING_SIZE] = S
     s[RING_COUNT] = count + 1
 
 
 @njit(cache=True)
-def _ring(s, channel):
-    """One channel of the ring, oldest first (``nan`` where there was none): 0 the residuals,
-    1 the GPS turn rates, 2 the IR's."""
+def _ring(s):
+    """The ring's samples, oldest first, against the calibration from before its oldest (one
+    sample per step since the last restart): the normalised consistency residual ``x`` and the
+    turn rate by the GPS and by the IR over its deviation (``nan`` where there was none)."""
     count = int(s[RING_COUNT])
-    first = count - RING_SIZE if count > RING_SIZE else 0
-    values = np.empty(count - first)
-    for m in range(first, count):
-        values[m - first] = s[RING + channel * RING_SIZE + m % RING_SIZE]
-    return values
+    n = count if count < RING_SIZE else RING_SIZE
+    ref = PAST + (int(s[PAST_COUNT]) - n) % PAST_SIZE
+    a, b = s[ref], s[ref + PAST_SIZE]
+    x, by_gps, by_ir = np.empty(n), np.empty(n), np.empty(n)
+    for m in range(n):
+        slot = RING + (count - n + m) % RING_SIZE
+        ir_pair, gps, root = s[slot], s[slot + RING_SIZE], math.sqrt(s[slot + 2 * RING_SIZE])
+        x[m] = (ir_pair - (a * gps + b)) / root
+        by_gps[m] = gps / root
+        by_ir[m] = (ir_pair - b) / (a * root)
+    return x, by_gps, by_ir
 
 
 @njit(cache=True)
 def _fit(x, u, onset, ramp, sign, ridge):
     """Log-likelihood ratio (unit variance) and size of the best offset ``d`` of sign ``sign``
     with the signature ``f_m = min(1, (m - onset + 1) / ramp)`` from sample ``onset`` on, in the
-    residuals ``x``, beyond an error of the held calibration: ``delta_b + delta_a u_m`` (``u``:
-    the turn rate, from the sensor the hypothesis holds healthy), fitted with it. The offset must be what the calibration's error, present
-    all along the ring, does not explain: a turn that exposes an error of ``a`` is no fault.
-    ``delta_a`` has a Gaussian prior (``ridge``: the noise variance over its variance), so that
-    a GPS offset, which changes ``u`` as much as ``x`` asks, is not taken for an error of ``a``
-    of the size of ``a`` itself."""
+    residuals ``x``, beyond an error of the calibration they are taken against, ``delta_b +
+    delta_a u_m`` (``u``: the turn rate, from the sensor the hypothesis holds healthy), fitted
+    with it. The offset must be what the calibration's error, present all along the ring, does
+    not explain: a turn that exposes an error of ``a`` is no fault. ``delta_a`` has a Gaussian
+    prior (``ridge``: the noise variance over its variance), so that an offset is not taken for
+    an error of ``a`` of the size of ``a`` itself."""
     n, su, suu, sx, sux, sf, suf, sff, sfx = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for m in range(x.shape[0]):
         if x[m] == x[m]:
@@ -287,12 +294,12 @@ def attribute(s, c):
     ``(sensor, size)``: 1 the GPS, 2 the IR, 0 none or not yet told apart; the size in
     normalised units."""
     sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
-    x = _ring(s, 0)
+    x, by_gps, by_ir = _ring(s)
     scale = s[HELD_SCALE]
     ridge = scale / (c[SD_A_HELD] * c[SD_A_HELD])
     # each hypothesis takes the turn rate from the sensor it holds healthy
-    step, step_size = _best(x, _ring(s, 2), 1.0, sign, ridge)
-    ramp, ramp_size = _best(x, _ring(s, 1), c[RAMP], sign, ridge)
+    step, step_size = _best(x, by_ir, 1.0, sign, ridge)
+    ramp, ramp_size = _best(x, by_gps, c[RAMP], sign, ridge)
     if (step if step > ramp else ramp) < c[SIGNIFICANCE] * scale:
         return 0, 0.0
     if step - ramp > c[MARGIN] * scale:
@@ -400,20 +407,12 @@ def detect(s, c, gps_seen, pair_seen):
         s[HOLD] -= 1.0
         pair_seen = False
     if not gps_seen:  # one sensor alone: a drift and a fault look alike, and nothing would replace it
+        _remember(s, math.nan, math.nan, math.nan)
         return
     gps = cusum(s, CUSUM_GPS, s[NU_GPS], s[GATE_GPS], c[CUSUM_K], c[CUSUM_H]) if gps_seen else -1.0
     pair = cusum(s, CUSUM_PAIR, s[NU_IR], s[GATE_IR], c[CUSUM_K], c[CUSUM_H]) if pair_seen else -1.0
     now = cusum(s, CUSUM_NOW, s[NU_NOW], s[GATE_NOW], c[NOW_K], c[NOW_H])
-    held = -1.0
-    if pair_seen:
-        root = math.sqrt(s[GATE_CONS])
-        z = s[NU_CONS] / root
-        _remember(s, z, s[HELD_GPS] / root, s[HELD_IR] / root)
-        held = cusum(s, CUSUM_CONS, s[NU_CONS], s[GATE_CONS], c[CONS_K], c[CONS_H])
-        if held == -1.0:  # its statistic is zero: no offset shows, the residual is noise and drift
-            s[HELD_SCALE] += c[SCALE_GAIN] * (z * z - s[HELD_SCALE])
-    else:
-        _remember(s, math.nan, math.nan, math.nan)
+    held = _held(s, c, pair_seen)
     ir = pair if pair > now else now
     if gps <= 0.0 and ir <= 0.0:
         sensor, size = attribute(s, c) if held > 0.0 else (0, 0.0)
@@ -427,6 +426,22 @@ def detect(s, c, gps_seen, pair_seen):
     s[END_STAT] = 0.0
     s[END_PAIR] = -1.0  # not armed
     restart(s)
+
+
+@njit(cache=True)
+def _held(s, c, pair_seen):
+    """The consistency CUSUM on this sample's residual (how far over its threshold, in
+    thresholds; -1 when it is zero or there is no residual), the sample kept in the ring, and
+    the residual's spread followed while its statistic is zero."""
+    if not pair_seen:
+        _remember(s, math.nan, math.nan, math.nan)
+        return -1.0
+    _remember(s, s[HELD_IR], s[HELD_GPS], s[GATE_CONS])
+    held = cusum(s, CUSUM_CONS, s[NU_CONS], s[GATE_CONS], c[CONS_K], c[CONS_H])
+    if held == -1.0:  # its statistic is zero: no offset shows, the residual is noise and drift
+        z = s[NU_CONS] / math.sqrt(s[GATE_CONS])
+        s[HELD_SCALE] += c[SCALE_GAIN] * (z * z - s[HELD_SCALE])
+    return held
 
 
 @njit(cache=True)

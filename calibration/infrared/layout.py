@@ -21,15 +21,14 @@ G_UP, SUM_UP, N_UP, G_DOWN, SUM_DOWN, N_DOWN = range(6)
 CUSUM_SIZE = 6
 # the GPS-IR consistency residual against the calibration of HELD_LAG samples before, its
 # variance, its CUSUM, the running mean square of its normalised values while no offset shows,
-# the turn rates it was taken at (the GPS's, and the paired IR's through the held calibration),
-# the ring of those values (normalised residual, then the two turn rates over its deviation) that
-# attributes a fault, and the ring of the past calibrations (a, b, then their covariance PAA,
-# PAB, PBB; one per sample)
+# the GPS turn rate and the paired IR it was taken from, the ring of the samples since the last
+# restart that attributes a fault (paired IR, then GPS turn rate, then the residual's variance),
+# and the ring of the past calibrations (a, b, then their covariance PAA, PAB, PBB; one per sample)
 NU_CONS, GATE_CONS, CUSUM_CONS, RING_COUNT, HELD_SCALE, HELD_GPS, HELD_IR, RING = 46, 47, 48, 54, 55, 56, 57, 58
 RING_SIZE = 60  # samples: 3 s at 20 Hz, the onset of the fault and the GPS window's ramp
 PAST_COUNT = RING + 3 * RING_SIZE
 PAST = PAST_COUNT + 1
-PAST_SIZE = 60  # samples: the longest lag of the held calibration
+PAST_SIZE = RING_SIZE + 4  # samples: the calibration from before the attribution ring, and the held one
 PAST_FIELDS = 5
 EKF_SIZE = PAST + PAST_FIELDS * PAST_SIZE
 # EKF configuration c: process noise variances per sample, measurement variances, gate, detectors.
