@@ -6,6 +6,8 @@ on, seed 1) with one fault at a time, the slides' onsets and lengths (IR from 60
 declaration, the sensor it was attributed to, and how long after its end it was ended; then
 flies fault-free flights (seeds 1 to 100 by default) and counts the faults declared there.
 The filter's detectors are those of :mod:`calibration.infrared.detection`.
+:mod:`scenarios.ir_detectability` measures why the smallest faults escape and what the detectors'
+settings were set on.
 """
 
 from __future__ import annotations
@@ -18,8 +20,8 @@ import numpy as np
 from calibration.infrared import EKFSettings, Estimator
 from scenarios.ir_calibration import fault_report, fault_windows, simulate_flight
 
-IR_SIZES = (100.0, 200.0, 400.0, 800.0, 1200.0)  # count
-GPS_SIZES = (0.1, 0.2, 0.3, 0.5, 1.0, 1.5)  # rad/s
+IR_SIZES = (50.0, 100.0, 200.0, 400.0, 800.0, 1200.0)  # count
+GPS_SIZES = (0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5)  # rad/s
 CLEAN_SEEDS = (1, 100)  # first and last seed of the fault-free flights
 SAMPLES = 8000
 

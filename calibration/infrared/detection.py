@@ -283,16 +283,10 @@ def _best(x, u, ramp, sign, ridge):
 
 
 @njit(cache=True)
-def attribute(s, c):
-    """Which sensor the consistency CUSUM's alarm comes from, by the shape of the residual in
-    the ring: an offset of the GPS turn rate enters it as a step (the sample it starts), one of
-    the IR as a ramp over the GPS window (``c[RAMP]`` samples, as the faulty samples fill the
-    paired mean). A generalised likelihood ratio with each signature, the onset and size free,
-    beyond an error of the held calibration (:func:`_fit`); log-likelihoods in units of the
-    residual's own spread while no offset showed (``s[HELD_SCALE]``). A fault needs the better
-    signature to reach ``c[SIGNIFICANCE]`` and to beat the other by ``c[MARGIN]``. Returns
-    ``(sensor, size)``: 1 the GPS, 2 the IR, 0 none or not yet told apart; the size in
-    normalised units."""
+def evidence(s, c):
+    """The generalised likelihood ratios of the ring (:func:`attribute`), in units of the
+    residual's own spread: ``(larger, step, ramp, step_size, ramp_size)``, the sizes in
+    normalised units, of the sign of the consistency CUSUM's higher side."""
     sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
     x, by_gps, by_ir = _ring(s)
     scale = s[HELD_SCALE]
@@ -300,11 +294,27 @@ def attribute(s, c):
     # each hypothesis takes the turn rate from the sensor it holds healthy
     step, step_size = _best(x, by_ir, 1.0, sign, ridge)
     ramp, ramp_size = _best(x, by_gps, c[RAMP], sign, ridge)
-    if (step if step > ramp else ramp) < c[SIGNIFICANCE] * scale:
+    step, ramp = step / scale, ramp / scale
+    return (step if step > ramp else ramp), step, ramp, step_size, ramp_size
+
+
+@njit(cache=True)
+def attribute(s, c):
+    """Which sensor the consistency CUSUM's alarm comes from, by the shape of the residual in
+    the ring: an offset of the GPS turn rate enters it as a step (the sample it starts), one of
+    the IR as a ramp over the GPS window (``c[RAMP]`` samples, as the faulty samples fill the
+    paired mean). A generalised likelihood ratio with each signature, the onset and size free,
+    beyond an error of the calibration (:func:`_fit`); log-likelihoods in units of the
+    residual's own spread while no offset showed (``s[HELD_SCALE]``). A fault needs the better
+    signature to reach ``c[SIGNIFICANCE]`` and to beat the other by ``c[MARGIN]``. Returns
+    ``(sensor, size)``: 1 the GPS, 2 the IR, 0 none or not yet told apart; the size in
+    normalised units."""
+    larger, step, ramp, step_size, ramp_size = evidence(s, c)
+    if larger < c[SIGNIFICANCE]:
         return 0, 0.0
-    if step - ramp > c[MARGIN] * scale:
+    if step - ramp > c[MARGIN]:
         return 1, step_size
-    if ramp - step > c[MARGIN] * scale:
+    if ramp - step > c[MARGIN]:
         return 2, ramp_size
     return 0, 0.0
 
