@@ -21,6 +21,16 @@ small offsets the gate lets through (and that the filter would otherwise absorb 
 - While a fault is declared, the faulty sensor is not fused (the IR: ``a`` and ``b`` held, the
   turn rate from the GPS; the GPS: the IR alone, ``a`` and ``b`` held), and its innovation is
   still computed against the state.
+- The filter's own innovations show a small offset only while ``b`` and ``a`` absorb it (within
+  seconds: the random walks that follow the drift follow an offset too). A fourth CUSUM runs on
+  the GPS-IR consistency residual ``IR_pair - (a gps + b)`` against the calibration of
+  ``held_lag`` samples before (:func:`consistency`), which has not absorbed it yet. Its alarm is
+  attributed by the residual's shape over the last ``RING_SIZE`` samples (:func:`attribute`): a
+  GPS offset enters it as a step, an IR offset as a ramp over the GPS window; a generalised
+  likelihood ratio fits each, onset and size free, beyond a constant error of the calibration
+  (``delta_b + delta_a r``, which a change of the turn exposes), and names the sensor only when
+  one shape is clearly the better; until then nothing is declared. The fault then proceeds as
+  below, ``a`` and ``b`` set back to that held calibration.
 - The fault ends when that sensor is consistent again: a CUSUM of the log-likelihood ratio of
   "no offset" against "the offset ``d`` estimated" (the mean innovation over the run that
   raised the alarm, then a running mean while the evidence favours the fault),

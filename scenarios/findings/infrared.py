@@ -1,8 +1,10 @@
 """Findings of the in-flight infrared calibration: the estimators' errors, the fault detection, the cost.
 
 ``quadcosim run ir-calibration`` in five cases, ``python -m scenarios.ir_detection`` (a fault of
-each size, then fault-free flights of seeds 1 to 100) and ``quadcosim bench infrared`` (the
-operation count; its timings are not findings). The quick subset: the two faults the
+each size, then fault-free flights of seeds 1 to 100, and of seeds 201 to 300),
+``python -m scenarios.ir_detectability`` (the small faults in the filter's innovations, and what
+the consistency detector was set on) and ``quadcosim bench infrared`` (the operation count; its
+timings are not findings). The quick subset: the two faults the
 acceptance names (IR +400 counts, GPS +0.3 rad/s).
 """
 
@@ -12,6 +14,8 @@ from scenarios.findings import command, finding
 
 RUN = "quadcosim run ir-calibration"
 DETECTION = "python -m scenarios.ir_detection"
+FRESH = (201, 300)  # fault-free flights no setting was chosen on, nor any design looked at
+DETECTABILITY = "python -m scenarios.ir_detectability"
 BENCH = "quadcosim bench infrared"
 CASES = {"drift": {}, "no_drift": {"drift": False}, "no_gps_resetting": {"gps_resetting": False},
          "faults": {"faults": "both"}, "faults_ungated": {"faults": "both", "gating": False}}
@@ -74,12 +78,42 @@ def detection(sizes=None) -> list[dict]:
 
 
 def fault_free() -> list[dict]:
-    """Faults declared over the fault-free flights of seeds 1 to 100."""
+    """Faults declared over the fault-free flights of seeds 1 to 100, and of seeds 201 to 300."""
     from scenarios import ir_detection
 
     clean = ir_detection.false_alarms()
+    fresh = ir_detection.false_alarms(range(FRESH[0], FRESH[1] + 1))
+    fresh_command = f"{DETECTION} --seeds {FRESH[0]}:{FRESH[1]}"
     return [finding("infrared.fault_free.flights", clean["flights"], "1", DETECTION, 0.0, 0),
-            finding("infrared.fault_free.false_alarms", clean["false_alarms"], "1", DETECTION, 0.0, 0)]
+            finding("infrared.fault_free.false_alarms", clean["false_alarms"], "1", DETECTION, 0.0, 0),
+            finding("infrared.fault_free.fresh_flights", fresh["flights"], "1", fresh_command, 0.0, 0),
+            finding("infrared.fault_free.fresh_false_alarms", fresh["false_alarms"], "1", fresh_command, 0.0, 0)]
+
+
+def detectability() -> list[dict]:
+    """Why the small faults escaped the CUSUMs on the filter's innovations (seed 1), and what the
+    consistency detector was set on (seeds 101 to 200)."""
+    from scenarios import ir_detectability
+
+    e = ir_detectability.explain()
+    free = e["fault_free"]
+    found = [finding(f"infrared.detectability.fault_free.{name}_std", free[name], "1", DETECTABILITY, 0.005, 2)
+             for name in ("gps", "pair", "held")]
+    found += [finding("infrared.detectability.fault_free.held_std_count", free["held_count"], "count",
+                      DETECTABILITY, 0.05, 1),
+              finding("infrared.detectability.fault_free.b_rate_max", free["b_rate_max"], "count/s", DETECTABILITY,
+                      0.05, 1)]
+    for sensor, size in ir_detectability.FAULTS:
+        row, label = e[f"{sensor}_{size:g}"], f"infrared.detectability.{sensor}_{size:g}".replace("0.", "0_")
+        found += [finding(f"{label}.{name}", row[name], "1", DETECTABILITY, 0.005, 2)
+                  for name in ("gps", "pair", "held")]
+        found += [finding(f"{label}.b_shift", row["b_shift"], "count", DETECTABILITY, 0.05, 1),
+                  finding(f"{label}.a_shift", row["a_shift"], "count s/rad", DETECTABILITY, 0.05, 1),
+                  finding(f"{label}.held_count", row["held_count"], "count", DETECTABILITY, 0.05, 1)]
+    trained, command = ir_detectability.calibrate(), f"{DETECTABILITY} --calibrate"
+    return found + [finding("infrared.training.statistic_max", trained["statistic_max"], "1", command, 0.005, 2),
+                    finding("infrared.training.a_error_max", trained["a_error_max"], "count s/rad", command, 0.05, 1),
+                    finding("infrared.training.significance_max", trained["significance_max"], "1", command, 0.05, 1)]
 
 
 def cost() -> list[dict]:
@@ -97,4 +131,4 @@ def compute(quick: bool = False) -> list[dict]:
     """Every infrared finding; ``quick``: the declarations of IR +400 and GPS +0.3 (two flights)."""
     if quick:
         return detection([("ir", 400.0), ("gps", 0.3)])
-    return errors() + detection() + fault_free() + cost()
+    return errors() + detection() + fault_free() + detectability() + cost()
