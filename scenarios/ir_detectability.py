@@ -8,6 +8,11 @@ innovations, against their fault-free spread; how much of it the filter has abso
 and ``a`` 3 s after it reached the filter; and its size in the consistency residual against the
 calibration held from before it (:func:`calibration.infrared.detection.consistency`).
 
+``--ramps`` flies the IR +400 counts and GPS +0.3 rad/s faults of the acceptance ramped in over
+2 to 60 s instead of at once (held for the slides' 2000 samples, then removed at once), and
+prints when and on which sensor each was declared: how slow an offset may come before the filter
+takes it for drift.
+
 ``--calibrate`` prints what the consistency detector's settings were set on, from the
 fault-free flights of seeds 101 to 200: the largest statistic of its CUSUM (against its threshold
 ``held_h``), the largest error of the held ``a`` (``sd_a_held``) and the largest attribution
@@ -22,7 +27,7 @@ import sys
 import numpy as np
 
 from calibration.infrared import EKFSettings, Estimator
-from scenarios.ir_calibration import GPS_FAULT, IR_FAULT, RATE, simulate_flight
+from scenarios.ir_calibration import FAULT_SAMPLES, GPS_FAULT, IR_FAULT, RATE, episodes, simulate_flight
 
 SAMPLES = 8000
 SETTLED_S = 30.0  # s: the spreads are taken after the filter has converged
@@ -33,6 +38,8 @@ TRAINING = (101, 200)  # the fault-free flights the settings were chosen on
 WATCHED = 3.0  # consistency statistic above which the attribution's evidence is recorded
 FAULTS = (("ir", 100.0), ("gps", 0.2))
 NEVER = 1e12  # a consistency threshold no statistic reaches: the detector watches, never declares
+RAMPED = (("ir", 400.0), ("gps", 0.3))  # the acceptance's faults (count, rad/s)
+RAMPS_S = (2.0, 5.0, 10.0, 20.0, 60.0)  # s over which they come in
 
 
 def _run(flight: dict, settings: EKFSettings | None = None) -> dict:
@@ -87,6 +94,46 @@ def explain(seed: int = 1) -> dict:
         first = slice(reached, reached + int(RATE))
         row["held_count"] = float(np.mean(estimate["nu_held"][first] - clean["nu_held"][first]))
         out[f"{sensor}_{size:g}"] = row
+    return out
+
+
+def ramped(sensor: str, size: float, ramp_s: float, seed: int = 1) -> dict:
+    """A fault that comes in linearly over ``ramp_s`` from the slides' onset, stays for the
+    slides' 2000 samples, then goes at once.
+
+    Parameters
+    ----------
+    sensor : {"ir", "gps"}
+        The faulty sensor.
+    size : float
+        Its offset once in (count for the IR, rad/s for the GPS).
+    ramp_s : float
+        Time it takes to come in (s).
+    seed : int
+        Flight and noise seed.
+
+    Returns
+    -------
+    dict
+        ``declared_after_s`` (s after the onset, None if not declared while it lasted) and
+        ``attributed`` (the sensor declared then); ``end_declared`` (a fault declared when it
+        went, the filter having absorbed it) and ``end_cleared`` (that declaration ended before
+        the flight's end).
+    """
+    flight = simulate_flight(SAMPLES, seed=seed)
+    onset = IR_FAULT[0] if sensor == "ir" else GPS_FAULT[0]
+    end = onset + FAULT_SAMPLES / RATE
+    t = flight["time"]
+    shape = np.clip((t - onset) / ramp_s, 0.0, 1.0) * (t < end - 1e-9)
+    flight["ir" if sensor == "ir" else "gps_turn_rate"] += size * shape
+    estimate = _run(flight)
+    out = {"declared_after_s": None, "attributed": None, "end_declared": False, "end_cleared": False}
+    for name in ("ir", "gps"):
+        for start, stop in episodes(estimate[f"{name}_fault"], t):
+            if onset <= start < end and (out["declared_after_s"] is None or start - onset < out["declared_after_s"]):
+                out["declared_after_s"], out["attributed"] = start - onset, name
+            elif start >= end:
+                out["end_declared"], out["end_cleared"] = True, stop is not None
     return out
 
 
@@ -145,7 +192,18 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--calibrate", action="store_true",
                         help="what the consistency detector's settings were set on (seeds 101 to 200, about a minute)")
+    parser.add_argument("--ramps", action="store_true", help="the acceptance's faults ramped in over 2 to 60 s")
     args = parser.parse_args(argv)
+    if args.ramps:
+        for sensor, size in RAMPED:
+            for ramp_s in RAMPS_S:
+                r = ramped(sensor, size, ramp_s)
+                declared = ("not declared while it lasted" if r["declared_after_s"] is None else
+                            f"declared after {r['declared_after_s']:.2f} s on {r['attributed']}")
+                gone = ("its end declared as a fault, " + ("ended" if r["end_cleared"] else "never ended")
+                        if r["end_declared"] else "nothing declared at its end")
+                print(f"{sensor} +{size:g} in over {ramp_s:g} s: {declared}; {gone}")
+        return 0
     if args.calibrate:
         c = calibrate()
         print(f"fault-free flights, seeds {TRAINING[0]} to {TRAINING[1]}: consistency CUSUM statistic at most "

@@ -91,8 +91,9 @@ def fault_free() -> list[dict]:
 
 
 def detectability() -> list[dict]:
-    """Why the small faults escaped the CUSUMs on the filter's innovations (seed 1), and what the
-    consistency detector was set on (seeds 101 to 200)."""
+    """Why the small faults escaped the CUSUMs on the filter's innovations (seed 1), how slow a
+    fault may come before it passes for drift, and what the consistency detector was set on
+    (seeds 101 to 200)."""
     from scenarios import ir_detectability
 
     e = ir_detectability.explain()
@@ -110,6 +111,12 @@ def detectability() -> list[dict]:
         found += [finding(f"{label}.b_shift", row["b_shift"], "count", DETECTABILITY, 0.05, 1),
                   finding(f"{label}.a_shift", row["a_shift"], "count s/rad", DETECTABILITY, 0.05, 1),
                   finding(f"{label}.held_count", row["held_count"], "count", DETECTABILITY, 0.05, 1)]
+    for sensor, size in ir_detectability.RAMPED:
+        for ramp_s in ir_detectability.RAMPS_S:
+            r = ir_detectability.ramped(sensor, size, ramp_s)
+            if r["declared_after_s"] is not None:  # one never declared gives no finding (the page says so)
+                found.append(finding(f"infrared.ramps.{sensor}_{ramp_s:g}s.declared_after_s", r["declared_after_s"],
+                                     "s", f"{DETECTABILITY} --ramps", 0.005, 2))
     trained, command = ir_detectability.calibrate(), f"{DETECTABILITY} --calibrate"
     return found + [finding("infrared.training.statistic_max", trained["statistic_max"], "1", command, 0.005, 2),
                     finding("infrared.training.a_error_max", trained["a_error_max"], "count s/rad", command, 0.05, 1),
