@@ -1,7 +1,7 @@
 """Findings of what a sweep costs: ``quadcosim bench sweep`` (:func:`benchmarks.sweep.measure`:
 40 closed-loop members on 1 then 2 local workers, and the 10 000-member study it extrapolates)
 and a study of :data:`STUDY_MEMBERS` members on 2 workers (``python -m benchmarks.study``:
-:func:`benchmarks.study.measure`), a few minutes in all on a loaded machine.
+run as written in a fresh interpreter, :func:`study`), a few minutes in all on a loaded machine.
 
 Wall times, rates, start-up and CPU times move about twofold with the machine's load: their
 tolerance is their value. The speed-up with 2 workers and a member's CPU over its stepping
@@ -58,15 +58,15 @@ def bench_findings(figures: dict) -> list[dict]:
                                               "table_bytes_per_member")]]
     study = figures["study_10000"]
     for n in STUDY_WORKER_COUNTS:
-        hours = study["workers"][n]
-        found += [_timing(f"bench.study_10000.hours_{n}", hours["hours"], "h", BENCH, 2),
-                  _timing(f"bench.study_10000.cpu_bound_hours_{n}", hours["cpu_bound_hours"], "h", BENCH, 2)]
+        minutes = study["workers"][n]
+        found += [_timing(f"bench.study_10000.minutes_{n}", minutes["minutes"], "min", BENCH, 1),
+                  _timing(f"bench.study_10000.cpu_bound_minutes_{n}", minutes["cpu_bound_minutes"], "min", BENCH, 1)]
     disk_tolerance = study["disk_mb"] * DISK_BYTES_TOLERANCE / figures["disk_per_member_bytes"]
     return found + [finding("sweep_cost.bench.study_10000.disk_mb", study["disk_mb"], "MB", BENCH, disk_tolerance, 0)]
 
 
 def study_findings(figures: dict) -> list[dict]:
-    """The findings of one ``python -m benchmarks.study`` (:func:`benchmarks.study.measure`'s dict ``figures``)."""
+    """The findings of one ``python -m benchmarks.study`` (:func:`study`'s dict ``figures``)."""
     if figures["failed"]:
         raise RuntimeError(f"{STUDY}: {figures['failed']} members failed")
     rss = figures["client_rss_mb"]
@@ -84,11 +84,46 @@ def study_findings(figures: dict) -> list[dict]:
                     STUDY, 1)]
 
 
+def study(members: int = STUDY_MEMBERS, workers: int = STUDY_WORKERS) -> dict:
+    """The figures of ``python -m benchmarks.study --members MEMBERS --workers WORKERS --json``,
+    run as written in a fresh interpreter: the client's memory is that of the command, not of
+    a process that ran other benchmarks first.
+
+    Parameters
+    ----------
+    members : int
+        Members of the study.
+    workers : int
+        Local worker processes.
+
+    Returns
+    -------
+    dict
+        :func:`benchmarks.study.measure`'s figures.
+
+    Raises
+    ------
+    RuntimeError
+        The command failed other than by failed members (which :func:`study_findings` refuses).
+    """
+    import json
+    import subprocess
+    import sys
+
+    from scenarios.findings import ROOT
+
+    command = [sys.executable, "-m", "benchmarks.study", "--members", str(members), "--workers", str(workers), "--json"]
+    done = subprocess.run(command, capture_output=True, text=True, cwd=ROOT)
+    if done.returncode not in (0, 1):  # 1: a member failed, reported in the figures
+        raise RuntimeError(f"{' '.join(command[1:])} exited with {done.returncode}: {done.stderr[-2000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
 def compute(quick: bool = False) -> list[dict]:
     """Every figure of the sweeps page's cost section, from one run of each benchmark. ``quick``:
     none (timings are not re-checked; the disk figures come from the timed sweep)."""
     if quick:
         return []
-    from benchmarks import study, sweep
+    from benchmarks import sweep
 
-    return bench_findings(sweep.measure()) + study_findings(study.measure(STUDY_MEMBERS, STUDY_WORKERS))
+    return bench_findings(sweep.measure()) + study_findings(study())
