@@ -12,7 +12,11 @@ turn rate. Three estimators of ``(a, b)`` and of the present turn rate ``(IR - b
   Beyond the slides: innovation gating as in PX4's EKF2 (test ratio
   ``nu^2 / (gamma^2 S)``, a rejected measurement is not fused), and CUSUM detectors on the
   normalised innovations that declare a fault, attribute it to the IR or the GPS and end it
-  when that sensor is consistent again (:mod:`calibration.infrared.detection`). The present
+  when that sensor is consistent again (:mod:`calibration.infrared.detection`). A fourth CUSUM
+  watches the GPS-IR consistency residual against the calibration of a few samples before, which
+  has not yet absorbed a small offset into ``b``, and a generalised likelihood ratio on the
+  residual's shape (a GPS offset: a step; an IR offset: a ramp over the GPS window) names the
+  sensor. The present
   IR is also checked against the state, so that an IR fault is declared before it reaches the
   paired window. While the GPS is not fused, the IR updates the turn rate only, so ``a`` and
   ``b`` keep their calibration; when a fault ends their variances are raised back to the
