@@ -229,19 +229,20 @@ def _remember(s, ir_pair, gps, S):
 def _ring(s):
     """The ring's samples, oldest first, against the calibration from before its oldest (one
     sample per step since the last restart): the normalised consistency residual ``x`` and the
-    turn rate by the GPS and by the IR over its deviation (``nan`` where there was none)."""
+    turn rate over its deviation, the mean of the GPS's and the IR's (``nan`` where there was
+    none). Both hypotheses take the same turn rate: half of either sensor's offset is in it, and
+    a turn that really happened is in it whole."""
     count = int(s[RING_COUNT])
     n = count if count < RING_SIZE else RING_SIZE
     ref = PAST + (int(s[PAST_COUNT]) - n) % PAST_SIZE
     a, b = s[ref], s[ref + PAST_SIZE]
-    x, by_gps, by_ir = np.empty(n), np.empty(n), np.empty(n)
+    x, turn = np.empty(n), np.empty(n)
     for m in range(n):
         slot = RING + (count - n + m) % RING_SIZE
         ir_pair, gps, root = s[slot], s[slot + RING_SIZE], math.sqrt(s[slot + 2 * RING_SIZE])
         x[m] = (ir_pair - (a * gps + b)) / root
-        by_gps[m] = gps / root
-        by_ir[m] = (ir_pair - b) / (a * root)
-    return x, by_gps, by_ir
+        turn[m] = 0.5 * (gps + (ir_pair - b) / a) / root
+    return x, turn
 
 
 @njit(cache=True)
@@ -249,11 +250,11 @@ def _fit(x, u, onset, ramp, sign, ridge):
     """Log-likelihood ratio (unit variance) and size of the best offset ``d`` of sign ``sign``
     with the signature ``f_m = min(1, (m - onset + 1) / ramp)`` from sample ``onset`` on, in the
     residuals ``x``, beyond an error of the calibration they are taken against, ``delta_b +
-    delta_a u_m`` (``u``: the turn rate, from the sensor the hypothesis holds healthy), fitted
-    with it. The offset must be what the calibration's error, present all along the ring, does
-    not explain: a turn that exposes an error of ``a`` is no fault. ``delta_a`` has a Gaussian
-    prior (``ridge``: the noise variance over its variance), so that an offset is not taken for
-    an error of ``a`` of the size of ``a`` itself."""
+    delta_a u_m`` (``u``: the turn rate, :func:`_ring`), fitted with it. The offset must be what
+    the calibration's error, present all along the ring, does not explain: a turn that exposes
+    an error of ``a`` is no fault. ``delta_a`` has a Gaussian prior (``ridge``: the noise
+    variance over its variance), so that an offset is not taken for an error of ``a`` of the
+    size of ``a`` itself."""
     n, su, suu, sx, sux, sf, suf, sff, sfx = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for m in range(x.shape[0]):
         if x[m] == x[m]:
@@ -298,12 +299,11 @@ def evidence(s, c):
     residual's own spread: ``(larger, step, ramp, step_size, ramp_size)``, the sizes in
     normalised units, of the sign of the consistency CUSUM's higher side."""
     sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
-    x, by_gps, by_ir = _ring(s)
+    x, turn = _ring(s)
     scale = s[HELD_SCALE]
     ridge = scale / (c[SD_A_HELD] * c[SD_A_HELD])
-    # each hypothesis takes the turn rate from the sensor it holds healthy
-    step, step_size = _best(x, by_ir, 1.0, sign, ridge)
-    ramp, ramp_size = _best(x, by_gps, c[RAMP], sign, ridge)
+    step, step_size = _best(x, turn, 1.0, sign, ridge)
+    ramp, ramp_size = _best(x, turn, c[RAMP], sign, ridge)
     step, ramp = step / scale, ramp / scale
     return (step if step > ramp else ramp), step, ramp, step_size, ramp_size
 
