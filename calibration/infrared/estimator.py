@@ -148,7 +148,7 @@ class EKFSettings:
         Log-likelihood (the residual scaled by its own spread) that an offset starting inside
         the attribution ring must reach beyond an error of the calibration (``delta_b +
         delta_a r``, which a change of the turn exposes) before a fault is declared; on seeds
-        101 to 200 it reached at most 10.7 while the consistency statistic exceeded 3.
+        101 to 200 it reached at most 10.9 while the consistency statistic exceeded 3.
     sd_a_held : float
         Prior standard deviation of the held calibration's error of ``a`` (count per rad/s)
         in that test: the largest error of the filter's ``a`` 10 samples old on the fault-free
