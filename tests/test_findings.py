@@ -156,7 +156,8 @@ def test_quick_findings_reproduce_the_committed_values(group):
 # commands run as written and checked to print their findings in CI: the fast ones (seconds each;
 # `python -m scenarios.findings --verify-commands` runs them all, the robustness study included)
 PRINT_CHECKED = ("flight.tilt.", "flight.tilt_without_drag.", "flight.wind.tilt", "rig.", "lab.linear_quasi_gt.",
-                 "lab.ablation.", "lab.passive_triad_",  "flightlogs.quad.internal.current.explained_half_b",
+                 "lab.ablation.ideal_", "lab.passive_convergence.reel.k100.",
+                 "flightlogs.quad.internal.current.explained_half_b",
                  "flightlogs.replay.b1.")
 
 
