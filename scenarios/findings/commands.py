@@ -255,7 +255,13 @@ def verify_all(findings: dict[str, dict], groups=None, timeout: float | None = N
 
 
 def summary(results: list[Verified]) -> str:
-    """One line: how many commands were ok, missing a finding, failed, skipped, and the time taken."""
+    """One line: how many commands were ok, missing a finding, failed, skipped, and the time taken.
+
+    Parameters
+    ----------
+    results : list of Verified
+        As :func:`verify_all` returns them.
+    """
     counts = {s: sum(r.status == s for r in results) for s in ("ok", "missing", "failed", "skipped")}
     return (f"{len(results)} commands: " + ", ".join(f"{n} {s}" for s, n in counts.items())
             + f"; {sum(r.seconds for r in results):.0f} s")
