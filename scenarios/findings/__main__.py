@@ -34,6 +34,8 @@ def parser() -> argparse.ArgumentParser:
                         "temporary folder, and check it prints their values; exit 1 if one does not")
     p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
                    help="with --verify-commands: stop a command after this long and count it failed")
+    p.add_argument("--matching", default="", metavar="TEXT",
+                   help="with --verify-commands: only the commands containing TEXT")
     return p
 
 
@@ -62,7 +64,7 @@ def run(groups, quick: bool) -> tuple[list[dict], dict[str, str]]:
     return computed, skipped
 
 
-def verify_commands(committed: dict, groups, timeout) -> int:
+def verify_commands(committed: dict, groups, timeout, matching: str = "") -> int:
     """Run the commands of ``groups``' findings as written; 1 if one does not print its findings.
 
     Parameters
@@ -73,10 +75,13 @@ def verify_commands(committed: dict, groups, timeout) -> int:
         Groups to verify (all when None).
     timeout : float or None
         Per command, seconds.
+    matching : str
+        Only the commands containing this text (all when empty).
     """
     from scenarios.findings import commands
 
-    results = commands.verify_all(committed, groups, timeout, report=lambda line: print(line, flush=True))
+    results = commands.verify_all(committed, groups, timeout, report=lambda line: print(line, flush=True),
+                                  matching=matching)
     print(commands.summary(results))
     return 1 if any(r.status in ("missing", "failed") for r in results) else 0
 
@@ -98,7 +103,7 @@ def main(argv=None) -> int:
         return 2
     committed = findings.load(args.out)
     if args.verify_commands:
-        return verify_commands(committed, args.groups or None, args.timeout)
+        return verify_commands(committed, args.groups or None, args.timeout, args.matching)
     computed, skipped = run(args.groups or findings.GROUPS, args.quick)
     for group, reason in skipped.items():
         kept = [n for n, f in committed.items() if f["group"] == group]

@@ -227,8 +227,8 @@ def verify(command: str, findings: list[dict], timeout: float | None = None) -> 
     return result
 
 
-def verify_all(findings: dict[str, dict], groups=None, timeout: float | None = None,
-               report=print) -> list[Verified]:
+def verify_all(findings: dict[str, dict], groups=None, timeout: float | None = None, report=print,
+               matching: str = "") -> list[Verified]:
     """Verify every distinct command of the findings of ``groups``, reporting each as it ends.
 
     Parameters
@@ -241,6 +241,8 @@ def verify_all(findings: dict[str, dict], groups=None, timeout: float | None = N
         Per command, seconds (none by default).
     report : callable
         Called with each command's :meth:`Verified.line`.
+    matching : str
+        Only the commands containing this text (all when empty).
 
     Returns
     -------
@@ -248,6 +250,8 @@ def verify_all(findings: dict[str, dict], groups=None, timeout: float | None = N
     """
     results = []
     for command, found in by_command(findings, groups).items():
+        if matching not in command:
+            continue
         report(f"running  {command}")
         results.append(verify(command, found, timeout))
         report(results[-1].line())
