@@ -157,8 +157,8 @@ def test_quick_findings_reproduce_the_committed_values(group):
 # `python -m scenarios.findings --verify-commands` runs them all, the robustness study included)
 PRINT_CHECKED = ("flight.tilt.", "flight.tilt_without_drag.", "flight.wind.tilt", "rig.", "lab.linear_quasi_gt.",
                  "lab.ablation.ideal_", "lab.passive_convergence.reel.k100.",
-                 "flightlogs.quad.internal.current.explained_half_b",
-                 "flightlogs.replay.b1.")
+                 "lab.triad_bias.times_true.", "infrared.slides.", "flight.wind.offset_",
+                 "flightlogs.quad.internal.current.explained_half_b", "flightlogs.replay.b1.")
 
 
 def _checked_commands() -> dict[str, list[dict]]:
