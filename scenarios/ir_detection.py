@@ -147,7 +147,8 @@ def main(argv=None) -> int:
         parser.error(f"--seeds {args.seeds!r}: write FIRST:LAST, e.g. 1:100")
     rows = table()
     clean = false_alarms(range(first, last + 1))
-    print(f"fault-free flights, seeds {first} to {last} ({clean['hours']:.1f} h): {clean['false_alarms']} faults "
+    print(f"fault-free flights, seeds {first} to {last} ({clean['flights']} flights, {clean['hours']:.1f} h): "
+          f"{clean['false_alarms']} faults "
           f"declared" + (f" (seeds {clean['flights_with_a_false_alarm']})" if clean["false_alarms"] else ""))
     if args.out:
         from orchestrator.files import write_json
