@@ -355,14 +355,14 @@ class CalibrationError(ValueError):
     """An estimator was given data or settings it cannot use."""
 
 
-@njit(cache=True)
+@njit  # not cached: numba's cache cannot key a function argument across processes
 def _sample(step, s, c, buffer, k, ir, gps, gps_use, delay, window, suspect):
     """One sample of any estimator: pair the IR with the GPS window, step, store the IR."""
     step(s, c, pair_at(buffer, k, delay, window), gps, gps_use, ir)
     push(buffer, k, ir, s[suspect] if suspect >= 0 else 0.0, delay, window)
 
 
-@njit(cache=True)
+@njit  # not cached, as _sample
 def _run(step, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, suspect, out):
     """The batch path: the step function over recorded arrays. Returns the samples done."""
     for k in range(ir.shape[0]):
