@@ -37,6 +37,10 @@ GROUPS = (
     "gain_ablation",
     "flightlogs",
     "real_recordings",
+    "plant",
+    "fmu_agreement",
+    "mag_rate",
+    "records",
 )
 
 ROOT = Path(__file__).resolve().parents[2]
