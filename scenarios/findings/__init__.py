@@ -41,6 +41,7 @@ GROUPS = (
     "fmu_agreement",
     "mag_rate",
     "records",
+    "excerpt",
 )
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -43,8 +43,8 @@ def compute(quick: bool = False) -> list[dict]:
                          COMPRESSED_TOLERANCE_MB, 1))
     peak = stream_peak()
     shortest, longest = min(peak["peak_mb"]), max(peak["peak_mb"])
-    return found + [finding("records.stream_peak_long_mb", peak["peak_mb"][longest], "MB", STREAM,
+    return found + [finding("records.stream_peak.long_mb", peak["peak_mb"][longest], "MB", STREAM,
                             PEAK_TOLERANCE_MB, 0),
-                    finding("records.stream_peak_short_mb", peak["peak_mb"][shortest], "MB", STREAM,
+                    finding("records.stream_peak.short_mb", peak["peak_mb"][shortest], "MB", STREAM,
                             PEAK_TOLERANCE_MB, 0),
-                    finding("records.stream_peak_ratio", peak["ratio"], "1", STREAM, RATIO_TOLERANCE, 2)]
+                    finding("records.stream_peak.ratio", peak["ratio"], "1", STREAM, RATIO_TOLERANCE, 2)]
