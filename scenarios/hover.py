@@ -87,13 +87,13 @@ def main(argv=None) -> int:
     """
     argparse.ArgumentParser(prog="python -m scenarios.hover", description=__doc__.splitlines()[0]).parse_args(argv)
     f = figures()
-    print(f"hover: ESC command {f['command']:.3f}, rotor speed {f['omega_rad_s']:.1f} rad/s, "
-          f"current {f['current_a']:.2f} A per motor")
+    print(f"hover: ESC command {f['command']:.3f}, rotor speed {f['omega_rad_s']:.2f} rad/s, "
+          f"current {f['current_a']:.3f} A per motor")
     print(f"command-to-speed time constant: {f['motor_time_constant_ms']:.1f} ms "
           f"(63.2 % of the response to a {STEP:g} command step)")
     print(f"yaw: spin-up reaction over the rate drag torque, J_r / (2 k_m omega tau) = {f['yaw_spin_up_ratio']:.2f}")
-    print(f"rotor drag: velocity time constant at hover m / (4 k_d omega) = {f['drag_time_constant_s']:.2f} s")
-    print(f"quasi cruise at {vehicle_cruise_speed():g} m/s: pitched {f['cruise_pitch_deg']:.2f} deg nose down")
+    print(f"rotor drag: velocity time constant at hover m / (4 k_d omega) = {f['drag_time_constant_s']:.3f} s")
+    print(f"quasi cruise at {vehicle_cruise_speed():g} m/s: pitched {f['cruise_pitch_deg']:.3f} deg nose down")
     return 0
 
 

@@ -178,3 +178,22 @@ def test_the_readme_states_the_default_result_format():
     default = parser().parse_args(["run", "tp"]).format
     stated = re.search(r"`--format\s+npz,mat,csv` the files written \(default `([^`]*)` alone\)", documentation())
     assert stated is not None and stated.group(1) == default
+
+
+# `python -m` commands checked the same way (fast ones: a few seconds each)
+MODULE_PRINT_CHECKED = ("plant.", "excerpt.")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", sorted({f["command"] for n, f in COMMITTED.items()
+                                            if n.startswith(MODULE_PRINT_CHECKED)}))
+def test_a_python_module_findings_command_run_as_written_prints_its_findings(command):
+    import subprocess
+
+    words = shlex.split(command)
+    assert words[:2] == ["python", "-m"]
+    printed = subprocess.run([sys.executable, *words[1:]], capture_output=True, text=True, check=True,
+                             cwd=findings.ROOT).stdout
+    shown = [float(x) for x in PRINTED_NUMBER.findall(printed)]
+    for f in (f for f in COMMITTED.values() if f["command"] == command):
+        assert any(abs(x - f["value"]) <= f["tolerance"] for x in shown), f"{f['name']} not printed by {command}"
