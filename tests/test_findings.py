@@ -91,6 +91,41 @@ def test_checker_reads_inputs_and_citations_as_such_and_finds_strays(tmp_path):
     assert "g.b = 3.64 m/s is not printed" in missing
 
 
+STRAYS = """# 2. Set-up
+
+In 2024, with Python 3.12 and FMI 2.0, `tilt_deg=5` [5.1] as in eq. 9:
+
+1. first
+<!-- inputs -->
+Roll of 20° at 0.4 Hz.
+<!-- /inputs -->
+
+```sh
+quadcosim run tp --set duration=30
+```
+<!-- findings:g.a -->
+Measured 4.994°.
+<!-- /findings -->
+The fitted lag is 4.257 s.
+"""
+
+
+def test_a_number_outside_findings_passages_is_a_stray_unless_an_input(tmp_path):
+    page = tmp_path / "guide.md"
+    page.write_text(STRAYS)
+    (stray,) = readme.strays(page)
+    assert stray.startswith("guide.md:16: 4.257 is stated outside a findings passage")
+    page.write_text(STRAYS.replace("The fitted lag is 4.257 s.", "The fitted lag is in `metrics.json`."))
+    assert readme.strays(page) == []
+    page.write_text(STRAYS.replace("<!-- /inputs -->", "").replace("The fitted lag is 4.257 s.", ""))
+    assert [s.split(":")[1] for s in readme.strays(page)] == ["7", "7"]  # 20 and 0.4, no longer inputs
+
+
+@pytest.mark.parametrize("page", readme.pages(findings.ROOT), ids=lambda p: p.name)
+def test_a_page_states_measured_numbers_only_in_findings_passages(page):
+    assert readme.strays(page) == []
+
+
 def test_unclosed_passage_is_refused(tmp_path):
     page = tmp_path / "README.md"
     page.write_text(PAGE.replace("<!-- /findings -->", ""))

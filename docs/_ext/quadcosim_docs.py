@@ -82,7 +82,8 @@ def _variable_tables(app):
 
     lines = ["# The FMUs' variables", "",
              "Generated from each model's `fmus/<Model>/variables.py` (the source of its "
-             "`modelDescription.xml` and C accessors).", ""]
+             "`modelDescription.xml` and C accessors): their start values are inputs.", "",
+             "<!-- inputs -->", ""]
     for model in MODELS:
         lines += [f"## {model}", "", "| name | causality | unit | start | description |", "|---|---|---|---|---|"]
         for variable in table(model).variables:
@@ -93,6 +94,7 @@ def _variable_tables(app):
             lines.append(f"| `{variable.name}` | {variable.causality} | {variable.unit or ''} | {start} | "
                          f"{description} |")
         lines.append("")
+    lines += ["<!-- /inputs -->", ""]
     GENERATED.mkdir(exist_ok=True)
     target = GENERATED / "fmu_variables.md"
     text = "\n".join(lines)

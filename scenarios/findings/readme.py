@@ -14,6 +14,11 @@ finding names or name prefixes (a group, ``metge``, or part of one, ``flight.til
 So a finding whose value moves by more than its rounding parts from the README, and the test
 fails. :func:`rewrite` replaces, in every passage, each number printed from an old value by the
 new value: the README is regenerated from the findings, not typed.
+
+Outside the passages a page states no measurement (:func:`strays`): a number there is an input
+or a citation as above, a fenced code block's, a heading's or list item's enumeration, a year, a
+version or degree after its name (``Python 3.12``), or it sits in an *inputs* passage, between
+``<!-- inputs -->`` and ``<!-- /inputs -->``, which holds settings, definitions and thresholds.
 """
 
 from __future__ import annotations
@@ -29,6 +34,13 @@ NUMBER = re.compile(r"(?<![\w.\-−+])([+\-−]?)(\d+(?:\.\d+)?(?:e[+\-]?\d+)?)(
 CODE_OR_CITATION = re.compile(r"`[^`]*`|\[[^\]]*\]\(?[^)\s]*\)?|<!--.*?-->")
 # a number after one of these words cites a reference (eq. 9, Table 1): it is not checked
 CITED = ("eq.", "eqs.", "Table", "Figure", "Fig.", "section", "Section")
+# outside findings passages: inputs passages, fenced code, enumerations, years, versions
+INPUTS = re.compile(r"<!--\s*inputs\s*-->.*?<!--\s*/inputs\s*-->", re.S)
+FENCE = re.compile(r"^(`{3,}|~{3,})[^\n]*\n.*?^\1", re.S | re.M)
+ENUMERATION = re.compile(r"^[ \t]*(?:#+[ \t]+|[-*][ \t]+)?\d+\.[ \t]", re.M)
+YEAR = re.compile(r"(?:19|20)\d\d")
+# a number in a name: a version (Python 3.12, FMI 2.0, Copter 3.4) or a degree (Master 2)
+NAMED = ("Python", "FMI", "Copter", "ArduPilot", "PX4", "Sphinx", "Master")
 
 
 @dataclass
@@ -176,6 +188,47 @@ def unprinted(scoped: list[dict], tokens: list[str]) -> list[dict]:
         return False
 
     return [f for i, f in enumerate(scoped) if not assign(i, set())]
+
+
+def strays(path) -> list[str]:
+    """The numbers of page ``path`` stated outside its findings passages as if measured: one line
+    each, naming the line of the page and the fix.
+
+    A number outside the findings passages is accepted as an input or a citation (see the
+    module's docstring); any other is a measurement with no finding behind it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A Markdown page.
+
+    Returns
+    -------
+    list of str
+        Empty when the page states every measurement inside a findings passage.
+    """
+    path = Path(path)
+    page = path.read_text()
+
+    def blank(match) -> str:
+        return re.sub(r"[^\n]", " ", match.group(0))
+
+    masked = page
+    for passage in passages(path):
+        masked = masked[:passage.start] + blank(re.match(r".*", passage.text, re.S)) + \
+            masked[passage.start + len(passage.text):]
+    for pattern in (INPUTS, FENCE, ENUMERATION):
+        masked = pattern.sub(blank, masked)
+    lines = []
+    for offset, token in numbers(masked):
+        before = masked[:offset].split()
+        if YEAR.fullmatch(token) or (before and before[-1] in NAMED):
+            continue
+        line = masked.count("\n", 0, offset) + 1
+        lines.append(f"{path.name}:{line}: {token} is stated outside a findings passage (a measured number: "
+                     "add it to a group in scenarios/findings/ and put it in a `<!-- findings:NAME -->` passage; "
+                     "an input: a code span or an `<!-- inputs -->` passage)")
+    return lines
 
 
 def pages(root) -> list[Path]:
