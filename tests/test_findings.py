@@ -190,7 +190,7 @@ def test_quick_findings_reproduce_the_committed_values(group):
 
 
 # findings whose command, run as written, is checked to print them (a few fast ones: CI time)
-PRINT_CHECKED = ("flight.tilt.", "rig.", "lab.linear_quasi_gt.")
+PRINT_CHECKED = ("flight.tilt.", "rig.", "lab.linear_quasi_gt.", "records.tp_npz_mb")
 PRINTED_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 
 
