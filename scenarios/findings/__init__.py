@@ -42,6 +42,7 @@ GROUPS = (
     "mag_rate",
     "records",
     "excerpt",
+    "log_info",
 )
 
 ROOT = Path(__file__).resolve().parents[2]
