@@ -85,6 +85,37 @@ def wall_times(args: list[str], repeats: int) -> tuple[list[float], list[float]]
     return walls, cpus
 
 
+#: The commands timed by default: ``quadcosim list`` and ``quadcosim --help``.
+DEFAULT_COMMANDS = (["list"], ["--help"])
+
+
+def measure(commands=DEFAULT_COMMANDS, repeats: int = 5) -> dict:
+    """Wall and CPU times of each command over ``repeats`` fresh interpreters, and its heavy imports.
+
+    Parameters
+    ----------
+    commands : sequence of list of str
+        Arguments after ``quadcosim``, one list per command.
+    repeats : int
+        Runs per command.
+
+    Returns
+    -------
+    dict
+        ``"list"`` (the command's words joined by spaces) -> ``median_s``, ``min_s``, ``max_s``
+        (wall, s), ``median_cpu_s`` (user + system of the child, s) and ``heavy_imports`` (the
+        modules of :data:`HEAVY` it imported).
+    """
+    figures = {}
+    for command in commands:
+        times, cpus = wall_times(command, repeats)
+        heavy = sorted(m for m in HEAVY if m in imported_modules(command))
+        figures[" ".join(command)] = {"median_s": statistics.median(times), "min_s": min(times),
+                                      "max_s": max(times), "median_cpu_s": statistics.median(cpus),
+                                      "heavy_imports": heavy}
+    return figures
+
+
 def main(argv=None) -> int:
     """Print the median wall time and the heavy imports of each command; returns 0.
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
@@ -93,14 +124,7 @@ def main(argv=None) -> int:
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("command", nargs="*", help="one quadcosim command (default: list, then --help)")
     args = parser.parse_args(argv)
-    commands = [args.command] if args.command else [["list"], ["--help"]]
-    figures = {}
-    for command in commands:
-        times, cpus = wall_times(command, args.repeats)
-        heavy = sorted(m for m in HEAVY if m in imported_modules(command))
-        figures[" ".join(command)] = {"median_s": statistics.median(times), "min_s": min(times),
-                                      "max_s": max(times), "median_cpu_s": statistics.median(cpus),
-                                      "heavy_imports": heavy}
+    figures = measure([args.command] if args.command else DEFAULT_COMMANDS, args.repeats)
     if args.json:
         print(json.dumps(figures))
     else:

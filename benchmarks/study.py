@@ -51,7 +51,9 @@ def measure(members: int = 10_000, workers: int = 2, duration: float = 5.0) -> d
         ``member_cpu_s`` and ``stepping_cpu_s`` (medians, s), ``member_wall_s`` (median, s),
         ``wall_per_member_s`` (the run's wall time over the members, s), ``slot_overhead_s``
         (worker time per member not spent in a member, s), ``client_cpu_per_member_s`` (s),
-        ``client_rss_mb`` (first, middle and last samples, and the peak, MB), counts and times.
+        ``client_rss_mb`` (first, middle and last samples, and the peak, MB),
+        ``client_rss_growth_per_member_kb`` (last sample less the first, over the members, kB),
+        counts and times.
     """
     from scenarios.sweep import engine, grid, table
 
@@ -80,6 +82,7 @@ def measure(members: int = 10_000, workers: int = 2, duration: float = 5.0) -> d
         "slot_overhead_s": (running * workers - sum(columns["wall_s"])) / members,
         "client_cpu_per_member_s": client_cpu / members,
         "client_rss_mb": {"first": rss[0], "middle": rss[len(rss) // 2], "last": rss[-1], "peak": max(rss)},
+        "client_rss_growth_per_member_kb": (rss[-1] - rss[0]) * 1e3 / members,
     }
 
 
@@ -109,7 +112,8 @@ def main(argv=None) -> int:
               f"{f['slot_overhead_s'] * 1e3:.1f} ms per member outside members (scheduler, transfers, client)\n"
               f"  client and scheduler process: {f['client_cpu_per_member_s'] * 1e3:.2f} ms of CPU per member; "
               f"resident memory {rss['first']:.0f} MB at the start, {rss['middle']:.0f} MB midway, "
-              f"{rss['last']:.0f} MB at the end (peak {rss['peak']:.0f} MB)")
+              f"{rss['last']:.0f} MB at the end (peak {rss['peak']:.0f} MB), "
+              f"{f['client_rss_growth_per_member_kb']:.1f} kB more per member")
     return 1 if f["failed"] else 0
 
 

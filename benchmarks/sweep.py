@@ -52,7 +52,7 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
     dict
         Rates (members/s), start-up (s), CPU and wall time per member (s) and of its stepping
         loop, ``member_over_stepping`` (the median over the 1-worker members of their CPU over
-        their stepping loop's CPU), disk per member (bytes), the 10 000-member extrapolation (h,
+        their stepping loop's CPU), disk per member (bytes), the 10 000-member extrapolation (min,
         MB), load averages.
     """
     from scenarios.sweep import engine, grid, table
@@ -102,7 +102,7 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
     for n in (1, 2, 8, 32):  # beyond 2, each worker keeps the rate it had among 2
         rate = one["members_per_s"] if n == 1 else two["members_per_s"] * n / 2
         # On idle cores a member costs its CPU time: the bound a quiet machine approaches.
-        study[n] = {"hours": 10_000 / rate / 3600, "cpu_bound_hours": 10_000 * one["median_member_cpu_s"] / n / 3600}
+        study[n] = {"minutes": 10_000 / rate / 60, "cpu_bound_minutes": 10_000 * one["median_member_cpu_s"] / n / 60}
     figures["study_10000"] = {
         "workers": study,
         "disk_mb": 10_000 * (figures["disk_per_member_allocated_bytes"] + figures["table_bytes_per_member"]) / 1e6,
@@ -131,11 +131,11 @@ def report(f: dict) -> str:
         f"  disk per member: {f['disk_per_member_bytes']:.0f} B of metrics.json "
         f"({f['disk_per_member_allocated_bytes']:.0f} B allocated), {f['table_bytes_per_member']:.0f} B of table",
         "  a 10 000-member study of such runs: "
-        + ", ".join(f"{n} worker{'s' * (int(n) > 1)} {s['hours']:.2f} h"
+        + ", ".join(f"{n} worker{'s' * (int(n) > 1)} {s['minutes']:.1f} min"
                     for n, s in f["study_10000"]["workers"].items())
         + f" (beyond 2: each worker at its 2-worker rate); {f['study_10000']['disk_mb']:.0f} MB on disk",
         "    on idle cores (CPU time per member): "
-        + ", ".join(f"{n}: {s['cpu_bound_hours']:.2f} h" for n, s in f["study_10000"]["workers"].items()),
+        + ", ".join(f"{n}: {s['cpu_bound_minutes']:.1f} min" for n, s in f["study_10000"]["workers"].items()),
     ]
     return "\n".join(lines)
 

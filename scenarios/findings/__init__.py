@@ -35,6 +35,8 @@ GROUPS = (
     "infrared",
     "gain_study",
     "gain_ablation",
+    "speed",
+    "sweep_cost",
     "flightlogs",
     "real_recordings",
     "plant",

@@ -106,8 +106,10 @@ def numbers(text: str) -> list[tuple[int, str]]:
 
 
 def printed(finding: dict) -> str:
-    """``finding``'s value as the README prints it: ``digits`` decimals."""
-    return f"{finding['value']:.{finding['digits']}f}"
+    """``finding``'s value as the README prints it: ``digits`` decimals (a value that rounds to
+    zero is printed without a sign, so that -0.3 and 0.2 at no decimal both print 0)."""
+    shown = f"{finding['value']:.{finding['digits']}f}"
+    return shown.lstrip("-") if float(shown) == 0 else shown
 
 
 def matches(token: str, finding: dict) -> bool:
