@@ -49,7 +49,8 @@ def figures() -> dict:
     dict
         ``command`` (1), ``omega_rad_s`` (rad/s) and ``current_a`` (A, per motor) at hover,
         ``motor_time_constant_ms`` (ms), ``yaw_spin_up_ratio`` (1), ``drag_time_constant_s`` (s)
-        and ``cruise_pitch_deg`` (deg, nose down positive).
+        and the ``quasi`` cruise's ``cruise_speed_m_s`` (m/s) and ``cruise_pitch_deg`` (deg, nose
+        down positive).
     """
     from orchestrator.fmu import FMUInstance
     from scenarios.flight import profiles, trim
@@ -69,7 +70,7 @@ def figures() -> dict:
     return {"command": command, "omega_rad_s": float(omega), "current_a": float(current),
             "motor_time_constant_ms": tau * 1e3, "yaw_spin_up_ratio": ratio,
             "drag_time_constant_s": trim.drag_time_constant(),
-            "cruise_pitch_deg": -math.degrees(profiles.cruise_pitch())}
+            "cruise_speed_m_s": profiles.CRUISE_SPEED, "cruise_pitch_deg": -math.degrees(profiles.cruise_pitch())}
 
 
 def main(argv=None) -> int:
@@ -93,15 +94,8 @@ def main(argv=None) -> int:
           f"(63.2 % of the response to a {STEP:g} command step)")
     print(f"yaw: spin-up reaction over the rate drag torque, J_r / (2 k_m omega tau) = {f['yaw_spin_up_ratio']:.2f}")
     print(f"rotor drag: velocity time constant at hover m / (4 k_d omega) = {f['drag_time_constant_s']:.3f} s")
-    print(f"quasi cruise at {vehicle_cruise_speed():g} m/s: pitched {f['cruise_pitch_deg']:.3f} deg nose down")
+    print(f"quasi cruise at {f['cruise_speed_m_s']:g} m/s: pitched {f['cruise_pitch_deg']:.3f} deg nose down")
     return 0
-
-
-def vehicle_cruise_speed() -> float:
-    """Speed (m/s) of the ``quasi`` profile's cruise."""
-    from scenarios.flight import profiles
-
-    return profiles.CRUISE_SPEED
 
 
 if __name__ == "__main__":
