@@ -292,7 +292,7 @@ def main(argv=None) -> int:
     path = Path(parser.parse_args(argv).file)
     d = describe(load(path))
     print(f"{path.name}: {d['samples']} samples at {d['rate_hz']:.1f} Hz, {d['duration_s']:.1f} s; "
-          f"{d['before_first_scored_s']:.1f} s before the first scored sample (at rest), "
+          f"{d['before_first_scored_s']:.2f} s before the first scored sample (at rest), "
           f"{d['scored_share']:.0%} of the samples scored")
     return 0
 

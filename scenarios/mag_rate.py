@@ -74,7 +74,7 @@ def main(argv=None) -> int:
             print(f"{estimator:10} {flight:14} {str(noise):5} | {fmt(fast)} | {fmt(held)} | {fmt(held - fast)}")
             largest[noise] = max(largest.get(noise, 0.0), float(np.abs(held - fast).max()))
     for noise, difference in largest.items():
-        print(f"largest difference {'with' if noise else 'without'} noise: {difference:.4f} deg RMS")
+        print(f"largest difference {'with' if noise else 'without'} noise: {difference:.5f} deg RMS")
     return 0
 
 

@@ -190,18 +190,25 @@ def test_quick_findings_reproduce_the_committed_values(group):
 
 
 # findings whose command, run as written, is checked to print them (a few fast ones: CI time)
-PRINT_CHECKED = ("flight.tilt.", "rig.", "lab.linear_quasi_gt.", "records.tp_npz_mb")
+PRINT_CHECKED = ("flight.tilt.", "rig.", "lab.linear_quasi_gt.", "records.tp_npz_mb", "log_info.")
 PRINTED_NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("command", sorted({f["command"] for n, f in COMMITTED.items() if n.startswith(PRINT_CHECKED)}))
-def test_a_findings_command_run_as_written_prints_its_findings(command, tmp_path, capsys):
+def test_a_findings_command_run_as_written_prints_its_findings(command, tmp_path, capsys, monkeypatch):
+    import os
+    from pathlib import Path
+
     from scenarios.cli import main
 
     words = shlex.split(command)
     assert words[0] == "quadcosim"
-    assert main(words[1:] + ["--out", str(tmp_path / "run")]) == 0
+    if any(w.startswith("logs/") for w in words):  # the logs as the commands name them, in a folder logs/
+        (tmp_path / "logs").symlink_to(Path(os.environ["QUADCOSIM_FLIGHT_LOGS"]).resolve())
+        monkeypatch.chdir(tmp_path)
+    out = ["--out", str(tmp_path / "run")] if words[1] == "run" else []  # a run's files go to tmp_path
+    assert main(words[1:] + out) == 0
     shown = [float(x) for x in PRINTED_NUMBER.findall(capsys.readouterr().out)]
     for f in (f for f in COMMITTED.values() if f["command"] == command):
         assert any(abs(x - f["value"]) <= f["tolerance"] for x in shown), f"{f['name']} not printed by {command}"

@@ -158,4 +158,4 @@ def test_describe_gives_the_time_before_the_first_scored_sample(tmp_path, capsys
     unscored = recording.describe(recording.load(unscored_path))
     assert unscored["before_first_scored_s"] == 0.0 and unscored["scored_share"] == 1.0
     assert recording.main([str(path)]) == 0
-    assert "2.4 s before the first scored sample" in capsys.readouterr().out
+    assert "2.40 s before the first scored sample" in capsys.readouterr().out
