@@ -173,17 +173,23 @@ def notes(results: dict) -> str:
 
 
 def table(results: dict) -> str:
-    """The summary table of :func:`evaluate`'s ``results``: per dataset (its role), mean total RMSE
-    (deg) of every filter, and our best filter's ratio to VQF."""
+    """The summary tables of :func:`evaluate`'s ``results``: per dataset (its role), mean total RMSE
+    (deg) of every filter and our best filter's ratio to VQF; then every filter's mean heading and
+    inclination RMSE (deg)."""
     lines = ["| dataset (recordings) | role | explicit | passive | VQF | Madgwick | Mahony | best / VQF |",
              "|---|---|---|---|---|---|---|---|"]
+    detail = ["| dataset | " + " | ".join(f"{k} heading / incl." for k in OURS + PUBLISHED) + " |",
+              "|---" * (len(OURS + PUBLISHED) + 1) + "|"]
     for name, found in results.items():
         m = {k: v["total_rmse_deg"] for k, v in found["means"].items()}
         role = "held out" if name in HELD_OUT else "chose the defaults"
         ratio = min(m["explicit"], m["passive"]) / m["vqf"]
         lines.append(f"| {name} ({found['recordings']}) | {role} | {m['explicit']:.2f} | {m['passive']:.2f} | "
                      f"{m['vqf']:.2f} | {m['madgwick']:.2f} | {m['mahony']:.2f} | {ratio:.2f} |")
-    return "\n".join(lines)
+        detail.append(f"| {name} | " + " | ".join(
+            f"{found['means'][k]['heading_rmse_deg']:.2f} / {found['means'][k]['inclination_rmse_deg']:.2f}"
+            for k in OURS + PUBLISHED) + " |")
+    return "\n".join(lines) + "\n\n" + "\n".join(detail)
 
 
 def main(argv=None) -> int:

@@ -161,7 +161,8 @@ def main(argv=None) -> int:
     ----------
     argv : list of str, optional
         Arguments (default ``sys.argv[1:]``): ``--set KEY=VALUE`` (tp options, repeated) and
-        ``--triad`` (the passive filter on TRIAD: final gyro bias errors, rad/s, instead).
+        ``--triad`` (the passive filter on TRIAD: final gyro bias errors, rad/s, and the recorded
+        accelerometer's error in times the true bias, instead).
 
     Returns
     -------
@@ -174,9 +175,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     settings = dict(s.split("=", 1) for s in args.set)
     if args.triad:
+        rows = triad_ablation(settings)
         print("| passive on TRIAD, gyro bias | final bias error (rad/s, x / y / z) |\n|---|---|")
-        for name, values in triad_ablation(settings).items():
+        for name, values in rows.items():
             print(f"| {name} | {' / '.join(f'{v:+.4f}' for v in values)} |")
+        times = [abs(error / bias) for error, bias in zip(rows["recorded"], rows["true bias"], strict=True)]
+        print(f"| recorded, times the true bias | {' / '.join(f'{t:.2f}' for t in times)} |")
     else:
         print(markdown(linear_ablation(settings)))
     return 0

@@ -207,7 +207,8 @@ def optimum_of(gains, values) -> float:
 METRIC_UNITS = {"gains": "1/s", "predicted_optimal_gain": "1/s", "simulated_optimal_gain": "1/s",
                 "relative_difference": "1", "max_abs_relative_difference": "1", "optimum_ratio": "1",
                 "simulated_relative_standard_error": "1", "max_relative_standard_error": "1",
-                "closed_loop_relative_difference": "1", "closed_loop_relative_standard_error": "1"}
+                "closed_loop_over_predicted": "1", "closed_loop_relative_difference": "1",
+                "closed_loop_relative_standard_error": "1"}
 
 
 def report(result, o, out) -> dict:
@@ -261,7 +262,7 @@ def report(result, o, out) -> dict:
     ax.legend(fontsize=8)
     figure = save_figure(fig, out, "gain_study.png")
     ratio = simulated / predicted - 1.0
-    return {
+    return in_percent({
         "gains": gains.tolist(),
         "predicted_variance_rad2": predicted.tolist(),
         "simulated_variance_rad2": simulated.tolist(),
@@ -275,12 +276,35 @@ def report(result, o, out) -> dict:
         "bandwidth_at_lab_gain_rad_s": analysis.linear_bandwidth(0.05),
         "closed_loop_variance_rad2": None if closed is None else closed.tolist(),
         "closed_loop_failures": [{"k": k, "error": error} for k, error in failures],
+        "closed_loop_over_predicted": None if closed is None else (closed / predicted).tolist(),
         "closed_loop_relative_difference": None if closed is None else (closed / predicted - 1.0).tolist(),
         "closed_loop_relative_standard_error": None if closed is None
         else closed_loop_relative_standard_error(gains, o).tolist(),
         "closed_loop_tracking_rms_deg": tracking,
         "figures": [figure] if figure else [],
-    }
+    })
+
+
+#: The relative metrics also given in percent (``NAME_pct``), as the README quotes them.
+IN_PERCENT = ("max_abs_relative_difference", "max_relative_standard_error", "closed_loop_relative_difference",
+              "closed_loop_relative_standard_error")
+PERCENT = 100.0
+
+
+def in_percent(metrics: dict) -> dict:
+    """``metrics`` with each of :data:`IN_PERCENT` also in percent, as ``NAME_pct`` (None stays None).
+
+    Parameters
+    ----------
+    metrics : dict
+        The report's metrics (relative figures as fractions, unit 1).
+    """
+    def percent(value):
+        if value is None:
+            return None
+        return [PERCENT * v for v in value] if isinstance(value, list) else PERCENT * value
+
+    return metrics | {f"{name}_pct": percent(metrics[name]) for name in IN_PERCENT}
 
 
 def _label(ax, result, o: dict) -> None:

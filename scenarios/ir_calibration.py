@@ -234,14 +234,17 @@ def episodes(flag: np.ndarray, time: np.ndarray) -> list[tuple[float, float | No
 
 def fault_report(windows, kalman_flags: dict[str, np.ndarray], time: np.ndarray) -> tuple[list[dict], int]:
     """Match the fault episodes declared by the Kalman filter (``kalman_flags``: sensor -> flag per
-    instant of ``time``, s) with the injected faults ``windows``; the rest are false alarms."""
+    instant of ``time``, s) with the injected faults ``windows``; the rest are false alarms. Each
+    fault: its onset and end, when it was declared and cleared, and (when declared) how long after
+    its onset it was declared and after its end cleared (s; None while still declared)."""
     declared = {sensor: episodes(flag, time) for sensor, flag in kalman_flags.items()}
     faults, matched = [], set()
     for sensor, onset, end, _ in windows:
         entry = {"sensor": sensor, "onset_s": onset, "end_s": end, "declared_s": None, "cleared_s": None}
         for i, (start, stop) in enumerate(declared[sensor]):
             if onset - 1e-9 <= start < end:
-                entry["declared_s"], entry["cleared_s"] = start, stop
+                entry |= {"declared_s": start, "cleared_s": stop, "declared_after_s": start - onset,
+                          "ended_after_s": None if stop is None else stop - end}
                 matched.add((sensor, i))
                 break
         faults.append(entry)

@@ -234,11 +234,7 @@ def main(argv=None) -> int:
     forwarded += ["--workers", args.workers] if args.workers else []
     forwarded += ["--scheduler", args.scheduler] if args.scheduler else []
     forwarded += ["--resume"] if args.resume else []
-    code = command.main(forwarded)
-    summary = Path(args.out) / "summary.md"
-    if code == 0 and summary.exists():
-        print(summary.read_text())
-    return code
+    return command.main(forwarded)  # prints the summary.md it writes
 
 
 def _sweep():

@@ -86,7 +86,7 @@ def test_plot_and_compare_draw_signals_of_finished_runs(tmp_path, capsys, monkey
 
 def test_numbers_are_printed_at_their_precision(capsys):
     assert shown(7920.000000000001, PARAMETER_DIGITS) == "7920"
-    assert shown([0.04806407807056596, None, True, 3]) == "[0.04806, None, True, 3]"
+    assert shown([0.04806407807056596, None, True, 3]) == "[0.048064, None, True, 3]"
     assert shown(1.19e-4, PARAMETER_DIGITS) == "0.000119"
     assert main(["list", "--parameters", "MotorMagnetics"]) == 0
     listed = capsys.readouterr().out

@@ -3,7 +3,9 @@
 Runs every group of :data:`scenarios.findings.GROUPS` (or those named), prints each finding
 with its command, writes ``findings.json`` and rewrites the README's numbers from it. A
 skipped group (its data absent) keeps its committed values and is said so. ``--check``
-writes nothing and exits 1 when a value moved by more than its tolerance.
+writes nothing and exits 1 when a value moved by more than its tolerance. ``--verify-commands``
+runs each finding's command as written and exits 1 when one does not print its findings
+(:mod:`scenarios.findings.commands`).
 """
 
 from __future__ import annotations
@@ -27,6 +29,13 @@ def parser() -> argparse.ArgumentParser:
                    help="compare with the committed findings.json; write nothing; exit 1 on a difference")
     p.add_argument("--out", type=Path, default=findings.FINDINGS_FILE, help="findings file (default: the repository's)")
     p.add_argument("--no-readme", action="store_true", help="leave the README and docs/ as they are")
+    p.add_argument("--verify-commands", action="store_true",
+                   help="run each distinct command of the committed findings (of GROUPs) as written, in a "
+                        "temporary folder, and check it prints their values; exit 1 if one does not")
+    p.add_argument("--timeout", type=float, default=None, metavar="SECONDS",
+                   help="with --verify-commands: stop a command after this long and count it failed")
+    p.add_argument("--matching", default="", metavar="TEXT",
+                   help="with --verify-commands: only the commands containing TEXT")
     return p
 
 
@@ -55,6 +64,28 @@ def run(groups, quick: bool) -> tuple[list[dict], dict[str, str]]:
     return computed, skipped
 
 
+def verify_commands(committed: dict, groups, timeout, matching: str = "") -> int:
+    """Run the commands of ``groups``' findings as written; 1 if one does not print its findings.
+
+    Parameters
+    ----------
+    committed : dict
+        Name -> committed finding.
+    groups : sequence of str or None
+        Groups to verify (all when None).
+    timeout : float or None
+        Per command, seconds.
+    matching : str
+        Only the commands containing this text (all when empty).
+    """
+    from scenarios.findings import commands
+
+    results = commands.verify_all(committed, groups, timeout, report=lambda line: print(line, flush=True),
+                                  matching=matching)
+    print(commands.summary(results))
+    return 1 if any(r.status in ("missing", "failed") for r in results) else 0
+
+
 def main(argv=None) -> int:
     """Run the findings; returns the exit code (2: a bad command line, 1: ``--check`` found a
     difference or the README could not be rewritten).
@@ -71,6 +102,8 @@ def main(argv=None) -> int:
               file=sys.stderr)
         return 2
     committed = findings.load(args.out)
+    if args.verify_commands:
+        return verify_commands(committed, args.groups or None, args.timeout, args.matching)
     computed, skipped = run(args.groups or findings.GROUPS, args.quick)
     for group, reason in skipped.items():
         kept = [n for n, f in committed.items() if f["group"] == group]

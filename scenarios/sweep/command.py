@@ -148,8 +148,10 @@ def sweep(args) -> int:
     except (KeyError, ValueError) as error:  # SweepError is a ValueError
         print(f"quadcosim sweep {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
-    named.summarise(plan, args.out, summary)
+    written = named.summarise(plan, args.out, summary)
     print(summary.text())
+    if written is not None:  # a named sweep's own tables and checks (lab-matrix's summary.md)
+        print(written.read_text())
     return summary.exit_code()
 
 

@@ -98,11 +98,15 @@ def records(plan, out) -> list[dict]:
     return [json.loads((member_folder(Path(out), m.index) / "metrics.json").read_text()) for m in plan.members]
 
 
-def summarise(plan, out, summary) -> None:
+def summarise(plan, out, summary) -> Path | None:
     """Run a named sweep's summary on the members of ``plan`` in ``out``, once every member has
-    finished well (according to the ``summary`` of the run)."""
+    finished well (according to the ``summary`` of the run); return the ``summary.md`` it wrote
+    in ``out`` (None when it wrote none)."""
     if not plan.name or summary.ok != summary.total:
-        return
+        return None
     named = registry()[plan.name]
-    if named.summarise is not None:
-        named.summarise(records(plan, out), Path(out))
+    if named.summarise is None:
+        return None
+    named.summarise(records(plan, out), Path(out))
+    written = Path(out) / "summary.md"
+    return written if written.is_file() else None
