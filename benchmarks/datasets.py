@@ -165,10 +165,17 @@ def usable(data: dict) -> bool:
 LOADERS = {"broad": broad, "smartphones": smartphones, "diodem": diodem, "repoimu": repoimu}
 
 
-def load(data_folder, name: str):
+def load(data_folder, name: str, left_out: list | None = None):
     """The recordings of the dataset ``name`` (a key of :data:`LOADERS`) under ``data_folder``, as
-    (recording name, recording) pairs; none when its sub-folder is absent."""
+    (recording name, recording) pairs; none when its sub-folder is absent. The names of those not
+    :func:`usable` are appended to ``left_out`` when it is given."""
     folder = Path(data_folder) / name
     if not folder.is_dir():
         return []
-    return [(label, data) for label, data in LOADERS[name](folder) if usable(data)]
+    kept = []
+    for label, data in LOADERS[name](folder):
+        if usable(data):
+            kept.append((label, data))
+        elif left_out is not None:
+            left_out.append(label)
+    return kept

@@ -41,6 +41,7 @@ HELD_OUT = ("repoimu",)  # kept aside until the defaults were frozen
 PUBLISHED = ("vqf", "madgwick", "mahony")
 OURS = ("explicit", "passive")
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
+LARGE_ERROR_DEG = 50.0  # deg, a recording's total RMSE reported as a failure of the filter (notes)
 FIELD_SECONDS = 1.0  # s, start of each recording the field references are taken from
 GRID = {
     "explicit": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.1, 0.3, 1.0],
@@ -99,12 +100,14 @@ def evaluate(folder, names=CHOOSING + HELD_OUT, cache=None, grids: bool = False)
     Returns
     -------
     dict
-        Dataset name -> ``{"recordings": count, "means": {filter: {metric: deg}}, "grid": {kind:
-        (G,) mean total RMSE}}``.
+        Dataset name -> ``{"recordings": count, "left_out": [names of the recordings not used],
+        "means": {filter: {metric: deg}}, "per_recording": {name: {filter: {metric: deg}}}, "grid":
+        {kind: (G,) mean total RMSE}}``.
     """
     out = {}
     for name in names:
-        recordings = datasets.load(folder, name)
+        left_out = []
+        recordings = datasets.load(folder, name, left_out)
         if not recordings:
             continue
         published = _published(name, recordings, None if cache is None else Path(cache))
@@ -117,7 +120,7 @@ def evaluate(folder, names=CHOOSING + HELD_OUT, cache=None, grids: bool = False)
                     grid_totals[kind].append(errors(kind, data, gain_grid(**GRID[kind]))["total_rmse_deg"])
         means = {kind: {m: float(np.mean([rows[label][kind][m] for label in rows])) for m in METRICS}
                  for kind in OURS + PUBLISHED}
-        out[name] = {"recordings": len(recordings), "means": means, "per_recording": rows}
+        out[name] = {"recordings": len(recordings), "left_out": left_out, "means": means, "per_recording": rows}
         if grids:
             out[name]["grid"] = {kind: np.mean(grid_totals[kind], axis=0).tolist() for kind in OURS}
         print(name, {k: round(v["total_rmse_deg"], 2) for k, v in means.items()}, file=sys.stderr)
@@ -143,6 +146,30 @@ def choose(results: dict) -> dict:
         choice[kind] = {"gains": {a: float(v[best]) for a, v in axes.items()},
                         "ratios_to_vqf": {n: float(ratios[n][best]) for n in names}, "left_out": folds}
     return choice
+
+
+def large_errors(found: dict, kind: str, above: float = LARGE_ERROR_DEG) -> list[float]:
+    """The total RMSE (deg) of filter ``kind`` on the recordings of one dataset (``found``, an entry
+    of :func:`evaluate`'s results) where it exceeds ``above`` (deg), largest first."""
+    return sorted((row[kind]["total_rmse_deg"] for row in found["per_recording"].values()
+                   if row[kind]["total_rmse_deg"] > above), reverse=True)
+
+
+def notes(results: dict) -> str:
+    """What the table's means hide, per dataset of ``results`` (:func:`evaluate`'s): the
+    recordings left out (:func:`datasets.usable`) and those on which a filter's error exceeds
+    :data:`LARGE_ERROR_DEG`."""
+    lines = []
+    for name, found in results.items():
+        used, left = found["recordings"], len(found.get("left_out", []))
+        lines.append(f"{name}: {used} of {used + left} recordings used, {left} left out (gyro and reference "
+                     f"rates differ by more than {datasets.MISMATCH_LIMIT:.0%})")
+        for kind in OURS + PUBLISHED:
+            large = large_errors(found, kind)
+            if large:
+                lines.append(f"  {kind}: total RMSE above {LARGE_ERROR_DEG:g} deg on {len(large)} recordings, "
+                             f"at most {large[0]:.1f} deg")
+    return "\n".join(lines)
 
 
 def table(results: dict) -> str:
@@ -185,6 +212,7 @@ def main(argv=None) -> int:
         names = tuple(n for n in names if n in CHOOSING)  # the held-out dataset never enters the choice
     results = evaluate(args.folder, names, args.cache, grids=args.choose)
     print(table(results))
+    print(notes(results))
     report = {"results": results, "defaults": {k: DEFAULT_GAINS[k] for k in OURS}}
     if args.choose:
         report["choice"] = choose(results)

@@ -9,9 +9,10 @@ build, the loop, the save, the report and its figures) is measured around the ca
 CPU is the time :class:`scenarios.outputs.RunFiles` spends writing the record
 (``metrics.json``'s ``save_cpu_s``). ``--compressed`` measures the compressed archive too.
 
-``--stream-peak`` measures how flat ``--stream`` keeps memory: the peak resident set of
-``quadcosim run tp --stream`` (bench supply on) for 60 s and 3600 s of flight, each in a child
-process (:func:`benchmarks.memory.peak_rss`), and their ratio.
+``--stream-peak`` measures, instead of the save's share, how flat ``--stream`` keeps memory: the
+peak resident set of ``quadcosim run tp --stream`` (bench supply on) for 60 s and 3600 s of
+flight, each in a child process (:func:`benchmarks.memory.peak_rss`), and their ratio (with
+``--compressed`` the save's share is measured as well).
 """
 
 from __future__ import annotations
@@ -89,7 +90,8 @@ def stream_peak(durations=(60.0, 3600.0)) -> dict:
 
 
 def main(argv=None) -> int:
-    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked).
+    """Print the save's share of a long run's CPU (uncompressed, and compressed if asked), or with
+    ``--stream-peak`` the streamed runs' peak memory.
 
     Parameters
     ----------
@@ -102,7 +104,7 @@ def main(argv=None) -> int:
     parser.add_argument("--stream-peak", action="store_true", help="peak memory of 60 s and 3600 s streamed runs")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
-    found = {"uncompressed": save_fraction(args.duration)}
+    found = {} if args.stream_peak and not args.compressed else {"uncompressed": save_fraction(args.duration)}
     if args.compressed:
         found["compressed"] = save_fraction(args.duration, compress=True)
     peak = stream_peak() if args.stream_peak else None
@@ -110,7 +112,9 @@ def main(argv=None) -> int:
         print(json.dumps(found | ({"stream_peak": peak} if peak else {})))
     else:
         if peak:
-            print(f"--stream peak memory: {peak['peak_mb']} MB, ratio {peak['ratio']:.3f}")
+            shortest, longest = min(peak["peak_mb"]), max(peak["peak_mb"])
+            print(f"--stream peak memory: {peak['peak_mb'][longest]:.0f} MB for {longest:g} s of flight, "
+                  f"{peak['peak_mb'][shortest]:.0f} MB for {shortest:g} s, ratio {peak['ratio']:.2f}")
         for kind, measured in found.items():
             print(f"{kind:13s} save_fraction {measured['fraction']:.3f}: save {measured['save_cpu_s']:.3f} s of "
                   f"{measured['run_cpu_s']:.2f} s CPU, results.npz {measured['record_mb']:.0f} MB")

@@ -32,7 +32,8 @@ import numpy as np
 # A small real recording shipped with the package: 24 s of BROAD's trial "01_undisturbed_slow_rotation_A"
 # (Laidig, Caruso, Cereatti, Seel, "BROAD - A Benchmark for Robust Inertial Orientation Estimation",
 # Data, 2021; CC BY 4.0, cut and stored in single precision, otherwise unchanged): 286 Hz, ENU, mag in uT,
-# 7.8 s at rest then slow rotations, with its optical reference and movement phases.
+# at rest, then slow rotations (`python -m estimators.recording` says how long each), with its optical
+# reference and movement phases.
 EXAMPLE = Path(__file__).parent / "data" / "broad_excerpt.npz"
 
 ALIASES = {
@@ -245,3 +246,56 @@ def save(path, *, gyro, acc, mag, rate: float, quat=None, scored=None, meta: dic
     else:
         raise ValueError(f"{path}: unknown recording format {suffix!r}; use .npz, .mat or .csv")
     return path
+
+
+def describe(data: dict) -> dict:
+    """What a loaded recording holds: its length, rate, and the time before its first scored sample.
+
+    Parameters
+    ----------
+    data : dict
+        A recording as :func:`load` gives it.
+
+    Returns
+    -------
+    dict
+        ``samples``, ``rate_hz`` (Hz), ``duration_s`` (s), ``scored_share`` (1, the share of
+        scored samples; 1 when the recording marks none) and ``before_first_scored_s`` (s, the
+        time before the first scored sample: the rest before the movement, in BROAD's phases).
+    """
+    samples, rate = len(data["gyro"]), float(data["rate"])
+    scored = data.get("scored")
+    scored = np.ones(samples, dtype=bool) if scored is None else np.asarray(scored, dtype=bool)
+    first = int(np.argmax(scored)) if scored.any() else samples
+    return {"samples": samples, "rate_hz": rate, "duration_s": samples / rate, "scored_share": float(scored.mean()),
+            "before_first_scored_s": first / rate}
+
+
+def main(argv=None) -> int:
+    """``python -m estimators.recording [FILE]``: print :func:`describe` of ``FILE`` (default
+    :data:`EXAMPLE`, the shipped excerpt).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (the process's by default).
+
+    Returns
+    -------
+    int
+        Exit status, 0.
+    """
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m estimators.recording", description=describe.__doc__.split("\n")[0])
+    parser.add_argument("file", nargs="?", default=str(EXAMPLE), help="a recording (default: the shipped excerpt)")
+    path = Path(parser.parse_args(argv).file)
+    d = describe(load(path))
+    print(f"{path.name}: {d['samples']} samples at {d['rate_hz']:.1f} Hz, {d['duration_s']:.1f} s; "
+          f"{d['before_first_scored_s']:.2f} s before the first scored sample (at rest), "
+          f"{d['scored_share']:.0%} of the samples scored")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -404,6 +404,7 @@ def _run_phases(scenario, options, base, files, given, progress):
         files.keep_record(result, saved, files.stream)
         if files.not_written:  # a full disk, or no memory left for a writer: metrics.json says which
             raise files.failed("; ".join(f"{file} not written: {why}" for file, why in files.not_written.items()))
+        metrics |= files.record_megabytes()
         files.phase = "reporting (metrics and figures)"
     status(f"{name}: report" + (" (metrics and figures)" if files else " (metrics)"))
     metrics |= _report(scenario, result, options, files, record)

@@ -14,7 +14,7 @@ import re
 SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_deg_s", "deg/s"), ("_rad2", "rad^2"),
                 ("_m_s", "m/s"), ("_deg", "deg"), ("_rad", "rad"), ("_uT", "uT"), ("_hz", "Hz"), ("_Hz", "Hz"),
                 ("_ms", "ms"), ("_mm", "mm"), ("_s", "s"), ("_m", "m"), ("_A", "A"), ("_v", "V"), ("_V", "V"),
-                ("_bytes", "B"), ("_pct", "%"))
+                ("_bytes", "B"), ("_mb", "MB"), ("_pct", "%"))
 
 _PARENTHESES = re.compile(r"\(([^()]*)\)")
 _UNIT_WORD = re.compile(r"[A-Za-zµ%]+")

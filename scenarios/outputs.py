@@ -26,6 +26,7 @@ RESERVE = ".metrics.reserve.part"
 
 #: Bytes kept for ``metrics.json`` (a run's is 3 to 10 kB).
 RESERVE_BYTES = 64 * 1024
+MEGABYTE = 1e6  # bytes, the unit of the record sizes in metrics.json
 
 
 def empty_result(meta: dict | None = None) -> Result:
@@ -103,6 +104,19 @@ class RunFiles:
                 self._write_formats(result, signals)
             self.record_saved = True
         self.save_cpu_seconds += time.process_time() - started
+
+    def record_megabytes(self) -> dict:
+        """Size of each record file written, ``results_<format>_mb`` (MB, 1e6 bytes; the
+        streamed folder's chunks as ``results_stream_mb``): what a run of this length and these
+        signals takes on the disk."""
+        sizes = {}
+        for kind in self.formats:
+            path = self.out / f"results.{kind}"
+            if path.is_file():
+                sizes[f"results_{kind}_mb"] = path.stat().st_size / MEGABYTE
+        if self.stream is not None and self.stream.path.is_dir():
+            sizes["results_stream_mb"] = sum(f.stat().st_size for f in self.stream.path.iterdir()) / MEGABYTE
+        return sizes
 
     def _write_formats(self, result: Result, signals):
         for kind in self.formats:

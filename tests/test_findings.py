@@ -193,7 +193,8 @@ def test_quick_findings_reproduce_the_committed_values(group):
 PRINT_CHECKED = ("flight.tilt.", "flight.tilt_without_drag.", "flight.wind.tilt", "rig.", "lab.linear_quasi_gt.",
                  "lab.ablation.ideal_", "lab.passive_convergence.reel.k100.",
                  "lab.triad_bias.times_true.", "infrared.slides.", "flight.wind.offset_",
-                 "flightlogs.quad.internal.current.explained_half_b", "flightlogs.replay.b1.")
+                 "flightlogs.quad.internal.current.explained_half_b", "flightlogs.replay.b1.",
+                 "records.tp_npz_mb", "log_info.", "plant.", "excerpt.")
 
 
 def _checked_commands() -> dict[str, list[dict]]:

@@ -151,9 +151,9 @@ def test_current_limit_holds_the_motor_current_on_a_start_from_rest(capsys):
 
 @pytest.mark.parametrize("case", [0, 1])
 def test_substep_manoeuvres_reach_both_current_bounds(case):
-    """The sub-step convergence manoeuvres (tests/test_substep.py) exercise the mode switches."""
+    """The sub-step convergence manoeuvres (fmus/agreement.py, tests/test_substep.py) exercise the mode switches."""
+    from fmus.agreement import SUBSTEP_CASES as CASES
     from fmus.twins import simulate_fmu
-    from tests.test_substep import CASES
 
     inputs, params, _ = CASES["MotorMagnetics"][case]
     _, out = simulate_fmu("MotorMagnetics", inputs, params, 2.0, 0.02, MOTOR_CURRENTS)

@@ -61,6 +61,8 @@ def test_a_20_s_tp_run_writes_its_record_uncompressed_and_matlab_reads_units_and
     metrics = json.loads((out / "metrics.json").read_text())
     values = 8 * len(saved) * (len(saved.names) + 1)
     assert values < written["results.npz"] < values + 100e3, written  # the arrays, their headers and _meta
+    assert metrics["results_npz_mb"] == written["results.npz"] / 1e6  # the size the run prints
+    assert metrics["units"]["results_npz_mb"] == "MB"
     assert total < 15e6, written  # measured 14.6 MB, figures included
     saved.to_npz(tmp_path / "compressed.npz", compress=True)
     assert (tmp_path / "compressed.npz").stat().st_size < 0.65 * values  # measured 0.60 of the values

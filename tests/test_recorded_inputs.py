@@ -142,3 +142,20 @@ def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(ca
     # 24 s of slow rotations from a TRIAD start: 0.99 to 1.25 deg measured, the least at kP = 1
     assert np.all((errors > 0.95) & (errors < 1.3)) and np.argmin(errors.min(axis=1)) == 2
     assert "[[" in capsys.readouterr().out
+
+
+def test_describe_gives_the_time_before_the_first_scored_sample(tmp_path, capsys):
+    rate, samples, first = 50.0, 300, 120
+    scored = np.arange(samples) >= first
+    zeros = np.zeros((samples, 3))
+    path = recording.save(tmp_path / "r.npz", gyro=zeros, acc=zeros + [0, 0, 9.81], mag=zeros + [20, 0, 40],
+                          rate=rate, scored=scored)
+    described = recording.describe(recording.load(path))
+    assert described["before_first_scored_s"] == first / rate and described["duration_s"] == samples / rate
+    assert described["scored_share"] == pytest.approx((samples - first) / samples)
+    unscored_path = recording.save(tmp_path / "u.npz", gyro=zeros, acc=zeros + [0, 0, 9.81], mag=zeros + [20, 0, 40],
+                                   rate=rate)
+    unscored = recording.describe(recording.load(unscored_path))
+    assert unscored["before_first_scored_s"] == 0.0 and unscored["scored_share"] == 1.0
+    assert recording.main([str(path)]) == 0
+    assert "2.40 s before the first scored sample" in capsys.readouterr().out

@@ -39,6 +39,12 @@ GROUPS = (
     "sweep_cost",
     "flightlogs",
     "real_recordings",
+    "plant",
+    "fmu_agreement",
+    "mag_rate",
+    "records",
+    "excerpt",
+    "log_info",
 )
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -36,6 +36,8 @@ def test_stream_on_the_command_line_writes_the_folder_and_result_load_reads_eith
     streamed, kept = Result.load(tmp_path / "s"), Result.load(tmp_path / "m" / "results.npz")
     assert np.array_equal(streamed["Quadrotor.q"], kept["Quadrotor.q"])
     assert metrics["rms_error_deg"] == assert_whole(tmp_path / "m")["rms_error_deg"]
+    chunks = sum(f.stat().st_size for f in (tmp_path / "s" / "results.stream").iterdir())
+    assert metrics["results_stream_mb"] == chunks / 1e6 and "results_npz_mb" not in metrics
     assert cli(["run", "tp", "--stream", "--format", "npz,mat", "--out", str(tmp_path / "x")]) == 2
 
 
