@@ -19,8 +19,8 @@ RUN = "quadcosim run tp"
 STREAM = "python -m benchmarks.save --stream-peak"
 SIZE_TOLERANCE_MB = 0.05  # MB: the uncompressed record is 8 bytes a value, its size fixed by the run
 COMPRESSED_TOLERANCE_MB = 0.2  # MB: compression depends on the values' last bits and on zlib's version
-PEAK_TOLERANCE_MB = 25.0  # MB: resident memory moves with the machine, numpy and numba
-RATIO_TOLERANCE = 0.05  # 1
+PEAK_TOLERANCE_MB = 50.0  # MB: resident memory moves with the machine, numpy, numba and whether its cache is warm
+RATIO_TOLERANCE = 0.1  # 1: 1.11 to 1.14 in three runs on one machine
 
 
 def record_size(compress: bool) -> float:
