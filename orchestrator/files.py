@@ -100,20 +100,29 @@ def atomic_path(path, size: int | None = None):
     size : int, optional
         Bytes the file is expected to take, named in the message of a full disk.
     """
+    from orchestrator.interrupts import held
+
     path = Path(path)
+    temporary = None
     try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}", dir=path.parent)
-    except OSError as error:
-        raise _no_room(error, path, 0, size) from None
-    os.close(handle)
-    temporary = Path(temporary)
-    try:
+        # a signal between the file's creation and its name being known would leave it behind:
+        # held there, it is raised once the name is known, and the file is removed below
+        with held():
+            try:
+                handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}",
+                                                dir=path.parent)
+            except OSError as error:
+                raise _no_room(error, path, 0, size) from None
+            temporary = Path(name)
+            os.close(handle)
         yield temporary
         with open(temporary, "rb+") as written:
             os.fsync(written.fileno())
         os.chmod(temporary, 0o666 & ~_UMASK)  # mkstemp makes it private; a result file is not
         os.replace(temporary, path)
     except BaseException as error:
+        if temporary is None:
+            raise
         reached = temporary.stat().st_size if temporary.exists() else 0
         temporary.unlink(missing_ok=True)
         if isinstance(error, OSError) and not isinstance(error, DiskFull):

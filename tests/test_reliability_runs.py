@@ -98,6 +98,21 @@ def test_atomic_files_take_the_usual_permissions(tmp_path):
     assert (tmp_path / "metrics.json").stat().st_mode & 0o777 == 0o666 & ~orchestrator.files._UMASK
 
 
+def test_a_signal_as_the_temporary_file_is_made_leaves_no_temporary(tmp_path, monkeypatch):
+    made = orchestrator.files.tempfile.mkstemp
+
+    def interrupted_right_after_creation(*args, **kwargs):
+        handle, name = made(*args, **kwargs)
+        signal.raise_signal(signal.SIGINT)  # the file exists, its name not yet returned
+        return handle, name
+
+    monkeypatch.setattr(orchestrator.files.tempfile, "mkstemp", interrupted_right_after_creation)
+    with pytest.raises(KeyboardInterrupt):
+        with atomic_path(tmp_path / "yaw.png") as temporary:
+            temporary.write_bytes(b"never reached")
+    assert list(tmp_path.iterdir()) == []
+
+
 # ---------------------------------------------------------------------- output folder
 def test_out_is_checked_before_the_run(tmp_path, capsys):
     existing_file = tmp_path / "results"
