@@ -212,15 +212,15 @@ def strays(path) -> list[str]:
     path = Path(path)
     page = path.read_text()
 
-    def blank(match) -> str:
-        return re.sub(r"[^\n]", " ", match.group(0))
+    def blank(text: str) -> str:  # spaces in place of text, its line breaks kept
+        return re.sub(r"[^\n]", " ", text)
 
     masked = page
     for passage in passages(path):
-        masked = masked[:passage.start] + blank(re.match(r".*", passage.text, re.S)) + \
-            masked[passage.start + len(passage.text):]
+        end = passage.start + len(passage.text)
+        masked = masked[:passage.start] + blank(passage.text) + masked[end:]
     for pattern in (INPUTS, FENCE, ENUMERATION):
-        masked = pattern.sub(blank, masked)
+        masked = pattern.sub(lambda match: blank(match.group(0)), masked)
     lines = []
     for offset, token in numbers(masked):
         before = masked[:offset].split()
