@@ -127,15 +127,14 @@ def _count_operations(estimator, ir, gps, use) -> np.ndarray:
                     setattr(module, name, value.py_func)
             saved.append((module, "math", module.__dict__.get("math", _REAL_MATH)))
             module.math = _CountedMath
-        filters, _, runner = _modules()
+        _, _, runner = _modules()
         state = [_Counted(v) for v in estimator._initial]
         config = [_Counted(v) for v in estimator.config]
         buffer = [_Counted(0.0) for _ in range(2 * (estimator.delay + estimator.window + 2) + 2)]
-        step = getattr(filters, estimator._step.__name__)
         counts = np.zeros((len(ir), 3), dtype=np.int64)
         for k in range(len(ir)):
             _TALLY.flops = _TALLY.comparisons = _TALLY.functions = 0
-            runner._sample(step, state, config, buffer, k, _Counted(ir[k]), _Counted(gps[k]), bool(use[k]),
+            runner._sample(estimator._kind, state, config, buffer, k, _Counted(ir[k]), _Counted(gps[k]), bool(use[k]),
                            estimator.delay, estimator.window, estimator._suspect)
             counts[k] = _TALLY.flops, _TALLY.comparisons, _TALLY.functions
         return counts

@@ -355,18 +355,36 @@ class CalibrationError(ValueError):
     """An estimator was given data or settings it cannot use."""
 
 
-@njit  # not cached: numba's cache cannot key a function argument across processes
-def _sample(step, s, c, buffer, k, ir, gps, gps_use, delay, window, suspect):
+# the step each estimator takes; by number, so that the compiled loops are cached (numba's cache
+# cannot key a function passed as an argument across processes)
+EKF_SEQUENTIAL, EKF_JOINT, REGRESSION, RLS = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def _step(kind, s, c, ir_pair, gps, gps_use, ir):
+    """One step of the estimator ``kind`` (:data:`EKF_SEQUENTIAL` ... :data:`RLS`)."""
+    if kind == EKF_SEQUENTIAL:
+        ekf_step(s, c, ir_pair, gps, gps_use, ir)
+    elif kind == EKF_JOINT:
+        ekf_joint_step(s, c, ir_pair, gps, gps_use, ir)
+    elif kind == REGRESSION:
+        regression_step(s, c, ir_pair, gps, gps_use, ir)
+    else:
+        rls_step(s, c, ir_pair, gps, gps_use, ir)
+
+
+@njit(cache=True)
+def _sample(kind, s, c, buffer, k, ir, gps, gps_use, delay, window, suspect):
     """One sample of any estimator: pair the IR with the GPS window, step, store the IR."""
-    step(s, c, pair_at(buffer, k, delay, window), gps, gps_use, ir)
+    _step(kind, s, c, pair_at(buffer, k, delay, window), gps, gps_use, ir)
     push(buffer, k, ir, s[suspect] if suspect >= 0 else 0.0, delay, window)
 
 
-@njit  # not cached, as _sample
-def _run(step, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, suspect, out):
-    """The batch path: the step function over recorded arrays. Returns the samples done."""
+@njit(cache=True)
+def _run(kind, s, c, buffer, delay, window, ir, gps, gps_use, fields, status, suspect, out):
+    """The batch path: the step over recorded arrays. Returns the samples done."""
     for k in range(ir.shape[0]):
-        _sample(step, s, c, buffer, k, ir[k], gps[k], gps_use[k], delay, window, suspect)
+        _sample(kind, s, c, buffer, k, ir[k], gps[k], gps_use[k], delay, window, suspect)
         for j in range(fields.shape[0]):
             out[k, j] = s[fields[j]]
         if status >= 0 and s[status] != 0.0:
@@ -409,17 +427,17 @@ class Estimator:
         self.method, self.delay, self.window = method, int(delay), int(window)
         if method == "kalman":
             self.settings = settings or EKFSettings()
-            self._step = ekf_step if self.settings.form == "sequential" else ekf_joint_step
+            self._kind = EKF_SEQUENTIAL if self.settings.form == "sequential" else EKF_JOINT
             self._fields, self._status = _EKF_FIELDS, STATUS
             self._suspect = IR_SUSPECT if self.settings.form == "sequential" else -1
             self._initial = self.settings.initial_state(covariance)
         elif method == "regression":
             self.settings = settings or RegressionSettings()
-            self._step, self._fields, self._status, self._suspect = regression_step, _REG_FIELDS, -1, -1
+            self._kind, self._fields, self._status, self._suspect = REGRESSION, _REG_FIELDS, -1, -1
             self._initial = self.settings.initial_state()
         else:
             self.settings = settings or RLSSettings()
-            self._step, self._fields, self._status, self._suspect = rls_step, _RLS_FIELDS, -1, -1
+            self._kind, self._fields, self._status, self._suspect = RLS, _RLS_FIELDS, -1, -1
             self._initial = self.settings.initial_state()
         self.config = self.settings.config()
         if method == "kalman":
@@ -445,7 +463,7 @@ class Estimator:
         if not (math.isfinite(ir) and math.isfinite(gps)):
             raise CalibrationError(f"sample {self.k}: IR = {ir!r}, GPS turn rate = {gps!r}; the estimators take "
                                    "finite readings only: drop or repair that sample")
-        _sample(self._step, self.state, self.config, self.buffer, self.k, float(ir), float(gps), bool(gps_use),
+        _sample(self._kind, self.state, self.config, self.buffer, self.k, float(ir), float(gps), bool(gps_use),
                 self.delay, self.window, self._suspect)
         self.k += 1
         if self._status >= 0 and self.state[self._status] != 0.0:
@@ -481,7 +499,7 @@ class Estimator:
             raise CalibrationError(f"gps_use {use.shape} must have the shape of IR {ir.shape}")
         self.reset()
         out = np.full((ir.shape[0], self._index.shape[0]), np.nan)
-        done = _run(self._step, self.state, self.config, self.buffer, self.delay, self.window, ir, gps, use,
+        done = _run(self._kind, self.state, self.config, self.buffer, self.delay, self.window, ir, gps, use,
                     self._index, self._status, self._suspect, out)
         self.k = done
         if done < ir.shape[0]:
