@@ -52,6 +52,32 @@ def exit_code(interrupt: BaseException) -> int:
     return 128 + signal_number(interrupt)
 
 
+def leave(code: int):
+    """End the process with exit code ``code``, even after an interrupt.
+
+    CPython marks a KeyboardInterrupt raised while a C extension runs Python code as unhandled
+    even when the program handles it, and then ends the process by SIGINT instead of with the
+    exit code. An interrupted command (130, 143) therefore leaves through ``os._exit``, once the
+    exit handlers have run and the streams are flushed; any other code through ``sys.exit``.
+
+    Parameters
+    ----------
+    code : int
+        The process's exit code.
+    """
+    import os
+    import sys
+
+    if code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
+        import atexit
+
+        atexit._run_exitfuncs()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    sys.exit(code)
+
+
 def _raise_terminated(number, frame):
     raise Terminated()
 

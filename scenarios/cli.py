@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import signal
 import sys
 import warnings
 from pathlib import Path
@@ -361,23 +360,11 @@ def main(argv=None) -> int:
 
 
 def entry() -> None:
-    """The ``quadcosim`` program: :func:`main`, then exit with its code.
+    """The ``quadcosim`` program: :func:`main`, then exit with its code
+    (:func:`orchestrator.interrupts.leave`)."""
+    from orchestrator.interrupts import leave
 
-    An interrupted command (130, 143) leaves through ``os._exit`` once the exit handlers have run
-    and the streams are flushed: CPython marks a KeyboardInterrupt raised inside code that a C
-    extension runs as unhandled even when this program handles it, and would end the process by
-    SIGINT rather than with the exit code.
-    """
-    code = main()
-    if code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
-        import atexit
-        import os
-
-        atexit._run_exitfuncs()
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code)
-    sys.exit(code)
+    leave(main())
 
 
 if __name__ == "__main__":

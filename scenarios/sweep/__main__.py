@@ -1,10 +1,13 @@
 import sys
 
-try:
-    from scenarios.sweep.command import main
-except KeyboardInterrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep
-    print("quadcosim sweep: interrupted", file=sys.stderr)
-    sys.exit(130)
+from orchestrator.interrupts import leave  # the standard library alone: no window before the try
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        from scenarios.sweep.command import main
+
+        code = main()
+    except KeyboardInterrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep
+        print("quadcosim sweep: interrupted", file=sys.stderr)
+        code = 130
+    leave(code)

@@ -210,11 +210,11 @@ def main(argv=None) -> int:
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
-    p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,
-                                              formatter_class=argparse.RawDescriptionHelpFormatter))
     try:
         with terminate_as_interrupt():
+            p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,
+                                                      formatter_class=argparse.RawDescriptionHelpFormatter))
             return sweep(p.parse_args(argv))
-    except KeyboardInterrupt as interrupt:  # before the members started: nothing to keep yet
+    except KeyboardInterrupt as interrupt:  # while loading or planning: nothing to keep yet
         print("quadcosim sweep: interrupted", file=sys.stderr)
         return exit_code(interrupt)
