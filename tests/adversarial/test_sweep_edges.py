@@ -53,7 +53,9 @@ def test_planning_gives_way_to_ctrl_c(cpu_s, tmp_path):
 
     process = subprocess.Popen([sys.executable, "-m", "scenarios.sweep", "tp", "--grid", "k=0.1:1:log990000",
                                 "--seeds", "1", "--out", str(tmp_path / "long"), "--quiet"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    # (a child of a background job would otherwise inherit SIGINT ignored, as a shell wants)
     # 0.4 s of CPU: loading numpy and the scenarios (about a second in all); 3 s: making and
     # checking the 990,000 values (several)
     child, deadline = psutil.Process(process.pid), time.monotonic() + 120
