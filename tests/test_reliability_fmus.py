@@ -70,9 +70,9 @@ def test_non_finite_times_are_refused(model):
 ])
 def test_steps_needing_too_much_work_are_refused_at_once(model, parameter, value, step, words):
     fmu = stepping(model, {parameter: value} if parameter else None)
-    start = time.perf_counter()
+    start = time.thread_time()  # CPU time: a busy machine's preemptions do not count
     assert fmu.do_step(0.0, step) == ERROR
-    elapsed = time.perf_counter() - start
+    elapsed = time.thread_time() - start
     assert words in fmu.messages()
     assert "more than the 200000 allowed per step" in fmu.messages()
     assert elapsed < 0.01
