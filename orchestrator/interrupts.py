@@ -8,13 +8,20 @@ partial results and no extracted FMU behind.
 While a record is being made safe (saved, and its ``metrics.json`` written), :func:`held`
 holds both signals back: the save finishes, and the first signal held is raised when the
 block ends. A second Ctrl-C, pressed because the first seemed slow, cannot cut the save short.
+
+Python drops an exception raised inside a finaliser or a weakref callback (matplotlib's
+figures run many as they are freed) after printing it. A signal whose interrupt is dropped so
+is raised again at the next point the main thread reaches (:func:`_dropped`): it is never lost.
 """
 
 from __future__ import annotations
 
+import _thread
 import contextlib
 import signal
+import sys
 import threading
+import time
 
 
 class Terminated(KeyboardInterrupt):
@@ -101,6 +108,8 @@ class _State:
 
     def __init__(self):
         self.previous: dict | None = None
+        self.unraisable = None  # the unraisable-exception hook replaced
+        self.dropping = False  # _dropped is running
         self.regions = 0
         self.depth = 0
         self.raised: int | None = None
@@ -134,12 +143,35 @@ def _handle(number, frame):
     raise interrupt_for(number)
 
 
+def _dropped(unraisable):
+    """``sys.unraisablehook`` while the signals are taken over: an interrupt that :func:`_handle`
+    raised inside a finaliser or weakref callback, which Python drops, is signalled again once
+    this hook has returned (:func:`_signal_again`); any other exception is reported as before."""
+    if (_state.raised is not None and isinstance(unraisable.exc_value, KeyboardInterrupt)
+            and threading.current_thread() is threading.main_thread()):
+        number, _state.raised = _state.raised, None
+        _state.dropping = True
+        threading.Thread(target=_signal_again, args=(number,), name="signal again", daemon=True).start()
+        _state.dropping = False  # the last statement: no signal can be handled between it and the return
+        return
+    (_state.unraisable or sys.__unraisablehook__)(unraisable)
+
+
+def _signal_again(number: int):
+    """Signal ``number`` to the main thread once :func:`_dropped` is over: signalled from inside
+    it, the interrupt would be raised there, and dropped again."""
+    while _state.dropping:
+        time.sleep(0.001)
+    _thread.interrupt_main(number)
+
+
 def _install() -> bool:
     """Take over both signals (main thread only); False where signals cannot be handled."""
     if threading.current_thread() is not threading.main_thread():
         return False
     if _state.previous is None:
         _state.previous = {number: signal.signal(number, _handle) for number in _HELD}
+        _state.unraisable, sys.unraisablehook = sys.unraisablehook, _dropped
     return True
 
 
@@ -147,7 +179,9 @@ def _uninstall():
     if _state.previous is not None and not _state.regions and not _state.depth:
         for number, handler in _state.previous.items():
             signal.signal(number, handler)
-        _state.previous, _state.raised, _state.noted = None, None, []
+        if sys.unraisablehook is _dropped:
+            sys.unraisablehook = _state.unraisable
+        _state.previous, _state.raised, _state.noted, _state.unraisable = None, None, [], None
 
 
 @contextlib.contextmanager
