@@ -10,8 +10,10 @@ holds both signals back: the save finishes, and the first signal held is raised 
 block ends. A second Ctrl-C, pressed because the first seemed slow, cannot cut the save short.
 
 Python drops an exception raised inside a finaliser or a weakref callback (matplotlib's
-figures run many as they are freed) after printing it. A signal whose interrupt is dropped so
-is raised again at the next point the main thread reaches (:func:`_dropped`): it is never lost.
+figures run many as they are freed) after printing it, and an extension module whose making is
+interrupted can be left broken (pybind11 turns the interrupt into an ImportError). A signal
+whose interrupt would be dropped, or that arrives during an import, is signalled again once
+that is over (:func:`_dropped`, :func:`_handle`): it is raised late, never lost.
 """
 
 from __future__ import annotations
@@ -139,30 +141,46 @@ def _handle(number, frame):
     if _state.depth or _state.raised is not None:
         _state.noted.append(number)  # a save is under way, or the run is already stopping
         return
+    if _importing(frame):  # an extension module stopped in its making can be left broken
+        _later(number, lambda: _importing(sys._current_frames().get(threading.main_thread().ident)))
+        return
     _state.raised = number
     raise interrupt_for(number)
+
+
+def _importing(frame) -> bool:
+    """Whether the code at ``frame`` runs inside an import."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _dropped(unraisable):
     """``sys.unraisablehook`` while the signals are taken over: an interrupt that :func:`_handle`
     raised inside a finaliser or weakref callback, which Python drops, is signalled again once
-    this hook has returned (:func:`_signal_again`); any other exception is reported as before."""
+    this hook has returned; any other exception is reported as before."""
     if (_state.raised is not None and isinstance(unraisable.exc_value, KeyboardInterrupt)
             and threading.current_thread() is threading.main_thread()):
         number, _state.raised = _state.raised, None
         _state.dropping = True
-        threading.Thread(target=_signal_again, args=(number,), name="signal again", daemon=True).start()
+        _later(number, lambda: _state.dropping)
         _state.dropping = False  # the last statement: no signal can be handled between it and the return
         return
     (_state.unraisable or sys.__unraisablehook__)(unraisable)
 
 
-def _signal_again(number: int):
-    """Signal ``number`` to the main thread once :func:`_dropped` is over: signalled from inside
-    it, the interrupt would be raised there, and dropped again."""
-    while _state.dropping:
-        time.sleep(0.001)
-    _thread.interrupt_main(number)
+def _later(number: int, waiting):
+    """Signal ``number`` to the main thread again, from another thread, once ``waiting()`` is
+    false: signalled at once, it would be handled where it could not be raised."""
+
+    def signal_again():
+        while waiting():
+            time.sleep(0.001)
+        _thread.interrupt_main(number)
+
+    threading.Thread(target=signal_again, name="signal again", daemon=True).start()
 
 
 def _install() -> bool:

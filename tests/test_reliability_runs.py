@@ -53,6 +53,23 @@ def test_a_signal_landing_in_a_weakref_callback_is_raised_once_the_callback_is_o
     assert sys.unraisablehook is hook and signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
+def test_a_signal_during_an_import_is_raised_once_the_module_is_made(tmp_path, monkeypatch):
+    # An interrupt inside an extension module's making (matplotlib's ft2font under pybind11)
+    # became an ImportError, and the process later crashed on the half-made module.
+    (tmp_path / "interrupted_module.py").write_text(
+        "import signal\nsignal.raise_signal(signal.SIGINT)\nfor k in range(100000):\n    pass\nMADE = True\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    after = []
+    with pytest.raises(KeyboardInterrupt):
+        with first_only():
+            import interrupted_module
+            deadline = time.monotonic() + 1.0
+            while time.monotonic() < deadline:  # the signal is raised here, after the import
+                after.append(time.monotonic())
+    assert sys.modules.pop("interrupted_module").MADE and interrupted_module.MADE
+    assert 0 < len(after) and after[-1] < deadline
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sent, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_an_interrupted_run_saves_what_it_recorded_and_leaves_no_temporary_files(tmp_path, sent, code):
