@@ -112,6 +112,7 @@ class _State:
         self.previous: dict | None = None
         self.unraisable = None  # the unraisable-exception hook replaced
         self.dropping = False  # _dropped is running
+        self.deferred: list[int] = []  # signals to raise once an import or a dropped interrupt is over
         self.regions = 0
         self.depth = 0
         self.raised: int | None = None
@@ -142,8 +143,12 @@ def _handle(number, frame):
         _state.noted.append(number)  # a save is under way, or the run is already stopping
         return
     if _importing(frame):  # an extension module stopped in its making can be left broken
-        _later(number, lambda: _importing(sys._current_frames().get(threading.main_thread().ident)))
+        _defer(number, lambda: _importing(sys._current_frames().get(threading.main_thread().ident)))
         return
+    if _state.deferred:  # the first signal deferred is the one that stops the run
+        number, later = _state.deferred[0], _state.deferred[1:]
+        _state.deferred = []
+        _state.noted.extend(later)
     _state.raised = number
     raise interrupt_for(number)
 
@@ -165,21 +170,27 @@ def _dropped(unraisable):
             and threading.current_thread() is threading.main_thread()):
         number, _state.raised = _state.raised, None
         _state.dropping = True
-        _later(number, lambda: _state.dropping)
+        _defer(number, lambda: _state.dropping, first=True)
         _state.dropping = False  # the last statement: no signal can be handled between it and the return
         return
     (_state.unraisable or sys.__unraisablehook__)(unraisable)
 
 
-def _later(number: int, waiting):
-    """Signal ``number`` to the main thread again, from another thread, once ``waiting()`` is
-    false: signalled at once, it would be handled where it could not be raised."""
+def _defer(number: int, waiting, first: bool = False):
+    """Keep signal ``number`` (in order, or ``first``) and, from another thread, signal the first
+    kept to the main thread once ``waiting()`` is false: handled at once, it would be where it
+    cannot be raised."""
 
     def signal_again():
         while waiting():
             time.sleep(0.001)
-        _thread.interrupt_main(number)
+        if _state.deferred:
+            _thread.interrupt_main(_state.deferred[0])
 
+    if first:
+        _state.deferred.insert(0, number)
+    else:
+        _state.deferred.append(number)
     threading.Thread(target=signal_again, name="signal again", daemon=True).start()
 
 
@@ -200,6 +211,7 @@ def _uninstall():
         if sys.unraisablehook is _dropped:
             sys.unraisablehook = _state.unraisable
         _state.previous, _state.raised, _state.noted, _state.unraisable = None, None, [], None
+        _state.deferred = []
 
 
 @contextlib.contextmanager
