@@ -142,8 +142,8 @@ def _handle(number, frame):
     if _state.depth or _state.raised is not None:
         _state.noted.append(number)  # a save is under way, or the run is already stopping
         return
-    if _importing(frame):  # an extension module stopped in its making can be left broken
-        _defer(number, lambda: _importing(sys._current_frames().get(threading.main_thread().ident)))
+    if _state.dropping or _importing(frame):  # raised here, it would be dropped, or break a module
+        _defer(number)
         return
     if _state.deferred:  # the first signal deferred is the one that stops the run
         number, later = _state.deferred[0], _state.deferred[1:]
@@ -162,6 +162,13 @@ def _importing(frame) -> bool:
     return False
 
 
+def _busy() -> bool:
+    """Whether a signal handled now in the main thread could not be raised: :func:`_dropped`
+    is running, or the main thread is importing (an extension module stopped in its making can
+    be left broken)."""
+    return _state.dropping or _importing(sys._current_frames().get(threading.main_thread().ident))
+
+
 def _dropped(unraisable):
     """``sys.unraisablehook`` while the signals are taken over: an interrupt that :func:`_handle`
     raised inside a finaliser or weakref callback, which Python drops, is signalled again once
@@ -170,19 +177,18 @@ def _dropped(unraisable):
             and threading.current_thread() is threading.main_thread()):
         number, _state.raised = _state.raised, None
         _state.dropping = True
-        _defer(number, lambda: _state.dropping, first=True)
+        _defer(number, first=True)
         _state.dropping = False  # the last statement: no signal can be handled between it and the return
         return
     (_state.unraisable or sys.__unraisablehook__)(unraisable)
 
 
-def _defer(number: int, waiting, first: bool = False):
-    """Keep signal ``number`` (in order, or ``first``) and, from another thread, signal the first
-    kept to the main thread once ``waiting()`` is false: handled at once, it would be where it
-    cannot be raised."""
+def _defer(number: int, first: bool = False):
+    """Keep signal ``number`` (last, or ``first``) and, from another thread, signal the first kept
+    to the main thread once it is no longer :func:`_busy`."""
 
     def signal_again():
-        while waiting():
+        while _busy():
             time.sleep(0.001)
         if _state.deferred:
             _thread.interrupt_main(_state.deferred[0])
@@ -210,8 +216,11 @@ def _uninstall():
             signal.signal(number, handler)
         if sys.unraisablehook is _dropped:
             sys.unraisablehook = _state.unraisable
+        waiting = _state.deferred[0] if _state.deferred and _state.raised is None else None
         _state.previous, _state.raised, _state.noted, _state.unraisable = None, None, [], None
         _state.deferred = []
+        if waiting is not None:  # kept, not yet raised: the handlers now in place act on it
+            signal.raise_signal(waiting)
 
 
 @contextlib.contextmanager
