@@ -64,10 +64,11 @@ def exit_code(interrupt: BaseException) -> int:
 def leave(code: int):
     """End the process with exit code ``code``, even after an interrupt.
 
-    CPython marks a KeyboardInterrupt raised while a C extension runs Python code as unhandled
-    even when the program handles it, and then ends the process by SIGINT instead of with the
-    exit code. An interrupted command (130, 143) therefore leaves through ``os._exit``, once the
-    exit handlers have run and the streams are flushed; any other code through ``sys.exit``.
+    CPython marks a KeyboardInterrupt raised inside code it runs from a string (``exec``, as
+    dataclasses and numba do) as unhandled even when the program handles it, and under
+    ``python -m`` then ends the process by SIGINT instead of with the exit code. An interrupted
+    command (130, 143) therefore leaves through ``os._exit``, once the exit handlers have run
+    and the streams are flushed; any other code through ``sys.exit``.
 
     Parameters
     ----------
@@ -75,7 +76,6 @@ def leave(code: int):
         The process's exit code.
     """
     import os
-    import sys
 
     if code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
         import atexit

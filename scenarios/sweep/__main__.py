@@ -1,13 +1,13 @@
 import sys
 
-from orchestrator.interrupts import leave  # the standard library alone: no window before the try
+from orchestrator.interrupts import exit_code, leave  # the standard library alone: no window before the try
 
 if __name__ == "__main__":
     try:
         from scenarios.sweep.command import main
 
         code = main()
-    except KeyboardInterrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep
+    except KeyboardInterrupt as interrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep
         print("quadcosim sweep: interrupted", file=sys.stderr)
-        code = 130
+        code = exit_code(interrupt)
     leave(code)
