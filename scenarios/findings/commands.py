@@ -99,13 +99,7 @@ def by_command(findings: dict[str, dict], groups=None) -> dict[str, list[dict]]:
 
 def printed_numbers(text: str) -> list[float]:
     """Every number in ``text`` (a command's standard output)."""
-    numbers = []
-    for token in PRINTED_NUMBER.findall(text):
-        try:
-            numbers.append(float(token))
-        except ValueError:  # a lone sign or dot
-            continue
-    return numbers
+    return [float(token) for token in PRINTED_NUMBER.findall(text)]  # each token holds a digit
 
 
 def bound(finding: dict) -> float:
