@@ -20,6 +20,8 @@ import numpy as np
 import scenarios
 from scenarios import tp
 
+DURATION_S = 20.0  # s, simulated time per run by default
+
 
 def rms_errors(settings: dict, mag_rate: float) -> np.ndarray:
     """RMS estimation error (deg) of a ``tp`` run with the options ``settings`` (name -> text)
@@ -61,7 +63,7 @@ def main(argv=None) -> int:
         Exit status, 0.
     """
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--duration", type=float, default=20.0, help="simulated time per run (s)")
+    parser.add_argument("--duration", type=float, default=DURATION_S, help="simulated time per run (s)")
     parser.add_argument("--noise", choices=("off", "on", "both"), default="both", help="IMU white noise")
     args = parser.parse_args(argv)
     noises = {"off": [False], "on": [True], "both": [False, True]}[args.noise]

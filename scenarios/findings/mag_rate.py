@@ -10,7 +10,6 @@ from __future__ import annotations
 from scenarios.findings import finding
 
 COMMAND = "python -m scenarios.mag_rate --noise off"
-DURATION_S = 20.0  # s, the command's default run length
 TOLERANCE_DEG = 5e-5  # deg: deterministic without noise, printed to 4 decimals
 
 
@@ -20,7 +19,7 @@ def compute(quick: bool = False) -> list[dict]:
         return []
     import numpy as np
 
-    from scenarios.mag_rate import differences
+    from scenarios.mag_rate import DURATION_S, differences
 
     largest = max(float(np.abs(held - fast).max()) for *_, fast, held in differences(DURATION_S, False))
     return [finding("mag_rate.largest_difference_noiseless_deg", largest, "deg", COMMAND, TOLERANCE_DEG, 4)]
