@@ -5,6 +5,7 @@ import pytest
 
 from fmus import vehicle
 from orchestrator.fmu import FMUInstance
+from scenarios.hover import figures
 
 OUT = ["omega_r1", "i1", "i2", "i3", "i4", "u_batt", "i_batt", "soc", "b_d_x", "b_d_y", "b_d_z",
        *[f"b_d{n}_{a}" for n in range(1, 5) for a in "xyz"], *[f"i_s{n}" for n in range(1, 5)],
@@ -23,21 +24,17 @@ def run(commands, seconds, h=1e-3, fmu=None, parameters=None):
 
 
 def test_hover_current_and_time_constant(capsys):
-    c = vehicle.hover_command()
-    fmu, out = run([c] * 4, 1.0)
-    assert out["omega_r1"][-1] == pytest.approx(vehicle.hover_rotor_speed(), rel=2e-3)
+    hover = figures()  # settled 1 s at the hover command, then a small command step
+    assert hover["omega_rad_s"] == pytest.approx(vehicle.hover_rotor_speed(), rel=2e-3)
     # the current that holds the speed against propeller drag (3.78 A, in the 3 to 5 A of a
     # 450-class hover); measured 1.0e-4 relative from the steady-state map after 1 s
-    assert out["i1"][-1] == pytest.approx(vehicle.steady_current(out["omega_r1"][-1]), rel=5e-4)
-    assert 0.4 <= c <= 0.6  # near half throttle on 3S
+    assert hover["current_a"] == pytest.approx(vehicle.steady_current(hover["omega_rad_s"]), rel=5e-4)
+    assert 0.4 <= hover["command"] <= 0.6  # near half throttle on 3S
     # command-to-speed time constant: 63 % of a small step
-    w0 = out["omega_r1"][-1]
-    _, step = run([c + 0.02] * 4, 0.5, h=1e-4, fmu=fmu)
-    w = step["omega_r1"]
-    tau = (np.argmax(w - w0 >= 0.632 * (w[-1] - w0)) + 1) * 1e-4
+    tau = hover["motor_time_constant_ms"] * 1e-3
     with capsys.disabled():
-        print(f"\nhover: c = {c:.3f}, i = {out['i1'][-1]:.2f} A, omega = {w0:.1f} rad/s, "
-              f"command-to-speed time constant = {tau * 1e3:.1f} ms")
+        print(f"\nhover: c = {hover['command']:.3f}, i = {hover['current_a']:.2f} A, "
+              f"omega = {hover['omega_rad_s']:.1f} rad/s, command-to-speed time constant = {tau * 1e3:.1f} ms")
     assert 0.01 < tau < 0.06
 
 
