@@ -156,8 +156,9 @@ def summarize(time, truth: dict, estimates: dict, windows) -> dict:
         error = np.degrees(e["turn_rate"] - truth["r"])[valid]
         metrics["turn_rate_error_deg_s"][m] = {"mean": float(error.mean()), "std": float(error.std())}
         settled = np.degrees(e["turn_rate"] - truth["r"])[time >= 30.0]
-        metrics.setdefault("turn_rate_error_after_30_s_deg_s", {})[m] = {"mean": float(settled.mean()),
-                                                                         "std": float(settled.std())}
+        if len(settled):  # a run shorter than 30 s has no settled part to score
+            metrics.setdefault("turn_rate_error_after_30_s_deg_s", {})[m] = {"mean": float(settled.mean()),
+                                                                             "std": float(settled.std())}
     kalman = estimates["kalman"]
     flags = {"ir": kalman["ir_fault"], "gps": kalman["gps_fault"]}
     metrics["faults"], metrics["false_alarms"] = fault_report(windows, flags, time)
