@@ -485,8 +485,11 @@ def _draw(scenario, system, options, files):
 
 def _report(scenario, result, options, files, record) -> dict:
     """The scenario's metrics (and figures); a report that fails keeps the saved record."""
+    from scenarios.figures import closed_on_failure
+
     try:
-        return scenario.report(result, options, files.out if files else None)
+        with closed_on_failure():
+            return scenario.report(result, options, files.out if files else None)
     except KeyError as error:
         if not record:
             if files is None:

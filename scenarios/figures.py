@@ -9,11 +9,32 @@ value), as :func:`scenarios.run` records them.
 
 from __future__ import annotations
 
+import contextlib
+import sys
 import textwrap
 
 import numpy as np
 
 FAULT_COLOUR = "#d62728"
+
+
+@contextlib.contextmanager
+def closed_on_failure():
+    """Close the figures opened inside the block if it raises (an error or an interrupt).
+
+    A report that fails half-way would otherwise leave its figure open in pyplot, and in a
+    process that runs many scenarios (a notebook, a sweep) those figures add up.
+    """
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    before = set(pyplot.get_fignums()) if pyplot else set()
+    try:
+        yield
+    except BaseException:
+        pyplot = sys.modules.get("matplotlib.pyplot")  # the block may have imported it
+        if pyplot:
+            for number in set(pyplot.get_fignums()) - before:
+                pyplot.close(number)
+        raise
 
 
 def faults_of(result) -> list[dict]:

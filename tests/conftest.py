@@ -1,6 +1,8 @@
-"""Shared fixtures: the FMUs are built once per session if they are missing."""
+"""Shared fixtures: the FMUs are built once per session if they are missing; a test's figures
+are closed after it, so no test sees another's."""
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -20,3 +22,11 @@ def built_fmus():
 
         build_all(verbose=False)
     return default_fmu_dir()
+
+
+@pytest.fixture(autouse=True)
+def figures_closed_after_each_test():
+    yield
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot:
+        pyplot.close("all")

@@ -201,6 +201,9 @@ def test_decimation_record_and_format_on_the_command_line(tmp_path, capsys):
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["decimation"] == 10 and metrics["samples"] == 11
     assert "report skipped" in metrics["report"] and "Setpoint.c" in metrics["report"]
+    import matplotlib.pyplot as plt  # imported by the run
+
+    assert not plt.get_fignums()  # the figure the report had begun is closed
 
 
 @pytest.mark.parametrize("arguments, words", [

@@ -35,13 +35,14 @@ def test_figures_are_never_left_truncated_when_the_disk_fills(tmp_path, monkeypa
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", _filling(5000))
     scenario = get("tp")
     system = scenario.system(scenario.parse(["duration=0.1"]))
+    open_before = plt.get_fignums()  # another test's figures are not this one's to judge
     with pytest.raises(DiskFull, match=r"no space left in .* to write diagram.png: it needs more than the 0.005 MB"):
         draw(system, tmp_path / "diagram.png", "tp")
     figure = plt.figure()
     with pytest.raises(DiskFull, match="to write yaw.png"):
         save_figure(figure, tmp_path, "yaw.png")
     assert list(tmp_path.iterdir()) == []  # neither the figures nor their temporaries
-    assert not plt.get_fignums()  # and the figure was closed
+    assert plt.get_fignums() == open_before  # and both figures were closed
 
 
 def test_a_full_disk_while_the_record_is_written_names_the_folder_and_keeps_metrics(tmp_path, monkeypatch, capsys):
