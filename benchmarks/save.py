@@ -66,7 +66,7 @@ def figures(duration: float = DURATION_S) -> dict:
 
 
 def stream_peak(durations=(60.0, 3600.0)) -> dict:
-    """Peak memory of streamed ``tp`` runs of each duration and the ratio of the last to the first.
+    """Peak memory of streamed ``tp`` runs of each duration and the ratio of the longest to the shortest.
 
     Parameters
     ----------
@@ -86,7 +86,7 @@ def stream_peak(durations=(60.0, 3600.0)) -> dict:
             peaks[duration] = peak_rss([sys.executable, "-m", "scenarios.cli", "run", "tp", "--set",
                                         f"duration={duration:g}", "bench_supply=on", "--stream", "--out",
                                         str(Path(folder) / "run")]) / 1e6
-    return {"peak_mb": peaks, "ratio": peaks[durations[-1]] / peaks[durations[0]]}
+    return {"peak_mb": peaks, "ratio": peaks[max(durations)] / peaks[min(durations)]}
 
 
 def main(argv=None) -> int:
