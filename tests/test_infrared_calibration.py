@@ -61,7 +61,8 @@ def test_gated_filter_declares_attributes_and_survives_both_faults(both_faults):
               f"{recovery['back_within_5_percent_s']:.2f} s after it")
         assert 0 <= delay <= 1.0  # the GPS fault: at its first sample
         assert 0 <= fault["cleared_s"] - fault["end_s"] <= 2.0
-        assert recovery["back_within_5_percent_s"] <= 10.0
+        # measured 0 s for both; None: not back within 5 % to stay, in the 10 s looked at
+        assert recovery["back_within_5_percent_s"] is not None and recovery["back_within_5_percent_s"] <= 1.0
     assert metrics["false_alarms"] == 0
     stats = metrics["turn_rate_error_deg_s"]
     assert stats["kalman"]["std"] < 0.1 * min(stats["regression"]["std"], stats["rls"]["std"])

@@ -167,7 +167,7 @@ def test_rotor_pair_step_yaws_the_body_by_the_reaction_of_the_rotor_acceleration
               f"J_r dω/dt predicts {peak:.3f}; largest difference {worst:.2%} of the peak; "
               f"yaw rate after 0.15 s {result['Quadrotor.omega_z'][-1]:.4f} rad/s; momentum drift "
               f"{np.ptp(momentum) / np.abs(vehicle.INERTIA[2] * result['Quadrotor.omega_z']).max():.1e} of the body's")
-    assert worst < 0.05
+    assert worst < 0.015  # measured 0.79 %
     assert measured[window].max() > 1.0  # a real acceleration, not zero against zero
     # the body sees each rotor acceleration held over a macro step: a transient lag of h/2
     assert np.ptp(momentum) < 3e-3 * np.abs(vehicle.INERTIA[2] * result["Quadrotor.omega_z"]).max()
@@ -184,6 +184,6 @@ def test_rotor_pair_step_with_drag_torque_adds_the_reaction():
                  + vehicle.DRAG_TORQUE_COEFF * (w ** 2 @ spin)) / vehicle.INERTIA[2]
     measured = np.gradient(result["Quadrotor.omega_z"], h)
     window = (t > 0.021) & (t < 0.035)
-    assert np.abs(measured[window] - predicted[window]).max() < 0.05 * np.abs(predicted[window]).max()
+    assert np.abs(measured[window] - predicted[window]).max() < 0.015 * np.abs(predicted[window]).max()  # 0.79 %
     reaction = vehicle.ROTOR_INERTIA * (result["MotorMagnetics.domega_r"] @ spin)[window]
     assert reaction.max() > 0.5 * (predicted[window] * vehicle.INERTIA[2]).max()

@@ -95,11 +95,11 @@ def test_a_missing_magnetometer_gives_a_tilt_estimate_with_a_warning(kind, optio
         with pytest.warns(checks.NoMagnetometerWarning, match="6-axis estimate"):
             out = estimate(kind, gyro=gyro, acc=acc, mag=absent, dt=1 / RATE, outputs=("q",), reference=quat,
                            scored=late, **options)
-        # from level, the 22 deg tilt is corrected (tilt time constant 2-4 s: within 50 s to a hundredth of a
-        # degree);
+        # from level, the 22 deg tilt is corrected (tilt time constant 2-4 s: after 50 s, measured 3e-4 deg
+        # for explicit, 1.5e-3 deg for passive);
         # nothing corrects the heading: it stays near its start, 17.2 deg off (19.0 measured, the tilt
         # correction turning about a tilted axis)
-        assert out["errors"]["inclination_rmse_deg"][0] < 0.01
+        assert out["errors"]["inclination_rmse_deg"][0] < (1e-3 if kind == "explicit" else 3e-3)
         assert out["errors"]["heading_rmse_deg"][0] == pytest.approx(math.degrees(0.3), abs=2.5)
         assert np.isfinite(out["q"]).all()
 
