@@ -112,7 +112,7 @@ def test_the_lowpass_in_the_gyro_frame_filters_linear_acceleration_without_laggi
           f"shaken {inclination[3.0]}")
     # the low-pass adds no lag while the body turns at 1 rad/s (the 0.034 deg of both: the
     # correction uses the attitude of the sample before)
-    assert abs(inclination[0.0][1] - inclination[0.0][0]) < 1e-5
+    assert abs(inclination[0.0][1] - inclination[0.0][0]) < 1e-9  # measured 2.4e-11 deg
     # shaken at 3 m/s^2, 2 Hz: the low-pass takes most of the linear acceleration out
     assert inclination[3.0][1] < 0.1 * inclination[3.0][0]
 

@@ -50,7 +50,7 @@ def test_passive_recovers_the_lab_bias_in_the_predicted_time(ry, gain):
     error = result["Quaternion_estim.b_est"] - result["IMU.gyro_bias"]
     assert np.abs(error[-1]).max() < 1e-3
     simulated = bias_convergence_time(result.time, error, 1e-3)
-    assert simulated == pytest.approx(predicted, rel=0.2)
+    assert simulated == pytest.approx(predicted, rel=2e-3)  # measured within 7.9e-4 (4 ms of 5.29 s at k = 1)
 
 
 @pytest.mark.parametrize("flight", ["quasi", "nonstationary"])
@@ -60,7 +60,10 @@ def test_estimate_fed_control_flies_with_noise_and_bias(estimator, flight):
                     kI=0.3 if estimator == "explicit" else -1.0, duration=15.0)
     tilt = np.degrees(np.abs(np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])))
     assert tilt.max() < 60.0  # never tumbles
-    assert max(m["tracking_rms_deg"]) < 20.0 and max(m["rms_error_deg"]) < 20.0
+    # seeded; measured over both flights: estimate error 12.7 / 9.4 / 0.097 deg, tracking 14.2 / 9.7 / 4.8 deg
+    bounds = {"linear": (20.0, 20.0), "explicit": (15.0, 15.0), "passive": (0.3, 10.0)}
+    estimate_bound, tracking_bound = bounds[estimator]
+    assert max(m["rms_error_deg"]) < estimate_bound and max(m["tracking_rms_deg"]) < tracking_bound
     if flight == "quasi" and estimator == "passive":  # it estimates the bias: the cruise stays as in GT
         speed = np.hypot(result["Quadrotor.v"][:, 0], result["Quadrotor.v"][:, 1])
         assert speed.min() > 1.25 and speed.max() < 2.01  # m/s; GT flight: 1.26 to 2.00
