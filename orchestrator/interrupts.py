@@ -142,7 +142,7 @@ def _handle(number, frame):
     if _state.depth or _state.raised is not None:
         _state.noted.append(number)  # a save is under way, or the run is already stopping
         return
-    if _state.dropping or _importing(frame):  # raised here, it would be dropped, or break a module
+    if _busy(frame):  # raised here, it would be dropped, or break a module
         _defer(number)
         return
     if _state.deferred:  # the first signal deferred is the one that stops the run
@@ -162,11 +162,11 @@ def _importing(frame) -> bool:
     return False
 
 
-def _busy() -> bool:
-    """Whether a signal handled now in the main thread could not be raised: :func:`_dropped`
-    is running, or the main thread is importing (an extension module stopped in its making can
-    be left broken)."""
-    return _state.dropping or _importing(sys._current_frames().get(threading.main_thread().ident))
+def _busy(frame) -> bool:
+    """Whether a signal handled in the main thread at ``frame`` could not be raised there:
+    :func:`_dropped` is running, or the main thread is importing (an extension module stopped in
+    its making can be left broken)."""
+    return _state.dropping or _importing(frame)
 
 
 def _dropped(unraisable):
@@ -188,7 +188,7 @@ def _defer(number: int, first: bool = False):
     to the main thread once it is no longer :func:`_busy`."""
 
     def signal_again():
-        while _busy():
+        while _busy(sys._current_frames().get(threading.main_thread().ident)):
             time.sleep(0.001)
         if _state.deferred:
             _thread.interrupt_main(_state.deferred[0])
