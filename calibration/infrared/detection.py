@@ -69,6 +69,7 @@ from calibration.infrared.layout import (
     ALT_LIFE,
     ANCHOR,
     B_SAFE,
+    COMPLETE,
     CONS_H,
     CONS_K,
     CONS_OFFSET,
@@ -81,8 +82,10 @@ from calibration.infrared.layout import (
     CUSUM_SIZE,
     DECISIVE,
     END_H,
+    END_LLR,
     END_MODE,
     END_PAIR,
+    END_SIGNIFICANCE,
     END_STAT,
     FAULT_SIZE,
     FREEZE,
@@ -445,13 +448,17 @@ def _best(x, u, w, ramp, sign, ridge_u, ridge_w):
 
 
 @njit(cache=True)
-def evidence(s, c, sign):
+def evidence(s, c, sign, healthy=0):
     """The generalised likelihood ratios of the ring (:func:`attribute`), in units of the
     residual's own spread: ``(larger, step, ramp, step_size, ramp_size, step_onset,
     ramp_onset)``, the sizes in normalised units, of the sign ``sign`` (+1 or -1), the onsets as
-    indices in the ring. The turn rate of the calibration's error: ``c[TURN_MODE]`` 0 the mean
-    of the two sensors', 1 for each shape the sensor it holds healthy (the step: the IR's; the
-    ramp: the GPS's), 2 the GPS's averaged over its window."""
+    indices in the ring.
+
+    The turn rate of the calibration's error: with ``healthy`` 1 (a GPS fault declared) the
+    IR's, 2 (an IR fault) the GPS's averaged over its window, for both shapes; else by
+    ``c[TURN_MODE]``: 0 the mean of the two sensors', 1 for each shape the sensor it holds
+    healthy (the step, a GPS offset: the IR's; the ramp, an IR offset: the GPS's averaged over
+    its window), 2 the GPS's averaged over its window."""
     x, mean, ir, smooth, time = _ring(s, c)
     scale = s[HELD_SCALE]
     ridge = scale / (c[SD_A_HELD] * c[SD_A_HELD])
@@ -460,10 +467,14 @@ def evidence(s, c, sign):
     else:  # no drift in the fit: its regressor zero, its coefficient pinned
         time[:] = 0.0
         ridge_w = 1.0
-    if c[TURN_MODE] > 1.5:
+    if healthy == 1:
+        step_turn, ramp_turn = ir, ir
+    elif healthy == 2:
+        step_turn, ramp_turn = smooth, smooth
+    elif c[TURN_MODE] > 1.5:
         step_turn, ramp_turn = smooth, smooth
     elif c[TURN_MODE] > 0.5:
-        step_turn, ramp_turn = ir, mean + mean - ir  # the GPS's
+        step_turn, ramp_turn = ir, smooth
     else:
         step_turn, ramp_turn = mean, mean
     step, step_size, step_at = _best(x, step_turn, time, 1.0, sign, ridge, ridge_w)
@@ -492,6 +503,8 @@ def attribute(s, c, statistic):
     if statistic >= c[DECISIVE] and larger > 0.0:
         return sensor, size, onset
     if larger < c[SIGNIFICANCE]:
+        return 0, 0.0, 0
+    if n_ring(s) - 1 - onset < c[COMPLETE]:  # too little of the shape yet: the other may still fit better
         return 0, 0.0, 0
     if abs(step - ramp) > c[MARGIN]:
         return sensor, size, onset
@@ -642,6 +655,7 @@ def _end_held(s, c, pair_seen):
     it, with a significant signature (:func:`evidence`, either shape). An error of the held
     calibration that a turn exposes meanwhile is no end (the signature's fit holds it). An IR
     offset is watched once it has filled the paired window (``s[SETTLING]``)."""
+    s[END_LLR] = 0.0
     if s[SETTLING] > 0.0:  # the offset is still entering the paired window: no baseline for its end yet
         s[SETTLING] -= 1.0
         s[RING_COUNT] = 0.0
@@ -650,11 +664,14 @@ def _end_held(s, c, pair_seen):
     if not pair_seen:
         return
     offset = s[CONS_OFFSET]
-    larger, step, ramp, step_size, ramp_size, step_at, ramp_at = evidence(s, c, -1.0 if offset > 0.0 else 1.0)
+    healthy = 1 if s[GPS_FAULT] > 0.5 else 2  # the turn rate of the sensor not faulty
+    larger, step, ramp, step_size, ramp_size, step_at, ramp_at = evidence(s, c, -1.0 if offset > 0.0 else 1.0,
+                                                                            healthy)
     size, onset = (step_size, step_at) if step >= ramp else (ramp_size, ramp_at)
-    if larger < c[SIGNIFICANCE]:
-        return
     if abs(size) * math.sqrt(s[GATE_CONS]) < 0.5 * abs(offset):
+        return
+    s[END_LLR] = larger
+    if larger < c[END_SIGNIFICANCE]:
         return
     if s[IR_FAULT] > 0.5:  # the paired window may still hold faulty samples: not fused until it does not
         left = c[RAMP] - (n_ring(s) - onset)

@@ -27,6 +27,7 @@ from calibration.infrared.layout import (
     ALT_LIFE,
     ANCHOR,
     B_SAFE,
+    COMPLETE,
     CONS_H,
     CONS_K,
     CUSUM_CONS,
@@ -36,7 +37,9 @@ from calibration.infrared.layout import (
     EKF_CONFIG_SIZE,
     EKF_SIZE,
     END_H,
+    END_LLR,
     END_MODE,
+    END_SIGNIFICANCE,
     FAULT_SIZE,
     FIT_A,
     FIT_B,
@@ -249,6 +252,8 @@ class EKFSettings:
     sd_drift: float = 0.2
     raw: bool = True
     end: str = "consistency"
+    end_significance: float = 15.0
+    complete: int = 0
     decisive: float = math.inf
     alt_level: float = math.inf
     alt_life: int = 4000
@@ -265,7 +270,7 @@ class EKFSettings:
         if not (self.gate == 0.0 or (math.isfinite(self.gate) and self.gate > 0.0)):
             raise ValueError(f"gate = {self.gate!r} standard deviations must be positive, or 0 for no gating")
         for name in ("cusum_k", "cusum_h", "now_k", "now_h", "held_k", "held_h", "margin", "significance", "sd_a_held",
-                     "scale_gain", "end_h", "size_gain", "decisive", "alt_level", "alt_life"):
+                     "scale_gain", "end_h", "size_gain", "decisive", "alt_level", "alt_life", "end_significance"):
             value = getattr(self, name)
             if not value > 0.0 or math.isnan(value):
                 raise ValueError(f"{name} = {value!r} must be positive (inf where it turns a detector off); "
@@ -296,6 +301,7 @@ class EKFSettings:
         c[FREEZE], c[DECISIVE], c[TURN_MODE] = float(self.freeze), self.decisive, TURNS.index(self.turn)
         c[END_MODE], c[RAW_SEEN] = float(self.end == "consistency"), float(self.raw)
         c[ALT_LEVEL], c[ALT_LIFE], c[SD_DRIFT] = self.alt_level, self.alt_life, self.sd_drift
+        c[END_SIGNIFICANCE], c[COMPLETE] = self.end_significance, self.complete
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c
@@ -420,7 +426,7 @@ _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_g
                "S_ir_now": GATE_NOW, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS,
                "fault_size": FAULT_SIZE, "nu_held": NU_CONS, "S_held": GATE_CONS,
                "held_up": CUSUM_CONS + G_UP, "held_down": CUSUM_CONS + G_DOWN,
-               "held_scale": HELD_SCALE, "run_peak": RUN_PEAK}
+               "held_scale": HELD_SCALE, "run_peak": RUN_PEAK, "end_llr": END_LLR}
 _REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
 _RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
 _STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "

@@ -34,7 +34,8 @@ SETTLING = 62  # samples before the end test of a fault watches the residual: it
 # a calibration from before a change the residual showed but no fault was declared on (a and b), the samples it
 # is kept for, and the largest attribution log-likelihood of the CUSUM's present run
 ALT_A, ALT_B, ALT_LEFT, RUN_PEAK = 63, 64, 65, 66
-RING = 67
+END_LLR = 67  # the end test's log-likelihood at this sample, of a step back at least half the offset
+RING = 68
 RING_SIZE = 60  # samples: 3 s at 20 Hz, the onset of the fault and the GPS window's ramp
 PAST_COUNT = RING + 3 * RING_SIZE
 PAST = PAST_COUNT + 1
@@ -53,10 +54,13 @@ CUSUM_K, CUSUM_H, NOW_K, NOW_H, END_H, SIZE_GAIN, WINDOW_SPAN = range(10, 17)
 # fault ends by the residual stepping back (1) or by the faulty sensor's innovation (0), whether the residual
 # takes the window's mean of every IR sample, suspect or not (1), or only the pair the filter fuses (0), the
 # attribution log-likelihood above which a run that declared nothing leaves its calibration remembered,
-# and for how many samples, and the prior deviation of the residual's drift in the fit (count per sample)
+# and for how many samples, the prior deviation of the residual's drift in the fit (count per sample), and the
+# log-likelihood of a step back that ends a fault, and how many samples the better signature's onset must lie
+# in the past before a fault is declared on it
 CONS_K, CONS_H, MARGIN, RAMP, HELD_LAG, SCALE_GAIN, SIGNIFICANCE, SD_A_HELD = range(17, 25)
 FREEZE, DECISIVE, TURN_MODE, END_MODE, RAW_SEEN, ALT_LEVEL, ALT_LIFE, SD_DRIFT = range(25, 33)
-EKF_CONFIG_SIZE = 33
+END_SIGNIFICANCE, COMPLETE = 33, 34
+EKF_CONFIG_SIZE = 35
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 
