@@ -198,6 +198,11 @@ def run(args) -> int:
         return 2
     print("\n".join(_report(metrics)))
     print(f"{', '.join(files)} in {out}/")
+    if not fitted:
+        sources = ", ".join(sorted({p.source.rsplit(":", 1)[0] for p in train}))
+        print(f"quadcosim calibrate: no interference model could be identified from {sources} (reasons above)",
+              file=sys.stderr)
+        return 2
     return 0
 
 
