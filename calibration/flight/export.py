@@ -213,6 +213,41 @@ def _motor_keys(params: dict) -> dict:
     return {k: v for k, v in params.items() if "MOT" in k or "COMP" in k}
 
 
+def _motor_trials(train, rule, trial, held, offsets, log_soft) -> dict:
+    """Each motor compensation the firmware has, fitted on ``train`` and scored by ``trial``: with
+    the offsets fitted with it (unless ``held``, when they cannot be identified) or ``offsets``,
+    whichever scores better; the reason when it cannot be fitted."""
+    trials = {}
+    for model in motor_models(train[0], rule):
+        fitted = fit_motor(train, model)
+        if fitted is None:
+            trials[model] = {"refused": "its input is not logged or its design cannot be told apart"}
+            continue
+        K = fitted[1] if model == "motors" else fitted[1][0]
+        options = [Candidate(b, log_soft, model, K) for b in ([] if held is not None else [fitted[0]]) + [offsets]]
+        results = [(c, *trial(c)) for c in options]
+        candidate, params, found = min(results, key=lambda r: r[2]["heading_rms_deg"])
+        trials[model] = found | {"candidate": candidate, "params": params}
+    return trials
+
+
+def _soft_iron_trial(first, soft, chosen, rule, trial, log_motor) -> tuple[dict, dict]:
+    """The fitted soft iron ``soft`` (A, b) with the ``chosen`` motor compensation (or the log's),
+    as parameters and their score."""
+    A, b = soft
+    candidate = Candidate(b, np.linalg.inv(A), chosen.model if chosen else None, chosen.K if chosen else None)
+    slot = first.log.compasses[first.compass].slot
+    scale = {} if is_px4(first) or not rules_of(first, rule).scale else {
+        f"COMPASS_SCALE{ardupilot.suffix(slot)}": 1.0}  # the fitted soft iron carries the scale
+    return trial(candidate, (log_motor if chosen is None else {}) | scale)
+
+
+def _zero_offsets(source: str, why: str) -> CalibrationError:
+    """The refusal of a compass whose offsets are all zero: never exported with zeros."""
+    return CalibrationError(f"{source}: its offsets are all zero (never calibrated), {why}; no parameter file is "
+                            "written rather than one with zero offsets")
+
+
 def choose(train, test, rule=None) -> tuple[dict, dict]:
     """The parameters to export for the compass of ``train``/``test`` and the notes saying what was
     exported and kept: offsets, then motor compensation, then soft iron, each kept only when it
@@ -231,9 +266,8 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
     identifiable, why = offsets_identifiable(train)
     notes = {"offsets": why}
     if zero and not identifiable:
-        raise CalibrationError(f"{first.source}: its offsets are all zero (never calibrated), and {why}: "
-                               "calibrate it with the field model (log a GPS fix) or with a rotation sweep; "
-                               "no parameter file is written rather than one with zero offsets")
+        raise _zero_offsets(first.source, f"and {why}: calibrate it with the field model (log a GPS fix) or with a "
+                                          "rotation sweep")
     names = list(parameters_of(first, Candidate(np.zeros(3), np.eye(3)), rule))
     flown = log_parameters(first, names)
     best, best_score = dict(flown), score_parameters(test, flown, rule)
@@ -251,22 +285,12 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
         if found["heading_rms_deg"] < best_score["heading_rms_deg"] or zero:
             best, best_score, kept["offsets"], offsets = params, found, "fitted", fitted_offsets
     if zero and kept["offsets"] != "fitted":
-        raise CalibrationError(f"{first.source}: its offsets are all zero and the fitted ones do not beat them on the "
-                               "held-out part; no parameter file is written rather than one with zero offsets")
-    trials = {}
-    for model in motor_models(first, rule):  # motor compensation: the models the firmware has
-        fitted = fit_motor(train, model)
-        if fitted is None:
-            trials[model] = {"refused": "its input is not logged or its design cannot be told apart"}
-            continue
-        b = fitted[0] if kept["offsets"] == "fitted" else offsets
-        candidate = Candidate(b, log_soft, model, fitted[1] if model == "motors" else fitted[1][0])
-        params, found = trial(candidate)
-        trials[model] = found | {"candidate": candidate, "params": params}
+        raise _zero_offsets(first.source, "and the fitted ones do not beat them on the held-out part")
+    trials = _motor_trials(train, rule, trial, offsets if not identifiable else None, offsets, log_soft)
     notes["motor_models"] = {m: {k: v for k, v in t.items() if k not in ("candidate", "params")}
                              for m, t in trials.items()}
     scored = {m: t for m, t in trials.items() if "refused" not in t}
-    chosen = None
+    chosen, notes["motor"] = None, "no motor compensation could be fitted: the log's kept"
     if scored:
         model = min(scored, key=lambda m: scored[m]["heading_rms_deg"])
         t = scored[model]
@@ -276,21 +300,17 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
         elif t["heading_rms_deg"] < best_score["heading_rms_deg"]:
             best, best_score, kept["motor"] = t["params"], {k: t[k] for k in ("heading_rms_deg", "explained")}, model
             chosen = t["candidate"]
+            if not np.allclose(chosen.offset, compass.offsets):
+                kept["offsets"] = "fitted"
             notes["motor"] = f"{model}: exported"
         else:
             notes["motor"] = (f"{model}: {t['heading_rms_deg']:.2f} deg on the held-out part, not below "
                               f"{best_score['heading_rms_deg']:.2f} deg: the log's motor compensation kept")
-    else:
-        notes["motor"] = "no motor compensation could be fitted: the log's kept"
     soft = fit_soft_iron(train, chosen.model if chosen else None, chosen.K if chosen else None)
     if isinstance(soft, str):
         notes["soft_iron"] = f"{soft}: the log's kept"
     else:
-        A, b = soft
-        candidate = Candidate(b, np.linalg.inv(A), chosen.model if chosen else None, chosen.K if chosen else None)
-        scale = {} if is_px4(first) or not rules_of(first, rule).scale else {
-            f"COMPASS_SCALE{ardupilot.suffix(compass.slot)}": 1.0}  # the fitted soft iron carries the scale
-        params, found = trial(candidate, (log_motor if chosen is None else {}) | scale)
+        params, found = _soft_iron_trial(first, soft, chosen, rule, trial, log_motor)
         if found["heading_rms_deg"] < best_score["heading_rms_deg"]:
             best, best_score, kept["soft_iron"], kept["offsets"] = params, found, "fitted", "fitted"
             notes["soft_iron"] = "fitted against the Earth field model: exported"

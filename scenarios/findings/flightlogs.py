@@ -1,7 +1,8 @@
 """Findings of the real flights: the quad's two compasses calibrated from its three flights
 (each model's explained share of the held-out residual, the perturbation at hover and the
-heading change), and the estimators replayed on every shared log without and with the
-compensation, against the autopilot's attitude.
+heading change), the exported parameter file of every compass of every ArduPilot log scored as
+its firmware applies it against the log as flown, and the estimators replayed on every shared
+log without and with the compensation, against the autopilot's attitude.
 
 The logs (three flights of one quad, an Erle-Brain flight and a PX4 bench log) are read from
 the folder that ``$QUADCOSIM_FLIGHT_LOGS`` names; without it the group is skipped
@@ -22,6 +23,8 @@ COMPASSES = {0: "external", 1: "internal"}
 MODELS = ("current", "throttle", "motors", "metge")
 REPLAYS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebrain", 0), ("px4", 0)]
 OTHER_LOGS = {"erlebrain": "erlebrain_APM_22.bin", "px4": "px4_sample.ulg"}
+# every compass of every ArduPilot log: its export against the log as flown (one column per judge)
+EXPORTS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebrain", 0)]
 REPLAYED = ("explicit", "vqf")
 PERCENT = 100.0
 # the means over the flights: the group prints them (and, with --check, writes nothing)
@@ -99,6 +102,35 @@ def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
     return found
 
 
+def export_command(key: str, compass: int) -> str:
+    """The command that exports compass ``compass`` of log ``key`` and prints its scores."""
+    return f"quadcosim calibrate {_shown(key)} --compass {compass} --out results/flightlogs"
+
+
+def _exports(keys) -> list[dict]:
+    """Each compass's exported file and the log as flown, scored on the last half as the log's
+    firmware applies them (heading error, deg RMS; explained share, %), through the command itself."""
+    import contextlib
+    import io
+    import json
+    import tempfile
+
+    from scenarios.cli import main
+
+    found = []
+    for key, compass in keys:
+        with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stdout(io.StringIO()), \
+                contextlib.redirect_stderr(io.StringIO()):
+            main(["calibrate", str(_path(key)), "--compass", str(compass), "--out", folder, "--overwrite"])
+            export = json.loads((Path(folder) / "metrics.json").read_text())["export"]
+        command = export_command(key, compass)
+        name = f"export.{key}{compass}"
+        found.append(_finding(f"{name}.as_flown_deg", export["as_flown"]["heading_rms_deg"], "deg", command, 0.02, 2))
+        found.append(_finding(f"{name}.export_deg", export["heading_rms_deg"], "deg", command, 0.02, 2))
+        found.append(_finding(f"{name}.explained_pct", PERCENT * export["explained_test"], "%", command, 0.2, 1))
+    return found
+
+
 def _replays() -> list[dict]:
     from scenarios.flightlog.replay import replay_log
 
@@ -120,5 +152,5 @@ def compute(quick: bool = False) -> list[dict]:
     current and throttle models, last half held out (a few seconds)."""
     if quick:
         return [f for f in _calibrations(["b"], [1], ("current", "throttle"), cross=False)
-                if ".explained_half_" in f["name"]]
-    return _calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _replays()
+                if ".explained_half_" in f["name"]] + _exports([("b", 1)])
+    return _calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _exports(EXPORTS) + _replays()

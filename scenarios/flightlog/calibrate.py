@@ -114,6 +114,12 @@ def _report(metrics: dict) -> list[str]:
     return lines + _export_lines(metrics["export"])
 
 
+def _percent(share: float) -> str:
+    """``share`` (1) as a percentage with one decimal, never ``-0.0``."""
+    shown = f"{100 * share:.1f}"
+    return "0.0" if float(shown) == 0 else shown
+
+
 def _export_lines(export: dict) -> list[str]:
     kept = export["kept"]
     fitted = [g for g in ("offsets", "soft_iron") if kept[g] == "fitted"] + ([kept["motor"]] if kept["motor"] != "log"
@@ -125,21 +131,19 @@ def _export_lines(export: dict) -> list[str]:
             f"{', '.join(logged) or 'nothing'}",
             f"  heading on the test part, {export['file']} applied as the firmware does: "
             f"{export['heading_rms_deg']:.2f} deg RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)",
-            f"  share of the test residual its compensation explains: {100 * export['explained_test']:.1f} % "
-            f"(as flown: {100 * flown['explained']:.1f} %)",
+            f"  share of the test residual its compensation explains: {_percent(export['explained_test'])} % "
+            f"(as flown: {_percent(flown['explained'])} %)",
             *(f"  {group}: {note}" for group, note in export["notes"].items() if isinstance(note, str))]
 
 
 def _score(args, train, test, split) -> int:
-    from calibration.flight.export import log_parameters, parameters_of, score_file, score_parameters
+    import numpy as np
+
+    from calibration.flight.export import Candidate, log_parameters, parameters_of, score_file, score_parameters
     from orchestrator.files import write_json
 
     rule = _rule(args, test[0])
     given = score_file(args.score, test, rule)
-    from calibration.flight.export import Candidate
-
-    import numpy as np
-
     names = list(parameters_of(test[0], Candidate(np.zeros(3), np.eye(3)), rule))
     flown = score_parameters(test, log_parameters(test[0], names), rule)
     out = Path(args.out)
@@ -149,8 +153,8 @@ def _score(args, train, test, split) -> int:
     print(f"tested on {', '.join(metrics['test'])} ({split['validation']})")
     print(f"heading on the test part, {args.score} applied as the firmware does: {given['heading_rms_deg']:.2f} deg "
           f"RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)")
-    print(f"share of the test residual its compensation explains: {100 * given['explained']:.1f} % "
-          f"(as flown: {100 * flown['explained']:.1f} %)")
+    print(f"share of the test residual its compensation explains: {_percent(given['explained'])} % "
+          f"(as flown: {_percent(flown['explained'])} %)")
     return 0
 
 
