@@ -243,18 +243,14 @@ def _finding(name, value, unit, tolerance, digits) -> dict:
 
 
 def findings_of(key: str, compass: int, settings=tuple(SETTINGS)) -> list[dict]:
-    """The findings of one compass: each setting's heading error (deg RMS) and explained share (%)
-    on the held-out part; none where magfit cannot run (the docs say why)."""
+    """The findings of one compass: each setting's heading error (deg RMS) on the held-out part, its
+    file applied as the log's firmware applies it; none where magfit cannot run (the docs say why)."""
     result = peer(key, compass, settings)
     if "cannot_run" in result:
         print(f"magfit cannot run on {_shown(key)} compass {compass}: {result['cannot_run']}", file=sys.stderr)
         return []
-    found = []
-    for setting in settings:
-        found.append(_finding(f"{key}{compass}.{setting}_deg", result[setting]["heading_rms_deg"], "deg", 0.02, 2))
-        found.append(_finding(f"{key}{compass}.{setting}_explained_pct", 100 * result[setting]["explained"], "%",
-                              0.2, 1))
-    return found
+    return [_finding(f"{key}{compass}.{setting}_deg", result[setting]["heading_rms_deg"], "deg", 0.02, 2)
+            for setting in settings]
 
 
 def compute(quick: bool = False) -> list[dict]:
