@@ -5,6 +5,8 @@ them, are in :mod:`orchestrator.logs.ardupilot` and :mod:`orchestrator.logs.px4`
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 def write_ardupilot(params: dict, path) -> None:
     """``params`` as an ArduPilot parameter file (``NAME,VALUE`` lines, as Mission Planner loads) at ``path``."""
@@ -30,7 +32,7 @@ def write_parameters(autopilot: str, params: dict, path) -> None:
 def read_parameters(path) -> dict:
     """Parameters from a file written by :func:`write_ardupilot` or :func:`write_px4` at ``path``."""
     params = {}
-    for line in open(path).read().splitlines():
+    for line in Path(path).read_text().splitlines():
         line = line.strip()
         if not line or line.startswith("#"):
             continue

@@ -5,11 +5,12 @@
 parameters and applied to the raw field exactly as the log's firmware applies them
 (:mod:`orchestrator.logs.ardupilot`, :mod:`orchestrator.logs.px4`), on the held-out parts. It
 returns the heading error against the log's attitude and the share of the field residual the
-parameters' compensation explains.
+parameters' motor compensation explains.
 
 :func:`choose` builds the export group by group (offsets, motor compensation, soft iron) from
 the fits on the training parts and keeps each group only when it beats what the log already
-holds on the held-out parts; the log's values stay for the others, and the notes say which.
+holds on the choice parts; the log's values stay for the others, and the notes say which. The
+export is then scored on parts that neither the fit nor the choice has seen.
 A compass whose offsets are all zero (never calibrated) gets offsets from the flight, with the
 Earth field model, or is refused: it is never exported with zeros.
 """
@@ -27,6 +28,9 @@ from orchestrator.logs import ardupilot, px4
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
 MOTOR_MODELS = ("current", "motors", "throttle")  # the export's motor compensation, in this order of preference
+# every firmware's motor compensation switched off (ArduPilot's COMPASS_MOTCT and COMPASS_PMOT_EN, PX4's
+# CAL_MAG_COMP_TYP): the baseline of the explained share
+MOTOR_OFF = {"COMPASS_MOTCT": 0, "COMPASS_PMOT_EN": 0, "CAL_MAG_COMP_TYP": 0}
 
 
 def _inputs(part) -> dict:
@@ -75,16 +79,19 @@ def score_parameters(parts, params: dict, rule=None) -> dict:
     dict
         ``heading_rms_deg``: RMS of the tilt-compensated heading of the corrected field against the
         log's heading, its mean (the declination and any mounting offset) removed (deg);
-        ``explained``: the share of the residual left by the Earth field and offset alone on the raw
-        field that is gone from the corrected field (with the Earth field and offset fitted again on
-        it), i.e. what the parameters' compensation and soft iron explain (1).
+        ``explained``: the share of the residual left by the Earth field and offset alone (fitted
+        again) on the field the same parameters give with their motor compensation switched off
+        that is gone with it on: what the motor compensation explains (1). The baseline carries the
+        parameters' own offsets and soft iron, so a soft iron that only matches the compass's scale
+        to the field model's magnitude is not counted as explained interference.
     """
     errors, base_cost, cost = [], 0.0, 0.0
     for p in parts:
         corrected = apply_parameters(p, params, rule)
         errors.append(heading_error(tilt_compensated_heading(corrected, p.euler), p.euler[:, 2]))
         attitude = p.rotation @ np.asarray(p.log.compasses[p.compass].rotation).T  # body to NED
-        base_cost += earth_and_offset(attitude, p.body(p.raw), p.earth).cost
+        uncompensated = apply_parameters(p, {**params, **MOTOR_OFF}, rule)
+        base_cost += earth_and_offset(attitude, uncompensated, p.earth).cost
         cost += earth_and_offset(attitude, corrected, p.earth).cost
     return {"heading_rms_deg": float(np.degrees(np.sqrt(np.mean(np.concatenate(errors) ** 2)))),
             "explained": 1.0 - cost / base_cost if base_cost > 0 else 0.0}
@@ -248,11 +255,12 @@ def _zero_offsets(source: str, why: str) -> CalibrationError:
                             "written rather than one with zero offsets")
 
 
-def choose(train, test, rule=None) -> tuple[dict, dict]:
-    """The parameters to export for the compass of ``train``/``test`` and the notes saying what was
-    exported and kept: offsets, then motor compensation, then soft iron, each kept only when it
-    lowers the heading error on the held-out ``test`` parts (the motor compensation also needs a
-    positive explained share there). ``rule`` overrides ArduPilot's version rules.
+def choose(train, choice, rule=None) -> tuple[dict, dict]:
+    """The parameters to export for the compass of ``train``/``choice`` and the notes saying what was
+    exported and kept: offsets, then motor compensation, then soft iron, each fitted on ``train``
+    and kept only when it lowers the heading error on the ``choice`` parts (the motor compensation
+    also needs a positive explained share there). The export's score belongs on parts neither has
+    seen. ``rule`` overrides ArduPilot's version rules.
 
     Raises
     ------
@@ -270,14 +278,14 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
                                           "rotation sweep")
     names = list(parameters_of(first, Candidate(np.zeros(3), np.eye(3)), rule))
     flown = log_parameters(first, names)
-    best, best_score = dict(flown), score_parameters(test, flown, rule)
+    best, best_score = dict(flown), score_parameters(choice, flown, rule)
     kept = {"offsets": "log", "motor": "log", "soft_iron": "log"}
     offsets = np.asarray(compass.offsets, dtype=float)
     log_motor = _motor_keys(flown)
 
     def trial(candidate: Candidate, motor: dict | None = None) -> tuple[dict, dict]:
         params = parameters_of(first, candidate, rule) | (motor or {})
-        return params, score_parameters(test, params, rule)
+        return params, score_parameters(choice, params, rule)
 
     if identifiable:  # offsets, with the log's soft iron and motor compensation
         fitted_offsets = fit_motor(train, None)[0]
@@ -285,7 +293,7 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
         if found["heading_rms_deg"] < best_score["heading_rms_deg"] or zero:
             best, best_score, kept["offsets"], offsets = params, found, "fitted", fitted_offsets
     if zero and kept["offsets"] != "fitted":
-        raise _zero_offsets(first.source, "and the fitted ones do not beat them on the held-out part")
+        raise _zero_offsets(first.source, "and the fitted ones do not beat them on the choice part")
     trials = _motor_trials(train, rule, trial, offsets if not identifiable else None, offsets, log_soft)
     notes["motor_models"] = {m: {k: v for k, v in t.items() if k not in ("candidate", "params")}
                              for m, t in trials.items()}
@@ -295,7 +303,7 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
         model = min(scored, key=lambda m: scored[m]["heading_rms_deg"])
         t = scored[model]
         if t["explained"] <= 0:
-            notes["motor"] = (f"{model} explains {100 * t['explained']:.1f} % of the held-out residual, less than "
+            notes["motor"] = (f"{model} explains {100 * t['explained']:.1f} % of the choice part's residual, less than "
                               "nothing: flagged and not exported; the log's motor compensation kept")
         elif t["heading_rms_deg"] < best_score["heading_rms_deg"]:
             best, best_score, kept["motor"] = t["params"], {k: t[k] for k in ("heading_rms_deg", "explained")}, model
@@ -304,7 +312,7 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
                 kept["offsets"] = "fitted"
             notes["motor"] = f"{model}: exported"
         else:
-            notes["motor"] = (f"{model}: {t['heading_rms_deg']:.2f} deg on the held-out part, not below "
+            notes["motor"] = (f"{model}: {t['heading_rms_deg']:.2f} deg on the choice part, not below "
                               f"{best_score['heading_rms_deg']:.2f} deg: the log's motor compensation kept")
     soft = fit_soft_iron(train, chosen.model if chosen else None, chosen.K if chosen else None)
     if isinstance(soft, str):
@@ -315,6 +323,6 @@ def choose(train, test, rule=None) -> tuple[dict, dict]:
             best, best_score, kept["soft_iron"], kept["offsets"] = params, found, "fitted", "fitted"
             notes["soft_iron"] = "fitted against the Earth field model: exported"
         else:
-            notes["soft_iron"] = (f"fitted: {found['heading_rms_deg']:.2f} deg on the held-out part, not below "
+            notes["soft_iron"] = (f"fitted: {found['heading_rms_deg']:.2f} deg on the choice part, not below "
                                   f"{best_score['heading_rms_deg']:.2f} deg: the log's kept")
     return best, {"kept": kept, "notes": notes, "model": kept["motor"] if kept["motor"] != "log" else None}

@@ -65,18 +65,18 @@ def _calibrate_command(files, compass: int, cross: bool) -> str:
 def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
     """Each flight's last half scored on a fit to its first half (and, with ``cross``, each
     flight scored on a fit to the two others)."""
-    from calibration.flight import calibrate, flight_data
+    from calibration.flight import calibrate
     from orchestrator.logs import read_log
+    from scenarios.flightlog.calibrate import split_parts
 
     logs = {k: read_log(_path(k)) for k in flights}
     found = []
     for compass in compasses:
-        data = {k: flight_data(log, compass) for k, log in logs.items()}
         where = f"quad.{COMPASSES[compass]}"
         hover, change = {m: [] for m in models}, {m: [] for m in models}
-        for key, flight in data.items():
-            train, test = flight.split(0.5)
-            metrics, _, _ = calibrate([train], [test], models)
+        for key in logs:
+            split = split_parts([logs[key]], [], compass)  # as the command splits it, the Earth field model attached
+            metrics, _, _ = calibrate(split.train, split.test, models)
             for m in models:
                 result = metrics["models"][m]
                 if "refused" in result:
@@ -86,8 +86,9 @@ def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
                 hover[m].append(result["perturbation_at_hover_T"] * 1e6)
                 change[m].append(result["heading_rms_change_deg"])
             if cross:
-                others = [k for k in data if k != key]
-                metrics, _, _ = calibrate([data[k] for k in others], [flight], models)
+                others = [k for k in logs if k != key]
+                split = split_parts([logs[k] for k in others], [logs[key]], compass)
+                metrics, _, _ = calibrate(split.train, split.test, models)
                 for m in models:
                     if "refused" not in metrics["models"][m]:
                         found.append(_finding(f"{where}.{m}.explained_cross_{key}",

@@ -4,8 +4,12 @@ as its firmware will apply them.
 
 Validation: one flight: its last ``--test-fraction`` (default 0.5) is held out; several flights
 (of one vehicle): the last one is held out and the others train (cross-flight, the default);
-``--train FILES --test FILES`` chooses. ``--score PARAMS`` scores a parameter file (any tool's)
-on the held-out part instead, with the same code that scores the export.
+``--train FILES --test FILES`` chooses. The export is fitted on the training part, each of its
+groups chosen on a choice part (one flight: the first half of the held-out part; several: the
+training flights' second halves, the fit taking their first halves) and scored on a score part
+neither has seen (the held-out part's second half, or the held-out flights); see :class:`Split`.
+``--score PARAMS`` scores a parameter file (any tool's) on that score part instead, with the
+same code that scores the export.
 Outputs in DIR: ``metrics.json``, ``calibration.json`` (the project's format, for ``tp``'s
 ``calibration=`` option), ``ardupilot.parm`` or ``px4.params`` (the log's autopilot's),
 ``residual.png`` and ``heading.png``.
@@ -14,7 +18,10 @@ Outputs in DIR: ``metrics.json``, ``calibration.json`` (the project's format, fo
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 FIGURES = ("residual.png", "heading.png")
 PARAMETER_FILES = {"ArduPilot": "ardupilot.parm", "PX4": "px4.params"}
@@ -26,16 +33,66 @@ def _logs(files, verb: str) -> list:
     return [load(f, verb) for f in files]
 
 
-def _parts(logs, args, fields):
+@dataclass
+class Split:
+    """The parts of the flights of one compass, the Earth field model attached.
+
+    ``train``/``test``: the models' analysis (fit, and score with the Earth field and offset fitted
+    again); ``fit``/``choice``/``score``: the export, fitted on ``fit``, each group chosen on
+    ``choice`` and every export figure measured on ``score``, which neither has seen. One flight:
+    ``train``=``fit`` its first part, ``test`` the held-out rest, ``choice`` and ``score`` that
+    rest's two halves in time. Several: ``train`` the training flights, ``fit``/``choice`` their
+    halves, ``test``=``score`` the held-out flights.
+    """
+
+    train: list
+    test: list
+    fit: list
+    choice: list
+    score: list
+    notes: dict
+
+
+def split_parts(train_logs, test_logs, compass: int, attitude: str = "auto", trim: bool = True,
+                earth: str = "model", test_fraction: float | None = None) -> Split:
+    """:class:`Split` of compass ``compass`` of ``train_logs`` (FlightLogs; one alone is split in time
+    with its last ``test_fraction``, default 0.5, held out) and ``test_logs`` (held-out flights, or
+    empty), with the attitude, trim and Earth field (``model`` or ``free``) the command uses."""
     from calibration.flight import flight_data
-
-    return [flight_data(log, args.compass, args.attitude, trim=not args.no_trim) for log in logs]
-
-
-def _split(args):
-    """Training and test parts (the Earth field model attached), the fields and the validation's name."""
     from calibration.flight.earth import align, model_field
 
+    fields, notes = {}, {}
+    for log in [*train_logs, *test_logs]:
+        fields[log.path], notes[log.path] = (None, "the free Earth field (--earth free)") if earth == "free" \
+            else model_field(log.position)
+
+    def parts(logs):
+        return [flight_data(log, compass, attitude, trim=trim) for log in logs]
+
+    if test_logs:
+        train, test = parts(train_logs), parts(test_logs)
+        halves = [p.split(0.5) for p in train]
+        fit, choice, score = [h[0] for h in halves], [h[1] for h in halves], test
+        validation = ("cross-flight; export fitted on the first half of each training flight, chosen on their "
+                      "second halves, scored on the held-out flights")
+    else:
+        fraction = test_fraction or 0.5
+        pairs = [f.split(fraction) for f in parts(train_logs)]
+        train, test = [p[0] for p in pairs], [p[1] for p in pairs]
+        quarters = [p.split(0.5) for p in test]
+        fit, choice, score = train, [q[0] for q in quarters], [q[1] for q in quarters]
+        validation = (f"last {fraction:g} of each flight held out; export fitted on the first {1 - fraction:g}, "
+                      f"chosen on the next {fraction / 2:g}, scored on the last {fraction / 2:g}")
+    rest = [*test, *fit, *choice, *score]
+    train, rest, check = align(train, rest, fields)
+    cuts = np.cumsum([len(test), len(fit), len(choice)])
+    test, fit, choice, score = (rest[:cuts[0]], rest[cuts[0]:cuts[1]], rest[cuts[1]:cuts[2]], rest[cuts[2]:])
+    return Split(train, test, fit, choice, score, {"validation": validation,
+                                                   "earth_field": sorted(set(notes.values())), "mounting": check})
+
+
+def _split(args) -> Split:
+    """The command's :class:`Split`, from its arguments."""
     if bool(args.train) != bool(args.test):
         raise ValueError("--train and --test go together: give both lists of flights, or neither")
     if not args.train and not args.files:
@@ -48,19 +105,8 @@ def _split(args):
         logs = _logs(args.files, "calibrate")
         train_logs, test_logs = (logs, []) if len(logs) == 1 or args.test_fraction is not None else \
             (logs[:-1], logs[-1:])
-    fields, notes = {}, {}
-    for log in [*train_logs, *test_logs]:
-        fields[log.path], notes[log.path] = (None, "the free Earth field (--earth free)") if args.earth == "free" \
-            else model_field(log.position)
-    if test_logs:
-        train, test = _parts(train_logs, args, fields), _parts(test_logs, args, fields)
-        validation = "cross-flight"
-    else:
-        pairs = [f.split(args.test_fraction or 0.5) for f in _parts(train_logs, args, fields)]
-        train, test = [p[0] for p in pairs], [p[1] for p in pairs]
-        validation = f"last {args.test_fraction or 0.5:g} of each flight held out"
-    train, test, check = align(train, test, fields)
-    return train, test, {"validation": validation, "earth_field": sorted(set(notes.values())), "mounting": check}
+    return split_parts(train_logs, test_logs, args.compass, args.attitude, not args.no_trim, args.earth,
+                       args.test_fraction)
 
 
 def _rule(args, part):
@@ -129,31 +175,32 @@ def _export_lines(export: dict) -> list[str]:
     return [f"export: {export['file']} for {export['firmware']}, carrying "
             f"{', '.join(g.replace('_', ' ') for g in fitted) or 'nothing fitted'}; the log's values kept for "
             f"{', '.join(logged) or 'nothing'}",
-            f"  heading on the test part, {export['file']} applied as the firmware does: "
+            f"  heading on the score part (seen by neither the fit nor the choice), {export['file']} applied as the "
+            "firmware does: "
             f"{export['heading_rms_deg']:.2f} deg RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)",
-            f"  share of the test residual its compensation explains: {_percent(export['explained_test'])} % "
+            f"  share of the score part's residual its motor compensation explains: "
+            f"{_percent(export['explained_test'])} % "
             f"(as flown: {_percent(flown['explained'])} %)",
             *(f"  {group}: {note}" for group, note in export["notes"].items() if isinstance(note, str))]
 
 
-def _score(args, train, test, split) -> int:
-    import numpy as np
-
+def _score(args, split: Split) -> int:
     from calibration.flight.export import Candidate, log_parameters, parameters_of, score_file, score_parameters
     from orchestrator.files import write_json
 
-    rule = _rule(args, test[0])
-    given = score_file(args.score, test, rule)
-    names = list(parameters_of(test[0], Candidate(np.zeros(3), np.eye(3)), rule))
-    flown = score_parameters(test, log_parameters(test[0], names), rule)
+    score = split.score
+    rule = _rule(args, score[0])
+    given = score_file(args.score, score, rule)
+    names = list(parameters_of(score[0], Candidate(np.zeros(3), np.eye(3)), rule))
+    flown = score_parameters(score, log_parameters(score[0], names), rule)
     out = Path(args.out)
-    metrics = {"test": sorted({p.source for p in test}), "validation": split["validation"], "score": given,
-               "as_flown": flown}
+    metrics = {"test": sorted({p.source for p in score}), "validation": split.notes["validation"],
+               "scored_on": "the export's score part", "score": given, "as_flown": flown}
     write_json(out / "metrics.json", metrics)
-    print(f"tested on {', '.join(metrics['test'])} ({split['validation']})")
-    print(f"heading on the test part, {args.score} applied as the firmware does: {given['heading_rms_deg']:.2f} deg "
+    print(f"tested on {', '.join(metrics['test'])} ({split.notes['validation']}; scored on the export's score part)")
+    print(f"heading on the score part, {args.score} applied as the firmware does: {given['heading_rms_deg']:.2f} deg "
           f"RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)")
-    print(f"share of the test residual its compensation explains: {_percent(given['explained'])} % "
+    print(f"share of the score part's residual its motor compensation explains: {_percent(given['explained'])} % "
           f"(as flown: {_percent(flown['explained'])} %)")
     return 0
 
@@ -170,26 +217,33 @@ def run(args) -> int:
     try:
         _check_choices(args)
         out = prepare_out_dir(args.out, args.overwrite)
-        train, test, split = _split(args)
+        split = _split(args)
         if args.score:
-            return _score(args, train, test, split)
+            return _score(args, split)
+        train, test, score = split.train, split.test, split.score
         metrics, calibration, fitted = calibrate(train, test, tuple(args.models), args.attitude)
-        metrics |= split
+        metrics |= split.notes
         rule = _rule(args, test[0])
-        params, chosen = choose(train, test, rule)
+        params, chosen = choose(split.fit, split.choice, rule)
         autopilot = train[0].log.autopilot
         name = PARAMETER_FILES[autopilot]
         write_parameters(autopilot, params, out / name)
         from calibration.flight.export import log_parameters
 
-        exported = score_parameters(test, params, rule)
-        flown = score_parameters(test, log_parameters(test[0], params), rule)
+        exported = score_parameters(score, params, rule)
+        flown = score_parameters(score, log_parameters(score[0], params), rule)
         from calibration.flight.export import rules_of
 
         firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
         metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
                              "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
-                             "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"]}
+                             "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"],
+                             "split": {"fit": sorted({p.source for p in split.fit}),
+                                       "choice": sorted({p.source for p in split.choice}),
+                                       "score": sorted({p.source for p in score}),
+                                       "score_from_s": [float(p.time[0]) for p in score],
+                                       "choice_from_s": [float(p.time[0]) for p in split.choice],
+                                       "rule": split.notes["validation"]}}
         calibration.save(out / "calibration.json")
         files = ["metrics.json", "calibration.json", name]
         analysis = next((m for m in ("current", "throttle") if m in fitted), None)
