@@ -220,12 +220,14 @@ def _motor_keys(params: dict) -> dict:
     return {k: v for k, v in params.items() if "MOT" in k or "COMP" in k}
 
 
-def _motor_trials(train, rule, trial, held, offsets, log_soft) -> dict:
+def _motor_trials(train, rule, trial, held, offsets, log_soft, models=None) -> dict:
     """Each motor compensation the firmware has, fitted on ``train`` and scored by ``trial``: with
     the offsets fitted with it (unless ``held``, when they cannot be identified) or ``offsets``,
     whichever scores better; the reason when it cannot be fitted."""
     trials = {}
     for model in motor_models(train[0], rule):
+        if models is not None and model not in models:
+            continue
         fitted = fit_motor(train, model)
         if fitted is None:
             trials[model] = {"refused": "its input is not logged or its design cannot be told apart"}
@@ -255,12 +257,13 @@ def _zero_offsets(source: str, why: str) -> CalibrationError:
                             "written rather than one with zero offsets")
 
 
-def choose(train, choice, rule=None) -> tuple[dict, dict]:
+def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     """The parameters to export for the compass of ``train``/``choice`` and the notes saying what was
     exported and kept: offsets, then motor compensation, then soft iron, each fitted on ``train``
     and kept only when it lowers the heading error on the ``choice`` parts (the motor compensation
     also needs a positive explained share there). The export's score belongs on parts neither has
-    seen. ``rule`` overrides ArduPilot's version rules.
+    seen. ``rule`` overrides ArduPilot's version rules; ``models`` (names of :data:`MOTOR_MODELS`)
+    restricts the motor compensations tried (default: all the firmware has).
 
     Raises
     ------
@@ -294,7 +297,7 @@ def choose(train, choice, rule=None) -> tuple[dict, dict]:
             best, best_score, kept["offsets"], offsets = params, found, "fitted", fitted_offsets
     if zero and kept["offsets"] != "fitted":
         raise _zero_offsets(first.source, "and the fitted ones do not beat them on the choice part")
-    trials = _motor_trials(train, rule, trial, offsets if not identifiable else None, offsets, log_soft)
+    trials = _motor_trials(train, rule, trial, offsets if not identifiable else None, offsets, log_soft, models)
     notes["motor_models"] = {m: {k: v for k, v in t.items() if k not in ("candidate", "params")}
                              for m, t in trials.items()}
     scored = {m: t for m, t in trials.items() if "refused" not in t}

@@ -1,7 +1,8 @@
 """Findings of the real flights: the quad's two compasses calibrated from its three flights
 (each model's explained share of the held-out residual, the perturbation at hover and the
 heading change), the exported parameter file of every compass of every ArduPilot log scored as
-its firmware applies it against the log as flown, and the estimators replayed on every shared
+its firmware applies it against the log as flown, what each wrong firmware rule costs that export
+(an ablation), and the estimators replayed on every shared
 log without and with the compensation, against the autopilot's attitude.
 
 The logs (three flights of one quad, an Erle-Brain flight and a PX4 bench log) are read from
@@ -26,6 +27,9 @@ OTHER_LOGS = {"erlebrain": "erlebrain_APM_22.bin", "px4": "px4_sample.ulg"}
 # every compass of every ArduPilot log: its export against the log as flown (one column per judge)
 EXPORTS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebrain", 0)]
 REPLAYED = ("explicit", "vqf")
+# the internal compass of the three quad flights and the Erle-Brain's: what each wrong firmware rule costs
+ABLATIONS = [("a", 1), ("b", 1), ("c", 1), ("erlebrain", 0)]
+ABLATION = "python -m scenarios.findings flightlogs"  # a function of the group, not a command's output
 PERCENT = 100.0
 # the means over the flights: the group prints them (and, with --check, writes nothing)
 MEANS = "python -m scenarios.findings flightlogs --check"
@@ -132,6 +136,19 @@ def _exports(keys) -> list[dict]:
     return found
 
 
+def _ablations() -> list[dict]:
+    """The heading error (deg RMS, score part) of the export under the right rules and under each
+    wrong one, applied as the log's firmware applies it (:mod:`scenarios.findings.flightlog_ablation`)."""
+    from orchestrator.logs import read_log
+    from scenarios.findings.flightlog_ablation import costs
+
+    found = []
+    for key, compass in ABLATIONS:
+        for rule, value in costs(read_log(_path(key)), compass).items():
+            found.append(_finding(f"ablation.{key}{compass}.{rule}_deg", value, "deg", ABLATION, 0.02, 2))
+    return found
+
+
 def _replays() -> list[dict]:
     from scenarios.flightlog.replay import replay_log
 
@@ -154,4 +171,5 @@ def compute(quick: bool = False) -> list[dict]:
     if quick:
         return [f for f in _calibrations(["b"], [1], ("current", "throttle"), cross=False)
                 if ".explained_half_" in f["name"]] + _exports([("b", 1)])
-    return _calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _exports(EXPORTS) + _replays()
+    return (_calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _exports(EXPORTS) + _ablations()
+            + _replays())
