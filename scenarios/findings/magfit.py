@@ -1,19 +1,21 @@
-"""Findings of the peer: MAVExplorer's ``magfit``, the field's own fitting code, run on the training
-part of every compass of every shared ArduPilot log, and the parameters it prints scored on the
-held-out part exactly as quadcosim's export is scored (``quadcosim calibrate LOG --compass N
---score FILE``: the file loaded on top of the log's parameters and applied as the log's firmware
-applies it).
+"""Findings of the peer: MAVExplorer's ``magfit``, the field's own fitting code, run on the same
+split as quadcosim's export, for every compass of every shared ArduPilot log: fitted on the export's
+fit part (the flight's first half), its setting chosen on the choice part (the third quarter), and
+the parameters it prints scored on the score part (the last quarter) exactly as the export is
+scored (``quadcosim calibrate LOG --compass N --score FILE``: the file loaded on top of the log's
+parameters and applied as the log's firmware applies it).
 
 How it is run: MAVProxy's ``MAVProxy.modules.lib.magfit.magfit(mlog, timestamp_in_range)``, the
 function MAVExplorer's ``magfit`` panel calls when its *Run* button is pressed, with the panel's
 options (``margs``) and its own way of restricting the log to a time range (the plot's limits;
-here the training part). The module imports wxPython only for the panel: it is imported with a
+here the fit part). The module imports wxPython only for the panel: it is imported with a
 stand-in for ``wx`` (nothing of it is used by the fit) and without letting its plotting helper
 switch matplotlib to the wx backend; its figure is saved to a file, as its own headless ``main``
 does. Two of the panel's settings are run: its defaults (offsets; scale held at 1) and with
 *Elliptical* checked (offsets, diagonal and off-diagonal soft iron, within the panel's default
-bounds). Its motor-current fit (*CMOT*) reads the current from
-``BAT`` messages, which the shared logs (Copter 3.4) do not have (they log ``CURR``).
+bounds); the one with the lower heading error on the choice part is magfit's column. Its
+motor-current fit (*CMOT*) reads the current from ``BAT`` messages, which the shared logs (Copter
+3.4) do not have (they log ``CURR``).
 
 magfit cannot run without a 3D GPS fix in the part it is given: it takes the Earth field, its
 target, from the World Magnetic Model at that fix. Such a compass is reported with the reason.
@@ -51,14 +53,8 @@ COMMAND = "python -m scenarios.findings magfit --check"
 PRINTED = re.compile(r"^(COMPASS_\w+) (-?\d+(?:\.\d+)?)$")
 
 
-def magfit_module():
-    """MAVProxy's ``magfit`` module, imported without wxPython (only its panel needs it).
-
-    Raises
-    ------
-    Skipped
-        MAVProxy is not installed, or not the pinned release.
-    """
+def require_mavproxy() -> None:
+    """Raise :class:`Skipped`, naming the install command, when MAVProxy is absent or not the pinned release."""
     from importlib import metadata
 
     try:
@@ -67,6 +63,17 @@ def magfit_module():
         raise Skipped(f"MAVProxy is not installed: {INSTALL} (MAVProxy {MAVPROXY})") from None
     if version != MAVPROXY:
         raise Skipped(f"MAVProxy {version} is installed, the findings are of {MAVPROXY}: {INSTALL}")
+
+
+def magfit_module():
+    """MAVProxy's ``magfit`` module, imported without wxPython (only its panel needs it).
+
+    Raises
+    ------
+    Skipped
+        MAVProxy is not installed, or not the pinned release.
+    """
+    require_mavproxy()
     import matplotlib
 
     absent, use = "wx" not in sys.modules, matplotlib.use
@@ -138,7 +145,7 @@ def cannot_run(mlog, in_range) -> str | None:
             break
     mlog.rewind()
     if not fix:
-        return ("no GPS fix in the training part: magfit's target is the World Magnetic Model's field at a 3D fix, "
+        return ("no GPS fix in the fit part: magfit's target is the World Magnetic Model's field at a 3D fix, "
                 "and the log has none")
     return None
 
@@ -189,35 +196,42 @@ def _orientation(params: dict, slot: int) -> int:
 
 
 def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
-    """magfit on the training part of compass ``compass`` of log ``key`` (the same split as
-    ``quadcosim calibrate``), each of ``settings`` scored on the held-out part by ``quadcosim
-    calibrate --score``.
+    """magfit on the export's fit part of compass ``compass`` of log ``key`` (the same split as
+    ``quadcosim calibrate``: :func:`scenarios.flightlog.calibrate.split_parts`), each of
+    ``settings`` scored on the choice part (:func:`calibration.flight.export.score_parameters`, as
+    the export's groups are chosen) and on the score part by ``quadcosim calibrate --score``.
 
     Returns
     -------
     dict
-        ``setting``: {``heading_rms_deg``, ``explained``, ``params``, ``points``} for each setting, and
-        ``as_flown``; or ``cannot_run``: the reason.
+        Per setting: ``heading_rms_deg`` and ``explained`` on the score part, ``choice_heading_rms_deg``
+        on the choice part, ``params`` (as magfit prints them), ``points`` (samples magfit used) and
+        ``samples`` (in the fit part); ``chosen``: the setting with the lower heading error on the
+        choice part; ``as_flown`` on the score part. Or ``cannot_run``: the reason.
     """
+    require_mavproxy()  # skips before any work when MAVProxy is absent
     from pymavlink import mavutil
 
     from calibration.flight.autopilot import write_ardupilot
-    from scenarios.cli import main, parser
-    from scenarios.flightlog.calibrate import _split
+    from calibration.flight.export import score_parameters
+    from orchestrator.logs import read_log
+    from scenarios.cli import main
+    from scenarios.flightlog.calibrate import split_parts
 
-    magfit_module()  # skips before any work when MAVProxy is absent
     path = _path(key)
+    mlog = mavutil.mavlink_connection(str(path))
+    reason = cannot_run(mlog, lambda timestamp: 0)  # the whole log: nothing to split when it cannot run at all
+    if reason is not None:
+        return {"cannot_run": reason.replace("in the fit part", "in the log")}
+    split = split_parts([read_log(path)], [], compass)  # as the command splits it
+    (part,) = split.fit
+    chosen = part.log.compasses[compass]
+    in_range, count = training_span(mlog, chosen.name, float(part.time[0]), float(part.time[-1]))
+    reason = cannot_run(mlog, in_range)
+    if reason is not None:
+        return {"cannot_run": reason}
+    found = {}
     with tempfile.TemporaryDirectory() as folder:
-        args = parser().parse_args(["calibrate", str(path), "--compass", str(compass), "--out", folder])
-        train, _, _ = _split(args)
-        (part,) = train
-        chosen = part.log.compasses[compass]
-        mlog = mavutil.mavlink_connection(str(path))
-        in_range, count = training_span(mlog, chosen.name, float(part.time[0]), float(part.time[-1]))
-        reason = cannot_run(mlog, in_range)
-        if reason is not None:
-            return {"cannot_run": reason}
-        found = {}
         for setting in settings:
             params, text = run_magfit(path, chosen.name, _orientation(part.log.params, chosen.slot), in_range, setting)
             if not params:
@@ -232,8 +246,11 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
             if code:
                 raise RuntimeError(f"quadcosim calibrate --score {file} failed on {path} (exit {code})")
             metrics = json.loads((out / "metrics.json").read_text())
-            found[setting] = metrics["score"] | {"params": params, "points": points, "samples": count}
+            choice = score_parameters(split.choice, params)["heading_rms_deg"]
+            found[setting] = metrics["score"] | {"choice_heading_rms_deg": choice, "params": params,
+                                                 "points": points, "samples": count}
             found["as_flown"] = metrics["as_flown"]
+    found["chosen"] = min(settings, key=lambda s: found[s]["choice_heading_rms_deg"])
     return found
 
 
@@ -243,19 +260,21 @@ def _finding(name, value, unit, tolerance, digits) -> dict:
 
 
 def findings_of(key: str, compass: int, settings=tuple(SETTINGS)) -> list[dict]:
-    """The findings of one compass: each setting's heading error (deg RMS) on the held-out part, its
-    file applied as the log's firmware applies it; none where magfit cannot run (the docs say why)."""
+    """The findings of one compass: each setting's heading error (deg RMS) on the score part, its
+    file applied as the log's firmware applies it, and that of the setting chosen on the choice
+    part; none where magfit cannot run (the docs say why)."""
     result = peer(key, compass, settings)
     if "cannot_run" in result:
         print(f"magfit cannot run on {_shown(key)} compass {compass}: {result['cannot_run']}", file=sys.stderr)
         return []
+    chosen = result[result["chosen"]]["heading_rms_deg"]
     return [_finding(f"{key}{compass}.{setting}_deg", result[setting]["heading_rms_deg"], "deg", 0.02, 2)
-            for setting in settings]
+            for setting in settings] + [_finding(f"{key}{compass}.chosen_deg", chosen, "deg", 0.02, 2)]
 
 
 def compute(quick: bool = False) -> list[dict]:
     """The group's findings (see the module docstring); ``quick``: flight b's internal compass with
     the panel's defaults (about half a minute)."""
-    if quick:
-        return findings_of("b", 1, ("offsets",))
+    if quick:  # the choice between settings needs both: the quick subset has none
+        return [f for f in findings_of("b", 1, ("offsets",)) if f["name"].endswith(".offsets_deg")]
     return [f for key, compass in EXPORTS for f in findings_of(key, compass)]
