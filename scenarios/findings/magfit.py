@@ -101,10 +101,26 @@ def _seconds(msg) -> float:
 
 def training_span(mlog, compass_name: str, start: float, end: float):
     """MAVExplorer's time-range test (``timestamp_in_range``) for the compass samples between
-    ``start`` and ``end`` (s, the log's clock, as :class:`calibration.flight.FlightData` holds them):
-    -1 before the range, 0 in it, 1 after. The range opens just after the last sample before
-    ``start``, so that the attitude logged before the first training sample is seen, and closes at
-    the last training sample. Also returns the number of samples in it."""
+    ``start`` and ``end``.
+
+    The range opens just after the last sample before ``start``, so that the attitude logged before
+    the first sample of the range is seen, and closes at the last sample of the range.
+
+    Parameters
+    ----------
+    mlog : pymavlink DFReader
+        The log, as ``mavutil.mavlink_connection`` opens it (rewound on return).
+    compass_name : str
+        The compass as the log names it (``MAG``, ``MAG2``, ``MAG[1]``).
+    start, end : float
+        The range (s, the log's clock, as :class:`calibration.flight.FlightData` holds it).
+
+    Returns
+    -------
+    (callable, int)
+        The test (a message's ``_timestamp`` to -1 before the range, 0 in it, 1 after) and the
+        number of compass samples in the range.
+    """
     message, instance = _message(compass_name)
     mlog.rewind()
     before, first, last, count = None, None, None, 0
@@ -262,7 +278,17 @@ def _finding(name, value, unit, tolerance, digits) -> dict:
 def findings_of(key: str, compass: int, settings=tuple(SETTINGS)) -> list[dict]:
     """The findings of one compass: each setting's heading error (deg RMS) on the score part, its
     file applied as the log's firmware applies it, and that of the setting chosen on the choice
-    part; none where magfit cannot run (the docs say why)."""
+    part; none where magfit cannot run (the docs say why).
+
+    Parameters
+    ----------
+    key : str
+        The log's key in :mod:`scenarios.findings.flightlogs` (``a``, ``b``, ``c``, ``erlebrain``).
+    compass : int
+        The compass, from 0 in the log's order.
+    settings : tuple of str
+        Keys of :data:`SETTINGS` to run.
+    """
     result = peer(key, compass, settings)
     if "cannot_run" in result:
         print(f"magfit cannot run on {_shown(key)} compass {compass}: {result['cannot_run']}", file=sys.stderr)
