@@ -50,7 +50,7 @@ def gyro_heading(log, times: np.ndarray, trim: bool = True) -> np.ndarray:
     """Heading (rad) at ``times`` (s) integrated from the first IMU's gyro, with the board's roll and
     pitch (:func:`board_quaternions`); its constant and its linear drift are matched to the log's
     heading over the whole flight, so no stretch shorter than the flight depends on the compass.
-    ``log``: the FlightLog."""
+    ``log``: the FlightLog; ``trim``: add ``AHRS_TRIM`` back (False: an ablation)."""
     imu = log.imus[0]
     euler = euler_of(board_quaternions(log, trim))
     roll = np.interp(imu.time, log.attitude.time, euler[:, 0])

@@ -99,7 +99,8 @@ def score_parameters(parts, params: dict, rule=None) -> dict:
 
 def score_file(path, parts, rule=None) -> dict:
     """:func:`score_parameters` of the parameter file at ``path`` (ArduPilot ``.parm`` or a PX4
-    ``.params`` of QGroundControl), with its name and parameter count."""
+    ``.params`` of QGroundControl) on ``parts``, applied under ``rule`` (None: the log's), with its
+    name and parameter count."""
     from calibration.flight.autopilot import read_parameters
 
     params = read_parameters(path)
@@ -109,7 +110,8 @@ def score_file(path, parts, rule=None) -> dict:
 @dataclass
 class Candidate:
     """A fitted piece of the export: the hard iron ``offset`` (3,) (T, raw frame), the soft-iron
-    inverse ``correction`` (3, 3), the motor ``model`` (or None) and its vectors ``K`` (T per unit)."""
+    inverse ``correction`` (3, 3), the motor ``model`` (or None), its vectors ``K`` (T per unit) and
+    ``notes`` (text)."""
 
     offset: np.ndarray
     correction: np.ndarray
@@ -132,7 +134,8 @@ def _motor_regressors(part, model: str) -> np.ndarray | None:
 
 def motor_models(part, rule=None) -> tuple[str, ...]:
     """The motor compensations ``part``'s firmware has for its compass: ``current`` and
-    ``throttle``, and ``motors`` (``COMPASS_PMOT``) on ArduPilot 4.0 and later's first compass."""
+    ``throttle``, and ``motors`` (``COMPASS_PMOT``) on ArduPilot 4.0 and later's first compass
+    (``rule`` overriding the log's version)."""
     if not is_px4(part) and rules_of(part, rule).per_motor and part.log.compasses[part.compass].slot == 0:
         return MOTOR_MODELS
     return ("current", "throttle")
@@ -169,7 +172,8 @@ def offsets_identifiable(train) -> tuple[bool, str]:
 
 def fit_soft_iron(train, model, K) -> tuple[np.ndarray, np.ndarray] | str:
     """Symmetric soft iron ``A`` and offsets ``b`` in ``raw - K x = A R^T m_E + b``, against the
-    Earth field model; the reason (str) when the model is absent or the rotations cannot identify it."""
+    Earth field model, fitted on the ``train`` parts; the reason (str) when the model is absent or the
+    rotations cannot identify it."""
     if any(p.earth is None for p in train):
         return "soft iron needs the Earth field model (a GPS fix) on flights like these"
     pairs = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
@@ -201,7 +205,8 @@ def fit_soft_iron(train, model, K) -> tuple[np.ndarray, np.ndarray] | str:
 
 
 def parameters_of(part, candidate: Candidate, rule=None) -> dict:
-    """``candidate`` as the parameters of ``part``'s firmware (compass's own slot)."""
+    """``candidate`` as the parameters of ``part``'s firmware (compass's own slot; ``rule`` overriding
+    ArduPilot's version)."""
     compass = part.log.compasses[part.compass]
     if is_px4(part):
         return px4.parameters(compass.slot, candidate.offset, candidate.correction,
@@ -211,7 +216,7 @@ def parameters_of(part, candidate: Candidate, rule=None) -> dict:
 
 
 def log_parameters(part, names) -> dict:
-    """The log's values of ``names`` (those it holds; the others keep the firmware's defaults)."""
+    """The values of ``names`` in ``part``'s log (those it holds; the others keep the firmware's defaults)."""
     return {n: part.log.params[n] for n in names if n in part.log.params}
 
 

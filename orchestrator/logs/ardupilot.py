@@ -105,7 +105,7 @@ def suffix(compass: int) -> str:
 
 def soft_iron(params: dict, compass: int) -> np.ndarray:
     """``M`` (3, 3) of compass ``compass`` from ``COMPASS_DIA*``/``ODI*`` as ``correct_field`` builds
-    it: an all-zero diagonal becomes ones, the off-diagonals kept."""
+    it from ``params`` (name: value): an all-zero diagonal becomes ones, the off-diagonals kept."""
     s = suffix(compass)
     dia = [float(params.get(f"COMPASS_DIA{s}_{a}", 0.0)) for a in AXES]
     odi = [float(params.get(f"COMPASS_ODI{s}_{a}", 0.0)) for a in AXES]
@@ -115,7 +115,8 @@ def soft_iron(params: dict, compass: int) -> np.ndarray:
 
 
 def scale_factor(params: dict, compass: int, rule: Rules) -> float:
-    """``COMPASS_SCALE*`` as applied: 1 before 4.0 or outside :data:`SCALE_RANGE` (``have_scale_factor``)."""
+    """``COMPASS_SCALE*`` of compass ``compass`` in ``params`` as applied under ``rule``: 1 before 4.0 or
+    outside :data:`SCALE_RANGE` (``have_scale_factor``)."""
     if not rule.scale:
         return 1.0
     value = float(params.get(f"COMPASS_SCALE{suffix(compass)}", 0.0))
@@ -123,13 +124,14 @@ def scale_factor(params: dict, compass: int, rule: Rules) -> float:
 
 
 def offsets(params: dict, compass: int) -> np.ndarray:
-    """``COMPASS_OFS*`` of compass ``compass`` (3,) (mG)."""
+    """``COMPASS_OFS*`` of compass ``compass`` in ``params`` (3,) (mG)."""
     return np.array([float(params.get(f"COMPASS_OFS{suffix(compass)}_{a}", 0.0)) for a in AXES])
 
 
 def per_motor_outputs(commands, voltage) -> np.ndarray:
     """``Compass_PerMotor::scaled_output`` of each motor (T, N): ``(c V_lp)^1`` before the exponent,
-    ``c`` the demand (0..1; 0 when not positive), ``V_lp`` the low-passed battery voltage (V)."""
+    ``c`` the demand (``commands``, T x N, 0..1; 0 when not positive), ``V_lp`` the low-passed battery
+    ``voltage`` (T,) (V)."""
     commands = np.asarray(commands, dtype=float)
     voltage = np.asarray(voltage, dtype=float)
     smoothed = np.empty_like(voltage)
@@ -144,7 +146,9 @@ def motor_offset(params: dict, compass: int, rule: Rules, current, throttle, com
                  voltage=None) -> np.ndarray:
     """The motor offset (T, 3) (mG) ``correct_field`` adds: per-motor for the first compass when
     ``COMPASS_PMOT_EN`` (4.0 and later), else ``COMPASS_MOT*`` times the current (A) or the throttle
-    (0..1) as ``COMPASS_MOTCT`` says; zeros when compensation is off or its input absent."""
+    (0..1) as ``COMPASS_MOTCT`` says; zeros when compensation is off or its input absent. ``params``:
+    the parameters; ``rule``: the version's :class:`Rules`; ``commands`` (T, N) and ``voltage`` (T,)
+    (V): the per-motor inputs."""
     n = len(current if current is not None else throttle)
     if rule.per_motor and compass == 0 and params.get("COMPASS_PMOT_EN", 0):
         if commands is None or voltage is None:
@@ -183,7 +187,7 @@ def apply(params: dict, compass: int, rule: Rules, raw, current=None, throttle=N
 def recover_raw(params: dict, compass: int, rule: Rules, field, logged_offsets, logged_motor) -> np.ndarray:
     """The raw field (T, 3) (T) under the logged ``field`` (T, 3) (T), inverting ``correct_field``
     with the logged ``Ofs`` (``logged_offsets``, T) and ``MOfs`` (``logged_motor``, T) sample by
-    sample, ``M`` and the scale from ``params``, in ``rule``'s order."""
+    sample, ``M`` and the scale of compass ``compass`` from ``params``, in ``rule``'s order."""
     M = soft_iron(params, compass)
     s = scale_factor(params, compass, rule)
     field, ofs, mofs = (np.asarray(a, dtype=float) for a in (field, logged_offsets, logged_motor))
@@ -225,7 +229,7 @@ def parameters(compass: int, rule: Rules, offset_T, correction, model: str | Non
 
 def trim_rotation(params: dict) -> np.ndarray:
     """``R(trim)`` (3, 3): the board's attitude is ``R_vehicle R(trim)`` (``AHRS_TRIM_X/Y`` in rad,
-    Z-Y-X Euler with no yaw, as ``Matrix3f::from_euler``)."""
+    Z-Y-X Euler with no yaw, as ``Matrix3f::from_euler``), from ``params``."""
     from scipy.spatial.transform import Rotation
 
     roll, pitch = float(params.get("AHRS_TRIM_X", 0.0)), float(params.get("AHRS_TRIM_Y", 0.0))
@@ -233,7 +237,7 @@ def trim_rotation(params: dict) -> np.ndarray:
 
 
 def fused_compass(params: dict) -> int:
-    """The compass the attitude estimator fuses (``COMPASS_PRIMARY``, 0-based)."""
+    """The compass the attitude estimator fuses (``COMPASS_PRIMARY`` in ``params``, 0-based)."""
     return int(params.get("COMPASS_PRIMARY", 0))
 
 

@@ -49,7 +49,8 @@ def rotation_matrix(value: int) -> np.ndarray:
 
 def slot(params: dict, device_id: int | None, order: int) -> int:
     """The calibration slot ``n`` of ``CAL_MAGn_*`` for the sensor ``device_id``
-    (``FindCalibrationIndex``); ``order`` (its topic instance) when the log has no device id."""
+    (``FindCalibrationIndex`` over ``params``' ``CAL_MAGn_ID``); ``order`` (its topic instance) when the
+    log has no device id."""
     if device_id:
         for n in range(4):
             if int(params.get(f"CAL_MAG{n}_ID", 0)) == int(device_id):
@@ -58,7 +59,7 @@ def slot(params: dict, device_id: int | None, order: int) -> int:
 
 
 def body_rotation(params: dict, n: int, external: bool) -> np.ndarray:
-    """``R`` (3, 3) of slot ``n``: ``CAL_MAGn_ROT`` when external, the board's rotation otherwise."""
+    """``R`` (3, 3) of slot ``n`` in ``params``: ``CAL_MAGn_ROT`` when ``external``, the board's rotation otherwise."""
     from scipy.spatial.transform import Rotation
 
     if external:
@@ -69,14 +70,15 @@ def body_rotation(params: dict, n: int, external: bool) -> np.ndarray:
 
 
 def scale_matrix(params: dict, n: int) -> np.ndarray:
-    """``S`` (3, 3) of slot ``n`` (``*SCALE`` on the diagonal, default 1; ``*ODIAG`` off it)."""
+    """``S`` (3, 3) of slot ``n`` in ``params`` (``*SCALE`` on the diagonal, default 1; ``*ODIAG`` off it)."""
     d = [float(params.get(f"CAL_MAG{n}_{a}SCALE", 1.0)) for a in AXES]
     o = [float(params.get(f"CAL_MAG{n}_{a}ODIAG", 0.0)) for a in AXES]
     return np.array([[d[0], o[0], o[1]], [o[0], d[1], o[2]], [o[1], o[2], d[2]]])
 
 
 def power(params: dict, current=None, thrust=None):
-    """``p`` (T,) as ``CAL_MAG_COMP_TYP`` says: the thrust (0..1) or the current (A) in kA; None when off."""
+    """``p`` (T,) as ``CAL_MAG_COMP_TYP`` in ``params`` says: the ``thrust`` (0..1) or the ``current``
+    (A) in kA; None when off."""
     kind = int(params.get("CAL_MAG_COMP_TYP", 0))
     if kind == COMP_TYPE["throttle"]:
         return None if thrust is None else np.asarray(thrust, dtype=float)
@@ -87,7 +89,8 @@ def power(params: dict, current=None, thrust=None):
 
 def apply(params: dict, n: int, external: bool, raw_sensor, current=None, thrust=None) -> np.ndarray:
     """The body-frame field (T, 3) (T) PX4 reports from ``raw_sensor`` (T, 3) (T, sensor frame) with
-    slot ``n`` of ``params`` (``Magnetometer::Correct``)."""
+    slot ``n`` of ``params`` (``Magnetometer::Correct``); ``external``: the sensor is external;
+    ``current`` (A) and ``thrust`` (0..1): the compensation's inputs (T,)."""
     raw_G = np.asarray(raw_sensor, dtype=float) / GAUSS
     offset = np.array([float(params.get(f"CAL_MAG{n}_{a}OFF", 0.0)) for a in AXES])
     comp = np.array([float(params.get(f"CAL_MAG{n}_{a}COMP", 0.0)) for a in AXES])
@@ -100,7 +103,8 @@ def apply(params: dict, n: int, external: bool, raw_sensor, current=None, thrust
 
 def recover_raw(params: dict, n: int, external: bool, field_body) -> np.ndarray:
     """The sensor-frame raw field (T, 3) (T) under a logged calibrated ``field_body`` (T, 3) (T) of
-    slot ``n``, with no compensation term (older logs record none)."""
+    slot ``n`` of ``params`` (``external``: an external sensor), with no compensation term (older
+    logs record none)."""
     R = body_rotation(params, n, external)
     S = scale_matrix(params, n)
     offset = np.array([float(params.get(f"CAL_MAG{n}_{a}OFF", 0.0)) for a in AXES]) * GAUSS

@@ -42,7 +42,8 @@ class Split:
     ``choice`` and every export figure measured on ``score``, which neither has seen. One flight:
     ``train``=``fit`` its first part, ``test`` the held-out rest, ``choice`` and ``score`` that
     rest's two halves in time. Several: ``train`` the training flights, ``fit``/``choice`` their
-    halves, ``test``=``score`` the held-out flights.
+    halves, ``test``=``score`` the held-out flights. ``notes``: the validation's description, the
+    Earth field's lines and the yaw-mounting check.
     """
 
     train: list
@@ -57,7 +58,7 @@ def split_parts(train_logs, test_logs, compass: int, attitude: str = "auto", tri
                 earth: str = "model", test_fraction: float | None = None) -> Split:
     """:class:`Split` of compass ``compass`` of ``train_logs`` (FlightLogs; one alone is split in time
     with its last ``test_fraction``, default 0.5, held out) and ``test_logs`` (held-out flights, or
-    empty), with the attitude, trim and Earth field (``model`` or ``free``) the command uses."""
+    empty), with the ``attitude``, ``trim`` and ``earth`` field (``model`` or ``free``) the command uses."""
     from calibration.flight import flight_data
     from calibration.flight.earth import align, model_field
 
