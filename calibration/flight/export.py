@@ -221,14 +221,22 @@ def log_parameters(part, names) -> dict:
 
 
 def _motor_keys(params: dict) -> dict:
-    """The motor-compensation entries of ``params`` (ArduPilot's ``*MOT*``, PX4's ``*COMP*``)."""
-    return {k: v for k, v in params.items() if "MOT" in k or "COMP" in k}
+    """The motor-compensation entries of ``params``: ArduPilot's ``COMPASS_*MOT*`` and PX4's
+    ``CAL_MAG*COMP*`` (not every ``COMPASS_*``, which would carry the log's offsets and soft iron)."""
+    return {k: v for k, v in params.items()
+            if (k.startswith("COMPASS_") and "MOT" in k) or (k.startswith("CAL_MAG") and "COMP" in k)}
 
 
-def _motor_trials(train, rule, trial, held, offsets, log_soft, models=None) -> dict:
-    """Each motor compensation the firmware has, fitted on ``train`` and scored by ``trial``: with
-    the offsets fitted with it (unless ``held``, when they cannot be identified) or ``offsets``,
-    whichever scores better; the reason when it cannot be fitted."""
+def _motor_trials(train, rule, trial, held, log_soft, models=None) -> dict:
+    """Each motor compensation the firmware has, fitted on ``train`` with the offsets (or with
+    ``held``, the offsets kept, when the flights cannot identify them) and scored by ``trial``; the
+    reason when it cannot be fitted.
+
+    The compensation goes out with the offsets fitted with it and no others: offsets fitted
+    without it hold the motors' mean field, which it would add a second time, and the log's (or
+    any others) with the fitted vectors are a pair no fit produced. A choice part flown at one
+    throttle cannot tell such pairs apart (only ``offsets + K x`` at that throttle shows), so
+    they are not offered to it."""
     trials = {}
     for model in motor_models(train[0], rule):
         if models is not None and model not in models:
@@ -238,9 +246,8 @@ def _motor_trials(train, rule, trial, held, offsets, log_soft, models=None) -> d
             trials[model] = {"refused": "its input is not logged or its design cannot be told apart"}
             continue
         K = fitted[1] if model == "motors" else fitted[1][0]
-        options = [Candidate(b, log_soft, model, K) for b in ([] if held is not None else [fitted[0]]) + [offsets]]
-        results = [(c, *trial(c)) for c in options]
-        candidate, params, found = min(results, key=lambda r: r[2]["heading_rms_deg"])
+        candidate = Candidate(fitted[0] if held is None else held, log_soft, model, K)
+        params, found = trial(candidate)
         trials[model] = found | {"candidate": candidate, "params": params}
     return trials
 
@@ -302,7 +309,7 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
             best, best_score, kept["offsets"], offsets = params, found, "fitted", fitted_offsets
     if zero and kept["offsets"] != "fitted":
         raise _zero_offsets(first.source, "and the fitted ones do not beat them on the choice part")
-    trials = _motor_trials(train, rule, trial, offsets if not identifiable else None, offsets, log_soft, models)
+    trials = _motor_trials(train, rule, trial, offsets if not identifiable else None, log_soft, models)
     notes["motor_models"] = {m: {k: v for k, v in t.items() if k not in ("candidate", "params")}
                              for m, t in trials.items()}
     scored = {m: t for m, t in trials.items() if "refused" not in t}
@@ -316,8 +323,7 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
         elif t["heading_rms_deg"] < best_score["heading_rms_deg"]:
             best, best_score, kept["motor"] = t["params"], {k: t[k] for k in ("heading_rms_deg", "explained")}, model
             chosen = t["candidate"]
-            if not np.allclose(chosen.offset, compass.offsets):
-                kept["offsets"] = "fitted"
+            kept["offsets"] = "log" if np.allclose(chosen.offset, compass.offsets) else "fitted"
             notes["motor"] = f"{model}: exported"
         else:
             notes["motor"] = (f"{model}: {t['heading_rms_deg']:.2f} deg on the choice part, not below "
