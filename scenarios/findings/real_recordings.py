@@ -55,7 +55,8 @@ def tuning(records: dict) -> list[dict]:
     out = []
     for kind, record in records.items():
         for name, value in record["chosen"].items():
-            out.append(_entry(f"tuning.{kind}.{name}", value, "1", 2, 0.0, f"{CHOOSE} --filter {kind}"))
+            digits = 0 if float(value).is_integer() else 3
+            out.append(_entry(f"tuning.{kind}.{name}", value, "1", digits, 0.0, f"{CHOOSE} --filter {kind}"))
         out.append(_entry(f"tuning.{kind}.score", record["score"], "1", 2, 0.005, f"{CHOOSE} --filter {kind}"))
     return out
 
