@@ -53,6 +53,7 @@ ABLATIONS = {
     # the reference follows the field, and adopts a lasting new one held while turning
     "tracked_reference": {name: CORRECTIONS[name] for name in ("mag_reference_time", "mag_new_min_gyro")},
     "no_separation": {"heading_level": 0.0, "heading_only": 0.0},  # the magnetometer's correction tilts too
+    "previous_attitude": {"correct_at_sample": 0.0},  # corrections against the previous sample's attitude
 }
 TUNING_RECORDS = Path(__file__).parent / "data"  # the search records of benchmarks.tuning
 

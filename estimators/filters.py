@@ -84,6 +84,11 @@ or tunes each:
     turns is fixed in the inertial frame and may become the reference; one carried by the body
     (a magnet on it) changes its dip as the body turns and never does, so the heading is not
     pulled to it (VQF's test).
+``correct_at_sample`` (0 or 1)
+    The corrections and the weights are taken against the attitude at the sample (the previous
+    estimate advanced by the corrected gyro), not the previous estimate: otherwise a turn of
+    ``omega dt`` during the sample reads as an error of that size (1.4 deg at 1.2 rad/s and
+    50 Hz), which fast time constants turn into an error that grows with the sample period.
 ``mag_rejection_time`` (s)
     A magnetometer rejected (weight under 0.5) for longer than this corrects the heading again at
     half its weight, so that a lasting disturbance bounds the gyro's heading drift; the time
@@ -120,7 +125,7 @@ TIME_CONSTANTS = ("tau_inclination", "tau_heading", "tau_bias")
 # norm, in uT at the lab's 47 uT field, and its dip, in deg): chosen on four public datasets with optical ground
 # truth (python -m benchmarks.tuning DATA; its record benchmarks/data/tuning_explicit.json), a fifth held out
 # until they were frozen.
-DEFAULT_TIME_CONSTANTS = {"tau_inclination": 1.0, "tau_heading": 10.0, "tau_bias": 200.0}
+DEFAULT_TIME_CONSTANTS = {"tau_inclination": 0.5, "tau_heading": 10.0, "tau_bias": 400.0}
 DEFAULT_MAG_THRESHOLDS = {"norm_uT": 32.0, "dip_deg": 5.0}
 
 
@@ -181,17 +186,20 @@ CORRECTIONS = {
     "rest_deviation": 1.0,
     "mag_new_min_gyro": math.radians(20.0),  # rad/s
     "mag_rejection_time": 60.0,  # s
+    "correct_at_sample": 1.0,
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 # The corrections each filter runs with by default (corrections=None or True), at the values of CORRECTIONS.
 # The recommended explicit filter takes the configured Earth field as the magnetic reference for ever (no
 # tracking: on the RING dataset a tracked reference followed slow disturbances, 20.9 deg heading RMSE against
 # 10.1 without, benchmarks/real_recordings.py); the passive filter keeps the corrections it was tuned with.
-NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time")
+NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time",
+                    "correct_at_sample")
 DEFAULT_CORRECTIONS = {
-    "explicit": CORRECTIONS | {"mag_reference_time": 0.0, "mag_new_min_gyro": 0.0,
-                               "mag_norm_tolerance": DEFAULT_MAG_THRESHOLDS["norm_uT"] * 1e-6 / vehicle.EARTH_FIELD_NORM,
-                               "mag_dip_tolerance": math.radians(DEFAULT_MAG_THRESHOLDS["dip_deg"])},
+    "explicit": CORRECTIONS | {
+        "mag_reference_time": 0.0, "mag_new_min_gyro": 0.0,
+        "mag_norm_tolerance": DEFAULT_MAG_THRESHOLDS["norm_uT"] * 1e-6 / vehicle.EARTH_FIELD_NORM,
+        "mag_dip_tolerance": math.radians(DEFAULT_MAG_THRESHOLDS["dip_deg"])},
     "passive": CORRECTIONS | dict.fromkeys(NEW_FOR_EXPLICIT, 0.0),
 }
 OUTPUT_NAMES = tuple(name for name, _ in core.OUTPUT_LAYOUT)
