@@ -149,6 +149,18 @@ PHONES = {"android": (("gyroscope-calibrated", "accelerometer", "magnetometer-ca
           "ios": (("gyroscope", "accelerometer", "magnetometer-calibrated"), -IOS_G, "*_iPhone*_*")}
 
 
+def _boot_time(phone: Path) -> float:
+    """The phone clock's time (s) at the recording's start: ``BootTime`` of its ``description.txt``
+    (the iPhones count from the phone's boot), 0 without one (the Nexus 5 counts from the start)."""
+    description = phone / "description.txt"
+    if description.exists():
+        for line in description.read_text().splitlines():
+            name, _, value = line.partition("=")
+            if name.strip() == "BootTime":
+                return float(value)
+    return 0.0
+
+
 def _phones(folder: Path, platform: str):
     """The recordings of one platform of the smartphone dataset in ``folder`` (its ``android`` or ``ios``
     folder and ``qualisys``), each on a 100 Hz grid, its clock matched to the capture's, aligned."""
@@ -167,8 +179,9 @@ def _phones(folder: Path, platform: str):
         tracked = np.isfinite(rotations).all(axis=(1, 2))
         quat = np.full((len(rotations), 4), np.nan)
         quat[tracked] = alignment._quaternion(Rotation.from_matrix(rotations[tracked]))
-        offset = _clock_offset(gyro, grid, quat_time, quat)
-        data = _aligned(gyro, acc_scale * acc, mag, PHONE_RATE, alignment.resample(quat_time, quat, grid + offset))
+        local = grid - _boot_time(phone)  # s from the recording's start, as the capture's clock counts
+        offset = _clock_offset(gyro, local, quat_time, quat)
+        data = _aligned(gyro, acc_scale * acc, mag, PHONE_RATE, alignment.resample(quat_time, quat, local + offset))
         data["meta"]["clock_offset_s"] = offset
         yield phone.name, data
 
