@@ -65,9 +65,21 @@ SEARCH = {
 
 
 def filter_gains(kind: str, values: dict) -> dict:
-    """The gains ``estimate`` takes for the physical parameter ``values`` (name -> array) of
-    :data:`SEARCH`: the thresholds become ``mag_norm_tolerance`` (relative to the lab's field) and
-    ``mag_dip_tolerance`` (rad)."""
+    """The gains ``estimate`` takes for physical parameter values of :data:`SEARCH`.
+
+    Parameters
+    ----------
+    kind : str
+        The filter (a key of :data:`SEARCH`).
+    values : dict
+        Parameter name -> array of values; the thresholds in uT and degrees.
+
+    Returns
+    -------
+    dict
+        The gains: the thresholds become ``mag_norm_tolerance`` (1, relative to the lab's field)
+        and ``mag_dip_tolerance`` (rad).
+    """
     gains = dict(values)
     if "mag_norm_threshold" in gains:
         gains["mag_norm_tolerance"] = np.asarray(gains.pop("mag_norm_threshold")) / LAB_FIELD_UT
@@ -78,7 +90,15 @@ def filter_gains(kind: str, values: dict) -> dict:
 
 class Scorer:
     """Mean total, heading and inclination RMSE (deg) of gain sets on the development datasets,
-    and their total over VQF's at its defaults."""
+    and their total over VQF's at its defaults.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder of the datasets (see :mod:`benchmarks.datasets`).
+    names : sequence of str
+        The datasets scored; the development ones by default.
+    """
 
     def __init__(self, folder, names=DEVELOPMENT):
         self.recordings = {}
@@ -101,7 +121,15 @@ class Scorer:
         return {m: np.mean([r[m] for r in rows], axis=0) for m in rows[0]}
 
     def ratios(self, kind: str, gains: dict) -> dict:
-        """Dataset -> (G,) mean total RMSE over VQF's (defaults); also keeps the means in ``self.last``."""
+        """Dataset -> (G,) mean total RMSE over VQF's (defaults); also keeps the means in ``self.last``.
+
+        Parameters
+        ----------
+        kind : str
+            The filter.
+        gains : dict
+            Gain name -> (G,) array: G gain sets scored at once.
+        """
         self.last = {name: self.means(kind, name, gains) for name in self.recordings}
         self.evaluated += len(next(iter(gains.values()))) if gains else 1
         return {name: self.last[name]["total_rmse_deg"] / self.vqf[name]["total_rmse_deg"] for name in self.recordings}
@@ -115,7 +143,13 @@ def _sets(gains: dict) -> list[dict]:
 
 
 def score(ratios: dict) -> np.ndarray:
-    """The mean of the worst development dataset's ratio and of the mean ratio, per gain set."""
+    """The mean of the worst development dataset's ratio and of the mean ratio, per gain set.
+
+    Parameters
+    ----------
+    ratios : dict
+        Dataset -> (G,) ratio to VQF, as :meth:`Scorer.ratios` returns.
+    """
     stacked = np.vstack(list(ratios.values()))
     return 0.5 * (np.max(stacked, axis=0) + np.mean(stacked, axis=0))
 
@@ -129,8 +163,24 @@ def _neighbours(point: dict) -> dict:
 
 
 def search(scorer: Scorer, kind: str, start: dict | None = None, log=print) -> dict:
-    """The compass search of the module docstring from ``start`` (default :data:`SEARCH`'s); returns the
-    chosen values, the score there and every gain set scored (``history``)."""
+    """The compass search of the module docstring.
+
+    Parameters
+    ----------
+    scorer : Scorer
+        Scores gain sets on the development datasets.
+    kind : str
+        The filter (a key of :data:`SEARCH`).
+    start : dict, optional
+        The first point; :data:`SEARCH`'s first values by default.
+    log : callable
+        Called with one line per step.
+
+    Returns
+    -------
+    dict
+        The chosen values, the score there and every gain set scored (``history``).
+    """
     point = {name: float(v[0]) for name, v in SEARCH[kind].items()} | (start or {})
     history = []
     while True:
@@ -154,8 +204,22 @@ def search(scorer: Scorer, kind: str, start: dict | None = None, log=print) -> d
 
 
 def sweeps(scorer: Scorer, kind: str, chosen: dict) -> dict:
-    """Each parameter over ``STEP**-SWEEP .. STEP**SWEEP`` times its chosen value, the others held:
-    parameter -> {"values", "ratios" (dataset -> list), "score"}."""
+    """Each parameter over ``STEP**-SWEEP .. STEP**SWEEP`` times its chosen value, the others held.
+
+    Parameters
+    ----------
+    scorer : Scorer
+        Scores gain sets on the development datasets.
+    kind : str
+        The filter.
+    chosen : dict
+        The chosen values, parameter -> value.
+
+    Returns
+    -------
+    dict
+        Parameter -> {"values", "ratios" (dataset -> list), "score"}.
+    """
     out = {}
     for name, value in chosen.items():
         values = value * STEP ** np.arange(-SWEEP, SWEEP + 1, dtype=float)
@@ -167,9 +231,25 @@ def sweeps(scorer: Scorer, kind: str, chosen: dict) -> dict:
 
 
 def figures(kind: str, swept: dict, chosen: dict, folder) -> list[Path]:
-    """One figure per parameter of ``swept`` (:func:`sweeps`): the ratio to VQF of every development
-    dataset and the score against the parameter, the chosen value marked; written as PNG into
-    ``folder``, their paths returned."""
+    """One figure per parameter: the ratio to VQF of every development dataset and the score
+    against the parameter, the chosen value marked.
+
+    Parameters
+    ----------
+    kind : str
+        The filter.
+    swept : dict
+        As :func:`sweeps` returns.
+    chosen : dict
+        The chosen values, parameter -> value.
+    folder : str or pathlib.Path
+        Where the PNG files are written.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The figures written.
+    """
     import matplotlib
     import matplotlib.ticker
 
