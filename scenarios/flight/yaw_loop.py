@@ -117,7 +117,7 @@ def study() -> dict:
     for name, rate, w, flight, settings in CASES:
         case = cases[name] = yaw_loop(rate, w, flight, settings)
         print(f"{name:28s} ringing {case['ringing_nm']:.1e} N m at {case['ring_hz']:.1f} Hz; commands "
-              f"{case['command_min']:.3f}-{case['command_max']:.3f}; motor currents {case['current_min_a']:.2f} to "
+              f"{case['command_min']:.3f} to {case['command_max']:.3f}; motor currents {case['current_min_a']:.2f} to "
               f"{case['current_max_a']:.2f} A", flush=True)
     quiet, bound = largest_quiet(), first_at_bound()
     print(f"at 100 Hz: quiet up to {quiet:.1f} rad/s in hover; commands at a bound in non-stationary flight from "
