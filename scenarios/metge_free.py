@@ -104,7 +104,7 @@ def free_run(o: dict, seed: int) -> RigRun:
 
 def uncompensated_free_deg(settings: dict, seeds=SEEDS) -> list[float]:
     """Mean uncompensated error (deg) of the free set of ``metge`` options ``settings`` on
-    each seed (no calibration needed: the quick findings)."""
+    each of ``seeds`` (``seed1`` values; no calibration needed: the quick findings)."""
     o = SCENARIO.parse(dict(settings))
     out = []
     for seed in seeds:
@@ -124,7 +124,8 @@ def heading_error_deg(field: np.ndarray, reference: np.ndarray) -> np.ndarray:
 
 
 def case_errors(o: dict, cal: Calibration, rig: RigSet, seeds=SEEDS) -> dict:
-    """One case's errors (deg, means over ``seeds``): ``sets_deg`` (set 1's settled rows,
+    """One case's errors (deg, means over ``seeds``, ``seed1`` values), options ``o``, scored
+    with the calibration ``cal`` made on the set ``rig``: ``sets_deg`` (set 1's settled rows,
     uncompensated), ``none_deg`` (and its range over the seeds), ``eq9_deg``, ``dynamic_deg``,
     ``quasi_static_deg`` (the identified steady-state map's field for the same commands),
     ``removed_deg`` (the angle between the raw and the eq. 9-compensated field: what eq. 9

@@ -98,8 +98,10 @@ def paper_regime() -> list[dict]:
                 0)]
 
 
-def _case(name: str, row: dict, fields=("sets", "none", "none_min", "none_max", "quasi_static", "eq9",
-                                        "dynamic")) -> list[dict]:
+CASE_FIELDS = ("none", "none_min", "none_max", "quasi_static", "eq9", "dynamic")  # a case's findings (deg)
+
+
+def _case(name: str, row: dict, fields=CASE_FIELDS) -> list[dict]:
     digits = {"dynamic": 2}
     return [finding(f"metge.free.{name}.{k}_deg", row[f"{k}_deg"], "deg", FREE_SET, DEG, digits.get(k, 1))
             for k in fields if f"{k}_deg" in row]
@@ -129,6 +131,11 @@ def free_set(quick: bool = False) -> list[dict]:
     study, found = metge_free.study(), []
     for name, row in study["cases"].items():
         found += _case(name, row)
+    # the sets, uncompensated: many cases share a plant (and its value), so their range and the default's
+    sets = [row["sets_deg"] for row in study["cases"].values()]
+    found += [finding("metge.free.sets_min_deg", min(sets), "deg", FREE_SET, DEG, 2),
+              finding("metge.free.sets_max_deg", max(sets), "deg", FREE_SET, DEG, 2),
+              finding("metge.free.default.sets_deg", study["cases"]["default"]["sets_deg"], "deg", FREE_SET, DEG, 2)]
     for name in ("default", "common_up", "paper_east"):
         row = study["cases"][name]
         found += [finding(f"metge.free.{name}.sets_heading_deg", row["sets_heading_deg"], "deg", FREE_SET, DEG, 1),
