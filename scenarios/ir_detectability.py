@@ -53,8 +53,8 @@ RAMPED = (("ir", 400.0), ("gps", 0.3))  # count, rad/s
 RAMPS_S = (2.0, 5.0, 10.0, 20.0, 60.0)  # s over which they come in
 Z99 = 2.3263478740408408  # the standard normal's 99 % quantile
 SIZES = {"ir": (20.0, 30.0, 40.0, 50.0, 70.0, 100.0, 150.0), "gps": (0.03, 0.04, 0.05, 0.06, 0.08, 0.1, 0.15)}
-MEASURED = (4_000_000, 4_000_199)  # fresh seeds of the measured limit: 200 flights per size
-SPREAD_SEEDS = (4_100_000, 4_100_049)  # fresh fault-free flights the residual's spread is measured on
+MEASURED = (40_000_000, 40_000_099)  # fresh seeds of the measured limit: 100 flights per size
+SPREAD_SEEDS = (40_100_000, 40_100_049)  # fresh fault-free flights the residual's spread is measured on
 LATE_S = 1.0  # s: an IR offset reaches the paired window the GPS delay later
 T_GRID = np.round(np.arange(0.05, 5.01, 0.05), 2)  # s after the onset
 
@@ -294,7 +294,7 @@ def calibrate(clean=(1, 9000), faults=(1, 300)) -> dict:
     likelihood ratio its attribution saw on the fault-free flights of ``clean``, and the
     smallest largest one in the first 5 s of a GPS +0.1 rad/s and an IR +100 counts offset on
     the flights of ``faults`` (the detector watching, never declaring)."""
-    assert clean[1] <= TUNING[1] and faults[1] <= TUNING[1], "calibrate on tuning seeds only"
+    assert clean[1] <= TUNING[0][1] and faults[1] <= TUNING[0][1], "calibrate on tuning seeds only"
     watching = EKFSettings(significance=math.inf)
     null = max((float(kalman(fly(seed), watching)["run_peak"].max()), seed) for seed in range(clean[0], clean[1] + 1))
     out = {"fault_free_max": null[0], "fault_free_max_seed": null[1], "flights": clean[1] - clean[0] + 1}

@@ -86,6 +86,7 @@ from calibration.infrared.layout import (
     END_MODE,
     END_PAIR,
     END_SIGNIFICANCE,
+    END_TURN,
     END_STAT,
     FAULT_SIZE,
     FREEZE,
@@ -664,7 +665,7 @@ def _end_held(s, c, pair_seen):
     if not pair_seen:
         return
     offset = s[CONS_OFFSET]
-    healthy = 1 if s[GPS_FAULT] > 0.5 else 2  # the turn rate of the sensor not faulty
+    healthy = 0 if c[END_TURN] < 0.5 else (1 if s[GPS_FAULT] > 0.5 else 2)  # 1, 2: the sensor not faulty's
     larger, step, ramp, step_size, ramp_size, step_at, ramp_at = evidence(s, c, -1.0 if offset > 0.0 else 1.0,
                                                                             healthy)
     size, onset = (step_size, step_at) if step >= ramp else (ramp_size, ramp_at)

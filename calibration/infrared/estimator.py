@@ -40,6 +40,7 @@ from calibration.infrared.layout import (
     END_LLR,
     END_MODE,
     END_SIGNIFICANCE,
+    END_TURN,
     FAULT_SIZE,
     FIT_A,
     FIT_B,
@@ -254,6 +255,7 @@ class EKFSettings:
     end: str = "consistency"
     end_significance: float = 15.0
     complete: int = 0
+    end_healthy: bool = False
     decisive: float = math.inf
     alt_level: float = math.inf
     alt_life: int = 4000
@@ -302,6 +304,7 @@ class EKFSettings:
         c[END_MODE], c[RAW_SEEN] = float(self.end == "consistency"), float(self.raw)
         c[ALT_LEVEL], c[ALT_LIFE], c[SD_DRIFT] = self.alt_level, self.alt_life, self.sd_drift
         c[END_SIGNIFICANCE], c[COMPLETE] = self.end_significance, self.complete
+        c[END_TURN] = float(self.end_healthy)
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c

@@ -59,8 +59,9 @@ CUSUM_K, CUSUM_H, NOW_K, NOW_H, END_H, SIZE_GAIN, WINDOW_SPAN = range(10, 17)
 # in the past before a fault is declared on it
 CONS_K, CONS_H, MARGIN, RAMP, HELD_LAG, SCALE_GAIN, SIGNIFICANCE, SD_A_HELD = range(17, 25)
 FREEZE, DECISIVE, TURN_MODE, END_MODE, RAW_SEEN, ALT_LEVEL, ALT_LIFE, SD_DRIFT = range(25, 33)
-END_SIGNIFICANCE, COMPLETE = 33, 34
-EKF_CONFIG_SIZE = 35
+# and whether the end test takes the turn rate of the sensor held healthy (1) or the attribution's (0)
+END_SIGNIFICANCE, COMPLETE, END_TURN = 33, 34, 35
+EKF_CONFIG_SIZE = 36
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 
