@@ -270,7 +270,8 @@ def main(argv=None) -> int:
         last = min(clean[1], clean[0] + ABLATION_CLEAN[1] - ABLATION_CLEAN[0])
         result = ablation(fresh=fresh, clean=(clean[0], last), jobs=args.jobs)
     else:
-        print(f"tuning seeds {', '.join(f'{a}-{b}' for a, b in TUNING)}; fresh seeds {fresh[0]} to {fresh[1]} per fault case, "
+        tuning = ", ".join(f"{a}-{b}" for a, b in TUNING)
+        print(f"tuning seeds {tuning}; fresh seeds {fresh[0]} to {fresh[1]} per fault case, "
               f"{clean[0]} to {clean[1]} fault-free", flush=True)
         result = study(CASES + (LARGER + BELOW if args.larger else ()), fresh=fresh, clean=clean, jobs=args.jobs)
     if args.out:
