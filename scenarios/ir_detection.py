@@ -218,7 +218,8 @@ def clean_line(c: dict, seeds) -> str:
     return (f"fault-free, seeds {seeds[0]} to {seeds[1]}: {c['flights']} flights, {c['hours']:.1f} flight-hours, "
             f"{fa['k']} faults declared = {fa['rate']:.4f} per flight-hour [{fa['low']:.4f}, {fa['high']:.4f}]"
             f" = one per {_hours_per(fa['rate'])} flight-hours"
-            + (f" (seeds {c['flights_with_one']})" if fa["k"] else ""))
+            + (f" (seeds {c['flights_with_one']})" if fa["k"] else "")
+            + f"; left standing at the flight's end {c['standing']['k']}")
 
 
 def _hours_per(rate: float) -> str:
