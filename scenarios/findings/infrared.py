@@ -3,7 +3,8 @@
 ``quadcosim run ir-calibration`` in five cases, ``python -m scenarios.ir_detection --quick``
 (IR +100 counts and GPS +0.1 rad/s over 40 fresh flights each, 200 fresh fault-free flights:
 the quick subset CI re-checks), ``python -m scenarios.ir_detectability --explain`` and
-``--ramps`` (the small faults in the filter's innovations, ramped faults) and ``quadcosim bench
+``--ramps`` (the small faults in the filter's innovations, ramped faults), ``python -m
+scenarios.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
 infrared`` (the operation count; its timings are not findings).
 """
 
@@ -11,12 +12,16 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from scenarios.findings import command, finding
 
 RUN = "quadcosim run ir-calibration"
 DETECTION = "python -m scenarios.ir_detection"
 DETECTABILITY = "python -m scenarios.ir_detectability"
 BENCH = "quadcosim bench infrared"
+SLIDES = "python -m scenarios.ir_slides"
+UNIT = {"ir": "count", "gps": "rad/s"}
 CASES = {"drift": {}, "no_drift": {"drift": False}, "no_gps_resetting": {"gps_resetting": False},
          "faults": {"faults": "both"}, "faults_ungated": {"faults": "both", "gating": False}}
 METHODS = {"kalman": "Kalman", "regression": "regression", "rls": "RLS"}
@@ -122,6 +127,44 @@ def detectability() -> list[dict]:
     return found
 
 
+def limits() -> list[dict]:
+    """The detectability limit: the residual's noise, the predicted smallest offset found in
+    99 % of flights, and per size the measured share declared on the right sensor and the delay
+    within which 99 % were (fresh seeds of :data:`scenarios.ir_detectability.MEASURED`)."""
+    from scenarios import ir_detectability
+
+    result, command = ir_detectability.limits(jobs=2), f"{DETECTABILITY} --jobs 2"
+    f = result["figures"]
+    found = [finding("infrared.limit.sigma_count", f["sigma"], "count", command, 0.05, 2)]
+    for sensor in ("ir", "gps"):
+        p = result["predicted"][sensor]
+        best = int(np.argmin(p["size"]))
+        found += [finding(f"infrared.limit.{sensor}.predicted_size", p["size"][best], UNIT[sensor], command,
+                          0.5 if sensor == "ir" else 0.0005, 1 if sensor == "ir" else 4),
+                  finding(f"infrared.limit.{sensor}.predicted_within_s", p["time_s"][best], "s", command, 0.05, 2)]
+        for key, v in result["measured"][sensor].items():
+            label = f"infrared.limit.{sensor}.{key.replace('.', '_')}"
+            found.append(finding(f"{label}.declared_right_pct", 100 * v["declared_right"], "%", command, 1.0, 1))
+            if math.isfinite(v["t99_s"]):
+                found.append(finding(f"{label}.t99_s", v["t99_s"], "s", command, 0.05, 2))
+    return found
+
+
+def comparison() -> list[dict]:
+    """The slides' Kalman/regression comparison in their terms (bank angle, degrees) and in turn
+    rate, with its ablation, as the mean over the fresh flights of :data:`scenarios.ir_slides.SEEDS`."""
+    from scenarios import ir_slides
+
+    found = []
+    for label, entry in ir_slides.table().items():
+        for unit, r in entry.items():
+            for name, value in r.items():
+                found.append(finding(f"infrared.comparison.{label}.{unit}.{name}", value,
+                                     "1" if name.startswith("ratio") else unit.split("_", 1)[1].replace("_", "/"),
+                                     SLIDES, 0.005, 2))
+    return found
+
+
 def cost() -> list[dict]:
     """Operations per iteration on the fault-free flight (the convention of calibration/infrared/cost.py)."""
     from benchmarks.infrared import measure
@@ -137,4 +180,4 @@ def compute(quick: bool = False) -> list[dict]:
     """Every infrared finding; ``quick``: the small fresh fleets CI re-checks (:func:`detection_quick`)."""
     if quick:
         return detection_quick()
-    return errors() + detection_quick() + detectability() + cost()
+    return errors() + detection_quick() + detectability() + limits() + comparison() + cost()
