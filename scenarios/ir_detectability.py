@@ -71,7 +71,7 @@ def spread(seeds=range(SPREAD_SEEDS[0], SPREAD_SEEDS[1] + 1)) -> dict:
     """The consistency residual on fault-free flights, after 30 s, while its CUSUM is at zero
     (against the calibration ``held_lag`` samples old): ``sigma`` its standard deviation
     (count), ``model`` the filter's model deviation of it (count, the median), ``a`` the median
-    gain (count per rad/s) over the GPS fault's window."""
+    gain (count per rad/s) over the GPS fault's window, over the fault-free flights of ``seeds``."""
     residuals, models, gains = [], [], []
     for seed in seeds:
         flight = fly(seed)
@@ -90,7 +90,8 @@ def energy(sensor: str, t: float, settings: EKFSettings | None = None, sigma: fl
     its onset, left after the fit of a constant and a drift (the drift's rate with the prior
     ``sd_drift``, against the noise ``sigma``, count). The GPS's is a step; the IR's a ramp over
     the GPS window, reaching the residual :data:`LATE_S` later. Zero once the onset has left the
-    ring (the reference has absorbed it)."""
+    ring (the reference has absorbed it). ``sensor`` is ``"ir"`` or ``"gps"``; ``settings`` the
+    filter's (:class:`EKFSettings`, its defaults when None)."""
     settings = settings or EKFSettings()
     window = int(RATE * 1.0)
     inside = t - (LATE_S if sensor == "ir" else 0.0)
@@ -175,7 +176,9 @@ def measured(sensor: str, sizes=None, seeds=range(MEASURED[0], MEASURED[1] + 1),
 def figure(out, prediction: dict, measurement: dict, figures: dict):
     """``detectability.png``: per sensor, the predicted smallest offset found in 99 % of flights
     within ``T`` s (likelihood ratio, CUSUM floor) against the measured delays by which 99 % of
-    the fleets of each size were found; returns its path."""
+    the fleets of each size were found; returns its path. ``out`` is the folder, ``prediction``
+    and ``measurement`` the per-sensor tables of :func:`limits` (``predicted``, ``measured``),
+    ``figures`` the residual's figures of :func:`spread`."""
     import matplotlib.pyplot as plt
 
     from scenarios.plant import save_figure
@@ -214,7 +217,8 @@ def figure(out, prediction: dict, measurement: dict, figures: dict):
 
 
 def limits(jobs: int = 1) -> dict:
-    """The predicted and measured limits of both sensors, and the residual's figures."""
+    """The predicted and measured limits of both sensors, and the residual's figures; the fleets
+    flown on ``jobs`` processes."""
     figures = spread()
     return {"figures": figures, "predicted": {s: predicted(s, figures=figures) for s in ("ir", "gps")},
             "measured": {s: measured(s, jobs=jobs) for s in ("ir", "gps")}}
@@ -222,7 +226,7 @@ def limits(jobs: int = 1) -> dict:
 
 def explain(seed: int = 1) -> dict:
     """Why the filter's own innovations miss small offsets, on one flight, from the difference
-    with the same flight without the fault (same noise).
+    with the same flight without the fault (same noise), flown with ``seed``.
 
     Returns
     -------
@@ -262,7 +266,8 @@ def _normalised(estimate: dict, nu: str, S: str) -> np.ndarray:
 
 def ramped(sensor: str, size: float, ramp_s: float, seed: int = 1) -> dict:
     """A fault that comes in linearly over ``ramp_s`` from the slides' onset, stays for the
-    slides' 2000 samples, then goes at once.
+    slides' 2000 samples, then goes at once: an offset of ``size`` (count for the IR, rad/s for
+    the GPS) on ``sensor`` (``"ir"`` or ``"gps"``), on the flight of ``seed``.
 
     Returns
     -------

@@ -96,7 +96,8 @@ def outcome(estimate: dict, time: np.ndarray, sensor: str, size: float) -> dict:
     """What the filter declared on one flight (see the module): for a fault-free flight
     (``sensor`` ``"none"``) the ``declarations``; else ``declared``, ``right``, ``delay_s``,
     ``ended_early``, ``standing``, ``cleared_s`` (``inf`` when left standing), ``at_end`` and
-    ``other`` declarations."""
+    ``other`` declarations. ``estimate`` is the filter's output (:func:`kalman`), ``time`` its
+    sample times (s), ``size`` the offset (count for the IR, rad/s for the GPS)."""
     runs = {name: episodes(estimate[f"{name}_fault"], time) for name in ("ir", "gps")}
     standing = any(estimate[f"{name}_fault"][-1] > 0.5 for name in runs)
     if sensor == "none":
@@ -158,7 +159,8 @@ def per_hour(k: int, hours: float) -> dict:
 
 
 def summary(rows: list[dict], sensor: str) -> dict:
-    """The rates of a fleet (:func:`fleet`) with their 95 % intervals."""
+    """The rates of a fleet's ``rows`` (:func:`fleet`) with their 95 % intervals; ``sensor`` is
+    the faulty one (``"ir"``, ``"gps"``) or ``"none"`` for fault-free flights."""
     n = len(rows)
     hours = n * SAMPLES / RATE / 3600.0
     if sensor == "none":
@@ -185,7 +187,8 @@ def study(cases=CASES, fresh=FRESH, clean=FRESH_CLEAN, overrides: dict | None = 
           echo: bool = True) -> dict:
     """The detection table: :func:`summary` of each fault case over the seeds ``fresh``
     (first, last) and of the fault-free flights over ``clean``, the filter's settings changed by
-    ``overrides``."""
+    ``overrides``, for each ``(sensor, size)`` of ``cases``; the fleets flown on ``jobs``
+    processes, each line printed as it comes when ``echo``."""
     out = {"cases": {}}
     for sensor, size in cases:
         out["cases"][f"{sensor}_{size:g}"] = s = summary(fleet(sensor, size, range(fresh[0], fresh[1] + 1),
@@ -203,7 +206,7 @@ def _rate(p: dict) -> str:
 
 
 def case_line(sensor: str, size: float, s: dict) -> str:
-    """One case of the table, as printed."""
+    """One case of the table, as printed: the summary ``s`` of the offset ``size`` on ``sensor``."""
     d, c = s["delay_s"], s["cleared_s"]
     return (f"{sensor} +{size:g} {UNITS[sensor]}: declared {_rate(s['declared'])}; on the right sensor "
             f"{_rate(s['right'])}; delay p50 {d['p50']:.2f} p90 {d['p90']:.2f} p99 {d['p99']:.2f} s; ended early "
@@ -213,7 +216,7 @@ def case_line(sensor: str, size: float, s: dict) -> str:
 
 
 def clean_line(c: dict, seeds) -> str:
-    """The fault-free flights, as printed."""
+    """The fault-free flights' summary ``c`` over the seeds ``seeds`` (first, last), as printed."""
     fa = c["false_alarms"]
     return (f"fault-free, seeds {seeds[0]} to {seeds[1]}: {c['flights']} flights, {c['hours']:.1f} flight-hours, "
             f"{fa['k']} faults declared = {fa['rate']:.4f} per flight-hour [{fa['low']:.4f}, {fa['high']:.4f}]"
@@ -229,7 +232,8 @@ def _hours_per(rate: float) -> str:
 def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=FRESH, clean=ABLATION_CLEAN, jobs: int = 1,
              echo: bool = True) -> dict:
     """Each design choice undone alone (:data:`ABLATIONS`), on the fresh fleets of ``cases``
-    and the fault-free flights of ``clean``: label -> :func:`study`."""
+    and the fault-free flights of ``clean``: label -> :func:`study`. ``variants`` maps a label to
+    the settings it overrides; ``jobs`` and ``echo`` as for :func:`study`."""
     out = {}
     for label, overrides in variants.items():
         if echo:
@@ -284,13 +288,14 @@ def main(argv=None) -> int:
 
 def quick(echo: bool = False) -> dict:
     """The small fresh set CI re-checks (:data:`QUICK`): IR +100 counts and GPS +0.1 rad/s over
-    40 seeds each, and 200 fault-free flights."""
+    40 seeds each, and 200 fault-free flights; printed as they come when ``echo``."""
     return study((("ir", 100.0), ("gps", 0.1)), QUICK["faults"], QUICK["clean"], echo=echo)
 
 
 def one_fault(sensor: str, size: float, seed: int = 1, settings: EKFSettings | None = None) -> dict:
     """The declaration of one fault of ``size`` on ``sensor`` in the flight of ``seed``
-    (:func:`outcome`, and the ``turn_rate_error_std_deg_s`` after 30 s)."""
+    (:func:`outcome`, and the ``turn_rate_error_std_deg_s`` after 30 s), under the filter's
+    ``settings`` (:class:`EKFSettings`, its defaults when None)."""
     flight = fly(seed, sensor, size)
     estimate = kalman(flight, settings)
     settled = flight["time"] >= 30.0

@@ -83,7 +83,8 @@ def _cloud(p: dict, t: np.ndarray) -> np.ndarray:
 
 
 def calibration(p: dict, t: np.ndarray, drift: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """True ``a`` (count per rad/s) and ``b`` (count) at ``t`` (s), the FMU's ``calibration``."""
+    """True ``a`` (count per rad/s) and ``b`` (count) at ``t`` (s), the FMU's ``calibration``, for
+    the FMU's parameters ``p``; constant at their initial values when ``drift`` is False."""
     if not drift:
         return np.full_like(t, p["ir_gain"]), np.full_like(t, p["ir_offset"])
     wave = np.sin(2.0 * np.pi * t / p["temperature_period"])

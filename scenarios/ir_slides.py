@@ -58,7 +58,8 @@ def errors(flight: dict, estimate: dict, reference: str = "truth") -> dict:
     """Standard deviations of an estimate's error, after the first 2 s: ``bank_deg`` (the bank
     angle of the estimated present turn rate, degrees) and ``rate_deg_s`` (the turn rate,
     degrees per second), against the ``reference``: ``"truth"``, or ``"gps"`` (the GPS turn rate
-    against the estimate at its window's middle, 1.5 s earlier)."""
+    against the estimate at its window's middle, 1.5 s earlier). ``flight`` is the simulated
+    flight, ``estimate`` an estimator's output on it."""
     from scenarios.ir_fleet import parameters
 
     p = parameters()
@@ -77,7 +78,9 @@ def errors(flight: dict, estimate: dict, reference: str = "truth") -> dict:
 
 def compare(seed: int = 1, reference: str = "truth", drift_scale: float = 1.0, primed: bool = True) -> dict:
     """The Kalman filter with and without GPS resetting, and the regression, on the flight of
-    ``seed``: :func:`errors` of each (``kalman_resetting``, ``kalman_real``, ``regression``)."""
+    ``seed``: :func:`errors` of each (``kalman_resetting``, ``kalman_real``, ``regression``)
+    against ``reference``; the IR's drift scaled by ``drift_scale``; the regression started from
+    the slides' line when ``primed``, else from its first two pairs."""
     flight = _flight(seed, drift_scale)
     valid = flight["gps_valid"] > 0.5
     regression = RegressionSettings() if primed else RegressionSettings(min_samples=2, min_spread=1e-9)

@@ -218,6 +218,15 @@ class EKFSettings:
         while its CUSUM is zero (1 / samples): the spread the attribution scales by.
     end_h : float
         Threshold of the log-likelihood ratio that ends a fault.
+    end_significance : float
+        Log-likelihood the step back of the consistency residual must reach before a fault
+        ends (``end="consistency"``), as ``significance`` for its start.
+    complete : int
+        Samples of the offset's shape the attribution ring must hold past its onset before a
+        fault is declared (0: as soon as the signatures part).
+    end_healthy : bool
+        Fit the end's turn-rate term with the sensor not at fault (the ``"healthy"`` reading of
+        ``turn``) rather than the smoothed GPS turn rate.
     size_gain : float
         Weight per sample of the running estimate of a declared fault's offset (1 / samples).
     form : str

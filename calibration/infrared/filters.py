@@ -112,7 +112,8 @@ def pair_at(buffer, k, delay, window):
 @njit(cache=True)
 def raw_pair(buffer, delay, window):
     """The mean IR over the GPS window of the last :func:`pair_at`, suspect samples included
-    (count); ``nan`` before the window is filled."""
+    (count); ``nan`` before the window is filled. ``buffer`` is the pairing buffer of
+    :func:`push`, ``delay`` and ``window`` the GPS delay and averaging window (samples)."""
     return buffer[2 * (delay + window + 2) + 2]
 
 
