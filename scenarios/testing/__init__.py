@@ -67,7 +67,8 @@ def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
     if report.failed and _SEED in item.stash:
-        lines = [f"seed {item.stash[_SEED]} (from the node id {item.nodeid}; a rerun of this test uses it again)"]
+        lines = [f"test seed {item.stash[_SEED]}, from the node id {item.nodeid} (the same on a rerun), given to "
+                 "every run that sets no seed of its own"]
         lines += [f"run: {text}" for text in item.stash.get(_RUNS, [])]
         report.sections.append(("quadcosim", "\n".join(lines)))
 
