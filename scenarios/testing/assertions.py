@@ -12,7 +12,7 @@ its value and the bound, and the seed of the run, so that the failure can be run
 - :func:`assert_bounds`: a signal within its bounds;
 - :func:`assert_runs_close`: two runs agreeing signal by signal within a tolerance.
 
-The errors they compute are those of the scenarios' metrics (:func:`scenarios.tp.errors`,
+The errors they compute are those of the scenarios' metrics (:func:`scenarios.tp.euler_error`,
 :func:`scenarios.tp.bias_convergence_time`), so that a test and a ``metrics.json`` measure the
 same thing.
 """
@@ -86,7 +86,7 @@ def _worst(excess: np.ndarray, mask: np.ndarray) -> int:
 def attitude_errors_deg(result) -> np.ndarray:
     """Estimation error of every sample (deg; columns roll, pitch, yaw, wrapped to +-180): the
     estimate ``Quaternion_estim.theta_est`` minus the truth ``Quadrotor.theta``, as tp's metrics
-    compute it (:func:`scenarios.tp.errors`).
+    compute it (:func:`scenarios.tp.euler_error`).
 
     Parameters
     ----------
@@ -97,10 +97,9 @@ def attitude_errors_deg(result) -> np.ndarray:
     -------
     numpy.ndarray, shape (len(result), 3)
     """
-    from scenarios.tp import errors
+    from scenarios.tp import euler_error
 
-    estimation, _ = errors(result)
-    return np.degrees(estimation)
+    return np.degrees(np.column_stack([euler_error(result, "Quaternion_estim.theta_est", k) for k in range(3)]))
 
 
 def assert_attitude_error(result, below_deg: float, after_s: float = 0.0, axes=AXES) -> float:
@@ -376,7 +375,7 @@ def assert_bounds(result, signal, lower: float | None = None, upper: float | Non
     table = values.reshape(len(result), -1)
     mask = _after(result, after_s)
     checked = table[mask]
-    components = result.columns(name) if isinstance(signal, str) else [f"{name}[{j}]" for j in range(table.shape[1])]
+    components = result.columns(name) if isinstance(signal, str) else [name]
     if len(components) != table.shape[1]:
         components = [f"{name}[{j}]" for j in range(table.shape[1])]
     unit = _unit(result, components[0] if isinstance(signal, str) else signal)
