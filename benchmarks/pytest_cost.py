@@ -112,7 +112,8 @@ def report(figures: dict) -> str:
         f"{figures['tests']} tests, each tp for {figures['simulated_s_per_test']:g} s of simulated time, "
         "in one pytest session (fixture run_scenario, FMU instances pooled)",
         f"first test:           {figures['first_test_s']:.3f} s wall (stepping {figures['first_stepping_s']:.3f} s)",
-        f"each test after it:   {figures['per_test_s']:.3f} s wall, median (largest {figures['per_test_max_s']:.3f} s); "
+        f"each test after it:   {figures['per_test_s']:.3f} s wall, median "
+        f"(largest {figures['per_test_max_s']:.3f} s); "
         f"target <= {figures['target_s']:g} s: {'met' if figures['passed'] else 'NOT met'}",
         f"  stepping alone:     {figures['stepping_s']:.3f} s",
         f"  the rest:           {figures['overhead_s']:.3f} s (building, FMU reset, metrics, pytest)",

@@ -334,7 +334,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
                         "injected_faults": [fault_record(f) for f in faults], "decimation": decimation}
                 files = RunFiles(out, formats, base, {}, compress) if out is not None else None
             with (files.tracking() if files else contextlib.nullcontext()):
-                return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream, blocks), progress)
+                return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream, blocks),
+                                    progress)
         except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
                 raise

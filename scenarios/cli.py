@@ -269,7 +269,8 @@ def parser() -> argparse.ArgumentParser:
     diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
     diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
     diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, pytest plugin")
+    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
+                                         "pytest plugin")
     bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"))
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)

@@ -294,11 +294,13 @@ def assert_step(result, signal, step_s: float, final: float | None = None, settl
     name = signal if isinstance(signal, str) else signal[0]
     unit = _unit(result, signal)
     step = step_response(result, signal, step_s, final, band)
-    low, high = sorted((step.final - band * abs(step.final - step.initial), step.final + band * abs(step.final - step.initial)))
+    half = band * abs(step.final - step.initial)
+    low, high = step.final - half, step.final + half
     if settles_within_s is not None and not step.settling_time_s <= settles_within_s:
         _fail(f"step of {name} at {step_s:g} s: settles in {step.settling_time_s:.4g} s, beyond the bound "
-              f"{settles_within_s:g} s; the last sample outside the {100 * band:g} % band [{low:.6g}, {high:.6g}]{unit} "
-              f"is {step.last_outside_value:.6g}{unit} at t = {step.last_outside_time_s:.4f} s", result)
+              f"{settles_within_s:g} s; the last sample outside the {100 * band:g} % band "
+              f"[{low:.6g}, {high:.6g}]{unit} is {step.last_outside_value:.6g}{unit} at t = "
+              f"{step.last_outside_time_s:.4f} s", result)
     if overshoot_below_percent is not None and step.overshoot_percent > overshoot_below_percent:
         _fail(f"step of {name} at {step_s:g} s from {step.initial:.6g} to {step.final:.6g}{unit}: overshoot "
               f"{step.overshoot_percent:.4g} %, above the bound {overshoot_below_percent:g} %; peak "
