@@ -60,13 +60,26 @@ def seed_of(nodeid: str) -> int:
 
 def pytest_configure(config):
     """Register the marker ``slow`` (a long simulated horizon), so that ``-m "not slow"`` and
-    ``--strict-markers`` know it."""
+    ``--strict-markers`` know it.
+
+    Parameters
+    ----------
+    config : pytest.Config
+    """
     config.addinivalue_line("markers", "slow: a long simulated horizon; deselect with -m 'not slow'")
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
-    """Add a ``quadcosim`` section to a failing test's report: its seed and every run it made."""
+    """Add a ``quadcosim`` section to a failing test's report: its seed and every run it made.
+
+    Parameters
+    ----------
+    item : pytest.Item
+        The test.
+    call : pytest.CallInfo
+        The phase (set-up, call, tear-down) just run.
+    """
     outcome = yield
     report = outcome.get_result()
     if report.failed and _SEED in item.stash:
