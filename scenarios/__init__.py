@@ -257,7 +257,7 @@ def get(name: str) -> Scenario:
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
         record=None, formats=("npz",), overwrite: bool = False, estimator=None, compress: bool = False,
-        stream: bool = False):
+        stream: bool = False, blocks=None):
     """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
 
     Parameters
@@ -292,6 +292,9 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         Write the record to ``results.stream/`` in chunks as the run goes, so that its memory
         stays flat however long the run (:mod:`orchestrator.stream`); needs ``out_dir`` and
         the ``npz`` format alone.
+    blocks : dict, optional
+        Blocks of the user's in the place of the scenario's, by name (``{"Controller":
+        MyController()}``), each wired as the block it replaces (:meth:`orchestrator.System.replace`).
 
     Returns
     -------
@@ -331,7 +334,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
                         "injected_faults": [fault_record(f) for f in faults], "decimation": decimation}
                 files = RunFiles(out, formats, base, {}, compress) if out is not None else None
             with (files.tracking() if files else contextlib.nullcontext()):
-                return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream), progress)
+                return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream, blocks),
+                                    progress)
         except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
                 raise
@@ -373,13 +377,15 @@ def _check_formats(formats, stream: bool, out_dir):
 
 def _run_phases(scenario, options, base, files, given, progress):
     """Build, draw, run, save and report, each phase named in ``files`` for ``metrics.json``;
-    ``given`` holds the faults, the user's estimator, the signals to record and ``stream``."""
+    ``given`` holds the faults, the user's estimator, the signals to record, ``stream`` and the
+    user's blocks."""
     from orchestrator import SimulationError
     from orchestrator.progress import status
     from scenarios.metrics import metric_units
 
-    name, (faults, estimator, record, stream) = scenario.name, given
-    system, duration, kept, saved = _build(scenario, options, base, files, faults, estimator, stream, record)
+    name, (faults, estimator, record, stream, blocks) = scenario.name, given
+    system, duration, kept, saved = _build(scenario, options, base, files, (faults, estimator, blocks), stream,
+                                           record)
     if files:
         files.phase, files.stream = "running", _open_stream(files, stream)
     status(f"{name}: starting {duration:g} s of simulated time ({len(system.blocks)} blocks)")
@@ -435,16 +441,20 @@ def _open_stream(files, stream: bool):
     return StreamWriter(files.out / FOLDER)
 
 
-def _build(scenario, options, base, files, faults, estimator, stream, record):
+def _build(scenario, options, base, files, users, stream, record):
     """The system, its duration (s), the signals recorded and those written (``base`` takes
-    the options as used and the duration); a refusal removes what this run wrote."""
+    the options as used and the duration); ``users`` holds the faults, the user's estimator and
+    blocks. A refusal removes what this run wrote."""
     from orchestrator.progress import status
 
+    faults, estimator, blocks = users
     if files:
         files.phase = "building the system"
     status(f"{scenario.name}: building the system")
     try:
         system = scenario.system(options, estimator=estimator)
+        for block_name, block in (blocks or {}).items():
+            system.replace(block_name, block)
         for fault in faults:
             system.inject(fault)
         duration = scenario.duration(options) if scenario.duration else options["duration"]

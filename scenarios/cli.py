@@ -10,6 +10,7 @@
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
+  quadcosim bench pytest [--json]          cost of a short test written with the pytest plugin
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
@@ -239,6 +240,10 @@ def _bench(args) -> int:
         from benchmarks import sweep
 
         return sweep.main(["--json"] if args.json else [])
+    if args.suite == "pytest":
+        from benchmarks import pytest_cost
+
+        return pytest_cost.main(["--json"] if args.json else [])
     from benchmarks import master as bench
 
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
@@ -264,8 +269,9 @@ def parser() -> argparse.ArgumentParser:
     diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
     diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
     diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))
+    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
+                                         "pytest plugin")
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"))
     bench.add_argument("--json", action="store_true")
     bench.add_argument("--seconds", type=float, default=5.0)
     bench.set_defaults(func=_bench)
