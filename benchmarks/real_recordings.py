@@ -34,6 +34,7 @@ import numpy as np
 
 from benchmarks import datasets
 from estimators import DEFAULT_GAINS, estimate, gain_grid
+from orchestrator.files import write_text
 from scenarios.replay import field_from_data, references
 
 CHOOSING = ("broad", "smartphones", "diodem")  # the datasets the defaults were chosen on
@@ -78,7 +79,7 @@ def _published(name: str, recordings: list, cache: Path | None) -> dict:
         print(name, label, {k: round(v["total_rmse_deg"], 2) for k, v in table[label].items()}, file=sys.stderr)
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(table, indent=1) + "\n")
+        write_text(path, json.dumps(table, indent=1) + "\n")
     return table
 
 
@@ -218,7 +219,7 @@ def main(argv=None) -> int:
         report["choice"] = choose(results)
         print(json.dumps(report["choice"], indent=1))
     if args.json:
-        Path(args.json).write_text(json.dumps(report, indent=1) + "\n")
+        write_text(args.json, json.dumps(report, indent=1) + "\n")
     return 0
 
 

@@ -167,7 +167,7 @@ def _run_reporting(args) -> int:
             print(f"what was recorded up to the failure ({len(error.result)} samples) is in {out}/", file=sys.stderr)
         return 1
     except (KeyError, ValueError) as error:
-        print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
+        print(f"quadcosim run {args.scenario}: {_said(error)}", file=sys.stderr)
         return 2
     except OSError as error:  # the output folder failed under the run (removed, read-only, a disk error)
         print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)
@@ -180,7 +180,18 @@ def _run_reporting(args) -> int:
         print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
+    if metrics.get("status") == "diverged":  # warned above, naming the settings
+        print(f"quadcosim run {args.scenario}: the run diverged (metrics.json: status diverged); its record and "
+              f"figures are in {out}/", file=sys.stderr)
+        return 1
     return 0
+
+
+def _said(error: Exception) -> str:
+    """The message of a refusal: its text (a KeyError's own, without the quotes its str adds)."""
+    if isinstance(error, KeyError) and error.args and isinstance(error.args[0], str):
+        return error.args[0]
+    return str(error)
 
 
 def _default_out(scenario: str, overwrite: bool) -> Path:

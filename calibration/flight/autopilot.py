@@ -94,19 +94,23 @@ def apply_px4(params: dict, compass: int, raw, x) -> np.ndarray:
 
 
 def write_ardupilot(params: dict, path) -> None:
-    """``params`` as an ArduPilot parameter file (``NAME,VALUE`` lines, as Mission Planner loads) at ``path``."""
-    with open(path, "w") as file:
-        for name, value in params.items():
-            file.write(f"{name},{value:.9g}\n")
+    """``params`` as an ArduPilot parameter file (``NAME,VALUE`` lines, as Mission Planner loads) at
+    ``path``, written atomically (:func:`orchestrator.files.atomic_path`)."""
+    from orchestrator.files import write_text
+
+    write_text(path, "".join(f"{name},{value:.9g}\n" for name, value in params.items()))
 
 
 def write_px4(params: dict, path) -> None:
-    """``params`` as a QGroundControl parameter file for PX4 (tab-separated, vehicle 1) at ``path``."""
-    with open(path, "w") as file:
-        file.write("# Vehicle-Id Component-Id Name Value Type\n")
-        for name, value in params.items():
-            kind = 6 if isinstance(value, int) else 9  # MAV_PARAM_TYPE_INT32, REAL32
-            file.write(f"1\t1\t{name}\t{value:.9g}\t{kind}\n")
+    """``params`` as a QGroundControl parameter file for PX4 (tab-separated, vehicle 1) at ``path``,
+    written atomically (:func:`orchestrator.files.atomic_path`)."""
+    from orchestrator.files import write_text
+
+    lines = ["# Vehicle-Id Component-Id Name Value Type\n"]
+    for name, value in params.items():
+        kind = 6 if isinstance(value, int) else 9  # MAV_PARAM_TYPE_INT32, REAL32
+        lines.append(f"1\t1\t{name}\t{value:.9g}\t{kind}\n")
+    write_text(path, "".join(lines))
 
 
 def read_parameters(path) -> dict:

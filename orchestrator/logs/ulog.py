@@ -27,6 +27,7 @@ from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, 
 
 GAUSS = 1e-4  # T
 MICRO = 1e-6
+MIN_SCALE = 1e-6  # a CAL_MAGn_*SCALE this small (1) cannot be undone
 INVALID_RELATIVE = 2147483647  # sensor_combined: no new sample of this sensor
 MAV_TYPE_MOTORS = {2: 4, 13: 6, 14: 8, 15: 3}
 MAV_TYPE_NAMES = {1: "fixed wing", 2: "quadrotor", 13: "hexarotor", 14: "octorotor", 15: "tricopter",
@@ -48,8 +49,10 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         k = d.multi_id
         offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
         scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
+        unusable = _singular(scale, k)
         out.append(Compass(f"sensor_mag[{k}]", d.data["timestamp"] * MICRO, (raw - offsets) * scale, raw, offsets,
-                           None, "sensor_mag (logged before calibration)", np.diag(1.0 / scale)))
+                           None, "sensor_mag (logged before calibration)",
+                           np.full((3, 3), np.nan) if unusable else np.diag(1.0 / scale), unusable))
     if out:
         return out
     calibrated = _topics(ulog, "vehicle_magnetometer")
@@ -71,8 +74,23 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
         field = field * GAUSS
         undone = f"{name} with CAL_MAG{k}_*OFF and *SCALE undone (no raw topic logged)"
-        out.append(Compass(name, time, field, field / scale + offsets, offsets, None, undone, np.diag(1.0 / scale)))
+        unusable = _singular(scale, k)
+        if unusable:
+            out.append(Compass(name, time, field, np.full_like(field, np.nan), offsets, None, undone,
+                               np.full((3, 3), np.nan), unusable))
+        else:
+            out.append(Compass(name, time, field, field / scale + offsets, offsets, None, undone,
+                               np.diag(1.0 / scale)))
     return out
+
+
+def _singular(scale: np.ndarray, k: int) -> str:
+    """Why the scale factors ``CAL_MAGk_*SCALE`` cannot be undone (empty when they can)."""
+    if np.all(np.isfinite(scale)) and np.all(np.abs(scale) > MIN_SCALE):
+        return ""
+    named = ", ".join(f"CAL_MAG{k}_{a}SCALE = {v:g}" for a, v in zip("XYZ", scale, strict=True))
+    return (f"its scale factors make a singular correction ({named}): the field before PX4's calibration cannot "
+            "be recovered from this log (a scale of 1 is no correction)")
 
 
 def _imus(ulog) -> list[Imu]:
@@ -139,11 +157,15 @@ def read_ulog(path: Path) -> FlightLog:
     """Read the PX4 ULog at ``path``."""
     from pyulog import ULog
 
-    try:
-        ulog = ULog(str(path))
-    except Exception as error:  # pyulog raises bare exceptions on a bad header or definitions
-        raise LogError(f"{path}: not a readable ULog ({type(error).__name__}: {error}); check the file is a "
-                       "complete PX4 .ulg") from None
+    from orchestrator.interrupts import surfaced
+    from orchestrator.logs.noise import captured
+
+    with surfaced(), captured() as noise:  # pyulog prints its warnings on standard output
+        try:
+            ulog = ULog(str(path))
+        except Exception as error:  # pyulog raises bare exceptions on a bad header or definitions
+            raise LogError(f"{path}: not a readable ULog ({type(error).__name__}: {error}); check the file is a "
+                           "complete PX4 .ulg") from None
     if not ulog.data_list:
         raise LogError(f"{path}: the ULog holds no logged topic; it is truncated before its data")
     params = dict(ulog.initial_parameters)
@@ -152,6 +174,8 @@ def read_ulog(path: Path) -> FlightLog:
     firmware = f"{info.get('ver_sw_release', info.get('ver_sw', 'version not logged'))} on {hardware}"
     simulator = "SITL" in hardware.upper() or hardware.upper().startswith("PX4_SITL") or "SIH" in hardware.upper()
     vehicle = MAV_TYPE_NAMES.get(int(params.get("MAV_TYPE", 0)), f"MAV_TYPE {params.get('MAV_TYPE', '?')}")
-    warnings = ["corrupt stretches skipped (pyulog reports file corruption)"] if ulog.file_corruption else []
+    said = noise.summary("pyulog")
+    warnings = [f"corrupt stretches skipped: {said or 'pyulog reports file corruption'}"] \
+        if ulog.file_corruption or said else []
     return FlightLog(str(path), "ulog", "PX4", firmware, vehicle, simulator, _compasses(ulog, params), _imus(ulog),
                      _motors(ulog, params, path), _battery(ulog), _attitude(ulog), params, warnings)

@@ -86,9 +86,18 @@ def verify_commands(committed: dict, groups, timeout, matching: str = "") -> int
     return 1 if any(r.status in ("missing", "failed") for r in results) else 0
 
 
+def checkout(root: Path) -> bool:
+    """Whether ``root`` (the package's parent folder) is a source checkout: its ``pyproject.toml``,
+    ``README.md`` and ``docs/`` beside the package, as the findings rewrite them. An installed
+    copy (site-packages) has none of them."""
+    return all((root / name).exists() for name in ("pyproject.toml", "README.md", "docs"))
+
+
 def main(argv=None) -> int:
-    """Run the findings; returns the exit code (2: a bad command line, 1: ``--check`` found a
-    difference or the README could not be rewritten).
+    """Run the findings; returns the exit code (2: a bad command line, or a copy that is not a
+    source checkout (:func:`checkout`: nothing is written into an installed package); 1:
+    ``--check`` found a difference or checked nothing (every group skipped), or the README could
+    not be rewritten).
 
     Parameters
     ----------
@@ -101,6 +110,12 @@ def main(argv=None) -> int:
         print(f"quadcosim findings: unknown group {', '.join(unknown)}; groups: {', '.join(findings.GROUPS)}",
               file=sys.stderr)
         return 2
+    if not checkout(findings.ROOT):
+        print(f"quadcosim findings: a maintainer's tool, run from a source checkout: it measures the README's "
+              f"numbers into findings.json and rewrites the README and docs/ beside it. This copy of quadcosim is "
+              f"installed in {findings.ROOT} (no pyproject.toml, README.md and docs/ there) and is not written "
+              "into; clone the repository and run it there", file=sys.stderr)
+        return 2
     committed = findings.load(args.out)
     if args.verify_commands:
         return verify_commands(committed, args.groups or None, args.timeout, args.matching)
@@ -109,10 +124,15 @@ def main(argv=None) -> int:
         kept = [n for n, f in committed.items() if f["group"] == group]
         print(f"{group}: skipped ({reason}); its {len(kept)} committed values are kept", file=sys.stderr)
     if args.check:
+        if not computed:
+            print(f"quadcosim findings --check: nothing was checked: every group asked for was skipped "
+                  f"({', '.join(skipped)}); give their data (see each reason above) to check them", file=sys.stderr)
+            return 1
         lines = findings.differences(computed, committed)
         for line in lines:
             print(line, file=sys.stderr)
-        print(f"{len(computed)} findings computed, {len(lines)} differences from {args.out}")
+        unchecked = f"; {len(skipped)} groups skipped, not checked ({', '.join(skipped)})" if skipped else ""
+        print(f"{len(computed)} findings computed, {len(lines)} differences from {args.out}{unchecked}")
         return 1 if lines else 0
     new = committed | {f["name"]: f for f in computed}
     findings.save(new, args.out)

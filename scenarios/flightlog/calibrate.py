@@ -46,35 +46,58 @@ def exported_model(fitted: dict) -> str | None:
 
 
 def _write(out: Path, train, test, metrics, calibration, fitted, compass: int) -> list[str]:
+    """Every output file, ``metrics.json`` last (in the room kept for it: a disk that fills on the
+    way still takes it, listing what was not written); the files written."""
     from calibration.flight import autopilot
-    from orchestrator.files import write_json
+    from orchestrator.files import DiskFull, Reserve, write_json
     from scenarios.flightlog.calibration_figures import heading_figure, residual_figure
+
+    reserve = Reserve(out)  # DiskFull when not even metrics.json fits: nothing is written
+    files, not_written = ["metrics.json"], {}
+
+    def keep(name, write):
+        try:
+            write(out / name)
+            files.append(name)
+        except DiskFull as error:
+            not_written[name] = str(error)
+        except Exception as error:  # a figure that could not be drawn: said in metrics.json, the rest kept
+            not_written[name] = f"{type(error).__name__}: {error}"
 
     model = exported_model(fitted)
     K = None if model is None else fitted[model].extra["K"][0]
     ardupilot = autopilot.ardupilot_parameters(compass, calibration.static, model, K)
     px4 = autopilot.px4_parameters(compass, calibration.static, model, K)
-    autopilot.write_ardupilot(ardupilot, out / PARAMETER_FILES[0])
-    autopilot.write_px4(px4, out / PARAMETER_FILES[1])
-    calibration.save(out / "calibration.json")
-    files = ["metrics.json", "calibration.json", *PARAMETER_FILES]
+    keep(PARAMETER_FILES[0], lambda path: autopilot.write_ardupilot(ardupilot, path))
+    keep(PARAMETER_FILES[1], lambda path: autopilot.write_px4(px4, path))
+    keep("calibration.json", calibration.save)
     metrics["exported_model"] = model
     if model is not None:
         name = Path(train[0].source).name
-        residual_figure(test, fitted[model], model, out / FIGURES[0],
-                        f"{name}: field residual on the held-out part, before and after the {model} model")
+        keep(FIGURES[0], lambda path: residual_figure(
+            test, fitted[model], model, path,
+            f"{name}: field residual on the held-out part, before and after the {model} model"))
         whole = train[0] if len(train) == len(test) and train[0].log is test[0].log else test[0]
         cut = test[0].time[0] if whole is train[0] else whole.time[0]
         if whole is train[0]:
             from calibration.flight import flight_data
 
             whole = flight_data(train[0].log, compass, metrics["attitude"])
-        heading_figure(whole, fitted[model], model, cut, out / FIGURES[1],
-                       f"{Path(whole.source).name}: heading from the compass against the log's, "
-                       f"before and after the {model} model")
-        files += list(FIGURES)
+        keep(FIGURES[1], lambda path: heading_figure(
+            whole, fitted[model], model, cut, path,
+            f"{Path(whole.source).name}: heading from the compass against the log's, before and after the {model} "
+            "model"))
+    metrics["status"] = "failed" if not_written else "completed"
     metrics["files"] = files
-    write_json(out / "metrics.json", metrics)
+    if not_written:
+        metrics["files_not_written"] = not_written
+    try:
+        write_json(out / "metrics.json", metrics)
+    except DiskFull:
+        reserve.release()  # the room kept for it
+        write_json(out / "metrics.json", metrics)
+    finally:
+        reserve.release()
     return files
 
 
@@ -92,22 +115,45 @@ def _report(metrics: dict) -> list[str]:
 
 
 def run(args) -> int:
-    """``quadcosim calibrate`` (``args`` from :func:`add_arguments`); 2 on bad input."""
+    """``quadcosim calibrate`` (``args`` from :func:`add_arguments`): 0, 2 on bad input (nothing
+    written), 1 when the disk filled while the files were written (``metrics.json`` says which
+    were not). The folder is held (:func:`orchestrator.files.folder_lock`) from before its
+    earlier results are replaced until ``metrics.json`` is written; signals wait while the files
+    are written, so that an interrupt leaves them all with their ``metrics.json``, or nothing."""
+    import contextlib
+
     from calibration.flight import calibrate
     from calibration.static import CalibrationError
     from orchestrator.files import prepare_out_dir
-    from orchestrator.logs import LogError
+    from orchestrator.interrupts import held
+    from scenarios.outputs import remove_if_empty
 
+    out, made = Path(args.out), not Path(args.out).exists()
     try:
         _check_choices(args)
-        out = prepare_out_dir(args.out, args.overwrite)
+        _check_out(out, args.overwrite)  # before the flights are read; again, held, before writing
         train, test = _split(args)
-        metrics, calibration, fitted = calibrate(train, test, tuple(args.models), args.attitude)
-        files = _write(out, train, test, metrics, calibration, fitted, args.compass)
-    except (LogError, CalibrationError, ValueError) as error:
+        metrics, calibration, fitted = _fit(calibrate, train, test, args)
+        with contextlib.ExitStack() as lock, held():
+            try:
+                prepare_out_dir(out, args.overwrite, lock)
+                files = _write(out, train, test, metrics, calibration, fitted, args.compass)
+            except BaseException:
+                if made:
+                    remove_if_empty(out)
+                raise
+    except (CalibrationError, ValueError) as error:  # LogError, FolderBusy and OutputRefused among them
         print(f"quadcosim calibrate: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # not even metrics.json fitted: nothing written
+        print(f"quadcosim calibrate: failed: {error}", file=sys.stderr)
+        return 1
     print("\n".join(_report(metrics)))
+    if metrics["status"] == "failed":
+        for name, why in metrics["files_not_written"].items():
+            print(f"quadcosim calibrate: {name} not written: {why}", file=sys.stderr)
+        print(f"quadcosim calibrate: failed; metrics.json in {out}/ lists what was written", file=sys.stderr)
+        return 1
     print(f"exported model: {metrics['exported_model'] or 'none identified'}; {', '.join(files)} in {out}/")
     if not fitted:
         sources = ", ".join(sorted({str(Path(p.source).parent / Path(p.source).name) for p in train}))
@@ -115,6 +161,38 @@ def run(args) -> int:
               "the parameter files keep the log's offsets", file=sys.stderr)
         return 2
     return 0
+
+
+def _check_out(out: Path, overwrite: bool):
+    """Refuse at once an output folder that will be refused after the flights are read and fitted."""
+    from orchestrator.files import FolderBusy, busy_message, held_by, holds_results
+
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out}: a file of that name exists; give a folder name")
+    earlier = holds_results(out)
+    if earlier and not overwrite:
+        raise ValueError(f"--out {out} already holds results ({', '.join(earlier)}); give another folder "
+                         "or add --overwrite to replace them")
+    holder = held_by(out) if out.is_dir() else None
+    if holder is not None:
+        raise FolderBusy(f"--out {busy_message(out, holder)}")
+
+
+def _fit(calibrate, train, test, args):
+    """:func:`calibration.flight.calibrate` of the parts, a numerical library's failure named with
+    the flights, its cause and the fix."""
+    import numpy as np
+
+    from calibration.static import CalibrationError
+
+    try:
+        return calibrate(train, test, tuple(args.models), args.attitude)
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as error:
+        sources = ", ".join(sorted({p.source for p in [*train, *test]}))
+        raise CalibrationError(f"{sources}: the fit failed ({type(error).__name__}: {error}): the flights hold too "
+                               "little usable data to identify a model (values that barely vary, or a damaged log); "
+                               "give longer flights with climbs, descents and turns, or --models with fewer "
+                               "models") from None
 
 
 def _check_choices(args):

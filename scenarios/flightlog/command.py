@@ -36,18 +36,35 @@ def info(args) -> int:
     return 0
 
 
+def figure_path(given, default_name: str, default_folder: Path) -> Path:
+    """Where a command draws its figure: ``given`` (a file; an existing folder takes
+    ``default_name``), or ``default_folder / default_name`` (the folder made) when not given."""
+    if not given:
+        default_folder.mkdir(parents=True, exist_ok=True)
+        return default_folder / default_name
+    given = Path(given)
+    return given / default_name if given.is_dir() else given
+
+
 def plot(args) -> int:
-    """``quadcosim log plot FILE [--out PNG]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
+    """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); 2 on a bad
+    log or output path, 1 when the figure could not be written (a full disk)."""
+    from orchestrator.files import OutputRefused, figure_format, output_file
     from orchestrator.logs import LogError
     from scenarios.flightlog.overview import plot_overview
 
     try:
+        out = figure_path(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
+        figure_format(out)  # refused before the log is read
+        output_file(out)
         log = load(args.file, "log plot")
-    except LogError as error:
+        print(plot_overview(log, out))
+    except (LogError, OutputRefused) as error:
         print(f"quadcosim log plot: {error}", file=sys.stderr)
         return 2
-    out = Path(args.out) if args.out else Path("results") / "logs" / f"{Path(args.file).stem}-overview.png"
-    print(plot_overview(log, out))
+    except OSError as error:  # a full disk (named, nothing left), a folder removed under it
+        print(f"quadcosim log plot: failed: {error}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -61,7 +78,8 @@ def add_arguments(parser):
     shown.set_defaults(func=info)
     drawn = sub.add_parser("plot", help="an overview figure: field, current, throttle and attitude")
     drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
-    drawn.add_argument("--out", help="PNG to write (default results/logs/NAME-overview.png)")
+    drawn.add_argument("--out", help="figure file to write, .png, .svg or .pdf (default "
+                       "results/logs/NAME-overview.png; a folder takes NAME-overview.png)")
     drawn.set_defaults(func=plot)
     from scenarios.flightlog import replay
 
