@@ -348,6 +348,9 @@ def main(argv=None) -> int:
     """Run ``quadcosim`` with ``argv`` (the process arguments if None); returns the exit code."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
+    for stream in (sys.stdout, sys.stderr):  # a file name that is not UTF-8 is printed escaped, never a traceback
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     try:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")

@@ -316,8 +316,8 @@ class RunFiles:
                               0 if stream else sum(len(m) for m in groups.values()))
         free = free_bytes(self.out)
         if free is not None and need > free:
-            raise NoRoom(f"the record's files need about {megabytes(need)} in {self.out}/, where "
-                         f"{megabytes(free)} are free. Free space there, choose another --out folder, or record "
+            raise NoRoom(f"the record's files need about {megabytes(need, free)} in {self.out}/, where "
+                         f"{megabytes(free, need)} are free. Free space there, choose another --out folder, or record "
                          f"less: every N-th step (--decimation N, now {decimation}), fewer signals (--record ...), "
                          "a shorter run")
 

@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import json
 import os
 import re
+import subprocess
 import sys
 import threading
 from dataclasses import dataclass, field
@@ -29,6 +31,7 @@ _KINDS = (
     ("skipped bytes", re.compile(r"^Skipped (\d+) bad bytes")),
     ("unknown message type", re.compile(r"unknown msg type|unknown message type")),
     ("unparsed message", re.compile(r"^Failed to parse|^bad msg at offset")),
+    ("message without its subscription", re.compile(r"no subscription found")),
     ("corruption", re.compile(r"[Cc]orruption detected|Failed to find sync|Found sync")),
 )
 
@@ -123,6 +126,38 @@ def _flush_c_streams():
         pass
 
 
+# The counter of the descriptors' output runs in a process of its own (this file run as a script,
+# standard library only): a reader's C code prints while it holds the interpreter's lock, so a
+# thread of this process could not drain the pipe, the pipe would fill, and the reader would block
+# on it for ever.
+def _count_standard_input():
+    """The counter's process: count standard input's lines, then print the counts as JSON."""
+    noise = Noise()
+    while chunk := sys.stdin.buffer.read1(1 << 16):
+        noise.feed(chunk.decode("utf-8", "replace"))
+    noise.close()
+    json.dump({"lines": noise.lines, "kinds": noise.kinds, "skipped_bytes": noise.skipped_bytes,
+               "first": noise.first}, sys.stdout)
+
+
+def _merge(noise: Noise, counted: dict):
+    """Add the counts of the descriptors' output (the counter's) to ``noise`` (Python's writes)."""
+    noise.lines += counted.get("lines", 0)
+    noise.skipped_bytes += counted.get("skipped_bytes", 0)
+    for kind, n in counted.get("kinds", {}).items():
+        noise.kinds[kind] = noise.kinds.get(kind, 0) + n
+    noise.first = (counted.get("first", []) + noise.first)[:KEPT_LINES]
+
+
+def _counter():
+    """The counting process (its standard input the pipe to count), or None where it cannot start."""
+    try:
+        return subprocess.Popen([sys.executable, "-I", __file__, "--count"], stdin=subprocess.PIPE,
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
+
+
 @contextlib.contextmanager
 def captured():
     """Within the block, standard output and error (both file descriptors and Python's streams)
@@ -140,35 +175,32 @@ def captured():
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()
-    saved, reader = None, None
+    counter, saved = None, None
     if threading.current_thread() is threading.main_thread():
-        try:
-            read_end, write_end = os.pipe()
-            saved = (os.dup(1), os.dup(2))
-        except OSError:
-            saved = None
-        if saved is not None:
-            _flush_c_streams()
-            os.dup2(write_end, 1)
-            os.dup2(write_end, 2)
-            os.close(write_end)
-
-            def drain():
-                with os.fdopen(read_end, "rb", buffering=0) as pipe:
-                    while chunk := pipe.read(1 << 16):
-                        noise.feed(chunk.decode("utf-8", "replace"))
-
-            reader = threading.Thread(target=drain, name="log reader output", daemon=True)
-            reader.start()
+        counter = _counter()
+    if counter is not None:
+        _flush_c_streams()
+        saved = (os.dup(1), os.dup(2))
+        os.dup2(counter.stdin.fileno(), 1)
+        os.dup2(counter.stdin.fileno(), 2)
     try:
         with contextlib.redirect_stdout(writer), contextlib.redirect_stderr(writer):
             yield noise
     finally:
-        if saved is not None:
+        if counter is not None:
             _flush_c_streams()
-            os.dup2(saved[0], 1)  # the pipe's last writers close: the reader sees its end
+            os.dup2(saved[0], 1)  # the pipe's last writers close with the counter's stdin: it sees its end
             os.dup2(saved[1], 2)
             os.close(saved[0])
             os.close(saved[1])
-            reader.join()
+            try:
+                out, _ = counter.communicate(timeout=60)
+                _merge(noise, json.loads(out or b"{}"))
+            except (ValueError, OSError, subprocess.TimeoutExpired):
+                counter.kill()
+                counter.wait()
         noise.close()
+
+
+if __name__ == "__main__" and sys.argv[1:] == ["--count"]:
+    _count_standard_input()

@@ -68,9 +68,9 @@ def _write(out: Path, train, test, metrics, calibration, fitted, compass: int) -
     K = None if model is None else fitted[model].extra["K"][0]
     ardupilot = autopilot.ardupilot_parameters(compass, calibration.static, model, K)
     px4 = autopilot.px4_parameters(compass, calibration.static, model, K)
+    keep("calibration.json", calibration.save)
     keep(PARAMETER_FILES[0], lambda path: autopilot.write_ardupilot(ardupilot, path))
     keep(PARAMETER_FILES[1], lambda path: autopilot.write_px4(px4, path))
-    keep("calibration.json", calibration.save)
     metrics["exported_model"] = model
     if model is not None:
         name = Path(train[0].source).name

@@ -115,6 +115,23 @@ def text(result: dict) -> str:
     return "\n".join(lines)
 
 
+def _replayed(log, compass: int) -> dict:
+    """:func:`replay_log` of the read ``log``, a numerical library's failure named with the file,
+    its likely cause and the fix."""
+    from calibration.static import CalibrationError
+    from orchestrator.files import OutputRefused
+    from orchestrator.logs import LogError
+
+    try:
+        return replay_log(log, compass)
+    except (LogError, CalibrationError, OutputRefused):
+        raise
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError, ZeroDivisionError) as error:
+        raise LogError(f"{log.path}: the replay failed ({type(error).__name__}: {error}): the log holds too little "
+                       "usable data for the estimators (a damaged stretch, a sensor that barely varies); replay a "
+                       "longer, undamaged flight") from None
+
+
 def run(args) -> int:
     """``quadcosim log replay FILE [--compass N] [--json OUT]`` (``args`` from argparse); 2 on bad
     input (a log, an option or an output path refused), 1 when the JSON could not be written (a
@@ -126,7 +143,7 @@ def run(args) -> int:
     try:
         if args.json:
             output_file(args.json)  # refused before the replay, not after it
-        result = replay_log(load(args.file, "log replay"), args.compass)
+        result = _replayed(load(args.file, "log replay"), args.compass)
     except (CalibrationError, ValueError) as error:  # LogError and OutputRefused among them
         print(f"quadcosim log replay: {error}", file=sys.stderr)
         return 2
