@@ -15,7 +15,7 @@ import pytest  # noqa: E402
 
 import orchestrator.files  # noqa: E402
 from calibration.flight import autopilot  # noqa: E402
-from orchestrator.files import DiskFull, OutputRefused, save_figure, write_json, write_text  # noqa: E402
+from orchestrator.files import DiskFull, save_figure, write_json, write_text  # noqa: E402
 
 PARAMETERS = {"COMPASS_OFS_X": 12.5, "COMPASS_MOTCT": 2}
 
@@ -55,6 +55,8 @@ def test_a_symbolic_link_is_followed_and_kept(tmp_path):
 
 
 def test_a_fifo_is_refused_and_its_reader_is_not_fed_a_replacement(tmp_path):
+    from orchestrator.files import OutputRefused
+
     fifo = tmp_path / "pipe.json"
     os.mkfifo(fifo)
     with pytest.raises(OutputRefused, match="a FIFO"):
@@ -64,6 +66,8 @@ def test_a_fifo_is_refused_and_its_reader_is_not_fed_a_replacement(tmp_path):
 
 
 def test_a_device_a_folder_and_a_missing_folder_are_refused(tmp_path):
+    from orchestrator.files import OutputRefused
+
     if os.geteuid() == 0:  # a device node of its own (the null device's numbers), never /dev/null itself
         device = tmp_path / "null"
         os.mknod(device, 0o666 | stat.S_IFCHR, os.makedev(1, 3))

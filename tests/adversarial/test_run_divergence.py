@@ -8,8 +8,6 @@ import pytest
 from conftest import assert_whole
 
 from scenarios.cli import main as cli
-from scenarios.divergence import Bounds, first_crossing
-from scenarios.tp import DIVERGENCE
 
 
 @pytest.mark.parametrize("gain", ["5000", "1e300"])
@@ -47,6 +45,9 @@ class _Record:
 
 def test_a_crossing_must_be_held_and_is_dated_where_it_starts():
     import numpy as np
+
+    from scenarios.divergence import Bounds, first_crossing
+    from scenarios.tp import DIVERGENCE
 
     t = np.arange(0.0, 5.0, 0.01)
     zero = np.zeros_like(t)
