@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup fmus demo test lint bench fuzz docs clean
+.PHONY: setup fmus demo test kernels digests references lint bench fuzz docs clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +26,25 @@ test: fmus
 	$(BIN)/ruff check .
 	$(MAKE) docs
 	$(BIN)/python -m pytest -q
+
+# The trajectory references and the findings' quick check under kernels other than this CPU's
+# own (OpenBLAS's oldest, numba's generic target, numpy's SIMD dispatch off, libm without FMA):
+# a test that holds on one machine only fails here.
+kernels: fmus
+	OPENBLAS_CORETYPE=Prescott NUMBA_CPU_NAME=generic $(BIN)/python -m pytest -q -p no:cacheprovider $(KERNEL_TESTS)
+	NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR" GLIBC_TUNABLES=glibc.cpu.hwcaps=-AVX2,-FMA,-AVX,-FMA4 \
+		$(BIN)/python -m pytest -q -p no:cacheprovider $(KERNEL_TESTS)
+KERNEL_TESTS := tests/test_trajectories_unchanged.py tests/test_portable.py tests/test_chunks.py
+
+# Bit-exact digests of the reference runs on this machine: saved by the first call, compared by
+# the next (before and after a refactor that must not change one bit).
+digests: fmus
+	$(BIN)/python tests/trajectory_runs.py digests
+
+# Re-measure the spread across kernels and rewrite the trajectory references (after a deliberate
+# change of physics or numerics).
+references: fmus
+	$(BIN)/python tests/trajectory_runs.py references
 
 # The documentation site, warnings as errors; its lab figures are made by the commands it shows.
 docs: fmus

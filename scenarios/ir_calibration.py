@@ -21,7 +21,7 @@ import numpy as np
 
 from calibration.infrared import METHODS, EKFSettings, Estimator, InfraredCalibration
 from fmus.build import table
-from orchestrator import Block, FMUBlock, System, Table
+from orchestrator import Block, FMUBlock, System, Table, portable
 from orchestrator.fmu import FMUInstance
 from scenarios import Option, Scenario
 from scenarios.figures import fault_text, faults_of, title_lines
@@ -64,7 +64,7 @@ def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gra
     rng = np.random.default_rng(seed)
     r = np.empty(samples)
     ramp = int(1.5 * rate)
-    blend = np.sin(0.5 * np.pi * np.arange(1, ramp + 1) / ramp) ** 2
+    blend = portable.sin(0.5 * np.pi * np.arange(1, ramp + 1) / ramp) ** 2
     k, previous = 0, 0.0
     while k < samples:
         length = max(int(rng.uniform(2.0, 8.0) * rate), ramp)
@@ -74,7 +74,7 @@ def bank_profile(samples: int, seed: int = 1, airspeed: float | None = None, gra
         r[k:k + length] = leg[:samples - k]
         k, previous = k + length, target
     r = TURN_RATE_MEAN + TURN_RATE_STD * (r - r.mean()) / r.std()
-    return np.arctan(r * airspeed / gravity)
+    return portable.arctan(r * airspeed / gravity)  # the same bits on every CPU
 
 
 def fault_windows(faults: str, ir_fault: float = IR_FAULT[1], gps_fault: float = GPS_FAULT[1]

@@ -29,7 +29,7 @@ import numpy as np
 
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
-from orchestrator import System, Table
+from orchestrator import System, Table, portable
 from orchestrator.files import write_json, write_text
 from orchestrator.parameters import apply
 from orchestrator.progress import status
@@ -133,8 +133,8 @@ def free_commands(o: dict, t: np.ndarray) -> np.ndarray:
     for n in range(4):
         slow_f, fast_f = rng.uniform(0.1, 0.6, 3), rng.uniform(1.0, 4.0, 3)
         phase = rng.uniform(0, 2 * np.pi, (2, 3))
-        slow = np.sin(2 * np.pi * slow_f[:, None] * t + phase[0][:, None]).sum(axis=0)
-        quick = np.sin(2 * np.pi * fast_f[:, None] * t + phase[1][:, None]).sum(axis=0)
+        slow = portable.sin(2 * np.pi * slow_f[:, None] * t + phase[0][:, None]).sum(axis=0)
+        quick = portable.sin(2 * np.pi * fast_f[:, None] * t + phase[1][:, None]).sum(axis=0)
         c[:, n] = np.where(fast, 0.5 + 0.13 * quick, 0.5 + 0.13 * slow)
     return np.clip(c, 0.0, 1.0)
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from orchestrator import System, Table
+from orchestrator import System, Table, portable
 from scenarios import Option, Scenario
 from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
@@ -87,7 +87,7 @@ def commands(o: dict) -> np.ndarray:
             for motor in range(4):
                 f = rng.uniform(0.3, 3.0, 4)
                 phase = rng.uniform(0, 2 * np.pi, 4)
-                wave = np.sin(2 * np.pi * f[:, None] * t[inside][None, :] + phase[:, None]).sum(axis=0)
+                wave = portable.sin(2 * np.pi * f[:, None] * t[inside][None, :] + phase[:, None]).sum(axis=0)
                 c[inside, motor] = np.clip(0.5 + 0.15 * wave, 0.0, 1.0)
     return c
 
