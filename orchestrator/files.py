@@ -383,6 +383,20 @@ def _alive(pid) -> bool:
 
 
 def busy_message(folder: Path, holder: dict) -> str:
+    """The refusal of a folder held by another process.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The output folder.
+    holder : dict
+        What its lock file says: ``pid``, ``command``, ``since`` (s since the epoch).
+
+    Returns
+    -------
+    str
+        The folder, the holder's pid and command, since when, and the fix.
+    """
     pid, command = holder.get("pid", "?"), holder.get("command") or "quadcosim"
     since = holder.get("since")
     started = f", since {time.strftime('%Y-%m-%d %H:%M:%S', time.localtime(since))}" if since else ""

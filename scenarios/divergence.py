@@ -110,7 +110,17 @@ def unchecked(result) -> list[str]:
 
 
 def message(scenario: str, crossing: dict, settings: list[str]) -> str:
-    """The warning of a run that diverged: when and how, the bound, the settings it ran with."""
+    """The warning of a run that diverged: when and how, the bound, the settings it ran with.
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name.
+    crossing : dict
+        What :func:`first_crossing` found.
+    settings : list of str
+        The options off their defaults and the block parameters set, ``key=value``.
+    """
     peaks = crossing.get("controller_peak", {})
     torque = max((v for n, v in peaks.items() if n.startswith("Controller.tau")), default=None)
     asked = f"; the controller asked for up to {torque:.3g} N.m" if torque is not None else ""
