@@ -335,6 +335,39 @@ def figure_format(path, figure=None) -> str:
     return kind
 
 
+def figure_file(given, name: str, folder) -> Path:
+    """The figure file a command writes, checked before anything is drawn or read.
+
+    Parameters
+    ----------
+    given : str or pathlib.Path or None
+        The user's ``--out``: a file, or an existing folder (which takes ``name``).
+    name : str
+        The figure's default name.
+    folder : str or pathlib.Path
+        Its default folder, made when ``given`` is None.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    OutputRefused
+        A suffix matplotlib does not write (:func:`figure_format`), or a path that cannot take
+        a file (:func:`output_file`).
+    """
+    if given:
+        path = Path(given)
+        path = path / name if path.is_dir() else path
+    else:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        path = Path(folder) / name
+    figure_format(path)
+    output_file(path)
+    return path
+
+
 def save_figure(figure, path, **options) -> Path:
     """``figure.savefig(path)``, atomically; a suffix matplotlib does not write is refused
     (:func:`figure_format`) before anything is written."""

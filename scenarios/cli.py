@@ -236,7 +236,17 @@ def _diagram(args) -> int:
             print(error.args[0] if error.args else error, file=sys.stderr)
             return 2
         status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
-        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+        from orchestrator.files import figure_file
+
+        try:
+            out = figure_file(args.out, "diagram.png", Path("results") / args.scenario)
+            path = draw(system, out, scenario.title(options))
+        except ValueError as error:  # an output path refused (OutputRefused), before anything is written
+            print(f"quadcosim diagram: {error}", file=sys.stderr)
+            return 2
+        except OSError as error:  # a full disk: named, nothing left under the figure's name
+            print(f"quadcosim diagram: failed: {error}", file=sys.stderr)
+            return 1
     print(path)
     return 0
 
@@ -273,7 +283,8 @@ def parser() -> argparse.ArgumentParser:
     diagram.add_argument("scenario")
     diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
     diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
-    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
+    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png; a folder takes "
+                         "diagram.png)")
     diagram.set_defaults(func=_diagram)
     bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
     bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"))

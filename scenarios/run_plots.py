@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from orchestrator.files import printable, save_figure
+from orchestrator.files import figure_file, printable, save_figure
 
 RESULTS_FILE = "results.npz"
 #: Width and height (inches) of one signal's axes.
@@ -80,20 +80,6 @@ def _check(result, folder: Path, signal: str):
         raise ValueError(f"{folder}: {error.args[0]}{hint}") from None
 
 
-def _figure(out, name: str, folder: Path) -> Path:
-    """The figure file to write: ``out`` (an existing folder takes ``name``), or ``folder / name``;
-    checked before anything is read (:func:`orchestrator.files.figure_format`,
-    :func:`orchestrator.files.output_file`)."""
-    from orchestrator.files import figure_format, output_file
-
-    path = Path(out) if out else folder / name
-    if path.is_dir():
-        path = path / name
-    figure_format(path)
-    output_file(path)
-    return path
-
-
 def _label(folder: Path) -> str:
     return folder.name or str(folder)
 
@@ -117,8 +103,10 @@ def plot(run, signals, out=None) -> Path:
     """
     import matplotlib.pyplot as plt
 
-    path = _figure(out, f"plot-{signals[0]}.png", Path(run) if Path(run).is_dir() else Path(run).parent)
+    name = f"plot-{signals[0]}.png"
+    path = figure_file(out, name, None) if out else None  # a path given is checked before the run is read
     result, folder = load(run)
+    path = path or figure_file(None, name, folder)
     for signal in signals:
         _check(result, folder, signal)
     fig, axes = plt.subplots(len(signals), 1, sharex=True, squeeze=False, layout="constrained",
@@ -154,7 +142,7 @@ def compare(runs, signal: str, out=None) -> Path:
     """
     import matplotlib.pyplot as plt
 
-    path = _figure(out, f"compare-{signal}.png", Path("."))
+    path = figure_file(out, f"compare-{signal}.png", Path("."))
     loaded = [load(run) for run in runs]
     for result, folder in loaded:
         _check(result, folder, signal)

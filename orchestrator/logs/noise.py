@@ -62,9 +62,20 @@ class Noise:
     def feed(self, text: str):
         """Count the complete lines of ``text`` (the rest waits for the next call)."""
         with self._lock:
-            text = self._partial + text
-            *complete, self._partial = text.split("\n")
-            for line in complete:
+            body, newline, rest = (self._partial + text).rpartition("\n")
+            self._partial = rest
+            if not newline:
+                return
+            lines = body.count("\n") + 1
+            if body.count("bad header") == lines and body.startswith("bad header"):  # a run of skipped bytes
+                wanted = KEPT_LINES - len(self.first)
+                if wanted > 0:
+                    self.first += [line[:200] for line in body.split("\n", wanted)[:wanted]]
+                self.lines += lines
+                self.kinds["bad header"] = self.kinds.get("bad header", 0) + lines
+                self.skipped_bytes += lines
+                return
+            for line in body.split("\n"):
                 self._line(line)
 
     def close(self):

@@ -36,27 +36,15 @@ def info(args) -> int:
     return 0
 
 
-def figure_path(given, default_name: str, default_folder: Path) -> Path:
-    """Where a command draws its figure: ``given`` (a file; an existing folder takes
-    ``default_name``), or ``default_folder / default_name`` (the folder made) when not given."""
-    if not given:
-        default_folder.mkdir(parents=True, exist_ok=True)
-        return default_folder / default_name
-    given = Path(given)
-    return given / default_name if given.is_dir() else given
-
-
 def plot(args) -> int:
     """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); 2 on a bad
     log or output path, 1 when the figure could not be written (a full disk)."""
-    from orchestrator.files import OutputRefused, figure_format, output_file
+    from orchestrator.files import OutputRefused, figure_file
     from orchestrator.logs import LogError
     from scenarios.flightlog.overview import plot_overview
 
     try:
-        out = figure_path(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
-        figure_format(out)  # refused before the log is read
-        output_file(out)
+        out = figure_file(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
         log = load(args.file, "log plot")
         print(plot_overview(log, out))
     except (LogError, OutputRefused) as error:
