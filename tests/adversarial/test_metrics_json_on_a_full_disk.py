@@ -6,11 +6,10 @@ permitted), and when not even ``metrics.json`` would fit."""
 import errno
 import json
 import os
-import subprocess
 
 import matplotlib.figure
 import pytest
-from conftest import SHORT_TP, metrics_of
+from conftest import SHORT_TP, metrics_of, mounted
 
 from scenarios.cli import main as cli
 from tests.flightlog_synthetic import write_log
@@ -41,16 +40,8 @@ def test_a_full_disk_while_the_diagram_is_drawn_leaves_metrics_json(tmp_path, mo
 @pytest.fixture
 def small_disk(tmp_path):
     """A 256 kB tmpfs at ``tmp_path / "disk"`` (skipped where mounting is not permitted)."""
-    disk = tmp_path / "disk"
-    disk.mkdir()
-    mounted = os.geteuid() == 0 and subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(disk)],
-                                                   capture_output=True).returncode == 0
-    if not mounted:
-        pytest.skip("mounting a tmpfs is not permitted here")
-    try:
+    with mounted(tmp_path / "disk", "256k") as disk:
         yield disk
-    finally:
-        subprocess.run(["umount", str(disk)], check=True)
 
 
 def _fill(disk, leave: int):
