@@ -11,9 +11,11 @@ PX4 and ArduPilot:
   restarted while logging) is refused, naming the series and where its clock went back;
 - a time stamp repeated (a sample logged twice) keeps its first sample;
 - a series left with no sample is read as absent, said in a warning;
+- a gap in a series (no sample for :data:`GAP_PERIODS` of its periods, and at least
+  :data:`GAP_MIN_S`) is said in a warning: two flights joined, or a logging stall;
 - the span of time all the series share is what a replay or a calibration can use
   (:meth:`orchestrator.logs.FlightLog.overlap`); a series that shares no time with the
-  others is said in a warning.
+  others, and a shared span shorter than :data:`SHARED_SHARE` of the log, are said in a warning.
 """
 
 from __future__ import annotations
@@ -28,6 +30,11 @@ from orchestrator.logs.model import FlightLog, LogError
 #: Share of a series' samples that may be out of order and dropped as damaged stamps; more is
 #: a clock that goes back for good (two logs joined), refused.
 MAX_OUT_OF_ORDER = 0.05
+#: A gap in a series this many of its median periods long, and at least GAP_MIN_S, is warned about.
+GAP_PERIODS = 100
+GAP_MIN_S = 2.0  # s
+#: A span shared by every series shorter than this share of the log's duration is warned about.
+SHARED_SHARE = 0.9
 
 
 #: The per-sample arrays of each kind of series (beside its ``time``).
@@ -156,7 +163,44 @@ def validated(log: FlightLog) -> FlightLog:
     outside = _apart(checked)
     if outside:
         checked.warnings.append(outside)
+    else:
+        checked.warnings += _short_span(checked)
+    checked.warnings += _gaps(checked)
     return checked
+
+
+def _gaps(log: FlightLog) -> list[str]:
+    """One warning naming the series with a gap in their samples (see the module docstring), and
+    each one's longest gap."""
+    found = []
+    for name, series in _series(log):
+        time = np.asarray(series.time)
+        if len(time) < 3:
+            continue
+        steps = np.diff(time)
+        gaps = np.flatnonzero(steps > max(GAP_MIN_S, GAP_PERIODS * float(np.median(steps))))
+        if len(gaps):
+            k = gaps[np.argmax(steps[gaps])]
+            count = f", {len(gaps)} gaps" if len(gaps) > 1 else ""
+            found.append(f"{name} {steps[k]:.1f} s from {time[k]:.1f} s{count}")
+    if not found:
+        return []
+    return [f"samples stop for a while (two flights in one file, or logging that stalled): {'; '.join(found)}"]
+
+
+def _short_span(log: FlightLog) -> list[str]:
+    """A warning when the span every series covers is a small part of the log."""
+    span, named = common_span(log), _series(log)
+    if span is None or not named or log.duration <= 0:
+        return []
+    shared = span[1] - span[0]
+    if shared >= SHARED_SHARE * log.duration:
+        return []
+    late = max(named, key=lambda item: item[1].time[0])
+    early = min(named, key=lambda item: item[1].time[-1])
+    return [f"its sensors share {shared:.1f} s of the {log.duration:.1f} s logged ({span[0]:.1f} to {span[1]:.1f} s; "
+            f"{late[0]} starts at {late[1].time[0]:.1f} s, {early[0]} ends at {early[1].time[-1]:.1f} s): a replay or "
+            "a calibration uses that span alone"]
 
 
 def _series(log: FlightLog) -> list[tuple[str, object]]:

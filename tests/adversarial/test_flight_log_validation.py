@@ -117,3 +117,23 @@ def test_test_flights_without_the_training_current_sensor(tmp_path, capsys):
     assert "current   refused: fitted on the training flights, but the test flights have no current sensor" in shown
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"] == "completed" and metrics["exported_model"] == "throttle"
+
+
+def test_a_short_shared_span_and_a_gap_are_reported(tmp_path, capsys):
+    log = _log(tmp_path, "late.log", _shift("ATT", 10.0))
+    assert cli(["log", "info", str(log), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["common_span_s"] == pytest.approx([11.0, 19.9], abs=1e-3)
+    assert info["warnings"] == ["its sensors share 8.9 s of the 28.9 s logged (11.0 to 19.9 s; attitude starts at "
+                                "11.0 s, motors ends at 19.9 s): a replay or a calibration uses that span alone"]
+
+    def stall(line):  # nothing logged from 10 to 25 s
+        parts = line.split(", ")
+        return None if parts[0] in ("IMU", "ATT", "RCOU", "BAT", "MAG") and 10e6 < int(parts[1]) < 25e6 else line
+
+    log = _log(tmp_path, "stalled.log", stall, duration=40.0)
+    assert cli(["log", "info", str(log), "--json"]) == 0
+    warnings = json.loads(capsys.readouterr().out)["warnings"]
+    assert warnings == ["samples stop for a while (two flights in one file, or logging that stalled): MAG[0] 15.1 s "
+                        "from 9.9 s; IMU[0] 15.0 s from 10.0 s; motors 15.1 s from 9.9 s; battery 15.1 s from 9.9 s; "
+                        "attitude 15.1 s from 9.9 s"]
