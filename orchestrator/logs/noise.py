@@ -142,7 +142,12 @@ def _flush_c_streams():
 # thread of this process could not drain the pipe, the pipe would fill, and the reader would block
 # on it for ever.
 def _count_standard_input():
-    """The counter's process: count standard input's lines, then print the counts as JSON."""
+    """The counter's process: count standard input's lines, then print the counts as JSON. A Ctrl-C
+    reaches the whole process group: the counter leaves it to its parent and ends with its input."""
+    import signal
+
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, signal.SIG_IGN)
     noise = Noise()
     while chunk := sys.stdin.buffer.read1(1 << 16):
         noise.feed(chunk.decode("utf-8", "replace"))
