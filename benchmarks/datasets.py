@@ -19,13 +19,20 @@ Each dataset sits in its own sub-folder of the data folder, as its authors publi
     recurrent inertial graph-based estimator", supplementary material; folders ``trial1`` and
     ``trial2`` of its ``data/dataset``): five segments of a kinematic chain moved by hand, an
     IMU rigidly on each (40 Hz), optical reference at 30 Hz. Aligned as the smartphones.
+``iphones/``
+    The same smartphone dataset's iPhone 4S and iPhone 5 recordings: its ``ios`` and
+    ``qualisys`` folders, the same people and motions; the raw gyro (iOS gives no calibrated
+    one), the accelerometer in g (its sign turned: iOS reads minus the specific force) and the
+    calibrated magnetometer, read and aligned as the Nexus 5's. Held out: never read before the
+    defaults were frozen.
 ``repoimu/``
     RepoIMU (Szczęsna, Skurowski, Pruszowski, Pęszor, Paszkuta, Wojciechowski, "Reference
     Data Set for Accuracy Evaluation of Orientation Estimation Algorithms for Inertial Motion
     Capture Systems", ICCVG 2016): its pendulum recordings (``Pendulum_*.csv``), an IMU on a
     swinging pendulum with a Vicon reference. Aligned as the smartphones.
 
-A recording whose reference does not turn as its gyro does (:func:`usable`) is left out.
+A recording whose reference does not turn as its gyro does (:func:`usable`), or cannot be aligned
+at all, is left out.
 Every loader gives recordings as :func:`estimators.recording.load` does (``gyro``, ``acc``,
 ``mag``, ``rate``, ``quat``, ``scored``, ``meta``), with ``meta["align"]`` saying whether the
 heading offset is removed when scoring.
@@ -33,6 +40,7 @@ heading offset is removed when scoring.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -53,10 +61,14 @@ def broad(folder: Path):
 
 
 def _aligned(gyro, acc, mag, rate, quat):
-    quat = alignment.align(gyro, acc, quat, 1.0 / rate)
+    try:
+        quat = alignment.align(gyro, acc, quat, 1.0 / rate)
+        mismatch = alignment.rate_mismatch(gyro, quat, 1.0 / rate)
+    except ValueError:  # the reference never turns while the gyro does (tracking lost): left out by usable()
+        quat, mismatch = np.full_like(quat, np.nan), math.inf
     return {"gyro": gyro, "acc": acc, "mag": mag, "rate": rate, "quat": quat,
             "scored": np.isfinite(quat).all(axis=1),
-            "meta": {"frame": "enu", "align": True, "rate_mismatch": alignment.rate_mismatch(gyro, quat, 1.0 / rate)}}
+            "meta": {"frame": "enu", "align": True, "rate_mismatch": mismatch}}
 
 
 def _csv_with_comments(path: Path) -> tuple[dict, float]:
@@ -129,30 +141,62 @@ def _clock_offset(gyro, grid, quat_time, quat):
     return float(offsets[int(np.argmax(scores))])
 
 
-def smartphones(folder: Path):
-    """The Nexus 5 recordings of the smartphone dataset in ``folder`` (``android``, ``qualisys``), each
-    on a 100 Hz grid, its clock matched to the capture's, aligned."""
+IOS_G = 9.80665  # m/s^2 per g: the iPhones' accelerometer reads in g
+# each platform's sensor files (gyro, accelerometer, magnetometer) and the factor turning its accelerometer
+# into the specific force in m/s^2: Android's reads it in m/s^2, iOS's reads minus it in g (-1 g along z
+# lying face up)
+PHONES = {"android": (("gyroscope-calibrated", "accelerometer", "magnetometer-calibrated"), 1.0, "*_Nexus5_*"),
+          "ios": (("gyroscope", "accelerometer", "magnetometer-calibrated"), -IOS_G, "*_iPhone*_*")}
+
+
+def _boot_time(phone: Path) -> float:
+    """The phone clock's time (s) at the recording's start: ``BootTime`` of its ``description.txt``
+    (the iPhones count from the phone's boot), 0 without one (the Nexus 5 counts from the start)."""
+    description = phone / "description.txt"
+    if description.exists():
+        for line in description.read_text().splitlines():
+            name, _, value = line.partition("=")
+            if name.strip() == "BootTime":
+                return float(value)
+    return 0.0
+
+
+def _phones(folder: Path, platform: str):
+    """The recordings of one platform of the smartphone dataset in ``folder`` (its ``android`` or ``ios``
+    folder and ``qualisys``), each on a 100 Hz grid, its clock matched to the capture's, aligned."""
     from scipy.spatial.transform import Rotation
 
-    for phone in sorted((folder / "android").glob("*_Nexus5_*")):
+    sensors, acc_scale, pattern = PHONES[platform]
+    for phone in sorted((folder / platform).glob(pattern)):
         capture = folder / "qualisys" / f"{phone.name}.mat"
         if not capture.exists():
             continue
-        start = max(np.loadtxt(phone / f"{n}.txt", usecols=0)[0] for n in
-                    ("accelerometer", "gyroscope-calibrated", "magnetometer-calibrated"))
-        stop = min(np.loadtxt(phone / f"{n}.txt", usecols=0)[-1] for n in
-                   ("accelerometer", "gyroscope-calibrated", "magnetometer-calibrated"))
+        start = max(np.loadtxt(phone / f"{n}.txt", usecols=0)[0] for n in sensors)
+        stop = min(np.loadtxt(phone / f"{n}.txt", usecols=0)[-1] for n in sensors)
         grid = np.arange(start, stop, 1.0 / PHONE_RATE)
-        gyro, acc, mag = (_phone_sensor(phone / f"{n}.txt", grid) for n in
-                          ("gyroscope-calibrated", "accelerometer", "magnetometer-calibrated"))
+        gyro, acc, mag = (_phone_sensor(phone / f"{n}.txt", grid) for n in sensors)
         quat_time, rotations = _qualisys(capture)
         tracked = np.isfinite(rotations).all(axis=(1, 2))
         quat = np.full((len(rotations), 4), np.nan)
         quat[tracked] = alignment._quaternion(Rotation.from_matrix(rotations[tracked]))
-        offset = _clock_offset(gyro, grid, quat_time, quat)
-        data = _aligned(gyro, acc, mag, PHONE_RATE, alignment.resample(quat_time, quat, grid + offset))
+        local = grid - _boot_time(phone)  # s from the recording's start, as the capture's clock counts
+        offset = _clock_offset(gyro, local, quat_time, quat)
+        data = _aligned(gyro, acc_scale * acc, mag, PHONE_RATE, alignment.resample(quat_time, quat, local + offset))
         data["meta"]["clock_offset_s"] = offset
         yield phone.name, data
+
+
+def smartphones(folder: Path):
+    """The Nexus 5 recordings of the smartphone dataset in ``folder`` (``android``, ``qualisys``), each
+    on a 100 Hz grid, its clock matched to the capture's, aligned."""
+    yield from _phones(folder, "android")
+
+
+def iphones(folder: Path):
+    """The iPhone 4S and iPhone 5 recordings of the smartphone dataset in ``folder`` (``ios``,
+    ``qualisys``): raw gyro, accelerometer turned into the specific force in m/s^2, calibrated
+    magnetometer, each on a 100 Hz grid, its clock matched to the capture's, aligned."""
+    yield from _phones(folder, "ios")
 
 
 def usable(data: dict) -> bool:
@@ -162,7 +206,7 @@ def usable(data: dict) -> bool:
     return data["meta"].get("rate_mismatch", 0.0) < MISMATCH_LIMIT
 
 
-LOADERS = {"broad": broad, "smartphones": smartphones, "diodem": diodem, "repoimu": repoimu}
+LOADERS = {"broad": broad, "smartphones": smartphones, "diodem": diodem, "repoimu": repoimu, "iphones": iphones}
 
 
 def load(data_folder, name: str, left_out: list | None = None):

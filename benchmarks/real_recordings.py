@@ -1,24 +1,22 @@
 """The estimators on public real recordings with optical ground truth, against VQF, Madgwick and Mahony.
 
-    python -m benchmarks.real_recordings DATA [--datasets broad,smartphones,...] [--choose]
-        [--cache DIR] [--json OUT]
+    python -m benchmarks.real_recordings DATA [--datasets broad,smartphones,...] [--cache DIR]
+        [--json OUT]
 
 DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes (where each comes
 from, by title, and how it is read and aligned); the data stay outside the repository. Every
 recording is scored by the quaternion-error RMSE (total, heading, inclination; the BROAD
 benchmark's decomposition, :func:`estimators.score`) over its scored samples, after the
-alignment its dataset needs, and the mean over a dataset's recordings is reported for our
-``explicit`` and ``passive`` (TRIAD) filters at their defaults (``estimators.DEFAULT_GAINS``,
-corrections on) and for VQF, Madgwick and Mahony at their packages' defaults. Every filter
-starts from the TRIAD attitude of the first sample (VQF from its own first samples); the
-field's dip and norm are taken from the first second.
+alignment its dataset needs, and the mean over a dataset's recordings is reported for the
+recommended ``explicit`` filter and the ``passive`` (TRIAD) filter at their defaults
+(``estimators.DEFAULT_GAINS``, corrections on), for the explicit filter with each of its parts
+for real recordings taken away in turn (:data:`ABLATIONS`), and for VQF, Madgwick and Mahony at
+their packages' defaults and VQF at the time constants chosen for it by the same procedure as
+ours (:data:`TUNED`, ``python -m benchmarks.tuning DATA --filter vqf``). Every filter starts from
+the TRIAD attitude of the first sample (VQF from its own first samples); the field's dip and norm
+are taken from the first second.
 
-``--choose`` runs the cross-validation that chose the defaults: over the grid :data:`GRID`, on
-the datasets of :data:`CHOOSING` only (never on :data:`HELD_OUT`), each gain set is scored by
-the mean over those datasets of its mean total RMSE divided by VQF's on the same dataset (so
-that each dataset counts alike, whatever its number of recordings); leaving each dataset out in
-turn, the set chosen on the others is scored on it (the cross-validated ratio), and the set
-chosen on all of them is the default.
+The defaults were chosen on :data:`DEVELOPMENT` only (``python -m benchmarks.tuning DATA``).
 
 The published filters' results do not depend on our gains: ``--cache DIR`` keeps them.
 """
@@ -27,29 +25,45 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from benchmarks import datasets
-from estimators import DEFAULT_GAINS, estimate, gain_grid
+from estimators import DEFAULT_GAINS, estimate
+from estimators.filters import CORRECTIONS, DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
 from orchestrator.files import write_text
 from scenarios.replay import field_from_data, references
 
-CHOOSING = ("broad", "smartphones", "diodem")  # the datasets the defaults were chosen on
-HELD_OUT = ("repoimu",)  # kept aside until the defaults were frozen
+DEVELOPMENT = ("broad", "smartphones", "diodem", "repoimu")  # the datasets the defaults were chosen on
+HELD_OUT = ("iphones",)  # read only once the defaults were frozen, and scored once
 PUBLISHED = ("vqf", "madgwick", "mahony")
 OURS = ("explicit", "passive")
 METRICS = ("total_rmse_deg", "heading_rmse_deg", "inclination_rmse_deg")
 LARGE_ERROR_DEG = 50.0  # deg, a recording's total RMSE reported as a failure of the filter (notes)
 FIELD_SECONDS = 1.0  # s, start of each recording the field references are taken from
-GRID = {
-    "explicit": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.1, 0.3, 1.0],
-                 "rest_gain": [0.03, 0.1, 0.3, 1.0]},
-    "passive": {"kP": [0.25, 0.5, 1.0, 2.0], "kI": [0.0003, 0.001, 0.003, 0.01], "k2": [0.01, 0.03, 0.1],
-                "rest_gain": [0.03, 0.1, 0.3, 1.0]},
+# The recommended filter with one of its parts for real recordings taken away: settings over its defaults
+ABLATIONS = {
+    "no_motion_bias": {"tau_bias": math.inf},  # the bias learnt at rest only
+    "no_rest_deviation": {"rest_deviation": 0.0},  # rest: the low-passes tested, not the deviations
+    "no_recovery": {"mag_rejection_time": 0.0},  # a disturbance rejected for as long as it lasts
+    "no_rejection": {"mag_norm_tolerance": 0.0, "mag_dip_tolerance": 0.0, "mag_rejection_time": 0.0},  # every
+    # field used
+    # the reference follows the field, and adopts a lasting new one held while turning
+    "tracked_reference": {name: CORRECTIONS[name] for name in ("mag_reference_time", "mag_new_min_gyro")},
+    "no_separation": {"heading_level": 0.0, "heading_only": 0.0},  # the magnetometer's correction tilts too
+    "previous_attitude": {"correct_at_sample": 0.0},  # corrections against the previous sample's attitude
 }
+TUNING_RECORDS = Path(__file__).parent / "data"  # the search records of benchmarks.tuning
+
+
+def tuned(kind: str) -> dict | None:
+    """The gains chosen for the published filter ``kind`` by :mod:`benchmarks.tuning` (its committed
+    record ``benchmarks/data/tuning_KIND.json``), or None when it was not tuned."""
+    path = TUNING_RECORDS / f"tuning_{kind}.json"
+    return json.loads(path.read_text())["chosen"] if path.exists() else None
 
 
 def _options(kind: str, data: dict) -> dict:
@@ -69,23 +83,52 @@ def errors(kind: str, data: dict, gains: dict | None = None) -> dict:
     return {metric: np.asarray(found[metric]) for metric in METRICS}
 
 
-def _published(name: str, recordings: list, cache: Path | None) -> dict:
-    path = None if cache is None else cache / f"{name}.json"
-    if path is not None and path.exists():
-        return json.loads(path.read_text())
-    table = {}
-    for label, data in recordings:
-        table[label] = {kind: {m: float(v[0]) for m, v in errors(kind, data).items()} for kind in PUBLISHED}
-        print(name, label, {k: round(v["total_rmse_deg"], 2) for k, v in table[label].items()}, file=sys.stderr)
-    if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_text(path, json.dumps(table, indent=1) + "\n")
+def _published(name: str, recordings: list, cache: Path | None, kinds=PUBLISHED) -> dict:
+    """Label -> {kind: {metric: deg}} of the published filters ``kinds`` at their defaults on the
+    dataset ``name``, kept per filter in ``cache`` (``NAME.KIND.json``) when given."""
+    table = {label: {} for label, _ in recordings}
+    for kind in kinds:
+        path = None if cache is None else cache / f"{name}.{kind}.json"
+        if path is not None and path.exists():
+            found = json.loads(path.read_text())
+        else:
+            found = {label: {m: float(v[0]) for m, v in errors(kind, data).items()} for label, data in recordings}
+            if path is not None:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                write_text(path, json.dumps(found, indent=1) + "\n")
+        for label in table:
+            table[label][kind] = found[label]
     return table
 
 
-def evaluate(folder, names=CHOOSING + HELD_OUT, cache=None, grids: bool = False) -> dict:
+def _ablations(data: dict) -> dict:
+    """Variant -> {metric: deg} of the explicit filter on ``data`` with each entry of :data:`ABLATIONS`
+    (all in one batch call)."""
+    variants = list(ABLATIONS)
+    names = sorted({k for v in ABLATIONS.values() for k in v})
+    defaults = {"tau_bias": DEFAULT_TIME_CONSTANTS["tau_bias"]} | DEFAULT_CORRECTIONS["explicit"]
+    gains = {name: np.array([ABLATIONS[v].get(name, defaults[name]) for v in variants]) for name in names}
+    found = errors("explicit", data, gains)
+    return {v: {m: float(found[m][k]) for m in METRICS} for k, v in enumerate(variants)}
+
+
+def _tuned_published(recordings: list, kinds=PUBLISHED) -> dict:
+    """Label -> {"KIND_tuned": {metric: deg}} of the published filters ``kinds`` at their tuned gains
+    (:func:`tuned`)."""
+    rows = {label: {} for label, _ in recordings}
+    for kind in kinds:
+        gains = tuned(kind)
+        if gains is None:
+            continue
+        for label, data in recordings:
+            rows[label][f"{kind}_tuned"] = {m: float(v[0]) for m, v in errors(kind, data, gains).items()}
+    return rows
+
+
+def evaluate(folder, names=DEVELOPMENT + HELD_OUT, cache=None, published=PUBLISHED) -> dict:
     """Per dataset, the mean total, heading and inclination RMSE (deg) of every filter at its
-    defaults; with ``grids``, also each gain set of :data:`GRID` (mean total RMSE per set).
+    defaults, of the explicit filter's ablations (:data:`ABLATIONS`) and of the published filters
+    tuned by :mod:`benchmarks.tuning` (``vqf_tuned``, ...).
 
     Parameters
     ----------
@@ -94,16 +137,15 @@ def evaluate(folder, names=CHOOSING + HELD_OUT, cache=None, grids: bool = False)
     names : sequence of str
         Datasets to score; those absent from ``folder`` are skipped.
     cache : str or pathlib.Path, optional
-        Folder keeping the published filters' results.
-    grids : bool
-        Also score the grid of :data:`GRID` (for :func:`choose`).
+        Folder keeping the published filters' results at their defaults.
+    published : sequence of str
+        The published filters to score (the ``ahrs`` package's take about a millisecond a sample).
 
     Returns
     -------
     dict
         Dataset name -> ``{"recordings": count, "left_out": [names of the recordings not used],
-        "means": {filter: {metric: deg}}, "per_recording": {name: {filter: {metric: deg}}}, "grid":
-        {kind: (G,) mean total RMSE}}``.
+        "means": {filter or variant: {metric: deg}}, "per_recording": {name: {filter: {metric: deg}}}}``.
     """
     out = {}
     for name in names:
@@ -111,42 +153,20 @@ def evaluate(folder, names=CHOOSING + HELD_OUT, cache=None, grids: bool = False)
         recordings = datasets.load(folder, name, left_out)
         if not recordings:
             continue
-        published = _published(name, recordings, None if cache is None else Path(cache))
-        rows = {label: dict(published[label]) for label, _ in recordings}
-        grid_totals = {kind: [] for kind in OURS}
+        found = _published(name, recordings, None if cache is None else Path(cache), published)
+        rows = {label: dict(found[label]) for label, _ in recordings}
+        for label, extra in _tuned_published(recordings, published).items():
+            rows[label] |= extra
         for label, data in recordings:
             for kind in OURS:
                 rows[label][kind] = {m: float(v[0]) for m, v in errors(kind, data).items()}
-                if grids:
-                    grid_totals[kind].append(errors(kind, data, gain_grid(**GRID[kind]))["total_rmse_deg"])
+            rows[label] |= {f"explicit_{v}": found for v, found in _ablations(data).items()}
+        kinds = list(next(iter(rows.values())))
         means = {kind: {m: float(np.mean([rows[label][kind][m] for label in rows])) for m in METRICS}
-                 for kind in OURS + PUBLISHED}
+                 for kind in kinds}
         out[name] = {"recordings": len(recordings), "left_out": left_out, "means": means, "per_recording": rows}
-        if grids:
-            out[name]["grid"] = {kind: np.mean(grid_totals[kind], axis=0).tolist() for kind in OURS}
         print(name, {k: round(v["total_rmse_deg"], 2) for k, v in means.items()}, file=sys.stderr)
     return out
-
-
-def choose(results: dict) -> dict:
-    """The cross-validation of the module docstring on :func:`evaluate`'s ``results`` (with
-    grids): per filter, the gain set chosen on all the choosing datasets and, per left-out
-    dataset, the set chosen without it and its ratio to VQF there."""
-    names = [n for n in CHOOSING if n in results]
-    choice = {}
-    for kind in OURS:
-        axes = gain_grid(**GRID[kind])
-        ratios = {n: np.asarray(results[n]["grid"][kind]) / results[n]["means"]["vqf"]["total_rmse_deg"]
-                  for n in names}
-        best = int(np.argmin(np.mean([ratios[n] for n in names], axis=0)))
-        folds = {}
-        for left in names:
-            inner = int(np.argmin(np.mean([ratios[n] for n in names if n != left], axis=0)))
-            folds[left] = {"gains": {a: float(v[inner]) for a, v in axes.items()},
-                           "ratio_to_vqf": float(ratios[left][inner])}
-        choice[kind] = {"gains": {a: float(v[best]) for a, v in axes.items()},
-                        "ratios_to_vqf": {n: float(ratios[n][best]) for n in names}, "left_out": folds}
-    return choice
 
 
 def large_errors(found: dict, kind: str, above: float = LARGE_ERROR_DEG) -> list[float]:
@@ -165,7 +185,7 @@ def notes(results: dict) -> str:
         used, left = found["recordings"], len(found.get("left_out", []))
         lines.append(f"{name}: {used} of {used + left} recordings used, {left} left out (gyro and reference "
                      f"rates differ by more than {datasets.MISMATCH_LIMIT:.0%})")
-        for kind in OURS + PUBLISHED:
+        for kind in (k for k in OURS + PUBLISHED if k in found["means"]):
             large = large_errors(found, kind)
             if large:
                 lines.append(f"  {kind}: total RMSE above {LARGE_ERROR_DEG:g} deg on {len(large)} recordings, "
@@ -173,34 +193,51 @@ def notes(results: dict) -> str:
     return "\n".join(lines)
 
 
+def _role(name: str) -> str:
+    return "held out" if name in HELD_OUT else "chose the defaults"
+
+
 def table(results: dict) -> str:
     """The summary tables of :func:`evaluate`'s ``results``: per dataset (its role), mean total RMSE
-    (deg) of every filter and our best filter's ratio to VQF; then every filter's mean heading and
-    inclination RMSE (deg)."""
-    lines = ["| dataset (recordings) | role | explicit | passive | VQF | Madgwick | Mahony | best / VQF |",
-             "|---|---|---|---|---|---|---|---|"]
-    detail = ["| dataset | " + " | ".join(f"{k} heading / incl." for k in OURS + PUBLISHED) + " |",
-              "|---" * (len(OURS + PUBLISHED) + 1) + "|"]
+    (deg) of every filter at its defaults and the recommended filter's over VQF's; every filter's
+    mean heading and inclination RMSE (deg); the recommended filter against the published filters
+    tuned the same way; and the ablations (total, heading and inclination RMSE, deg)."""
+    present = next(iter(results.values()))["means"] if results else {}
+    filters = tuple(k for k in OURS + PUBLISHED if k in present)
+    lines = ["| dataset (recordings) | role | " + " | ".join(filters) + " | explicit / VQF |",
+             "|---" * (len(filters) + 3) + "|"]
+    detail = ["| dataset | " + " | ".join(f"{k} heading / incl." for k in filters) + " |",
+              "|---" * (len(filters) + 1) + "|"]
+    tuned_kinds = [k for k in PUBLISHED if f"{k}_tuned" in present]
+    versus = ["| dataset | explicit | " + " | ".join(f"{k} tuned" for k in tuned_kinds) + " | " +
+              " | ".join(f"explicit / {k} tuned" for k in tuned_kinds) + " |",
+              "|---" * (2 * len(tuned_kinds) + 2) + "|"]
+    variants = ["explicit"] + [f"explicit_{v}" for v in ABLATIONS]
+    ablation = ["| dataset | " + " | ".join(variants) + " |", "|---" * (len(variants) + 1) + "|"]
     for name, found in results.items():
-        m = {k: v["total_rmse_deg"] for k, v in found["means"].items()}
-        role = "held out" if name in HELD_OUT else "chose the defaults"
-        ratio = min(m["explicit"], m["passive"]) / m["vqf"]
-        lines.append(f"| {name} ({found['recordings']}) | {role} | {m['explicit']:.2f} | {m['passive']:.2f} | "
-                     f"{m['vqf']:.2f} | {m['madgwick']:.2f} | {m['mahony']:.2f} | {ratio:.2f} |")
+        m = found["means"]
+        total = {k: v["total_rmse_deg"] for k, v in m.items()}
+        lines.append(f"| {name} ({found['recordings']}) | {_role(name)} | " +
+                     " | ".join(f"{total[k]:.2f}" for k in filters) + f" | {total['explicit'] / total['vqf']:.2f} |")
         detail.append(f"| {name} | " + " | ".join(
-            f"{found['means'][k]['heading_rmse_deg']:.2f} / {found['means'][k]['inclination_rmse_deg']:.2f}"
-            for k in OURS + PUBLISHED) + " |")
-    return "\n".join(lines) + "\n\n" + "\n".join(detail)
+            f"{m[k]['heading_rmse_deg']:.2f} / {m[k]['inclination_rmse_deg']:.2f}" for k in filters) + " |")
+        versus.append(f"| {name} | {total['explicit']:.2f} | " +
+                      " | ".join(f"{total[f'{k}_tuned']:.2f}" for k in tuned_kinds) + " | " +
+                      " | ".join(f"{total['explicit'] / total[f'{k}_tuned']:.2f}" for k in tuned_kinds) + " |")
+        ablation.append(f"| {name} | " + " | ".join(
+            f"{m[v]['total_rmse_deg']:.2f} ({m[v]['heading_rmse_deg']:.2f} / {m[v]['inclination_rmse_deg']:.2f})"
+            for v in variants) + " |")
+    return "\n\n".join("\n".join(t) for t in (lines, detail, versus, ablation))
 
 
 def main(argv=None) -> int:
-    """Command line (see the module docstring); prints the table, returns 0 (2 for a bad folder).
+    """Command line (see the module docstring); prints the tables, returns 0 (2 for a bad folder).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks.real_recordings", description=__doc__.splitlines()[0])
     parser.add_argument("folder")
-    parser.add_argument("--datasets", default=",".join(CHOOSING + HELD_OUT), help="comma-separated dataset names")
-    parser.add_argument("--choose", action="store_true", help="cross-validate the defaults on the choosing datasets")
+    parser.add_argument("--datasets", default=",".join(DEVELOPMENT + HELD_OUT), help="comma-separated dataset names")
     parser.add_argument("--cache", help="folder keeping the published filters' results")
+    parser.add_argument("--published", default=",".join(PUBLISHED), help="comma-separated published filters to run")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args(argv)
     names = tuple(n.strip() for n in args.datasets.split(","))
@@ -209,15 +246,11 @@ def main(argv=None) -> int:
         print(f"real_recordings: {args.folder} is not a folder, or unknown dataset {unknown}; datasets are "
               f"{', '.join(datasets.LOADERS)}", file=sys.stderr)
         return 2
-    if args.choose:
-        names = tuple(n for n in names if n in CHOOSING)  # the held-out dataset never enters the choice
-    results = evaluate(args.folder, names, args.cache, grids=args.choose)
+    results = evaluate(args.folder, names, args.cache, tuple(k.strip() for k in args.published.split(",") if k))
     print(table(results))
     print(notes(results))
-    report = {"results": results, "defaults": {k: DEFAULT_GAINS[k] for k in OURS}}
-    if args.choose:
-        report["choice"] = choose(results)
-        print(json.dumps(report["choice"], indent=1))
+    report = {"results": results, "defaults": {k: DEFAULT_GAINS[k] for k in OURS},
+              "time_constants": DEFAULT_TIME_CONSTANTS}
     if args.json:
         write_text(args.json, json.dumps(report, indent=1) + "\n")
     return 0

@@ -2,6 +2,8 @@
 
 - :class:`QuaternionEstim`: the streaming block (``linear``, ``explicit``, ``passive``, and the
   published ``vqf`` and ``madgwick`` for comparison);
+- :data:`RECOMMENDED`: the filter for real recordings (``explicit``, at :data:`DEFAULT_GAINS`, set by the
+  time constants :data:`DEFAULT_TIME_CONSTANTS` through :func:`explicit_gains`), :func:`estimate`'s default;
 - :func:`estimate`: the same filters on recorded arrays, many gain sets at once
   (:func:`gain_grid` builds them), with errors against a reference reduced in the loop;
 - :func:`score`: the quaternion-error RMSE (total, inclination, heading);
@@ -12,14 +14,17 @@
 from estimators.filters import (
     CORRECTIONS,
     DEFAULT_GAINS,
+    DEFAULT_TIME_CONSTANTS,
     LAB_GAINS,
+    RECOMMENDED,
     QuaternionEstim,
     estimate,
+    explicit_gains,
     gain_grid,
     parse_corrections,
     references,
     score,
 )
 
-__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "LAB_GAINS", "QuaternionEstim", "estimate", "gain_grid",
-           "parse_corrections", "references", "score"]
+__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "DEFAULT_TIME_CONSTANTS", "LAB_GAINS", "RECOMMENDED", "QuaternionEstim",
+           "estimate", "explicit_gains", "gain_grid", "parse_corrections", "references", "score"]

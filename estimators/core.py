@@ -62,15 +62,16 @@ GRAVITY, FIELD, DISCRETE, RY = (CONFIG_SLOTS[n][0] for n in ("gravity", "earth_f
 # "started" is 0 until the first sample has set the low-pass filters (rest detector, specific force);
 # "acc_filter", "mag_filter": the two delay vectors of the low-passes of specific force and field,
 # body coordinates; "field_reference" and "field_candidate": (norm, dip) of the accepted field
-# and of the candidate one, "candidate_time" how long the candidate has held (s)
+# and of the candidate one, "candidate_time" how long the candidate has held (s); "rejection_time" how
+# long the magnetometer has been rejected, less twice the time it has been accepted since (s)
 STATE_LAYOUT = (("q", 4), ("b", 3), ("theta", 3), ("gyro_lowpass", 3), ("acc_lowpass", 3), ("rest_time", 1),
                 ("pending", 1), ("started", 1), ("acc_filter", 6), ("mag_filter", 6), ("field_reference", 2),
-                ("field_candidate", 2), ("candidate_time", 1))
+                ("field_candidate", 2), ("candidate_time", 1), ("rejection_time", 1))
 STATE_SLOTS, STATE_SIZE = _offsets(STATE_LAYOUT)
 Q, B, THETA, GYRO_LP, ACC_LP, REST_TIME, PENDING, STARTED, ACC_FILTER, MAG_FILTER = (STATE_SLOTS[n][0] for n in (
     "q", "b", "theta", "gyro_lowpass", "acc_lowpass", "rest_time", "pending", "started", "acc_filter", "mag_filter"))
-FIELD_REF, FIELD_CANDIDATE, CANDIDATE_TIME = (STATE_SLOTS[n][0] for n in ("field_reference", "field_candidate",
-                                                                          "candidate_time"))
+FIELD_REF, FIELD_CANDIDATE, CANDIDATE_TIME, REJECTION_TIME = (STATE_SLOTS[n][0] for n in (
+    "field_reference", "field_candidate", "candidate_time", "rejection_time"))
 
 # weights: accelerometer weight, magnetometer weight (0..1), at rest (0 or 1)
 OUTPUT_LAYOUT = (("q", 4), ("theta", 3), ("b", 3), ("omega", 3), ("weights", 3))
@@ -80,7 +81,8 @@ OUT_Q, OUT_THETA, OUT_B, OUT_OMEGA, OUT_WEIGHTS = (OUTPUT_SLOTS[n][0] for n in (
 # Gains and correction settings, one vector per gain set; see estimators.filters for meanings.
 GAIN_NAMES = ("k1", "k2", "k3", "kP", "kI", "heading_only", "acc_tolerance", "mag_norm_tolerance",
               "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain",
-              "acc_lowpass", "mag_lowpass", "mag_reference_time", "bias_clip")
+              "acc_lowpass", "mag_lowpass", "mag_reference_time", "bias_clip", "heading_level", "rest_deviation",
+              "mag_new_min_gyro", "mag_rejection_time", "correct_at_sample")
 GAIN_SLOTS = {name: i for i, name in enumerate(GAIN_NAMES)}
 GAIN_SIZE = len(GAIN_NAMES)
 K1, K2, K3, KP, KI = (GAIN_SLOTS[n] for n in ("k1", "k2", "k3", "kP", "kI"))
@@ -90,8 +92,12 @@ REST_GYRO, REST_ACC, REST_MIN_TIME, REST_GAIN = (GAIN_SLOTS[n] for n in ("rest_g
                                                                           "rest_gain"))
 ACC_LOWPASS, MAG_LOWPASS, MAG_REF_TIME, BIAS_CLIP = (GAIN_SLOTS[n] for n in ("acc_lowpass", "mag_lowpass",
                                                                              "mag_reference_time", "bias_clip"))
+HEADING_LEVEL, REST_DEVIATION, MAG_NEW_MIN_GYRO, MAG_REJECTION_TIME, CORRECT_AT_SAMPLE = (GAIN_SLOTS[n] for n in (
+    "heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time", "correct_at_sample"))
 
 REST_LOWPASS_TAU = 0.5  # s, time constant of the low-pass filters of the rest detector
+REJECTION_SLOWDOWN = 0.5  # magnetometer weight once rejected for longer than mag_rejection_time (VQF's factor 2)
+REJECTION_RECOVERY = 2.0  # the rejection time runs back this many times faster while the field is accepted (VQF's)
 SMALL_ANGLE = 1e-12  # rad: a smaller rotation in one step is integrated to first order (sin x = x)
 WORK_LAYOUT = (("R", 9), ("omega", 3), ("R_y", 9), ("v_up", 3), ("v_field", 3), ("scratch", 3), ("acc", 3),
                ("mag", 3))
@@ -358,8 +364,16 @@ def _rest(x, acc, gyro, gains, g, dt, first):
         x[ACC_LP + i] += alpha * (acc[i] - x[ACC_LP + i])
     if gains[REST_GYRO] <= 0.0:
         return False
-    still = (_norm(x[GYRO_LP], x[GYRO_LP + 1], x[GYRO_LP + 2]) < gains[REST_GYRO]
-             and abs(_norm(x[ACC_LP], x[ACC_LP + 1], x[ACC_LP + 2]) - g) < gains[REST_ACC])
+    if gains[REST_DEVIATION] > 0.0:
+        # deviation test (VQF's): each signal stays near its own low-pass, and the low-passed gyro is
+        # a bias (within bias_clip), not a slow rotation
+        still = (_norm(gyro[0] - x[GYRO_LP], gyro[1] - x[GYRO_LP + 1], gyro[2] - x[GYRO_LP + 2]) < gains[REST_GYRO]
+                 and _norm(acc[0] - x[ACC_LP], acc[1] - x[ACC_LP + 1], acc[2] - x[ACC_LP + 2]) < gains[REST_ACC]
+                 and (gains[BIAS_CLIP] <= 0.0 or max(abs(x[GYRO_LP]), abs(x[GYRO_LP + 1]), abs(x[GYRO_LP + 2]))
+                      <= gains[BIAS_CLIP]))
+    else:
+        still = (_norm(x[GYRO_LP], x[GYRO_LP + 1], x[GYRO_LP + 2]) < gains[REST_GYRO]
+                 and abs(_norm(x[ACC_LP], x[ACC_LP + 1], x[ACC_LP + 2]) - g) < gains[REST_ACC])
     x[REST_TIME] = x[REST_TIME] + dt if still else 0.0
     return x[REST_TIME] >= gains[REST_MIN_TIME]
 
@@ -438,7 +452,8 @@ def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
     field that has held its own norm and dip (within the tolerances) for ``mag_reference_time``
     while the reference is rejected becomes the reference. A short disturbance stays rejected,
     a lasting new field (an uncompensated motor field, a room's iron) is accepted instead of
-    being rejected for ever."""
+    being rejected for ever. With ``mag_new_min_gyro`` (rad/s) the candidate's time runs only while the
+    low-passed gyro norm reaches it (VQF's test)."""
     if first:
         x[FIELD_REF], x[FIELD_REF + 1] = field, field_dip
         x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
@@ -451,11 +466,30 @@ def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
     if _field_weight(norm, dip, x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], gains) > 0.0:
         x[FIELD_CANDIDATE] += k * (norm - x[FIELD_CANDIDATE])
         x[FIELD_CANDIDATE + 1] += k * (dip - x[FIELD_CANDIDATE + 1])
-        x[CANDIDATE_TIME] += dt
+        # with mag_new_min_gyro, only time spent turning counts: a field that keeps its norm and dip
+        # while the body turns is fixed in the inertial frame, one carried by the body is not
+        if gains[MAG_NEW_MIN_GYRO] <= 0.0 or (_norm(x[GYRO_LP], x[GYRO_LP + 1], x[GYRO_LP + 2])
+                                              >= gains[MAG_NEW_MIN_GYRO]):
+            x[CANDIDATE_TIME] += dt
     else:
         x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
     if not accepted and x[CANDIDATE_TIME] >= span:
         x[FIELD_REF], x[FIELD_REF + 1] = x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _rejection(x, mag_weight, longest, dt):
+    """The magnetometer weight after a bounded rejection (after VQF): a field rejected (weight under 0.5)
+    for longer than ``longest`` (s) corrects the heading again at :data:`REJECTION_SLOWDOWN` of its weight,
+    so that a lasting disturbance bounds the gyro's heading drift; the time spent rejected runs back
+    :data:`REJECTION_RECOVERY` times faster while the field is accepted."""
+    if mag_weight < 0.5:
+        if x[REJECTION_TIME] <= longest:
+            x[REJECTION_TIME] += dt
+            return mag_weight
+        return REJECTION_SLOWDOWN
+    x[REJECTION_TIME] = max(0.0, x[REJECTION_TIME] - REJECTION_RECOVERY * dt)
+    return mag_weight
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -476,11 +510,14 @@ def _weights(acc, mag, gains, v_up, v_field, g, field, x, dt, first):
     if gains[MAG_REF_TIME] > 0.0:
         field_dip = _asin(-(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2]))
         _track_field(x, nm, _asin(sin_dip), gains, dt, first, field, field_dip)
-        return acc_weight, _field_weight(nm, _asin(sin_dip), x[FIELD_REF], x[FIELD_REF + 1], gains)
-    mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL])
-    if gains[MAG_DIP_TOL] > 0.0:
-        sin_ref = -(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2])
-        mag_weight *= _ramp(_asin(sin_dip) - _asin(sin_ref), gains[MAG_DIP_TOL])
+        mag_weight = _field_weight(nm, _asin(sin_dip), x[FIELD_REF], x[FIELD_REF + 1], gains)
+    else:
+        mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL])
+        if gains[MAG_DIP_TOL] > 0.0:
+            sin_ref = -(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2])
+            mag_weight *= _ramp(_asin(sin_dip) - _asin(sin_ref), gains[MAG_DIP_TOL])
+    if gains[MAG_REJECTION_TIME] > 0.0:
+        mag_weight = _rejection(x, mag_weight, gains[MAG_REJECTION_TIME], dt)
     return acc_weight, mag_weight
 
 
@@ -491,7 +528,18 @@ def _explicit_correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field)
     if acc_weight > 0.0:
         c = _cross(acc, _norm3(acc), v_up, gains[K1] * acc_weight)
         w0, w1, w2 = w0 + c[0], w1 + c[1], w2 + c[2]
-    if mag_weight > 0.0:
+    if mag_weight > 0.0 and gains[HEADING_LEVEL] > 0.0:
+        # the sine of the heading error between the horizontal parts of the measured and the predicted
+        # field, about the vertical: k2 kP is the heading's rate whatever the dip
+        m_up = mag[0] * v_up[0] + mag[1] * v_up[1] + mag[2] * v_up[2]
+        f_up = v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2]
+        h = (mag[0] - m_up * v_up[0], mag[1] - m_up * v_up[1], mag[2] - m_up * v_up[2])
+        f = (v_field[0] - f_up * v_up[0], v_field[1] - f_up * v_up[1], v_field[2] - f_up * v_up[2])
+        norms = _norm(h[0], h[1], h[2]) * _norm(f[0], f[1], f[2])
+        if norms > 0.0:
+            c = _cross(h, norms, f, gains[K2] * mag_weight)
+            w0, w1, w2 = w0 + c[0], w1 + c[1], w2 + c[2]
+    elif mag_weight > 0.0:
         c = _cross(mag, _norm3(mag), v_field, gains[K2] * mag_weight)
         if gains[HEADING_ONLY] > 0.0:
             # the magnetometer's correction kept along the vertical: it turns the heading only
@@ -574,6 +622,13 @@ def _complementary(kind, x, u, gains, config, dt, work, y):
     g = math.sqrt(gx * gx + gy * gy + gz * gz)
     v_up = _direction(r, -gx, -gy, -gz)  # estimated direction of the specific force at rest ("up")
     v_field = _direction(r, mx, my, mz)
+    if gains[CORRECT_AT_SAMPLE] > 0.0:
+        # corrections and weights against this sample's attitude, the previous one advanced by the gyro:
+        # against the previous one, a turn of omega dt reads as an error (1.4 deg at 1.2 rad/s, 50 Hz)
+        p = _advance(x[Q], x[Q + 1], x[Q + 2], x[Q + 3], wx, wy, wz, dt, int(config[DISCRETE]))
+        r = _rotation(p[0], p[1], p[2], p[3])
+        v_up = _direction(r, -gx, -gy, -gz)
+        v_field = _direction(r, mx, my, mz)
     acc_weight, mag_weight = _weights(filtered, field, gains, v_up, v_field, g, math.sqrt(mx * mx + my * my + mz * mz),
                                       x, dt, first)
     if kind == EXPLICIT:

@@ -29,7 +29,9 @@ orthogonal group", 2008, eqs. 32/48; lab section III.1)
     to the estimated vertical) and its heading part (along it): 1 and 1 are the lab's filter.
 
 Disturbance-aware corrections (explicit and passive; the passive filter's only with TRIAD),
-each switched by its own setting, off when 0. By default all are on at :data:`CORRECTIONS`;
+each switched by its own setting, off when 0. By default each filter runs those of
+:data:`DEFAULT_CORRECTIONS` (the explicit filter all but the magnetic reference tracking, the
+passive filter those it was tuned with) at the values of :data:`CORRECTIONS`;
 ``corrections=False`` turns all off (the lab's filters, as ``tp`` runs them); a dict switches
 or tunes each:
 
@@ -66,6 +68,31 @@ or tunes each:
     Rest detection: once the low-passed gyro norm stays under ``rest_gyro`` and the low-passed
     specific force within ``rest_acc`` of g for ``rest_time``, the bias follows the gyro,
     ``db = rest_gain (omega_m - b)``.
+``rest_deviation`` (0 or 1)
+    The rest detector's deviation test (VQF's): rest is the gyro and the specific force each
+    staying within ``rest_gyro`` and ``rest_acc`` of their own low-passes (time constant 0.5 s),
+    with the low-passed gyro within ``bias_clip`` (a bias, not a slow turn). Without it, the
+    low-passes themselves are tested (a slow turn under ``rest_gyro`` passes for rest).
+``heading_level`` (0 or 1), explicit filter
+    The magnetometer's correction is ``k2 sin(psi)`` about the estimated vertical, ``psi`` the
+    angle between the horizontal parts of the measured and the predicted field: a heading
+    correction only (it never tilts the estimate), whose rate ``k2 kP`` does not depend on the
+    dip. Without it (and with ``heading_only``), the rate is ``k2 kP cos^2(dip)``.
+``mag_new_min_gyro`` (rad/s)
+    With ``mag_reference_time``: the time a candidate field must hold runs only while the
+    low-passed gyro norm reaches this rate. A field that keeps its norm and dip while the body
+    turns is fixed in the inertial frame and may become the reference; one carried by the body
+    (a magnet on it) changes its dip as the body turns and never does, so the heading is not
+    pulled to it (VQF's test).
+``correct_at_sample`` (0 or 1)
+    The corrections and the weights are taken against the attitude at the sample (the previous
+    estimate advanced by the corrected gyro), not the previous estimate: otherwise a turn of
+    ``omega dt`` during the sample reads as an error of that size (1.4 deg at 1.2 rad/s and
+    50 Hz), which fast time constants turn into an error that grows with the sample period.
+``mag_rejection_time`` (s)
+    A magnetometer rejected (weight under 0.5) for longer than this corrects the heading again at
+    half its weight, so that a lasting disturbance bounds the gyro's heading drift; the time
+    spent rejected runs back twice as fast while the field is accepted (VQF's choice).
 
 The outputs ``weights`` are the accelerometer and magnetometer weights in use and the rest flag.
 
@@ -92,13 +119,48 @@ from fmus import vehicle
 from orchestrator.blocks import Block
 
 FILTERS = tuple(core.KINDS)
-# Defaults for real recordings, corrections on: chosen by cross-validation over three public datasets with
-# optical ground truth (benchmarks/real_recordings.py --choose), a fourth held out until they were frozen.
-# Time constants: tilt 1/(k1 kP) (2 s explicit, 4 s passive); heading 1/(k2 kP cos^2(dip)) explicit (37 s at
-# 65 deg dip), 1/(k2 kP) passive (40 s); the bias is learnt mostly at rest (rest_gain 0.1 1/s).
+RECOMMENDED = "explicit"  # the filter for real recordings: estimate()'s default
+TIME_CONSTANTS = ("tau_inclination", "tau_heading", "tau_bias")
+# The recommended filter's defaults, as time constants (s) and magnetic disturbance thresholds (the field's
+# norm, in uT at the lab's 47 uT field, and its dip, in deg): chosen on four public datasets with optical ground
+# truth (python -m benchmarks.tuning DATA; its record benchmarks/data/tuning_explicit.json), a fifth held out
+# until they were frozen.
+DEFAULT_TIME_CONSTANTS = {"tau_inclination": 0.5, "tau_heading": 10.0, "tau_bias": 400.0}
+DEFAULT_MAG_THRESHOLDS = {"norm_uT": 32.0, "dip_deg": 5.0}
+
+
+def explicit_gains(tau_inclination, tau_heading, tau_bias) -> dict:
+    """The explicit filter's gains from its time constants (s; scalars or arrays of gain sets).
+
+    With ``heading_level`` (see the module docstring), a tilt error decays as
+    ``exp(-t / tau_inclination)``, a heading error as ``exp(-t / tau_heading)``, and a constant
+    gyro bias is learnt in motion with the time constant ``tau_bias`` (the slow pole of the
+    proportional-integral loop, for ``tau_bias >> tau_inclination``): ``k1 = 1``,
+    ``kP = 1 / tau_inclination``, ``k2 = tau_inclination / tau_heading`` and
+    ``kI = 1 / (tau_inclination tau_bias)`` (``tau_bias = inf``: no bias learnt in motion).
+    Each correction, and so the bias it feeds, is weighed by its sensor's weight (the
+    disturbance tests): the bias is learnt as fast as the corrections are trusted.
+    """
+    tau_i, tau_h, tau_b = (np.asarray(v, dtype=float) for v in (tau_inclination, tau_heading, tau_bias))
+    if np.any(tau_i <= 0) or np.any(tau_h <= 0) or np.any(tau_b <= 0):
+        raise ValueError("the time constants tau_inclination, tau_heading and tau_bias must be positive (s)")
+    gains = {"k1": np.ones_like(tau_i), "k2": tau_i / tau_h, "kP": 1.0 / tau_i, "kI": 1.0 / (tau_i * tau_b)}
+    return {k: (float(v) if np.ndim(v) == 0 else v) for k, v in gains.items()}
+
+
+def time_constants(gains: dict) -> dict:
+    """The time constants (s) of the explicit filter's gains ``k1, k2, kP, kI`` (the inverse of
+    :func:`explicit_gains`; ``tau_bias`` is ``inf`` when ``kI`` is 0)."""
+    k1, k2, kp, ki = (float(gains[k]) for k in ("k1", "k2", "kP", "kI"))
+    return {"tau_inclination": 1.0 / (k1 * kp), "tau_heading": 1.0 / (k2 * kp),
+            "tau_bias": math.inf if ki == 0 else kp / ki}
+
+
 DEFAULT_GAINS = {
     "linear": {"k1": 0.05, "k2": 0.05, "k3": 0.05},
-    "explicit": {"k1": 1.0, "k2": 0.3, "kP": 0.5, "kI": 0.0003},
+    "explicit": explicit_gains(**DEFAULT_TIME_CONSTANTS),
+    # chosen on three public datasets by a cross-validation over a grid of kP, kI, k2 and the rest gain, with the
+    # corrections of DEFAULT_CORRECTIONS["passive"]; not re-tuned since the explicit filter became the recommended one
     "passive": {"k1": 1.0, "k2": 0.1, "kP": 0.25, "kI": 0.0003},
 }
 # The lab report's values
@@ -120,8 +182,26 @@ CORRECTIONS = {
     "mag_lowpass": 1.0,  # s
     "mag_reference_time": 2.0,  # s
     "bias_clip": math.radians(2.0),  # rad/s
+    "heading_level": 1.0,
+    "rest_deviation": 1.0,
+    "mag_new_min_gyro": math.radians(20.0),  # rad/s
+    "mag_rejection_time": 60.0,  # s
+    "correct_at_sample": 1.0,
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
+# The corrections each filter runs with by default (corrections=None or True), at the values of CORRECTIONS.
+# The recommended explicit filter takes the configured Earth field as the magnetic reference for ever (no
+# tracking: on the RING dataset a tracked reference followed slow disturbances, 20.9 deg heading RMSE against
+# 10.1 without, benchmarks/real_recordings.py); the passive filter keeps the corrections it was tuned with.
+NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time",
+                    "correct_at_sample")
+DEFAULT_CORRECTIONS = {
+    "explicit": CORRECTIONS | {
+        "mag_reference_time": 0.0, "mag_new_min_gyro": 0.0,
+        "mag_norm_tolerance": DEFAULT_MAG_THRESHOLDS["norm_uT"] * 1e-6 / vehicle.EARTH_FIELD_NORM,
+        "mag_dip_tolerance": math.radians(DEFAULT_MAG_THRESHOLDS["dip_deg"])},
+    "passive": CORRECTIONS | dict.fromkeys(NEW_FOR_EXPLICIT, 0.0),
+}
 OUTPUT_NAMES = tuple(name for name, _ in core.OUTPUT_LAYOUT)
 OUTPUTS = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "theta_est3",
            "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z",
@@ -148,11 +228,14 @@ def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
     kind : {"linear", "explicit", "passive"}
     gains : dict, optional
         Gain values by name (see the module docstring); a value may be an array of gain sets.
-        Correction settings may be given here too, to vary them across gain sets.
+        Correction settings may be given here too, to vary them across gain sets. The explicit
+        filter also takes its time constants ``tau_inclination``, ``tau_heading`` and
+        ``tau_bias`` (s; :func:`explicit_gains`; those not given at their defaults), which set
+        ``k1, k2, kP, kI`` unless those are given too.
     corrections : bool or dict, optional
-        ``None`` (default) or ``True``: all at :data:`CORRECTIONS`; ``False``: all off (the
-        lab's filters); a dict: those given on (``True`` for the default value, or a value),
-        the others off.
+        ``None`` (default) or ``True``: the filter's own, :data:`DEFAULT_CORRECTIONS`, at the
+        values of :data:`CORRECTIONS`; ``False``: all off (the lab's filters); a dict: those
+        given on (``True`` for the value of :data:`CORRECTIONS`, or a value), the others off.
 
     Returns
     -------
@@ -164,10 +247,17 @@ def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
         raise ValueError(f"unknown estimator {kind!r}; use one of {', '.join(FILTERS + _reference_kinds())}")
     merged = dict(DEFAULT_GAINS[kind])
     if kind != "linear":
-        merged |= _corrections(corrections)
+        merged |= _corrections(corrections, kind)
     elif corrections:
         raise ValueError("the linear filter has no disturbance-aware corrections; use corrections=False")
-    for name, value in (gains or {}).items():
+    gains = dict(gains or {})
+    taus = {name: gains.pop(name) for name in TIME_CONSTANTS if name in gains}
+    if taus and kind != "explicit":
+        raise ValueError(f"the time constants {', '.join(taus)} set the explicit filter's gains; give the {kind} "
+                         "filter its gains by name")
+    if taus:
+        merged |= explicit_gains(**(DEFAULT_TIME_CONSTANTS | taus))
+    for name, value in gains.items():
         if name not in merged:
             raise ValueError(f"the {kind} estimator has no gain {name!r}; its gains are {', '.join(merged)}")
         merged[name] = value
@@ -178,11 +268,11 @@ def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
     return merged
 
 
-def _corrections(corrections) -> dict:
+def _corrections(corrections, kind: str = "explicit") -> dict:
     if corrections is False:
         return dict(CORRECTIONS_OFF)
     if corrections is None or corrections is True:
-        return dict(CORRECTIONS)
+        return dict(DEFAULT_CORRECTIONS[kind])
     if not isinstance(corrections, dict):
         raise ValueError(f"corrections={corrections!r}: give True, False or a dict of {', '.join(CORRECTIONS)}")
     chosen = dict(CORRECTIONS_OFF)
@@ -446,17 +536,18 @@ def _compile(code: int):
                 np.empty(core.WORK_SIZE))
 
 
-def estimate(kind: str, *, gyro, acc, mag, dt: float, gains: dict | None = None, corrections=None, R_reel=None,
-             q0=None, b0=(0.0, 0.0, 0.0), initial=None, discretisation: str = "exp", ry: str = "reel",
+def estimate(kind: str = RECOMMENDED, *, gyro, acc, mag, dt: float, gains: dict | None = None, corrections=None,
+             R_reel=None, q0=None, b0=(0.0, 0.0, 0.0), initial=None, discretisation: str = "exp", ry: str = "reel",
              gravity=vehicle.GRAVITY, earth_field=None, dip=None, declination=0.0, outputs=OUTPUT_NAMES,
              reference=None, scored=None, align_heading: bool = False, check_units: bool = True) -> dict:
     """Run a filter on recorded arrays, for one or many gain sets at once.
 
     Parameters
     ----------
-    kind : {"linear", "explicit", "passive", "vqf", "madgwick"}
-        The filter (see the module docstring; ``vqf`` and ``madgwick`` are the published
-        filters of :mod:`estimators.reference`).
+    kind : {"explicit", "linear", "passive", "vqf", "madgwick", "mahony"}
+        The filter (see the module docstring; ``vqf``, ``madgwick`` and ``mahony`` are the
+        published filters of :mod:`estimators.reference`). Default: ``"explicit"``, the
+        recommended filter for real recordings (at :data:`DEFAULT_GAINS`, corrections on).
     gyro, acc, mag : (N, 3) arrays, keyword-only
         Body-frame measurements: rad/s, m/s^2 (specific force: ``-g`` rotated into the body at
         rest), and T (or the unit of ``earth_field``); sample ``n`` at time ``n * dt``. A

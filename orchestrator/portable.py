@@ -65,7 +65,18 @@ def sin(x) -> np.ndarray:
 
 
 def cos(x) -> np.ndarray:
-    """Cosine, with the same bits on every CPU; see :func:`sin`."""
+    """Cosine, with the same bits on every CPU.
+
+    Parameters
+    ----------
+    x : array_like
+        Angles (rad), finite, of magnitude below about 1e7.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``cos(x)``, float64, within a few ulp of the exact value.
+    """
     r, quadrant = _reduce(np.asarray(x, dtype=float))
     s, c = _sin_cos_reduced(r)
     return np.choose(quadrant, (c, -s, -c, s))

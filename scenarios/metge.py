@@ -18,6 +18,13 @@ clamped, so the Earth field is constant in the sensor frame.
   reference, rows "no dynamic calibration / calibration 1 / calibration 2", columns
   "set 1 / set 2 / free set"; Figure 3: the error against time on the free set, with the
   four commands.
+- Regimes (option ``regime``): ``default``, the vehicle's own cables (each ESC's field along
+  its own direction) and a free set swinging the commands by 0.13 about 0.5; ``paper``, the
+  regime of the paper's free set: one common lead (every motor's field along one direction,
+  up, as the current loops of a power board below the sensor make it), its gains scaled so
+  that a one-motor sweep deflects the field as much as on the default vehicle (the sets keep
+  their error), and a free set swinging 0.25. :mod:`scenarios.metge_free` measures what each
+  ingredient does.
 """
 
 from __future__ import annotations
@@ -59,7 +66,23 @@ OPTIONS = {
     "noise": Option(True, "IMU white noise"),
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
     "static": Option("", "static calibration file (JSON) for A, b_s; empty: the IMU's identity"),
+    "regime": Option("default", "the vehicle's own ESC cables and a free set swinging 0.13, or 'paper': one common "
+                                "lead (every motor's field up, -z_B) and a free set swinging 0.25, the regime of the "
+                                "paper's free set", choices=("default", "paper")),
+    "free_swing": Option(-1.0, "amplitude of each of the free set's three sines (1); -1: the regime's (0.13 "
+                               "default, 0.25 paper)"),
+    "free_speed": Option(1.0, "the free set's frequencies times this (1)", minimum=0.01),
 }
+#: Swing (1) of each of the free set's three sines, by regime.
+REGIME_SWING = {"default": 0.13, "paper": 0.25}
+#: Direction (1, body frame) of the common lead's field in the ``paper`` regime: up, normal to a
+#: power board below the magnetometer, whose current loops make a field normal to their plane.
+COMMON_LEAD_DIRECTION = (0.0, 0.0, -1.0)
+#: Command levels (1) of the one-motor sweep the common lead's gains are matched on: the
+#: default rig's K = 12 levels.
+MATCHED_LEVELS = tuple(np.arange(1, 13) / 12)
+#: States of charge (1) of the battery of that sweep: those of the default sets' four runs.
+MATCHED_SOCS = (0.95, 0.6, 0.8, 0.45)
 RECORD = ["Setpoint.c", "MotorMagnetics.u_batt", "IMU.magneto"]
 #: Block parameters the rig sets from its options (``--set`` on one of them is refused, naming the option).
 DERIVED = {"IMU.noise_enabled": "noise", "IMU.seed": "seed1 and seed2", "IMU.sample_rate": "mag_rate",
@@ -104,13 +127,14 @@ def vehicle_settings(o: dict) -> tuple[tuple[str, str], ...]:
                         if k.startswith(rig_blocks) and k not in DERIVED and not k.startswith(_NOT_ON_THE_RIG)))
 
 
-def schedule(o: dict, set_number: int) -> tuple[list[tuple[str, float, float, int, float]], float]:
+def schedule(o: dict, set_number: int, sweeps: bool = True) -> tuple[list[tuple[str, float, float, int, float]], float]:
     """Phases ``(name, start, stop, motor, command)`` of a calibration set and its end time (s).
 
     Set 1: motors 1..4, levels rising; set 2: motors 4..1, levels shuffled (``set_number``);
-    ``o``: the parsed options (levels, hold and settle times)."""
+    ``o``: the parsed options (levels, hold and settle times); ``sweeps`` False: the motors-off
+    reference alone (a free set with no sweep before it)."""
     levels = np.arange(1, o["levels"] + 1) / o["levels"]
-    motors = [0, 1, 2, 3]
+    motors = [0, 1, 2, 3] if sweeps else []
     if set_number == 2:
         motors = motors[::-1]
         levels = np.random.default_rng(o["seed2"]).permutation(levels)
@@ -123,20 +147,93 @@ def schedule(o: dict, set_number: int) -> tuple[list[tuple[str, float, float, in
     return out, t
 
 
+def free_swing(o: dict) -> float:
+    """Amplitude (1) of each of the free set's three sines: option ``free_swing``, or the regime's."""
+    return REGIME_SWING[o["regime"]] if o["free_swing"] == -1.0 else o["free_swing"]
+
+
 def free_commands(o: dict, t: np.ndarray) -> np.ndarray:
-    """All four commands together: sums of sinusoids, slow (0.1 to 0.6 Hz) in the outer thirds,
-    fast (1 to 4 Hz) in the middle third, around 0.5."""
+    """All four commands together: sums of three sinusoids of amplitude :func:`free_swing` each
+    about 0.5, slow (0.1 to 0.6 Hz) in the outer thirds, fast (1 to 4 Hz) in the middle third,
+    every frequency times ``free_speed``; clipped to [0, 1]. ``o``: the options (``seed1``
+    draws the frequencies and phases); ``t``: times from the start of the free set (s)."""
     rng = np.random.default_rng(o["seed1"] + 100)
-    third = o["free"] / 3
+    third, swing, speed = o["free"] / 3, free_swing(o), o["free_speed"]
     fast = (t >= third) & (t < 2 * third)
     c = np.empty((len(t), 4))
     for n in range(4):
-        slow_f, fast_f = rng.uniform(0.1, 0.6, 3), rng.uniform(1.0, 4.0, 3)
+        slow_f, fast_f = speed * rng.uniform(0.1, 0.6, 3), speed * rng.uniform(1.0, 4.0, 3)
         phase = rng.uniform(0, 2 * np.pi, (2, 3))
         slow = portable.sin(2 * np.pi * slow_f[:, None] * t + phase[0][:, None]).sum(axis=0)
         quick = portable.sin(2 * np.pi * fast_f[:, None] * t + phase[1][:, None]).sum(axis=0)
-        c[:, n] = np.where(fast, 0.5 + 0.13 * quick, 0.5 + 0.13 * slow)
+        c[:, n] = np.where(fast, 0.5 + swing * quick, 0.5 + swing * slow)
     return np.clip(c, 0.0, 1.0)
+
+
+def steady_supply_current(c, u) -> np.ndarray:
+    """Steady supply current ``c i`` (A) of one default motor at commands ``c`` (1) and battery
+    voltage ``u`` (V): ``c u = R i + k_e omega`` with ``k_e i = k_m omega^2`` (the plant's
+    steady state, :func:`fmus.vehicle.steady_command` solved for ``omega``)."""
+    c, u = np.asarray(c, dtype=float), np.asarray(u, dtype=float)
+    a = vehicle.MOTOR_RESISTANCE * vehicle.DRAG_TORQUE_COEFF / vehicle.MOTOR_KE  # V s^2
+    omega = (-vehicle.MOTOR_KE + np.sqrt(vehicle.MOTOR_KE**2 + 4 * a * c * u)) / (2 * a)
+    return c * vehicle.steady_current(omega)
+
+
+def one_motor_deflection_deg(directions, gains) -> float:
+    """Mean angle (deg) by which one motor alone, swept over :data:`MATCHED_LEVELS` at steady
+    state, turns the Earth field at the clamped rig, over the four motors and the battery
+    states :data:`MATCHED_SOCS` (open-circuit voltage); ``directions`` (4, 3) and ``gains``
+    (4,) (T/A) of the cables' fields. A static prediction of Table 1's uncompensated sets."""
+    m0 = np.array(vehicle.EARTH_FIELD)  # the rig is level, heading north: {B} = {I}
+    v = np.asarray(directions, dtype=float)
+    v = v / np.linalg.norm(v, axis=1, keepdims=True)
+    u = vehicle.BATTERY_CELLS * np.array([vehicle.cell_voltage(soc) for soc in MATCHED_SOCS])
+    current = steady_supply_current(np.array(MATCHED_LEVELS)[None, :], u[:, None]).ravel()  # A, (socs x levels)
+    fields = m0 + np.asarray(gains, dtype=float)[:, None, None] * current[None, :, None] * v[:, None, :]
+    return float(np.degrees(angle_between(fields.reshape(-1, 3), m0)).mean())
+
+
+def common_lead_settings(direction=COMMON_LEAD_DIRECTION) -> dict:
+    """``MotorMagnetics`` settings of one common lead: every motor's field along ``direction``
+    (1, body frame), the default gains times the one factor that keeps the one-motor sweep's
+    deflection (:func:`one_motor_deflection_deg`) that of the default vehicle.
+
+    Parameters
+    ----------
+    direction : sequence of 3 float
+        Direction of the common field in {B} (normalised here).
+
+    Returns
+    -------
+    dict
+        ``{"MotorMagnetics.kappaN": T/A, "MotorMagnetics.vN_a": 1}``.
+    """
+    from scipy.optimize import brentq
+
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    gains = np.array(vehicle.MOTOR_FIELD_GAIN)
+    target = one_motor_deflection_deg(vehicle.MOTOR_FIELD_DIRECTION, gains)
+    v = np.tile(d, (4, 1))
+    scale = brentq(lambda s: one_motor_deflection_deg(v, s * gains) - target, 1e-3, 1e3, xtol=1e-12)
+    out = {f"MotorMagnetics.kappa{n + 1}": float(scale * g) for n, g in enumerate(gains)}
+    return out | {f"MotorMagnetics.v{n + 1}_{a}": float(d[k]) for n in range(4) for k, a in enumerate("xyz")}
+
+
+def cable_directions(o: dict) -> np.ndarray:
+    """Unit directions (4, 3) of the cables' fields of the options' vehicle: the regime's, or
+    those set (``MotorMagnetics.vN_a``), else the default vehicle's."""
+    settings = regime_settings(o) | block_settings(o)
+    v = np.array([[float(settings.get(f"MotorMagnetics.v{n + 1}_{a}", vehicle.MOTOR_FIELD_DIRECTION[n][k]))
+                   for k, a in enumerate("xyz")] for n in range(4)])
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def regime_settings(o: dict) -> dict:
+    """The ``MotorMagnetics`` settings of the options' regime: none for ``default``,
+    :func:`common_lead_settings` for ``paper``."""
+    return common_lead_settings() if o["regime"] == "paper" else {}
 
 
 def socs(o: dict, set_number: int) -> list[float]:
@@ -151,10 +248,11 @@ def socs(o: dict, set_number: int) -> list[float]:
     return values
 
 
-def commands(o: dict, set_number: int, free: bool = False) -> tuple[np.ndarray, float, float]:
+def commands(o: dict, set_number: int, free: bool = False, sweeps: bool = True) -> tuple[np.ndarray, float, float]:
     """Command table (rows every macro step, columns motors 1..4), the end of the sweeps and the end
-    of the run (s), of calibration set ``set_number``, followed by the free set when ``free``."""
-    phases, end = schedule(o, set_number)
+    of the run (s), of calibration set ``set_number``, followed by the free set when ``free``;
+    without the sweeps when not ``sweeps``."""
+    phases, end = schedule(o, set_number, sweeps)
     stop = end + (o["free"] if free else 0.0)
     t = np.arange(int(round(stop / o["dt"])) + 1) * o["dt"]
     c = np.zeros((len(t), 4))
@@ -166,9 +264,10 @@ def commands(o: dict, set_number: int, free: bool = False) -> tuple[np.ndarray, 
     return c, end, stop
 
 
-def system_for(o: dict, set_number: int, run: int) -> System:
-    """Run ``run`` of calibration set ``set_number``; the first run of set 1 ends with the free set."""
-    c, _, _ = commands(o, set_number, free=(set_number, run) == (1, 0))
+def system_for(o: dict, set_number: int, run: int, sweeps: bool = True) -> System:
+    """Run ``run`` of calibration set ``set_number``; the first run of set 1 ends with the free set
+    (which is all it holds, after the motors-off reference, when not ``sweeps``)."""
+    c, _, _ = commands(o, set_number, free=(set_number, run) == (1, 0), sweeps=sweeps)
     system = System(dt=o["dt"])
     system.add(Table("Setpoint", ["c1", "c2", "c3", "c4"], c, units=dict.fromkeys(("c1", "c2", "c3", "c4"), "1")))
     seed = o[f"seed{set_number}"] + 10 * run
@@ -176,7 +275,7 @@ def system_for(o: dict, set_number: int, run: int) -> System:
               imu=imu_parameters(o["noise"], False, seed, sample_rate=o["mag_rate"],
                                  mag_sample_rate=o["mag_rate"]))
     system.connect("Setpoint.c", "MotorMagnetics.c")
-    settings = block_settings(o)
+    settings = regime_settings(o) | block_settings(o)
     if settings:  # every run of the rig is the same vehicle: the parameters set reach them all
         apply(system, settings, DERIVED)
     return system
@@ -190,6 +289,12 @@ def build(o: dict) -> System:
     parse_orders(o["orders"])
     if abs(round(1.0 / (o["mag_rate"] * o["dt"])) * o["mag_rate"] * o["dt"] - 1.0) > 1e-9:
         raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
+    if not (o["free_swing"] == -1.0 or o["free_swing"] >= 0):
+        raise ValueError(f"option free_swing = {o['free_swing']} must be at least 0 (or -1 for the regime's)")
+    clash = sorted(set(regime_settings(o)) & set(block_settings(o)))
+    if clash:
+        raise ValueError(f"regime={o['regime']} sets {', '.join(clash)} (one common lead): leave them out, or "
+                         "choose regime=default to set the cables yourself")
     return system_for(o, 1, 0)
 
 
@@ -208,14 +313,15 @@ def parse_orders(text: str):
 
 class RigRun:
     """One recorded run on the clamped rig: arrays, phases, and the rows of its K measurements,
-    from the run's ``result``, its options ``o`` and its calibration set ``set_number``."""
+    from the run's ``result``, its options ``o`` and its calibration set ``set_number``
+    (``sweeps`` False: a free set alone, after the motors-off reference)."""
 
-    def __init__(self, result, o: dict, set_number: int):
+    def __init__(self, result, o: dict, set_number: int, sweeps: bool = True):
         self.time = result.time
         self.field = result["IMU.magneto"]
         self.commands = result["Setpoint.c"]
         self.voltage = result["MotorMagnetics.u_batt"]
-        self.phases, self.end = schedule(o, set_number)
+        self.phases, self.end = schedule(o, set_number, sweeps)
         t = self.time
         _, a, b, _, _ = self.phases[0]
         self.reference = self.field[(t >= a + 0.1) & (t < b)].mean(axis=0)  # m0, after the start-up
@@ -223,7 +329,7 @@ class RigRun:
         for _, a, b, motor, _ in self.phases[1:]:
             self.motor_of[(t >= a + o["settle"]) & (t < b - 1e-9)] = motor
         self.settled = self.motor_of >= 0
-        self.sweeping = (t >= self.phases[1][1]) & (t < self.end)
+        self.sweeping = (t >= self.phases[1][1]) & (t < self.end) if len(self.phases) > 1 else np.zeros(len(t), bool)
         self.free = t >= self.end
 
     def record(self):
@@ -334,9 +440,11 @@ def run_line(o: dict) -> str:
     -------
     str
     """
-    return (f"K = {o['levels']} command levels of {o['hold']:g} s per motor, free set {o['free']:g} s, "
-            f"magnetometer {o['mag_rate']:g} Hz, IMU noise {'on' if o['noise'] else 'off'}, battery states "
-            f"{o['soc1']} (set 1) and {o['soc2']} (set 2)")
+    regime = "" if o["regime"] == "default" else f"regime {o['regime']} (one common lead), "
+    speed = "" if o["free_speed"] == 1.0 else f" x{o['free_speed']:g} in frequency"
+    return (f"{regime}K = {o['levels']} command levels of {o['hold']:g} s per motor, free set {o['free']:g} s "
+            f"(swing {free_swing(o):g}{speed}), magnetometer {o['mag_rate']:g} Hz, IMU noise "
+            f"{'on' if o['noise'] else 'off'}, battery states {o['soc1']} (set 1) and {o['soc2']} (set 2)")
 
 
 def figure3(first: RigRun, numbers: dict, o: dict, out):
@@ -437,8 +545,7 @@ def report(result, o, out) -> dict:
     fast = fast_third(first, o)
     e_free = numbers["series"]["calibration1"][first.free]
     ed_free = numbers["series"]["calibration1_dynamic"][first.free]
-    true_v = np.array(vehicle.MOTOR_FIELD_DIRECTION)
-    true_v /= np.linalg.norm(true_v, axis=1, keepdims=True)
+    true_v = cable_directions(o)
     figures = [figure3(first, numbers, o, out), table1_text(numbers, orders, o, out)]
     return {
         "table1_deg": table,
@@ -454,6 +561,8 @@ def report(result, o, out) -> dict:
         "free_dynamic_slow_fast_deg": {"slow": float(ed_free[~fast].mean()), "fast": float(ed_free[fast].mean())},
         "direction_error_deg": {name: np.degrees(np.arccos(np.clip((c.field.v * true_v).sum(axis=1), -1, 1))).tolist()
                                 for name, c in cals.items()},
+        "regime": o["regime"],
+        "free_swing": free_swing(o),
         "orders": list(orders),
         "order_study_uT": {f"I={i},J={j}": s * 1e6 for (i, j), s in study["scores"].items()},
         "order_study_best": list(study["best"]),
@@ -598,30 +707,35 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
 
 def main(argv=None):
     """Command line of the studies: ``python -m scenarios.metge --calibration FILE --out DIR``
-    (the yaw study) or ``--robustness --out DIR`` (:mod:`scenarios.metge_robustness`).
+    (the yaw study), ``--robustness --out DIR`` (:mod:`scenarios.metge_robustness`) or
+    ``--free-set --out DIR`` (:mod:`scenarios.metge_free`).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
     parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated "
-                                                 "(--calibration), or the compensation on perturbed plants "
-                                                 "(--robustness).")
+                                                 "(--calibration), the compensation on perturbed plants "
+                                                 "(--robustness), or the free set's ablation (--free-set).")
     parser.add_argument("--calibration", help="calibration file, e.g. from quadcosim run metge (the yaw study)")
     parser.add_argument("--robustness", nargs="*", metavar="CASE",
                         help="the robustness study (every case, or those named)")
+    parser.add_argument("--free-set", nargs="*", metavar="CASE",
+                        help="the free set's ablation (scenarios/metge_free.py; every case, or those named)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
     parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
     args = parser.parse_args(argv)
-    if args.robustness is not None:
-        from scenarios import metge_robustness
+    for chosen, name in ((args.free_set, "metge_free"), (args.robustness, "metge_robustness")):
+        if chosen is not None:  # a study of its own module, with its cases
+            import importlib
 
-        unknown = set(args.robustness) - set(metge_robustness.cases())
-        if unknown:
-            parser.error(f"unknown case {', '.join(sorted(unknown))}; cases: {', '.join(metge_robustness.cases())}")
-        metge_robustness.study(args.out, args.robustness or None)
-        return
+            study = importlib.import_module(f"scenarios.{name}")
+            unknown = set(chosen) - set(study.cases())
+            if unknown:
+                parser.error(f"unknown case {', '.join(sorted(unknown))}; cases: {', '.join(study.cases())}")
+            study.study(args.out, chosen or None)
+            return
     if not args.calibration:
-        parser.error("give --calibration FILE (the yaw study) or --robustness")
+        parser.error("give --calibration FILE (the yaw study), --robustness or --free-set")
     yaw_study(args.out, args.calibration, estimators=tuple(args.estimators.split(",")), duration=args.duration)
 
 

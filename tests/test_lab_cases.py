@@ -53,31 +53,50 @@ def test_passive_recovers_the_lab_bias_in_the_predicted_time(ry, gain):
     assert simulated == pytest.approx(predicted, rel=2e-3)  # measured within 7.9e-4 (4 ms of 5.29 s at k = 1)
 
 
+# Estimate-fed flights with noise and bias, measured on seeds 1-5 (they moved by < 1 %):
+# (estimator, flight) -> largest estimate error RMS (deg), tracking RMS (deg), largest tilt (deg).
+ESTIMATE_FED = {("linear", "quasi"): (11.96, 11.93, 13.21), ("linear", "nonstationary"): (12.76, 14.22, 37.08),
+                ("explicit", "quasi"): (8.84, 8.95, 2.96), ("explicit", "nonstationary"): (9.48, 9.79, 23.15),
+                ("passive", "quasi"): (0.100, 0.16, 2.75), ("passive", "nonstationary"): (0.094, 4.77, 20.17)}
+SEEDS = (1, 2, 3)
+
+
 @pytest.mark.parametrize("flight", ["quasi", "nonstationary"])
 @pytest.mark.parametrize("estimator", ["linear", "explicit", "passive"])
 def test_estimate_fed_control_flies_with_noise_and_bias(estimator, flight):
-    result, m = run(estimator=estimator, flight=flight, feedback="estimate", noise=True, bias=True,
-                    kI=0.3 if estimator == "explicit" else -1.0, duration=15.0)
-    tilt = np.degrees(np.abs(np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])))
-    assert tilt.max() < 60.0  # never tumbles
-    # seeded; measured over both flights: estimate error 12.7 / 9.4 / 0.097 deg, tracking 14.2 / 9.7 / 4.8 deg
-    bounds = {"linear": (20.0, 20.0), "explicit": (15.0, 15.0), "passive": (0.3, 10.0)}
-    estimate_bound, tracking_bound = bounds[estimator]
-    assert max(m["rms_error_deg"]) < estimate_bound and max(m["tracking_rms_deg"]) < tracking_bound
-    if flight == "quasi" and estimator == "passive":  # it estimates the bias: the cruise stays as in GT
-        speed = np.hypot(result["Quadrotor.v"][:, 0], result["Quadrotor.v"][:, 1])
-        assert speed.min() > 1.25 and speed.max() < 2.01  # m/s; GT flight: 1.26 to 2.00
+    """Each figure within a fifth of what seeds 1-5 measured (:data:`ESTIMATE_FED`), on seeds
+    1-3. The vehicle flies the estimate: its tilt is the setpoint's (2.75 deg in the cruise,
+    20 deg in the non-stationary flight) plus what the estimate gets wrong."""
+    expected = np.array(ESTIMATE_FED[(estimator, flight)])
+    for seed in SEEDS:
+        result, m = run(estimator=estimator, flight=flight, feedback="estimate", noise=True, bias=True,
+                        kI=0.3 if estimator == "explicit" else -1.0, duration=15.0, seed=seed)
+        tilt = np.degrees(np.abs(np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]]))).max()
+        measured = np.array([max(m["rms_error_deg"]), max(m["tracking_rms_deg"]), tilt])
+        print(estimator, flight, seed, measured.round(3))
+        assert np.all(measured > 0.8 * expected) and np.all(measured < 1.25 * expected)
+        if flight == "quasi" and estimator == "passive":  # it estimates the bias: the cruise stays as in GT
+            speed = np.hypot(result["Quadrotor.v"][:, 0], result["Quadrotor.v"][:, 1])
+            assert speed.min() > 1.25 and speed.max() < 2.01  # m/s; GT flight: 1.26 to 2.00
 
 
 def test_linear_gain_prediction_matches_simulation():
     """python-control's predicted roll/pitch error variance against the batch path on a
-    recorded GT stream (a shortened gain-study: gains around the optimum)."""
-    _, m = scenarios.run("gain-study", {"k_min": 0.25, "k_max": 2.0, "count": 5, "duration": 1200.0,
-                                        "closed_loop": False})
-    se = np.array(m["simulated_relative_standard_error"])
-    assert se.max() < 0.06
-    assert np.all(np.abs(m["relative_difference"]) < 0.15)
-    assert m["optimum_ratio"] < 1.5
+    recorded GT stream (a shortened gain-study: gains around the optimum), on seeds 1-3.
+    Measured on seeds 1-8: relative standard error of a variance 0.053-0.070, relative
+    difference to the prediction at most 0.023-0.082, the simulated optimum 0.944-1.045 times
+    the predicted (seeds 1-3: 0.985, 1.035, 1.008; geometric mean 1.009)."""
+    optima = []
+    for seed in (1, 2, 3):
+        _, m = scenarios.run("gain-study", {"k_min": 0.25, "k_max": 2.0, "count": 5, "duration": 1200.0,
+                                            "closed_loop": False, "seed": seed})
+        se, difference = np.array(m["simulated_relative_standard_error"]), np.abs(m["relative_difference"])
+        optima.append(m["simulated_optimal_gain"] / m["predicted_optimal_gain"])
+        print(f"seed {seed}: standard error {se.max():.3f}, difference {difference.max():.3f}, "
+              f"optimum ratio {optima[-1]:.4f}")
+        assert se.max() < 0.1 and difference.max() < 0.1
+        assert 0.9 < optima[-1] < 1.1
+    assert np.exp(np.mean(np.log(optima))) == pytest.approx(1.0, abs=0.02)
 
 
 def test_linear_non_stationary_error_comes_from_integrating_body_rates_as_euler_rates():

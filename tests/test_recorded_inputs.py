@@ -119,7 +119,7 @@ def test_gains_that_make_a_filter_diverge_are_named():
     table = gain_table("explicit", {"kP": [1.0, 2.0]})
     stored = np.zeros((2, 3, 4))
     stored[1, 2, 0] = np.nan
-    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.3, kP = 2"):
+    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.05, kP = 2"):
         checks.check_finite("explicit", table, stored, np.zeros((2, 6)))
 
 
@@ -139,8 +139,9 @@ def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(ca
     exec(compile(code, "README.md", "exec"), namespace)
     errors = namespace["out"]["errors"]["total_rmse_deg"].reshape(4, 3)
     print(errors)
-    # 24 s of slow rotations from a TRIAD start: 0.99 to 1.25 deg measured, the least at kP = 1
-    assert np.all((errors > 0.95) & (errors < 1.3)) and np.argmin(errors.min(axis=1)) == 2
+    # 24 s of slow rotations from a TRIAD start: 0.61 to 0.95 deg measured (the recommended filter's
+    # corrections, the other gains at their defaults), the least at kP = 1
+    assert np.all((errors > 0.55) & (errors < 1.0)) and np.argmin(errors.min(axis=1)) == 2
     assert "[[" in capsys.readouterr().out
 
 

@@ -53,14 +53,17 @@ RUNS = {
     "rig": ("rig", {"reference": 0.2, "sweep": 0.2, "noise": True}),
     "ir-calibration": ("ir-calibration", {"duration": 20.0}),
 }
-#: The lab's filters on :func:`synthetic_imu`: (kind, gains changed from the lab's, options of
-#: :func:`estimators.estimate`).
+#: The filters on :func:`synthetic_imu`: (kind, gains, options of :func:`estimators.estimate`).
+#: The lab's (its gains, corrections off, as ``tp`` runs them), and the one recommended for real
+#: recordings at its defaults.
+_LAB = {"corrections": False}
 FILTERS = {
-    "filter-linear": ("linear", {}, {}),
-    "filter-explicit": ("explicit", {}, {}),
-    "filter-explicit-bias": ("explicit", {"kI": 0.01}, {}),
-    "filter-passive-triad": ("passive", {}, {"ry": "triad"}),
-    "filter-passive-euler": ("passive", {}, {"ry": "triad", "discretisation": "euler"}),
+    "filter-linear": ("linear", "lab", {}),
+    "filter-explicit": ("explicit", "lab", _LAB),
+    "filter-explicit-bias": ("explicit", {"kI": 0.01}, _LAB),
+    "filter-passive-triad": ("passive", "lab", _LAB | {"ry": "triad"}),
+    "filter-passive-euler": ("passive", "lab", _LAB | {"ry": "triad", "discretisation": "euler"}),
+    "filter-recommended": ("recommended", None, {}),
 }
 #: Instants kept of each signal, spread evenly over its run (the first and the last included).
 POINTS = 100
@@ -112,10 +115,14 @@ def record(label: str) -> dict[str, np.ndarray]:
     """Every recorded signal of run ``label`` of :data:`RUNS` and ``time``, or every output of
     filter ``label`` of :data:`FILTERS`, whole."""
     if label in FILTERS:
-        from estimators import LAB_GAINS, estimate
+        from estimators import LAB_GAINS, RECOMMENDED, estimate
 
         kind, gains, options = FILTERS[label]
-        out = estimate(kind, **synthetic_imu(), gains=LAB_GAINS[kind] | gains, outputs=("q", "b"), **options)
+        if kind == "recommended":
+            kind = RECOMMENDED
+        elif gains is not None:
+            gains = LAB_GAINS[kind] | ({} if gains == "lab" else gains)
+        out = estimate(kind, **synthetic_imu(), gains=gains, outputs=("q", "b"), **options)
         return {f"{name}{i}": np.asarray(out[name])[..., i].ravel() for name in ("q", "b")
                 for i in range(np.asarray(out[name]).shape[-1])}
     import scenarios

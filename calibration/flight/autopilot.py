@@ -1,96 +1,11 @@
-"""A flight calibration as ArduPilot and PX4 parameters, and the corrections those autopilots
-apply with them (to check the export against the project's own correction).
-
-ArduPilot (``AP_Compass``), field in milligauss, compass ``k`` named ``""``, ``2``, ``3``::
-
-    corrected = M (raw + COMPASS_OFS) + COMPASS_MOT * x
-
-``M`` from ``COMPASS_DIA*`` and ``COMPASS_ODI*`` (all-zero diagonal: identity); ``x`` the current
-(A, ``COMPASS_MOTCT = 2``) or the throttle (0..1, ``COMPASS_MOTCT = 1``).
-
-PX4 (``sensor_calibration::Magnetometer``), field in gauss, compass ``k`` as ``CAL_MAGk_*``::
-
-    corrected = S ((raw + CAL_MAGk_COMP * p) - CAL_MAGk_OFF)
-
-``S`` from ``*SCALE`` and ``*ODIAG``; ``p`` the throttle (``CAL_MAG_COMP_TYP = 1``) or the battery
-current in kA (``CAL_MAG_COMP_TYP = 2``). Both apply the offsets and compensation in the frame the
-field was calibrated in (the body frame here; a compass with its own rotation parameter keeps it).
-
-The project's correction is ``A^-1 (raw - b_s - K x)``; the motor vector is exported as ``-A^-1 K``
-for ArduPilot (which adds it after the soft iron) and ``-K`` for PX4 (before it).
+"""Parameter files: ArduPilot's (``NAME,VALUE`` lines, as Mission Planner loads them) and PX4's
+(QGroundControl's tab-separated format). The parameters themselves, and how each firmware applies
+them, are in :mod:`orchestrator.logs.ardupilot` and :mod:`orchestrator.logs.px4`.
 """
 
 from __future__ import annotations
 
-import numpy as np
-
-MILLIGAUSS = 1e-7  # T
-GAUSS = 1e-4  # T
-KILO = 1e3
-AXES = "XYZ"
-ARDUPILOT_MOTCT = {"throttle": 1, "current": 2}
-PX4_COMP_TYPE = {"throttle": 1, "current": 2}
-
-
-def _symmetric(diagonal, off) -> np.ndarray:
-    return np.array([[diagonal[0], off[0], off[1]], [off[0], diagonal[1], off[2]], [off[1], off[2], diagonal[2]]])
-
-
-def ardupilot_parameters(compass: int, static, model: str | None, K) -> dict:
-    """ArduPilot parameters (name: value, in ArduPilot's units) of compass ``compass`` (0-based):
-    ``static`` a :class:`calibration.StaticCalibration` (T), ``model`` ``"current"``,
-    ``"throttle"`` or None, ``K`` its field vector (T/A or T per unit throttle)."""
-    suffix = "" if compass == 0 else str(compass + 1)
-    correction = np.linalg.inv(static.A)
-    params = {f"COMPASS_OFS{suffix}_{a}": float(-static.b_s[i] / MILLIGAUSS) for i, a in enumerate(AXES)}
-    params |= {f"COMPASS_DIA{suffix}_{a}": float(correction[i, i]) for i, a in enumerate(AXES)}
-    params |= {f"COMPASS_ODI{suffix}_{a}": float(correction[i, j]) for a, (i, j) in zip(AXES, ((0, 1), (0, 2), (1, 2)),
-                                                                                         strict=True)}
-    params["COMPASS_MOTCT"] = ARDUPILOT_MOTCT.get(model, 0)
-    motor = np.zeros(3) if model is None else -correction @ np.asarray(K, dtype=float) / MILLIGAUSS
-    params |= {f"COMPASS_MOT{suffix}_{a}": float(motor[i]) for i, a in enumerate(AXES)}
-    return params
-
-
-def apply_ardupilot(params: dict, compass: int, raw, x) -> np.ndarray:
-    """The field (T) ArduPilot's compass ``compass`` reports for ``raw`` (T, 3) (T) with ``params``;
-    ``x`` (T,) the current (A) or throttle (1) as ``COMPASS_MOTCT`` says."""
-    suffix = "" if compass == 0 else str(compass + 1)
-    diagonal = [params[f"COMPASS_DIA{suffix}_{a}"] for a in AXES]
-    M = _symmetric(diagonal if any(diagonal) else [1.0, 1.0, 1.0], [params[f"COMPASS_ODI{suffix}_{a}"] for a in AXES])
-    offsets = np.array([params[f"COMPASS_OFS{suffix}_{a}"] for a in AXES])
-    motor = np.array([params[f"COMPASS_MOT{suffix}_{a}"] for a in AXES]) if params["COMPASS_MOTCT"] else np.zeros(3)
-    field_mG = (np.asarray(raw) / MILLIGAUSS + offsets) @ M.T + np.outer(np.asarray(x), motor)
-    return field_mG * MILLIGAUSS
-
-
-def px4_parameters(compass: int, static, model: str | None, K) -> dict:
-    """PX4 parameters (name: value, in PX4's units) of compass ``compass`` (0-based): ``static`` a
-    :class:`calibration.StaticCalibration` (T), ``model`` ``"current"``, ``"throttle"`` or None,
-    ``K`` its field vector (T/A or T per unit throttle)."""
-    prefix = f"CAL_MAG{compass}_"
-    correction = np.linalg.inv(static.A)
-    params = {f"{prefix}{a}OFF": float(static.b_s[i] / GAUSS) for i, a in enumerate(AXES)}
-    params |= {f"{prefix}{a}SCALE": float(correction[i, i]) for i, a in enumerate(AXES)}
-    params |= {f"{prefix}{a}ODIAG": float(correction[i, j]) for a, (i, j) in zip(AXES, ((0, 1), (0, 2), (1, 2)),
-                                                                                strict=True)}
-    per_unit = KILO if model == "current" else 1.0  # PX4 takes the current in kA
-    comp = np.zeros(3) if model is None else -np.asarray(K, dtype=float) * per_unit / GAUSS
-    params |= {f"{prefix}{a}COMP": float(comp[i]) for i, a in enumerate(AXES)}
-    params["CAL_MAG_COMP_TYP"] = PX4_COMP_TYPE.get(model, 0)
-    return params
-
-
-def apply_px4(params: dict, compass: int, raw, x) -> np.ndarray:
-    """The field (T) PX4 reports for compass ``compass``'s ``raw`` (T, 3) (T) with ``params``;
-    ``x`` (T,) the current (A) or throttle (1) as ``CAL_MAG_COMP_TYP`` says."""
-    prefix = f"CAL_MAG{compass}_"
-    S = _symmetric([params[f"{prefix}{a}SCALE"] for a in AXES], [params[f"{prefix}{a}ODIAG"] for a in AXES])
-    offsets = np.array([params[f"{prefix}{a}OFF"] for a in AXES])
-    comp = np.array([params[f"{prefix}{a}COMP"] for a in AXES]) if params["CAL_MAG_COMP_TYP"] else np.zeros(3)
-    power = np.asarray(x) / KILO if params["CAL_MAG_COMP_TYP"] == PX4_COMP_TYPE["current"] else np.asarray(x)
-    field_G = (np.asarray(raw) / GAUSS + np.outer(power, comp) - offsets) @ S.T
-    return field_G * GAUSS
+from pathlib import Path
 
 
 def write_ardupilot(params: dict, path) -> None:
@@ -113,13 +28,56 @@ def write_px4(params: dict, path) -> None:
     write_text(path, "".join(lines))
 
 
+def write_parameters(autopilot: str, params: dict, path) -> None:
+    """``params`` in the file format of ``autopilot`` (``ArduPilot`` or ``PX4``) at ``path``."""
+    (write_px4 if autopilot == "PX4" else write_ardupilot)(params, path)
+
+
+MAX_PARAMETER_BYTES = 16 * 1024 * 1024  # an autopilot's whole parameter list takes a few hundred kB
+
+
 def read_parameters(path) -> dict:
-    """Parameters from a file written by :func:`write_ardupilot` or :func:`write_px4` at ``path``."""
+    """Parameters from an ArduPilot ``.parm`` (``NAME,VALUE`` or ``NAME VALUE`` lines) or a
+    QGroundControl ``.params`` file (tab-separated) at ``path``, as :func:`write_ardupilot` and
+    :func:`write_px4` write them.
+
+    Raises
+    ------
+    ValueError
+        The file is missing, not a regular file (a FIFO would block), too large, not text, or a
+        line holds no ``NAME VALUE``; the message names the file, the line and the fix.
+    """
+    import os
+    import stat
+
+    path = Path(path)
+    try:
+        status = os.stat(path)
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read the parameter file ({error.strerror})") from None
+    if not stat.S_ISREG(status.st_mode):
+        raise ValueError(f"{path}: not a regular file; give a parameter file (.parm or .params)")
+    if status.st_size > MAX_PARAMETER_BYTES:
+        raise ValueError(f"{path}: {status.st_size / 1e6:.0f} MB, not a parameter file (.parm or .params)")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path}: not a text parameter file (byte {error.start} is not UTF-8); give the .parm or "
+                         ".params the ground station saved") from None
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read the parameter file ({error.strerror})") from None
     params = {}
-    for line in open(path).read().splitlines():
+    for number, line in enumerate(text.splitlines(), 1):
+        line = line.strip()
         if not line or line.startswith("#"):
             continue
-        parts = line.split("\t") if "\t" in line else line.split(",")
-        name, value = (parts[2], parts[3]) if len(parts) > 2 else parts
-        params[name] = int(value) if value.lstrip("-").isdigit() else float(value)
+        parts = line.split("\t") if "\t" in line else line.split(",") if "," in line else line.split()
+        try:
+            name, value = (parts[2], parts[3]) if len(parts) > 3 else parts[:2]
+            params[name.strip()] = int(value) if value.strip().lstrip("-").isdigit() else float(value)
+        except (ValueError, IndexError):
+            raise ValueError(f"{path}, line {number}: {line[:60]!r} is not NAME,VALUE (ArduPilot) nor "
+                             "1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE (QGroundControl); fix or remove the line") from None
+    if not params:
+        raise ValueError(f"{path}: no parameters in the file; give the .parm or .params the ground station saved")
     return params

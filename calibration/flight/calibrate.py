@@ -56,7 +56,7 @@ def _unscorable(fitted: dict, test) -> dict:
 def _static(train, best, offsets, soft_iron) -> tuple[StaticCalibration, dict]:
     """Hard and soft iron from the flights' rotations when they cover enough of the sphere, else the log's."""
     first = train[0]
-    base = earth_and_offset(first.rotation, first.raw - (0 if best is None else best.predict(first)))
+    base = earth_and_offset(first.rotation, first.raw - (0 if best is None else best.predict(first)), first.earth)
     m_E = base.nuisance[0, :3]
     directions = np.einsum("tji,j->ti", first.rotation, m_E)
     coverage = sphere_coverage(directions)
@@ -89,7 +89,7 @@ def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel
     return None, None
 
 
-def calibrate(train, test, names=MODELS, attitude: str = "gyro") -> tuple[dict, Calibration, dict]:
+def calibrate(train, test, names=MODELS, attitude: str = "auto") -> tuple[dict, Calibration, dict]:
     """Fit on the ``train`` parts, score on the ``test`` parts (lists of FlightData of one compass);
     ``names`` the models tried, ``attitude`` the attitude the parts were built with (recorded).
 

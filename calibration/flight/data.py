@@ -11,7 +11,7 @@ import numpy as np
 
 from calibration.static import CalibrationError
 
-ATTITUDES = ("gyro", "log")
+ATTITUDES = ("auto", "gyro", "log")
 MIN_SAMPLES = 40  # compass samples a flight (or a part of one) needs: 3 residuals each, and the per-motor
 # model of an octorotor has 54 unknowns (6 of the flight, 2 direction angles and 4 coefficients a motor)
 
@@ -32,12 +32,29 @@ def rotation_of(euler: np.ndarray) -> np.ndarray:
     return Rotation.from_euler("ZYX", euler[:, ::-1]).as_matrix()
 
 
-def gyro_heading(log, times: np.ndarray) -> np.ndarray:
-    """Heading (rad) at ``times`` (s) integrated from the first IMU's gyro, with the log's roll and
-    pitch; its constant and its linear drift are matched to the log's heading over the whole
-    flight, so no stretch shorter than the flight depends on the compass. ``log``: the FlightLog."""
+def board_quaternions(log, trim: bool = True) -> np.ndarray:
+    """The attitude (T, 4) of the frame the autopilot's sensors are rotated into, at the log's
+    attitude instants: ArduPilot's ``ATT`` is the vehicle's, the board's turned by ``AHRS_TRIM``,
+    which is added back (:func:`orchestrator.logs.ardupilot.trim_rotation`); PX4 rotates its
+    sensors into the vehicle's frame itself. ``trim=False`` ignores the trim (an ablation)."""
+    from scipy.spatial.transform import Rotation
+
+    from orchestrator.logs import ardupilot
+
+    q = log.attitude.q
+    if not trim or log.autopilot != "ArduPilot":
+        return q
+    board = Rotation.from_quat(q, scalar_first=True) * Rotation.from_matrix(ardupilot.trim_rotation(log.params))
+    return board.as_quat(scalar_first=True)
+
+
+def gyro_heading(log, times: np.ndarray, trim: bool = True) -> np.ndarray:
+    """Heading (rad) at ``times`` (s) integrated from the first IMU's gyro, with the board's roll and
+    pitch (:func:`board_quaternions`); its constant and its linear drift are matched to the log's
+    heading over the whole flight, so no stretch shorter than the flight depends on the compass.
+    ``log``: the FlightLog; ``trim``: add ``AHRS_TRIM`` back (False: an ablation)."""
     imu = log.imus[0]
-    euler = euler_of(log.attitude.q)
+    euler = euler_of(board_quaternions(log, trim))
     roll = np.interp(imu.time, log.attitude.time, euler[:, 0])
     pitch = np.interp(imu.time, log.attitude.time, euler[:, 1])
     p, q, r = imu.gyro.T
@@ -71,6 +88,9 @@ class FlightData:
         The log itself.
     compass : int
         The compass's index in the log.
+    earth : (3,) array or None
+        The Earth field model at the log's position (NED, T; :mod:`calibration.flight.earth`), or
+        None: then it is fitted, free, per flight.
     """
 
     source: str
@@ -82,6 +102,17 @@ class FlightData:
     battery: object
     log: object
     compass: int
+    earth: np.ndarray | None = None
+
+    def body(self, field: np.ndarray) -> np.ndarray:
+        """``field`` (T, 3) in the raw field's frame turned into the body frame (the compass's rotation)."""
+        return np.asarray(field) @ np.asarray(self.log.compasses[self.compass].rotation).T
+
+    def autopilot_throttle(self, delay: float = 0.0) -> np.ndarray | None:
+        """The autopilot's own throttle (T,) (``CTUN.ThO``, PX4's thrust) at ``time - delay`` (s),
+        the signal its compass compensation multiplies; None when the log has none."""
+        t = self.log.throttle if self.log is not None else None
+        return None if t is None else np.interp(self.time - delay, t.time, t.value)
 
     def commands(self, delay: float = 0.0) -> np.ndarray:
         """Motor commands (T, N) (1) at ``time - delay`` (s)."""
@@ -115,13 +146,23 @@ class FlightData:
         return self.part(self.time < cut), self.part(self.time >= cut)
 
 
-def flight_data(log, compass: int, attitude: str = "gyro") -> FlightData:
+def fused(log, compass: int) -> bool:
+    """Whether the log's heading fuses compass ``compass``: ArduPilot's ``COMPASS_PRIMARY``, PX4's first."""
+    from orchestrator.logs import ardupilot
+
+    return compass == (ardupilot.fused_compass(log.params) if log.autopilot == "ArduPilot" else 0)
+
+
+def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: bool = True) -> FlightData:
     """Align compass ``compass`` of the :class:`orchestrator.logs.FlightLog` ``log`` for calibration.
 
-    ``attitude`` chooses the rotation that removes the Earth field: ``"gyro"`` (default) takes roll
-    and pitch from the log and integrates the heading from the gyro (see :func:`gyro_heading`), so
-    the heading does not come from the compass being calibrated; ``"log"`` takes the autopilot's
-    attitude as it is, whose heading the compass itself steered.
+    ``attitude`` chooses the rotation that removes the Earth field: ``"gyro"`` takes roll and pitch
+    from the log and integrates the heading from the gyro (see :func:`gyro_heading`), so the heading
+    does not come from the compass being calibrated; ``"log"`` takes the autopilot's attitude as it
+    is; ``"auto"`` (default) is ``"gyro"`` for the compass the log's heading fuses and ``"log"`` for
+    the others. The attitude is the board's (``AHRS_TRIM`` added back, unless ``trim`` is False),
+    turned by the compass's own rotation into its raw field's frame (PX4). ``earth``: the Earth field
+    model (NED, T) or None.
 
     Raises
     ------
@@ -146,10 +187,11 @@ def flight_data(log, compass: int, attitude: str = "gyro") -> FlightData:
                                f"sensors share ({lo:.1f} to {hi:.1f} s); a flight calibration needs at least "
                                f"{MIN_SAMPLES}: give a longer flight")
     time = chosen.time[rows]
-    euler_log = euler_of(log.attitude.q)
+    euler_log = euler_of(board_quaternions(log, trim))
     euler = np.column_stack([np.interp(time, log.attitude.time, euler_log[:, k]) for k in range(3)])
     used = euler.copy()
-    if attitude == "gyro":
-        used[:, 2] = gyro_heading(log, time)
-    return FlightData(f"{log.path}:{chosen.name}", time, chosen.raw[rows], rotation_of(used), euler, log.motors,
-                      log.battery, log, compass)
+    if attitude == "gyro" or (attitude == "auto" and fused(log, compass)):
+        used[:, 2] = gyro_heading(log, time, trim)
+    rotation = rotation_of(used) @ np.asarray(chosen.rotation)
+    return FlightData(f"{log.path}:{chosen.name}", time, chosen.raw[rows], rotation, euler, log.motors,
+                      log.battery, log, compass, None if earth is None else np.asarray(earth, dtype=float))

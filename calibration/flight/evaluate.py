@@ -29,7 +29,9 @@ def tilt_compensated_heading(field: np.ndarray, euler: np.ndarray) -> np.ndarray
     return np.arctan2(-east, north)
 
 
-def _heading_error(heading: np.ndarray, reference: np.ndarray) -> np.ndarray:
+def heading_error(heading: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``heading - reference`` (rad) wrapped, its circular mean (the declination and any mounting
+    offset) removed."""
     error = wrap(heading - reference)
     return wrap(error - np.angle(np.mean(np.exp(1j * error))))  # the declination and mounting offset removed
 
@@ -40,16 +42,16 @@ def score(fitted, parts) -> dict:
     base_cost = model_cost = 0.0
     change, before, after, perturbation = [], [], [], []
     for p in parts:
-        base = earth_and_offset(p.rotation, p.raw)
+        base = earth_and_offset(p.rotation, p.raw, p.earth)
         predicted = np.zeros_like(p.raw) if fitted is None else fitted.predict(p)
-        fit = earth_and_offset(p.rotation, p.raw - predicted)
+        fit = earth_and_offset(p.rotation, p.raw - predicted, p.earth)
         base_cost += base.cost
         model_cost += fit.cost
-        without = tilt_compensated_heading(p.raw - base.nuisance[0, 3:], p.euler)
-        with_model = tilt_compensated_heading(p.raw - predicted - fit.nuisance[0, 3:], p.euler)
+        without = tilt_compensated_heading(p.body(p.raw - base.nuisance[0, 3:]), p.euler)
+        with_model = tilt_compensated_heading(p.body(p.raw - predicted - fit.nuisance[0, 3:]), p.euler)
         change.append(wrap(with_model - without))
-        before.append(_heading_error(without, p.euler[:, 2]))
-        after.append(_heading_error(with_model, p.euler[:, 2]))
+        before.append(heading_error(without, p.euler[:, 2]))
+        after.append(heading_error(with_model, p.euler[:, 2]))
         flying = p.throttle() > AIRBORNE_THROTTLE
         perturbation.append(np.linalg.norm(predicted[flying], axis=1))
 

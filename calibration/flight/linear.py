@@ -7,7 +7,9 @@ For the samples ``k`` of flight ``p``::
 
 ``R_k`` the body-to-NED rotation, ``m_E,p`` the Earth field (NED, T) and ``b_p`` the offset (body,
 T) of that flight, ``x_kj`` the interference regressors (current, throttle, commands) and
-``K_j`` their field vectors (T per unit), shared by all flights.
+``K_j`` their field vectors (T per unit), shared by all flights. When the Earth field is known
+(the World Magnetic Model at the log's position, :mod:`calibration.flight.earth`), ``m_E,p`` is
+that field and only the offset is fitted with the coefficients.
 """
 
 from __future__ import annotations
@@ -37,14 +39,17 @@ class LinearFit:
         return float(sum((r**2).sum() for r in self.residual))
 
 
-def _blocks(rotation: np.ndarray, regressors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Design of one flight: the Earth-field and offset columns (3T, 6) and the regressor columns (3T, 3J)."""
+def _blocks(rotation: np.ndarray, regressors: np.ndarray, known: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Design of one flight: the Earth-field and offset columns (3T, 6), or the offset's alone (3T, 3)
+    when the field is ``known``, and the regressor columns (3T, 3J)."""
     T = len(rotation)
     nuisance = np.zeros((T, 3, NUISANCE))
     nuisance[:, :, :3] = np.transpose(rotation, (0, 2, 1))  # R^T
     nuisance[:, :, 3:] = np.eye(3)
+    if known:
+        nuisance = nuisance[:, :, 3:]
     shared = np.einsum("tj,ab->tajb", regressors, np.eye(3)).reshape(T, 3, -1)
-    return nuisance.reshape(3 * T, NUISANCE), shared.reshape(3 * T, -1)
+    return nuisance.reshape(3 * T, -1), shared.reshape(3 * T, -1)
 
 
 def fit_linear(parts) -> LinearFit:
@@ -52,25 +57,31 @@ def fit_linear(parts) -> LinearFit:
 
     Parameters
     ----------
-    parts : sequence of (rotation, raw, regressors)
+    parts : sequence of (rotation, raw, regressors) or (rotation, raw, regressors, earth)
         Per flight: body-to-NED rotations (T, 3, 3), raw field (T, 3) (T), regressors (T, J)
-        (J may be 0).
+        (J may be 0), and the known Earth field (3,) (NED, T) or None to fit it.
     """
     from scipy.optimize import least_squares  # imported where used: start-up
 
-    designs, targets = [], []
+    designs, targets, earths = [], [], []
     J = np.asarray(parts[0][2]).shape[1]
-    for rotation, raw, regressors in parts:
-        nuisance, shared = _blocks(np.asarray(rotation), np.asarray(regressors, dtype=float).reshape(len(raw), J))
+    for part in parts:
+        rotation, raw, regressors = (np.asarray(a, dtype=float) for a in part[:3])
+        earth = None if len(part) < 4 or part[3] is None else np.asarray(part[3], dtype=float)
+        nuisance, shared = _blocks(rotation, regressors.reshape(len(raw), J), earth is not None)
         designs.append((nuisance, shared))
-        targets.append(np.asarray(raw, dtype=float).ravel())
+        target = raw if earth is None else raw - np.einsum("tji,j->ti", rotation, earth)
+        targets.append(target.ravel())
+        earths.append(earth)
     P = len(parts)
+    widths = [d[0].shape[1] for d in designs]
+    first = np.concatenate([[0], np.cumsum(widths)])
     rows = sum(len(t) for t in targets)
-    D = np.zeros((rows, NUISANCE * P + 3 * J))
+    D = np.zeros((rows, first[-1] + 3 * J))
     start = 0
     for p, (nuisance, shared) in enumerate(designs):
-        D[start:start + len(nuisance), NUISANCE * p:NUISANCE * (p + 1)] = nuisance
-        D[start:start + len(nuisance), NUISANCE * P:] = shared
+        D[start:start + len(nuisance), first[p]:first[p + 1]] = nuisance
+        D[start:start + len(nuisance), first[-1]:] = shared
         start += len(nuisance)
     y = np.concatenate(targets)
     scale = np.linalg.norm(D, axis=0)
@@ -83,12 +94,16 @@ def fit_linear(parts) -> LinearFit:
     for nuisance, _ in designs:
         residual.append((D[start:start + len(nuisance)] @ x - y[start:start + len(nuisance)]).reshape(-1, 3))
         start += len(nuisance)
-    return LinearFit(x[:NUISANCE * P].reshape(P, NUISANCE), x[NUISANCE * P:].reshape(J, 3), residual,
-                     float(singular[0] / max(singular[-1], 1e-300)))
+    nuisance = np.zeros((P, NUISANCE))
+    for p, earth in enumerate(earths):
+        found = x[first[p]:first[p + 1]]
+        nuisance[p] = found if earth is None else np.r_[earth, found]
+    return LinearFit(nuisance, x[first[-1]:].reshape(J, 3), residual, float(singular[0] / max(singular[-1], 1e-300)))
 
 
-def earth_and_offset(rotation, raw) -> LinearFit:
-    """The Earth field and offset alone on one flight (``rotation`` (T, 3, 3), ``raw`` (T, 3) T):
-    the baseline every interference model is scored against."""
+def earth_and_offset(rotation, raw, earth=None) -> LinearFit:
+    """The Earth field and offset alone on one flight (``rotation`` (T, 3, 3), ``raw`` (T, 3) T), the
+    offset alone when the Earth field ``earth`` (3,) (NED, T) is known: the baseline every
+    interference model is scored against."""
     raw = np.asarray(raw)
-    return fit_linear([(rotation, raw, np.zeros((len(raw), 0)))])
+    return fit_linear([(rotation, raw, np.zeros((len(raw), 0)), earth)])

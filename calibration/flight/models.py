@@ -2,7 +2,9 @@
 and each refused, with the reason, when the flight cannot identify it.
 
 - ``current``: ``b_d = K i``, one vector per ampere (ArduPilot's ``COMPASS_MOTCT = 2``);
-- ``throttle``: ``b_d = K t`` with ``t`` the collective throttle (``COMPASS_MOTCT = 1``);
+- ``throttle``: ``b_d = K t`` with ``t`` the autopilot's throttle (``CTUN.ThO``, PX4's thrust: the
+  signal ``COMPASS_MOTCT = 1`` and ``CAL_MAG_COMP_TYP = 1`` multiply), or the mean motor command
+  when the log has none;
 - ``motors``: ``b_d = sum_n K_n c_n``, one vector per motor command;
 - ``metge``: Metge et al.'s ``b_d = sum_n f(c_n, u; theta_n) v_n`` (eqs. 3, 4), the bi-polynomial
   of command and battery voltage evaluated by :class:`calibration.MotorFieldModel`;
@@ -66,7 +68,8 @@ class LinearModel:
         if self.name == "current":
             return data.current(delay)[:, None]
         if self.name == "throttle":
-            return data.throttle(delay)[:, None]
+            autopilot = data.autopilot_throttle(delay)
+            return (data.throttle(delay) if autopilot is None else autopilot)[:, None]
         return data.commands(delay)
 
     def refusal(self, parts) -> str | None:
@@ -79,7 +82,7 @@ class LinearModel:
             if spread < MIN_CURRENT_SPREAD_A:
                 return f"the current varies too little ({spread:.2f} A standard deviation < {MIN_CURRENT_SPREAD_A} A)"
             return None
-        spread = _spread(parts, lambda p: p.throttle()) if self.name == "throttle" else \
+        spread = _spread(parts, lambda p: self.regressors(p, 0.0)[:, 0]) if self.name == "throttle" else \
             min(_spread(parts, lambda p, n=n: p.commands()[:, n]) for n in range(parts[0].motors.commands.shape[1]))
         if spread < MIN_COMMAND_SPREAD:
             what = "throttle" if self.name == "throttle" else "least varied motor command"
@@ -91,7 +94,7 @@ class LinearModel:
         """Fit on the training ``parts`` (FlightData), the delay searched over :data:`DELAYS`."""
         best = None
         for delay in DELAYS:
-            fit = fit_linear([(p.rotation, p.raw, self.regressors(p, delay)) for p in parts])
+            fit = fit_linear([(p.rotation, p.raw, self.regressors(p, delay), p.earth) for p in parts])
             if best is None or fit.cost < best[1].cost:
                 best = (float(delay), fit)
         delay, fit = best

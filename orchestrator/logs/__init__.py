@@ -15,7 +15,18 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, rate
+from orchestrator.logs.model import (
+    Attitude,
+    Battery,
+    Compass,
+    FlightLog,
+    Imu,
+    LogError,
+    Motors,
+    Position,
+    Throttle,
+    rate,
+)
 
 ULOG_MAGIC = b"ULog\x01\x12\x35"
 DATAFLASH_HEAD = b"\xa3\x95"
@@ -133,5 +144,5 @@ def read_log(path) -> FlightLog:
     return validated(read_dataflash(path, text=kind == "dataflash-text"))
 
 
-__all__ = ["Attitude", "Battery", "Compass", "FlightLog", "Imu", "LogError", "Motors", "check_file", "detect_format",
-           "rate", "read_log"]
+__all__ = ["Attitude", "Battery", "Compass", "FlightLog", "Imu", "LogError", "Motors", "Position", "Throttle",
+           "check_file", "detect_format", "rate", "read_log"]

@@ -4,10 +4,14 @@
 What ArduPilot logs, and how it is turned into the project's conventions:
 
 - ``MAG``, ``MAG2``, ``MAG3`` (or ``MAG`` with an instance column ``I``): the field in the body
-  frame, in milligauss, *after* the compass's corrections: ``MagX = M (raw + Ofs) + MOfs``,
-  with ``Ofs`` the offsets (``COMPASS_OFS*``), ``M`` the soft-iron matrix (``COMPASS_DIA*``,
-  ``COMPASS_ODI*``) and ``MOfs`` the motor compensation, both logged beside the field. The raw
-  field is recovered as ``M^-1 (Mag - MOfs) - Ofs``, sample by sample.
+  frame, in milligauss, *after* the compass's corrections, with the offsets ``Ofs``
+  (``COMPASS_OFS*``) and the motor compensation ``MOfs`` logged beside it. The raw field is
+  recovered sample by sample in the order of the log's firmware version
+  (:func:`orchestrator.logs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter 3.5,
+  ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later).
+- ``GPS``: the position and date the Earth field model is evaluated at (3D fixes only).
+- ``CTUN.ThO`` (``ThrOut`` in 0..1000 in older firmware): ``motors->get_throttle()``, the throttle
+  ``COMPASS_MOTCT = 1`` multiplies.
 - ``IMU``, ``IMU2``, ``IMU3`` (or ``IMU`` with ``I``): rad/s and m/s^2, body frame.
 - ``ATT``: roll, pitch, yaw (degrees, Z-Y-X), the attitude the vehicle flew on.
 - ``RCOU``: PWM (us) per output; motors are normalised with ``MOT_PWM_MIN``/``MOT_PWM_MAX``,
@@ -24,11 +28,16 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors
+from orchestrator.logs import ardupilot
+from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
 
 MILLIGAUSS = 1e-7  # T
 CENTI = 0.01
-WANTED = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT", "MSG"}
+WANTED = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT", "MSG", "GPS", "CTUN"}
+SENSORS = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT"}
+GPS_3D_FIX = 3
+GPS_EPOCH = "1980-01-06"  # GPS week 0
+SECONDS_PER_WEEK = 604800.0
 INTEGER_FORMATS = "bBhHiI"
 # motors per frame: Copter's FRAME_CLASS, and the "Frame: NAME" message of older firmware
 FRAME_CLASS_MOTORS = {1: 4, 2: 6, 3: 8, 4: 8, 5: 6, 7: 3, 12: 4, 14: 4}
@@ -131,32 +140,23 @@ def _instances(rows: dict, base: str, key: str = "I") -> list[tuple[str, list]]:
     return found
 
 
-def _soft_iron(params: dict, suffix: str) -> np.ndarray:
-    dia = [params.get(f"COMPASS_DIA{suffix}_{a}", 0.0) for a in "XYZ"]
-    odi = [params.get(f"COMPASS_ODI{suffix}_{a}", 0.0) for a in "XYZ"]
-    if not any(dia):  # ArduPilot treats an all-zero diagonal as the identity
-        dia = [1.0, 1.0, 1.0]
-    return np.array([[dia[0], odi[0], odi[1]], [odi[0], dia[1], odi[2]], [odi[1], odi[2], dia[2]]])
-
-
-def _compasses(rows: dict, params: dict) -> list[Compass]:
+def _compasses(rows: dict, params: dict, rule: ardupilot.Rules) -> list[Compass]:
     out = []
     for k, (name, group) in enumerate(_instances(rows, "MAG")):
-        suffix = "" if k == 0 else str(k + 1)
         mag = _columns(group, ["MagX", "MagY", "MagZ"]) * MILLIGAUSS
         ofs = _columns(group, ["OfsX", "OfsY", "OfsZ"]) * MILLIGAUSS
         mofs = _columns(group, ["MOfsX", "MOfsY", "MOfsZ"]) * MILLIGAUSS
-        matrix = _soft_iron(params, suffix)
+        matrix = ardupilot.soft_iron(params, k)
         flag = params.get("COMPASS_EXTERNAL" if k == 0 else f"COMPASS_EXTERN{k + 1}")
-        unusable = _singular(matrix, params, suffix)
+        unusable = _singular(matrix, params, ardupilot.suffix(k))
         if unusable:
             raw, inverse = np.full_like(mag, np.nan), np.full((3, 3), np.nan)
         else:
-            raw, inverse = np.linalg.solve(matrix, (mag - mofs).T).T - ofs, np.linalg.inv(matrix)
+            raw, inverse = ardupilot.recover_raw(params, k, rule, mag, ofs, mofs), np.linalg.inv(matrix)
         out.append(Compass(name, _time(group), mag, raw, -np.median(ofs, axis=0),
                            None if flag is None else bool(flag),
-                           "logged field with the logged offsets, soft iron and motor offsets undone", inverse,
-                           unusable))
+                           f"logged field with the logged offsets, soft iron and motor offsets undone as {rule.name} "
+                           "applies them", inverse, np.eye(3), k, unusable))
     return out
 
 
@@ -169,6 +169,32 @@ def _singular(matrix: np.ndarray, params: dict, suffix: str) -> str:
                       for kind in ("COMPASS_DIA", "COMPASS_ODI") for a in "XYZ")
     return (f"its soft-iron matrix is singular ({named}): the field before the autopilot's corrections cannot "
             "be recovered from this log (a diagonal of 1 and off-diagonals of 0 are no correction)")
+
+
+def _position(rows: dict) -> Position | None:
+    """The median 3D fix of ``GPS`` and its date (GPS week and milliseconds of the week)."""
+    import datetime
+
+    group = [r for r in rows.get("GPS", []) if r.get("Status", 0) >= GPS_3D_FIX and r.get("GWk", 0) > 0]
+    if not group:
+        return None
+    lat, lon, alt = np.median(_columns(group, ["Lat", "Lng", "Alt"]), axis=0)
+    week, ms = group[0]["GWk"], group[0]["GMS"]
+    when = datetime.datetime.fromisoformat(GPS_EPOCH) + datetime.timedelta(seconds=week * SECONDS_PER_WEEK + ms / 1e3)
+    start = datetime.datetime(when.year, 1, 1)
+    year = when.year + (when - start).total_seconds() / (datetime.datetime(when.year + 1, 1, 1) - start).total_seconds()
+    return Position(float(lat), float(lon), float(alt), float(year), "GPS (median of the 3D fixes)")
+
+
+def _throttle(rows: dict) -> Throttle | None:
+    group = rows.get("CTUN")
+    column = next((c for c in ("ThO", "ThrOut") if group and c in group[0]), None)
+    if column is None:
+        return None
+    value = _columns(group, [column])[:, 0]
+    scaled = value.max() > 1.5  # older firmware logged it from 0 to 1000 and passed it divided by 1000
+    return Throttle(_time(group), value / 1000.0 if scaled else value,
+                    f"CTUN.{column}{' / 1000' if scaled else ''} (motors->get_throttle())")
 
 
 def _imus(rows: dict) -> list[Imu]:
@@ -241,7 +267,7 @@ def _battery(rows: dict, formats: dict, params: dict) -> Battery | None:
 def read_dataflash(path: Path, text: bool) -> FlightLog:
     """Read an ArduPilot DataFlash log at ``path``: text form when ``text`` is true, else binary."""
     rows, formats, params, noise, trailing = _collect(path, text)
-    if not rows or not any(rows.get(k) for k in WANTED - {"MSG"}):
+    if not rows or not any(rows.get(k) for k in SENSORS):
         raise LogError(f"{path}: no sensor messages could be read (MAG, IMU, ATT, RCOU, BAT); the file is empty, "
                        "truncated before its data or not a DataFlash log")
     messages = [r["Message"] for r in rows.get("MSG", [])]
@@ -264,7 +290,13 @@ def read_dataflash(path: Path, text: bool) -> FlightLog:
     if vehicle == "Copter":
         vehicle = {3: "tricopter", 4: "quadrotor", 6: "hexarotor", 8: "octorotor"}[_motor_count(params, messages)]
         vehicle += f" (Copter{', ' + frame if frame else ''})"
+    version = ardupilot.parse_version(firmware)
+    if version is None:
+        warnings.append(f"firmware {firmware!r} names no Copter version: the compass corrections are read with "
+                        f"the rules of Copter {ardupilot.DEFAULT_VERSION[0]}.{ardupilot.DEFAULT_VERSION[1]}")
+    rule = ardupilot.rules(version or ardupilot.DEFAULT_VERSION)
     log = FlightLog(str(path), "dataflash-text" if text else "dataflash-binary", "ArduPilot", firmware, vehicle,
-                    simulator, _compasses(rows, params), _imus(rows), _motors(rows, params, messages, path),
-                    _battery(rows, formats, params), _attitude(rows), params, warnings)
+                    simulator, _compasses(rows, params, rule), _imus(rows), _motors(rows, params, messages, path),
+                    _battery(rows, formats, params), _attitude(rows), params, warnings, _position(rows),
+                    _throttle(rows))
     return log

@@ -37,6 +37,12 @@ class Compass:
         corrections undone).
     soft_iron : (3, 3) array
         The autopilot's soft-iron correction in our convention, ``raw = soft_iron m + offsets``.
+    rotation : (3, 3) array
+        Body-from-sensor rotation of ``raw``: the identity where the log's raw field is already in
+        the body frame (ArduPilot), ``CAL_MAGn_ROT`` or the board's rotation for PX4's sensor frame.
+    slot : int
+        The calibration parameters' index: ArduPilot's compass number, PX4's ``CAL_MAGn`` matched by
+        ``CAL_MAGn_ID`` to the sensor's device id.
     unusable : str
         Why the raw field cannot be recovered (a singular soft-iron matrix in the log's
         parameters, named), or empty; ``raw`` is then NaN and the compass is refused for a
@@ -51,7 +57,31 @@ class Compass:
     external: bool | None = None
     raw_source: str = ""
     soft_iron: np.ndarray = _default(default_factory=lambda: np.eye(3))
+    rotation: np.ndarray = _default(default_factory=lambda: np.eye(3))
+    slot: int = 0
     unusable: str = ""
+
+
+@dataclass(frozen=True)
+class Position:
+    """Where and when the vehicle flew, from its GPS: ``latitude_deg``, ``longitude_deg`` (WGS 84),
+    ``altitude_m`` (above mean sea level), ``year`` (decimal year, UTC) and ``source`` (the message)."""
+
+    latitude_deg: float
+    longitude_deg: float
+    altitude_m: float
+    year: float
+    source: str
+
+
+@dataclass(frozen=True)
+class Throttle:
+    """The throttle the autopilot's compass compensation uses: ``value`` (T,) (0..1) at ``time``
+    (T,) (s); ``source`` names it (ArduPilot's ``CTUN.ThO``, PX4's thrust setpoint)."""
+
+    time: np.ndarray
+    value: np.ndarray
+    source: str
 
 
 @dataclass(frozen=True)
@@ -130,6 +160,10 @@ class FlightLog:
     attitude : Attitude or None
     params : dict
         The log's parameters (name: value), as the autopilot names them.
+    position : Position or None
+        The GPS fix the Earth field model is evaluated at (None without a GPS fix).
+    throttle : Throttle or None
+        The autopilot's own throttle signal, the one its compass compensation multiplies.
     warnings : list of str
         What was found wrong but could be read past (corruption skipped, a truncated end).
     """
@@ -147,6 +181,8 @@ class FlightLog:
     attitude: Attitude | None = None
     params: dict = _default(default_factory=dict)
     warnings: list[str] = _default(default_factory=list)
+    position: Position | None = None
+    throttle: Throttle | None = None
 
     @property
     def start(self) -> float:

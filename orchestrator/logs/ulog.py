@@ -9,6 +9,12 @@ How PX4's logged topics differ from ArduPilot's messages:
   is logged, the raw one is recovered by undoing ``CAL_MAGn_*OFF`` and ``*SCALE``.
 - No motor-compensation offsets are logged: PX4 adds ``CAL_MAGn_*COMP`` times the throttle or
   the current inside the calibration step, so the raw topic is the field before it.
+- The calibration slot ``CAL_MAGn`` of a sensor is the one whose ``CAL_MAGn_ID`` is its
+  ``device_id`` (:func:`orchestrator.logs.px4.slot`); the raw field stays in the sensor's frame and
+  :attr:`Compass.rotation` carries ``CAL_MAGn_ROT`` or the board's rotation into the body frame.
+- ``vehicle_gps_position``: the position and date of the Earth field model; the thrust setpoint's
+  norm (``vehicle_thrust_setpoint``, or ``actuator_controls_0.control[3]`` in older logs) is the
+  throttle ``CAL_MAG_COMP_TYP = 1`` multiplies.
 - IMUs: ``sensor_accel`` and ``sensor_gyro`` per instance (newer), or ``sensor_combined``.
 - Motors: ``actuator_motors`` (already 0..1, newer) or ``actuator_outputs`` in us, normalised
   with ``PWM_MAIN_MIN``/``PWM_MAIN_MAX`` (or ``PWM_MIN``/``PWM_MAX`` in older firmware).
@@ -23,11 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors
+from orchestrator.logs import px4
+from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
 
 GAUSS = 1e-4  # T
 MICRO = 1e-6
-MIN_SCALE = 1e-6  # a CAL_MAGn_*SCALE this small (1) cannot be undone
+SINGULAR_CONDITION = 1e12  # a CAL_MAGn scale matrix this ill-conditioned cannot be undone
 INVALID_RELATIVE = 2147483647  # sensor_combined: no new sample of this sensor
 MAV_TYPE_MOTORS = {2: 4, 13: 6, 14: 8, 15: 3}
 MAV_TYPE_NAMES = {1: "fixed wing", 2: "quadrotor", 13: "hexarotor", 14: "octorotor", 15: "tricopter",
@@ -42,17 +49,30 @@ def _vector(data: dict, names) -> np.ndarray:
     return np.column_stack([np.asarray(data[n], dtype=float) for n in names])
 
 
+def _external(params: dict, n: int) -> bool:
+    """PX4 marks an internal compass by ``CAL_MAGn_ROT = -1``."""
+    return int(params.get(f"CAL_MAG{n}_ROT", -1)) >= 0
+
+
 def _compasses(ulog, params: dict) -> list[Compass]:
     out = []
     for d in _topics(ulog, "sensor_mag"):
         raw = _vector(d.data, ["x", "y", "z"]) * GAUSS
-        k = d.multi_id
-        offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
-        scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
-        unusable = _singular(scale, k)
-        out.append(Compass(f"sensor_mag[{k}]", d.data["timestamp"] * MICRO, (raw - offsets) * scale, raw, offsets,
-                           None, "sensor_mag (logged before calibration)",
-                           np.full((3, 3), np.nan) if unusable else np.diag(1.0 / scale), unusable))
+        device = int(d.data["device_id"][0]) if "device_id" in d.data else None
+        n = px4.slot(params, device, d.multi_id)
+        external = _external(params, n)
+        offsets = np.array([params.get(f"CAL_MAG{n}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
+        matched = f"CAL_MAG{n} matched by device id {device}" if device else f"CAL_MAG{n} by topic order (no device id)"
+        source = f"sensor_mag (logged before calibration, sensor frame); {matched}"
+        unusable = _unusable(params, n, external)
+        if unusable:
+            out.append(Compass(f"sensor_mag[{d.multi_id}]", d.data["timestamp"] * MICRO, np.full_like(raw, np.nan),
+                               raw, offsets, external, source, np.full((3, 3), np.nan), np.eye(3), n, unusable))
+            continue
+        field = px4.apply(params, n, external, raw)
+        out.append(Compass(f"sensor_mag[{d.multi_id}]", d.data["timestamp"] * MICRO, field, raw, offsets, external,
+                           source, np.linalg.inv(px4.scale_matrix(params, n)), px4.body_rotation(params, n, external),
+                           n))
     if out:
         return out
     calibrated = _topics(ulog, "vehicle_magnetometer")
@@ -71,26 +91,71 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         sources = [("sensor_combined.magnetometer_ga", time, field[first], 0)]
     for name, time, field, k in sources:
         offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
-        scale = np.array([params.get(f"CAL_MAG{k}_{a}SCALE", 1.0) for a in "XYZ"])
         field = field * GAUSS
-        undone = f"{name} with CAL_MAG{k}_*OFF and *SCALE undone (no raw topic logged)"
-        unusable = _singular(scale, k)
+        external = _external(params, k)
+        undone = f"{name} with CAL_MAG{k}_*OFF, *SCALE, *ODIAG and the rotation undone (no raw topic logged)"
+        unusable = _unusable(params, k, external)
         if unusable:
             out.append(Compass(name, time, field, np.full_like(field, np.nan), offsets, None, undone,
-                               np.full((3, 3), np.nan), unusable))
-        else:
-            out.append(Compass(name, time, field, field / scale + offsets, offsets, None, undone,
-                               np.diag(1.0 / scale)))
+                               np.full((3, 3), np.nan), np.eye(3), k, unusable))
+            continue
+        out.append(Compass(name, time, field, px4.recover_raw(params, k, external, field), offsets, None, undone,
+                           np.linalg.inv(px4.scale_matrix(params, k)), px4.body_rotation(params, k, external), k))
     return out
 
 
-def _singular(scale: np.ndarray, k: int) -> str:
-    """Why the scale factors ``CAL_MAGk_*SCALE`` cannot be undone (empty when they can)."""
-    if np.all(np.isfinite(scale)) and np.all(np.abs(scale) > MIN_SCALE):
-        return ""
-    named = ", ".join(f"CAL_MAG{k}_{a}SCALE = {v:g}" for a, v in zip("XYZ", scale, strict=True))
-    return (f"its scale factors make a singular correction ({named}): the field before PX4's calibration cannot "
-            "be recovered from this log (a scale of 1 is no correction)")
+def _unusable(params: dict, n: int, external: bool) -> str:
+    """Why slot ``n``'s calibration in ``params`` cannot be undone (empty when it can): a singular
+    ``CAL_MAGn_*SCALE``/``*ODIAG`` matrix or a rotation this reader does not handle, named."""
+    S = px4.scale_matrix(params, n)
+    if not (np.all(np.isfinite(S)) and np.linalg.cond(S) < SINGULAR_CONDITION):
+        named = ", ".join(f"CAL_MAG{n}_{a}{kind} = {params.get(f'CAL_MAG{n}_{a}{kind}', default):g}"
+                          for kind, default in (("SCALE", 1.0), ("ODIAG", 0.0)) for a in "XYZ")
+        return (f"its scale factors make a singular correction ({named}): the field before PX4's calibration "
+                "cannot be recovered from this log (a scale of 1 and off-diagonals of 0 are no correction)")
+    try:
+        px4.body_rotation(params, n, external)
+    except ValueError as error:
+        which = f"CAL_MAG{n}_ROT" if external else "SENS_BOARD_ROT"
+        return f"its rotation cannot be applied ({which}: {error})"
+    return ""
+
+
+def _position(ulog) -> Position | None:
+    """The median 3D fix of ``vehicle_gps_position`` (or ``sensor_gps``) and its UTC date."""
+    import datetime
+
+    topics = _topics(ulog, "vehicle_gps_position") or _topics(ulog, "sensor_gps")
+    if not topics:
+        return None
+    d = topics[0].data
+    fixed = (np.asarray(d.get("fix_type", np.zeros(1))) >= 3) & (np.asarray(d.get("time_utc_usec", np.zeros(1))) > 0)
+    if not fixed.any():
+        return None
+    if "latitude_deg" in d:
+        lat, lon, alt = d["latitude_deg"][fixed], d["longitude_deg"][fixed], d["altitude_msl_m"][fixed]
+    else:
+        lat, lon, alt = d["lat"][fixed] * 1e-7, d["lon"][fixed] * 1e-7, d["alt"][fixed] * 1e-3
+    when = datetime.datetime.fromtimestamp(float(d["time_utc_usec"][fixed][0]) * MICRO, datetime.UTC)
+    start = datetime.datetime(when.year, 1, 1, tzinfo=datetime.UTC)
+    end = datetime.datetime(when.year + 1, 1, 1, tzinfo=datetime.UTC)
+    year = when.year + (when - start).total_seconds() / (end - start).total_seconds()
+    return Position(float(np.median(lat)), float(np.median(lon)), float(np.median(alt)), float(year),
+                    f"{topics[0].name} (median of the 3D fixes)")
+
+
+def _thrust(ulog) -> Throttle | None:
+    topics = _topics(ulog, "vehicle_thrust_setpoint")
+    if topics:
+        d = topics[0].data
+        value = np.linalg.norm(_vector(d, [f"xyz[{k}]" for k in range(3)]), axis=1)
+        return Throttle(d["timestamp"] * MICRO, value, "vehicle_thrust_setpoint (norm)")
+    topics = _topics(ulog, "actuator_controls_0")
+    if topics and "control[3]" in topics[0].data:
+        d = topics[0].data
+        return Throttle(d["timestamp"] * MICRO, np.asarray(d["control[3]"], dtype=float),
+                        "actuator_controls_0.control[3]")
+    return None
 
 
 def _imus(ulog) -> list[Imu]:
@@ -178,4 +243,5 @@ def read_ulog(path: Path) -> FlightLog:
     warnings = [f"corrupt stretches skipped: {said or 'pyulog reports file corruption'}"] \
         if ulog.file_corruption or said else []
     return FlightLog(str(path), "ulog", "PX4", firmware, vehicle, simulator, _compasses(ulog, params), _imus(ulog),
-                     _motors(ulog, params, path), _battery(ulog), _attitude(ulog), params, warnings)
+                     _motors(ulog, params, path), _battery(ulog), _attitude(ulog), params, warnings,
+                     _position(ulog), _thrust(ulog))

@@ -38,6 +38,7 @@ GROUPS = (
     "speed",
     "sweep_cost",
     "flightlogs",
+    "magfit",
     "real_recordings",
     "plant",
     "fmu_agreement",

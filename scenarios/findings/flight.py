@@ -1,8 +1,10 @@
-"""Findings of the flight side: what rotor drag lets the accelerometer see, and the wind hold.
+"""Findings of the flight side: what rotor drag lets the accelerometer see, the wind hold, and
+how fast the yaw loop may be at a 100 Hz loop rate.
 
 Each is a ``tp`` run whose ``metrics.json`` records the number (:mod:`scenarios.flight.measured`),
 except the PD hold without integral, an ablation of the controller's gain that no option
-reaches: it is computed here, as ``tests/test_flight.py`` does, and printed by this group.
+reaches: it is computed here, as ``tests/test_flight.py`` does, and printed by this group; and
+the yaw loop's cases (:mod:`scenarios.flight.yaw_loop`), printed by their module.
 """
 
 from __future__ import annotations
@@ -83,9 +85,40 @@ def offset_without_integral() -> float:
     return math.hypot(result["Quadrotor.p"][-1, 0], result["Quadrotor.p"][-1, 1])
 
 
+YAW = "python -m scenarios.flight.yaw_loop"
+#: Tolerances of the yaw loop's figures: a ringing loop's limit cycle grows from rounding error,
+#: so another CPU may sample it at other phases.
+YAW_TOLERANCE = {"ringing_nm": 0.002, "ring_hz": 0.3, "command_min": 0.005, "command_max": 0.005,
+                 "current_min_a": 0.05, "current_max_a": 0.05}
+YAW_DIGITS = {"ringing_nm": 3, "ring_hz": 1, "command_min": 3, "command_max": 3, "current_min_a": 2,
+              "current_max_a": 2}
+YAW_UNITS = {"ringing_nm": "N m", "ring_hz": "Hz", "command_min": "1", "command_max": "1", "current_min_a": "A",
+             "current_max_a": "A"}
+
+
+def yaw(quick: bool = False) -> list[dict]:
+    """The yaw loop's cases (a ringing one's ringing and its frequency; every one's command and
+    current ranges), the largest quiet loop at 100 Hz and the first whose commands reach a
+    bound; ``quick``: the 100 Hz cases alone (a second each)."""
+    from scenarios.flight import yaw_loop
+
+    found = []
+    for name, rate, w, flight, settings in yaw_loop.CASES:
+        if quick and rate != 100.0:
+            continue
+        case = yaw_loop.yaw_loop(rate, w, flight, settings)
+        keys = [k for k in YAW_DIGITS if case["oscillating"] or k not in ("ringing_nm", "ring_hz")]
+        found += [finding(f"flight.yaw.{name}.{k}", case[k], YAW_UNITS[k], YAW, YAW_TOLERANCE[k], YAW_DIGITS[k])
+                  for k in keys]
+    if not quick:
+        found += [finding("flight.yaw.largest_quiet_100hz_rad_s", yaw_loop.largest_quiet(), "rad/s", YAW, 0.0, 1),
+                  finding("flight.yaw.first_at_bound_100hz_rad_s", yaw_loop.first_at_bound(), "rad/s", YAW, 0.0, 1)]
+    return found
+
+
 def compute(quick: bool = False) -> list[dict]:
-    """The flight findings; ``quick``: the 30 s tilt step alone (about 5 s)."""
+    """The flight findings; ``quick``: the 30 s tilt step and the yaw loop's 100 Hz cases (about 10 s)."""
     found = tilt("flight.tilt", TILT)
     if quick:
-        return found
-    return found + tilt("flight.tilt_without_drag", TILT | {"rotor_drag": False}) + wind()
+        return found + yaw(quick=True)
+    return found + tilt("flight.tilt_without_drag", TILT | {"rotor_drag": False}) + wind() + yaw()

@@ -1,7 +1,9 @@
 """Findings of the real flights: the quad's two compasses calibrated from its three flights
 (each model's explained share of the held-out residual, the perturbation at hover and the
-heading change), and the estimators replayed on every shared log without and with the
-compensation, against the autopilot's attitude.
+heading change), the exported parameter file of every compass of every ArduPilot log scored as
+its firmware applies it against the log as flown, what each wrong firmware rule costs that export
+(an ablation), and the estimators replayed on every shared
+log without and with the compensation, against the autopilot's attitude.
 
 The logs (three flights of one quad, an Erle-Brain flight and a PX4 bench log) are read from
 the folder that ``$QUADCOSIM_FLIGHT_LOGS`` names; without it the group is skipped
@@ -22,7 +24,12 @@ COMPASSES = {0: "external", 1: "internal"}
 MODELS = ("current", "throttle", "motors", "metge")
 REPLAYS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebrain", 0), ("px4", 0)]
 OTHER_LOGS = {"erlebrain": "erlebrain_APM_22.bin", "px4": "px4_sample.ulg"}
+# every compass of every ArduPilot log: its export against the log as flown (one column per judge)
+EXPORTS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebrain", 0)]
 REPLAYED = ("explicit", "vqf")
+# the internal compass of the three quad flights and the Erle-Brain's: what each wrong firmware rule costs
+ABLATIONS = [("a", 1), ("b", 1), ("c", 1), ("erlebrain", 0)]
+ABLATION = "python -m scenarios.findings flightlogs"  # a function of the group, not a command's output
 PERCENT = 100.0
 # the means over the flights: the group prints them (and, with --check, writes nothing)
 MEANS = "python -m scenarios.findings flightlogs --check"
@@ -62,18 +69,18 @@ def _calibrate_command(files, compass: int, cross: bool) -> str:
 def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
     """Each flight's last half scored on a fit to its first half (and, with ``cross``, each
     flight scored on a fit to the two others)."""
-    from calibration.flight import calibrate, flight_data
+    from calibration.flight import calibrate
     from orchestrator.logs import read_log
+    from scenarios.flightlog.calibrate import split_parts
 
     logs = {k: read_log(_path(k)) for k in flights}
     found = []
     for compass in compasses:
-        data = {k: flight_data(log, compass) for k, log in logs.items()}
         where = f"quad.{COMPASSES[compass]}"
         hover, change = {m: [] for m in models}, {m: [] for m in models}
-        for key, flight in data.items():
-            train, test = flight.split(0.5)
-            metrics, _, _ = calibrate([train], [test], models)
+        for key in logs:
+            split = split_parts([logs[key]], [], compass)  # as the command splits it, the Earth field model attached
+            metrics, _, _ = calibrate(split.train, split.test, models)
             for m in models:
                 result = metrics["models"][m]
                 if "refused" in result:
@@ -83,8 +90,9 @@ def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
                 hover[m].append(result["perturbation_at_hover_T"] * 1e6)
                 change[m].append(result["heading_rms_change_deg"])
             if cross:
-                others = [k for k in data if k != key]
-                metrics, _, _ = calibrate([data[k] for k in others], [flight], models)
+                others = [k for k in logs if k != key]
+                split = split_parts([logs[k] for k in others], [logs[key]], compass)
+                metrics, _, _ = calibrate(split.train, split.test, models)
                 for m in models:
                     if "refused" not in metrics["models"][m]:
                         found.append(_finding(f"{where}.{m}.explained_cross_{key}",
@@ -96,6 +104,48 @@ def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
                                       MEANS, 0.05, 1))
                 found.append(_finding(f"{where}.{m}.heading_change_deg", np.mean(change[m]), "deg",
                                       MEANS, 0.05, 1))
+    return found
+
+
+def export_command(key: str, compass: int) -> str:
+    """The command that exports compass ``compass`` of log ``key`` and prints its scores."""
+    return f"quadcosim calibrate {_shown(key)} --compass {compass} --out results/flightlogs"
+
+
+def _exports(keys) -> list[dict]:
+    """Each compass's exported file and the log as flown, scored on the last half as the log's
+    firmware applies them (heading error, deg RMS; explained share, %), through the command itself."""
+    import contextlib
+    import io
+    import json
+    import tempfile
+
+    from scenarios.cli import main
+
+    found = []
+    for key, compass in keys:
+        with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stdout(io.StringIO()), \
+                contextlib.redirect_stderr(io.StringIO()):
+            main(["calibrate", str(_path(key)), "--compass", str(compass), "--out", folder, "--overwrite"])
+            export = json.loads((Path(folder) / "metrics.json").read_text())["export"]
+        command = export_command(key, compass)
+        name = f"export.{key}{compass}"
+        found.append(_finding(f"{name}.as_flown_deg", export["as_flown"]["heading_rms_deg"], "deg", command, 0.02, 2))
+        found.append(_finding(f"{name}.export_deg", export["heading_rms_deg"], "deg", command, 0.02, 2))
+        found.append(_finding(f"{name}.explained_pct", PERCENT * export["explained_test"], "%", command, 0.2, 1))
+    return found
+
+
+def _ablations() -> list[dict]:
+    """The heading error (deg RMS, score part) of the export under the right rules and under each
+    wrong one, applied as the log's firmware applies it (:mod:`scenarios.findings.flightlog_ablation`)."""
+    from orchestrator.logs import read_log
+    from scenarios.findings.flightlog_ablation import costs
+
+    found = []
+    for key, compass in ABLATIONS:
+        for rule, value in costs(read_log(_path(key)), compass).items():
+            found.append(_finding(f"ablation.{key}{compass}.{rule}_deg", value, "deg", ABLATION, 0.02, 2))
     return found
 
 
@@ -120,5 +170,6 @@ def compute(quick: bool = False) -> list[dict]:
     current and throttle models, last half held out (a few seconds)."""
     if quick:
         return [f for f in _calibrations(["b"], [1], ("current", "throttle"), cross=False)
-                if ".explained_half_" in f["name"]]
-    return _calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _replays()
+                if ".explained_half_" in f["name"]] + _exports([("b", 1)])
+    return (_calibrations(list(FLIGHTS), list(COMPASSES), MODELS, cross=True) + _exports(EXPORTS) + _ablations()
+            + _replays())

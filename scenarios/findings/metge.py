@@ -1,7 +1,10 @@
 """Findings of the magnetometer calibration on the clamped rig (Metge et al.) and of its robustness.
 
-Three ``metge`` runs (default options; ``noise=off``; one battery state per set) and the
-robustness study (:mod:`scenarios.metge_robustness`). About 10 minutes; nothing here is quick.
+Four ``metge`` runs (default options; ``noise=off``; one battery state per set; the paper's
+free-set regime), the robustness study (:mod:`scenarios.metge_robustness`) and the free set's
+ablation (:mod:`scenarios.metge_free`). About 20 minutes; the quick subset is the free set's
+uncompensated error of the default and the paper's regime over the ablation's seeds (no
+calibration needed) and the bounds (seconds).
 """
 
 from __future__ import annotations
@@ -12,6 +15,10 @@ RUN = "quadcosim run metge"
 NOISELESS = f"{RUN} --set noise=off"
 ONE_STATE = f"{RUN} --set soc1=0.95 soc2=0.8"
 ROBUSTNESS = "python -m scenarios.metge --robustness --out results/robustness"
+PAPER_REGIME = f"{RUN} --set regime=paper"
+FREE_SET = "python -m scenarios.metge --free-set --out results/free-set"
+#: The ablation's cases whose uncompensated free set the quick subset re-measures.
+QUICK_CASES = ("default", "paper")
 DEG = 0.005  # deg, tolerance of a re-run (the runs are seeded: a re-run differs by round-off)
 
 
@@ -75,8 +82,73 @@ def robustness() -> list[dict]:
     return found
 
 
-def compute(quick: bool = False) -> list[dict]:
-    """Every metge finding; ``quick``: none (each run takes minutes)."""
+def paper_regime() -> list[dict]:
+    """Table 1 re-measured in the paper's free-set regime (``regime=paper``)."""
+    m = _run({"regime": "paper"})
+    t, found = m["table1_deg"], []
+    for row in ("none", "calibration1", "calibration2"):
+        for column in ("set1", "set2", "free"):
+            digits = 2 if row != "none" and column != "free" else 1
+            found.append(finding(f"metge.paper.{row}.{column}_deg", t[row][column], "deg", PAPER_REGIME, DEG, digits))
+    return found + [
+        finding("metge.paper.free_dynamic_calibration1_deg", m["free_set_dynamic_deg"], "deg", PAPER_REGIME, DEG, 2),
+        finding("metge.paper.free_dynamic_calibration2_deg", m["free_set_dynamic_calibration2_deg"], "deg",
+                PAPER_REGIME, DEG, 2),
+        finding("metge.paper.eq9_gain_free", t["none"]["free"] / t["calibration1"]["free"], "1", PAPER_REGIME, 0.05,
+                0)]
+
+
+CASE_FIELDS = ("none", "none_min", "none_max", "quasi_static", "eq9", "dynamic")  # a case's findings (deg)
+
+
+def _case(name: str, row: dict, fields=CASE_FIELDS) -> list[dict]:
+    digits = {"dynamic": 2}
+    return [finding(f"metge.free.{name}.{k}_deg", row[f"{k}_deg"], "deg", FREE_SET, DEG, digits.get(k, 1))
+            for k in fields if f"{k}_deg" in row]
+
+
+def _bounds() -> list[dict]:
+    from scenarios import metge_free
+
+    return [finding("metge.free.bound_steady_deg", metge_free.largest_turn_deg(), "deg", FREE_SET, DEG, 1),
+            finding("metge.free.bound_current_limit_deg", metge_free.largest_turn_deg(limit_current=True), "deg",
+                    FREE_SET, DEG, 1),
+            finding("metge.free.paper_removed_min_deg", metge_free.paper_removed_min_deg(), "deg", FREE_SET, 1e-9, 1)]
+
+
+def free_set(quick: bool = False) -> list[dict]:
+    """The free set's ablation: every case, the heading and the flight, the bounds; ``quick``:
+    the uncompensated free set of :data:`QUICK_CASES` and the bounds."""
+    from scenarios import metge_free
+
     if quick:
-        return []
-    return default() + noiseless_and_one_state() + robustness()
+        found = []
+        for name in QUICK_CASES:
+            errors = metge_free.uncompensated_free_deg(metge_free.cases()[name][1])
+            found += _case(name, {"none_deg": float(sum(errors) / len(errors)), "none_min_deg": min(errors),
+                                  "none_max_deg": max(errors)})
+        return found + _bounds()
+    study, found = metge_free.study(), []
+    for name, row in study["cases"].items():
+        found += _case(name, row)
+    # the sets, uncompensated: many cases share a plant (and its value), so their range and the default's
+    sets = [row["sets_deg"] for row in study["cases"].values()]
+    found += [finding("metge.free.sets_min_deg", min(sets), "deg", FREE_SET, DEG, 2),
+              finding("metge.free.sets_max_deg", max(sets), "deg", FREE_SET, DEG, 2),
+              finding("metge.free.default.sets_deg", study["cases"]["default"]["sets_deg"], "deg", FREE_SET, DEG, 2)]
+    for name in ("default", "common_up", "paper_east"):
+        row = study["cases"][name]
+        found += [finding(f"metge.free.{name}.sets_heading_deg", row["sets_heading_deg"], "deg", FREE_SET, DEG, 1),
+                  finding(f"metge.free.{name}.heading_deg", row["heading_deg"], "deg", FREE_SET, DEG, 1)]
+    for name in ("default", "paper"):
+        found.append(finding(f"metge.free.{name}.removed_deg", study["cases"][name]["removed_deg"], "deg", FREE_SET,
+                             DEG, 1))
+    found += [finding(f"metge.free.flying.{k}", v, "deg", FREE_SET, DEG, 1) for k, v in study["flying"].items()]
+    return found + _bounds()
+
+
+def compute(quick: bool = False) -> list[dict]:
+    """Every metge finding; ``quick``: the free set's quick subset (:func:`free_set`)."""
+    if quick:
+        return free_set(quick=True)
+    return default() + noiseless_and_one_state() + robustness() + paper_regime() + free_set()

@@ -14,7 +14,7 @@ import os
 from pathlib import Path
 
 COMMAND = "python -m benchmarks.real_recordings DATA"
-CHOOSE = "python -m benchmarks.real_recordings DATA --choose"
+CHOOSE = "python -m benchmarks.tuning DATA"
 LARGE = "mahony"  # the filter whose failures on single recordings the documentation counts
 FILTERS = {"explicit": "explicit", "passive": "passive", "vqf": "VQF", "madgwick": "Madgwick", "mahony": "Mahony"}
 METRICS = {"total_rmse_deg": "total", "heading_rmse_deg": "heading", "inclination_rmse_deg": "inclination"}
@@ -22,26 +22,43 @@ TOLERANCE_DEG = 0.005  # deg: the figures are deterministic; printed to 2 decima
 DIGITS = 2
 
 
-def _entry(name, value, unit, digits=DIGITS, tolerance=TOLERANCE_DEG) -> dict:
-    return {"name": f"real_recordings.{name}", "value": float(value), "unit": unit, "command": COMMAND,
+def _entry(name, value, unit, digits=DIGITS, tolerance=TOLERANCE_DEG, command=COMMAND) -> dict:
+    return {"name": f"real_recordings.{name}", "value": float(value), "unit": unit, "command": command,
             "tolerance": tolerance, "digits": digits}
 
 
 def findings(results: dict) -> list[dict]:
     """The findings of :func:`benchmarks.real_recordings.evaluate`'s ``results``: per dataset, its
-    number of recordings, every filter's mean total, heading and inclination RMSE (deg), and our
-    best filter's mean total RMSE over VQF's."""
+    number of recordings, the mean total, heading and inclination RMSE (deg) of every filter, of
+    the published filters tuned the same way as ours and of the recommended filter's ablations,
+    and the recommended filter's mean total RMSE over VQF's (at VQF's defaults, and tuned)."""
     out = []
     for dataset, found in results.items():
         out.append(_entry(f"{dataset}.recordings", found["recordings"], "1", 0, 0.0))
-        for kind in FILTERS:
+        for kind, means in found["means"].items():
             for metric in METRICS:
-                value = found["means"][kind][metric]
+                value = means[metric]
                 if not math.isnan(value):  # a filter not run on the dataset: no finding
                     out.append(_entry(f"{dataset}.{kind}.{metric}", value, "deg"))
-        best = min(found["means"][k]["total_rmse_deg"] for k in ("explicit", "passive"))
-        out.append(_entry(f"{dataset}.best_over_vqf", best / found["means"]["vqf"]["total_rmse_deg"], "1"))
+        total = {k: v["total_rmse_deg"] for k, v in found["means"].items()}
+        out.append(_entry(f"{dataset}.explicit_over_vqf", total["explicit"] / total["vqf"], "1"))
+        for kind in ("vqf", "madgwick", "mahony"):
+            if f"{kind}_tuned" in total:
+                out.append(_entry(f"{dataset}.explicit_over_{kind}_tuned", total["explicit"] / total[f"{kind}_tuned"],
+                                  "1"))
     return out + notes(results)
+
+
+def tuning(records: dict) -> list[dict]:
+    """The search records of :mod:`benchmarks.tuning` (filter -> record): the values chosen, the score
+    there (the worst development dataset's ratio to VQF) and the number of gain sets scored."""
+    out = []
+    for kind, record in records.items():
+        for name, value in record["chosen"].items():
+            digits = 0 if float(value).is_integer() else 3
+            out.append(_entry(f"tuning.{kind}.{name}", value, "1", digits, 0.0, f"{CHOOSE} --filter {kind}"))
+        out.append(_entry(f"tuning.{kind}.score", record["score"], "1", 2, 0.005, f"{CHOOSE} --filter {kind}"))
+    return out
 
 
 def notes(results: dict) -> list[dict]:
@@ -57,58 +74,34 @@ def notes(results: dict) -> list[dict]:
         if left:
             out += [_entry(f"notes.{dataset}.left_out", left, "1", 0, 0.0),
                     _entry(f"notes.{dataset}.available", found["recordings"] + left, "1", 0, 0.0)]
-    if "broad" in results:
+    if "broad" in results and LARGE in results["broad"]["means"]:
         large = large_errors(results["broad"], LARGE)
         out += [_entry(f"notes.broad.{LARGE}_large_errors", len(large), "1", 0, 0.0),
                 _entry(f"notes.broad.{LARGE}_largest_error_deg", large[0] if large else 0.0, "deg", 1, 0.05)]
     return out
 
 
-def left_out_ratios(choice: dict) -> list[dict]:
-    """The cross-validation ``choice`` of :func:`benchmarks.real_recordings.choose`: for each filter and each
-    choosing dataset, its error over VQF's there at the gains chosen without it."""
-    return [{**_entry(f"choice.{kind}.without_{dataset}_over_vqf", fold["ratio_to_vqf"], "1"), "command": CHOOSE}
-            for kind, chosen in choice.items() for dataset, fold in chosen["left_out"].items()]
-
-
 def compute(quick: bool = False) -> list[dict]:
-    """The group's findings, from the data folder named by ``QUADCOSIM_REAL_DATA``; ``quick`` leaves
-    out the cross-validation over the gain grid (the published filters' results come from
-    ``QUADCOSIM_REAL_CACHE`` when kept there).
+    """The group's findings, from the data folder named by ``QUADCOSIM_REAL_DATA`` (the published
+    filters' results at their defaults come from ``QUADCOSIM_REAL_CACHE`` when kept there), and the
+    tuning's committed records (``benchmarks/data/tuning_*.json``; ``quick`` or not, the search itself
+    is not re-run here: ``python -m benchmarks.tuning DATA`` re-runs it). ``QUADCOSIM_REAL_PUBLISHED``
+    names the published filters to run (comma-separated; default all).
     Raises ``FileNotFoundError`` when the data are absent."""
     folder = os.environ.get("QUADCOSIM_REAL_DATA")
     if not folder or not Path(folder).is_dir():
         raise FileNotFoundError("the real recordings are not on this machine: set QUADCOSIM_REAL_DATA to their "
                                 "folder (see benchmarks/datasets.py); the recorded values are kept")
+    import json
+
     from benchmarks import real_recordings
 
     cache = os.environ.get("QUADCOSIM_REAL_CACHE")
-    found = findings(real_recordings.evaluate(folder, cache=cache))
-    if quick:
-        return found
-    grids = real_recordings.evaluate(folder, real_recordings.CHOOSING, cache, grids=True)
-    return found + left_out_ratios(real_recordings.choose(grids))
+    published = tuple(k for k in os.environ.get("QUADCOSIM_REAL_PUBLISHED", "vqf,madgwick,mahony").split(",") if k)
+    records = {path.stem.removeprefix("tuning_"): json.loads(path.read_text())
+               for path in sorted(real_recordings.TUNING_RECORDS.glob("tuning_*.json"))}
+    return findings(real_recordings.evaluate(folder, cache=cache, published=published)) + tuning(records)
 
 
 def _deg(value) -> str:
     return "—" if math.isnan(value) else f"{value:.2f}"
-
-
-def readme_tables(results: dict) -> str:
-    """The README's two tables (mean total RMSE and best over VQF; heading and inclination) from
-    :func:`benchmarks.real_recordings.evaluate`'s ``results``."""
-    from benchmarks.real_recordings import HELD_OUT
-
-    head = "| dataset (recordings) | role | " + " | ".join(FILTERS.values()) + " | best / VQF |"
-    lines = [head, "|---" * (len(FILTERS) + 3) + "|"]
-    detail = ["| dataset | " + " | ".join(f"{label} heading / incl." for label in FILTERS.values()) + " |",
-              "|---" * (len(FILTERS) + 1) + "|"]
-    for dataset, found in results.items():
-        m = found["means"]
-        role = "held out" if dataset in HELD_OUT else "chose the defaults"
-        best = min(m["explicit"]["total_rmse_deg"], m["passive"]["total_rmse_deg"]) / m["vqf"]["total_rmse_deg"]
-        lines.append(f"| {dataset} ({found['recordings']}) | {role} | " +
-                     " | ".join(_deg(m[k]["total_rmse_deg"]) for k in FILTERS) + f" | {best:.2f} |")
-        detail.append(f"| {dataset} | " + " | ".join(
-            f"{_deg(m[k]['heading_rmse_deg'])} / {_deg(m[k]['inclination_rmse_deg'])}" for k in FILTERS) + " |")
-    return "\n".join(lines) + "\n\n" + "\n".join(detail)

@@ -21,9 +21,11 @@ Law, per sample of period ``dt``:
   ``tau = J (-K_p e - K_d omega) + omega x J omega``, ``K_p = diag(kp, kp, kp_yaw)``, ``K_d`` alike.
   Yaw is slower (8 against 12 rad/s): the rotors' reaction to their own acceleration,
   ``J_r dω/dt``, acts in the sense of the drag torque and makes the yaw actuator's first
-  30 ms about 7 times stronger than ``k_m ω^2`` says (``J_r / (2 k_m ω τ_motor)``); at
-  12 rad/s a 100 Hz control loop saturates the motors in non-stationary flight, at 8 rad/s
-  it does not;
+  30 ms about 7 times stronger than ``k_m ω^2`` says (``J_r / (2 k_m ω τ_motor)``). With the
+  whole loop at 100 Hz, a yaw loop above 11 rad/s is unstable: at 12 rad/s an 18 Hz
+  oscillation grows until the motor currents reach zero, where free-wheeling ESCs hold them
+  (the ESC commands stay inside [0, 1]: 0.35 to 0.58 in non-stationary flight); 8 rad/s is
+  quiet, and so is 12 rad/s at 1 kHz (:mod:`scenarios.flight.yaw_loop` measures it);
 - altitude: ``a_z = kp_z (z_d - p_z) - kd_z v_z``, ``T = m (g - a_z) / R33``;
 - mixer: ``[T_1..T_4] = M^-1 [T, tau]`` (:func:`scenarios.flight.mixer.allocation_matrix`),
   each rotor thrust saturated to ``[0, T_max]``, ``omega_n = sqrt(T_n / k_f)``, and the ESC

@@ -1,56 +1,134 @@
 """``quadcosim calibrate FILE [FILE...] --compass N --out DIR``: a magnetometer calibration from
-real flights, validated out of sample, exported as ArduPilot and PX4 parameters.
+real flights, validated out of sample, exported as the log's autopilot's parameters and scored
+as its firmware will apply them.
 
-Validation: ``--test-fraction F`` (default 0.5) keeps the last fraction of each flight for
-testing; ``--train FILES --test FILES`` trains on some flights of one vehicle and tests on others.
+Validation: one flight: its last ``--test-fraction`` (default 0.5) is held out; several flights
+(of one vehicle): the last one is held out and the others train (cross-flight, the default);
+``--train FILES --test FILES`` chooses. The export is fitted on the training part, each of its
+groups chosen on a choice part (one flight: the first half of the held-out part; several: the
+training flights' second halves, the fit taking their first halves) and scored on a score part
+neither has seen (the held-out part's second half, or the held-out flights); see :class:`Split`.
+``--score PARAMS`` scores a parameter file (any tool's) on that score part instead, with the
+same code that scores the export.
 Outputs in DIR: ``metrics.json``, ``calibration.json`` (the project's format, for ``tp``'s
-``calibration=`` option), ``ardupilot.parm``, ``px4.params``, ``residual.png`` and ``heading.png``.
+``calibration=`` option), ``ardupilot.parm`` or ``px4.params`` (the log's autopilot's),
+``residual.png`` and ``heading.png``.
 """
 
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 FIGURES = ("residual.png", "heading.png")
-PARAMETER_FILES = ("ardupilot.parm", "px4.params")
+PARAMETER_FILES = {"ArduPilot": "ardupilot.parm", "PX4": "px4.params"}
 
 
-def _parts(files, compass: int, attitude: str, verb: str):
-    from calibration.flight import flight_data
+def _logs(files, verb: str) -> list:
     from scenarios.flightlog.command import load
 
-    return [flight_data(load(f, verb), compass, attitude) for f in files]
+    return [load(f, verb) for f in files]
 
 
-def _split(args):
-    """Training and test parts, from --train/--test or from --test-fraction."""
+@dataclass
+class Split:
+    """The parts of the flights of one compass, the Earth field model attached.
+
+    ``train``/``test``: the models' analysis (fit, and score with the Earth field and offset fitted
+    again); ``fit``/``choice``/``score``: the export, fitted on ``fit``, each group chosen on
+    ``choice`` and every export figure measured on ``score``, which neither has seen. One flight:
+    ``train``=``fit`` its first part, ``test`` the held-out rest, ``choice`` and ``score`` that
+    rest's two halves in time. Several: ``train`` the training flights, ``fit``/``choice`` their
+    halves, ``test``=``score`` the held-out flights. ``notes``: the validation's description, the
+    Earth field's lines and the yaw-mounting check.
+    """
+
+    train: list
+    test: list
+    fit: list
+    choice: list
+    score: list
+    notes: dict
+
+
+def split_parts(train_logs, test_logs, compass: int, attitude: str = "auto", trim: bool = True,
+                earth: str = "model", test_fraction: float | None = None) -> Split:
+    """:class:`Split` of compass ``compass`` of ``train_logs`` (FlightLogs; one alone is split in time
+    with its last ``test_fraction``, default 0.5, held out) and ``test_logs`` (held-out flights, or
+    empty), with the ``attitude``, ``trim`` and ``earth`` field (``model`` or ``free``) the command uses."""
+    from calibration.flight import flight_data
+    from calibration.flight.earth import align, model_field
+
+    fields, notes = {}, {}
+    for log in [*train_logs, *test_logs]:
+        fields[log.path], notes[log.path] = (None, "the free Earth field (--earth free)") if earth == "free" \
+            else model_field(log.position)
+
+    def parts(logs):
+        return [flight_data(log, compass, attitude, trim=trim) for log in logs]
+
+    if test_logs:
+        train, test = parts(train_logs), parts(test_logs)
+        halves = [p.split(0.5) for p in train]
+        fit, choice, score = [h[0] for h in halves], [h[1] for h in halves], test
+        validation = ("cross-flight; export fitted on the first half of each training flight, chosen on their "
+                      "second halves, scored on the held-out flights")
+    else:
+        fraction = test_fraction or 0.5
+        pairs = [f.split(fraction) for f in parts(train_logs)]
+        train, test = [p[0] for p in pairs], [p[1] for p in pairs]
+        quarters = [p.split(0.5) for p in test]
+        fit, choice, score = train, [q[0] for q in quarters], [q[1] for q in quarters]
+        validation = (f"last {fraction:g} of each flight held out; export fitted on the first {1 - fraction:g}, "
+                      f"chosen on the next {fraction / 2:g}, scored on the last {fraction / 2:g}")
+    rest = [*test, *fit, *choice, *score]
+    train, rest, check = align(train, rest, fields)
+    cuts = np.cumsum([len(test), len(fit), len(choice)])
+    test, fit, choice, score = (rest[:cuts[0]], rest[cuts[0]:cuts[1]], rest[cuts[1]:cuts[2]], rest[cuts[2]:])
+    return Split(train, test, fit, choice, score, {"validation": validation,
+                                                   "earth_field": sorted(set(notes.values())), "mounting": check})
+
+
+def _split(args) -> Split:
+    """The command's :class:`Split`, from its arguments."""
     if bool(args.train) != bool(args.test):
         raise ValueError("--train and --test go together: give both lists of flights, or neither")
-    if args.train:
-        return (_parts(args.train, args.compass, args.attitude, "calibrate"),
-                _parts(args.test, args.compass, args.attitude, "calibrate"))
-    if not args.files:
+    if not args.train and not args.files:
         raise ValueError("give FILE(s) to calibrate from, or --train FILES --test FILES")
-    if not 0.0 < args.test_fraction < 1.0:
+    if args.test_fraction is not None and not 0.0 < args.test_fraction < 1.0:
         raise ValueError(f"--test-fraction {args.test_fraction} must lie strictly between 0 and 1")
-    flights = _parts(args.files, args.compass, args.attitude, "calibrate")
-    pairs = [f.split(args.test_fraction) for f in flights]
-    return [p[0] for p in pairs], [p[1] for p in pairs]
+    if args.train:
+        train_logs, test_logs = _logs(args.train, "calibrate"), _logs(args.test, "calibrate")
+    else:
+        logs = _logs(args.files, "calibrate")
+        train_logs, test_logs = (logs, []) if len(logs) == 1 or args.test_fraction is not None else \
+            (logs[:-1], logs[-1:])
+    return split_parts(train_logs, test_logs, args.compass, args.attitude, not args.no_trim, args.earth,
+                       args.test_fraction)
 
 
-def exported_model(fitted: dict) -> str | None:
-    """The model the autopilots' parameters carry, of the ``fitted`` models (name: Fitted): the
-    current model when identified (both autopilots recommend it), else the throttle model, else none."""
-    return next((name for name in ("current", "throttle") if name in fitted), None)
+def _rule(args, part):
+    """ArduPilot's rules for the export: the log's firmware, or --firmware's."""
+    if args.firmware is None:
+        return None
+    from orchestrator.logs import ardupilot
+
+    version = ardupilot.parse_version(f"ArduCopter V{args.firmware}")
+    if version is None:
+        raise ValueError(f"--firmware {args.firmware!r} is not a Copter version such as 3.4 or 4.5")
+    return ardupilot.rules(version)
 
 
-def _write(out: Path, train, test, metrics, calibration, fitted, compass: int) -> list[str]:
+def _write(out: Path, split: Split, metrics: dict, calibration, fitted: dict, export: tuple,
+           attitude: str) -> list[str]:
     """Every output file, ``metrics.json`` last (in the room kept for it: a disk that fills on the
-    way still takes it, listing what was not written); the files written."""
-    from calibration.flight import autopilot
+    way still takes it, listing what was not written); the files written. ``export``: the
+    autopilot, the parameter file's name and its parameters."""
+    from calibration.flight.autopilot import write_parameters
     from orchestrator.files import DiskFull, Reserve, write_json
-    from scenarios.flightlog.calibration_figures import heading_figure, residual_figure
 
     reserve = Reserve(out)  # DiskFull when not even metrics.json fits: nothing is written
     files, not_written = ["metrics.json"], {}
@@ -64,29 +142,13 @@ def _write(out: Path, train, test, metrics, calibration, fitted, compass: int) -
         except Exception as error:  # a figure that could not be drawn: said in metrics.json, the rest kept
             not_written[name] = f"{type(error).__name__}: {error}"
 
-    model = exported_model(fitted)
-    K = None if model is None else fitted[model].extra["K"][0]
-    ardupilot = autopilot.ardupilot_parameters(compass, calibration.static, model, K)
-    px4 = autopilot.px4_parameters(compass, calibration.static, model, K)
+    autopilot, name, params = export
     keep("calibration.json", calibration.save)
-    keep(PARAMETER_FILES[0], lambda path: autopilot.write_ardupilot(ardupilot, path))
-    keep(PARAMETER_FILES[1], lambda path: autopilot.write_px4(px4, path))
-    metrics["exported_model"] = model
-    if model is not None:
-        name = Path(train[0].source).name
-        keep(FIGURES[0], lambda path: residual_figure(
-            test, fitted[model], model, path,
-            f"{name}: field residual on the held-out part, before and after the {model} model"))
-        whole = train[0] if len(train) == len(test) and train[0].log is test[0].log else test[0]
-        cut = test[0].time[0] if whole is train[0] else whole.time[0]
-        if whole is train[0]:
-            from calibration.flight import flight_data
-
-            whole = flight_data(train[0].log, compass, metrics["attitude"])
-        keep(FIGURES[1], lambda path: heading_figure(
-            whole, fitted[model], model, cut, path,
-            f"{Path(whole.source).name}: heading from the compass against the log's, before and after the {model} "
-            "model"))
+    keep(name, lambda path: write_parameters(autopilot, params, path))
+    analysis = next((m for m in ("current", "throttle") if m in fitted), None)
+    if analysis is not None:
+        for figure, draw in zip(FIGURES, _figures(split.train, split.test, fitted, analysis, attitude), strict=True):
+            keep(figure, draw)
     metrics["status"] = "failed" if not_written else "completed"
     metrics["files"] = files
     if not_written:
@@ -101,9 +163,66 @@ def _write(out: Path, train, test, metrics, calibration, fitted, compass: int) -
     return files
 
 
+def _figures(train, test, fitted, model, attitude) -> tuple:
+    """The drawers (path -> None) of :data:`FIGURES`: the residual on the held-out part and the
+    heading over a whole flight, before and after ``model``."""
+    from scenarios.flightlog.calibration_figures import heading_figure, residual_figure
+
+    name = Path(train[0].source).name
+
+    def residual(path):
+        residual_figure(test, fitted[model], model, path,
+                        f"{name}: field residual on the held-out part, before and after the {model} model fitted here")
+
+    def heading(path):
+        whole = train[0] if len(train) == len(test) and train[0].log is test[0].log else test[0]
+        cut = test[0].time[0] if whole is train[0] else whole.time[0]
+        if whole is train[0]:
+            from dataclasses import replace
+
+            from calibration.flight import flight_data
+
+            whole = replace(flight_data(train[0].log, train[0].compass, attitude), earth=train[0].earth)
+        heading_figure(whole, fitted[model], model, cut, path,
+                       f"{Path(whole.source).name}: heading from the compass against the log's, before and after "
+                       f"the {model} model fitted here")
+
+    return residual, heading
+
+
+def _export(args, split: Split, metrics: dict) -> tuple:
+    """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
+    described in ``metrics["export"]``; (autopilot, file name, parameters)."""
+    from calibration.flight.export import choose, log_parameters, rules_of, score_parameters
+
+    train, score = split.train, split.score
+    rule = _rule(args, split.test[0])
+    params, chosen = choose(split.fit, split.choice, rule)
+    autopilot = train[0].log.autopilot
+    name = PARAMETER_FILES[autopilot]
+    exported = score_parameters(score, params, rule)
+    flown = score_parameters(score, log_parameters(score[0], params), rule)
+    firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
+    metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
+                         "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
+                         "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"],
+                         "split": {"fit": sorted({p.source for p in split.fit}),
+                                   "choice": sorted({p.source for p in split.choice}),
+                                   "score": sorted({p.source for p in score}),
+                                   "score_from_s": [float(p.time[0]) for p in score],
+                                   "choice_from_s": [float(p.time[0]) for p in split.choice],
+                                   "rule": split.notes["validation"]}}
+    return autopilot, name, params
+
 def _report(metrics: dict) -> list[str]:
-    lines = [f"trained on {', '.join(metrics['train'])}; tested on {', '.join(metrics['test'])}",
-             f"hard and soft iron: {metrics['static']['reason']}"]
+    lines = [f"trained on {', '.join(metrics['train'])}; tested on {', '.join(metrics['test'])} "
+             f"({metrics['validation']})"]
+    lines += [f"Earth field: {note}" for note in metrics["earth_field"]]
+    if metrics["mounting"]:
+        lines.append(f"yaw mounting: {metrics['mounting']['note']}")
+    lines.append(f"hard and soft iron (calibration.json): {metrics['static']['reason']}")
+    lines.append("models fitted here, each scored with the Earth field and offset fitted again on the test part "
+                 "(an analysis; the export is scored below):")
     for name, m in metrics["models"].items():
         if "refused" in m:
             lines.append(f"  {name:9s} refused: {m['refused']}")
@@ -111,7 +230,56 @@ def _report(metrics: dict) -> list[str]:
         lines.append(f"  {name:9s} explained {100 * m['explained_test']:5.1f} % of the test residual "
                      f"({100 * m['explained_train']:.1f} % in training), {m['perturbation_at_hover_T'] * 1e6:.2f} uT "
                      f"at hover, heading moved {m['heading_rms_change_deg']:.2f} deg RMS, delay {m['delay_s']:.2f} s")
-    return lines
+    return lines + _export_lines(metrics["export"])
+
+
+def _percent(share: float) -> str:
+    """``share`` (1) as a percentage with one decimal, never ``-0.0``."""
+    shown = f"{100 * share:.1f}"
+    return "0.0" if float(shown) == 0 else shown
+
+
+def _export_lines(export: dict) -> list[str]:
+    kept = export["kept"]
+    fitted = [g for g in ("offsets", "soft_iron") if kept[g] == "fitted"] + ([kept["motor"]] if kept["motor"] != "log"
+                                                                             else [])
+    logged = [g.replace("_", " ") for g in ("offsets", "motor", "soft_iron") if kept[g] == "log"]
+    flown = export["as_flown"]
+    return [f"export: {export['file']} for {export['firmware']}, carrying "
+            f"{', '.join(g.replace('_', ' ') for g in fitted) or 'nothing fitted'}; the log's values kept for "
+            f"{', '.join(logged) or 'nothing'}",
+            f"  heading on the score part (seen by neither the fit nor the choice), {export['file']} applied as the "
+            "firmware does: "
+            f"{export['heading_rms_deg']:.2f} deg RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)",
+            f"  share of the score part's residual its motor compensation explains: "
+            f"{_percent(export['explained_test'])} % "
+            f"(as flown: {_percent(flown['explained'])} %)",
+            *(f"  {group}: {note}" for group, note in export["notes"].items() if isinstance(note, str))]
+
+
+def _score(args, split: Split) -> int:
+    from calibration.flight.export import Candidate, log_parameters, parameters_of, score_file, score_parameters
+    from orchestrator.files import write_json
+
+    score = split.score
+    rule = _rule(args, score[0])
+
+    def scores():
+        given = score_file(args.score, score, rule)
+        names = list(parameters_of(score[0], Candidate(np.zeros(3), np.eye(3)), rule))
+        return given, score_parameters(score, log_parameters(score[0], names), rule)
+
+    given, flown = _numeric(scores, [p.source for p in score])
+    out = Path(args.out)
+    metrics = {"test": sorted({p.source for p in score}), "validation": split.notes["validation"],
+               "scored_on": "the export's score part", "score": given, "as_flown": flown, "files": ["metrics.json"]}
+    _saved(out, args.overwrite, lambda: write_json(out / "metrics.json", metrics))
+    print(f"tested on {', '.join(metrics['test'])} ({split.notes['validation']}; scored on the export's score part)")
+    print(f"heading on the score part, {args.score} applied as the firmware does: {given['heading_rms_deg']:.2f} deg "
+          f"RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)")
+    print(f"share of the score part's residual its motor compensation explains: {_percent(given['explained'])} % "
+          f"(as flown: {_percent(flown['explained'])} %)")
+    return 0
 
 
 def run(args) -> int:
@@ -120,28 +288,23 @@ def run(args) -> int:
     were not). The folder is held (:func:`orchestrator.files.folder_lock`) from before its
     earlier results are replaced until ``metrics.json`` is written; signals wait while the files
     are written, so that an interrupt leaves them all with their ``metrics.json``, or nothing."""
-    import contextlib
-
     from calibration.flight import calibrate
     from calibration.static import CalibrationError
-    from orchestrator.files import prepare_out_dir
-    from orchestrator.interrupts import held
-    from scenarios.outputs import remove_if_empty
 
-    out, made = Path(args.out), not Path(args.out).exists()
+    out = Path(args.out)
     try:
         _check_choices(args)
         _check_out(out, args.overwrite)  # before the flights are read; again, held, before writing
-        train, test = _split(args)
-        metrics, calibration, fitted = _fit(calibrate, train, test, args)
-        with contextlib.ExitStack() as lock, held():
-            try:
-                prepare_out_dir(out, args.overwrite, lock)
-                files = _write(out, train, test, metrics, calibration, fitted, args.compass)
-            except BaseException:
-                if made:
-                    remove_if_empty(out)
-                raise
+        split = _numeric(lambda: _split(args), args.files or [*(args.train or []), *(args.test or [])], also=())
+        if args.score:
+            return _score(args, split)
+        sources = [p.source for p in [*split.train, *split.test]]
+        metrics, calibration, fitted = _numeric(
+            lambda: calibrate(split.train, split.test, tuple(args.models), args.attitude), sources)
+        metrics |= split.notes
+        export = _numeric(lambda: _export(args, split, metrics), sources)
+        files = _saved(out, args.overwrite,
+                       lambda: _write(out, split, metrics, calibration, fitted, export, args.attitude))
     except (CalibrationError, ValueError) as error:  # LogError, FolderBusy and OutputRefused among them
         print(f"quadcosim calibrate: {error}", file=sys.stderr)
         return 2
@@ -154,14 +317,33 @@ def run(args) -> int:
             print(f"quadcosim calibrate: {name} not written: {why}", file=sys.stderr)
         print(f"quadcosim calibrate: failed; metrics.json in {out}/ lists what was written", file=sys.stderr)
         return 1
-    print(f"exported model: {metrics['exported_model'] or 'none identified'}; {', '.join(files)} in {out}/")
+    print(f"{', '.join(files)} in {out}/")
     if not fitted:
-        sources = ", ".join(sorted({str(Path(p.source).parent / Path(p.source).name) for p in train}))
-        print(f"quadcosim calibrate: no interference model could be identified from {sources} (reasons above); "
-              "the parameter files keep the log's offsets", file=sys.stderr)
+        sources = ", ".join(sorted({p.source.rsplit(":", 1)[0] for p in split.train}))
+        print(f"quadcosim calibrate: no interference model could be identified from {sources} (reasons above)",
+              file=sys.stderr)
         return 2
     return 0
 
+
+def _saved(out: Path, overwrite: bool, write):
+    """``write()``'s result, the folder ``out`` prepared and held, and signals waiting, meanwhile;
+    a folder this command created is removed again when nothing could be written into it."""
+    import contextlib
+
+    from orchestrator.files import prepare_out_dir
+    from orchestrator.interrupts import held
+    from scenarios.outputs import remove_if_empty
+
+    made = not out.exists()
+    with contextlib.ExitStack() as lock, held():
+        try:
+            prepare_out_dir(out, overwrite, lock)
+            return write()
+        except BaseException:
+            if made:
+                remove_if_empty(out)
+            raise
 
 def _check_out(out: Path, overwrite: bool):
     """Refuse at once an output folder that will be refused after the flights are read and fitted."""
@@ -178,22 +360,25 @@ def _check_out(out: Path, overwrite: bool):
         raise FolderBusy(f"--out {busy_message(out, holder)}")
 
 
-def _fit(calibrate, train, test, args):
-    """:func:`calibration.flight.calibrate` of the parts, a numerical library's failure named with
-    the flights, its cause and the fix."""
-    import numpy as np
-
+def _numeric(call, sources, also=(ValueError,)):
+    """``call()``, a numerical library's failure (``LinAlgError``, ``FloatingPointError``,
+    ``IndexError`` and the classes ``also``) named with the flights ``sources``, its cause and the
+    fix; the project's own refusals (:class:`~calibration.static.CalibrationError`,
+    :class:`~orchestrator.logs.LogError`, ...) pass unchanged."""
     from calibration.static import CalibrationError
+    from orchestrator.files import OutputRefused
+    from orchestrator.logs import LogError
 
     try:
-        return calibrate(train, test, tuple(args.models), args.attitude)
-    except (np.linalg.LinAlgError, ValueError, FloatingPointError) as error:
-        sources = ", ".join(sorted({p.source for p in [*train, *test]}))
-        raise CalibrationError(f"{sources}: the fit failed ({type(error).__name__}: {error}): the flights hold too "
+        return call()
+    except (CalibrationError, LogError, OutputRefused):
+        raise
+    except (np.linalg.LinAlgError, FloatingPointError, IndexError, ZeroDivisionError, *also) as error:
+        named = ", ".join(sorted({str(s) for s in sources}))
+        raise CalibrationError(f"{named}: the fit failed ({type(error).__name__}: {error}): the flights hold too "
                                "little usable data to identify a model (values that barely vary, or a damaged log); "
                                "give longer flights with climbs, descents and turns, or --models with fewer "
                                "models") from None
-
 
 def _check_choices(args):
     """--attitude and --models against the calibration's own names (checked here rather than by
@@ -205,6 +390,8 @@ def _check_choices(args):
     unknown = [m for m in args.models if m not in MODELS]
     if unknown:
         raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
+    if args.earth not in ("model", "free"):
+        raise ValueError(f"--earth {args.earth!r} must be model or free")
 
 
 def add_arguments(parser):
@@ -212,15 +399,25 @@ def add_arguments(parser):
     parser.add_argument("files", nargs="*", metavar="FILE", help="PX4 .ulg, ArduPilot .bin or .log flights")
     parser.add_argument("--compass", type=int, default=0, help="compass to calibrate, from 0 in the log's order")
     parser.add_argument("--out", required=True, help="folder for the results")
-    parser.add_argument("--test-fraction", type=float, default=0.5,
-                        help="last fraction of each flight kept for testing (default 0.5)")
+    parser.add_argument("--test-fraction", type=float, default=None,
+                        help="last fraction of each flight kept for testing (default 0.5 for one flight; several "
+                             "flights hold out the last one)")
     parser.add_argument("--train", nargs="+", metavar="FILE", help="flights to fit on (with --test)")
     parser.add_argument("--test", nargs="+", metavar="FILE", help="flights of the same vehicle to score on")
-    parser.add_argument("--attitude", default="gyro",
-                        help="attitude removing the Earth field: gyro (default: roll and pitch from the log, heading "
-                             "integrated from the gyro, so not from the compass being calibrated) or log")
+    parser.add_argument("--attitude", default="auto",
+                        help="attitude removing the Earth field: auto (default: gyro for the compass the log's heading "
+                             "fuses, log for the others), gyro (roll and pitch from the log, heading integrated from "
+                             "the gyro) or log")
     parser.add_argument("--models", nargs="+", default=["current", "throttle", "motors", "metge", "dynamic"],
                         help="models to fit: current, throttle, motors, metge, dynamic (default all)")
+    parser.add_argument("--earth", default="model",
+                        help="Earth field: model (default: the World Magnetic Model at the log's GPS position and "
+                             "date; free without a GPS fix) or free (fitted per flight)")
+    parser.add_argument("--firmware", help="ArduPilot Copter version whose rules the export follows (default: the "
+                                           "log's)")
+    parser.add_argument("--no-trim", action="store_true", help="ignore AHRS_TRIM (an ablation)")
+    parser.add_argument("--score", metavar="PARAMS", help="score this parameter file (.parm, .params) on the "
+                                                          "held-out part instead of calibrating")
     parser.add_argument("--overwrite", action="store_true", help="replace the results already in --out")
     parser.set_defaults(func=run)
     return parser

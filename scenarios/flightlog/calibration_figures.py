@@ -29,8 +29,8 @@ def residual_figure(parts, fitted, name: str, path, title: str):
     fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True, constrained_layout=True)
     for p in parts:
         x = p.current() if name == "current" else p.throttle()
-        before = earth_and_offset(p.rotation, p.raw).residual[0]
-        after = earth_and_offset(p.rotation, p.raw - fitted.predict(p)).residual[0]
+        before = earth_and_offset(p.rotation, p.raw, p.earth).residual[0]
+        after = earth_and_offset(p.rotation, p.raw - fitted.predict(p), p.earth).residual[0]
         for k, ax in enumerate(axes):
             ax.plot(x, -before[:, k] * TESLA_TO_UT, ".", ms=2, color="0.6", label="Earth field and offset only")
             ax.plot(x, -after[:, k] * TESLA_TO_UT, ".", ms=2, color="C3", label=f"with the {name} model")
@@ -53,14 +53,14 @@ def heading_figure(data, fitted, name: str, cut: float, path, title: str):
     removed, without and with the model ``fitted`` (named ``name``), over the whole flight
     ``data`` (FlightData); the held-out part after ``cut`` (s) shaded; into ``path`` under ``title``."""
     plt = _pyplot()
-    base = earth_and_offset(data.rotation, data.raw)
+    base = earth_and_offset(data.rotation, data.raw, data.earth)
     predicted = fitted.predict(data)
-    fit = earth_and_offset(data.rotation, data.raw - predicted)
+    fit = earth_and_offset(data.rotation, data.raw - predicted, data.earth)
     fig, ax = plt.subplots(figsize=(11, 4), constrained_layout=True)
     t0 = data.time[0]
     for field, label, colour in ((data.raw - base.nuisance[0, 3:], "Earth field and offset only", "0.5"),
                                  (data.raw - predicted - fit.nuisance[0, 3:], f"with the {name} model", "C3")):
-        error = wrap(tilt_compensated_heading(field, data.euler) - data.euler[:, 2])
+        error = wrap(tilt_compensated_heading(data.body(field), data.euler) - data.euler[:, 2])
         error = wrap(error - np.angle(np.mean(np.exp(1j * error))))
         rms = np.degrees(np.sqrt(np.mean(error**2)))
         ax.plot(data.time - t0, np.degrees(error), lw=0.8, color=colour, label=f"{label} (RMS {rms:.2f} deg)")

@@ -1,0 +1,320 @@
+"""Choose the recommended filter's defaults on the development datasets, and tune VQF the same way.
+
+    python -m benchmarks.tuning DATA [--filter explicit|vqf] [--out FILE] [--figures DIR]
+
+DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes. Only the datasets
+of :data:`DEVELOPMENT` are read: the held-out one is never touched here.
+
+The score of a gain set is made of its mean total RMSE over VQF's (at VQF's package defaults) on
+each development dataset, so that each dataset counts alike whatever its number of recordings:
+the mean of the worst dataset's ratio and of the mean ratio. The worst alone would choose the set
+that loses least where it loses most but leaves the parameters that dataset does not care about
+to drift; the mean lets every dataset speak.
+
+The search is a compass search on a logarithmic grid: around the current point, each parameter
+alone at ``1/STEP`` and ``STEP`` times its value (2n + 1 gain sets, in one batch call per
+recording) is scored; the search moves to the best when it gains more than :data:`MIN_GAIN` and
+repeats until the best is the centre, so that no chosen value sits on the edge of the grid it was
+chosen on (the grid is widened, by
+recentring, until none does). Then each parameter is swept alone over ``STEP^-3 .. STEP^3``
+times its chosen value, the others held: the sensitivity curves, drawn per dataset with the
+score (``--figures``).
+
+The search starts where an earlier search, scored by the worst dataset alone, stopped moving
+anything but the norm threshold. Parameters, all physical (:data:`SEARCH`): for ``explicit``
+(the recommended filter, corrections on), the time constants of inclination, heading and bias
+(s, :func:`estimators.filters.explicit_gains`) and the magnetic disturbance thresholds, on the
+field's norm (µT at the lab's 47 µT field; the filter applies it relative to the reference norm,
+so any magnetometer unit works) and on its dip
+(deg); for ``vqf``, its two time constants ``tauAcc`` and ``tauMag`` (s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks import datasets
+from benchmarks.real_recordings import DEVELOPMENT, errors
+from fmus import vehicle
+from orchestrator.files import save_figure, write_text
+
+STEP = 2.0  # ratio between neighbouring grid values
+SWEEP = 3  # the sensitivity sweeps reach STEP**SWEEP either side of the chosen value
+MIN_GAIN = 1e-3  # a move must lower the score by more than this; the scores of means over tens of recordings
+# differ by less than this in directions no dataset cares about
+LAB_FIELD_UT = vehicle.EARTH_FIELD_NORM * 1e6  # µT, the field the norm threshold is stated at
+# parameter: (start, unit, description)
+SEARCH = {
+    "explicit": {
+        "tau_inclination": (0.5, "s", "inclination time constant"),
+        "tau_heading": (10.0, "s", "heading time constant"),
+        "tau_bias": (200.0, "s", "bias time constant"),
+        "mag_norm_threshold": (32.0, "µT", "magnetic norm threshold"),
+        "mag_dip_threshold": (20.0, "deg", "magnetic dip threshold"),
+    },
+    "vqf": {
+        "tauAcc": (3.0, "s", "VQF's inclination time constant"),
+        "tauMag": (9.0, "s", "VQF's heading time constant"),
+    },
+}
+
+
+def filter_gains(kind: str, values: dict) -> dict:
+    """The gains ``estimate`` takes for physical parameter values of :data:`SEARCH`.
+
+    Parameters
+    ----------
+    kind : str
+        The filter (a key of :data:`SEARCH`).
+    values : dict
+        Parameter name -> array of values; the thresholds in uT and degrees.
+
+    Returns
+    -------
+    dict
+        The gains: the thresholds become ``mag_norm_tolerance`` (1, relative to the lab's field)
+        and ``mag_dip_tolerance`` (rad).
+    """
+    gains = dict(values)
+    if "mag_norm_threshold" in gains:
+        gains["mag_norm_tolerance"] = np.asarray(gains.pop("mag_norm_threshold")) / LAB_FIELD_UT
+    if "mag_dip_threshold" in gains:
+        gains["mag_dip_tolerance"] = np.radians(gains.pop("mag_dip_threshold"))
+    return gains
+
+
+class Scorer:
+    """Mean total, heading and inclination RMSE (deg) of gain sets on the development datasets,
+    and their total over VQF's at its defaults.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder of the datasets (see :mod:`benchmarks.datasets`).
+    names : sequence of str
+        The datasets scored; the development ones by default.
+    """
+
+    def __init__(self, folder, names=DEVELOPMENT):
+        self.recordings = {}
+        for name in names:
+            found = datasets.load(folder, name)
+            if found:
+                self.recordings[name] = found
+        if not self.recordings:
+            raise FileNotFoundError(f"none of the datasets {', '.join(names)} is under {folder}")
+        self.vqf = {name: self.means("vqf", name, {}) for name in self.recordings}
+        self.evaluated = 0
+
+    def means(self, kind: str, name: str, gains: dict) -> dict:
+        """Per metric, the (G,) mean over the recordings of ``name`` of the filter ``kind`` with ``gains``."""
+        if kind == "vqf":
+            sets = _sets(gains)
+            rows = [[errors("vqf", data, s) for s in sets] for _, data in self.recordings[name]]
+            return {m: np.mean([[r[m][0] for r in row] for row in rows], axis=0) for m in rows[0][0]}
+        rows = [errors(kind, data, filter_gains(kind, gains)) for _, data in self.recordings[name]]
+        return {m: np.mean([r[m] for r in rows], axis=0) for m in rows[0]}
+
+    def ratios(self, kind: str, gains: dict) -> dict:
+        """Dataset -> (G,) mean total RMSE over VQF's (defaults); also keeps the means in ``self.last``.
+
+        Parameters
+        ----------
+        kind : str
+            The filter.
+        gains : dict
+            Gain name -> (G,) array: G gain sets scored at once.
+        """
+        self.last = {name: self.means(kind, name, gains) for name in self.recordings}
+        self.evaluated += len(next(iter(gains.values()))) if gains else 1
+        return {name: self.last[name]["total_rmse_deg"] / self.vqf[name]["total_rmse_deg"] for name in self.recordings}
+
+
+def _sets(gains: dict) -> list[dict]:
+    if not gains:
+        return [{}]
+    count = len(next(iter(gains.values())))
+    return [{k: float(v[g]) for k, v in gains.items()} for g in range(count)]
+
+
+def score(ratios: dict) -> np.ndarray:
+    """The mean of the worst development dataset's ratio and of the mean ratio, per gain set.
+
+    Parameters
+    ----------
+    ratios : dict
+        Dataset -> (G,) ratio to VQF, as :meth:`Scorer.ratios` returns.
+    """
+    stacked = np.vstack(list(ratios.values()))
+    return 0.5 * (np.max(stacked, axis=0) + np.mean(stacked, axis=0))
+
+
+def _neighbours(point: dict) -> dict:
+    """``point`` and, for each parameter alone, ``point`` with it divided and multiplied by :data:`STEP`."""
+    sets = [dict(point)]
+    for name, value in point.items():
+        sets += [point | {name: value / STEP}, point | {name: value * STEP}]
+    return {name: np.array([s[name] for s in sets]) for name in point}
+
+
+def search(scorer: Scorer, kind: str, start: dict | None = None, log=print) -> dict:
+    """The compass search of the module docstring.
+
+    Parameters
+    ----------
+    scorer : Scorer
+        Scores gain sets on the development datasets.
+    kind : str
+        The filter (a key of :data:`SEARCH`).
+    start : dict, optional
+        The first point; :data:`SEARCH`'s first values by default.
+    log : callable
+        Called with one line per step.
+
+    Returns
+    -------
+    dict
+        The chosen values, the score there and every gain set scored (``history``).
+    """
+    point = {name: float(v[0]) for name, v in SEARCH[kind].items()} | (start or {})
+    history = []
+    while True:
+        grid = _neighbours(point)
+        ratios = scorer.ratios(kind, grid)
+        scores = score(ratios)
+        for g in range(len(scores)):
+            history.append({"values": {k: float(v[g]) for k, v in grid.items()}, "score": float(scores[g]),
+                            "ratios": {n: float(r[g]) for n, r in ratios.items()}})
+        best = int(np.argmin(scores))
+        if scores[best] > scores[0] - MIN_GAIN:
+            best = 0  # the centre: no move gains enough
+        chosen = {name: float(v[best]) for name, v in grid.items()}
+        log(f"{kind}: around {point} best {scores[best]:.4f} at {chosen}")
+        if chosen == point:
+            return {"values": point, "score": float(scores[best]),
+                    "ratios": {n: float(r[best]) for n, r in ratios.items()},
+                    "means": {n: {m: float(v[best]) for m, v in found.items()} for n, found in scorer.last.items()},
+                    "history": history}
+        point = chosen
+
+
+def sweeps(scorer: Scorer, kind: str, chosen: dict) -> dict:
+    """Each parameter over ``STEP**-SWEEP .. STEP**SWEEP`` times its chosen value, the others held.
+
+    Parameters
+    ----------
+    scorer : Scorer
+        Scores gain sets on the development datasets.
+    kind : str
+        The filter.
+    chosen : dict
+        The chosen values, parameter -> value.
+
+    Returns
+    -------
+    dict
+        Parameter -> {"values", "ratios" (dataset -> list), "score"}.
+    """
+    out = {}
+    for name, value in chosen.items():
+        values = value * STEP ** np.arange(-SWEEP, SWEEP + 1, dtype=float)
+        grid = {k: (values if k == name else np.full(len(values), v)) for k, v in chosen.items()}
+        ratios = scorer.ratios(kind, grid)
+        out[name] = {"values": values.tolist(), "ratios": {n: r.tolist() for n, r in ratios.items()},
+                     "score": score(ratios).tolist()}
+    return out
+
+
+def figures(kind: str, swept: dict, chosen: dict, folder) -> list[Path]:
+    """One figure per parameter: the ratio to VQF of every development dataset and the score
+    against the parameter, the chosen value marked.
+
+    Parameters
+    ----------
+    kind : str
+        The filter.
+    swept : dict
+        As :func:`sweeps` returns.
+    chosen : dict
+        The chosen values, parameter -> value.
+    folder : str or pathlib.Path
+        Where the PNG files are written.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The figures written.
+    """
+    import matplotlib
+    import matplotlib.ticker
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, found in swept.items():
+        _, unit, label = SEARCH[kind][name]
+        fig, ax = plt.subplots(figsize=(5.5, 3.6))
+        try:
+            for dataset, ratios in found["ratios"].items():
+                ax.plot(found["values"], ratios, marker="o", ms=3, lw=1, label=dataset)
+            ax.plot(found["values"], found["score"], color="k", lw=2.2, label="score")
+            ax.axvline(chosen[name], color="0.4", ls="--", lw=1, label=f"chosen {chosen[name]:g} {unit}")
+            ax.axhline(1.0, color="0.6", lw=0.8)
+            ax.set_xscale("log")
+            ax.set_xticks(found["values"], [f"{v:g}" for v in found["values"]])
+            ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+            ax.set_xlabel(f"{label} ({unit})")
+            ax.set_ylabel("mean total RMSE / VQF's")
+            ax.set_title(f"{kind}: {label}, the others at their chosen values", fontsize=9)
+            ax.legend(fontsize=7)
+            fig.tight_layout()
+            path = folder / f"tuning_{kind}_{name}.png"
+            save_figure(fig, path, dpi=110)
+            paths.append(path)
+        finally:
+            plt.close(fig)
+    return paths
+
+
+def main(argv=None) -> int:
+    """Command line (see the module docstring); prints the chosen values, returns 0 (2 for a bad
+    folder). ``argv``: the arguments (default ``sys.argv[1:]``)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.tuning", description=__doc__.splitlines()[0])
+    parser.add_argument("folder")
+    parser.add_argument("--filter", default="explicit", choices=sorted(SEARCH))
+    parser.add_argument("--out", help="write the search record (JSON) here")
+    parser.add_argument("--figures", help="write the sensitivity figures (PNG) into this folder")
+    args = parser.parse_args(argv)
+    if not Path(args.folder).is_dir():
+        print(f"tuning: {args.folder} is not a folder", file=sys.stderr)
+        return 2
+    started = time.perf_counter()
+    scorer = Scorer(args.folder)
+    chosen = search(scorer, args.filter, log=lambda text: print(text, file=sys.stderr, flush=True))
+    swept = sweeps(scorer, args.filter, chosen["values"])
+    record = {"filter": args.filter, "development": list(scorer.recordings), "step": STEP, "chosen": chosen["values"],
+              "score": chosen["score"], "ratios": chosen["ratios"], "means": chosen["means"],
+              "vqf_defaults": {n: {m: float(v[0]) for m, v in found.items()} for n, found in scorer.vqf.items()},
+              "sweeps": swept, "history": chosen["history"], "gain_sets": scorer.evaluated,
+              "seconds": round(time.perf_counter() - started, 1)}
+    print(json.dumps({k: record[k] for k in ("filter", "chosen", "score", "ratios", "gain_sets", "seconds")}, indent=1))
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        write_text(args.out, json.dumps(record, indent=1) + "\n")
+    if args.figures:
+        for path in figures(args.filter, swept, chosen["values"], args.figures):
+            print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
