@@ -33,6 +33,7 @@ def write_parameters(autopilot: str, params: dict, path) -> None:
     (write_px4 if autopilot == "PX4" else write_ardupilot)(params, path)
 
 
+FLOAT32_MAX = 3.4028234663852886e38  # the largest value of the autopilots' 32-bit float parameters
 MAX_PARAMETER_BYTES = 16 * 1024 * 1024  # an autopilot's whole parameter list takes a few hundred kB
 
 
@@ -78,6 +79,9 @@ def read_parameters(path) -> dict:
         except (ValueError, IndexError):
             raise ValueError(f"{path}, line {number}: {line[:60]!r} is not NAME,VALUE (ArduPilot) nor "
                              "1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE (QGroundControl); fix or remove the line") from None
+        if not abs(params[name.strip()]) <= FLOAT32_MAX:  # NaN and infinities too
+            raise ValueError(f"{path}, line {number}: {name.strip()} = {value.strip()} is not a value an autopilot "
+                             "stores (its parameters are finite 32-bit floats); fix or remove the line")
     if not params:
         raise ValueError(f"{path}: no parameters in the file; give the .parm or .params the ground station saved")
     return params

@@ -180,7 +180,13 @@ def _position(rows: dict) -> Position | None:
         return None
     lat, lon, alt = np.median(_columns(group, ["Lat", "Lng", "Alt"]), axis=0)
     week, ms = group[0]["GWk"], group[0]["GMS"]
-    when = datetime.datetime.fromisoformat(GPS_EPOCH) + datetime.timedelta(seconds=week * SECONDS_PER_WEEK + ms / 1e3)
+    try:
+        when = datetime.datetime.fromisoformat(GPS_EPOCH) + datetime.timedelta(
+            seconds=week * SECONDS_PER_WEEK + ms / 1e3)
+    except (OverflowError, ValueError):  # a GPS week no receiver reports (a damaged message): no date, no position
+        return None
+    if not (np.isfinite([lat, lon, alt]).all() and abs(lat) <= 90 and abs(lon) <= 180 and when.year < 9999):
+        return None
     start = datetime.datetime(when.year, 1, 1)
     year = when.year + (when - start).total_seconds() / (datetime.datetime(when.year + 1, 1, 1) - start).total_seconds()
     return Position(float(lat), float(lon), float(alt), float(year), "GPS (median of the 3D fixes)")

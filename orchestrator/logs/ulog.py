@@ -136,7 +136,12 @@ def _position(ulog) -> Position | None:
         lat, lon, alt = d["latitude_deg"][fixed], d["longitude_deg"][fixed], d["altitude_msl_m"][fixed]
     else:
         lat, lon, alt = d["lat"][fixed] * 1e-7, d["lon"][fixed] * 1e-7, d["alt"][fixed] * 1e-3
-    when = datetime.datetime.fromtimestamp(float(d["time_utc_usec"][fixed][0]) * MICRO, datetime.UTC)
+    try:
+        when = datetime.datetime.fromtimestamp(float(d["time_utc_usec"][fixed][0]) * MICRO, datetime.UTC)
+    except (OverflowError, ValueError, OSError):  # a date no receiver reports (a damaged message)
+        return None
+    if when.year >= 9999 or not np.isfinite([np.median(lat), np.median(lon), np.median(alt)]).all():
+        return None
     start = datetime.datetime(when.year, 1, 1, tzinfo=datetime.UTC)
     end = datetime.datetime(when.year + 1, 1, 1, tzinfo=datetime.UTC)
     year = when.year + (when - start).total_seconds() / (end - start).total_seconds()

@@ -374,11 +374,25 @@ def _numeric(call, sources, also=(ValueError,)):
     except (CalibrationError, LogError, OutputRefused):
         raise
     except (np.linalg.LinAlgError, FloatingPointError, IndexError, ZeroDivisionError, *also) as error:
+        if type(error) is ValueError and _ours(error):  # a refusal of the project's own, in its words already
+            raise
         named = ", ".join(sorted({str(s) for s in sources}))
         raise CalibrationError(f"{named}: the fit failed ({type(error).__name__}: {error}): the flights hold too "
                                "little usable data to identify a model (values that barely vary, or a damaged log); "
                                "give longer flights with climbs, descents and turns, or --models with fewer "
                                "models") from None
+
+def _ours(error: BaseException) -> bool:
+    """Whether ``error`` was raised by the project's own code (its last frame is not a library's)."""
+    import traceback
+
+    frames = traceback.extract_tb(error.__traceback__)
+    if not frames:
+        return True
+    root = Path(__file__).resolve().parents[2]
+    where = Path(frames[-1].filename).resolve()
+    return where.is_relative_to(root) and "site-packages" not in where.parts
+
 
 def _check_choices(args):
     """--attitude and --models against the calibration's own names (checked here rather than by
@@ -392,6 +406,7 @@ def _check_choices(args):
         raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
     if args.earth not in ("model", "free"):
         raise ValueError(f"--earth {args.earth!r} must be model or free")
+    _rule(args, None)  # --firmware refused before the flights are read
 
 
 def add_arguments(parser):
