@@ -93,6 +93,17 @@ def checkout(root: Path) -> bool:
     return all((root / name).exists() for name in ("pyproject.toml", "README.md", "docs"))
 
 
+def _check_out(path: Path, write: bool):
+    """Refuse ``--out`` before any group runs: a folder, or (when it is to be written) what the one
+    writer refuses (:func:`orchestrator.files.output_file`: a FIFO, a device, a missing folder)."""
+    from orchestrator.files import OutputRefused, output_file
+
+    if path.is_dir():
+        raise OutputRefused(f"--out {path}: a folder, not a file; give a findings file such as findings.json")
+    if write:
+        output_file(path)
+
+
 def main(argv=None) -> int:
     """Run the findings; returns the exit code (2: a bad command line, or a copy that is not a
     source checkout (:func:`checkout`: nothing is written into an installed package); 1:
@@ -116,7 +127,12 @@ def main(argv=None) -> int:
               f"installed in {findings.ROOT} (no pyproject.toml, README.md and docs/ there) and is not written "
               "into; clone the repository and run it there", file=sys.stderr)
         return 2
-    committed = findings.load(args.out)
+    try:
+        _check_out(args.out, write=not (args.check or args.verify_commands))
+        committed = findings.load(args.out)
+    except (ValueError, OSError) as error:  # OutputRefused and FindingError among them
+        print(f"quadcosim findings: {error}", file=sys.stderr)
+        return 2
     if args.verify_commands:
         return verify_commands(committed, args.groups or None, args.timeout, args.matching)
     computed, skipped = run(args.groups or findings.GROUPS, args.quick)
@@ -135,7 +151,11 @@ def main(argv=None) -> int:
         print(f"{len(computed)} findings computed, {len(lines)} differences from {args.out}{unchecked}")
         return 1 if lines else 0
     new = committed | {f["name"]: f for f in computed}
-    findings.save(new, args.out)
+    try:
+        findings.save(new, args.out)
+    except OSError as error:  # a full disk (named, the earlier file kept whole) or a folder gone meanwhile
+        print(f"quadcosim findings: {error}", file=sys.stderr)
+        return 1
     print(f"{len(computed)} findings written to {args.out}")
     if args.no_readme:
         return 0

@@ -39,6 +39,7 @@ LOGS = ROOT.parent / "shared" / "data" / "flightlogs"
 IN_PROCESS_LIMIT_S = 120
 PROCESS_LIMIT_S = 240
 EXITS = {0, 1, 2, 130, 143}
+SIGNAL = "Setpoint.z_d"  # a signal every run of tp records
 
 
 class Hang(BaseException):
@@ -329,16 +330,16 @@ def sweep_plot_compare(s: Sweep):
     targets = [("a missing folder", s.work / "absent" / "x.png"), ("a folder", s.work),
                ("an unknown suffix", s.work / "x.xyz"), ("a FIFO", fifo), ("no suffix", s.work / "plain")]
     for name, folder in [("whole", whole), ("streamed", streamed), *damaged]:
-        s.cli("plot", f"{name}: yaw", ["plot", folder, "yaw", "--out", s.folder().with_suffix(".png")])
-        s.cli("compare", f"{name} with whole: yaw", ["compare", folder, whole, "yaw",
+        s.cli("plot", f"{name}: z_d", ["plot", folder, SIGNAL, "--out", s.folder().with_suffix(".png")])
+        s.cli("compare", f"{name} with whole: z_d", ["compare", folder, whole, SIGNAL,
                                                      "--out", s.folder().with_suffix(".png")])
     for what, target in targets:
-        s.cli("plot", f"into {what}", ["plot", whole, "yaw", "--out", target])
-        s.cli("compare", f"into {what}", ["compare", whole, streamed, "yaw", "--out", target])
+        s.cli("plot", f"into {what}", ["plot", whole, SIGNAL, "--out", target])
+        s.cli("compare", f"into {what}", ["compare", whole, streamed, SIGNAL, "--out", target])
     for what, argv in (("unknown signal", ["plot", whole, "no_such_signal"]),
-                       ("no signal", ["plot", whole]), ("missing run", ["plot", s.work / "absent", "yaw"]),
-                       ("a file as run", ["plot", whole / "metrics.json", "yaw"]),
-                       ("compare one run", ["compare", whole, "yaw"]),
+                       ("no signal", ["plot", whole]), ("missing run", ["plot", s.work / "absent", SIGNAL]),
+                       ("a file as run", ["plot", whole / "metrics.json", SIGNAL]),
+                       ("compare one run", ["compare", whole, SIGNAL]),
                        ("compare unknown signal", ["compare", whole, streamed, "nope"])):
         s.cli("plot/compare", what, argv)
 
@@ -389,12 +390,17 @@ def sweep_gains(s: Sweep):
 
 
 def sweep_findings(s: Sweep):
+    """Never without --out (or --check): the findings would be written into this checkout."""
+    fifo = s.work / "findings.fifo"
+    os.mkfifo(fifo)
     for what, argv in (("unknown group", ["findings", "nope"]), ("--check of an unknown group", ["findings", "nope",
                                                                                                    "--check"]),
                        ("--out into a missing folder", ["findings", "excerpt", "--quick", "--out",
                                                         s.work / "absent" / "f.json", "--no-readme"]),
                        ("--out onto a folder", ["findings", "excerpt", "--quick", "--out", s.work, "--no-readme"]),
-                       ("--timeout -1 without --verify-commands", ["findings", "--timeout", "-1"])):
+                       ("--check of a missing findings file", ["findings", "excerpt", "--quick", "--check",
+                                                               "--out", s.work / "none.json"]),
+                       ("--out onto a FIFO", ["findings", "excerpt", "--quick", "--no-readme", "--out", fifo])):
         s.cli("findings", what, argv, limit=180)
 
 
@@ -463,8 +469,8 @@ def sweep_full_disk(s: Sweep, logs: list[tuple[str, Path]]):
     if os.geteuid() != 0:
         return
     text = next(p for w, p in logs if w == "a whole synthetic text log")
-    commands = [("plot", ["plot", "{run}", "yaw", "--out", "{disk}/yaw.png"]),
-                ("compare", ["compare", "{run}", "{run}", "yaw", "--out", "{disk}/cmp.png"]),
+    commands = [("plot", ["plot", "{run}", SIGNAL, "--out", "{disk}/yaw.png"]),
+                ("compare", ["compare", "{run}", "{run}", SIGNAL, "--out", "{disk}/cmp.png"]),
                 ("log plot", ["log", "plot", text, "--out", "{disk}/log.png"]),
                 ("log info --json", ["log", "info", text, "--json"]),
                 ("diagram", ["diagram", "tp", "--out", "{disk}/diagram.png"]),

@@ -43,3 +43,17 @@ def test_a_checkout_still_runs(argv, tmp_path, monkeypatch, capsys):
     findings.save({"present.x": findings.finding("present.x", 2.5, "s", "quadcosim run x", 0.1, 1)
                    | {"group": "present"}}, out)
     assert findings_main([*argv, "--out", str(out)]) == 0
+
+
+@pytest.mark.parametrize("kind", ["folder", "missing folder", "fifo"])
+def test_an_output_the_writer_refuses_is_refused_before_any_group_runs(tmp_path, monkeypatch, capsys, kind):
+    import os
+
+    ran = []
+    monkeypatch.setattr(findings, "compute_group", lambda group, quick=False: ran.append(group) or [])
+    out = {"folder": tmp_path, "missing folder": tmp_path / "absent" / "f.json", "fifo": tmp_path / "f.fifo"}[kind]
+    if kind == "fifo":
+        os.mkfifo(out)
+    assert findings_main(["excerpt", "--quick", "--no-readme", "--out", str(out)]) == 2  # a traceback before
+    err = capsys.readouterr().err
+    assert err.startswith(f"quadcosim findings: {'--out ' if kind == 'folder' else ''}{out}") and not ran

@@ -27,3 +27,25 @@ def test_a_latin_1_profile_is_named_as_not_utf_8(tmp_path, capsys):
     assert f"{profile}: not UTF-8 text (byte 0xe0 at byte 28, a Latin-1 or Windows character?); save the file as " \
            "UTF-8" in err
     assert not err.rstrip().endswith(": utf-8")
+
+
+def test_a_spreadsheets_byte_order_mark_is_not_part_of_the_header(tmp_path):
+    from scenarios.flight import SETPOINT
+    from scenarios.flight.profile_file import read_profile
+
+    marked = tmp_path / "marked.csv"
+    marked.write_text("t,z_d\n0,0\n2,-1.5\n", encoding="utf-8-sig")  # "CSV UTF-8" of a spreadsheet
+    assert marked.read_bytes().startswith(b"\xef\xbb\xbf")  # before: "unknown column '\ufefft'"
+    times, rows = read_profile(marked, SETPOINT)
+    assert times.tolist() == [0.0, 2.0] and rows[:, SETPOINT.index("z_d")].tolist() == [0.0, -1.5]
+
+
+def test_a_fifo_or_a_folder_is_named_as_not_a_file(tmp_path, capsys):
+    import os
+
+    os.mkfifo(tmp_path / "pipe.csv")  # exists, and a read would block until a writer came
+    (tmp_path / "folder.csv").mkdir()
+    for name in ("pipe.csv", "folder.csv"):
+        assert cli([*RUN, f"flight={tmp_path / name}", "--out", str(tmp_path / "run")]) == 2
+        err = capsys.readouterr().err
+        assert f"flight={tmp_path / name}: not a regular file" in err and "no such file" not in err
