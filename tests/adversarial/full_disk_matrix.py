@@ -1,8 +1,8 @@
 """A disk that fills at every phase of ``calibrate``, ``run``, ``run --stream`` and ``log replay``.
 
-Each command runs once on a roomy folder, which measures the bytes it writes; then nine times on
-a tmpfs that holds only a share of them (0 % to 97 %, so the disk fills before the folder is
-made, while the record, the figures, the diagram or the parameter files are written, or while
+Each command runs once on a roomy folder, which measures the bytes it writes; then on tmpfs
+disks that hold only a share of them (:data:`SHARES`, 36 runs from 0 % to 105 %: the disk fills
+before the folder is made, while the record, the figures, the diagram or the parameter files are written, or while
 ``metrics.json`` itself is). Every run must leave its ``metrics.json`` (``log replay``: its JSON
 file) or nothing, and no temporary, empty or partial file under a final name: each PNG ends with
 its ``IEND`` chunk, each JSON parses, each record loads, each parameter file reads.
@@ -27,9 +27,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 #: shares of what each command writes that its disk holds: 36 runs. ``log replay`` writes one JSON
 #: file of a few kB (it fits or it does not); the others write megabytes in phases.
-SHARES = {"calibrate": (0.0, 0.05, 0.15, 0.3, 0.45, 0.6, 0.75, 0.85, 0.92, 0.97, 0.995),
-          "run": (0.0, 0.03, 0.1, 0.25, 0.4, 0.55, 0.7, 0.85, 0.95, 0.99),
-          "run --stream": (0.0, 0.03, 0.1, 0.2, 0.35, 0.5, 0.65, 0.8, 0.9, 0.97, 0.995),
+SHARES = {"calibrate": (0.0, 0.2, 0.3, 0.31, 0.33, 0.36, 0.42, 0.5, 0.7, 0.9, 1.05),
+          "run": (0.0, 0.5, 0.6, 0.65, 0.7, 0.75, 0.8, 0.9, 1.0, 1.05),
+          "run --stream": (0.0, 0.6, 0.7, 0.75, 0.8, 0.83, 0.86, 0.9, 0.95, 1.0, 1.05),
           "log replay": (0.0, 0.5, 1.0, 2.0)}
 PAGE = 4096
 TIMEOUT_S = 300
