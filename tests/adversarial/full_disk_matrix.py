@@ -220,7 +220,9 @@ def main(argv=None) -> int:
     broken = sum(bool(o["problems"]) for o in outcomes)
     print(f"\n{len(outcomes)} runs, {broken} broke the rule")
     if args.json:
-        Path(args.json).write_text(json.dumps(outcomes, indent=1) + "\n")
+        from orchestrator.files import write_json
+
+        write_json(args.json, outcomes)
     return 1 if broken else 0
 
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import json
 import os
 import random
 import shutil
@@ -530,7 +529,9 @@ def main(argv=None) -> int:
     for o in broken:
         print(f"  [{o['surface']}] {o['what']}: {o['problem']}")
     if args.json:
-        Path(args.json).write_text(json.dumps(outcomes, indent=1) + "\n")
+        from orchestrator.files import write_json
+
+        write_json(args.json, outcomes)
     return 1 if broken else 0
 
 
