@@ -316,23 +316,28 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     from orchestrator.files import prepare_out_dir
     from orchestrator.interrupts import first_only, held
     from orchestrator.progress import status
-    from scenarios.outputs import RunFiles
+    from scenarios.outputs import RunFiles, remove_if_empty
 
     status(f"{name}: loading the scenario")
     files = None
-    with first_only():
+    with first_only(), contextlib.ExitStack() as lock:  # the folder is this run's until it ends
         try:
             with held():  # a signal while the folder is made is raised once the run can record it
                 _check_formats(formats, stream, out_dir)
                 if name not in _MODULES:
                     get(name)  # refused (the nearest names given) before any folder is made
                 made = out_dir is not None and not Path(out_dir).exists()
-                out = prepare_out_dir(out_dir, overwrite) if out_dir else None
+                out = prepare_out_dir(out_dir, overwrite, lock) if out_dir else None
                 given = dict(settings) if isinstance(settings, dict) else dict(
                     _split(s) for s in settings or [] if "=" in s)
                 base = {"scenario": name, "options": given,
                         "injected_faults": [fault_record(f) for f in faults], "decimation": decimation}
-                files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+                try:
+                    files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+                except ValueError:  # no room for even metrics.json: refused, the folder left as it was
+                    if made:
+                        remove_if_empty(out)
+                    raise
             with (files.tracking() if files else contextlib.nullcontext()):
                 return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream, blocks),
                                     progress)
@@ -362,6 +367,10 @@ def _run_tracked(name, settings, files, base, made, given, progress):
         if files is not None and files.result is None:
             files.refused(remove_folder=made)
         raise
+    except OSError as error:  # the disk filled, or the folder failed, outside the loop and the save
+        if files is None:
+            raise
+        raise files.broke(error) from None
 
 
 def _check_formats(formats, stream: bool, out_dir):
@@ -403,6 +412,7 @@ def _run_phases(scenario, options, base, files, given, progress):
     result.meta |= {"scenario": {"name": name, "options": base["options"]}, "faults": base["injected_faults"]}
     metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
                       "fmu_warnings": _warning_counts(result)}
+    metrics |= _divergence(scenario, result, options)
     if files is not None:
         files.phase = "saving the record"
         status(f"{name}: writing {', '.join(f'results.{f}' for f in files.formats)} "
@@ -420,7 +430,38 @@ def _run_phases(scenario, options, base, files, given, progress):
     if files is not None:
         metrics["save_cpu_s"] = files.save_cpu_seconds
         files.finish(metrics)
+    if metrics["status"] == "diverged":
+        import warnings
+
+        from scenarios.divergence import message
+
+        warnings.warn(message(name, metrics["diverged"], _settings_given(scenario, options)), stacklevel=2)
     return result, metrics
+
+
+def _divergence(scenario, result, options) -> dict:
+    """``status`` ``diverged`` and the first bound crossed (``diverged``) when the scenario bounds its
+    flight (``extra["divergence"]``) and the run crossed a bound; the signals a bound reads that
+    were not recorded (``divergence_unchecked``)."""
+    bounds = scenario.extra.get("divergence")
+    if bounds is None or not len(result):
+        return {}
+    from scenarios.divergence import first_crossing, unchecked
+
+    found = {}
+    missing = unchecked(result)
+    if missing:
+        found["divergence_unchecked"] = missing
+    crossing = first_crossing(result, bounds)
+    if crossing is not None:
+        found |= {"status": "diverged", "diverged": crossing | {"settings": _settings_given(scenario, options)}}
+    return found
+
+
+def _settings_given(scenario, options) -> list[str]:
+    """The options off their defaults and the block parameters set, as ``key=value``."""
+    return [f"{key}={value}" for key, value in options.items()
+            if key not in scenario.options or value != scenario.options[key].default]
 
 
 def _recorded_names(system, kept) -> list[str]:

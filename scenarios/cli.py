@@ -168,7 +168,7 @@ def _run_reporting(args) -> int:
             print(f"what was recorded up to the failure ({len(error.result)} samples) is in {out}/", file=sys.stderr)
         return 1
     except (KeyError, ValueError) as error:
-        print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
+        print(f"quadcosim run {args.scenario}: {_said(error)}", file=sys.stderr)
         return 2
     except OSError as error:  # the output folder failed under the run (removed, read-only, a disk error)
         print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)
@@ -181,7 +181,18 @@ def _run_reporting(args) -> int:
         print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
     print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
+    if metrics.get("status") == "diverged":  # warned above, naming the settings
+        print(f"quadcosim run {args.scenario}: the run diverged (metrics.json: status diverged); its record and "
+              f"figures are in {out}/", file=sys.stderr)
+        return 1
     return 0
+
+
+def _said(error: Exception) -> str:
+    """The message of a refusal: its text (a KeyError's own, without the quotes its str adds)."""
+    if isinstance(error, KeyError) and error.args and isinstance(error.args[0], str):
+        return error.args[0]
+    return str(error)
 
 
 def _default_out(scenario: str, overwrite: bool) -> Path:
@@ -226,7 +237,17 @@ def _diagram(args) -> int:
             print(error.args[0] if error.args else error, file=sys.stderr)
             return 2
         status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
-        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+        from orchestrator.files import figure_file
+
+        try:
+            out = figure_file(args.out, "diagram.png", Path("results") / args.scenario)
+            path = draw(system, out, scenario.title(options))
+        except ValueError as error:  # an output path refused (OutputRefused), before anything is written
+            print(f"quadcosim diagram: {error}", file=sys.stderr)
+            return 2
+        except OSError as error:  # a full disk: named, nothing left under the figure's name
+            print(f"quadcosim diagram: failed: {error}", file=sys.stderr)
+            return 1
     print(path)
     return 0
 
@@ -267,7 +288,8 @@ def parser() -> argparse.ArgumentParser:
     diagram.add_argument("scenario")
     diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
     diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
-    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
+    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png; a folder takes "
+                         "diagram.png)")
     diagram.set_defaults(func=_diagram)
     bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
                                          "pytest plugin")
@@ -343,6 +365,9 @@ def main(argv=None) -> int:
     """Run ``quadcosim`` with ``argv`` (the process arguments if None); returns the exit code."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
+    for stream in (sys.stdout, sys.stderr):  # a file name that is not UTF-8 is printed escaped, never a traceback
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     try:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")

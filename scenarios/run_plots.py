@@ -12,6 +12,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from orchestrator.files import figure_file, printable, save_figure
+
 RESULTS_FILE = "results.npz"
 #: Width and height (inches) of one signal's axes.
 AXES_SIZE = (9.0, 2.6)
@@ -33,17 +35,33 @@ def load(run) -> tuple:
     Raises
     ------
     ValueError
-        No results there; the message says what a run folder holds.
+        No record there (the message says what a run folder holds), a damaged record (named,
+        with what is wrong), or a record of no sample.
     """
+    import zipfile
+
     from orchestrator import Result
 
     path = Path(run)
     folder = path if path.is_dir() else path.parent
-    try:
-        return Result.load(path), folder
-    except (FileNotFoundError, OSError, ValueError):
+    if not path.exists() or (path.is_dir() and not _holds_record(path)):
         raise ValueError(f"{run}: no {RESULTS_FILE} or streamed record there; give the folder of a finished run "
-                         "(the --out of `quadcosim run`, e.g. results/tp) or its results.npz") from None
+                         "(the --out of `quadcosim run`, e.g. results/tp) or its results.npz")
+    try:
+        result = Result.load(path)
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise ValueError(f"{run}: the run's record is damaged and cannot be read ({type(error).__name__}: {error}); "
+                         "run the scenario again") from None
+    if len(result) == 0:
+        raise ValueError(f"{run}: the run's record holds no sample (it stopped before its loop; see its "
+                         "metrics.json): nothing to draw")
+    return result, folder
+
+
+def _holds_record(folder: Path) -> bool:
+    from orchestrator.stream import FOLDER
+
+    return (folder / RESULTS_FILE).exists() or (folder / FOLDER).is_dir() or (folder / "meta.json").exists()
 
 
 def _check(result, folder: Path, signal: str):
@@ -85,7 +103,10 @@ def plot(run, signals, out=None) -> Path:
     """
     import matplotlib.pyplot as plt
 
+    name = f"plot-{signals[0]}.png"
+    path = figure_file(out, name, None) if out else None  # a path given is checked before the run is read
     result, folder = load(run)
+    path = path or figure_file(None, name, folder)
     for signal in signals:
         _check(result, folder, signal)
     fig, axes = plt.subplots(len(signals), 1, sharex=True, squeeze=False, layout="constrained",
@@ -94,11 +115,11 @@ def plot(run, signals, out=None) -> Path:
         result.plot(signal, ax=ax)
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
-    fig.suptitle(f"{_label(folder)}: {', '.join(signals)}", fontsize=10)
-    path = Path(out) if out else folder / f"plot-{signals[0]}.png"
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    fig.suptitle(printable(f"{_label(folder)}: {', '.join(signals)}"), fontsize=10)
+    try:
+        return save_figure(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def compare(runs, signal: str, out=None) -> Path:
@@ -121,6 +142,7 @@ def compare(runs, signal: str, out=None) -> Path:
     """
     import matplotlib.pyplot as plt
 
+    path = figure_file(out, f"compare-{signal}.png", Path("."))
     loaded = [load(run) for run in runs]
     for result, folder in loaded:
         _check(result, folder, signal)
@@ -133,11 +155,11 @@ def compare(runs, signal: str, out=None) -> Path:
                 result.plot(component, ax=ax, label_prefix=f"{_label(folder)}: ")
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
-    fig.suptitle(f"{signal}: {' vs '.join(_label(folder) for _, folder in loaded)}", fontsize=10)
-    path = Path(out) if out else Path(f"compare-{signal}.png")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    fig.suptitle(printable(f"{signal}: {' vs '.join(_label(folder) for _, folder in loaded)}"), fontsize=10)
+    try:
+        return save_figure(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def plot_command(args) -> int:
@@ -152,9 +174,12 @@ def plot_command(args) -> int:
 
     try:
         print(plot(args.run, args.signals, args.out))
-    except ValueError as error:
+    except ValueError as error:  # OutputRefused among them
         print(f"quadcosim plot: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # a full disk (named; nothing left under the figure's name)
+        print(f"quadcosim plot: failed: {error}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -175,9 +200,12 @@ def compare_command(args) -> int:
         return 2
     try:
         print(compare(runs, signal, args.out))
-    except ValueError as error:
+    except ValueError as error:  # OutputRefused among them
         print(f"quadcosim compare: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # a full disk (named; nothing left under the figure's name)
+        print(f"quadcosim compare: failed: {error}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -188,7 +216,9 @@ def add_arguments(sub):
     plotting.add_argument("signals", nargs="+", metavar="SIGNAL", help="signal or vector names (IMU.acc)")
     plotting.add_argument("--out", help="PNG/SVG/PDF file (default RUN/plot-SIGNAL.png)")
     plotting.set_defaults(func=plot_command)
-    comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure")
+    comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure",
+                               usage="quadcosim compare [-h] [--out FILE] RUN RUN [RUN...] SIGNAL\n"
+                                     "       quadcosim compare [-h] [--out FILE] --signal SIGNAL RUN RUN [RUN...]")
     comparing.add_argument("items", nargs="+", metavar="RUN... SIGNAL",
                            help="two run folders or more (or their results.npz), then a signal or vector name")
     comparing.add_argument("--signal", help="the signal, when given apart: then every positional is a run")

@@ -18,6 +18,7 @@ from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
+from scenarios.divergence import Bounds
 from scenarios.figures import (
     angle_curve,
     fault_text,
@@ -639,9 +640,14 @@ def diagram_title(o: dict) -> str:
     return title_lines(*describe(o))
 
 
+# a flight that strays this far, for a second, diverged (scenarios/divergence.py): 20 s flights of every
+# profile, estimate-fed by each filter with noise and bias, reach 27 deg of tilt error, 0.73 m of altitude
+# error and 15 m/s (the linear filter's non-stationary flight); a 20 deg tilt step is tracked within it
+DIVERGENCE = Bounds(tilt_error_deg=60.0, altitude_error_m=10.0, speed_m_s=60.0, held_s=1.0)
+
 # IMU parameters the options set: --set IMU.seed=... would contradict the option seed
 DERIVED = {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed", "IMU.sample_rate": "imu_rate"}
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
                     extra={"diagram": True, "title": diagram_title, "derived": DERIVED, "unrecorded": UNRECORDED,
-                           "components": COMPONENTS},
+                           "components": COMPONENTS, "divergence": DIVERGENCE},
                     resolve=resolve)

@@ -7,7 +7,7 @@ import numpy as np
 
 from calibration.flight.evaluate import tilt_compensated_heading, wrap
 from calibration.flight.linear import earth_and_offset
-from orchestrator.files import save_figure
+from orchestrator.files import printable, save_figure
 
 TESLA_TO_UT = 1e6
 
@@ -41,9 +41,11 @@ def residual_figure(parts, fitted, name: str, path, title: str):
     axes[0].set_ylabel("field left unexplained (uT)")
     handles, labels = axes[0].get_legend_handles_labels()
     axes[0].legend(handles[:2], labels[:2], markerscale=5, fontsize=8)
-    fig.suptitle(title, fontsize=10)
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
+    fig.suptitle(printable(title), fontsize=10)
+    try:
+        save_figure(fig, path, dpi=110)
+    finally:
+        plt.close(fig)
 
 
 def heading_figure(data, fitted, name: str, cut: float, path, title: str):
@@ -67,6 +69,8 @@ def heading_figure(data, fitted, name: str, cut: float, path, title: str):
     ax.set_ylabel("compass heading - log heading (deg)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.suptitle(title, fontsize=10)
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
+    fig.suptitle(printable(title), fontsize=10)
+    try:
+        save_figure(fig, path, dpi=110)
+    finally:
+        plt.close(fig)
