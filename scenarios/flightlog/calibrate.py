@@ -391,7 +391,8 @@ def _ours(error: BaseException) -> bool:
         return True
     root = Path(__file__).resolve().parents[2]
     where = Path(frames[-1].filename).resolve()
-    return where.is_relative_to(root) and "site-packages" not in where.parts
+    return "site-packages" not in where.parts and any(
+        where.is_relative_to(root / package) for package in ("calibration", "orchestrator", "scenarios", "estimators"))
 
 
 def _check_choices(args):
