@@ -141,7 +141,7 @@ def _out_path(out, default: Path, figure_format: str | None) -> Path:
         if path.suffix.lstrip(".").lower() not in FORMATS:
             raise ValueError(f"--out {out}: give a .png, .svg or .pdf file")
         return path
-    return default.with_suffix("." + (figure_format or "png"))
+    return default.with_name(f"{default.name}.{figure_format or 'png'}")  # a name may hold dots (IMU.gyro)
 
 
 def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
