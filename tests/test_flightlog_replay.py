@@ -16,18 +16,46 @@ def test_the_estimators_run_on_shared_logs_of_every_format(name, compass):
     for kind in ("explicit", "vqf"):
         for label in ("without", "with"):
             r = result["estimators"][kind][label]
-            assert r["inclination_rms_deg"] < 4.0  # roll and pitch agree with the autopilot's to a few degrees
-            assert r["heading_rms_deg"] < 25.0
+            # roll and pitch agree with the autopilot's to a few degrees: measured up to 4.16 (explicit) and
+            # 3.0 (VQF) deg on these three logs
+            assert r["inclination_rms_deg"] < INCLINATION_BOUND_DEG[kind]
+            assert r["heading_rms_deg"] < HEADING_BOUND_DEG[name]
     explicit = result["estimators"]["explicit"]
     vqf = result["estimators"]["vqf"]
-    if name == PX4:  # a bench log, motors off: the filters and PX4's estimator agree closely
-        assert vqf["without"]["heading_rms_deg"] < 0.3 and explicit["without"]["heading_rms_deg"] < 1.5
+    if name == PX4:  # a bench log, motors off: the filters and PX4's estimator agree closely (0.2, 0.3 deg)
+        assert vqf["without"]["heading_rms_deg"] < 0.4 and explicit["without"]["heading_rms_deg"] < 0.5
         assert result["compensation_model"] is None
-    if name == QUAD[1]:  # the internal compass compensated: VQF's heading moves toward the autopilot's
+    if name == QUAD[1]:  # the internal compass compensated: both headings move toward the autopilot's
         # measured 5.1 against 6.4 deg (0.80): calibrated against the trimmed board attitude and the log's
         # heading (this compass is not the fused one), as the firmware frames it; the bound was 0.7 before
         assert vqf["with"]["heading_rms_deg"] < 0.9 * vqf["without"]["heading_rms_deg"]
-        assert 1.8 < explicit["without"]["heading_rms_deg"] < 2.4 and explicit["with"]["heading_rms_deg"] < 3.2
+        # measured 4.58 without, 3.52 with
+        assert 4.2 < explicit["without"]["heading_rms_deg"] < 5.0 and explicit["with"]["heading_rms_deg"] < 3.9
+
+
+INCLINATION_BOUND_DEG = {"explicit": 4.5, "vqf": 3.3}
+HEADING_BOUND_DEG = {QUAD[1]: 7.0, ERLE: 21.0, PX4: 0.5}  # measured up to 6.4, 18.9 and 0.3 deg
+
+
+@pytest.mark.slow
+def test_the_explicit_filters_inclination_on_a_flight_is_set_by_its_correction_time(monkeypatch):
+    """The recommended explicit filter differs from the autopilot's roll and pitch more than VQF
+    because its inclination correction is fast (0.5 s): with 5 s, the difference shrinks and the
+    heading pays (flight b, internal compass: 4.16 -> 2.65 deg inclination, 4.58 -> 5.45 deg
+    heading, measured)."""
+    import scenarios.flightlog.replay as replay
+    from estimators.filters import DEFAULT_TIME_CONSTANTS, explicit_gains
+
+    found = {}
+    for tau in (DEFAULT_TIME_CONSTANTS["tau_inclination"], 5.0):
+        gains = explicit_gains(**dict(DEFAULT_TIME_CONSTANTS, tau_inclination=tau))
+        monkeypatch.setitem(replay.ESTIMATORS, "explicit", {"gains": gains})
+        estimators = replay.replay_log(log(QUAD[1]), 1, kinds=("explicit", "vqf"))["estimators"]
+        found[tau] = estimators["explicit"]["without"]
+    fast, slow = found[DEFAULT_TIME_CONSTANTS["tau_inclination"]], found[5.0]
+    assert 3.9 < fast["inclination_rms_deg"] < 4.4 and 2.4 < slow["inclination_rms_deg"] < 2.9
+    assert slow["inclination_rms_deg"] < estimators["vqf"]["without"]["inclination_rms_deg"]  # 2.65 < 2.89
+    assert slow["heading_rms_deg"] > fast["heading_rms_deg"] + 0.5
 
 
 @pytest.mark.slow
