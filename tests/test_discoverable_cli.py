@@ -176,3 +176,63 @@ def test_labels_fit_their_axes(finished_run, tmp_path):
         assert label.height < box.height, (ax.get_ylabel(), label.height, box.height)
         assert ax.get_title(loc="left").startswith("Quaternion_estim.theta_est")
     plt.close(fig)
+
+
+class _Terminal:
+    """A stream that says it is a terminal (tqdm then draws its bar in place), keeping all."""
+
+    def __init__(self):
+        self.text = ""
+
+    def write(self, text):
+        self.text += text
+        return len(text)
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return True
+
+
+def test_a_status_line_during_a_progress_bar_is_written_on_a_line_of_its_own(monkeypatch):
+    from orchestrator import progress
+
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    with progress.reporting(True):
+        bar = progress.Progress(200.0, "run tp")
+        bar.update(80.0)
+        progress.status("Quaternion_estim: a line in the middle of the run")
+        progress.say("quadcosim: warning: another one")
+        bar.update(120.0)
+        bar.close()
+    lines = [part for chunk in terminal.text.split("\n") for part in chunk.split("\r")]
+    said = [part for part in lines if "a line in the middle" in part or "another one" in part]
+    assert len(said) == 2 and all("%|" not in part for part in said), said  # not inside the bar's line
+    assert said[0].lstrip().startswith("[") and said[1].startswith("quadcosim: warning")
+    assert "100%|" in terminal.text.rsplit("another one", 1)[1]  # the bar drawn again below, to the end
+
+
+def test_the_run_names_the_figures_it_wrote_and_counts_as_metrics_json_counts(tmp_path, capsys):
+    """--record with --decimation: the report needs signals not recorded and is skipped; the last
+    line names diagram.png alone, not "figures". The status lines count the blocks as the
+    diagram does and the signals as metrics.json does."""
+    out = tmp_path / "tp"
+    assert main(["run", "tp", "--set", "duration=0.5", "--record", "Quadrotor.theta", "--decimation", "10",
+                 "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["report"].startswith("report skipped")
+    last = captured.out.strip().splitlines()[-1]
+    assert last == f"results (npz), metrics.json and diagram.png in {out}/ (no report figures: see report above)"
+    assert "and figures in" not in captured.out
+    assert "(6 blocks and 4 constants tying off inputs)" in captured.err  # the diagram's heading counts alike
+    assert "loading its compiled step (numba" not in captured.err  # a compile is announced when it happens
+    full = tmp_path / "full"
+    assert main(["run", "tp", "--set", "duration=0.2", "--out", str(full)]) == 0
+    captured = capsys.readouterr()
+    metrics = json.loads((full / "metrics.json").read_text())
+    recorded, left_out = metrics["signals_recorded"], len(metrics["signals_not_saved"])
+    assert f"({recorded - left_out} of the {recorded} signals recorded;" in captured.err
+    assert "and diagram.png, roll_pitch.png, yaw.png in" in captured.out.strip().splitlines()[-1]
