@@ -111,6 +111,7 @@ def report(result, o, out) -> dict:
     ``static.json`` and the figure into ``out`` (none when None); return the figures of merit.
     ``o``: the parsed options."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     A, b = iron(o)
     samples = result["IMU.magneto"][:: max(1, round(1.0 / (o["mag_rate"] * o["dt"])))]
@@ -135,9 +136,12 @@ def report(result, o, out) -> dict:
         ax.scatter(*points.T, s=1, color=colour)
         ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(-reach, reach))
         ax.set_box_aspect((1.0, 1.0, 1.0))
-        ax.set_xlabel("x (µT)")
-        ax.set_ylabel("y (µT)")
-        ax.set_zlabel("z (µT)")
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # four ticks a side: the default eight collide in 3-D
+            axis.set_major_locator(MaxNLocator(4, symmetric=True))
+        ax.tick_params(labelsize=7, pad=0)
+        ax.set_xlabel("x (µT)", labelpad=2)
+        ax.set_ylabel("y (µT)", labelpad=2)
+        ax.set_zlabel("z (µT)", labelpad=2)
         ax.set_title(f"{what} readings, |m| from {norm.min():.1f} to {norm.max():.1f} µT", fontsize=9)
     ax2 = fig.add_subplot(1, 3, 3)
     ax2.plot(np.degrees(yaw), heading_raw, label="uncorrected")
