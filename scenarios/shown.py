@@ -67,7 +67,16 @@ def plain(text: str) -> str:
 
 class PlainHelp(argparse.RawDescriptionHelpFormatter):
     """An argparse formatter that prints the description as written (its line breaks kept) and
-    the whole help without reST markup (:func:`plain`)."""
+    the whole help without reST markup (:func:`plain`).
+
+    Parameters
+    ----------
+    prog : str
+        The program's name, as argparse gives it.
+    indent_increment, max_help_position, width : int, optional
+        argparse's layout settings (characters).
+    """
 
     def format_help(self) -> str:
+        """The help text, plain (:func:`plain`)."""
         return plain(super().format_help())
