@@ -34,6 +34,7 @@ import numpy as np
 from benchmarks import datasets
 from estimators import DEFAULT_GAINS, estimate
 from estimators.filters import CORRECTIONS, DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
+from orchestrator.files import write_text
 from scenarios.replay import field_from_data, references
 
 DEVELOPMENT = ("broad", "smartphones", "diodem", "repoimu")  # the datasets the defaults were chosen on
@@ -94,7 +95,7 @@ def _published(name: str, recordings: list, cache: Path | None, kinds=PUBLISHED)
             found = {label: {m: float(v[0]) for m, v in errors(kind, data).items()} for label, data in recordings}
             if path is not None:
                 path.parent.mkdir(parents=True, exist_ok=True)
-                path.write_text(json.dumps(found, indent=1) + "\n")
+                write_text(path, json.dumps(found, indent=1) + "\n")
         for label in table:
             table[label][kind] = found[label]
     return table
@@ -251,7 +252,7 @@ def main(argv=None) -> int:
     report = {"results": results, "defaults": {k: DEFAULT_GAINS[k] for k in OURS},
               "time_constants": DEFAULT_TIME_CONSTANTS}
     if args.json:
-        Path(args.json).write_text(json.dumps(report, indent=1) + "\n")
+        write_text(args.json, json.dumps(report, indent=1) + "\n")
     return 0
 
 

@@ -42,6 +42,7 @@ import numpy as np
 from benchmarks import datasets
 from benchmarks.real_recordings import DEVELOPMENT, errors
 from fmus import vehicle
+from orchestrator.files import save_figure, write_text
 
 STEP = 2.0  # ratio between neighbouring grid values
 SWEEP = 3  # the sensitivity sweeps reach STEP**SWEEP either side of the chosen value
@@ -277,7 +278,7 @@ def figures(kind: str, swept: dict, chosen: dict, folder) -> list[Path]:
             ax.legend(fontsize=7)
             fig.tight_layout()
             path = folder / f"tuning_{kind}_{name}.png"
-            fig.savefig(path, dpi=110)
+            save_figure(fig, path, dpi=110)
             paths.append(path)
         finally:
             plt.close(fig)
@@ -308,7 +309,7 @@ def main(argv=None) -> int:
     print(json.dumps({k: record[k] for k in ("filter", "chosen", "score", "ratios", "gain_sets", "seconds")}, indent=1))
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text(json.dumps(record, indent=1) + "\n")
+        write_text(args.out, json.dumps(record, indent=1) + "\n")
     if args.figures:
         for path in figures(args.filter, swept, chosen["values"], args.figures):
             print(path)

@@ -87,11 +87,13 @@ class Calibration:
         }
 
     def save(self, path) -> Path:
-        """Write the calibration to ``path`` (JSON) and return the path."""
+        """Write the calibration to ``path`` (JSON, atomically: :func:`orchestrator.files.atomic_path`)
+        and return the path."""
+        from orchestrator.files import write_text
+
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(self.to_dict(), indent=2) + "\n")
-        return path
+        return write_text(path, json.dumps(self.to_dict(), indent=2) + "\n")
 
     @classmethod
     def from_dict(cls, data: dict, motors: int | None = None, orders: tuple[int, int] | None = None,

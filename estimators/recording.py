@@ -61,7 +61,10 @@ def _read_csv(path: Path) -> dict:
             table = np.atleast_1d(np.genfromtxt(path, delimiter=",", names=True))
         except IndexError:  # numpy's answer to a file without a header row
             table = np.zeros(0)
-        except (ValueError, UnicodeDecodeError) as error:
+        except UnicodeDecodeError as error:
+            raise ValueError(f"{path}: not UTF-8 text (byte {error.object[error.start]:#04x} at byte {error.start}, "
+                             "a Latin-1 or Windows character?); save the file as UTF-8") from None
+        except ValueError as error:
             raise ValueError(f"{path} is not a readable CSV recording ({error}); write it with "
                              "estimators.recording.save") from None
     names = table.dtype.names or ()
@@ -224,15 +227,26 @@ def save(path, *, gyro, acc, mag, rate: float, quat=None, scored=None, meta: dic
         data["quat"] = np.asarray(quat, float)
     if scored is not None:
         data["scored"] = np.asarray(scored, bool)
-    path.parent.mkdir(parents=True, exist_ok=True)
     suffix = path.suffix.lower()
+    if suffix not in (".npz", ".mat", ".csv"):
+        raise ValueError(f"{path}: unknown recording format {suffix!r}; use .npz, .mat or .csv")
+    from orchestrator.files import atomic_path
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as temporary:
+        _write(temporary, suffix, data, meta, rate, quat, scored)
+    return path
+
+
+def _write(path: Path, suffix: str, data: dict, meta, rate: float, quat, scored):
+    """The recording ``data`` into ``path`` in the format of ``suffix`` (see :func:`save`)."""
     if suffix == ".npz":
         np.savez(path, meta=np.array(json.dumps(meta or {})), **data)
     elif suffix == ".mat":
         from scipy.io import savemat
 
         savemat(path, data | {"meta": json.dumps(meta or {})})
-    elif suffix == ".csv":
+    else:
         n = len(data["gyro"])
         columns = {"time": np.arange(n) / rate}
         for key in ("gyro", "acc", "mag"):
@@ -243,9 +257,6 @@ def save(path, *, gyro, acc, mag, rate: float, quat=None, scored=None, meta: dic
             columns["scored"] = data["scored"].astype(float)
         np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", header=",".join(columns),
                    comments="", fmt="%.17g")
-    else:
-        raise ValueError(f"{path}: unknown recording format {suffix!r}; use .npz, .mat or .csv")
-    return path
 
 
 def describe(data: dict) -> dict:

@@ -111,11 +111,18 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     if done.returncode != 0:
         raise BuildError(f"{model}: {' '.join(command)}\n{done.stderr}")
 
+    # written whole, then renamed (fmus sits below the orchestrator and its writer): a build cut
+    # short leaves the earlier FMU, never a truncated one a run would load
     fmu = out_dir / f"{model}.fmu"
-    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as archive:
-        for path in sorted(stage.rglob("*")):
-            if path.is_file():
-                archive.write(path, path.relative_to(stage).as_posix())
+    partial = out_dir / f".{model}.fmu.part"
+    try:
+        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
+            for path in sorted(stage.rglob("*")):
+                if path.is_file():
+                    archive.write(path, path.relative_to(stage).as_posix())
+        os.replace(partial, fmu)
+    finally:
+        partial.unlink(missing_ok=True)
     return fmu
 
 

@@ -1,16 +1,23 @@
-"""The one save path of a run: files written whole or not at all, disks that fill, output folders.
+"""The one save path of the project: files written whole or not at all, disks that fill, output folders.
 
-Every result, metrics, figure or calibration file is first written under a temporary name in
-its own folder, flushed to disk (``fsync``), then renamed over the final name: an interrupt, a
-crash or a full disk while saving leaves the earlier file (or none), never a truncated one.
+Every file the project writes (results, metrics, figures, calibration and parameter files,
+recordings, tables) is first written under a temporary name in its own folder, flushed to disk
+(``fsync``), then renamed over the final name: an interrupt, a crash or a full disk while
+saving leaves the earlier file (or none), never a truncated one.
 
 - :func:`atomic_path` is that writer; :func:`write_text`, :func:`write_json` and
   :func:`save_figure` use it. A full disk raises :class:`DiskFull`, naming the folder, the
   file, the bytes it needed and the bytes free; the partial file is removed.
+- What it writes to is checked first (:func:`output_file`): a symbolic link is *followed*
+  (the file it points to is replaced, the link is kept, as ``open(path, "w")`` would do); a
+  folder, a FIFO, a device or a socket, a read-only file and a folder that does not exist are
+  refused with :class:`OutputRefused`, before anything is written.
 - :func:`tracking` lists the files written into a folder while it is active, so that a run's
   ``metrics.json`` names exactly the files it wrote (figures included).
 - :func:`prepare_out_dir` checks an output folder before a run and, with ``overwrite``,
-  removes every file an earlier run left there.
+  removes every file an earlier run left there; :func:`folder_lock` holds it for one process
+  (a second one is refused with :class:`FolderBusy`, naming the first).
+- :class:`Reserve` keeps room for a folder's ``metrics.json`` on a disk that may fill.
 """
 
 from __future__ import annotations
@@ -22,7 +29,9 @@ import json
 import math
 import os
 import shutil
+import stat
 import tempfile
+import time
 from pathlib import Path
 
 #: Files a run leaves in its output folder (figures aside): an existing folder holding any of
@@ -71,9 +80,26 @@ class DiskFull(OSError):
         return self.message
 
 
-def megabytes(count: int | None) -> str:
-    """``count`` bytes as text: ``"12.3 MB"`` (``"0.004 MB"`` for a small file)."""
-    return "an unknown size" if count is None else f"{count / 1e6:.3g} MB"
+def printable(text) -> str:
+    """``text`` (a file name read from the disk) with the bytes that are not UTF-8 shown as
+    U+FFFD: what a figure title or a JSON file can hold (a name is bytes on Linux; Python keeps
+    the undecodable ones as lone surrogates, which no text encoder takes)."""
+    return str(text).encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+
+
+def megabytes(count: int | None, against: int | None = None) -> str:
+    """``count`` bytes as text: ``"12.3 MB"`` (``"0.004 MB"`` for a small file).
+
+    With ``against``, another count of bytes printed beside it, enough digits are given for the
+    two texts to differ when the counts do (``"2.0312 MB"`` beside ``"2.0305 MB"``).
+    """
+    if count is None:
+        return "an unknown size"
+    digits = 3
+    while against is not None and against != count and digits < 12 and \
+            f"{count / 1e6:.{digits}g}" == f"{against / 1e6:.{digits}g}":
+        digits += 1
+    return f"{count / 1e6:.{digits}g} MB"
 
 
 def free_bytes(folder) -> int | None:
@@ -84,6 +110,65 @@ def free_bytes(folder) -> int | None:
         return None
 
 
+class OutputRefused(ValueError):
+    """A path that cannot take a file: a folder, a FIFO or device, a read-only file, or a file in
+    a folder that does not exist. Nothing was written; the message names the path and the fix."""
+
+
+_KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def output_file(path) -> Path:
+    """The regular file a writer replaces for ``path``, checked before anything is written.
+
+    A symbolic link is followed, to the end of its chain: the file it points to is the one
+    written (and created if it does not exist), and the link itself is kept. Everything else
+    that is not a regular file is refused.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The output path as the user gave it.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, or the target of the link it is.
+
+    Raises
+    ------
+    OutputRefused
+        ``path`` (or its target) is a folder, a FIFO, a device or a socket, a read-only file,
+        a link that loops, or lies in a folder that does not exist.
+    """
+    path = Path(path)
+    target = Path(os.path.realpath(path)) if path.is_symlink() else path
+    shown = path if target == path else f"{path} (a link to {target})"
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as error:  # a link that loops, a folder that cannot be searched
+        raise OutputRefused(f"{shown}: cannot write there ({error.strerror}); give another file name") from None
+    if mode is not None:
+        if stat.S_ISDIR(mode):
+            raise OutputRefused(f"{shown}: a folder, not a file; give a file name (a folder/name)")
+        for test, kind in _KINDS:
+            if test(mode):
+                raise OutputRefused(f"{shown}: {kind}, not a regular file; quadcosim writes its outputs to files "
+                                    "(written whole, then renamed), never into a stream; give a file name")
+        if not os.access(target, os.W_OK):
+            raise OutputRefused(f"{shown}: the file is read-only; make it writable or give another file name")
+    folder = target.parent
+    if not folder.is_dir():
+        what = "is not a folder" if folder.exists() else "does not exist"
+        raise OutputRefused(f"{shown}: the folder {folder}/ {what}; create it or give another path")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputRefused(f"{shown}: the folder {folder}/ is not writable; give another path")
+    return target
+
+
 @contextlib.contextmanager
 def atomic_path(path, size: int | None = None):
     """Yield a temporary path beside ``path``; on success it is renamed to ``path``.
@@ -91,7 +176,10 @@ def atomic_path(path, size: int | None = None):
     The temporary file keeps the suffix of ``path`` (writers such as ``numpy.savez`` and
     ``matplotlib`` choose their format by it). It is flushed to disk before the rename. On any
     exception, KeyboardInterrupt included, it is removed and ``path`` is left as it was; a
-    full disk is raised as :class:`DiskFull`.
+    full disk is raised as :class:`DiskFull`. ``path`` is checked first (:func:`output_file`):
+    a symbolic link is followed (its target is replaced, the link kept); a folder, a FIFO, a
+    device, a read-only file or a missing folder is refused with :class:`OutputRefused`. A
+    file replaced keeps its permissions; a hard link to it keeps the earlier content.
 
     Parameters
     ----------
@@ -102,7 +190,12 @@ def atomic_path(path, size: int | None = None):
     """
     from orchestrator.interrupts import held
 
-    path = Path(path)
+    asked = Path(path)
+    path = output_file(asked)
+    try:
+        mode = stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        mode = 0o666 & ~_UMASK  # mkstemp makes it private; a result file is not
     temporary = None
     try:
         # a signal between the file's creation and its name being known would leave it behind:
@@ -118,7 +211,7 @@ def atomic_path(path, size: int | None = None):
         yield temporary
         with open(temporary, "rb+") as written:
             os.fsync(written.fileno())
-        os.chmod(temporary, 0o666 & ~_UMASK)  # mkstemp makes it private; a result file is not
+        os.chmod(temporary, mode)
         os.replace(temporary, path)
     except BaseException as error:
         if temporary is None:
@@ -128,7 +221,22 @@ def atomic_path(path, size: int | None = None):
         if isinstance(error, OSError) and not isinstance(error, DiskFull):
             raise _no_room(error, path, reached, size) from None
         raise
-    _note_written(path)
+    _sync_folder(path.parent)
+    _note_written(asked)
+
+
+def _sync_folder(folder: Path):
+    """Flush the folder's entry of a renamed file, so that a crash after the rename keeps it."""
+    try:
+        descriptor = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    except OSError:
+        return
+    try:
+        os.fsync(descriptor)
+    except OSError:  # some filesystems do not sync a folder: the rename stands all the same
+        pass
+    finally:
+        os.close(descriptor)
 
 
 def _no_room(error: OSError, path: Path, reached: int, size: int | None) -> OSError:
@@ -209,11 +317,64 @@ def finite(data):
     return data
 
 
-def save_figure(figure, path, **options) -> Path:
-    """``figure.savefig(path)``, atomically."""
+def figure_format(path, figure=None) -> str:
+    """The format matplotlib writes ``path`` in, from its suffix (``figure``: the figure to write,
+    whose canvas may write more formats than the default one); :class:`OutputRefused` for a
+    suffix it does not write (or none), naming those it does."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
     path = Path(path)
+    kinds = (figure.canvas if figure is not None else FigureCanvasBase).get_supported_filetypes()
+    kind = path.suffix.lstrip(".").lower()
+    if kind not in kinds:
+        said = f".{kind} is not a figure format matplotlib writes" if kind else "the name has no suffix to choose " \
+            "the figure's format"
+        raise OutputRefused(f"{path}: {said}; end it with "
+                            f"{', '.join('.' + k for k in ('png', 'svg', 'pdf') if k in kinds)} "
+                            f"(or {', '.join('.' + k for k in sorted(kinds) if k not in ('png', 'svg', 'pdf'))})")
+    return kind
+
+
+def figure_file(given, name: str, folder) -> Path:
+    """The figure file a command writes, checked before anything is drawn or read.
+
+    Parameters
+    ----------
+    given : str or pathlib.Path or None
+        The user's ``--out``: a file, or an existing folder (which takes ``name``).
+    name : str
+        The figure's default name.
+    folder : str or pathlib.Path
+        Its default folder, made when ``given`` is None.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    OutputRefused
+        A suffix matplotlib does not write (:func:`figure_format`), or a path that cannot take
+        a file (:func:`output_file`).
+    """
+    if given:
+        path = Path(given)
+        path = path / name if path.is_dir() else path
+    else:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        path = Path(folder) / name
+    figure_format(path)
+    output_file(path)
+    return path
+
+
+def save_figure(figure, path, **options) -> Path:
+    """``figure.savefig(path)``, atomically; a suffix matplotlib does not write is refused
+    (:func:`figure_format`) before anything is written."""
+    path = Path(path)
+    kind = figure_format(path, figure)
     with atomic_path(path) as temporary:
-        figure.savefig(temporary, format=path.suffix.lstrip(".") or None, **options)
+        figure.savefig(temporary, format=kind, **options)
     return path
 
 
@@ -230,13 +391,209 @@ def _plain(value):
         return str(value)
 
 
-def prepare_out_dir(out, overwrite: bool = False) -> Path:
+#: The lock file of an output folder held by a process (:func:`folder_lock`).
+LOCK_NAME = ".quadcosim.lock"
+
+
+class FolderBusy(ValueError):
+    """Another process is writing into the output folder; the message names it (pid, command)."""
+
+
+def _holder(text: str) -> dict:
+    try:
+        holder = json.loads(text)
+        return holder if isinstance(holder, dict) else {}
+    except ValueError:
+        return {}
+
+
+def _alive(pid) -> bool:
+    try:
+        os.kill(int(pid), 0)
+    except (OSError, ValueError, TypeError) as error:
+        return isinstance(error, PermissionError)  # another user's process: alive
+    return True
+
+
+def busy_message(folder: Path, holder: dict) -> str:
+    """The refusal of a folder held by another process.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The output folder.
+    holder : dict
+        What its lock file says: ``pid``, ``command``, ``since`` (s since the epoch).
+
+    Returns
+    -------
+    str
+        The folder, the holder's pid and command, since when, and the fix.
+    """
+    pid, command = holder.get("pid", "?"), holder.get("command") or "quadcosim"
+    since = holder.get("since")
+    started = f", since {time.strftime('%Y-%m-%d %H:%M:%S', time.localtime(since))}" if since else ""
+    child = "" if _alive(holder.get("pid")) else " (that process has ended; one it started still holds the folder)"
+    return (f"{folder}/ is being written by another process: pid {pid}, `{command}`{started}{child}. Wait for it "
+            "to end, or choose another folder (two runs in one folder would mix their files)")
+
+
+def _try_lock(descriptor: int) -> bool:
+    """Take the lock on the open lock file; False when another process holds it."""
+    import fcntl
+
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    except OSError:  # a filesystem without locks: the pid written in the file decides
+        holder = _holder(os.pread(descriptor, 4096, 0).decode(errors="replace"))
+        return not holder or holder.get("pid") == os.getpid() or not _alive(holder.get("pid"))
+    return True
+
+
+def held_by(folder) -> dict | None:
+    """The process holding ``folder`` (``pid``, ``command``, ``since``), or None when it is free."""
+    lock = Path(folder) / LOCK_NAME
+    try:
+        descriptor = os.open(lock, os.O_RDWR)
+    except OSError:
+        return None
+    try:
+        if _try_lock(descriptor):
+            return None
+        return _holder(os.pread(descriptor, 4096, 0).decode(errors="replace"))
+    finally:
+        os.close(descriptor)  # closing releases a lock taken just above
+
+
+@contextlib.contextmanager
+def folder_lock(folder, command: str | None = None):
+    """Hold the output folder ``folder`` for this process while the block runs.
+
+    The lock is ``folder/.quadcosim.lock``, locked with ``flock`` and holding this process's
+    pid and command line. A second process asking for the folder is refused; a lock left by a
+    process that died (killed outright) is free, and taken over. The file is removed when the
+    block ends.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        An existing folder.
+    command : str, optional
+        What this process is doing, named to a process refused (default: its command line).
+
+    Raises
+    ------
+    FolderBusy
+        Another live process holds the folder; the message names its pid and command.
+    """
+    import sys
+
+    folder = Path(folder)
+    lock = folder / LOCK_NAME
+    while True:
+        try:
+            descriptor = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as error:
+            raise OutputRefused(f"{folder}/: cannot take the folder ({error.strerror}); choose another "
+                                "place") from None
+        if not _try_lock(descriptor):
+            holder = _holder(os.pread(descriptor, 4096, 0).decode(errors="replace"))
+            os.close(descriptor)
+            raise FolderBusy(busy_message(folder, holder))
+        try:  # the file locked must still be the one named: a holder ending removes it
+            same = os.stat(lock).st_ino == os.fstat(descriptor).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(descriptor)
+    holder = {"pid": os.getpid(), "command": command or " ".join(["quadcosim", *sys.argv[1:]]),
+              "since": time.time()}
+    try:
+        os.ftruncate(descriptor, 0)
+        os.pwrite(descriptor, (json.dumps(holder) + "\n").encode(), 0)
+    except OSError:  # a full disk: the lock holds without its note
+        pass
+    try:
+        yield holder
+    finally:
+        try:
+            if os.stat(lock).st_ino == os.fstat(descriptor).st_ino:
+                lock.unlink()
+        except OSError:
+            pass
+        os.close(descriptor)
+
+
+class Reserve:
+    """Room kept on the disk of a folder for one small file written last (``metrics.json``).
+
+    A file of ``size`` bytes is written at once; :meth:`release` removes it just before that
+    last file is written, so that a disk that filled in between still takes it.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The output folder.
+    size : int
+        Bytes kept.
+
+    Raises
+    ------
+    DiskFull
+        Not even ``size`` bytes are free: nothing was left.
+    """
+
+    #: Name of the file that keeps the room (a temporary name: ``--overwrite`` removes one a
+    #: killed process left).
+    NAME = ".metrics.reserve.part"
+
+    def __init__(self, folder: Path, size: int = 64 * 1024):
+        self.path = Path(folder) / self.NAME
+        try:
+            with open(self.path, "wb") as file:
+                file.write(bytes(size))
+                file.flush()
+                os.fsync(file.fileno())
+        except OSError as error:
+            self.path.unlink(missing_ok=True)
+            raise _no_room(error, Path(folder) / "metrics.json", 0, size) from None
+
+    @property
+    def held(self) -> bool:
+        """Whether the room is still kept."""
+        return self.path.exists()
+
+    def release(self):
+        """Give the room back (idempotent)."""
+        self.path.unlink(missing_ok=True)
+
+
+def prepare_out_dir(out, overwrite: bool = False, lock: contextlib.ExitStack | None = None) -> Path:
     """Check that ``out`` can hold a run's results before the run starts, and create it.
 
-    Refuses an existing file, a folder that cannot be written, and a folder that already
-    holds results unless ``overwrite``: then every file an earlier run left is removed (its
-    result files, those its ``metrics.json`` lists, its figures and any temporary file of a
-    save cut short), so that none is left stale beside the new ones.
+    Refuses an existing file, a folder that cannot be written, a folder another process is
+    writing (with ``lock``), and a folder that already holds results unless ``overwrite``:
+    then every file an earlier run left is removed (its result files, those its
+    ``metrics.json`` lists, its figures and any temporary file of a save cut short), so that
+    none is left stale beside the new ones.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        The output folder.
+    overwrite : bool
+        Replace the results already there.
+    lock : contextlib.ExitStack, optional
+        Hold the folder (:func:`folder_lock`) until this stack closes; taken before the
+        folder's results are checked or removed.
+
+    Raises
+    ------
+    ValueError
+        The folder is refused (:class:`FolderBusy` when another process holds it).
     """
     out = Path(out)
     if out.exists() and not out.is_dir():
@@ -247,6 +604,11 @@ def prepare_out_dir(out, overwrite: bool = False) -> Path:
         raise ValueError(f"--out {out}: cannot create the folder ({error.strerror}); choose another place") from None
     if not os.access(out, os.W_OK | os.X_OK):
         raise ValueError(f"--out {out}: the folder is not writable; choose another place")
+    if lock is not None:
+        try:
+            lock.enter_context(folder_lock(out))
+        except FolderBusy as error:
+            raise FolderBusy(f"--out {error}") from None
     earlier = holds_results(out)
     if earlier:
         if not overwrite:
@@ -281,10 +643,11 @@ def holds_results(out) -> list[str]:
 
 def free_folder(base) -> Path:
     """``base`` if it holds no results, else the first of ``base-2``, ``base-3``, ... that
-    holds none: a default output folder never replaces earlier results."""
+    holds none and that no other process is writing: a default output folder never replaces
+    earlier results."""
     base = Path(base)
     candidate, number = base, 1
-    while holds_results(candidate) or (candidate.exists() and not candidate.is_dir()):
+    while holds_results(candidate) or (candidate.exists() and not candidate.is_dir()) or held_by(candidate):
         number += 1
         candidate = base.with_name(f"{base.name}-{number}")
     return candidate

@@ -287,3 +287,23 @@ def pending() -> list[int]:
 def stopping() -> int | None:
     """The signal that a :func:`first_only` region has raised, if any (it is ending the run)."""
     return _state.raised
+
+
+@contextlib.contextmanager
+def surfaced():
+    """Within the block, a signal is raised as its interrupt even when the library it lands in
+    turns it into another exception.
+
+    pymavlink's compiled indexer reports a Ctrl-C that lands in it as a ``MemoryError``, which a
+    reader would then call a corrupt log. Here the first SIGINT or SIGTERM is noted as it is
+    raised (:func:`first_only`), and any exception leaving the block after it, whatever its
+    type, becomes that interrupt: the command ends with 130 or 143, not with a refusal.
+    """
+    with first_only():
+        try:
+            yield
+        except Exception:
+            number = stopping()
+            if number is not None:
+                raise interrupt_for(number) from None
+            raise

@@ -18,18 +18,22 @@ _lock = threading.Lock()
 _enabled = False
 
 
-def reuse(enabled: bool = True) -> bool:
+def reuse(enabled: bool = True, free: bool = True) -> bool:
     """Turn the reuse of FMU instances in this process on or off; returns the previous state.
-    Turning it off frees the idle instances.
+    Turning it off frees the idle instances, unless ``free`` is False.
 
     Parameters
     ----------
     enabled : bool
         Keep instances between runs.
+    free : bool
+        With ``enabled`` False: free the idle instances. False keeps them for a later
+        ``reuse(True)`` (the pytest plugin's fixtures turn reuse on for their own tests alone,
+        and keep the instances for the next such test of the session).
     """
     global _enabled
     previous, _enabled = _enabled, bool(enabled)
-    if not _enabled:
+    if not _enabled and free:
         with _lock:
             idle = [instance for stack in _idle.values() for instance in stack]
             _idle.clear()

@@ -514,7 +514,8 @@ class Result:
         Result
             With its meta data (units and options included) and error message.
         """
-        with np.load(path) as archive:
+        # the file opened here and closed here: NumPy leaves its own handle open on a damaged archive
+        with open(path, "rb") as file, np.load(file) as archive:
             meta = json.loads(str(archive["_meta"]))
             time = archive["time"]
             vectors = meta.pop("vectors", {})

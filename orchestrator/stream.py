@@ -99,6 +99,23 @@ class StreamWriter:
         write_json(self.path / "meta.json", description)
 
 
+class DamagedRecord(ValueError):
+    """A streamed record whose chunks are missing or whose description is unreadable."""
+
+
+def _check_chunks(folder: Path, chunk_files: list[Path], meta: dict):
+    """Refuse a stream whose chunks are not ``chunk-000000.npy`` onwards without a gap, or fewer
+    than its finished ``meta.json`` lists (chunks removed, or a copy cut short)."""
+    expected = [f"chunk-{k:06d}.npy" for k in range(len(chunk_files))]
+    gaps = [e for e, found in zip(expected, chunk_files, strict=True) if found.name != e]
+    listed = meta.get("chunks") if meta.get("ended") else None
+    if gaps or (listed is not None and len(chunk_files) < listed):
+        missing = gaps[0] if gaps else f"chunk-{len(chunk_files):06d}.npy"
+        count = f"{listed} chunks ({meta.get('samples')} samples)" if listed is not None else "its chunks"
+        raise DamagedRecord(f"{folder}: the streamed record is damaged: its meta.json lists {count}, "
+                            f"{len(chunk_files)} are there ({missing} is missing); it cannot be read whole")
+
+
 class StreamedResult(Result):
     """A record read from a stream folder; a signal is read from disk when asked for.
 
@@ -111,12 +128,16 @@ class StreamedResult(Result):
 
     def __init__(self, folder):
         folder = Path(folder)
-        meta = json.loads((folder / "meta.json").read_text())
+        try:
+            meta = json.loads((folder / "meta.json").read_text())
+            names = meta.pop("names")
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
+            raise DamagedRecord(f"{folder}: its meta.json is damaged ({type(error).__name__}: {error})") from None
         self.folder = folder
         self.chunk_files = sorted(folder.glob("chunk-*.npy"))
         if meta.get("ended"):
             self.chunk_files = self.chunk_files[:meta["chunks"]]
-        names = meta.pop("names")
+        _check_chunks(folder, self.chunk_files, meta)
         error = meta.pop("error", None)
         lengths = [self._chunk(path).shape[1] for path in self.chunk_files]  # from the headers alone
         time = np.empty(sum(lengths))

@@ -282,7 +282,7 @@ def get(name: str) -> Scenario:
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
         record=None, formats=("npz",), overwrite: bool = False, estimator=None, compress: bool = False,
-        stream: bool = False, fmus: dict | None = None):
+        stream: bool = False, blocks=None, fmus: dict | None = None):
     """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
 
     Parameters
@@ -317,6 +317,9 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         Write the record to ``results.stream/`` in chunks as the run goes, so that its memory
         stays flat however long the run (:mod:`orchestrator.stream`); needs ``out_dir`` and
         the ``npz`` format alone.
+    blocks : dict, optional
+        Blocks of the user's in the place of the scenario's, by name (``{"Controller":
+        MyController()}``), each wired as the block it replaces (:meth:`orchestrator.System.replace`).
     fmus : dict, optional
         Block name to the path of an FMU of the user's with the same interface, in that block's
         place (``{"MotorMagnetics": "my_motor.fmu"}``; :meth:`Scenario.system`); recorded in
@@ -342,25 +345,30 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     from orchestrator.files import prepare_out_dir
     from orchestrator.interrupts import first_only, held
     from orchestrator.progress import status
-    from scenarios.outputs import RunFiles
+    from scenarios.outputs import RunFiles, remove_if_empty
 
     status(f"{name}: loading the scenario")
     files = None
-    with first_only():
+    with first_only(), contextlib.ExitStack() as lock:  # the folder is this run's until it ends
         try:
             with held():  # a signal while the folder is made is raised once the run can record it
                 _check_formats(formats, stream, out_dir)
                 if name not in _MODULES:
                     get(name)  # refused (the nearest names given) before any folder is made
                 made = out_dir is not None and not Path(out_dir).exists()
-                out = prepare_out_dir(out_dir, overwrite) if out_dir else None
+                out = prepare_out_dir(out_dir, overwrite, lock) if out_dir else None
                 given = dict(settings) if isinstance(settings, dict) else dict(
                     _split(s) for s in settings or [] if "=" in s)
                 base = {"scenario": name, "options": given,
                         "injected_faults": [fault_record(f) for f in faults], "decimation": decimation}
-                files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+                try:
+                    files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+                except ValueError:  # no room for even metrics.json: refused, the folder left as it was
+                    if made:
+                        remove_if_empty(out)
+                    raise
             with (files.tracking() if files else contextlib.nullcontext()):
-                given = (faults, estimator, record, stream, fmus)
+                given = (faults, estimator, record, stream, blocks, fmus)
                 return _run_tracked(name, settings, files, base, made, given, progress)
         except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
@@ -388,6 +396,10 @@ def _run_tracked(name, settings, files, base, made, given, progress):
         if files is not None and files.result is None:
             files.refused(remove_folder=made)
         raise
+    except OSError as error:  # the disk filled, or the folder failed, outside the loop and the save
+        if files is None:
+            raise
+        raise files.broke(error) from None
 
 
 def _check_formats(formats, stream: bool, out_dir):
@@ -403,13 +415,15 @@ def _check_formats(formats, stream: bool, out_dir):
 
 def _run_phases(scenario, options, base, files, given, progress):
     """Build, draw, run, save and report, each phase named in ``files`` for ``metrics.json``;
-    ``given`` holds the faults, the user's estimator, the signals to record and ``stream``."""
+    ``given`` holds the faults, the user's estimator, the signals to record, ``stream`` and the
+    user's blocks."""
     from orchestrator import SimulationError
     from orchestrator.progress import status
     from scenarios.metrics import metric_units
 
-    name, (faults, estimator, record, stream, fmus) = scenario.name, given
-    system, duration, kept, saved = _build(scenario, options, base, files, faults, (estimator, fmus), stream, record)
+    name, (faults, estimator, record, stream, blocks, fmus) = scenario.name, given
+    system, duration, kept, saved = _build(scenario, options, base, files, (faults, estimator, blocks, fmus),
+                                           stream, record)
     if files:
         files.phase, files.stream = "running", _open_stream(files, stream)
     from orchestrator.diagram import blocks_text
@@ -429,6 +443,7 @@ def _run_phases(scenario, options, base, files, given, progress):
     result.meta |= {"scenario": {"name": name, "options": base["options"]}, "faults": base["injected_faults"]}
     metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
                       "fmu_warnings": _warning_counts(result)}
+    metrics |= _divergence(scenario, result, options)
     if files is not None:
         files.phase = "saving the record"
         status(f"{name}: writing {', '.join(f'results.{f}' for f in files.formats)} "
@@ -446,6 +461,12 @@ def _run_phases(scenario, options, base, files, given, progress):
     if files is not None:
         metrics["save_cpu_s"] = files.save_cpu_seconds
         files.finish(metrics)
+    if metrics["status"] == "diverged":
+        import warnings
+
+        from scenarios.divergence import message
+
+        warnings.warn(message(name, metrics["diverged"], _settings_given(scenario, options)), stacklevel=2)
     return result, metrics
 
 
@@ -455,6 +476,31 @@ def _signals_text(saved, recorded) -> str:
         return f"{len(recorded)} signals"
     return (f"{len(saved)} of the {len(recorded)} signals recorded; the others follow from them "
             "(metrics.json: signals_not_saved)")
+
+
+def _divergence(scenario, result, options) -> dict:
+    """``status`` ``diverged`` and the first bound crossed (``diverged``) when the scenario bounds its
+    flight (``extra["divergence"]``) and the run crossed a bound; the signals a bound reads that
+    were not recorded (``divergence_unchecked``)."""
+    bounds = scenario.extra.get("divergence")
+    if bounds is None or not len(result):
+        return {}
+    from scenarios.divergence import first_crossing, unchecked
+
+    found = {}
+    missing = unchecked(result)
+    if missing:
+        found["divergence_unchecked"] = missing
+    crossing = first_crossing(result, bounds)
+    if crossing is not None:
+        found |= {"status": "diverged", "diverged": crossing | {"settings": _settings_given(scenario, options)}}
+    return found
+
+
+def _settings_given(scenario, options) -> list[str]:
+    """The options off their defaults and the block parameters set, as ``key=value``."""
+    return [f"{key}={value}" for key, value in options.items()
+            if key not in scenario.options or value != scenario.options[key].default]
 
 
 def _recorded_names(system, kept) -> list[str]:
@@ -475,20 +521,22 @@ def _open_stream(files, stream: bool):
     return StreamWriter(files.out / FOLDER)
 
 
-def _build(scenario, options, base, files, faults, replacing, stream, record):
+def _build(scenario, options, base, files, users, stream, record):
     """The system, its duration (s), the signals recorded and those written (``base`` takes
-    the options as used, the duration and the blocks replaced); ``replacing`` is the user's
-    estimator and FMUs, ``(estimator, fmus)``; a refusal removes what this run wrote."""
+    the options as used, the duration and the FMUs replaced); ``users`` holds the faults, the
+    user's estimator, blocks and FMUs. A refusal removes what this run wrote."""
     from orchestrator.progress import status
 
+    faults, estimator, blocks, fmus = users
     if files:
         files.phase = "building the system"
     status(f"{scenario.name}: building the system")
     try:
-        estimator, fmus = replacing
         system = scenario.system(options, estimator=estimator, fmus=fmus)
         if system.replaced:
             base["replaced_blocks"] = system.replaced
+        for block_name, block in (blocks or {}).items():
+            system.replace(block_name, block)
         for fault in faults:
             system.inject(fault)
         duration = scenario.duration(options) if scenario.duration else options["duration"]

@@ -10,6 +10,7 @@
   quadcosim bench [--json]                 speed of the master
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
+  quadcosim bench pytest [--json]          cost of a short test written with the pytest plugin
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
@@ -189,7 +190,7 @@ def _run_reporting(args) -> int:
             print(f"what was recorded up to the failure ({len(error.result)} samples) is in {out}/", file=sys.stderr)
         return 1
     except (KeyError, ValueError) as error:
-        print(f"quadcosim run {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
+        print(f"quadcosim run {args.scenario}: {_said(error)}", file=sys.stderr)
         return 2
     except OSError as error:  # the output folder failed under the run (removed, read-only, a disk error)
         print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)
@@ -205,7 +206,18 @@ def _run_reporting(args) -> int:
     drawn = [p.name for p in sorted(out.glob("diagram.*"))] + figures
     print(f"results ({', '.join(formats)}), metrics.json" + (f" and {', '.join(drawn)}" if drawn else "")
           + f" in {out}/" + (" (no report figures: see report above)" if "report" in metrics else ""))
+    if metrics.get("status") == "diverged":  # warned above, naming the settings
+        print(f"quadcosim run {args.scenario}: the run diverged (metrics.json: status diverged); its record and "
+              f"figures are in {out}/", file=sys.stderr)
+        return 1
     return 0
+
+
+def _said(error: Exception) -> str:
+    """The message of a refusal: its text (a KeyError's own, without the quotes its str adds)."""
+    if isinstance(error, KeyError) and error.args and isinstance(error.args[0], str):
+        return error.args[0]
+    return str(error)
 
 
 def _default_out(scenario: str, overwrite: bool) -> Path:
@@ -250,9 +262,18 @@ def _diagram(args) -> int:
             print(error.args[0] if error.args else error, file=sys.stderr)
             return 2
         from orchestrator.diagram import blocks_text
+        from orchestrator.files import figure_file
 
         status(f"{args.scenario}: drawing the wiring ({blocks_text(system)})")
-        path = draw(system, args.out or f"results/{args.scenario}/diagram.png", scenario.title(options))
+        try:
+            out = figure_file(args.out, "diagram.png", Path("results") / args.scenario)
+            path = draw(system, out, scenario.title(options))
+        except ValueError as error:  # an output path refused (OutputRefused), before anything is written
+            print(f"quadcosim diagram: {error}", file=sys.stderr)
+            return 2
+        except OSError as error:  # a full disk: named, nothing left under the figure's name
+            print(f"quadcosim diagram: failed: {error}", file=sys.stderr)
+            return 1
     print(path)
     return 0
 
@@ -266,6 +287,10 @@ def _bench(args) -> int:
         from benchmarks import sweep
 
         return sweep.main(["--json"] if args.json else [])
+    if args.suite == "pytest":
+        from benchmarks import pytest_cost
+
+        return pytest_cost.main(["--json"] if args.json else [])
     from benchmarks import master as bench
 
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
@@ -295,12 +320,15 @@ def parser() -> argparse.ArgumentParser:
                          help="scenario options or block parameters, as for run (the wiring may depend on them: "
                               "magnetic=on adds the motors' field)")
     diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
-    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png)")
+    diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png; a folder takes "
+                         "diagram.png)")
     diagram.set_defaults(func=_diagram)
-    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep"),
+    bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
+                                         "pytest plugin")
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"),
                        help="what to time: master (the co-simulation loop, the default), infrared (the IR "
-                            "calibration's cost per update) or sweep (40 closed-loop runs on Dask)")
+                            "calibration's cost per update), sweep (40 closed-loop runs on Dask) or pytest (the "
+                            "pytest plugin's fixtures)")
     bench.add_argument("--json", action="store_true",
                        help="print the measurements as one JSON object on standard output instead of a table")
     bench.add_argument("--seconds", type=float, default=5.0, metavar="S",
@@ -384,6 +412,9 @@ def main(argv=None) -> int:
     """Run ``quadcosim`` with ``argv`` (the process arguments if None); returns the exit code."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
+    for stream in (sys.stdout, sys.stderr):  # a file name that is not UTF-8 is printed escaped, never a traceback
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     try:
         with terminate_as_interrupt(), warnings.catch_warnings():  # SIGTERM ends it as Ctrl-C does: cleanly
             warnings.simplefilter("default")

@@ -1,135 +1,249 @@
-"""How small a sensor fault the infrared calibration's Kalman filter finds, how fast, and how often it cries wolf.
+"""How often the infrared calibration's Kalman filter finds a fault, on the right sensor, and cries wolf.
 
-``python -m scenarios.ir_detection`` flies the ``ir-calibration`` flight (8000 samples, drift
-on, seed 1) with one fault at a time, the slides' onsets and lengths (IR from 60 s, GPS from
-280 s, 2000 samples each), over a range of sizes, and tabulates for each the delay of its
-declaration, the sensor it was attributed to, and how long after its end it was ended; then
-flies fault-free flights (seeds 1 to 100 by default) and counts the faults declared there.
-The filter's detectors are those of :mod:`calibration.infrared.detection`.
-:mod:`scenarios.ir_detectability` measures why the smallest faults escape and what the detectors'
-settings were set on.
+Judged on fleets of flights it was never tuned on.
+
+``python -m scenarios.ir_detection`` flies the ``ir-calibration`` flight (8000 samples at
+20 Hz, drift on) in batch (:mod:`scenarios.ir_fleet`, the InfraredSensor's arithmetic on
+arrays), one fault at a time at the slides' onsets and length (IR from 60 s, GPS from 280 s,
+2000 samples), over a fleet of seeds per fault kind and size, and fault-free flights over
+another; it prints for each case the rates with their 95 % intervals (Clopper-Pearson for a
+proportion, Garwood's exact Poisson interval for false alarms per flight-hour):
+
+- declared: a fault declared, on either sensor, while the offset lasts;
+- on the right sensor: the first such declaration names the faulty sensor;
+- the delay of that declaration (percentiles over the flights where it came);
+- ended early: the fault's declaration ended while the offset still lasted;
+- left standing: a fault still declared at the flight's end (the GPS offset ends 20 s before
+  it, the IR's 240 s before);
+- cleared: how long after the offset's end no fault was declared any more;
+- other declarations: faults declared outside the offset and the 5 s after it;
+- fault-free flights: faults declared, and per flight-hour.
+
+The seeds: :data:`TUNING` are those the detector's settings were chosen on (and every design
+was looked at on); :data:`FRESH` (per fault case) and :data:`FRESH_CLEAN` (fault-free) are
+disjoint from them and were flown only to score the design once frozen.
+
+``--ablation`` scores each design choice of :mod:`calibration.infrared.detection` by flying the
+same fresh fleets with it undone (:data:`ABLATIONS`), and the earlier design as a whole.
+``--quick`` is the small fresh set CI re-checks (:data:`QUICK`).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
 from calibration.infrared import EKFSettings, Estimator
-from scenarios.ir_calibration import fault_report, fault_windows, simulate_flight
+from scenarios.ir_calibration import RATE, episodes, fault_windows
 
-IR_SIZES = (50.0, 100.0, 200.0, 400.0, 800.0, 1200.0)  # count
-GPS_SIZES = (0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 1.5)  # rad/s
-CLEAN_SEEDS = (1, 100)  # first and last seed of the fault-free flights
 SAMPLES = 8000
+#: seeds the settings were chosen on or a design looked at: the first fault-free 9999 and fault seeds 1-300, then
+#: fleets flown to judge an earlier design and looked at before its last change (so tuning seeds now)
+TUNING = ((1, 9999), (1_000_000, 1_000_999), (2_000_000, 2_008_999), (3_000_000, 3_000_039), (3_100_000, 3_100_199),
+          (3_200_000, 3_200_199), (4_000_000, 4_000_199), (4_100_000, 4_100_049), (5_000_000, 5_000_010))
+FRESH = (10_000_000, 10_000_999)  # per fault case: 1000 flights, flown once, after the design was frozen
+FRESH_CLEAN = (20_000_000, 20_004_499)  # fault-free: 4500 flights, 500 flight-hours
+QUICK = {"faults": (30_000_000, 30_000_039), "clean": (30_100_000, 30_100_199)}  # CI's fresh subset
+CASES = (("ir", 100.0), ("gps", 0.1))  # the smallest offsets the detector is designed for
+LARGER = (("ir", 200.0), ("ir", 400.0), ("ir", 1200.0), ("gps", 0.2), ("gps", 0.3), ("gps", 1.5))
+BELOW = (("ir", 50.0), ("gps", 0.05))  # below the sizes the detector is designed for
+UNITS = {"ir": "count", "gps": "rad/s"}
+AFTER_S = 5.0  # s after an offset's end within which a declaration is "at its end"
+CONFIDENCE = 0.95
+EARLIER = {"cusum_h": 10.0, "now_k": 3.5, "freeze": False, "turn": "mean", "raw": False, "end": "innovation",
+           "sd_drift": 0.0, "significance": 25.0}
+#: each design choice undone alone (label -> settings), and the earlier design whole
+ABLATIONS = {
+    "designed": {},
+    "held_not_frozen": {"freeze": False},
+    "held_40_not_frozen": {"freeze": False, "held_lag": 40},
+    "turn_mean": {"turn": "mean"},
+    "turn_healthy": {"turn": "healthy"},
+    "no_drift": {"sd_drift": 0.0},
+    "no_drift_significance_25": {"sd_drift": 0.0, "significance": 25.0},
+    "pair_not_raw": {"raw": False},
+    "end_on_innovation": {"end": "innovation"},
+    "innovation_cusums": {"cusum_h": 10.0},
+    "present_ir_k_3_5": {"now_k": 3.5},
+    "present_ir_off": {"now_h": math.inf},
+    "decisive_100": {"decisive": 100.0},
+    "alt_level_10": {"alt_level": 10.0},
+    "earlier_design": EARLIER,
+}
+ABLATION_CASES = (("ir", 100.0), ("gps", 0.1), ("ir", 50.0), ("ir", 1200.0))
+ABLATION_CLEAN = (2_000_000, 2_001_999)  # fault-free flights of the ablation: 2000 of the fresh ones
 
 
-def kalman(flight: dict) -> dict:
-    """The gated Kalman filter (default settings) over ``flight`` (:func:`simulate_flight`)."""
+def kalman(flight: dict, settings: EKFSettings | None = None) -> dict:
+    """The gated Kalman filter (default settings unless ``settings``) over ``flight``."""
     use = flight["gps_valid"] > 0.5
-    return Estimator("kalman", EKFSettings()).run(flight["ir"], flight["gps_turn_rate"], use)
+    return Estimator("kalman", settings or EKFSettings()).run(flight["ir"], flight["gps_turn_rate"], use)
 
 
-def one_fault(sensor: str, size: float, seed: int = 1) -> dict:
-    """The declaration of one fault of ``size`` on ``sensor`` (``"ir"``, count, or ``"gps"``, rad/s).
+def fly(seed: int, sensor: str = "none", size: float = 0.0) -> dict:
+    """The ``ir-calibration`` flight of ``seed`` with one fault of ``size`` on ``sensor``
+    (``"ir"``, count; ``"gps"``, rad/s; ``"none"``), in batch."""
+    from scenarios.ir_fleet import fly as batch
 
-    Parameters
-    ----------
-    sensor : {"ir", "gps"}
-        The faulty sensor.
-    size : float
-        Its offset (count for the IR, rad/s for the GPS).
-    seed : int
-        Flight and noise seed.
-
-    Returns
-    -------
-    dict
-        ``sensor``, ``size``, ``declared_after_s`` (s after the onset, None if never),
-        ``attributed`` (the sensor it was declared on, None if never), ``ended_after_s`` (s after
-        the fault's end, None if never ended), ``false_alarms`` (other declarations) and
-        ``turn_rate_error_std_deg_s`` (deg/s, after 30 s).
-    """
-    flight = simulate_flight(SAMPLES, seed=seed, faults=sensor, ir_fault=size, gps_fault=size)
-    estimate = kalman(flight)
-    windows = fault_windows(sensor, size, size)
-    flags = {"ir": estimate["ir_fault"], "gps": estimate["gps_fault"]}
-    faults, false_alarms = fault_report(windows, flags, flight["time"])
-    other = "gps" if sensor == "ir" else "ir"
-    wrong, _ = fault_report([(other, *windows[0][1:])], flags, flight["time"])
-    (fault,) = faults
-    declared, attributed = fault["declared_s"], sensor
-    if declared is None and wrong[0]["declared_s"] is not None:
-        declared, attributed, false_alarms = wrong[0]["declared_s"], other, false_alarms - 1
-    settled = flight["time"] >= 30.0
-    return {"sensor": sensor, "size": size,
-            "declared_after_s": None if declared is None else declared - fault["onset_s"],
-            "attributed": attributed if declared is not None else None,
-            "ended_after_s": None if fault["cleared_s"] is None else fault["cleared_s"] - fault["end_s"],
-            "false_alarms": false_alarms,
-            "turn_rate_error_std_deg_s": float(np.degrees(estimate["turn_rate"] - flight["r"])[settled].std())}
+    return batch(seed, SAMPLES, faults=sensor, ir_fault=size, gps_fault=size)
 
 
-def false_alarms(seeds=range(CLEAN_SEEDS[0], CLEAN_SEEDS[1] + 1)) -> dict:
-    """Faults declared on fault-free flights (drift on), one per seed.
-
-    Parameters
-    ----------
-    seeds : iterable of int
-        Flight and noise seeds.
-
-    Returns
-    -------
-    dict
-        ``flights``, ``hours`` (of flight, h), ``false_alarms`` (declarations in all),
-        ``flights_with_a_false_alarm`` (their seeds).
-    """
-    total, flagged, flights = 0, [], 0
-    for seed in seeds:
-        flight = simulate_flight(SAMPLES, seed=seed)
-        estimate = kalman(flight)
-        _, count = fault_report([], {"ir": estimate["ir_fault"], "gps": estimate["gps_fault"]}, flight["time"])
-        total += count
-        flights += 1
-        if count:
-            flagged.append(seed)
-    return {"flights": flights, "hours": flights * float(flight["time"][-1] + flight["time"][1]) / 3600.0,
-            "false_alarms": total, "flights_with_a_false_alarm": flagged}
+def outcome(estimate: dict, time: np.ndarray, sensor: str, size: float) -> dict:
+    """What the filter declared on one flight (see the module): for a fault-free flight
+    (``sensor`` ``"none"``) the ``declarations``; else ``declared``, ``right``, ``delay_s``,
+    ``ended_early``, ``standing``, ``cleared_s`` (``inf`` when left standing), ``at_end`` and
+    ``other`` declarations. ``estimate`` is the filter's output (:func:`kalman`), ``time`` its
+    sample times (s), ``size`` the offset (count for the IR, rad/s for the GPS)."""
+    runs = {name: episodes(estimate[f"{name}_fault"], time) for name in ("ir", "gps")}
+    standing = any(estimate[f"{name}_fault"][-1] > 0.5 for name in runs)
+    if sensor == "none":
+        return {"declarations": sum(len(r) for r in runs.values()), "standing": standing}
+    ((_, onset, end, _),) = fault_windows(sensor, size, size)
+    inside = sorted((start, name) for name, r in runs.items() for start, _ in r if onset - 1e-9 <= start < end)
+    right = [(start, stop) for start, stop in runs[sensor] if onset - 1e-9 <= start < end]
+    stops = [stop for r in runs.values() for start, stop in r
+             if start < end + AFTER_S and (stop is None or stop >= end)]
+    return {"declared": bool(inside), "right": bool(inside) and inside[0][1] == sensor,
+            "delay_s": right[0][0] - onset if right else math.nan,
+            "ended_early": any(stop is not None and stop < end - 1e-9 for _, stop in right),
+            "standing": standing,
+            "cleared_s": 0.0 if not stops else (math.inf if None in stops else max(stops) - end),
+            "at_end": sum(1 for r in runs.values() for start, _ in r if end - 1e-9 <= start < end + AFTER_S),
+            "other": sum(1 for r in runs.values() for start, _ in r if not onset - 1e-9 <= start < end + AFTER_S)}
 
 
-def table(ir_sizes=IR_SIZES, gps_sizes=GPS_SIZES) -> list[dict]:
-    """:func:`one_fault` for every size, printed as it comes.
-
-    Parameters
-    ----------
-    ir_sizes : sequence of float
-        IR offsets (count).
-    gps_sizes : sequence of float
-        GPS turn-rate offsets (rad/s).
-    """
+def _fly_seeds(job) -> list[dict]:
+    sensor, size, seeds, overrides = job
+    settings = EKFSettings(**overrides)
     rows = []
-    for sensor, sizes, unit in (("ir", ir_sizes, "count"), ("gps", gps_sizes, "rad/s")):
-        for size in sizes:
-            row = one_fault(sensor, size)
-            rows.append(row)
-            print(_line(row, unit), flush=True)
+    for seed in seeds:
+        flight = fly(seed, sensor, size)
+        rows.append(outcome(kalman(flight, settings), flight["time"], sensor, size) | {"seed": seed})
     return rows
 
 
-def _line(row: dict, unit: str) -> str:
-    def seconds(value):
-        return "never" if value is None else f"{value:.2f} s"
+def fleet(sensor: str, size: float, seeds, overrides: dict | None = None, jobs: int = 1) -> list[dict]:
+    """:func:`outcome` of every flight of ``seeds`` (one fault of ``size`` on ``sensor``, or
+    ``"none"``), the filter's settings changed by ``overrides``; over ``jobs`` processes."""
+    seeds = list(seeds)
+    work = [(sensor, size, seeds[i::jobs], dict(overrides or {})) for i in range(jobs)]
+    if jobs == 1:
+        return _fly_seeds(work[0])
+    with ProcessPoolExecutor(jobs) as pool:
+        rows = [row for part in pool.map(_fly_seeds, work) for row in part]
+    return sorted(rows, key=lambda row: row["seed"])
 
-    return (f"{row['sensor']:3s} +{row['size']:g} {unit}: declared after {seconds(row['declared_after_s'])} "
-            f"on {row['attributed'] or '-'}, ended {seconds(row['ended_after_s'])} after its end, "
-            f"{row['false_alarms']} other declarations, "
-            f"turn-rate error std {row['turn_rate_error_std_deg_s']:.2f} deg/s")
+
+def proportion(k: int, n: int) -> dict:
+    """``k`` of ``n`` as a rate with its Clopper-Pearson 95 % interval."""
+    from scipy.stats import binomtest
+
+    if n == 0:
+        return {"k": 0, "n": 0, "rate": math.nan, "low": 0.0, "high": 1.0}
+    interval = binomtest(k, n).proportion_ci(CONFIDENCE, method="exact")
+    return {"k": int(k), "n": int(n), "rate": k / n, "low": float(interval.low), "high": float(interval.high)}
+
+
+def per_hour(k: int, hours: float) -> dict:
+    """``k`` events in ``hours`` as a rate per hour with Garwood's exact 95 % Poisson interval."""
+    from scipy.stats import chi2
+
+    tail = 0.5 * (1.0 - CONFIDENCE)
+    low = 0.0 if k == 0 else chi2.ppf(tail, 2 * k) / 2.0
+    high = chi2.ppf(1.0 - tail, 2 * k + 2) / 2.0
+    return {"k": int(k), "hours": hours, "rate": k / hours, "low": low / hours, "high": high / hours}
+
+
+def summary(rows: list[dict], sensor: str) -> dict:
+    """The rates of a fleet's ``rows`` (:func:`fleet`) with their 95 % intervals; ``sensor`` is
+    the faulty one (``"ir"``, ``"gps"``) or ``"none"`` for fault-free flights."""
+    n = len(rows)
+    hours = n * SAMPLES / RATE / 3600.0
+    if sensor == "none":
+        declared = sum(r["declarations"] for r in rows)
+        return {"flights": n, "hours": hours, "false_alarms": per_hour(declared, hours),
+                "flights_with_one": [r["seed"] for r in rows if r["declarations"]],
+                "standing": proportion(sum(r["standing"] for r in rows), n)}
+    delays = np.array([r["delay_s"] for r in rows if r["right"]])
+    cleared = np.array([r["cleared_s"] for r in rows if r["declared"]])
+    return {"flights": n, "hours": hours,
+            "declared": proportion(sum(r["declared"] for r in rows), n),
+            "right": proportion(sum(r["right"] for r in rows), n),
+            "ended_early": proportion(sum(r["ended_early"] for r in rows), n),
+            "standing": proportion(sum(r["standing"] for r in rows), n),
+            "delay_s": {f"p{q}": float(np.percentile(delays, q)) if len(delays) else math.nan for q in (50, 90, 99)},
+            "cleared_s": {f"p{q}": float(np.percentile(cleared, q)) if len(cleared) else math.nan for q in (50, 99)},
+            "cleared_max_s": float(cleared.max()) if len(cleared) else math.nan,
+            "at_end": sum(r["at_end"] for r in rows), "other": sum(r["other"] for r in rows),
+            "missed": [r["seed"] for r in rows if not r["right"]],
+            "standing_seeds": [r["seed"] for r in rows if r["standing"]]}
+
+
+def study(cases=CASES, fresh=FRESH, clean=FRESH_CLEAN, overrides: dict | None = None, jobs: int = 1,
+          echo: bool = True) -> dict:
+    """The detection table: :func:`summary` of each fault case over the seeds ``fresh``
+    (first, last) and of the fault-free flights over ``clean``, the filter's settings changed by
+    ``overrides``, for each ``(sensor, size)`` of ``cases``; the fleets flown on ``jobs``
+    processes, each line printed as it comes when ``echo``."""
+    out = {"cases": {}}
+    for sensor, size in cases:
+        out["cases"][f"{sensor}_{size:g}"] = s = summary(fleet(sensor, size, range(fresh[0], fresh[1] + 1),
+                                                               overrides, jobs), sensor)
+        if echo:
+            print(case_line(sensor, size, s), flush=True)
+    out["clean"] = c = summary(fleet("none", 0.0, range(clean[0], clean[1] + 1), overrides, jobs), "none")
+    if echo:
+        print(clean_line(c, clean), flush=True)
+    return out
+
+
+def _rate(p: dict) -> str:
+    return f"{p['k']}/{p['n']} = {100 * p['rate']:.2f} % [{100 * p['low']:.2f}, {100 * p['high']:.2f}]"
+
+
+def case_line(sensor: str, size: float, s: dict) -> str:
+    """One case of the table, as printed: the summary ``s`` of the offset ``size`` on ``sensor``."""
+    d, c = s["delay_s"], s["cleared_s"]
+    return (f"{sensor} +{size:g} {UNITS[sensor]}: declared {_rate(s['declared'])}; on the right sensor "
+            f"{_rate(s['right'])}; delay p50 {d['p50']:.2f} p90 {d['p90']:.2f} p99 {d['p99']:.2f} s; ended early "
+            f"{_rate(s['ended_early'])}; left standing {_rate(s['standing'])}; cleared after its end p50 "
+            f"{c['p50']:.2f} p99 {c['p99']:.2f} s; declared at its end {s['at_end']}; other declarations "
+            f"{s['other']}")
+
+
+def clean_line(c: dict, seeds) -> str:
+    """The fault-free flights' summary ``c`` over the seeds ``seeds`` (first, last), as printed."""
+    fa = c["false_alarms"]
+    return (f"fault-free, seeds {seeds[0]} to {seeds[1]}: {c['flights']} flights, {c['hours']:.1f} flight-hours, "
+            f"{fa['k']} faults declared = {fa['rate']:.4f} per flight-hour [{fa['low']:.4f}, {fa['high']:.4f}]"
+            f" = one per {_hours_per(fa['rate'])} flight-hours"
+            + (f" (seeds {c['flights_with_one']})" if fa["k"] else "")
+            + f"; left standing at the flight's end {c['standing']['k']}")
+
+
+def _hours_per(rate: float) -> str:
+    return "inf" if rate == 0 else f"{1.0 / rate:.0f}"
+
+
+def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=FRESH, clean=ABLATION_CLEAN, jobs: int = 1,
+             echo: bool = True) -> dict:
+    """Each design choice undone alone (:data:`ABLATIONS`), on the fresh fleets of ``cases``
+    and the fault-free flights of ``clean``: label -> :func:`study`. ``variants`` maps a label to
+    the settings it overrides; ``jobs`` and ``echo`` as for :func:`study`."""
+    out = {}
+    for label, overrides in variants.items():
+        if echo:
+            print(f"[{label}] {overrides or 'the design as shipped'}", flush=True)
+        out[label] = study(cases, fresh, clean, overrides, jobs, echo)
+    return out
 
 
 def main(argv=None) -> int:
-    """``python -m scenarios.ir_detection [--seeds A:B] [--out FILE]``: the table and the false alarms.
+    """``python -m scenarios.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--jobs N] [--out FILE]``.
 
     Parameters
     ----------
@@ -137,25 +251,60 @@ def main(argv=None) -> int:
         The arguments (the process's if None).
     """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", default=f"{CLEAN_SEEDS[0]}:{CLEAN_SEEDS[1]}",
-                        help="fault-free flights, first:last seed (default 1:100)")
-    parser.add_argument("--out", help="write the table and the false alarms to this JSON file")
+    parser.add_argument("--fresh", default=f"{FRESH[0]}:{FRESH[1]}", help="seeds of each fault case, FIRST:LAST")
+    parser.add_argument("--clean", default=f"{FRESH_CLEAN[0]}:{FRESH_CLEAN[1]}",
+                        help="seeds of the fault-free flights, FIRST:LAST")
+    parser.add_argument("--ablation", action="store_true", help="each design choice undone (on the fresh fleets)")
+    parser.add_argument("--quick", action="store_true", help="the small fresh set CI re-checks")
+    parser.add_argument("--larger", action="store_true", help="also the larger offsets and those below the design")
+    parser.add_argument("--jobs", type=int, default=1, help="processes (default 1)")
+    parser.add_argument("--out", help="write the results to this JSON file")
     args = parser.parse_args(argv)
     try:
-        first, last = (int(x) for x in args.seeds.split(":"))
+        fresh = tuple(int(x) for x in args.fresh.split(":"))
+        clean = tuple(int(x) for x in args.clean.split(":"))
+        if len(fresh) != 2 or len(clean) != 2:
+            raise ValueError
     except ValueError:
-        parser.error(f"--seeds {args.seeds!r}: write FIRST:LAST, e.g. 1:100")
-    rows = table()
-    clean = false_alarms(range(first, last + 1))
-    print(f"fault-free flights, seeds {first} to {last} ({clean['flights']} flights, {clean['hours']:.1f} h): "
-          f"{clean['false_alarms']} faults "
-          f"declared" + (f" (seeds {clean['flights_with_a_false_alarm']})" if clean["false_alarms"] else ""))
+        parser.error("write the seeds as FIRST:LAST, e.g. 1000000:1000999")
+    if args.jobs < 1:
+        parser.error(f"--jobs {args.jobs}: give at least one process")
+    if args.quick:
+        result = quick(echo=True)
+    elif args.ablation:
+        last = min(clean[1], clean[0] + ABLATION_CLEAN[1] - ABLATION_CLEAN[0])
+        result = ablation(fresh=fresh, clean=(clean[0], last), jobs=args.jobs)
+    else:
+        tuning = ", ".join(f"{a}-{b}" for a, b in TUNING)
+        print(f"tuning seeds {tuning}; fresh seeds {fresh[0]} to {fresh[1]} per fault case, "
+              f"{clean[0]} to {clean[1]} fault-free", flush=True)
+        result = study(CASES + (LARGER + BELOW if args.larger else ()), fresh=fresh, clean=clean, jobs=args.jobs)
     if args.out:
         from orchestrator.files import write_json
 
-        write_json(args.out, {"faults": rows, "fault_free": clean})
+        write_json(args.out, result)
     return 0
 
+
+def quick(echo: bool = False) -> dict:
+    """The small fresh set CI re-checks (:data:`QUICK`): IR +100 counts and GPS +0.1 rad/s over
+    40 seeds each, and 200 fault-free flights; printed as they come when ``echo``."""
+    return study((("ir", 100.0), ("gps", 0.1)), QUICK["faults"], QUICK["clean"], echo=echo)
+
+
+def one_fault(sensor: str, size: float, seed: int = 1, settings: EKFSettings | None = None) -> dict:
+    """The declaration of one fault of ``size`` on ``sensor`` in the flight of ``seed``
+    (:func:`outcome`, and the ``turn_rate_error_std_deg_s`` after 30 s), under the filter's
+    ``settings`` (:class:`EKFSettings`, its defaults when None)."""
+    flight = fly(seed, sensor, size)
+    estimate = kalman(flight, settings)
+    settled = flight["time"] >= 30.0
+    return outcome(estimate, flight["time"], sensor, size) | {
+        "turn_rate_error_std_deg_s": float(np.degrees(estimate["turn_rate"] - flight["r"])[settled].std())}
+
+
+__all__ = ["ABLATIONS", "CASES", "FRESH", "FRESH_CLEAN", "QUICK", "TUNING", "ablation", "fleet", "one_fault",
+           "outcome", "per_hour", "proportion", "quick", "study", "summary"]
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator import Result, RunInterrupted, SimulationError
-from orchestrator.files import DiskFull, free_bytes, megabytes, note_written, tracking, write_json
+from orchestrator.files import LOCK_NAME, DiskFull, Reserve, free_bytes, megabytes, note_written, tracking, write_json
 from orchestrator.interrupts import held, signal_name, signal_number, stopping
 
 #: The file that keeps room for ``metrics.json`` on a disk that fills during the run (named as
 #: a temporary file: ``--overwrite`` removes one a killed run left).
-RESERVE = ".metrics.reserve.part"
+RESERVE = Reserve.NAME
 
 #: Bytes kept for ``metrics.json`` (a run's is 3 to 10 kB).
 RESERVE_BYTES = 64 * 1024
@@ -67,11 +67,11 @@ class RunFiles:
         self.save_cpu_seconds = 0.0
         self.saved = None  # the signals the files hold (None: all recorded)
         self.stream = None  # the record's stream writer, with --stream
-        self.reserve = out / RESERVE
         try:  # room kept for metrics.json, given back if the disk fills before it is written
-            self.reserve.write_bytes(bytes(RESERVE_BYTES))
-        except OSError:
-            self.reserve.unlink(missing_ok=True)
+            self.reserve = Reserve(out, RESERVE_BYTES)
+        except DiskFull:
+            raise NoRoom(f"no room in {out}/ for even its metrics.json ({megabytes(free_bytes(out))} free): free "
+                         "space there or choose another --out folder") from None
 
     @contextlib.contextmanager
     def tracking(self):
@@ -159,12 +159,12 @@ class RunFiles:
             try:
                 write_json(self.out / "metrics.json", metrics)
             except DiskFull:
-                if not self.reserve.exists():
+                if not self.reserve.held:
                     raise
-                self.reserve.unlink()  # the room kept for this file
+                self.reserve.release()  # the room kept for this file
                 write_json(self.out / "metrics.json", metrics)
             finally:
-                self.reserve.unlink(missing_ok=True)
+                self.reserve.release()
 
     def stopped(self, error: SimulationError, signals=None, stream=None, complete: bool = False):
         """Keep what a failed or interrupted run recorded, and a ``metrics.json`` saying where
@@ -241,6 +241,26 @@ class RunFiles:
         self.stopped(error, complete=True)
         return error
 
+    def broke(self, error: OSError) -> SimulationError:
+        """The disk filled, or the folder failed, in a phase outside the loop and the save
+        (drawing the wiring diagram, say): keep what was recorded and a ``metrics.json`` saying
+        so (written in the room kept for it).
+
+        Parameters
+        ----------
+        error : OSError
+            What failed (:class:`orchestrator.files.DiskFull` for a full disk).
+
+        Returns
+        -------
+        orchestrator.SimulationError
+            The error to raise.
+        """
+        what = str(error) if isinstance(error, DiskFull) else f"{type(error).__name__}: {error}"
+        failure = SimulationError(f"{what} (while {self.phase})", self.result)
+        self.stopped(failure, self.saved, self.stream, complete=self.result is not None)
+        return failure
+
     def refused(self, remove_folder: bool = False):
         """Remove what this run wrote: it was refused before it started (a value an FMU
         refused, a record too large), and the folder is left as it was.
@@ -256,9 +276,9 @@ class RunFiles:
             (self.out / name).unlink(missing_ok=True)
         if self.stream is not None and self.stream.path.is_dir():
             shutil.rmtree(self.stream.path)
-        self.reserve.unlink(missing_ok=True)
-        if remove_folder and self.out.is_dir() and not any(self.out.iterdir()):
-            self.out.rmdir()
+        self.reserve.release()
+        if remove_folder:
+            remove_if_empty(self.out)
 
     # ------------------------------------------------------------------ room, before the run
     def check_room(self, rows: int, recorded: list[str], saved: list[str], decimation: int, stream: bool):
@@ -296,8 +316,8 @@ class RunFiles:
                               0 if stream else sum(len(m) for m in groups.values()))
         free = free_bytes(self.out)
         if free is not None and need > free:
-            raise NoRoom(f"the record's files need about {megabytes(need)} in {self.out}/, where "
-                         f"{megabytes(free)} are free. Free space there, choose another --out folder, or record "
+            raise NoRoom(f"the record's files need about {megabytes(need, free)} in {self.out}/, where "
+                         f"{megabytes(free, need)} are free. Free space there, choose another --out folder, or record "
                          f"less: every N-th step (--decimation N, now {decimation}), fewer signals (--record ...), "
                          "a shorter run")
 
@@ -320,6 +340,14 @@ class RunFiles:
         sizes = {"npz": 0 if self.compress else 8 * values, "csv": CSV_BYTES_PER_VALUE * values,
                  "mat": 0 if self.compress else 8 * (values + rows * vector_members)}
         return sum(sizes[kind] for kind in self.formats)
+
+
+def remove_if_empty(folder: Path):
+    """Remove ``folder`` when it holds nothing but this process's lock (a folder a refused
+    run made is left as it was: absent)."""
+    if folder.is_dir() and {p.name for p in folder.iterdir()} <= {LOCK_NAME}:
+        (folder / LOCK_NAME).unlink(missing_ok=True)
+        folder.rmdir()
 
 
 class NoRoom(ValueError):

@@ -12,6 +12,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from orchestrator.files import figure_file, printable, save_figure
+
 RESULTS_FILE = "results.npz"
 #: Width and height (inches) of one signal's axes.
 AXES_SIZE = (9.0, 2.6)
@@ -33,17 +35,33 @@ def load(run) -> tuple:
     Raises
     ------
     ValueError
-        No results there; the message says what a run folder holds.
+        No record there (the message says what a run folder holds), a damaged record (named,
+        with what is wrong), or a record of no sample.
     """
+    import zipfile
+
     from orchestrator import Result
 
     path = Path(run)
     folder = path if path.is_dir() else path.parent
-    try:
-        return Result.load(path), folder
-    except (FileNotFoundError, OSError, ValueError):
+    if not path.exists() or (path.is_dir() and not _holds_record(path)):
         raise ValueError(f"{run}: no {RESULTS_FILE} or streamed record there; give the folder of a finished run "
-                         "(the --out of `quadcosim run`, e.g. results/tp) or its results.npz") from None
+                         "(the --out of `quadcosim run`, e.g. results/tp) or its results.npz")
+    try:
+        result = Result.load(path)
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
+        raise ValueError(f"{run}: the run's record is damaged and cannot be read ({type(error).__name__}: {error}); "
+                         "run the scenario again") from None
+    if len(result) == 0:
+        raise ValueError(f"{run}: the run's record holds no sample (it stopped before its loop; see its "
+                         "metrics.json): nothing to draw")
+    return result, folder
+
+
+def _holds_record(folder: Path) -> bool:
+    from orchestrator.stream import FOLDER
+
+    return (folder / RESULTS_FILE).exists() or (folder / FOLDER).is_dir() or (folder / "meta.json").exists()
 
 
 def _check(result, folder: Path, signal: str):
@@ -126,22 +144,22 @@ def _draw(ax, result, signal: str, deg: bool, label_prefix: str = ""):
     else:
         result.plot(signal, ax=ax, label_prefix=label_prefix)
     ax.set_ylabel(in_degrees or unit or "unit unknown")
-    ax.set_title(signal, loc="left", fontsize=9)
+    ax.set_title(printable(signal), loc="left", fontsize=9)
 
 
-def _out_path(out, default: Path, figure_format: str | None) -> Path:
-    """The file to write: ``out`` (its suffix says the format, or ``figure_format`` adds one), or
-    ``default`` with the suffix of ``figure_format``."""
-    if out:
-        path = Path(out)
-        if figure_format and path.suffix.lstrip(".").lower() != figure_format:
-            if path.suffix.lstrip(".").lower() in FORMATS:
-                raise ValueError(f"--out {out} and --format {figure_format} disagree: give one of them")
-            path = path.with_name(path.name + "." + figure_format)
-        if path.suffix.lstrip(".").lower() not in FORMATS:
-            raise ValueError(f"--out {out}: give a .png, .svg or .pdf file")
+def _with_format(out, figure_format: str | None):
+    """The ``--out`` given, made to agree with ``--format``: a file without a figure suffix takes
+    the format's, a folder is kept (the default name carries the format), another figure suffix
+    is refused."""
+    if not out or not figure_format or Path(out).is_dir():
+        return out
+    path = Path(out)
+    suffix = path.suffix.lstrip(".").lower()
+    if suffix == figure_format:
         return path
-    return default.with_name(f"{default.name}.{figure_format or 'png'}")  # a name may hold dots (IMU.gyro)
+    if suffix in FORMATS:
+        raise ValueError(f"--out {out} and --format {figure_format} disagree: give one of them")
+    return path.with_name(f"{path.name}.{figure_format}")
 
 
 def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
@@ -167,24 +185,24 @@ def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = 
     """
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import save_figure
-
+    name = f"plot-{signals[0]}.{figure_format or 'png'}"
+    # a path given is checked before the run is read
+    path = figure_file(_with_format(out, figure_format), name, None) if out else None
     result, folder = load(run)
+    path = path or figure_file(None, name, folder)
     for signal in signals:
         _check(result, folder, signal)
-    path = _out_path(out, folder / f"plot-{signals[0]}", figure_format)
     fig, axes = plt.subplots(len(signals), 1, sharex=True, squeeze=False, layout="constrained",
                              figsize=(AXES_SIZE[0], AXES_SIZE[1] * len(signals)))
     for ax, signal in zip(axes[:, 0], signals, strict=True):
         _draw(ax, result, signal, deg)
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
-    fig.suptitle(_label(folder), fontsize=10)
+    fig.suptitle(printable(_label(folder)), fontsize=10)
     try:
-        save_figure(fig, path, dpi=120)
+        return save_figure(fig, path, dpi=120)
     finally:
         plt.close(fig)
-    return path
 
 
 def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
@@ -211,12 +229,10 @@ def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str |
     """
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import save_figure
-
+    path = figure_file(_with_format(out, figure_format), f"compare-{signal}.{figure_format or 'png'}", Path("."))
     loaded = [load(run) for run in runs]
     for result, folder in loaded:
         _check(result, folder, signal)
-    path = _out_path(out, Path(f"compare-{signal}"), figure_format)
     components = loaded[0][0].columns(signal)
     fig, axes = plt.subplots(len(components), 1, sharex=True, squeeze=False, layout="constrained",
                              figsize=(AXES_SIZE[0], AXES_SIZE[1] * len(components)))
@@ -226,12 +242,11 @@ def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str |
                 _draw(ax, result, component, deg, label_prefix=f"{_label(folder)}: ")
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
-    fig.suptitle(f"{signal}: {' vs '.join(_label(folder) for _, folder in loaded)}", fontsize=10)
+    fig.suptitle(printable(f"{signal}: {' vs '.join(_label(folder) for _, folder in loaded)}"), fontsize=10)
     try:
-        save_figure(fig, path, dpi=120)
+        return save_figure(fig, path, dpi=120)
     finally:
         plt.close(fig)
-    return path
 
 
 def plot_command(args) -> int:
@@ -249,9 +264,12 @@ def plot_command(args) -> int:
             print("\n".join(signal_lines(args.run)))
             return 0
         print(plot(args.run, args.signals, args.out, deg=args.deg, figure_format=args.format))
-    except ValueError as error:
+    except ValueError as error:  # OutputRefused among them
         print(f"quadcosim plot: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # a full disk (named; nothing left under the figure's name)
+        print(f"quadcosim plot: failed: {error}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -272,9 +290,12 @@ def compare_command(args) -> int:
         return 2
     try:
         print(compare(runs, signal, args.out, deg=args.deg, figure_format=args.format))
-    except ValueError as error:
+    except ValueError as error:  # OutputRefused among them
         print(f"quadcosim compare: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # a full disk (named; nothing left under the figure's name)
+        print(f"quadcosim compare: failed: {error}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -286,7 +307,9 @@ def add_arguments(sub):
                           help="signal or vector names (IMU.acc); none: list the run's signals and their units")
     _add_figure_options(plotting, "RUN/plot-SIGNAL.png")
     plotting.set_defaults(func=plot_command)
-    comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure")
+    comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure",
+                               usage="quadcosim compare [-h] [--out FILE] RUN RUN [RUN...] SIGNAL\n"
+                                     "       quadcosim compare [-h] [--out FILE] --signal SIGNAL RUN RUN [RUN...]")
     comparing.add_argument("items", nargs="+", metavar="RUN... SIGNAL",
                            help="two run folders or more (or their results.npz), then a signal or vector name")
     comparing.add_argument("--signal", help="the signal, when given apart: then every positional is a run")

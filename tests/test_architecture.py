@@ -20,9 +20,10 @@ ALLOWED = {
     # to find built FMUs only: the package's locating functions, not its build or its models
     "orchestrator": ("fmus",),
     # the block contract, and the plant's constants (vehicle, sensor densities)
-    # and the flight-log reading layer (orchestrator.logs), which replay and calibration share
-    "estimators": ("orchestrator.blocks", "orchestrator.logs.", "fmus.", "calibration."),
-    "calibration": ("orchestrator.blocks", "orchestrator.logs.", "fmus.", "estimators."),
+    # and the flight-log reading layer (orchestrator.logs), which replay and calibration share,
+    # and the one writer of every file the project writes (orchestrator.files)
+    "estimators": ("orchestrator.blocks", "orchestrator.logs.", "orchestrator.files", "fmus.", "calibration."),
+    "calibration": ("orchestrator.blocks", "orchestrator.logs.", "orchestrator.files", "fmus.", "estimators."),
     "scenarios": tuple(f"{p}." for p in PACKAGES),
     "benchmarks": tuple(f"{p}." for p in PACKAGES),
 }

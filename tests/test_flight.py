@@ -7,6 +7,7 @@ import scenarios
 from fmus import vehicle
 from scenarios.flight import GAINS, Controller, allocation_matrix, esc_command, initial_state, profile, profiles, trim
 from scenarios.flight import controller as law
+from scenarios.testing.assertions import assert_bounds
 
 
 def test_unknown_or_bad_gains_are_refused_with_the_nearest_name():
@@ -121,7 +122,7 @@ def test_position_hold_in_steady_wind_at_the_tilt_that_balances_drag():
     assert metrics["position_error_final_mm"] < 0.1 and metrics["drift_max_m"] < 0.6  # measured 0.030 mm, 0.51 m
     assert abs(result["Quadrotor.theta1"][-1]) < 1e-9
     assert np.abs(result["Quadrotor.p"][-1, :2]).max() < 1e-4  # m, position held (measured 3.0e-5)
-    assert np.abs(result["Quadrotor.p"][:, 0]).max() < 0.6  # m, blown off at most
+    assert_bounds(result, "Quadrotor.p_x", lower=-0.6, upper=0.6)  # m, blown off at most
 
 
 def test_without_integral_action_the_wind_pushes_the_vehicle_off():

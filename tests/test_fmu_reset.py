@@ -10,6 +10,7 @@ import scenarios
 from fmus import MODELS
 from orchestrator import pool
 from orchestrator.fmu import FMUError, FMUInstance
+from scenarios.testing.assertions import assert_runs_close
 
 DT = 1e-3
 PARAMETERS = {  # off their defaults, so that a reset that kept the earlier run's values would show
@@ -84,7 +85,6 @@ def test_a_sweep_member_on_reused_instances_equals_one_on_fresh_instances():
         pool.reuse(previous)
     assert pool.idle_count() == 0
     assert fresh.names == reused.names
-    for name in fresh.names:
-        assert np.array_equal(fresh[name], reused[name]), name
+    assert_runs_close(fresh, reused)  # bit for bit
     assert {k: v for k, v in fresh_metrics.items() if k != "real_time_factor"} == \
         {k: v for k, v in reused_metrics.items() if k != "real_time_factor"}

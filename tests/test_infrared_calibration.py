@@ -7,7 +7,7 @@ import pytest
 
 import scenarios
 from calibration.infrared import SLIDES_OPERATIONS, CalibrationError, EKFSettings, Estimator, cost
-from scenarios.ir_calibration import estimate, fault_windows, simulate_flight, summarize
+from scenarios.ir_calibration import estimate, fault_windows, simulate_flight
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +59,7 @@ def test_gated_filter_declares_attributes_and_survives_both_faults(both_faults):
         print(f"\n{fault['sensor']} fault at {fault['onset_s']:g} s: declared after {delay:.2f} s, cleared "
               f"{fault['cleared_s'] - fault['end_s']:.2f} s after its end; a and b within 5 % "
               f"{recovery['back_within_5_percent_s']:.2f} s after it")
-        assert 0 <= delay <= 1.0  # the GPS fault: at its first sample
+        assert 0 <= delay <= 0.4  # measured 0.20 s (IR) and 0.00 s (GPS)
         assert 0 <= fault["cleared_s"] - fault["end_s"] <= 2.0
         # measured 0 s for both; None: not back within 5 % to stay, in the 10 s looked at
         assert recovery["back_within_5_percent_s"] is not None and recovery["back_within_5_percent_s"] <= 1.0
@@ -68,14 +68,15 @@ def test_gated_filter_declares_attributes_and_survives_both_faults(both_faults):
     assert stats["kalman"]["std"] < 0.1 * min(stats["regression"]["std"], stats["rls"]["std"])
 
 
-def test_no_false_alarm_over_20_seeds_of_clean_flight():
-    declared = []
-    for seed in range(1, 21):
-        flight = simulate_flight(8000, seed=seed)
-        metrics = summarize(flight["time"], flight, estimate(flight), [])
-        declared.append(metrics["false_alarms"])
-    print(f"\nfaults declared on 20 clean flights of 8000 samples: {sum(declared)}")
-    assert declared == [0] * 20
+def test_no_false_alarm_on_100_fresh_fault_free_flights():
+    """Seeds no setting was chosen on, flown in batch (the FMU's arithmetic): 0 declared in 11.1
+    flight-hours (``python -m scenarios.ir_detection`` judges 500)."""
+    from scenarios.ir_detection import fleet
+
+    rows = fleet("none", 0.0, range(50_100_000, 50_100_100))
+    declared = sum(r["declarations"] for r in rows)
+    print(f"\nfaults declared on 100 fresh fault-free flights of 8000 samples: {declared}")
+    assert declared == 0
 
 
 def test_joint_and_sequential_forms_agree_without_gating():
@@ -104,7 +105,7 @@ def test_non_finite_input_and_bad_covariance_are_refused():
         EKFSettings(sd_ir=0.0)
 
 
-GATED_MAX_OPERATIONS = 192  # the gated filter with its detectors, counted by cost.py
+GATED_MAX_OPERATIONS = 208  # the gated filter with its detectors (GLR with drift), counted by cost.py
 
 
 def test_gated_filter_costs_less_than_the_slides_300_operations_on_a_fault_free_flight():
@@ -130,20 +131,6 @@ def test_sequential_scalar_updates_cost_fewer_flops_than_the_slides_joint_update
     sequential, joint = figures["kalman_ungated"]["flops_mean"], figures["kalman_joint"]["flops_mean"]
     print(f"\nflops per iteration: sequential {sequential:.1f}, joint {joint:.1f}")
     assert sequential < 0.85 * joint
-
-
-@pytest.mark.parametrize(("sensor", "size", "within"), [("ir", 400.0, 2.0), ("gps", 0.3, 3.0)])
-def test_a_small_fault_is_declared_attributed_and_ended(sensor, size, within):
-    """Faults the gate lets through (the filter would absorb them into b or r): the CUSUMs declare
-    them on the right sensor, and end them within 2 s of their end, with no other declaration."""
-    from scenarios.ir_detection import one_fault
-
-    row = one_fault(sensor, size)
-    print(f"\n{sensor} +{size:g}: {row}")
-    assert row["attributed"] == sensor
-    assert 0.0 <= row["declared_after_s"] <= within
-    assert 0.0 < row["ended_after_s"] <= 2.0
-    assert row["false_alarms"] == 0
 
 
 def test_fault_sizes_are_options_recorded_with_the_declarations():

@@ -1,32 +1,58 @@
-"""The infrared EKF's consistency detector: small offsets the filter would absorb into b and a
-are declared on the right sensor, a turn that exposes an error of a in the cloud is not, and the
-streaming block runs the same arithmetic as the batch path."""
+"""The infrared EKF's consistency detector on seeds no setting was chosen on: small offsets the
+filter would absorb into b and a are declared on the right sensor within their measured delays
+and ended, the Kalman filter's error stays about a fifth of the regression's, a turn that
+exposes an error of a in the cloud is no fault, and the streaming block runs the same arithmetic
+as the batch path."""
 
 import numpy as np
 import pytest
 
 from calibration.infrared import EKFSettings, Estimator
 from scenarios.ir_calibration import episodes, fault_report, simulate_flight
-from scenarios.ir_detection import one_fault
+from scenarios.ir_detection import fleet, fly
+
+SEEDS = range(50_000_000, 50_000_020)  # fresh: flown in batch (the FMU's arithmetic), 20 per case
 
 
-@pytest.mark.parametrize(("sensor", "size", "within", "ended_within"),
-                         [("gps", 0.1, 0.6, 2.0), ("gps", 0.2, 0.3, 1.0), ("ir", 100.0, 2.0, 2.5)])
-def test_small_offsets_are_declared_on_their_sensor_and_ended(sensor, size, within, ended_within):
-    """Seed 1: GPS +0.1 declared after 0.40 s, +0.2 after 0.10 s, IR +100 after 1.65 s (the
-    filter's own CUSUMs declared none of them); ended 1.45, 0.35 and 2.30 s after their end."""
-    row = one_fault(sensor, size)
-    print(f"\n{sensor} +{size:g}: {row}")
-    assert row["attributed"] == sensor
-    assert 0.0 <= row["declared_after_s"] <= within
-    assert 0.0 < row["ended_after_s"] <= ended_within
-    assert row["false_alarms"] == 0
+@pytest.mark.parametrize(("sensor", "size", "median_s", "delay_s", "cleared_s"), [
+    # measured on SEEDS: delay median / max, cleared max after the offset's end (s)
+    ("ir", 100.0, 2.0, 2.0, 2.0),  # 1.62 / 1.70, 1.50
+    ("gps", 0.1, 0.6, 1.5, 0.2),  # 0.42 / 1.20, 0.10
+    ("ir", 400.0, 1.5, 1.5, 1.5),  # 1.25 / 1.30, 1.15
+    ("gps", 0.3, 0.1, 0.3, 0.1),  # 0.05 / 0.15, 0.00
+    ("ir", 1200.0, 0.4, 0.5, 1.5),  # the slides' IR fault: 0.30 / 0.35, 1.10 (seed 1: 0.20)
+    ("gps", 1.5, 0.1, 0.2, 0.1),  # the slides' GPS fault: 0.05 / 0.10, 0.00
+])
+def test_offsets_are_declared_on_their_sensor_and_ended_on_fresh_seeds(sensor, size, median_s, delay_s, cleared_s):
+    rows = fleet(sensor, size, SEEDS)
+    delays = np.array([r["delay_s"] for r in rows])
+    cleared = np.array([r["cleared_s"] for r in rows])
+    print(f"\n{sensor} +{size:g}: right sensor {sum(r['right'] for r in rows)}/{len(rows)}, delay median "
+          f"{np.median(delays):.2f} max {delays.max():.2f} s, cleared at most {cleared.max():.2f} s after its end")
+    assert all(r["right"] for r in rows)
+    assert not any(r["standing"] or r["ended_early"] or r["other"] or r["at_end"] for r in rows)
+    assert np.median(delays) <= median_s and delays.max() <= delay_s
+    assert cleared.max() <= cleared_s
+
+
+def test_kalman_error_is_a_fifth_of_the_regression_on_fresh_drifting_flights():
+    """Turn-rate error std after 30 s on 10 fresh fault-free flights: regression / Kalman 5.05 to
+    5.56, mean 5.33 (seed 1 through the FMUs: 5.4)."""
+    ratios = []
+    for seed in range(50_200_000, 50_200_010):
+        flight = fly(seed)
+        use, settled = flight["gps_valid"] > 0.5, flight["time"] >= 30.0
+        std = {m: np.degrees(Estimator(m).run(flight["ir"], flight["gps_turn_rate"], use)["turn_rate"]
+                             - flight["r"])[settled].std() for m in ("kalman", "regression")}
+        ratios.append(std["regression"] / std["kalman"])
+    print(f"\nregression / Kalman: {np.round(ratios, 2)}")
+    assert 4.0 <= min(ratios) and 4.5 <= np.mean(ratios) <= 6.5
 
 
 def test_a_turn_exposing_an_error_of_a_in_the_cloud_is_no_fault():
-    """Seed 84, fault-free: entering the cloud the filter's a is 43 counts per rad/s off, and the
-    turn reversal at 183 s exposes it in the consistency residual, whose CUSUM passes its
-    threshold; the attribution explains it by the calibration's error and declares nothing."""
+    """Seed 84, fault-free: entering the cloud the filter's a is off, and the turn reversal near
+    190 s exposes it in the consistency residual, whose CUSUM passes its threshold 35 times over
+    (356 measured); the attribution explains it by the calibration's error and declares nothing."""
     flight = simulate_flight(8000, seed=84)
     estimate = Estimator("kalman").run(flight["ir"], flight["gps_turn_rate"], flight["gps_valid"] > 0.5)
     statistic = np.maximum(estimate["held_up"], estimate["held_down"])
@@ -34,7 +60,7 @@ def test_a_turn_exposing_an_error_of_a_in_the_cloud_is_no_fault():
     peak = float(flight["time"][statistic.argmax()])
     print(f"\nseed 84: consistency statistic {statistic.max():.1f} at {peak:.1f} s "
           f"(threshold {EKFSettings().held_h:g}), {declared} faults declared")
-    assert statistic.max() > 2 * EKFSettings().held_h and 180.0 < peak < 190.0
+    assert 18 * EKFSettings().held_h < statistic.max() and 185.0 < peak < 200.0
     assert declared == 0
 
 
@@ -51,11 +77,13 @@ def test_streaming_runs_the_batch_arithmetic_through_a_small_gps_fault():
                          for k in range(window.stop)])
     for j, name in enumerate(estimator.names):
         assert np.array_equal(streamed[window, j], batch[name][window], equal_nan=True), name
-    assert episodes(batch["gps_fault"][window], flight["time"][window])[0][0] == pytest.approx(280.4)
+    first = episodes(batch["gps_fault"][window], flight["time"][window])[0][0]
+    print(f"\nGPS +0.1 rad/s from 280 s: declared at {first:.2f} s")
+    assert 280.0 < first <= 281.0
 
 
 def test_consistency_settings_are_checked():
-    with pytest.raises(ValueError, match="held_lag"):
-        EKFSettings(held_lag=64)
     with pytest.raises(ValueError, match="significance"):
         EKFSettings(significance=0.0)
+    with pytest.raises(ValueError, match="end_significance"):
+        EKFSettings(end_significance=-1.0)

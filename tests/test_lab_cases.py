@@ -6,7 +6,7 @@ import pytest
 import scenarios
 from estimators import analysis
 from fmus.IMU.variables import LAB_GYRO_BIAS as LAB_BIAS
-from scenarios.tp import bias_convergence_time
+from scenarios.testing.assertions import assert_bias_converges, assert_bounds
 
 
 def run(**options):
@@ -47,9 +47,7 @@ def test_passive_recovers_the_lab_bias_in_the_predicted_time(ry, gain):
     predicted = analysis.passive_bias_convergence_time(gain, gain, max(np.abs(LAB_BIAS)), 1e-3)
     result, m = run(estimator="passive", flight="hover", bias=True, kP=gain, kI=gain, ry=ry,
                     duration=max(10.0, 1.5 * predicted))
-    error = result["Quaternion_estim.b_est"] - result["IMU.gyro_bias"]
-    assert np.abs(error[-1]).max() < 1e-3
-    simulated = bias_convergence_time(result.time, error, 1e-3)
+    simulated = assert_bias_converges(result, tolerance=1e-3)  # every axis within 1e-3 rad/s from then to the end
     assert simulated == pytest.approx(predicted, rel=2e-3)  # measured within 7.9e-4 (4 ms of 5.29 s at k = 1)
 
 
@@ -77,7 +75,7 @@ def test_estimate_fed_control_flies_with_noise_and_bias(estimator, flight):
         assert np.all(measured > 0.8 * expected) and np.all(measured < 1.25 * expected)
         if flight == "quasi" and estimator == "passive":  # it estimates the bias: the cruise stays as in GT
             speed = np.hypot(result["Quadrotor.v"][:, 0], result["Quadrotor.v"][:, 1])
-            assert speed.min() > 1.25 and speed.max() < 2.01  # m/s; GT flight: 1.26 to 2.00
+            assert_bounds(result, ("horizontal speed (m/s)", speed), lower=1.25, upper=2.01)  # GT flight: 1.26 to 2.00
 
 
 def test_linear_gain_prediction_matches_simulation():

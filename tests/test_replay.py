@@ -66,7 +66,9 @@ def test_replay_command_line(tmp_path, capsys):
     settle = json.loads((tmp_path / "run" / "metrics.json").read_text())["settle_s"]
     reported = score(run["Quaternion_estim.q_est"], run["Quadrotor.q"], run.time >= min(settle, 0.5))
     assert same["estimator"] == "madgwick" and same["gains_in_force"] == {"beta": 0.041}
-    assert abs(same["errors"]["total_rmse_deg"] - reported["total_rmse_deg"]) < 1e-9
+    # the same arithmetic but for the kernels' rounding: under 1e-9 deg with this CPU's OpenBLAS kernels,
+    # 6.9e-9 with OPENBLAS_CORETYPE=Prescott NUMBA_CPU_NAME=generic
+    assert abs(same["errors"]["total_rmse_deg"] - reported["total_rmse_deg"]) < 2e-8
     # every estimator option by name, ry included
     assert replay.main([str(tmp_path / "run" / "results.npz"), "--estimator", "passive", "--ry", "triad", "--set",
                         "k2=0.1", "--corrections", "heading_only", "--discretisation", "euler", "--b0", "0,0,0.01",

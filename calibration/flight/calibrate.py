@@ -37,6 +37,22 @@ def _fit_models(train, names) -> tuple[dict, dict]:
     return fitted, refused
 
 
+def _unscorable(fitted: dict, test) -> dict:
+    """The fitted models the ``test`` parts cannot score, with the reason: what a model reads that
+    the test flights did not log (a current sensor, a battery voltage)."""
+    reasons = {}
+    for name, f in fitted.items():
+        lacking = [p.source for p in test if name == "current" and p.current() is None]
+        if lacking:
+            reasons[name] = (f"fitted on the training flights, but the test flights have no current sensor to score "
+                             f"it on ({', '.join(sorted(set(lacking)))}); test on flights that log the current")
+            continue
+        if not all(np.isfinite(f.predict(p)).all() for p in test):
+            reasons[name] = ("fitted on the training flights, but its prediction on the test flights is not finite "
+                             "(they lack what it reads: the battery voltage?); test on flights that log it")
+    return reasons
+
+
 def _static(train, best, offsets, soft_iron) -> tuple[StaticCalibration, dict]:
     """Hard and soft iron from the flights' rotations when they cover enough of the sphere, else the log's."""
     first = train[0]
@@ -81,6 +97,9 @@ def calibrate(train, test, names=MODELS, attitude: str = "auto") -> tuple[dict, 
     fitted models by name (:class:`calibration.flight.models.Fitted`).
     """
     fitted, refused = _fit_models(train, names)
+    for name, reason in _unscorable(fitted, test).items():  # fitted on the training flights, not testable
+        refused[name] = reason
+        del fitted[name]
     compass = train[0].log.compasses[train[0].compass]
     chosen, field = _field_model(fitted, train[0].motors.commands.shape[1])
     models = {}

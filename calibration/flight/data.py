@@ -12,6 +12,8 @@ import numpy as np
 from calibration.static import CalibrationError
 
 ATTITUDES = ("auto", "gyro", "log")
+MIN_SAMPLES = 40  # compass samples a flight (or a part of one) needs: 3 residuals each, and the per-motor
+# model of an octorotor has 54 unknowns (6 of the flight, 2 direction angles and 4 coefficients a motor)
 
 
 def euler_of(q: np.ndarray) -> np.ndarray:
@@ -165,7 +167,8 @@ def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: boo
     Raises
     ------
     CalibrationError
-        No such compass, no motors, attitude or battery voltage in the log, or an unknown ``attitude``.
+        No such compass, no motors, attitude or IMU in the log (named), sensors that share no span
+        of time, too few compass samples in the span they share, or an unknown ``attitude``.
     """
     from orchestrator.logs import LogError
 
@@ -173,17 +176,16 @@ def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: boo
         raise CalibrationError(f"attitude {attitude!r} must be one of {', '.join(ATTITUDES)}")
     try:
         chosen = log.compass(compass)
+        log.require("a flight calibration", "motors", "attitude", "imu")
+        lo, hi = log.overlap((chosen.name, chosen), ("attitude", log.attitude), ("motors", log.motors),
+                             ("battery", log.battery), (log.imus[0].name, log.imus[0]))
     except LogError as error:
         raise CalibrationError(str(error)) from None
-    missing = [name for name, part in (("motor outputs", log.motors), ("attitude", log.attitude),
-                                       ("IMU", log.imus or None)) if part is None]
-    if missing:
-        raise CalibrationError(f"{log.path}: the log has no {', '.join(missing)}; a flight calibration needs "
-                               "them all (log RCOU, ATT and IMU, or PX4's actuator_outputs, vehicle_attitude and "
-                               "sensor_combined)")
-    series = [s for s in (log.attitude, log.motors, log.battery) if s is not None]
-    lo, hi = max(s.time[0] for s in series), min(s.time[-1] for s in series)
     rows = (chosen.time >= lo) & (chosen.time <= hi)
+    if rows.sum() < MIN_SAMPLES:
+        raise CalibrationError(f"{log.path}: {chosen.name} has {rows.sum()} samples in the {hi - lo:.1f} s its "
+                               f"sensors share ({lo:.1f} to {hi:.1f} s); a flight calibration needs at least "
+                               f"{MIN_SAMPLES}: give a longer flight")
     time = chosen.time[rows]
     euler_log = euler_of(board_quaternions(log, trim))
     euler = np.column_stack([np.interp(time, log.attitude.time, euler_log[:, k]) for k in range(3)])

@@ -46,15 +46,23 @@ def model_field(position) -> tuple[EarthField | None, str]:
     from pygeomag import GeoMag
 
     geomag = GeoMag(base_year=int(position.year))
-    result = geomag.calculate(glat=position.latitude_deg, glon=position.longitude_deg,
-                              alt=position.altitude_m / 1e3, time=position.year)
-    ned = np.array([result.x, result.y, result.z]) * NANOTESLA
+    try:
+        result = geomag.calculate(glat=position.latitude_deg, glon=position.longitude_deg,
+                                  alt=position.altitude_m / 1e3, time=position.year)
+        ned = np.array([result.x, result.y, result.z]) * NANOTESLA
+    except (ValueError, ArithmeticError):
+        ned = np.full(3, np.nan)
+    if not (np.isfinite(ned).all() and abs(position.latitude_deg) <= 90 and abs(position.altitude_m) < MAX_ALTITUDE_M):
+        return None, (f"the log's GPS position ({position.latitude_deg:g}, {position.longitude_deg:g}, "
+                      f"{position.altitude_m:g} m) is not one the World Magnetic Model covers (a damaged fix?): the "
+                      "Earth field is left free per flight")
     where = (f"{geomag.model} at {position.latitude_deg:.4f}, {position.longitude_deg:.4f}, {position.year:.2f} "
              f"({position.source}): {np.linalg.norm(ned) * 1e6:.1f} uT, declination {result.d:.1f} deg, "
              f"inclination {result.i:.1f} deg")
     return EarthField(ned, float(result.d), float(result.i), geomag.model, where), where
 
 
+MAX_ALTITUDE_M = 1e5  # the model is valid from below sea level to 850 km; a fix beyond 100 km is damaged
 MOUNTING_TOLERANCE_DEG = 5.0  # a compass whose heading differs from the model's by more is reported
 
 

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from calibration.infrared.estimator import CalibrationError, EKFSettings, Estimator, _finite
+from calibration.infrared.filters import buffer_size
 
 SLIDES_OPERATIONS = 300  # per iteration, counted by the slides
 SLIDES_RATE = 20.0  # Hz
@@ -130,7 +131,7 @@ def _count_operations(estimator, ir, gps, use) -> np.ndarray:
         _, _, runner = _modules()
         state = [_Counted(v) for v in estimator._initial]
         config = [_Counted(v) for v in estimator.config]
-        buffer = [_Counted(0.0) for _ in range(2 * (estimator.delay + estimator.window + 2) + 2)]
+        buffer = [_Counted(0.0) for _ in range(buffer_size(estimator.delay, estimator.window))]
         counts = np.zeros((len(ir), 3), dtype=np.int64)
         for k in range(len(ir)):
             _TALLY.flops = _TALLY.comparisons = _TALLY.functions = 0

@@ -1,47 +1,56 @@
 """Fault detection of the Kalman filter: which sensor is wrong, from when to when.
 
-Beside the gate (a single measurement outside ``gamma`` standard deviations is not fused), a
-two-sided CUSUM (Page, "Continuous inspection schemes", Biometrika 1954) runs on each
-normalised innovation ``z = nu / sqrt(S)``: the GPS turn rate against the state, the paired IR
-against the state, and the present IR against the state. Upwards ``g = max(0, g + z - k)``,
-downwards the same on ``-z``; a fault is declared when a statistic exceeds ``h``. It finds the
-small offsets the gate lets through (and that the filter would otherwise absorb into ``b`` or
-``r``), and the large ones at their first samples.
+The filter follows the drift of ``a`` and ``b`` with random walks fast enough for a cloud, so
+it absorbs a small offset of either sensor into ``b`` (and ``a``) within a second or two, and
+its own innovations show the offset only meanwhile. The detector therefore watches what the
+filter cannot absorb: the GPS-IR consistency residual ``IR_pair - (a gps + b)`` against a
+calibration *held* from before (:func:`consistency`).
 
-- Only while both sensors are in use: with the GPS alone gone (not valid, or not used after a
+- **The held calibration.** The filter's of ``held_lag`` samples before; once the residual's
+  two-sided CUSUM (Page, "Continuous inspection schemes", Biometrika 1954; ``g = max(0, g + z -
+  k)`` on ``z = nu / sqrt(S)`` and on ``-z``) leaves zero, it stays the one the run started
+  against (``freeze``), so an offset keeps showing for as long as it lasts, however much the
+  filter absorbs; the run restarts when it outlasts the ring of past calibrations.
+- **The IR it takes.** The mean over the GPS window of every IR sample, those the present-IR
+  gate keeps out of the filter included (``raw``): a large IR offset is gated out of the
+  filter's pairs, not out of the detector's view.
+- **Declaration and attribution.** Above its threshold the CUSUM's alarm is examined by a
+  generalised likelihood ratio on the residual's last ``RING_SIZE`` samples, against the
+  calibration from before them (:func:`attribute`): a GPS offset enters the residual as a step,
+  an IR offset as a ramp over the GPS window (the faulty samples fill the paired mean). Each
+  shape is fitted, onset and size free, beside an error of that calibration, ``delta_b +
+  delta_a u`` (a turn exposes an error of ``a``), ``delta_a`` with a Gaussian prior; ``u`` is the
+  GPS turn rate averaged over the GPS window (``turn="smoothed"``): the residual holds the GPS
+  noise, which the raw GPS or the mean of the sensors' rates would carry into ``u`` and let
+  ``delta_a`` explain, offset and all, in straight flight. A fault is declared on the better
+  shape once it is significant and clearly the better. ``a`` and ``b`` go back to the held
+  calibration; the faulty sensor is no longer fused (the IR: ``a`` and ``b`` held, the turn
+  rate from the GPS; the GPS: the IR alone, ``a`` and ``b`` held).
+- **The end** (``end="consistency"``): the same residual, the same ring and fit, watched for
+  the residual stepping back against the offset's sign by at least half of it; a turn that
+  exposes the held calibration's error of ``a`` meanwhile is no end. Then every detector
+  restarts, ``a`` and ``b`` are reopened (their variances raised back to the initial ones) and,
+  after an IR fault, the pairs are not fused until the window is clean.
+  (``end="innovation"``: a CUSUM of the log-likelihood ratio "no offset" against "the offset
+  estimated" on the faulty sensor's innovation, which a turn exposing that error of ``a`` can
+  end early.)
+- **Only while both sensors are in use**: with the GPS gone (not valid, or not used after a
   calibration phase) an offset of the IR cannot be told from a drift of ``b``, and nothing
   would replace the IR.
-- Attribution: an IR fault shows first in the IR's innovations (the present IR at once, the
-  paired IR when the faulty samples reach the GPS window), a GPS fault first in the GPS's. The
-  first statistic over its threshold names the sensor; at the same sample, the one furthest
-  over it (in units of its threshold).
-- The detectors' runs start before their alarm: meanwhile the faulty sensor was fused and
-  pulled ``a`` and ``b``. When a fault is declared they are set back to their values at the
-  last sample where every statistic was zero.
-- While a fault is declared, the faulty sensor is not fused (the IR: ``a`` and ``b`` held, the
-  turn rate from the GPS; the GPS: the IR alone, ``a`` and ``b`` held), and its innovation is
-  still computed against the state.
-- The filter's own innovations show a small offset only while ``b`` and ``a`` absorb it (within
-  seconds: the random walks that follow the drift follow an offset too). A fourth CUSUM runs on
-  the GPS-IR consistency residual ``IR_pair - (a gps + b)`` against the calibration of
-  ``held_lag`` samples before (:func:`consistency`), which has not absorbed it yet. Its alarm is
-  attributed by the residual's shape over the last ``RING_SIZE`` samples (:func:`attribute`): a
-  GPS offset enters it as a step, an IR offset as a ramp over the GPS window; a generalised
-  likelihood ratio fits each, onset and size free, beyond a constant error of the calibration
-  (``delta_b + delta_a r``, which a change of the turn exposes), and names the sensor only when
-  one shape is clearly the better; until then nothing is declared. The fault then proceeds as
-  below, ``a`` and ``b`` set back to that held calibration.
-- The fault ends when that sensor is consistent again: a CUSUM of the log-likelihood ratio of
-  "no offset" against "the offset ``d`` estimated" (the mean innovation over the run that
-  raised the alarm, then a running mean while the evidence favours the fault),
-  ``g = max(0, g + d (d / 2 - nu) / S)``, ending the fault when it exceeds ``end_h``. For the
-  GPS, on its innovation; for the IR, on the paired IR, once the faulty samples fill the GPS
-  window (the present IR varies with the turn over the lag, too much to end a small fault on).
-  An offset that persists keeps it at zero, whatever the variance grows to
-  meanwhile: a fault is not ended while the sensor is still faulty. When it ends, every CUSUM
-  restarts from zero (the end of a fault is no new fault: after an IR fault the paired IR is not
-  watched until its window is clean) and the variances of ``a`` and ``b`` are raised back to
-  their initial values, so that the next turns recalibrate them.
+- **The filter's innovations.** Beside the gate (a single measurement outside ``gamma``
+  standard deviations is not fused), CUSUMs on the normalised innovations: the present IR
+  against the state declares a large IR offset at its first samples, a second before it reaches
+  the pairs (its allowance ``now_k`` above what a turn reversal over the GPS lag gives); the
+  GPS and the paired IR (``cusum_h``, off by default: the consistency residual sees the same
+  offsets without the turn's lag, which made them declare faults in hard turns). When one
+  declares a fault, ``a`` and ``b`` are set back to their values at the last sample where every
+  statistic was zero.
+- **Options measured and left off**: ``decisive`` (declare on the better shape whatever the
+  fit, once the CUSUM's statistic is that strong: under a frozen calibration the statistic grows
+  with the cloud's drift too) and ``alt_level`` (remember the calibration from before a change
+  the fit saw but could not confirm, and take a later opposite change back to it for the end of
+  an absorbed offset rather than a fault: it also takes real faults for returns).
+  ``scenarios/ir_detection.py`` measures each choice.
 """
 
 from __future__ import annotations
@@ -53,9 +62,17 @@ from numba import njit
 
 from calibration.infrared.layout import (
     A_SAFE,
+    ALT_A,
+    ALT_B,
+    ALT_LEFT,
+    ALT_LEVEL,
+    ALT_LIFE,
+    ANCHOR,
     B_SAFE,
+    COMPLETE,
     CONS_H,
     CONS_K,
+    CONS_OFFSET,
     CUSUM_CONS,
     CUSUM_GPS,
     CUSUM_H,
@@ -63,10 +80,16 @@ from calibration.infrared.layout import (
     CUSUM_NOW,
     CUSUM_PAIR,
     CUSUM_SIZE,
+    DECISIVE,
     END_H,
+    END_LLR,
+    END_MODE,
     END_PAIR,
+    END_SIGNIFICANCE,
     END_STAT,
+    END_TURN,
     FAULT_SIZE,
+    FREEZE,
     G_DOWN,
     G_UP,
     GAMMA2,
@@ -75,6 +98,7 @@ from calibration.infrared.layout import (
     GATE_IR,
     GATE_NOW,
     GPS_FAULT,
+    HELD_FAULT,
     HELD_GPS,
     HELD_IR,
     HELD_LAG,
@@ -110,12 +134,16 @@ from calibration.infrared.layout import (
     RING,
     RING_COUNT,
     RING_SIZE,
+    RUN_PEAK,
     SCALE_GAIN,
     SD_A_HELD,
+    SD_DRIFT,
+    SETTLING,
     SIGNIFICANCE,
     SIZE_GAIN,
     SUM_DOWN,
     SUM_UP,
+    TURN_MODE,
     WINDOW_SPAN,
     A,
     B,
@@ -185,19 +213,65 @@ def reopen(s, c):
 
 @njit(cache=True)
 def consistency(s, c, ir_pair, gps):
-    """The paired IR ``ir_pair`` (count) against the GPS turn rate ``gps`` (rad/s) through the
-    calibration of ``c[HELD_LAG]`` samples before (:func:`remember_calibration`): the residual
-    ``ir_pair - (a gps + b)`` (count) and its variance (count^2) under the filter's noise model
-    and the covariance that calibration had, stored in the state ``s``. The filter itself
-    absorbs an offset into ``b`` (and ``a``) within a few seconds; the calibration held from
-    before the offset does not, and drifts by at most the drift of ``a`` and ``b`` over the lag."""
-    held = PAST + (int(s[PAST_COUNT]) - int(c[HELD_LAG])) % PAST_SIZE
+    """The paired IR ``ir_pair`` (count) against the GPS turn rate ``gps`` (rad/s) through a
+    held calibration (:func:`remember_calibration`): the residual ``ir_pair - (a gps + b)``
+    (count) and its variance (count^2) under the filter's noise model and the covariance that
+    calibration had, stored in the state ``s``. The filter itself absorbs an offset into ``b``
+    (and ``a``) within a second or two; the calibration held from before the offset does not.
+
+    The held calibration is that of ``c[HELD_LAG]`` samples before; with ``c[FREEZE]``, once the
+    residual's CUSUM runs (its statistic above zero) it stays the one the run started against,
+    so that an offset the filter absorbs meanwhile keeps showing, until the statistic falls back
+    to zero, or the run outlasts the ring of past calibrations (it then restarts)."""
+    count = int(s[PAST_COUNT])
+    running = s[CUSUM_CONS + G_UP] > 0.0 or s[CUSUM_CONS + G_DOWN] > 0.0
+    if c[FREEZE] > 0.5 and running and count - int(s[ANCHOR]) < PAST_SIZE - 1:
+        index = int(s[ANCHOR])
+    else:
+        if c[FREEZE] > 0.5 and running:  # too long a run to keep its calibration: it starts again
+            _run_over(s, c)
+            for j in range(CUSUM_SIZE):
+                s[CUSUM_CONS + j] = 0.0
+        index = count - int(c[HELD_LAG])
+        s[ANCHOR] = index
+    held = PAST + index % PAST_SIZE
     a = s[held]
-    s[NU_CONS] = ir_pair - (a * gps + s[held + PAST_SIZE])
+    s[NU_CONS] = ir_pair - (a * gps + s[held + PAST_SIZE]) - s[CONS_OFFSET]
     s[HELD_GPS] = gps
     s[HELD_IR] = ir_pair
     var_a, cov_ab, var_b = s[held + 2 * PAST_SIZE], s[held + 3 * PAST_SIZE], s[held + 4 * PAST_SIZE]
-    s[GATE_CONS] = a * a * c[RG] + c[RI] + gps * (gps * var_a + 2.0 * cov_ab) + var_b
+    s[GATE_CONS] = a * a * c[RG] + c[RI]
+    if s[HELD_FAULT] < 0.5:  # during a fault the offset followed holds the calibration's error, whose variance grows
+        s[GATE_CONS] += gps * (gps * var_a + 2.0 * cov_ab) + var_b
+
+
+@njit(cache=True)
+def _run_over(s, c):
+    """The consistency CUSUM's run ends (its statistic back to zero, or restarted) without a
+    fault declared: if the attribution saw an abrupt change in it (a log-likelihood of at least
+    ``c[ALT_LEVEL]``) that it could not confirm, the filter has absorbed it, and the calibration
+    the run was held against, from before it, is remembered for ``c[ALT_LIFE]`` samples
+    (:func:`_returned`)."""
+    if s[HELD_FAULT] < 0.5 and s[RUN_PEAK] >= c[ALT_LEVEL] and int(s[PAST_COUNT]) - int(s[ANCHOR]) < PAST_SIZE:
+        held = PAST + int(s[ANCHOR]) % PAST_SIZE
+        s[ALT_A], s[ALT_B] = s[held], s[held + PAST_SIZE]
+        s[ALT_LEFT] = c[ALT_LIFE]
+    s[RUN_PEAK] = 0.0
+
+
+@njit(cache=True)
+def _returned(s, c, size):
+    """Whether the change about to be declared, of normalised ``size`` in the ring, brings the
+    sensors back to the calibration remembered by :func:`_run_over`: an offset the filter
+    absorbed earlier, ending. Against that calibration the residual would be ``d + delta``,
+    ``d`` the change and ``delta`` the two calibrations' difference at the present turn rate;
+    it is a return when that is less than half of ``d``."""
+    if s[ALT_LEFT] <= 0.0:
+        return False
+    ref = PAST + (int(s[PAST_COUNT]) - n_ring(s)) % PAST_SIZE
+    d = size * math.sqrt(s[GATE_CONS])
+    delta = (s[ref] - s[ALT_A]) * s[HELD_GPS] + s[ref + PAST_SIZE] - s[ALT_B]
+    return abs(d + delta) < 0.5 * abs(d)
 
 
 @njit(cache=True)
@@ -226,107 +300,216 @@ def _remember(s, ir_pair, gps, S):
 
 
 @njit(cache=True)
-def _ring(s):
-    """The ring's samples, oldest first, against the calibration from before its oldest (one
-    sample per step since the last restart): the normalised consistency residual ``x`` and the
-    turn rate over its deviation, the mean of the GPS's and the IR's (``nan`` where there was
-    none). Both hypotheses take the same turn rate: half of either sensor's offset is in it, and
-    a turn that really happened is in it whole."""
+def _ring(s, c):
+    """The ring's samples, oldest first (one per step since the last restart), against the
+    calibration from before its oldest: the normalised consistency residual ``x``; three turn
+    rates over its deviation: the mean of the GPS's and the IR's, the IR's, and the GPS's
+    averaged over the GPS window, centred (``nan`` where there was none; ``c[TURN_MODE]`` says
+    which the fit takes); and the sample's index from the ring's middle over its deviation (the
+    time of a drift)."""
     count = int(s[RING_COUNT])
-    n = count if count < RING_SIZE else RING_SIZE
+    n = n_ring(s)
     ref = PAST + (int(s[PAST_COUNT]) - n) % PAST_SIZE
     a, b = s[ref], s[ref + PAST_SIZE]
-    x, turn = np.empty(n), np.empty(n)
+    x, mean, ir, gps, time = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     for m in range(n):
         slot = RING + (count - n + m) % RING_SIZE
-        ir_pair, gps, root = s[slot], s[slot + RING_SIZE], math.sqrt(s[slot + 2 * RING_SIZE])
-        x[m] = (ir_pair - (a * gps + b)) / root
-        turn[m] = 0.5 * (gps + (ir_pair - b) / a) / root
-    return x, turn
+        ir_pair, rate, root = s[slot], s[slot + RING_SIZE], math.sqrt(s[slot + 2 * RING_SIZE])
+        x[m] = (ir_pair - (a * rate + b)) / root
+        ir[m] = (ir_pair - b) / a / root
+        gps[m] = rate / root
+        mean[m] = 0.5 * (gps[m] + ir[m])
+        time[m] = (m - 0.5 * (n - 1)) / root
+    smooth = np.empty(n)
+    half = int(c[RAMP]) // 2
+    total, used = np.zeros(n + 1), np.zeros(n + 1)
+    for m in range(n):
+        seen = gps[m] == gps[m]
+        total[m + 1] = total[m] + (gps[m] if seen else 0.0)
+        used[m + 1] = used[m] + (1.0 if seen else 0.0)
+    for m in range(n):
+        lo, hi = max(m - half, 0), min(m + half + 1, n)
+        smooth[m] = (total[hi] - total[lo]) / (used[hi] - used[lo]) if used[hi] > used[lo] else 0.0
+    return x, mean, ir, smooth, time
 
 
 @njit(cache=True)
-def _fit(x, u, onset, ramp, sign, ridge):
-    """Log-likelihood ratio (unit variance) and size of the best offset ``d`` of sign ``sign``
-    with the signature ``f_m = min(1, (m - onset + 1) / ramp)`` from sample ``onset`` on, in the
-    residuals ``x``, beyond an error of the calibration they are taken against, ``delta_b +
-    delta_a u_m`` (``u``: the turn rate, :func:`_ring`), fitted with it. The offset must be what
-    the calibration's error, present all along the ring, does not explain: a turn that exposes
-    an error of ``a`` is no fault. ``delta_a`` has a Gaussian prior (``ridge``: the noise
-    variance over its variance), so that an offset is not taken for an error of ``a`` of the
-    size of ``a`` itself."""
-    n, su, suu, sx, sux, sf, suf, sff, sfx = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    for m in range(x.shape[0]):
+def n_ring(s):
+    """How many samples the ring holds (fewer than ``RING_SIZE`` since a restart)."""
+    count = int(s[RING_COUNT])
+    return count if count < RING_SIZE else RING_SIZE
+
+
+@njit(cache=True)
+def _prefix(q, v):
+    """Prefix sums of ``q`` and of ``m q`` over the valid samples (``v`` 1, else 0): entry ``j``
+    sums the samples before ``j``."""
+    n = q.shape[0]
+    total, moment = np.zeros(n + 1), np.zeros(n + 1)
+    for m in range(n):
+        value = q[m] * v[m]
+        total[m + 1] = total[m] + value
+        moment[m + 1] = moment[m] + m * value
+    return total, moment
+
+
+@njit(cache=True)
+def _shape_sums(total, moment, onset, ramp, n):
+    """``sum_m f_m q_m`` for the signature ``f_m = min(1, (m - onset + 1) / ramp)`` (0 before
+    ``onset``), from the prefix sums of ``q`` and ``m q`` (:func:`_prefix`)."""
+    a0 = min(max(onset, 0), n)
+    a1 = min(max(onset + int(ramp) - 1, 0), n)
+    rising = (moment[a1] - moment[a0] - (onset - 1) * (total[a1] - total[a0])) / ramp
+    return rising + total[n] - total[a1]
+
+
+@njit(cache=True)
+def _solve3(g00, g01, g02, g11, g12, g22, r0, r1, r2):
+    """``G^-1 r`` for the symmetric positive definite 3x3 ``G`` (upper triangle given), by its
+    cofactors; zeros when ``G`` is singular to rounding."""
+    c00 = g11 * g22 - g12 * g12
+    c01 = g02 * g12 - g01 * g22
+    c02 = g01 * g12 - g02 * g11
+    det = g00 * c00 + g01 * c01 + g02 * c02
+    if not det > 1e-12 * g00 * g11 * g22:
+        return 0.0, 0.0, 0.0
+    c11 = g00 * g22 - g02 * g02
+    c12 = g01 * g02 - g00 * g12
+    c22 = g00 * g11 - g01 * g01
+    return ((c00 * r0 + c01 * r1 + c02 * r2) / det, (c01 * r0 + c11 * r1 + c12 * r2) / det,
+            (c02 * r0 + c12 * r1 + c22 * r2) / det)
+
+
+@njit(cache=True)
+def _best(x, u, w, ramp, sign, ridge_u, ridge_w):
+    """The generalised likelihood ratio of an offset in the residuals ``x`` (unit variance),
+    over every onset in the ring (a ramp may have started before it): the largest
+    log-likelihood ratio, the offset's size and its onset.
+
+    The offset ``d`` has the signature ``f_m = min(1, (m - onset + 1) / ramp)`` from sample
+    ``onset`` on and the sign ``sign``; it must be what an error of the calibration the residuals
+    are taken against and a drift, ``delta_b + delta_a u_m + beta w_m`` (``u``: a turn rate,
+    ``w``: the time, :func:`_ring`), do not explain, fitted with it: a turn that exposes an error
+    of ``a`` is no fault, nor is the cloud's steady change of ``b``. ``delta_a`` and ``beta`` have
+    Gaussian priors (``ridge_u``, ``ridge_w``: the noise variance over their variances), so that
+    an offset is not taken for an error of ``a`` of the size of ``a`` itself, nor for a drift
+    faster than the sensor's. Samples where ``x`` is ``nan`` are left out. Sums over the ring by
+    prefix sums, so that every onset costs the same few operations."""
+    n = x.shape[0]
+    v, xs, us, ws = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    for m in range(n):
         if x[m] == x[m]:
-            f = 0.0 if m < onset else min(1.0, (m - onset + 1) / ramp)
-            n += 1.0
-            su += u[m]
-            suu += u[m] * u[m]
-            sx += x[m]
-            sux += u[m] * x[m]
-            sf += f
-            suf += u[m] * f
-            sff += f * f
-            sfx += f * x[m]
-    suu += ridge
-    det = n * suu - su * su
-    if det > 1e-9 * n * suu:  # project the offset's signature and the residuals off (1, u)
-        fx = sfx - (sf * (suu * sx - su * sux) + suf * (n * sux - su * sx)) / det
-        ff = sff - (sf * (suu * sf - su * suf) + suf * (n * suf - su * sf)) / det
-    else:  # a steady turn: u is a constant, the calibration's error one offset
-        fx = sfx - sf * sx / n if n > 0.0 else 0.0
-        ff = sff - sf * sf / n if n > 0.0 else 0.0
-    if ff <= 1e-9 * sff or fx * sign <= 0.0:
-        return 0.0, 0.0
-    return 0.5 * fx * fx / ff, fx / ff
-
-
-@njit(cache=True)
-def _best(x, u, ramp, sign, ridge):
-    """The generalised likelihood ratio over every onset in the ring (a ramp may have started
-    before it): the largest log-likelihood ratio and its offset (:func:`_fit`)."""
-    best, size = 0.0, 0.0
-    for onset in range(1 - int(ramp), x.shape[0]):
-        llr, d = _fit(x, u, onset, ramp, sign, ridge)
+            v[m], xs[m], us[m], ws[m] = 1.0, x[m], u[m], w[m]
+    count, su, sw, suu, suw, sww, sx, sux, swx = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for m in range(n):
+        count += v[m]
+        su += us[m]
+        sw += ws[m]
+        suu += us[m] * us[m]
+        suw += us[m] * ws[m]
+        sww += ws[m] * ws[m]
+        sx += xs[m]
+        sux += us[m] * xs[m]
+        swx += ws[m] * xs[m]
+    if count < 2.0:
+        return 0.0, 0.0, 0
+    g00, g01, g02, g11, g12, g22 = count, su, sw, suu + ridge_u, suw, sww + ridge_w
+    bx0, bx1, bx2 = _solve3(g00, g01, g02, g11, g12, g22, sx, sux, swx)  # the nuisance fitted to x alone
+    i00, i01, i02 = _solve3(g00, g01, g02, g11, g12, g22, 1.0, 0.0, 0.0)  # its normal matrix inverted
+    _, i11, i12 = _solve3(g00, g01, g02, g11, g12, g22, 0.0, 1.0, 0.0)
+    _, _, i22 = _solve3(g00, g01, g02, g11, g12, g22, 0.0, 0.0, 1.0)
+    pv, pmv = _prefix(v, v)
+    pu, pmu = _prefix(us, v)
+    pw, pmw = _prefix(ws, v)
+    px, pmx = _prefix(xs, v)
+    squares = np.zeros(n + 1)  # prefix sums of m^2 over the valid samples, for the ramp's f^2
+    for m in range(n):
+        squares[m + 1] = squares[m] + m * m * v[m]
+    best, size, at = 0.0, 0.0, 0
+    for onset in range(1 - int(ramp), n):
+        sf = _shape_sums(pv, pmv, onset, ramp, n)
+        suf = _shape_sums(pu, pmu, onset, ramp, n)
+        swf = _shape_sums(pw, pmw, onset, ramp, n)
+        sfx = _shape_sums(px, pmx, onset, ramp, n)
+        a0 = min(max(onset, 0), n)
+        a1 = min(max(onset + int(ramp) - 1, 0), n)
+        shift = onset - 1.0
+        sff = ((squares[a1] - squares[a0] - 2.0 * shift * (pmv[a1] - pmv[a0]) + shift * shift * (pv[a1] - pv[a0]))
+               / (ramp * ramp) + pv[n] - pv[a1])
+        # the signature and the residuals projected off the nuisance (1, u, w)
+        fx = sfx - (sf * bx0 + suf * bx1 + swf * bx2)
+        ff = sff - (sf * (i00 * sf + i01 * suf + i02 * swf) + suf * (i01 * sf + i11 * suf + i12 * swf)
+                    + swf * (i02 * sf + i12 * suf + i22 * swf))
+        if ff <= 1e-9 * sff or fx * sign <= 0.0:
+            continue
+        llr = 0.5 * fx * fx / ff
         if llr > best:
-            best, size = llr, d
-    return best, size
+            best, size, at = llr, fx / ff, onset
+    return best, size, at
 
 
 @njit(cache=True)
-def evidence(s, c):
+def evidence(s, c, sign, healthy=0):
     """The generalised likelihood ratios of the ring (:func:`attribute`), in units of the
-    residual's own spread: ``(larger, step, ramp, step_size, ramp_size)``, the sizes in
-    normalised units, of the sign of the consistency CUSUM's higher side."""
-    sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
-    x, turn = _ring(s)
+    residual's own spread: ``(larger, step, ramp, step_size, ramp_size, step_onset,
+    ramp_onset)``, the sizes in normalised units, of the sign ``sign`` (+1 or -1), the onsets as
+    indices in the ring.
+
+    The turn rate of the calibration's error: with ``healthy`` 1 (a GPS fault declared) the
+    IR's, 2 (an IR fault) the GPS's averaged over its window, for both shapes; else by
+    ``c[TURN_MODE]``: 0 the mean of the two sensors', 1 for each shape the sensor it holds
+    healthy (the step, a GPS offset: the IR's; the ramp, an IR offset: the GPS's averaged over
+    its window), 2 the GPS's averaged over its window."""
+    x, mean, ir, smooth, time = _ring(s, c)
     scale = s[HELD_SCALE]
     ridge = scale / (c[SD_A_HELD] * c[SD_A_HELD])
-    step, step_size = _best(x, turn, 1.0, sign, ridge)
-    ramp, ramp_size = _best(x, turn, c[RAMP], sign, ridge)
+    if c[SD_DRIFT] > 0.0:
+        ridge_w = scale / (c[SD_DRIFT] * c[SD_DRIFT])
+    else:  # no drift in the fit: its regressor zero, its coefficient pinned
+        time[:] = 0.0
+        ridge_w = 1.0
+    if healthy == 1:
+        step_turn, ramp_turn = ir, ir
+    elif healthy == 2:
+        step_turn, ramp_turn = smooth, smooth
+    elif c[TURN_MODE] > 1.5:
+        step_turn, ramp_turn = smooth, smooth
+    elif c[TURN_MODE] > 0.5:
+        step_turn, ramp_turn = ir, smooth
+    else:
+        step_turn, ramp_turn = mean, mean
+    step, step_size, step_at = _best(x, step_turn, time, 1.0, sign, ridge, ridge_w)
+    ramp, ramp_size, ramp_at = _best(x, ramp_turn, time, c[RAMP], sign, ridge, ridge_w)
     step, ramp = step / scale, ramp / scale
-    return (step if step > ramp else ramp), step, ramp, step_size, ramp_size
+    return (step if step > ramp else ramp), step, ramp, step_size, ramp_size, step_at, ramp_at
 
 
 @njit(cache=True)
-def attribute(s, c):
+def attribute(s, c, statistic):
     """Which sensor the consistency CUSUM's alarm comes from, by the shape of the residual in
     the ring: an offset of the GPS turn rate enters it as a step (the sample it starts), one of
     the IR as a ramp over the GPS window (``c[RAMP]`` samples, as the faulty samples fill the
     paired mean). A generalised likelihood ratio with each signature, the onset and size free,
-    beyond an error of the calibration (:func:`_fit`); log-likelihoods in units of the
-    residual's own spread while no offset showed (``s[HELD_SCALE]``). A fault needs the better
-    signature to reach ``c[SIGNIFICANCE]`` and to beat the other by ``c[MARGIN]``. Returns
-    ``(sensor, size)``: 1 the GPS, 2 the IR, 0 none or not yet told apart; the size in
-    normalised units."""
-    larger, step, ramp, step_size, ramp_size = evidence(s, c)
+    beyond an error of the calibration (:func:`_best`); log-likelihoods in units of
+    the residual's own spread while no offset showed (``s[HELD_SCALE]``). A fault needs the
+    better signature to reach ``c[SIGNIFICANCE]`` and to beat the other by ``c[MARGIN]``; once
+    the CUSUM's ``statistic`` reaches ``c[DECISIVE]`` the better signature is declared whatever
+    the margin and the significance. Returns ``(sensor, size, onset)``: 1 the GPS, 2 the IR, 0
+    none or not yet told apart; the size in normalised units, the onset in the ring."""
+    sign = 1.0 if s[CUSUM_CONS + G_UP] >= s[CUSUM_CONS + G_DOWN] else -1.0
+    larger, step, ramp, step_size, ramp_size, step_at, ramp_at = evidence(s, c, sign)
+    if larger > s[RUN_PEAK]:
+        s[RUN_PEAK] = larger
+    sensor, size, onset = (1, step_size, step_at) if step >= ramp else (2, ramp_size, ramp_at)
+    if statistic >= c[DECISIVE] and larger > 0.0:
+        return sensor, size, onset
     if larger < c[SIGNIFICANCE]:
-        return 0, 0.0
-    if step - ramp > c[MARGIN]:
-        return 1, step_size
-    if ramp - step > c[MARGIN]:
-        return 2, ramp_size
-    return 0, 0.0
+        return 0, 0.0, 0
+    if n_ring(s) - 1 - onset < c[COMPLETE]:  # too little of the shape yet: the other may still fit better
+        return 0, 0.0, 0
+    if abs(step - ramp) > c[MARGIN]:
+        return sensor, size, onset
+    return 0, 0.0, 0
 
 
 @njit(cache=True)
@@ -387,6 +570,9 @@ def _end_ir(s, c, pair_seen):
 def _ended(s, c, flag):
     """End the fault ``flag``: detectors restarted, a and b reopened."""
     s[flag] = 0.0
+    s[CONS_OFFSET] = 0.0
+    s[HELD_FAULT] = 0.0
+    s[SETTLING] = 0.0
     s[END_STAT] = 0.0
     s[END_PAIR] = 0.0
     restart(s)
@@ -403,7 +589,7 @@ def _quiet(s):
 
 
 @njit(cache=True)
-def detect(s, c, gps_seen, pair_seen):
+def detect(s, c, gps_seen, pair_seen, raw_seen):
     """Declare, attribute and end faults from this sample's innovations (see the module).
 
     Parameters
@@ -414,38 +600,86 @@ def detect(s, c, gps_seen, pair_seen):
         A GPS innovation was computed at this sample (``s[NU_GPS]``, ``s[GATE_GPS]``).
     pair_seen : bool
         A paired IR innovation was computed (``s[NU_IR]``, ``s[GATE_IR]``).
+    raw_seen : bool
+        The consistency residual's IR was there (:func:`consistency`).
     """
+    if s[IR_FAULT] > 0.5:
+        s[IR_SUSPECT] = 0.0  # the IR is not fused: its samples may fill the window the end test watches
+    if s[HELD_FAULT] > 0.5 and c[END_MODE] > 0.5:
+        if gps_seen:
+            _end_held(s, c, raw_seen)
+        return
     if s[GPS_FAULT] > 0.5:
         if gps_seen:
             _end_gps(s, c)
         return
     if s[IR_FAULT] > 0.5:
-        s[IR_SUSPECT] = 0.0  # the IR is not fused: its samples may fill the window the end test watches
         _end_ir(s, c, pair_seen)
         return
+    if s[ALT_LEFT] > 0.0:
+        s[ALT_LEFT] -= 1.0
     if s[HOLD] > 0.0:
         s[HOLD] -= 1.0
         pair_seen = False
+        raw_seen = False
     if not gps_seen:  # one sensor alone: a drift and a fault look alike, and nothing would replace it
         _remember(s, math.nan, math.nan, math.nan)
         return
     gps = cusum(s, CUSUM_GPS, s[NU_GPS], s[GATE_GPS], c[CUSUM_K], c[CUSUM_H]) if gps_seen else -1.0
     pair = cusum(s, CUSUM_PAIR, s[NU_IR], s[GATE_IR], c[CUSUM_K], c[CUSUM_H]) if pair_seen else -1.0
     now = cusum(s, CUSUM_NOW, s[NU_NOW], s[GATE_NOW], c[NOW_K], c[NOW_H])
-    held = _held(s, c, pair_seen)
+    held = _held(s, c, raw_seen)
     ir = pair if pair > now else now
     if gps <= 0.0 and ir <= 0.0:
-        sensor, size = attribute(s, c) if held > 0.0 else (0, 0.0)
+        sensor, size, onset = attribute(s, c, (held + 1.0) * c[CONS_H]) if held > 0.0 else (0, 0.0, 0)
         if sensor == 0:  # nothing, or a small offset whose sensor the residual does not tell yet
             if _quiet(s):
                 s[A_SAFE], s[B_SAFE] = s[A], s[B]
             return
-        _declare_held(s, c, sensor, size)
+        if _returned(s, c, size):  # the end of an offset absorbed earlier: its calibration back, no fault
+            s[A], s[B] = s[ALT_A], s[ALT_B]
+            s[ALT_LEFT] = 0.0
+            reopen(s, c)
+        else:
+            _declare_held(s, c, sensor, size, onset)
     else:
-        _declare(s, gps, pair, now, ir)
+        _declare(s, c, gps, pair, now, ir)
     s[END_STAT] = 0.0
     s[END_PAIR] = -1.0  # not armed
     restart(s)
+
+
+@njit(cache=True)
+def _end_held(s, c, pair_seen):
+    """The end test of a fault (``c[END_MODE]`` 1): the consistency residual, watched as before
+    the fault (:func:`_held`), must step back, against the offset's sign, by at least half of
+    it, with a significant signature (:func:`evidence`, either shape). An error of the held
+    calibration that a turn exposes meanwhile is no end (the signature's fit holds it). An IR
+    offset is watched once it has filled the paired window (``s[SETTLING]``)."""
+    s[END_LLR] = 0.0
+    if s[SETTLING] > 0.0:  # the offset is still entering the paired window: no baseline for its end yet
+        s[SETTLING] -= 1.0
+        s[RING_COUNT] = 0.0
+        return
+    _held(s, c, pair_seen)
+    if not pair_seen:
+        return
+    offset = s[CONS_OFFSET]
+    healthy = 0 if c[END_TURN] < 0.5 else (1 if s[GPS_FAULT] > 0.5 else 2)  # 1, 2: the sensor not faulty's
+    larger, step, ramp, step_size, ramp_size, step_at, ramp_at = evidence(s, c, -1.0 if offset > 0.0 else 1.0,
+                                                                            healthy)
+    size, onset = (step_size, step_at) if step >= ramp else (ramp_size, ramp_at)
+    if abs(size) * math.sqrt(s[GATE_CONS]) < 0.5 * abs(offset):
+        return
+    s[END_LLR] = larger
+    if larger < c[END_SIGNIFICANCE]:
+        return
+    if s[IR_FAULT] > 0.5:  # the paired window may still hold faulty samples: not fused until it does not
+        left = c[RAMP] - (n_ring(s) - onset)
+        _ended(s, c, IR_FAULT)
+        s[HOLD] = left if left > 0.0 else 0.0
+    else:
+        _ended(s, c, GPS_FAULT)
 
 
 @njit(cache=True)
@@ -456,35 +690,51 @@ def _held(s, c, pair_seen):
     if not pair_seen:
         _remember(s, math.nan, math.nan, math.nan)
         return -1.0
-    _remember(s, s[HELD_IR], s[HELD_GPS], s[GATE_CONS])
+    _remember(s, s[HELD_IR] - s[CONS_OFFSET], s[HELD_GPS], s[GATE_CONS])
+    running = s[CUSUM_CONS + G_UP] > 0.0 or s[CUSUM_CONS + G_DOWN] > 0.0
     held = cusum(s, CUSUM_CONS, s[NU_CONS], s[GATE_CONS], c[CONS_K], c[CONS_H])
-    if held == -1.0:  # its statistic is zero: no offset shows, the residual is noise and drift
+    if running and held == -1.0:
+        _run_over(s, c)
+    if held == -1.0 and s[HELD_FAULT] < 0.5:  # its statistic is zero: no offset shows, the residual is noise and drift
         z = s[NU_CONS] / math.sqrt(s[GATE_CONS])
         s[HELD_SCALE] += c[SCALE_GAIN] * (z * z - s[HELD_SCALE])
     return held
 
 
 @njit(cache=True)
-def _declare(s, gps, pair, now, ir):
+def _declare(s, c, gps, pair, now, ir):
     """A fault declared by the CUSUM of the GPS, the paired IR or the present IR (how far each
-    is over its threshold): the furthest names the sensor, its run the offset."""
+    is over its threshold): the furthest names the sensor, its run the offset. With
+    ``c[END_MODE]`` its end is watched on the consistency residual too (:func:`_end_held`):
+    the offset there, and for the present IR the wait until it has entered the paired window."""
     s[A], s[B] = s[A_SAFE], s[B_SAFE]  # what the faulty sensor pulled a and b by before the alarm, undone
     if gps > ir:
         s[GPS_FAULT] = 1.0
         s[FAULT_SIZE] = run_mean(s, CUSUM_GPS)
+        s[CONS_OFFSET] = -s[A] * s[FAULT_SIZE]
     else:
         s[IR_FAULT] = 1.0
         s[FAULT_SIZE] = run_mean(s, CUSUM_PAIR) if pair > now else run_mean(s, CUSUM_NOW)
+        s[CONS_OFFSET] = s[FAULT_SIZE]
+        s[SETTLING] = c[WINDOW_SPAN] if now >= pair else c[RAMP]
+    s[HELD_FAULT] = 1.0 if c[END_MODE] > 0.5 else 0.0
 
 
 @njit(cache=True)
-def _declare_held(s, c, sensor, size):
+def _declare_held(s, c, sensor, size, onset):
     """A fault declared by the consistency CUSUM, on the ``sensor`` :func:`attribute` named
-    (1 the GPS, 2 the IR), of normalised ``size``: the offset in the units of that sensor's
-    end test (the GPS: rad/s, ``-d / a``; the IR: count)."""
+    (1 the GPS, 2 the IR), of normalised ``size``, fitted to start at ``onset`` in the ring: the
+    offset in the units of that sensor's innovation end test (the GPS: rad/s, ``-d / a``; the IR:
+    count) and in the residual's (count). ``a`` and ``b`` go back to the held calibration, from
+    before the offset."""
     offset = size * math.sqrt(s[GATE_CONS])
-    held = PAST + (int(s[PAST_COUNT]) - int(c[HELD_LAG])) % PAST_SIZE
+    held = PAST + int(s[ANCHOR]) % PAST_SIZE
     s[A], s[B] = s[held], s[held + PAST_SIZE]  # the calibration from before the offset
+    s[CONS_OFFSET] = offset
+    s[HELD_FAULT] = 1.0 if c[END_MODE] > 0.5 else 0.0
+    if sensor == 2:  # the end test waits until the IR's ramp is whole
+        left = c[RAMP] - (n_ring(s) - onset)
+        s[SETTLING] = left if left > 0.0 else 0.0
     if sensor == 1:
         s[GPS_FAULT] = 1.0
         s[FAULT_SIZE] = -offset / s[A]

@@ -11,21 +11,40 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from calibration.infrared.filters import ekf_joint_step, ekf_step, pair_at, push, regression_step, rls_step
+from calibration.infrared.filters import (
+    buffer_size,
+    ekf_joint_step,
+    ekf_step,
+    pair_at,
+    push,
+    raw_pair,
+    regression_step,
+    rls_step,
+)
 from calibration.infrared.layout import (
     A_SAFE,
+    ALT_LEVEL,
+    ALT_LIFE,
+    ANCHOR,
     B_SAFE,
+    COMPLETE,
     CONS_H,
     CONS_K,
     CUSUM_CONS,
     CUSUM_H,
     CUSUM_K,
+    DECISIVE,
     EKF_CONFIG_SIZE,
     EKF_SIZE,
     END_H,
+    END_LLR,
+    END_MODE,
+    END_SIGNIFICANCE,
+    END_TURN,
     FAULT_SIZE,
     FIT_A,
     FIT_B,
+    FREEZE,
     G_DOWN,
     G_UP,
     GAMMA2,
@@ -64,20 +83,26 @@ from calibration.infrared.layout import (
     QR,
     RAMP,
     RATE,
+    RAW_PAIR,
+    RAW_SEEN,
     REG_RATE,
     REG_SIZE,
     REJECTED,
     RG,
     RI,
     RI1,
+    RING_SIZE,
     RLS_A,
     RLS_B,
     RLS_RATE,
+    RUN_PEAK,
     SCALE_GAIN,
     SD_A_HELD,
+    SD_DRIFT,
     SIGNIFICANCE,
     SIZE_GAIN,
     STATUS,
+    TURN_MODE,
     WINDOW_SPAN,
     ZERO_GAIN,
     A,
@@ -90,6 +115,9 @@ from orchestrator.blocks import Block
 def _check_positive(name: str, value: float, unit: str, fix: str):
     if not (math.isfinite(value) and value > 0.0):
         raise ValueError(f"{name} = {value!r} {unit} must be positive and finite; {fix}")
+
+
+TURNS = ("mean", "healthy", "smoothed")  # the turn rates the attribution may take (EKFSettings.turn), in c[TURN_MODE]
 
 
 @dataclass(frozen=True)
@@ -120,44 +148,85 @@ class EKFSettings:
         Innovation gate gamma in standard deviations; 0 turns gating and fault detection off.
     cusum_k, cusum_h : float
         Allowance and threshold (standard deviations) of the CUSUMs on the GPS and the paired
-        IR innovations (:mod:`calibration.infrared.detection`). The defaults were set on the
-        fault-free flights of seeds 101 to 200 (drift on), whose largest statistics were 5.7 (GPS
-        and paired IR, at this allowance) and 15.7 (present IR), against the thresholds 10 and
-        25; the flights of seeds 1 to 100 score them (``python -m scenarios.ir_detection``).
+        IR innovations (:mod:`calibration.infrared.detection`); ``cusum_h = inf`` (the default)
+        turns them off: the consistency residual sees the same offsets without the lag of the
+        filter's turn rate, which made them declare faults in hard turn reversals (fault-free
+        flights of seeds 1 to 2000: three; the earlier design's ``cusum_h = 10``).
     now_k, now_h : float
-        The same for the present IR, whose variance includes the turn's change over the lag.
+        The same for the present IR, whose variance includes the turn's change over the lag: it
+        declares a large IR offset a second before it reaches the pairs. The allowance of 6
+        standard deviations lies above what the hardest turn reversals of the fault-free
+        flights of seeds 1 to 2000 give (the earlier design's 3.5 declared two faults there).
     held_k, held_h : float
         Allowance and threshold (standard deviations) of the two-sided CUSUM on the GPS-IR
-        consistency residual against the calibration of ``held_lag`` samples before
+        consistency residual against the held calibration
         (:func:`calibration.infrared.detection.consistency`), which finds the offsets the filter
-        absorbs into ``b`` and ``a`` before the other CUSUMs see them. The allowance is half
-        the smallest offset it is meant for (a GPS +0.1 rad/s, 40 counts, 2.3 standard
-        deviations); the threshold was set on the fault-free flights of seeds 101 to 200, whose
-        largest statistic was 6.13 (``python -m scenarios.ir_detectability --calibrate``).
+        absorbs into ``b`` and ``a`` before its own innovations show them. The allowance is
+        half the smallest offset it is meant for (a GPS +0.1 rad/s, 40 counts, 2.3 standard
+        deviations); its alarm is only examined (:func:`~calibration.infrared.detection.attribute`).
     held_lag : int
-        How old the calibration held for the consistency residual is (samples, fewer than
-        64): long enough for the detector to fire before the filter's absorption of an offset
-        reaches it, short enough that the drift of ``a`` and ``b`` over it stays small (10:
-        the largest fault-free statistic grows with it, 6.1 at 10 and 9.9 at 15 on seeds 101
-        to 200, where it was chosen).
+        How old the held calibration is (samples) while the CUSUM is at zero.
+    freeze : bool
+        Once the CUSUM runs, hold the calibration it started against until it falls back to
+        zero (or the run outlasts the ring of past calibrations), rather than one ``held_lag``
+        samples old, which absorbs a small offset within a second.
     margin : float
         Log-likelihood by which one sensor's signature in the consistency residual (the GPS:
         a step; the IR: a ramp over the GPS window) must beat the other's before a fault is
         declared on it, the residual scaled by its own spread: ``log 100``.
     significance : float
         Log-likelihood (the residual scaled by its own spread) that an offset starting inside
-        the attribution ring must reach beyond an error of the calibration (``delta_b +
-        delta_a r``, which a change of the turn exposes) before a fault is declared; on seeds
-        101 to 200 it reached at most 10.9 while the consistency statistic exceeded 3.
+        the attribution ring must reach beyond an error of the calibration and a drift
+        (``delta_b + delta_a u + beta t``) before a fault is declared. Set on the tuning seeds:
+        on the fault-free flights of seeds 1 to 9000 the largest was 10.3; in the first 5 s of
+        a GPS +0.1 rad/s offset on seeds 1 to 300 the smallest 25.0
+        (``python -m scenarios.ir_detectability --calibrate``).
     sd_a_held : float
         Prior standard deviation of the held calibration's error of ``a`` (count per rad/s)
         in that test: the largest error of the filter's ``a`` 10 samples old on the fault-free
         flights of seeds 101 to 200 was 50.6.
+    turn : {"smoothed", "mean", "healthy"}
+        The turn rate ``u`` of that error: the GPS's averaged over the GPS window (its noise,
+        which the residual holds, mostly out of it), the mean of the GPS's and the IR's (the
+        earlier design: in straight flight the error of ``a`` then explains the GPS noise and a
+        GPS offset with it), or for each hypothesis the sensor it holds healthy.
+    sd_drift : float
+        Prior standard deviation of the drift rate ``beta`` in that test (count per sample; 0:
+        no drift in the fit). 0.2 (4 counts/s at 20 Hz, against the cloud's 7.3 at most):
+        without it the cloud's change of ``b`` passes for an IR offset's ramp (fault-free
+        flights of seeds 1 to 3000: largest log-likelihood 37.8, against 9.1 with it).
+    raw : bool
+        The consistency residual takes the mean over the GPS window of every IR sample,
+        including those the present-IR gate keeps out of the filter's pairs (a large IR offset
+        would otherwise leave it blind).
+    end : {"consistency", "innovation"}
+        How a fault ends: the consistency residual stepping back by half the offset or more
+        (:func:`~calibration.infrared.detection._end_held`), or the faulty sensor's innovation
+        consistent again (the earlier design; a turn exposing the held calibration's error of
+        ``a`` ended GPS faults early).
+    decisive : float
+        Consistency statistic (standard deviations) from which the better signature is declared
+        whatever its fit (``inf``: never; under a frozen calibration the cloud's drift drives the
+        statistic as high as a fault).
+    alt_level, alt_life : float, int
+        Attribution log-likelihood from which a CUSUM run that declared nothing leaves the
+        calibration from before it remembered for ``alt_life`` samples, so that a later change
+        back to it is taken for the end of an offset the filter absorbed, not for a fault
+        (``inf``: never; it takes real faults for returns too).
     scale_gain : float
         Weight per sample of the running mean square of the normalised consistency residual
         while its CUSUM is zero (1 / samples): the spread the attribution scales by.
     end_h : float
         Threshold of the log-likelihood ratio that ends a fault.
+    end_significance : float
+        Log-likelihood the step back of the consistency residual must reach before a fault
+        ends (``end="consistency"``), as ``significance`` for its start.
+    complete : int
+        Samples of the offset's shape the attribution ring must hold past its onset before a
+        fault is declared (0: as soon as the signatures part).
+    end_healthy : bool
+        Fit the end's turn-rate term with the sensor not at fault (the ``"healthy"`` reading of
+        ``turn``) rather than the smoothed GPS turn rate.
     size_gain : float
         Weight per sample of the running estimate of a declared fault's offset (1 / samples).
     form : str
@@ -179,15 +248,26 @@ class EKFSettings:
     sd_lag: float = 0.3
     gate: float = 5.0
     cusum_k: float = 2.0
-    cusum_h: float = 10.0
-    now_k: float = 3.5
+    cusum_h: float = math.inf
+    now_k: float = 6.0
     now_h: float = 25.0
     held_k: float = 1.15
     held_h: float = 10.0
     held_lag: int = 10
+    freeze: bool = True
     margin: float = 4.6
-    significance: float = 25.0
+    significance: float = 15.0
     sd_a_held: float = 50.0
+    turn: str = "smoothed"
+    sd_drift: float = 0.2
+    raw: bool = True
+    end: str = "consistency"
+    end_significance: float = 15.0
+    complete: int = 0
+    end_healthy: bool = False
+    decisive: float = math.inf
+    alt_level: float = math.inf
+    alt_life: int = 4000
     scale_gain: float = 0.01
     end_h: float = 10.0
     size_gain: float = 0.05
@@ -201,10 +281,20 @@ class EKFSettings:
         if not (self.gate == 0.0 or (math.isfinite(self.gate) and self.gate > 0.0)):
             raise ValueError(f"gate = {self.gate!r} standard deviations must be positive, or 0 for no gating")
         for name in ("cusum_k", "cusum_h", "now_k", "now_h", "held_k", "held_h", "margin", "significance", "sd_a_held",
-                     "scale_gain", "end_h", "size_gain"):
-            _check_positive(name, getattr(self, name), "", "the detector needs a positive allowance and threshold")
-        if int(self.held_lag) != self.held_lag or not 1 <= self.held_lag < PAST_SIZE:
-            raise ValueError(f"held_lag = {self.held_lag!r} must be a whole number of samples in [1, {PAST_SIZE})")
+                     "scale_gain", "end_h", "size_gain", "decisive", "alt_level", "alt_life", "end_significance"):
+            value = getattr(self, name)
+            if not value > 0.0 or math.isnan(value):
+                raise ValueError(f"{name} = {value!r} must be positive (inf where it turns a detector off); "
+                                 "the detector needs a positive allowance and threshold")
+        if int(self.held_lag) != self.held_lag or not 1 <= self.held_lag < PAST_SIZE - RING_SIZE:
+            raise ValueError(f"held_lag = {self.held_lag!r} must be a whole number of samples in "
+                             f"[1, {PAST_SIZE - RING_SIZE})")
+        if not (self.sd_drift >= 0.0 and math.isfinite(self.sd_drift)):
+            raise ValueError(f"sd_drift = {self.sd_drift!r} count per sample must be finite and >= 0 (0: no drift)")
+        if self.turn not in TURNS:
+            raise ValueError(f"turn = {self.turn!r} must be one of {', '.join(TURNS)}")
+        if self.end not in ("consistency", "innovation"):
+            raise ValueError(f"end = {self.end!r} must be 'consistency' or 'innovation'")
         if self.form not in ("sequential", "joint"):
             raise ValueError(f"form = {self.form!r} must be 'sequential' or 'joint'")
         if self.form == "joint" and self.gate:
@@ -219,6 +309,11 @@ class EKFSettings:
         c[END_H], c[SIZE_GAIN] = self.end_h, self.size_gain
         c[CONS_K], c[CONS_H], c[MARGIN], c[HELD_LAG] = self.held_k, self.held_h, self.margin, self.held_lag
         c[SCALE_GAIN], c[SIGNIFICANCE], c[SD_A_HELD] = self.scale_gain, self.significance, self.sd_a_held
+        c[FREEZE], c[DECISIVE], c[TURN_MODE] = float(self.freeze), self.decisive, TURNS.index(self.turn)
+        c[END_MODE], c[RAW_SEEN] = float(self.end == "consistency"), float(self.raw)
+        c[ALT_LEVEL], c[ALT_LIFE], c[SD_DRIFT] = self.alt_level, self.alt_life, self.sd_drift
+        c[END_SIGNIFICANCE], c[COMPLETE] = self.end_significance, self.complete
+        c[END_TURN] = float(self.end_healthy)
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c
@@ -237,6 +332,7 @@ class EKFSettings:
         s[A], s[B] = self.a0, self.b0
         s[A_SAFE], s[B_SAFE] = self.a0, self.b0
         s[HELD_SCALE] = 1.0  # the filter's noise model, until the residuals say otherwise
+        s[ANCHOR] = -float(self.held_lag)
         P = np.diag(np.square([self.sd_a0, self.sd_b0, self.sd_r0])) if covariance is None else covariance
         P = np.asarray(P, dtype=float)
         if P.shape != (3, 3) or not np.isfinite(P).all() or not np.allclose(P, P.T):
@@ -342,7 +438,7 @@ _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_g
                "S_ir_now": GATE_NOW, "var_a": PAA, "var_b": PBB, "var_r": PRR, "status": STATUS,
                "fault_size": FAULT_SIZE, "nu_held": NU_CONS, "S_held": GATE_CONS,
                "held_up": CUSUM_CONS + G_UP, "held_down": CUSUM_CONS + G_DOWN,
-               "held_scale": HELD_SCALE}
+               "held_scale": HELD_SCALE, "run_peak": RUN_PEAK, "end_llr": END_LLR}
 _REG_FIELDS = {"a": FIT_A, "b": FIT_B, "turn_rate": REG_RATE, "rejected": REJECTED}
 _RLS_FIELDS = {"a": RLS_A, "b": RLS_B, "turn_rate": RLS_RATE}
 _STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance fell to zero or below); "
@@ -375,8 +471,13 @@ def _step(kind, s, c, ir_pair, gps, gps_use, ir):
 
 @njit(cache=True)
 def _sample(kind, s, c, buffer, k, ir, gps, gps_use, delay, window, suspect):
-    """One sample of any estimator: pair the IR with the GPS window, step, store the IR."""
-    _step(kind, s, c, pair_at(buffer, k, delay, window), gps, gps_use, ir)
+    """One sample of any estimator: pair the IR with the GPS window, step, store the IR. The
+    Kalman filter's consistency detector also takes the window's mean of every sample, suspect
+    or not (``s[RAW_PAIR]``)."""
+    pair = pair_at(buffer, k, delay, window)
+    if kind == EKF_SEQUENTIAL:
+        s[RAW_PAIR] = raw_pair(buffer, delay, window)
+    _step(kind, s, c, pair, gps, gps_use, ir)
     push(buffer, k, ir, s[suspect] if suspect >= 0 else 0.0, delay, window)
 
 
@@ -450,7 +551,7 @@ class Estimator:
     def reset(self):
         """Back to the initial state, before any sample."""
         self.state = self._initial.copy()
-        self.buffer = np.zeros(2 * (self.delay + self.window + 2) + 2)
+        self.buffer = np.zeros(buffer_size(self.delay, self.window))
         self.k = 0
 
     def update(self, ir: float, gps: float, gps_use: bool = True) -> np.ndarray:

@@ -49,6 +49,8 @@ from calibration.infrared.layout import (
     QB,
     QR,
     RATE,
+    RAW_PAIR,
+    RAW_SEEN,
     REG_RATE,
     REJECT_K,
     REJECTED,
@@ -80,14 +82,16 @@ from calibration.infrared.layout import (
 def pair_at(buffer, k, delay, window):
     """Mean IR over the samples ``[k - delay - window, k - delay)``, the GPS window of sample
     ``k``, from the ring buffer that :func:`push` fills; ``nan`` before the window is filled or
-    while it holds a sample flagged suspect.
+    while it holds a sample flagged suspect. The mean of every sample, suspect or not, is kept
+    in the buffer's last entry (:func:`raw_pair`).
 
-    ``buffer`` holds ``2 (delay + window + 2) + 2`` values: the last ``delay + window + 2``
-    samples, their suspect flags, the running sum and the running count of flags.
+    ``buffer`` holds ``2 (delay + window + 2) + 3`` values: the last ``delay + window + 2``
+    samples, their suspect flags, the running sum, the running count of flags and the mean.
     """
     size = delay + window
     kept = size + 2
     if k < size:
+        buffer[2 * kept + 2] = math.nan
         return math.nan
     if k == size:
         total, flagged = 0.0, 0.0
@@ -101,7 +105,21 @@ def pair_at(buffer, k, delay, window):
         flagged = buffer[2 * kept + 1] + buffer[kept + i] - buffer[kept + o]
     buffer[2 * kept] = total
     buffer[2 * kept + 1] = flagged
+    buffer[2 * kept + 2] = total / window
     return total / window if flagged == 0.0 else math.nan
+
+
+@njit(cache=True)
+def raw_pair(buffer, delay, window):
+    """The mean IR over the GPS window of the last :func:`pair_at`, suspect samples included
+    (count); ``nan`` before the window is filled. ``buffer`` is the pairing buffer of
+    :func:`push`, ``delay`` and ``window`` the GPS delay and averaging window (samples)."""
+    return buffer[2 * (delay + window + 2) + 2]
+
+
+def buffer_size(delay: int, window: int) -> int:
+    """Length of the pairing buffer for a GPS ``delay`` and ``window`` (samples)."""
+    return 2 * (delay + window + 2) + 3
 
 
 @njit(cache=True)
@@ -174,9 +192,11 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     s[GPS_USED] = 1.0 if gps_pass else 0.0
     if gamma2 > 0.0:
         check_present(s, c, ir_now)
-        if have_pair and gps_available:
-            consistency(s, c, ir_pair, gps)
-        detect(s, c, gps_available, have_pair)
+        watched = s[RAW_PAIR] if c[RAW_SEEN] > 0.5 else ir_pair  # the IR the consistency residual takes
+        raw_seen = watched == watched
+        if raw_seen and gps_available:
+            consistency(s, c, watched, gps)
+        detect(s, c, gps_available, have_pair, raw_seen)
         remember_calibration(s)
     _finish(s, ir_now)
 

@@ -19,16 +19,27 @@ CUSUM_GPS, CUSUM_PAIR, CUSUM_NOW = 24, 30, 36
 # inside a CUSUM: statistic, sum of the raw innovations and count of its run, upwards then downwards
 G_UP, SUM_UP, N_UP, G_DOWN, SUM_DOWN, N_DOWN = range(6)
 CUSUM_SIZE = 6
-# the GPS-IR consistency residual against the calibration of HELD_LAG samples before, its
-# variance, its CUSUM, the running mean square of its normalised values while no offset shows,
-# the GPS turn rate and the paired IR it was taken from, the ring of the samples since the last
-# restart that attributes a fault (paired IR, then GPS turn rate, then the residual's variance),
-# and the ring of the past calibrations (a, b, then their covariance PAA, PAB, PBB; one per sample)
-NU_CONS, GATE_CONS, CUSUM_CONS, RING_COUNT, HELD_SCALE, HELD_GPS, HELD_IR, RING = 46, 47, 48, 54, 55, 56, 57, 58
+# the GPS-IR consistency residual against the held calibration, its variance, its CUSUM, the
+# running mean square of its normalised values while no offset shows, the GPS turn rate and the
+# paired IR it was taken from, the index (in the ring of past calibrations) of the calibration it
+# is held against while its CUSUM runs (ANCHOR; -1 when none is frozen), the ring of the samples
+# since the last restart that attributes a fault (paired IR, then GPS turn rate, then the
+# residual's variance), and the ring of the past calibrations (a, b, then their covariance PAA,
+# PAB, PBB; one per sample)
+NU_CONS, GATE_CONS, CUSUM_CONS, RING_COUNT, HELD_SCALE, HELD_GPS, HELD_IR = 46, 47, 48, 54, 55, 56, 57
+ANCHOR = 58
+CONS_OFFSET, HELD_FAULT = 59, 60  # a declared fault's offset in the residual (count); 1: it was declared on it
+RAW_PAIR = 61  # the mean IR over the GPS window, suspect samples included (count)
+SETTLING = 62  # samples before the end test of a fault watches the residual: its onset is still coming in
+# a calibration from before a change the residual showed but no fault was declared on (a and b), the samples it
+# is kept for, and the largest attribution log-likelihood of the CUSUM's present run
+ALT_A, ALT_B, ALT_LEFT, RUN_PEAK = 63, 64, 65, 66
+END_LLR = 67  # the end test's log-likelihood at this sample, of a step back at least half the offset
+RING = 68
 RING_SIZE = 60  # samples: 3 s at 20 Hz, the onset of the fault and the GPS window's ramp
 PAST_COUNT = RING + 3 * RING_SIZE
 PAST = PAST_COUNT + 1
-PAST_SIZE = RING_SIZE + 4  # samples: the calibration from before the attribution ring, and the held one
+PAST_SIZE = 200  # samples: the calibrations a frozen run may be held against (10 s at 20 Hz)
 PAST_FIELDS = 5
 EKF_SIZE = PAST + PAST_FIELDS * PAST_SIZE
 # EKF configuration c: process noise variances per sample, measurement variances, gate, detectors.
@@ -36,9 +47,21 @@ EKF_SIZE = PAST + PAST_FIELDS * PAST_SIZE
 QA, QB, QR, RG, RI, GAMMA2, LAG, RI1, PA0, PB0 = range(10)
 CUSUM_K, CUSUM_H, NOW_K, NOW_H, END_H, SIZE_GAIN, WINDOW_SPAN = range(10, 17)
 # the consistency detector: allowance and threshold, attribution margin (log-likelihood), GPS window (samples),
-# lag of the held calibration (samples), weight of its spread, significance, prior deviation of a's error
+# lag of the held calibration (samples), weight of its spread, significance, prior deviation of a's error,
+# whether the held calibration is frozen while the CUSUM runs, the CUSUM statistic from which the better
+# shape is declared whatever the fit, which turn rate the attribution takes (0: the mean of the two
+# sensors'; 1: each hypothesis the healthy sensor's; 2: the GPS's averaged over its window), whether a
+# fault ends by the residual stepping back (1) or by the faulty sensor's innovation (0), whether the residual
+# takes the window's mean of every IR sample, suspect or not (1), or only the pair the filter fuses (0), the
+# attribution log-likelihood above which a run that declared nothing leaves its calibration remembered,
+# and for how many samples, the prior deviation of the residual's drift in the fit (count per sample), and the
+# log-likelihood of a step back that ends a fault, and how many samples the better signature's onset must lie
+# in the past before a fault is declared on it
 CONS_K, CONS_H, MARGIN, RAMP, HELD_LAG, SCALE_GAIN, SIGNIFICANCE, SD_A_HELD = range(17, 25)
-EKF_CONFIG_SIZE = 25
+FREEZE, DECISIVE, TURN_MODE, END_MODE, RAW_SEEN, ALT_LEVEL, ALT_LIFE, SD_DRIFT = range(25, 33)
+# and whether the end test takes the turn rate of the sensor held healthy (1) or the attribution's (0)
+END_SIGNIFICANCE, COMPLETE, END_TURN = 33, 34, 35
+EKF_CONFIG_SIZE = 36
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 

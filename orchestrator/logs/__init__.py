@@ -33,10 +33,70 @@ DATAFLASH_HEAD = b"\xa3\x95"
 FORMATS = "PX4 ULog (.ulg), ArduPilot DataFlash binary (.bin) or text (.log)"
 
 
+#: The largest log read (bytes). The readers take about a second per megabyte of DataFlash (a
+#: gigabyte is hours); the longest flights log a few hundred megabytes.
+MAX_LOG_BYTES = 1_000_000_000
+#: A log this large (bytes) or larger whose blocks on the disk hold less than half its length
+#: is a sparse file, not a log written by a vehicle.
+SPARSE_MIN_BYTES = 16_000_000
+
+
+def check_file(path) -> int:
+    """Refuse, before any reader opens it, a path that is not a log a reader can finish.
+
+    A FIFO, a device, a socket or a folder (a reader would block on it, or read forever), a
+    file larger than :data:`MAX_LOG_BYTES`, and a sparse file (mostly holes: a copy cut
+    short, or a file made with ``truncate``) are refused.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The log.
+
+    Returns
+    -------
+    int
+        The file's size (bytes).
+
+    Raises
+    ------
+    LogError
+        Naming the file, what it is and the fix.
+    """
+    import os
+    import stat
+
+    path = Path(path)
+    try:
+        status = os.stat(path)
+    except OSError as error:
+        raise LogError(f"{path}: cannot read the log ({error.strerror})") from None
+    mode = status.st_mode
+    if stat.S_ISDIR(mode):
+        raise LogError(f"{path}: a folder, not a log; give a log file ({FORMATS})")
+    if not stat.S_ISREG(mode):
+        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
+                stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
+        raise LogError(f"{path}: {kind}, not a log file; quadcosim reads logs from files (copy the log to a "
+                       "file first)")
+    size = status.st_size
+    if size > MAX_LOG_BYTES:
+        raise LogError(f"{path}: {size / 1e9:.1f} GB, more than the {MAX_LOG_BYTES / 1e9:.0f} GB quadcosim reads "
+                       "(a long flight logs a few hundred MB; reading this one would take hours); cut the log to "
+                       "the flight you need")
+    stored = getattr(status, "st_blocks", None)
+    if stored is not None and size >= SPARSE_MIN_BYTES and stored * 512 < size // 2:
+        raise LogError(f"{path}: a sparse file ({size / 1e6:.0f} MB long, {stored * 512 / 1e6:.1f} MB stored): its "
+                       "holes read as zeros, not a log a vehicle wrote (a copy cut short?); copy the log again")
+    return size
+
+
 def detect_format(path) -> str:
     """``ulog``, ``dataflash-binary`` or ``dataflash-text`` from the first bytes of the file at
-    ``path`` (not its name); a :class:`LogError` naming the file otherwise."""
+    ``path`` (not its name), checked first by :func:`check_file`; a :class:`LogError` naming
+    the file otherwise."""
     path = Path(path)
+    check_file(path)
     try:
         with open(path, "rb") as file:
             head = file.read(64)
@@ -56,23 +116,33 @@ def detect_format(path) -> str:
 def read_log(path) -> FlightLog:
     """Read the flight log at ``path`` (format detected from its content).
 
+    The file is checked before a reader opens it (:func:`check_file`); what the readers print
+    while they read is summarised in one warning (:mod:`orchestrator.logs.noise`); every
+    sensor's time stamps are checked, and the span the sensors share reported
+    (:func:`orchestrator.logs.checks.validated`).
+
     Raises
     ------
     LogError
-        Unknown format, unreadable, empty, corrupt beyond use or truncated before its data; the
+        Unknown format, unreadable, empty, corrupt beyond use or truncated before its data, not
+        a regular file, too large, sparse, or a clock that restarts (two logs joined); the
         message names the file and the fix. Corruption read past is listed in
         ``FlightLog.warnings``.
+    KeyboardInterrupt
+        A signal stopped the reading (never reported as a corrupt log).
     """
+    from orchestrator.logs.checks import validated
+
     path = Path(path)
     kind = detect_format(path)
     if kind == "ulog":
         from orchestrator.logs.ulog import read_ulog
 
-        return read_ulog(path)
+        return validated(read_ulog(path))
     from orchestrator.logs.dataflash import read_dataflash
 
-    return read_dataflash(path, text=kind == "dataflash-text")
+    return validated(read_dataflash(path, text=kind == "dataflash-text"))
 
 
 __all__ = ["Attitude", "Battery", "Compass", "FlightLog", "Imu", "LogError", "Motors", "Position", "Throttle",
-           "detect_format", "rate", "read_log"]
+           "check_file", "detect_format", "rate", "read_log"]

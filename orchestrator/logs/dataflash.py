@@ -23,8 +23,6 @@ What ArduPilot logs, and how it is turned into the project's conventions:
 
 from __future__ import annotations
 
-import contextlib
-import io
 import re
 from pathlib import Path
 
@@ -46,6 +44,8 @@ FRAME_CLASS_MOTORS = {1: 4, 2: 6, 3: 8, 4: 8, 5: 6, 7: 3, 12: 4, 14: 4}
 FRAME_NAME_MOTORS = {"QUAD": 4, "HEXA": 6, "OCTA": 8, "OCTA_QUAD": 8, "Y6": 6, "TRI": 3}
 VOLTAGE_ONLY_MONITOR = 3
 MIN_CURRENT_A = 0.2  # a current sensor that never reads more than this is not wired
+SINGULAR_CONDITION = 1e12  # a soft-iron matrix this ill-conditioned cannot be undone
+ZERO_TAIL_BYTES = 528  # zeros past this at a binary log's end are named (pymavlink reads past fewer)
 
 
 def _reader(path: Path, text: bool):
@@ -59,11 +59,14 @@ def _reader(path: Path, text: bool):
 
 
 def _collect(path: Path, text: bool):
-    """Rows of the wanted messages (type -> list of dicts), the formats, the parameters and
-    the complaints pymavlink printed about skipped bytes."""
+    """Rows of the wanted messages (type -> list of dicts), the formats, the parameters, what
+    pymavlink printed while it read (:class:`orchestrator.logs.noise.Noise`) and the bytes the
+    last message lacks."""
+    from orchestrator.interrupts import surfaced
+    from orchestrator.logs.noise import captured
+
     rows: dict[str, list] = {}
-    complaints = io.StringIO()
-    with contextlib.redirect_stderr(complaints), contextlib.redirect_stdout(complaints):
+    with surfaced(), captured() as noise:
         reader = _reader(path, text)
         try:
             while (m := reader.recv_match(type=WANTED)) is not None:
@@ -74,8 +77,37 @@ def _collect(path: Path, text: bool):
         finally:
             reader.close()
     formats = {f.name: f for f in reader.formats.values()}
-    trailing = 0 if text else _unfinished(reader)
-    return rows, formats, dict(reader.params), complaints.getvalue(), trailing
+    trailing = _cut_line(path) if text else _unfinished(reader)
+    return rows, formats, dict(reader.params), noise, trailing
+
+
+def _cut_line(path: Path) -> int:
+    """Bytes of a text log's last line when it does not end with a newline (a copy cut short), else 0."""
+    with open(path, "rb") as file:
+        file.seek(0, 2)
+        size = file.tell()
+        file.seek(max(0, size - 4096))
+        tail = file.read()
+    return 0 if not tail or tail.endswith(b"\n") else len(tail) - (tail.rfind(b"\n") + 1)
+
+
+def _zero_tail(path: Path) -> int:
+    """Bytes of zeros that end the file at ``path`` (a log padded, or cut when power was lost)."""
+    block = 1 << 16
+    with open(path, "rb") as file:
+        file.seek(0, 2)
+        end = file.tell()
+        zeros = 0
+        while end > 0:
+            start = max(0, end - block)
+            file.seek(start)
+            data = file.read(end - start)
+            kept = data.rstrip(b"\0")
+            zeros += len(data) - len(kept)
+            if kept:
+                break
+            end = start
+    return zeros
 
 
 def _unfinished(reader) -> int:
@@ -115,13 +147,28 @@ def _compasses(rows: dict, params: dict, rule: ardupilot.Rules) -> list[Compass]
         ofs = _columns(group, ["OfsX", "OfsY", "OfsZ"]) * MILLIGAUSS
         mofs = _columns(group, ["MOfsX", "MOfsY", "MOfsZ"]) * MILLIGAUSS
         matrix = ardupilot.soft_iron(params, k)
-        raw = ardupilot.recover_raw(params, k, rule, mag, ofs, mofs)
         flag = params.get("COMPASS_EXTERNAL" if k == 0 else f"COMPASS_EXTERN{k + 1}")
+        unusable = _singular(matrix, params, ardupilot.suffix(k))
+        if unusable:
+            raw, inverse = np.full_like(mag, np.nan), np.full((3, 3), np.nan)
+        else:
+            raw, inverse = ardupilot.recover_raw(params, k, rule, mag, ofs, mofs), np.linalg.inv(matrix)
         out.append(Compass(name, _time(group), mag, raw, -np.median(ofs, axis=0),
                            None if flag is None else bool(flag),
                            f"logged field with the logged offsets, soft iron and motor offsets undone as {rule.name} "
-                           "applies them", np.linalg.inv(matrix), np.eye(3), k))
+                           "applies them", inverse, np.eye(3), k, unusable))
     return out
+
+
+def _singular(matrix: np.ndarray, params: dict, suffix: str) -> str:
+    """Why the soft-iron ``matrix`` of compass ``suffix`` cannot be undone (empty when it can),
+    naming the parameters it comes from."""
+    if np.all(np.isfinite(matrix)) and np.linalg.cond(matrix) < SINGULAR_CONDITION:
+        return ""
+    named = ", ".join(f"{kind}{suffix}_{a} = {params.get(f'{kind}{suffix}_{a}', 0.0):g}"
+                      for kind in ("COMPASS_DIA", "COMPASS_ODI") for a in "XYZ")
+    return (f"its soft-iron matrix is singular ({named}): the field before the autopilot's corrections cannot "
+            "be recovered from this log (a diagonal of 1 and off-diagonals of 0 are no correction)")
 
 
 def _position(rows: dict) -> Position | None:
@@ -133,7 +180,13 @@ def _position(rows: dict) -> Position | None:
         return None
     lat, lon, alt = np.median(_columns(group, ["Lat", "Lng", "Alt"]), axis=0)
     week, ms = group[0]["GWk"], group[0]["GMS"]
-    when = datetime.datetime.fromisoformat(GPS_EPOCH) + datetime.timedelta(seconds=week * SECONDS_PER_WEEK + ms / 1e3)
+    try:
+        when = datetime.datetime.fromisoformat(GPS_EPOCH) + datetime.timedelta(
+            seconds=week * SECONDS_PER_WEEK + ms / 1e3)
+    except (OverflowError, ValueError):  # a GPS week no receiver reports (a damaged message): no date, no position
+        return None
+    if not (np.isfinite([lat, lon, alt]).all() and abs(lat) <= 90 and abs(lon) <= 180 and when.year < 9999):
+        return None
     start = datetime.datetime(when.year, 1, 1)
     year = when.year + (when - start).total_seconds() / (datetime.datetime(when.year + 1, 1, 1) - start).total_seconds()
     return Position(float(lat), float(lon), float(alt), float(year), "GPS (median of the 3D fixes)")
@@ -219,19 +272,22 @@ def _battery(rows: dict, formats: dict, params: dict) -> Battery | None:
 
 def read_dataflash(path: Path, text: bool) -> FlightLog:
     """Read an ArduPilot DataFlash log at ``path``: text form when ``text`` is true, else binary."""
-    rows, formats, params, complaints, trailing = _collect(path, text)
+    rows, formats, params, noise, trailing = _collect(path, text)
     if not rows or not any(rows.get(k) for k in SENSORS):
         raise LogError(f"{path}: no sensor messages could be read (MAG, IMU, ATT, RCOU, BAT); the file is empty, "
                        "truncated before its data or not a DataFlash log")
     messages = [r["Message"] for r in rows.get("MSG", [])]
     warnings = []
-    skipped = sum(int(n) for n in re.findall(r"Skipped (\d+) bad bytes", complaints))
-    skipped += complaints.count("bad header")
-    failed = complaints.count("Failed to parse")
-    if skipped or failed:
-        warnings.append(f"corrupt stretches skipped: {skipped} bytes, {failed} messages")
+    said = noise.summary("pymavlink")
+    if said:
+        warnings.append(f"corrupt stretches skipped: {said}")
+    zeros = 0 if text else _zero_tail(path)
+    if zeros > ZERO_TAIL_BYTES:
+        warnings.append(f"the last {zeros / 1e6:.3g} MB are zeros (a log padded, or cut when the vehicle lost power); "
+                        "the data before them are read")
     if trailing > 0:
-        warnings.append(f"truncated: the last message lacks {trailing} bytes")
+        warnings.append(f"truncated: the last line is cut ({trailing} bytes without their end of line)" if text
+                        else f"truncated: the last message lacks {trailing} bytes")
     firmware = next((m for m in messages if re.match(r"(APM:|Ardu)\w+ V", m)), "ArduPilot (version not logged)")
     simulator = any(k.startswith("SIM_") for k in params) or any("SITL" in m for m in messages)
     kind = re.search(r"(?:APM:|Ardu)(\w+)", firmware)

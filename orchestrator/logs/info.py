@@ -9,7 +9,12 @@ from orchestrator.logs.model import FlightLog, rate
 
 def summary(log: FlightLog) -> dict:
     """Sensors (instances, samples, rates in Hz, mean field norm in T, mean specific-force norm
-    in m/s^2), duration (s), vehicle, firmware, simulator flag and current sensor of ``log``."""
+    in m/s^2), duration (s), the span every sensor covers (``common_span_s``, s on the log's
+    clock, None when they share none), vehicle, firmware, simulator flag and current sensor of
+    ``log``."""
+    from orchestrator.logs.checks import common_span
+
+    span = common_span(log)
     compasses = [{"index": k, "name": c.name, "samples": len(c.time), "rate_hz": rate(c.time),
                   "external": c.external, "field_norm_T": float(np.median(np.linalg.norm(c.field, axis=1))),
                   "raw_source": c.raw_source} for k, c in enumerate(log.compasses)]
@@ -27,6 +32,7 @@ def summary(log: FlightLog) -> dict:
         "current_sensor": log.battery.current_sensor}
     return {"file": log.path, "format": log.format, "autopilot": log.autopilot, "firmware": log.firmware,
             "vehicle": log.vehicle, "simulator": log.simulator, "duration_s": log.duration,
+            "common_span_s": None if span is None else list(span),
             "compasses": compasses, "imus": imus, "motors": motors, "battery": battery,
             "current_sensor": log.battery is not None and log.battery.current is not None,
             "attitude": None if log.attitude is None else {"source": log.attitude.source,
@@ -39,6 +45,9 @@ def text(info: dict) -> str:
     lines = [f"{info['file']}: {info['format']}, {info['autopilot']} {info['firmware']}",
              f"  vehicle: {info['vehicle']}; {'SIMULATOR log' if info['simulator'] else 'real hardware'}; "
              f"{info['duration_s']:.1f} s; {info['parameters']} parameters"]
+    span = info["common_span_s"]
+    lines.append("  sensors together: none (their time stamps do not overlap)" if span is None else
+                 f"  sensors together: {span[1] - span[0]:.1f} s ({span[0]:.1f} to {span[1]:.1f} s on the log's clock)")
     for c in info["compasses"]:
         where = {True: "external", False: "internal", None: "location not logged"}[c["external"]]
         lines.append(f"  compass {c['index']} {c['name']}: {c['samples']} samples at {c['rate_hz']:.1f} Hz, {where}, "

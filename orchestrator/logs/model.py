@@ -43,6 +43,10 @@ class Compass:
     slot : int
         The calibration parameters' index: ArduPilot's compass number, PX4's ``CAL_MAGn`` matched by
         ``CAL_MAGn_ID`` to the sensor's device id.
+    unusable : str
+        Why the raw field cannot be recovered (a singular soft-iron matrix in the log's
+        parameters, named), or empty; ``raw`` is then NaN and the compass is refused for a
+        calibration (:meth:`FlightLog.compass`).
     """
 
     name: str
@@ -55,6 +59,7 @@ class Compass:
     soft_iron: np.ndarray = _default(default_factory=lambda: np.eye(3))
     rotation: np.ndarray = _default(default_factory=lambda: np.eye(3))
     slot: int = 0
+    unusable: str = ""
 
 
 @dataclass(frozen=True)
@@ -200,7 +205,66 @@ class FlightLog:
         if not 0 <= index < len(self.compasses):
             names = ", ".join(f"{k}: {c.name}" for k, c in enumerate(self.compasses))
             raise LogError(f"{self.path}: no compass {index}; the log holds {names}")
-        return self.compasses[index]
+        chosen = self.compasses[index]
+        if chosen.unusable:
+            others = [str(k) for k, c in enumerate(self.compasses) if not c.unusable]
+            hint = f"; use another compass (--compass {' or '.join(others)})" if others else ""
+            raise LogError(f"{self.path}: compass {index} ({chosen.name}): {chosen.unusable}{hint}")
+        return chosen
+
+    def require(self, purpose: str, *parts: str):
+        """Refuse a log that lacks a part ``purpose`` needs, naming the messages (ArduPilot) or
+        topics (PX4) that carry it.
+
+        Parameters
+        ----------
+        purpose : str
+            What needs them (``"a replay"``), for the message.
+        *parts : str
+            Among ``"compass"``, ``"imu"``, ``"attitude"``, ``"motors"``, ``"battery"``.
+
+        Raises
+        ------
+        LogError
+            The parts missing, each with the message types that carry it.
+        """
+        present = {"compass": bool(self.compasses), "imu": bool(self.imus), "attitude": self.attitude is not None,
+                   "motors": self.motors is not None, "battery": self.battery is not None}
+        missing = [part for part in parts if not present[part]]
+        if missing:
+            carriers = MESSAGES["PX4" if self.autopilot == "PX4" else "ArduPilot"]
+            named = "; ".join(f"{PARTS[part]} ({carriers[part]})" for part in missing)
+            raise LogError(f"{self.path}: {purpose} needs what the log does not hold: {named}. Log them "
+                           f"({LOGGING[self.autopilot if self.autopilot in LOGGING else 'ArduPilot']}) or give "
+                           "another log")
+
+    def overlap(self, *series) -> tuple[float, float]:
+        """The span of time (s) that every one of ``series`` covers (objects with a ``time``).
+
+        Raises
+        ------
+        LogError
+            They share no span: each one's span is named (time stamps shifted, or two logs joined).
+        """
+        named = [(name, s.time) for name, s in series if s is not None and len(s.time)]
+        lo, hi = max(t[0] for _, t in named), min(t[-1] for _, t in named)
+        if hi <= lo:
+            spans = ", ".join(f"{name} {t[0]:.1f} to {t[-1]:.1f} s" for name, t in named)
+            raise LogError(f"{self.path}: its sensors share no span of time ({spans}): their time stamps do not "
+                           "match (shifted, or parts of different logs); give a log whose sensors were recorded "
+                           "together")
+        return float(lo), float(hi)
+
+
+#: The messages (ArduPilot) and topics (PX4) that carry each part of a log, named when one is missing.
+MESSAGES = {"ArduPilot": {"compass": "MAG", "imu": "IMU", "attitude": "ATT", "motors": "RCOU",
+                          "battery": "BAT or CURR"},
+            "PX4": {"compass": "sensor_mag or vehicle_magnetometer", "imu": "sensor_accel and sensor_gyro, or "
+                    "sensor_combined", "attitude": "vehicle_attitude", "motors": "actuator_motors or "
+                    "actuator_outputs", "battery": "battery_status"}}
+LOGGING = {"ArduPilot": "LOG_BITMASK", "PX4": "SDLOG_PROFILE"}
+PARTS = {"compass": "a magnetometer", "imu": "an IMU", "attitude": "the attitude", "motors": "the motor outputs",
+         "battery": "the battery"}
 
 
 def rate(time: np.ndarray) -> float:

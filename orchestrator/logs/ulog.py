@@ -34,6 +34,7 @@ from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, 
 
 GAUSS = 1e-4  # T
 MICRO = 1e-6
+SINGULAR_CONDITION = 1e12  # a CAL_MAGn scale matrix this ill-conditioned cannot be undone
 INVALID_RELATIVE = 2147483647  # sensor_combined: no new sample of this sensor
 MAV_TYPE_MOTORS = {2: 4, 13: 6, 14: 8, 15: 3}
 MAV_TYPE_NAMES = {1: "fixed wing", 2: "quadrotor", 13: "hexarotor", 14: "octorotor", 15: "tricopter",
@@ -60,12 +61,18 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         device = int(d.data["device_id"][0]) if "device_id" in d.data else None
         n = px4.slot(params, device, d.multi_id)
         external = _external(params, n)
-        field = px4.apply(params, n, external, raw)
         offsets = np.array([params.get(f"CAL_MAG{n}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
         matched = f"CAL_MAG{n} matched by device id {device}" if device else f"CAL_MAG{n} by topic order (no device id)"
+        source = f"sensor_mag (logged before calibration, sensor frame); {matched}"
+        unusable = _unusable(params, n, external)
+        if unusable:
+            out.append(Compass(f"sensor_mag[{d.multi_id}]", d.data["timestamp"] * MICRO, np.full_like(raw, np.nan),
+                               raw, offsets, external, source, np.full((3, 3), np.nan), np.eye(3), n, unusable))
+            continue
+        field = px4.apply(params, n, external, raw)
         out.append(Compass(f"sensor_mag[{d.multi_id}]", d.data["timestamp"] * MICRO, field, raw, offsets, external,
-                           f"sensor_mag (logged before calibration, sensor frame); {matched}",
-                           np.linalg.inv(px4.scale_matrix(params, n)), px4.body_rotation(params, n, external), n))
+                           source, np.linalg.inv(px4.scale_matrix(params, n)), px4.body_rotation(params, n, external),
+                           n))
     if out:
         return out
     calibrated = _topics(ulog, "vehicle_magnetometer")
@@ -87,9 +94,31 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         field = field * GAUSS
         external = _external(params, k)
         undone = f"{name} with CAL_MAG{k}_*OFF, *SCALE, *ODIAG and the rotation undone (no raw topic logged)"
+        unusable = _unusable(params, k, external)
+        if unusable:
+            out.append(Compass(name, time, field, np.full_like(field, np.nan), offsets, None, undone,
+                               np.full((3, 3), np.nan), np.eye(3), k, unusable))
+            continue
         out.append(Compass(name, time, field, px4.recover_raw(params, k, external, field), offsets, None, undone,
                            np.linalg.inv(px4.scale_matrix(params, k)), px4.body_rotation(params, k, external), k))
     return out
+
+
+def _unusable(params: dict, n: int, external: bool) -> str:
+    """Why slot ``n``'s calibration in ``params`` cannot be undone (empty when it can): a singular
+    ``CAL_MAGn_*SCALE``/``*ODIAG`` matrix or a rotation this reader does not handle, named."""
+    S = px4.scale_matrix(params, n)
+    if not (np.all(np.isfinite(S)) and np.linalg.cond(S) < SINGULAR_CONDITION):
+        named = ", ".join(f"CAL_MAG{n}_{a}{kind} = {params.get(f'CAL_MAG{n}_{a}{kind}', default):g}"
+                          for kind, default in (("SCALE", 1.0), ("ODIAG", 0.0)) for a in "XYZ")
+        return (f"its scale factors make a singular correction ({named}): the field before PX4's calibration "
+                "cannot be recovered from this log (a scale of 1 and off-diagonals of 0 are no correction)")
+    try:
+        px4.body_rotation(params, n, external)
+    except ValueError as error:
+        which = f"CAL_MAG{n}_ROT" if external else "SENS_BOARD_ROT"
+        return f"its rotation cannot be applied ({which}: {error})"
+    return ""
 
 
 def _position(ulog) -> Position | None:
@@ -107,7 +136,12 @@ def _position(ulog) -> Position | None:
         lat, lon, alt = d["latitude_deg"][fixed], d["longitude_deg"][fixed], d["altitude_msl_m"][fixed]
     else:
         lat, lon, alt = d["lat"][fixed] * 1e-7, d["lon"][fixed] * 1e-7, d["alt"][fixed] * 1e-3
-    when = datetime.datetime.fromtimestamp(float(d["time_utc_usec"][fixed][0]) * MICRO, datetime.UTC)
+    try:
+        when = datetime.datetime.fromtimestamp(float(d["time_utc_usec"][fixed][0]) * MICRO, datetime.UTC)
+    except (OverflowError, ValueError, OSError):  # a date no receiver reports (a damaged message)
+        return None
+    if when.year >= 9999 or not np.isfinite([np.median(lat), np.median(lon), np.median(alt)]).all():
+        return None
     start = datetime.datetime(when.year, 1, 1, tzinfo=datetime.UTC)
     end = datetime.datetime(when.year + 1, 1, 1, tzinfo=datetime.UTC)
     year = when.year + (when - start).total_seconds() / (end - start).total_seconds()
@@ -193,11 +227,15 @@ def read_ulog(path: Path) -> FlightLog:
     """Read the PX4 ULog at ``path``."""
     from pyulog import ULog
 
-    try:
-        ulog = ULog(str(path))
-    except Exception as error:  # pyulog raises bare exceptions on a bad header or definitions
-        raise LogError(f"{path}: not a readable ULog ({type(error).__name__}: {error}); check the file is a "
-                       "complete PX4 .ulg") from None
+    from orchestrator.interrupts import surfaced
+    from orchestrator.logs.noise import captured
+
+    with surfaced(), captured() as noise:  # pyulog prints its warnings on standard output
+        try:
+            ulog = ULog(str(path))
+        except Exception as error:  # pyulog raises bare exceptions on a bad header or definitions
+            raise LogError(f"{path}: not a readable ULog ({type(error).__name__}: {error}); check the file is a "
+                           "complete PX4 .ulg") from None
     if not ulog.data_list:
         raise LogError(f"{path}: the ULog holds no logged topic; it is truncated before its data")
     params = dict(ulog.initial_parameters)
@@ -206,7 +244,9 @@ def read_ulog(path: Path) -> FlightLog:
     firmware = f"{info.get('ver_sw_release', info.get('ver_sw', 'version not logged'))} on {hardware}"
     simulator = "SITL" in hardware.upper() or hardware.upper().startswith("PX4_SITL") or "SIH" in hardware.upper()
     vehicle = MAV_TYPE_NAMES.get(int(params.get("MAV_TYPE", 0)), f"MAV_TYPE {params.get('MAV_TYPE', '?')}")
-    warnings = ["corrupt stretches skipped (pyulog reports file corruption)"] if ulog.file_corruption else []
+    said = noise.summary("pyulog")
+    warnings = [f"corrupt stretches skipped: {said or 'pyulog reports file corruption'}"] \
+        if ulog.file_corruption or said else []
     return FlightLog(str(path), "ulog", "PX4", firmware, vehicle, simulator, _compasses(ulog, params), _imus(ulog),
                      _motors(ulog, params, path), _battery(ulog), _attitude(ulog), params, warnings,
                      _position(ulog), _thrust(ulog))

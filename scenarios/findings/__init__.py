@@ -201,7 +201,7 @@ def load(path=FINDINGS_FILE) -> dict[str, dict]:
     try:
         data = json.loads(path.read_text())
         return {f["name"]: f for f in data["findings"]}
-    except (ValueError, KeyError, TypeError) as error:
+    except (ValueError, KeyError, TypeError, OSError) as error:
         raise FindingError(f"{path}: not a findings file ({error}); regenerate it with "
                            "`python -m scenarios.findings`") from None
 

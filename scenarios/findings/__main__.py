@@ -88,9 +88,29 @@ def verify_commands(committed: dict, groups, timeout, matching: str = "") -> int
     return 1 if any(r.status in ("missing", "failed") for r in results) else 0
 
 
+def checkout(root: Path) -> bool:
+    """Whether ``root`` (the package's parent folder) is a source checkout: its ``pyproject.toml``,
+    ``README.md`` and ``docs/`` beside the package, as the findings rewrite them. An installed
+    copy (site-packages) has none of them."""
+    return all((root / name).exists() for name in ("pyproject.toml", "README.md", "docs"))
+
+
+def _check_out(path: Path, write: bool):
+    """Refuse ``--out`` before any group runs: a folder, or (when it is to be written) what the one
+    writer refuses (:func:`orchestrator.files.output_file`: a FIFO, a device, a missing folder)."""
+    from orchestrator.files import OutputRefused, output_file
+
+    if path.is_dir():
+        raise OutputRefused(f"--out {path}: a folder, not a file; give a findings file such as findings.json")
+    if write:
+        output_file(path)
+
+
 def main(argv=None) -> int:
-    """Run the findings; returns the exit code (2: a bad command line, 1: ``--check`` found a
-    difference or the README could not be rewritten).
+    """Run the findings; returns the exit code (2: a bad command line, or a copy that is not a
+    source checkout (:func:`checkout`: nothing is written into an installed package); 1:
+    ``--check`` found a difference or checked nothing (every group skipped), or the README could
+    not be rewritten).
 
     Parameters
     ----------
@@ -103,7 +123,18 @@ def main(argv=None) -> int:
         print(f"quadcosim findings: unknown group {', '.join(unknown)}; groups: {', '.join(findings.GROUPS)}",
               file=sys.stderr)
         return 2
-    committed = findings.load(args.out)
+    if not checkout(findings.ROOT):
+        print(f"quadcosim findings: a maintainer's tool, run from a source checkout: it measures the README's "
+              f"numbers into findings.json and rewrites the README and docs/ beside it. This copy of quadcosim is "
+              f"installed in {findings.ROOT} (no pyproject.toml, README.md and docs/ there) and is not written "
+              "into; clone the repository and run it there", file=sys.stderr)
+        return 2
+    try:
+        _check_out(args.out, write=not (args.check or args.verify_commands))
+        committed = findings.load(args.out)
+    except (ValueError, OSError) as error:  # OutputRefused and FindingError among them
+        print(f"quadcosim findings: {error}", file=sys.stderr)
+        return 2
     if args.verify_commands:
         return verify_commands(committed, args.groups or None, args.timeout, args.matching)
     computed, skipped = run(args.groups or findings.GROUPS, args.quick)
@@ -111,13 +142,22 @@ def main(argv=None) -> int:
         kept = [n for n, f in committed.items() if f["group"] == group]
         print(f"{group}: skipped ({reason}); its {len(kept)} committed values are kept", file=sys.stderr)
     if args.check:
+        if not computed:
+            print(f"quadcosim findings --check: nothing was checked: every group asked for was skipped "
+                  f"({', '.join(skipped)}); give their data (see each reason above) to check them", file=sys.stderr)
+            return 1
         lines = findings.differences(computed, committed)
         for line in lines:
             print(line, file=sys.stderr)
-        print(f"{len(computed)} findings computed, {len(lines)} differences from {args.out}")
+        unchecked = f"; {len(skipped)} groups skipped, not checked ({', '.join(skipped)})" if skipped else ""
+        print(f"{len(computed)} findings computed, {len(lines)} differences from {args.out}{unchecked}")
         return 1 if lines else 0
     new = committed | {f["name"]: f for f in computed}
-    findings.save(new, args.out)
+    try:
+        findings.save(new, args.out)
+    except OSError as error:  # a full disk (named, the earlier file kept whole) or a folder gone meanwhile
+        print(f"quadcosim findings: {error}", file=sys.stderr)
+        return 1
     print(f"{len(computed)} findings written to {args.out}")
     if args.no_readme:
         return 0

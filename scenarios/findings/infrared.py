@@ -1,22 +1,27 @@
 """Findings of the in-flight infrared calibration: the estimators' errors, the fault detection, the cost.
 
-``quadcosim run ir-calibration`` in five cases, ``python -m scenarios.ir_detection`` (a fault of
-each size, then fault-free flights of seeds 1 to 100, and of seeds 201 to 300),
-``python -m scenarios.ir_detectability`` (the small faults in the filter's innovations, and what
-the consistency detector was set on) and ``quadcosim bench infrared`` (the operation count; its
-timings are not findings). The quick subset: the two faults the
-acceptance names (IR +400 counts, GPS +0.3 rad/s).
+``quadcosim run ir-calibration`` in five cases, ``python -m scenarios.ir_detection --quick``
+(IR +100 counts and GPS +0.1 rad/s over 40 fresh flights each, 200 fresh fault-free flights:
+the quick subset CI re-checks), ``python -m scenarios.ir_detectability --explain`` and
+``--ramps`` (the small faults in the filter's innovations, ramped faults), ``python -m
+scenarios.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
+infrared`` (the operation count; its timings are not findings).
 """
 
 from __future__ import annotations
+
+import math
+
+import numpy as np
 
 from scenarios.findings import command, finding
 
 RUN = "quadcosim run ir-calibration"
 DETECTION = "python -m scenarios.ir_detection"
-FRESH = (201, 300)  # fault-free flights no setting was chosen on, nor any design looked at
 DETECTABILITY = "python -m scenarios.ir_detectability"
 BENCH = "quadcosim bench infrared"
+SLIDES = "python -m scenarios.ir_slides"
+UNIT = {"ir": "count", "gps": "rad/s"}
 CASES = {"drift": {}, "no_drift": {"drift": False}, "no_gps_resetting": {"gps_resetting": False},
          "faults": {"faults": "both"}, "faults_ungated": {"faults": "both", "gating": False}}
 METHODS = {"kalman": "Kalman", "regression": "regression", "rls": "RLS"}
@@ -58,69 +63,106 @@ def errors() -> list[dict]:
     return found
 
 
-def detection(sizes=None) -> list[dict]:
-    """Declaration delay and end of one fault of each size (``sizes``: ``(sensor, size)`` pairs,
-    default every size of :mod:`scenarios.ir_detection`); a fault never declared gives no finding
-    (the README says "never")."""
-    from scenarios import ir_detection
-
-    sizes = sizes or [("ir", s) for s in ir_detection.IR_SIZES] + [("gps", s) for s in ir_detection.GPS_SIZES]
-    found = []
-    for sensor, size in sizes:
-        row = ir_detection.one_fault(sensor, size)
-        label = f"infrared.detection.{sensor}_{size:g}".replace(".", "_").replace("infrared_detection_",
-                                                                                "infrared.detection.")
-        if row["declared_after_s"] is not None and row["attributed"] == sensor:
-            found += [finding(f"{label}.declared_after_s", row["declared_after_s"], "s", DETECTION, 0.005, 2),
-                      finding(f"{label}.ended_after_s", row["ended_after_s"], "s", DETECTION, 0.005, 2)]
-        found.append(finding(f"{label}.other_declarations", row["false_alarms"], "1", DETECTION, 0.0, 0))
+def _case(label: str, s: dict, command: str) -> list[dict]:
+    """The findings of one fault case of :func:`scenarios.ir_detection.summary`."""
+    found = [finding(f"{label}.flights", s["flights"], "1", command, 0.0, 0)]
+    for key in ("right", "ended_early", "standing"):
+        p = s[key]
+        found += [finding(f"{label}.{key}", p["k"], "1", command, 1.0, 0),
+                  finding(f"{label}.{key}_pct", 100 * p["rate"], "%", command, 100.0 / p["n"], 2),
+                  finding(f"{label}.{key}_low_pct", 100 * p["low"], "%", command, 100.0 / p["n"], 2),
+                  finding(f"{label}.{key}_high_pct", 100 * p["high"], "%", command, 100.0 / p["n"], 2)]
+    found += [finding(f"{label}.delay_{q}_s", s["delay_s"][q], "s", command, 0.05, 2)
+              for q in ("p50", "p90", "p99") if math.isfinite(s["delay_s"][q])]
+    found += [finding(f"{label}.at_end", s["at_end"], "1", command, 1.0, 0),
+              finding(f"{label}.other", s["other"], "1", command, 1.0, 0)]
     return found
 
 
-def fault_free() -> list[dict]:
-    """Faults declared over the fault-free flights of seeds 1 to 100, and of seeds 201 to 300."""
+def _clean(label: str, c: dict, command: str) -> list[dict]:
+    """The findings of the fault-free fleet of :func:`scenarios.ir_detection.summary`."""
+    fa = c["false_alarms"]
+    return [finding(f"{label}.flights", c["flights"], "1", command, 0.0, 0),
+            finding(f"{label}.hours", c["hours"], "h", command, 0.05, 1),
+            finding(f"{label}.false_alarms", fa["k"], "1", command, 1.0, 0),
+            finding(f"{label}.per_hour_high", fa["high"], "1/h", command, 0.0005, 4),
+            finding(f"{label}.standing", c["standing"]["k"], "1", command, 1.0, 0)]
+
+
+def detection_quick() -> list[dict]:
+    """CI's re-check: IR +100 counts and GPS +0.1 rad/s over the 40 fresh flights each of
+    :data:`scenarios.ir_detection.QUICK`, and its 200 fault-free flights."""
     from scenarios import ir_detection
 
-    clean = ir_detection.false_alarms()
-    fresh = ir_detection.false_alarms(range(FRESH[0], FRESH[1] + 1))
-    fresh_command = f"{DETECTION} --seeds {FRESH[0]}:{FRESH[1]}"
-    return [finding("infrared.fault_free.flights", clean["flights"], "1", DETECTION, 0.0, 0),
-            finding("infrared.fault_free.false_alarms", clean["false_alarms"], "1", DETECTION, 0.0, 0),
-            finding("infrared.fault_free.fresh_flights", fresh["flights"], "1", fresh_command, 0.0, 0),
-            finding("infrared.fault_free.fresh_false_alarms", fresh["false_alarms"], "1", fresh_command, 0.0, 0)]
+    result, command = ir_detection.quick(), f"{DETECTION} --quick"
+    found = []
+    for case, s in result["cases"].items():
+        found += _case(f"infrared.quick.{case.replace('.', '_')}", s, command)
+    return found + _clean("infrared.quick.fault_free", result["clean"], command)
 
 
 def detectability() -> list[dict]:
-    """Why the small faults escaped the CUSUMs on the filter's innovations (seed 1), how slow a
-    fault may come before it passes for drift, and what the consistency detector was set on
-    (seeds 101 to 200)."""
+    """Why the small faults escape the CUSUMs on the filter's own innovations (seed 1), and how
+    slow a fault may come before it passes for drift (seed 1)."""
     from scenarios import ir_detectability
 
     e = ir_detectability.explain()
     free = e["fault_free"]
-    found = [finding(f"infrared.detectability.fault_free.{name}_std", free[name], "1", DETECTABILITY, 0.005, 2)
-             for name in ("gps", "pair", "held")]
-    found += [finding("infrared.detectability.fault_free.held_std_count", free["held_count"], "count",
-                      DETECTABILITY, 0.05, 1),
-              finding("infrared.detectability.fault_free.b_rate_max", free["b_rate_max"], "count/s", DETECTABILITY,
-                      0.05, 1)]
+    found = [finding(f"infrared.detectability.fault_free.{name}_std", free[name], "1", f"{DETECTABILITY} --explain",
+                     0.005, 2) for name in ("gps", "pair")]
+    found.append(finding("infrared.detectability.fault_free.b_rate_max", free["b_rate_max"], "count/s",
+                         f"{DETECTABILITY} --explain", 0.05, 1))
     for sensor, size in ir_detectability.FAULTS:
         row, label = e[f"{sensor}_{size:g}"], f"infrared.detectability.{sensor}_{size:g}".replace("0.", "0_")
-        found += [finding(f"{label}.{name}", row[name], "1", DETECTABILITY, 0.005, 2)
-                  for name in ("gps", "pair", "held")]
-        found += [finding(f"{label}.b_shift", row["b_shift"], "count", DETECTABILITY, 0.05, 1),
-                  finding(f"{label}.a_shift", row["a_shift"], "count s/rad", DETECTABILITY, 0.05, 1),
-                  finding(f"{label}.held_count", row["held_count"], "count", DETECTABILITY, 0.05, 1)]
+        found += [finding(f"{label}.{name}", row[name], "1", f"{DETECTABILITY} --explain", 0.005, 2)
+                  for name in ("gps", "pair")]
+        found += [finding(f"{label}.b_shift", row["b_shift"], "count", f"{DETECTABILITY} --explain", 0.05, 1),
+                  finding(f"{label}.a_shift", row["a_shift"], "count s/rad", f"{DETECTABILITY} --explain", 0.05, 1)]
     for sensor, size in ir_detectability.RAMPED:
         for ramp_s in ir_detectability.RAMPS_S:
             r = ir_detectability.ramped(sensor, size, ramp_s)
             if r["declared_after_s"] is not None:  # one never declared gives no finding (the page says so)
                 found.append(finding(f"infrared.ramps.{sensor}_{ramp_s:g}s.declared_after_s", r["declared_after_s"],
                                      "s", f"{DETECTABILITY} --ramps", 0.005, 2))
-    trained, command = ir_detectability.calibrate(), f"{DETECTABILITY} --calibrate"
-    return found + [finding("infrared.training.statistic_max", trained["statistic_max"], "1", command, 0.005, 2),
-                    finding("infrared.training.a_error_max", trained["a_error_max"], "count s/rad", command, 0.05, 1),
-                    finding("infrared.training.significance_max", trained["significance_max"], "1", command, 0.05, 1)]
+    return found
+
+
+def limits() -> list[dict]:
+    """The detectability limit: the residual's noise, the predicted smallest offset found in
+    99 % of flights, and per size the measured share declared on the right sensor and the delay
+    within which 99 % were (fresh seeds of :data:`scenarios.ir_detectability.MEASURED`)."""
+    from scenarios import ir_detectability
+
+    result, command = ir_detectability.limits(jobs=2), f"{DETECTABILITY} --jobs 2"
+    f = result["figures"]
+    found = [finding("infrared.limit.sigma_count", f["sigma"], "count", command, 0.05, 2)]
+    for sensor in ("ir", "gps"):
+        p = result["predicted"][sensor]
+        best = int(np.argmin(p["size"]))
+        found += [finding(f"infrared.limit.{sensor}.predicted_size", p["size"][best], UNIT[sensor], command,
+                          0.5 if sensor == "ir" else 0.0005, 1 if sensor == "ir" else 4),
+                  finding(f"infrared.limit.{sensor}.predicted_within_s", p["time_s"][best], "s", command, 0.05, 2)]
+        for key, v in result["measured"][sensor].items():
+            label = f"infrared.limit.{sensor}.{key.replace('.', '_')}"
+            found.append(finding(f"{label}.declared_right_pct", 100 * v["declared_right"], "%", command, 1.0, 1))
+            if math.isfinite(v["t99_s"]):
+                found.append(finding(f"{label}.t99_s", v["t99_s"], "s", command, 0.05, 2))
+    return found
+
+
+def comparison() -> list[dict]:
+    """The slides' Kalman/regression comparison in their terms (bank angle, degrees) and in turn
+    rate, with its ablation, as the mean over the fresh flights of :data:`scenarios.ir_slides.SEEDS`."""
+    from scenarios import ir_slides
+
+    found = []
+    for label, entry in ir_slides.table().items():
+        for unit, r in entry.items():
+            for name, value in r.items():
+                found.append(finding(f"infrared.comparison.{label}.{unit}.{name}", value,
+                                     "1" if name.startswith("ratio") else unit.split("_", 1)[1].replace("_", "/"),
+                                     SLIDES, 0.005, 2))
+    return found
 
 
 def cost() -> list[dict]:
@@ -135,7 +177,7 @@ def cost() -> list[dict]:
 
 
 def compute(quick: bool = False) -> list[dict]:
-    """Every infrared finding; ``quick``: the declarations of IR +400 and GPS +0.3 (two flights)."""
+    """Every infrared finding; ``quick``: the small fresh fleets CI re-checks (:func:`detection_quick`)."""
     if quick:
-        return detection([("ir", 400.0), ("gps", 0.3)])
-    return errors() + detection() + fault_free() + detectability() + cost()
+        return detection_quick()
+    return errors() + detection_quick() + detectability() + limits() + comparison() + cost()

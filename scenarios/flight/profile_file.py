@@ -29,6 +29,7 @@ import numpy as np
 from orchestrator.fmu import nearest
 
 TIME_COLUMN = "t"
+MAX_PROFILE_BYTES = 100_000_000  # a profile is a table of setpoints, not a recording
 ANGLES = ("theta_d1", "theta_d2", "theta_d3")
 DEGREE_SUFFIX = "_deg"
 RAD_PER_DEG = math.pi / 180.0  # rad per degree, for the columns given in degrees
@@ -66,16 +67,29 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
     Raises
     ------
     ValueError
-        A missing file, an unknown or repeated column (the nearest names offered), no ``t``
-        column, a value that is not a finite number, or times not strictly increasing; the
-        message names the file, row and column.
+        A missing file, text that is not UTF-8, an unknown or repeated column (the nearest names
+        offered), an angle given twice (in rad and in deg), no ``t`` column, a value that is not
+        a finite number, or times not strictly increasing; the message names the file, row and
+        column.
     """
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise ValueError(f"flight={path}: no such file (a setpoint profile is a CSV file with a header row; "
                          "see scenarios/flight/profile_file.py)")
-    with path.open(newline="") as handle:
-        table = list(csv.reader(handle))
+    if not path.is_file():  # a FIFO would block the read, a folder cannot be read
+        raise ValueError(f"flight={path}: not a regular file; a setpoint profile is a CSV file with a header row")
+    if path.stat().st_size > MAX_PROFILE_BYTES:
+        raise ValueError(f"flight={path}: {path.stat().st_size / 1e6:.0f} MB, not a setpoint profile (a CSV of "
+                         f"at most {MAX_PROFILE_BYTES / 1e6:.0f} MB)")
+    try:
+        # utf-8-sig: a spreadsheet's "CSV UTF-8" begins with a byte-order mark, not part of the header
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            table = list(csv.reader(handle))
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{path}: not UTF-8 text (byte {error.object[error.start]:#04x} at byte {error.start}, a "
+                         "Latin-1 or Windows character?); save the file as UTF-8") from None
+    except (OSError, csv.Error) as error:
+        raise ValueError(f"{path}: not a readable CSV file ({error})") from None
     header, body = [name.strip() for name in table[0]] if table else [], [r for r in table[1:] if any(r)]
     columns = _columns(setpoint)
     for name in header:
@@ -85,6 +99,10 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
     if len(set(header)) != len(header) or TIME_COLUMN not in header or not body:
         raise ValueError(f"{path}: needs a header with the time column {TIME_COLUMN!r} (s), each column once, "
                          "and at least one row")
+    twice = [name for name in ANGLES if name in header and name + DEGREE_SUFFIX in header]
+    if twice:
+        raise ValueError(f"{path}: {', '.join(f'{n} and {n}{DEGREE_SUFFIX}' for n in twice)} give one angle twice "
+                         "(rad and deg); keep one of the two columns")
     values = np.empty((len(body), len(header)))
     for row_number, row in enumerate(body, start=2):
         if len(row) != len(header):

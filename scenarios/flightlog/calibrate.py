@@ -122,25 +122,97 @@ def _rule(args, part):
     return ardupilot.rules(version)
 
 
-def _figures(out: Path, train, test, fitted, model, attitude) -> list[str]:
+def _write(out: Path, split: Split, metrics: dict, calibration, fitted: dict, export: tuple,
+           attitude: str) -> list[str]:
+    """Every output file, ``metrics.json`` last (in the room kept for it: a disk that fills on the
+    way still takes it, listing what was not written); the files written. ``export``: the
+    autopilot, the parameter file's name and its parameters."""
+    from calibration.flight.autopilot import write_parameters
+    from orchestrator.files import DiskFull, Reserve, write_json
+
+    reserve = Reserve(out)  # DiskFull when not even metrics.json fits: nothing is written
+    files, not_written = ["metrics.json"], {}
+
+    def keep(name, write):
+        try:
+            write(out / name)
+            files.append(name)
+        except DiskFull as error:
+            not_written[name] = str(error)
+        except Exception as error:  # a figure that could not be drawn: said in metrics.json, the rest kept
+            not_written[name] = f"{type(error).__name__}: {error}"
+
+    autopilot, name, params = export
+    keep("calibration.json", calibration.save)
+    keep(name, lambda path: write_parameters(autopilot, params, path))
+    analysis = next((m for m in ("current", "throttle") if m in fitted), None)
+    if analysis is not None:
+        for figure, draw in zip(FIGURES, _figures(split.train, split.test, fitted, analysis, attitude), strict=True):
+            keep(figure, draw)
+    metrics["status"] = "failed" if not_written else "completed"
+    metrics["files"] = files
+    if not_written:
+        metrics["files_not_written"] = not_written
+    try:
+        write_json(out / "metrics.json", metrics)
+    except DiskFull:
+        reserve.release()  # the room kept for it
+        write_json(out / "metrics.json", metrics)
+    finally:
+        reserve.release()
+    return files
+
+
+def _figures(train, test, fitted, model, attitude) -> tuple:
+    """The drawers (path -> None) of :data:`FIGURES`: the residual on the held-out part and the
+    heading over a whole flight, before and after ``model``."""
     from scenarios.flightlog.calibration_figures import heading_figure, residual_figure
 
     name = Path(train[0].source).name
-    residual_figure(test, fitted[model], model, out / FIGURES[0],
-                    f"{name}: field residual on the held-out part, before and after the {model} model fitted here")
-    whole = train[0] if len(train) == len(test) and train[0].log is test[0].log else test[0]
-    cut = test[0].time[0] if whole is train[0] else whole.time[0]
-    if whole is train[0]:
-        from dataclasses import replace
 
-        from calibration.flight import flight_data
+    def residual(path):
+        residual_figure(test, fitted[model], model, path,
+                        f"{name}: field residual on the held-out part, before and after the {model} model fitted here")
 
-        whole = replace(flight_data(train[0].log, train[0].compass, attitude), earth=train[0].earth)
-    heading_figure(whole, fitted[model], model, cut, out / FIGURES[1],
-                   f"{Path(whole.source).name}: heading from the compass against the log's, before and after "
-                   f"the {model} model fitted here")
-    return list(FIGURES)
+    def heading(path):
+        whole = train[0] if len(train) == len(test) and train[0].log is test[0].log else test[0]
+        cut = test[0].time[0] if whole is train[0] else whole.time[0]
+        if whole is train[0]:
+            from dataclasses import replace
 
+            from calibration.flight import flight_data
+
+            whole = replace(flight_data(train[0].log, train[0].compass, attitude), earth=train[0].earth)
+        heading_figure(whole, fitted[model], model, cut, path,
+                       f"{Path(whole.source).name}: heading from the compass against the log's, before and after "
+                       f"the {model} model fitted here")
+
+    return residual, heading
+
+
+def _export(args, split: Split, metrics: dict) -> tuple:
+    """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
+    described in ``metrics["export"]``; (autopilot, file name, parameters)."""
+    from calibration.flight.export import choose, log_parameters, rules_of, score_parameters
+
+    train, score = split.train, split.score
+    rule = _rule(args, split.test[0])
+    params, chosen = choose(split.fit, split.choice, rule)
+    autopilot = train[0].log.autopilot
+    name = PARAMETER_FILES[autopilot]
+    exported = score_parameters(score, params, rule)
+    flown = score_parameters(score, log_parameters(score[0], params), rule)
+    firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
+    metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
+                         "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
+                         "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"],
+                         "split": {"fit": sorted({p.source for p in split.fit}),
+                                   "choice": sorted({p.source for p in split.choice}),
+                                   "score": sorted({p.source for p in score}),
+                                   "score_from_s": [float(p.time[0]) for p in score],
+                                   "choice_from_s": [float(p.time[0]) for p in split.choice],
+                                   "rule": split.notes["validation"]}}
+    return autopilot, name, params
 
 def _report(metrics: dict) -> list[str]:
     lines = [f"trained on {', '.join(metrics['train'])}; tested on {', '.join(metrics['test'])} "
@@ -191,13 +263,17 @@ def _score(args, split: Split) -> int:
 
     score = split.score
     rule = _rule(args, score[0])
-    given = score_file(args.score, score, rule)
-    names = list(parameters_of(score[0], Candidate(np.zeros(3), np.eye(3)), rule))
-    flown = score_parameters(score, log_parameters(score[0], names), rule)
+
+    def scores():
+        given = score_file(args.score, score, rule)
+        names = list(parameters_of(score[0], Candidate(np.zeros(3), np.eye(3)), rule))
+        return given, score_parameters(score, log_parameters(score[0], names), rule)
+
+    given, flown = _numeric(scores, [p.source for p in score])
     out = Path(args.out)
     metrics = {"test": sorted({p.source for p in score}), "validation": split.notes["validation"],
-               "scored_on": "the export's score part", "score": given, "as_flown": flown}
-    write_json(out / "metrics.json", metrics)
+               "scored_on": "the export's score part", "score": given, "as_flown": flown, "files": ["metrics.json"]}
+    _saved(out, args.overwrite, lambda: write_json(out / "metrics.json", metrics))
     print(f"tested on {', '.join(metrics['test'])} ({split.notes['validation']}; scored on the export's score part)")
     print(f"heading on the score part, {args.score} applied as the firmware does: {given['heading_rms_deg']:.2f} deg "
           f"RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)")
@@ -207,62 +283,115 @@ def _score(args, split: Split) -> int:
 
 
 def run(args) -> int:
-    """``quadcosim calibrate`` (``args`` from :func:`add_arguments`); 2 on bad input."""
+    """``quadcosim calibrate`` (``args`` from :func:`add_arguments`): 0, 2 on bad input (nothing
+    written), 1 when the disk filled while the files were written (``metrics.json`` says which
+    were not). The folder is held (:func:`orchestrator.files.folder_lock`) from before its
+    earlier results are replaced until ``metrics.json`` is written; signals wait while the files
+    are written, so that an interrupt leaves them all with their ``metrics.json``, or nothing."""
     from calibration.flight import calibrate
-    from calibration.flight.autopilot import write_parameters
-    from calibration.flight.export import choose, score_parameters
     from calibration.static import CalibrationError
-    from orchestrator.files import prepare_out_dir, write_json
-    from orchestrator.logs import LogError
 
+    out = Path(args.out)
     try:
         _check_choices(args)
-        out = prepare_out_dir(args.out, args.overwrite)
-        split = _split(args)
+        _check_out(out, args.overwrite)  # before the flights are read; again, held, before writing
+        split = _numeric(lambda: _split(args), args.files or [*(args.train or []), *(args.test or [])], also=())
         if args.score:
             return _score(args, split)
-        train, test, score = split.train, split.test, split.score
-        metrics, calibration, fitted = calibrate(train, test, tuple(args.models), args.attitude)
+        sources = [p.source for p in [*split.train, *split.test]]
+        metrics, calibration, fitted = _numeric(
+            lambda: calibrate(split.train, split.test, tuple(args.models), args.attitude), sources)
         metrics |= split.notes
-        rule = _rule(args, test[0])
-        params, chosen = choose(split.fit, split.choice, rule)
-        autopilot = train[0].log.autopilot
-        name = PARAMETER_FILES[autopilot]
-        write_parameters(autopilot, params, out / name)
-        from calibration.flight.export import log_parameters
-
-        exported = score_parameters(score, params, rule)
-        flown = score_parameters(score, log_parameters(score[0], params), rule)
-        from calibration.flight.export import rules_of
-
-        firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
-        metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
-                             "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
-                             "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"],
-                             "split": {"fit": sorted({p.source for p in split.fit}),
-                                       "choice": sorted({p.source for p in split.choice}),
-                                       "score": sorted({p.source for p in score}),
-                                       "score_from_s": [float(p.time[0]) for p in score],
-                                       "choice_from_s": [float(p.time[0]) for p in split.choice],
-                                       "rule": split.notes["validation"]}}
-        calibration.save(out / "calibration.json")
-        files = ["metrics.json", "calibration.json", name]
-        analysis = next((m for m in ("current", "throttle") if m in fitted), None)
-        if analysis is not None:
-            files += _figures(out, train, test, fitted, analysis, args.attitude)
-        metrics["files"] = files
-        write_json(out / "metrics.json", metrics)
-    except (LogError, CalibrationError, ValueError) as error:
+        export = _numeric(lambda: _export(args, split, metrics), sources)
+        files = _saved(out, args.overwrite,
+                       lambda: _write(out, split, metrics, calibration, fitted, export, args.attitude))
+    except (CalibrationError, ValueError) as error:  # LogError, FolderBusy and OutputRefused among them
         print(f"quadcosim calibrate: {error}", file=sys.stderr)
         return 2
+    except OSError as error:  # not even metrics.json fitted: nothing written
+        print(f"quadcosim calibrate: failed: {error}", file=sys.stderr)
+        return 1
     print("\n".join(_report(metrics)))
+    if metrics["status"] == "failed":
+        for name, why in metrics["files_not_written"].items():
+            print(f"quadcosim calibrate: {name} not written: {why}", file=sys.stderr)
+        print(f"quadcosim calibrate: failed; metrics.json in {out}/ lists what was written", file=sys.stderr)
+        return 1
     print(f"{', '.join(files)} in {out}/")
     if not fitted:
-        sources = ", ".join(sorted({p.source.rsplit(":", 1)[0] for p in train}))
+        sources = ", ".join(sorted({p.source.rsplit(":", 1)[0] for p in split.train}))
         print(f"quadcosim calibrate: no interference model could be identified from {sources} (reasons above)",
               file=sys.stderr)
         return 2
     return 0
+
+
+def _saved(out: Path, overwrite: bool, write):
+    """``write()``'s result, the folder ``out`` prepared and held, and signals waiting, meanwhile;
+    a folder this command created is removed again when nothing could be written into it."""
+    import contextlib
+
+    from orchestrator.files import prepare_out_dir
+    from orchestrator.interrupts import held
+    from scenarios.outputs import remove_if_empty
+
+    made = not out.exists()
+    with contextlib.ExitStack() as lock, held():
+        try:
+            prepare_out_dir(out, overwrite, lock)
+            return write()
+        except BaseException:
+            if made:
+                remove_if_empty(out)
+            raise
+
+def _check_out(out: Path, overwrite: bool):
+    """Refuse at once an output folder that will be refused after the flights are read and fitted."""
+    from orchestrator.files import FolderBusy, busy_message, held_by, holds_results
+
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out}: a file of that name exists; give a folder name")
+    earlier = holds_results(out)
+    if earlier and not overwrite:
+        raise ValueError(f"--out {out} already holds results ({', '.join(earlier)}); give another folder "
+                         "or add --overwrite to replace them")
+    holder = held_by(out) if out.is_dir() else None
+    if holder is not None:
+        raise FolderBusy(f"--out {busy_message(out, holder)}")
+
+
+def _numeric(call, sources, also=(ValueError,)):
+    """``call()``, a numerical library's failure (``LinAlgError``, ``FloatingPointError``,
+    ``IndexError`` and the classes ``also``) named with the flights ``sources``, its cause and the
+    fix; the project's own refusals (:class:`~calibration.static.CalibrationError`,
+    :class:`~orchestrator.logs.LogError`, ...) pass unchanged."""
+    from calibration.static import CalibrationError
+    from orchestrator.files import OutputRefused
+    from orchestrator.logs import LogError
+
+    try:
+        return call()
+    except (CalibrationError, LogError, OutputRefused):
+        raise
+    except (np.linalg.LinAlgError, FloatingPointError, IndexError, ZeroDivisionError, *also) as error:
+        if type(error) is ValueError and _ours(error):  # a refusal of the project's own, in its words already
+            raise
+        named = ", ".join(sorted({str(s) for s in sources}))
+        raise CalibrationError(f"{named}: the fit failed ({type(error).__name__}: {error}): the flights hold too "
+                               "little usable data to identify a model (values that barely vary, or a damaged log); "
+                               "give longer flights with climbs, descents and turns, or --models with fewer "
+                               "models") from None
+
+def _ours(error: BaseException) -> bool:
+    """Whether ``error`` was raised by the project's own code (its last frame is not a library's)."""
+    import traceback
+
+    frames = traceback.extract_tb(error.__traceback__)
+    if not frames:
+        return True
+    root = Path(__file__).resolve().parents[2]
+    where = Path(frames[-1].filename).resolve()
+    return where.is_relative_to(root) and "site-packages" not in where.parts
 
 
 def _check_choices(args):
@@ -277,6 +406,7 @@ def _check_choices(args):
         raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
     if args.earth not in ("model", "free"):
         raise ValueError(f"--earth {args.earth!r} must be model or free")
+    _rule(args, None)  # --firmware refused before the flights are read
 
 
 def add_arguments(parser):

@@ -7,7 +7,7 @@ import numpy as np
 
 from calibration.flight.evaluate import tilt_compensated_heading, wrap
 from calibration.flight.linear import earth_and_offset
-from orchestrator.files import save_figure
+from orchestrator.files import printable, save_figure
 
 TESLA_TO_UT = 1e6
 
@@ -65,9 +65,11 @@ def residual_figure(parts, fitted, name: str, path, title: str):
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("field left unexplained (uT)")
     axes[0].legend(fontsize=8, loc="best")
-    fig.suptitle(title, fontsize=10)
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
+    fig.suptitle(printable(title), fontsize=10)
+    try:
+        save_figure(fig, path, dpi=110)
+    finally:
+        plt.close(fig)
 
 
 def heading_figure(data, fitted, name: str, cut: float, path, title: str):
@@ -91,6 +93,8 @@ def heading_figure(data, fitted, name: str, cut: float, path, title: str):
     ax.set_ylabel("compass heading - log heading (deg)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.suptitle(title, fontsize=10)
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
+    fig.suptitle(printable(title), fontsize=10)
+    try:
+        save_figure(fig, path, dpi=110)
+    finally:
+        plt.close(fig)

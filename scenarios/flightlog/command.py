@@ -37,17 +37,22 @@ def info(args) -> int:
 
 
 def plot(args) -> int:
-    """``quadcosim log plot FILE [--out PNG]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
+    """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); 2 on a bad
+    log or output path, 1 when the figure could not be written (a full disk)."""
+    from orchestrator.files import OutputRefused, figure_file
     from orchestrator.logs import LogError
     from scenarios.flightlog.overview import plot_overview
 
     try:
+        out = figure_file(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
         log = load(args.file, "log plot")
-    except LogError as error:
+        print(plot_overview(log, out))
+    except (LogError, OutputRefused) as error:
         print(f"quadcosim log plot: {error}", file=sys.stderr)
         return 2
-    out = Path(args.out) if args.out else Path("results") / "logs" / f"{Path(args.file).stem}-overview.png"
-    print(plot_overview(log, out))
+    except OSError as error:  # a full disk (named, nothing left), a folder removed under it
+        print(f"quadcosim log plot: failed: {error}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -61,7 +66,8 @@ def add_arguments(parser):
     shown.set_defaults(func=info)
     drawn = sub.add_parser("plot", help="an overview figure: field, current, throttle and attitude")
     drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
-    drawn.add_argument("--out", help="PNG to write (default results/logs/NAME-overview.png)")
+    drawn.add_argument("--out", help="figure file to write, .png, .svg or .pdf (default "
+                       "results/logs/NAME-overview.png; a folder takes NAME-overview.png)")
     drawn.set_defaults(func=plot)
     from scenarios.flightlog import replay
 

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.files import printable, save_figure
+
 TESLA_TO_UT = 1e6
 #: Legends stand right of their axes, where they cover no trace.
 LEGEND = {"loc": "upper left", "bbox_to_anchor": (1.005, 1.0), "fontsize": 7, "frameon": False, "borderaxespad": 0.0}
@@ -22,9 +24,10 @@ def _euler_deg(q: np.ndarray) -> np.ndarray:
 
 
 def plot_overview(log, out) -> Path:
-    """Draw the overview of ``log`` (:class:`orchestrator.logs.FlightLog`) into the PNG ``out``:
-    each compass's raw field (uT), battery current (A) and voltage (V), motor commands and
-    throttle (1), and the autopilot's roll, pitch and yaw (deg), on the log's clock (s)."""
+    """Draw the overview of ``log`` (:class:`orchestrator.logs.FlightLog`) into the figure file ``out``
+    (its format from its suffix, written atomically: :func:`orchestrator.files.save_figure`): each
+    compass's raw field (uT), battery current (A) and voltage (V), motor commands and throttle
+    (1), and the autopilot's roll, pitch and yaw (deg), on the log's clock (s)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -70,9 +73,9 @@ def plot_overview(log, out) -> Path:
     ax.set_ylabel(f"attitude (deg)\n{log.attitude.source if log.attitude else 'none logged'}")
     ax.set_xlabel("time from the first sample (s)")
     sim = ", SIMULATOR" if log.simulator else ""
-    fig.suptitle(f"{Path(log.path).name}: {log.autopilot} {log.firmware}, {log.vehicle}{sim}", fontsize=10)
+    fig.suptitle(printable(f"{Path(log.path).name}: {log.autopilot} {log.firmware}, {log.vehicle}{sim}"), fontsize=10)
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    try:
+        return save_figure(fig, out, dpi=110)
+    finally:
+        plt.close(fig)

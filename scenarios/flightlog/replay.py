@@ -23,19 +23,26 @@ import sys
 
 import numpy as np
 
+MIN_SAMPLES = 100  # IMU samples a replay needs: half of them, the second, are scored
 ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
 REFERENCE_NOTE = ("differences from the autopilot's own attitude estimate, a reference and not the truth "
                   "(it fuses the primary compass itself)")
 
 
-def _uniform(log):
+def _uniform(log, compass: int):
     from scipy.spatial.transform import Rotation, Slerp
 
+    from orchestrator.logs import LogError
+
     imu = log.imus[0]
+    chosen = log.compass(compass)
+    lo, hi = log.overlap((imu.name, imu), ("attitude", log.attitude), (chosen.name, chosen))
     dt = float(np.median(np.diff(imu.time)))
-    lo = max(imu.time[0], log.attitude.time[0])
-    hi = min(imu.time[-1], log.attitude.time[-1])
     time = np.arange(lo, hi, dt)
+    if len(time) < MIN_SAMPLES:
+        raise LogError(f"{log.path}: {imu.name}, the attitude and {chosen.name} share {hi - lo:.1f} s "
+                       f"({len(time)} IMU samples, from {lo:.1f} to {hi:.1f} s); a replay needs {MIN_SAMPLES} or more: "
+                       "give a longer flight")
     gyro = np.column_stack([np.interp(time, imu.time, imu.gyro[:, k]) for k in range(3)])
     acc = np.column_stack([np.interp(time, imu.time, imu.acc[:, k]) for k in range(3)])
     rotations = Rotation.from_quat(log.attitude.q, scalar_first=True)
@@ -73,7 +80,8 @@ def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMA
     from orchestrator.logs import FlightLog, read_log
 
     log = path if isinstance(path, FlightLog) else read_log(path)
-    time, dt, gyro, acc, reference = _uniform(log)
+    log.require("a replay", "imu", "attitude", "compass", "motors")
+    time, dt, gyro, acc, reference = _uniform(log, compass)
     without, with_model, model = _fields(log, compass, time)
     half = time[0] + 0.5 * (time[-1] - time[0])
     scored = time >= max(half, time[0] + settle_s)
@@ -107,19 +115,43 @@ def text(result: dict) -> str:
     return "\n".join(lines)
 
 
-def run(args) -> int:
-    """``quadcosim log replay FILE [--compass N] [--json OUT]`` (``args`` from argparse); 2 on bad input."""
+def _replayed(log, compass: int) -> dict:
+    """:func:`replay_log` of the read ``log``, a numerical library's failure named with the file,
+    its likely cause and the fix."""
     from calibration.static import CalibrationError
+    from orchestrator.files import OutputRefused
     from orchestrator.logs import LogError
 
     try:
-        result = replay_log(args.file, args.compass)
-    except (LogError, CalibrationError, ValueError) as error:
+        return replay_log(log, compass)
+    except (LogError, CalibrationError, OutputRefused):
+        raise
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError, ZeroDivisionError) as error:
+        raise LogError(f"{log.path}: the replay failed ({type(error).__name__}: {error}): the log holds too little "
+                       "usable data for the estimators (a damaged stretch, a sensor that barely varies); replay a "
+                       "longer, undamaged flight") from None
+
+
+def run(args) -> int:
+    """``quadcosim log replay FILE [--compass N] [--json OUT]`` (``args`` from argparse); 2 on bad
+    input (a log, an option or an output path refused), 1 when the JSON could not be written (a
+    full disk: nothing is left under its name)."""
+    from calibration.static import CalibrationError
+    from orchestrator.files import output_file, write_json
+    from scenarios.flightlog.command import load
+
+    try:
+        if args.json:
+            output_file(args.json)  # refused before the replay, not after it
+        result = _replayed(load(args.file, "log replay"), args.compass)
+    except (CalibrationError, ValueError) as error:  # LogError and OutputRefused among them
         print(f"quadcosim log replay: {error}", file=sys.stderr)
         return 2
     print(text(result))
     if args.json:
-        from orchestrator.files import write_json
-
-        write_json(args.json, result)
+        try:
+            write_json(args.json, result)
+        except OSError as error:
+            print(f"quadcosim log replay: failed: {error}", file=sys.stderr)
+            return 1
     return 0

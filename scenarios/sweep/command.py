@@ -181,7 +181,7 @@ def sweep_plot(args) -> int:
     Returns
     -------
     int
-        Exit code: 0, or 2 for a missing table or column.
+        Exit code: 0, 2 for a missing table or column or a figure path refused, 1 for a full disk.
     """
     from scenarios.sweep import figure, table
 
@@ -201,6 +201,9 @@ def sweep_plot(args) -> int:
     except (KeyError, ValueError) as error:
         print(f"quadcosim sweep-plot: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
+    except OSError as error:  # a full disk: named, nothing left under the figure's name
+        print(f"quadcosim sweep-plot: failed: {error}", file=sys.stderr)
+        return 1
     print(path)
     return 0
 

@@ -37,6 +37,7 @@ from pathlib import Path
 
 from distributed import WorkerPlugin
 
+from orchestrator.files import atomic_path, write_text
 from scenarios.sweep import table
 from scenarios.sweep.grid import Member, Plan, stored_members
 
@@ -234,9 +235,7 @@ class Summary:
 
 
 def _write_json(path: Path, data: dict) -> None:
-    temporary = path.with_name(f".{path.name}.tmp")
-    temporary.write_text(json.dumps(data, indent=1, default=float) + "\n")
-    os.replace(temporary, path)
+    write_text(path, json.dumps(data, indent=1, default=float) + "\n")
 
 
 def member_folder(out: Path, index: int) -> Path:
@@ -306,9 +305,10 @@ def _save_member(out: Path, member: Member, record: dict, attempts: int, scenari
     folder = member_folder(out, member.index)
     folder.mkdir(parents=True, exist_ok=True)
     for name, data in (record.get("files") or {}).items():
-        (folder / name).write_bytes(data)
+        with atomic_path(folder / name, size=len(data)) as temporary:
+            temporary.write_bytes(data)
     if record.get("traceback"):
-        (folder / "error.txt").write_text(record["traceback"])
+        write_text(folder / "error.txt", record["traceback"])
     saved = {"member": member.index, "label": member.label, "status": record["status"], "error": record["error"],
              "attempts": attempts, "wall_s": record.get("wall_s"), "cpu_s": record.get("cpu_s"),
              "stepping_cpu_s": record.get("stepping_cpu_s"),

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from orchestrator.files import save_figure
+
 
 def _number(value) -> float | None:
     if isinstance(value, bool) or value is None:
@@ -150,8 +152,10 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    try:
+        save_figure(figure, path, dpi=120)
+    finally:
+        plt.close(figure)
     return str(path)
 
 

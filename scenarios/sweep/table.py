@@ -10,11 +10,12 @@ import csv
 import io
 import json
 import math
-import os
 from pathlib import Path
 
 import pyarrow as pa
 import pyarrow.parquet as pq
+
+from orchestrator.files import atomic_path
 
 #: Columns that come first, in this order; the options and then the metrics follow.
 LEADING = ("member", "label", "status", "error", "attempts", "wall_s", "cpu_s", "stepping_cpu_s", "worker")
@@ -71,9 +72,8 @@ def _arrow_column(values: list) -> pa.Array:
 
 
 def _replace(path: Path, write):
-    temporary = path.with_name(f".{path.name}.tmp")
-    write(temporary)
-    os.replace(temporary, path)
+    with atomic_path(path) as temporary:
+        write(temporary)
 
 
 def write(rows: list[dict], out: Path) -> None:

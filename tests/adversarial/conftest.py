@@ -1,9 +1,11 @@
 """Helpers of the adversarial tests: a small run, its files, and checks that nothing on disk is
 truncated or half-written."""
 
+import contextlib
 import json
 import os
 import signal
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +41,22 @@ def assert_whole(out: Path) -> dict:
             data = (out / name).read_bytes()
             assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[-8:-4] == b"IEND", name
     return metrics
+
+
+@contextlib.contextmanager
+def mounted(folder: Path, size: str):
+    """A tmpfs of ``size`` (``"2m"``, ``"256k"``) mounted at ``folder`` (made) while the block runs;
+    the test is skipped where mounting is not permitted (the injected full-disk tests cover the
+    same paths)."""
+    folder.mkdir()
+    mounted = os.geteuid() == 0 and subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs",
+                                                    str(folder)], capture_output=True).returncode == 0
+    if not mounted:
+        pytest.skip(f"mounting a {size} tmpfs is not permitted here")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=True)
 
 
 def send_self(number: int = signal.SIGINT):

@@ -4,9 +4,9 @@ or fails with the folder and the bytes named, or completes; what is on the disk 
 
 import json
 import os
-import subprocess
 
 import pytest
+from conftest import mounted
 from scipy.io import loadmat
 
 from orchestrator import Result
@@ -15,18 +15,9 @@ from scenarios.cli import main as cli
 
 @pytest.fixture
 def small_disk(tmp_path):
-    """A 2 MB tmpfs mounted at ``tmp_path / "disk"``; skipped where mounting is not permitted
-    (the injected full-disk tests of ``test_full_disk.py`` cover the same paths)."""
-    disk = tmp_path / "disk"
-    disk.mkdir()
-    mounted = os.geteuid() == 0 and subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(disk)],
-                                                   capture_output=True).returncode == 0
-    if not mounted:
-        pytest.skip("mounting a 2 MB tmpfs is not permitted here")
-    try:
+    """A 2 MB tmpfs mounted at ``tmp_path / "disk"`` (skipped where mounting is not permitted)."""
+    with mounted(tmp_path / "disk", "2m") as disk:
         yield disk
-    finally:
-        subprocess.run(["umount", str(disk)], check=True)
 
 
 def _whole(path):

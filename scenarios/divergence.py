@@ -1,0 +1,130 @@
+"""Whether a closed-loop run diverged: bounds on the attitude and altitude errors, per scenario.
+
+A gain set that destabilises the loop (``--set Controller.kp=5000``) still gives finite numbers:
+the vehicle tumbles and falls, and its errors are those of a crash, not of a controller. A
+scenario that flies declares :class:`Bounds` (``Scenario.extra["divergence"]``); after the loop,
+:func:`first_crossing` finds the first time a bound was crossed and held, and the run ends with
+the status ``diverged`` (its record, figures and ``metrics.json`` kept), a warning naming the
+settings it ran with, and exit code 1.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Signals the bounds are read from: the true attitude and position, and what the controller asked.
+ROLL_PITCH = (("Quadrotor.theta1", "Controller.theta_d1"), ("Quadrotor.theta2", "Controller.theta_d2"))
+ALTITUDE = ("Quadrotor.p_z", "Setpoint.z_d")
+SPEED = ("Quadrotor.v_x", "Quadrotor.v_y", "Quadrotor.v_z")
+CONTROLLER = ("Controller.tau_x", "Controller.tau_y", "Controller.tau_z", "Controller.thrust")
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """How far a closed-loop flight may stray before it counts as diverged.
+
+    Attributes
+    ----------
+    tilt_error_deg : float
+        Roll or pitch away from the controller's setpoint (deg).
+    altitude_error_m : float
+        Altitude away from its setpoint, above or below (m).
+    speed_m_s : float
+        Speed (m/s).
+    held_s : float
+        How long a bound must stay crossed (s): a setpoint step is not a divergence.
+    """
+
+    tilt_error_deg: float
+    altitude_error_m: float
+    speed_m_s: float
+    held_s: float
+
+
+def _held(crossed: np.ndarray, time: np.ndarray, held_s: float) -> int | None:
+    """Index of the first sample of the first run of ``crossed`` lasting ``held_s`` (s), or None."""
+    if not crossed.any():
+        return None
+    edges = np.diff(np.concatenate([[0], crossed.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    lasting = time[stops] - time[starts] >= held_s
+    return int(starts[lasting][0]) if lasting.any() else None
+
+
+def first_crossing(result, bounds: Bounds) -> dict | None:
+    """The first bound ``result`` crossed and held, or None (also when it did not record what a
+    bound reads: see :func:`unchecked`).
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A closed-loop run's record.
+    bounds : Bounds
+
+    Returns
+    -------
+    dict or None
+        ``at_s`` (s), ``what`` (the text of the crossing), ``bound`` and ``value`` (in the
+        bound's unit), and ``controller_peak`` (the largest torque, N.m, and thrust, N, the
+        controller asked for) when recorded.
+    """
+    time = np.asarray(result.time)
+    found = []
+    names = set(result.names)
+    if all(a in names and b in names for a, b in ROLL_PITCH):
+        for k, (true, wanted) in enumerate(ROLL_PITCH):
+            error = np.degrees(np.abs((result[wanted] - result[true] + math.pi) % (2 * math.pi) - math.pi))
+            at = _held(error > bounds.tilt_error_deg, time, bounds.held_s)
+            if at is not None:
+                found.append((at, f"{'roll' if k == 0 else 'pitch'} {error[at]:.0f} deg from its setpoint",
+                              bounds.tilt_error_deg, float(error[at]), "deg"))
+    if all(n in names for n in ALTITUDE):
+        error = result[ALTITUDE[0]] - result[ALTITUDE[1]]  # NED: positive is below the setpoint
+        at = _held(np.abs(error) > bounds.altitude_error_m, time, bounds.held_s)
+        if at is not None:
+            where = "below" if error[at] > 0 else "above"
+            found.append((at, f"{abs(error[at]):.1f} m {where} its altitude setpoint", bounds.altitude_error_m,
+                          float(abs(error[at])), "m"))
+    if all(n in names for n in SPEED):
+        speed = np.sqrt(sum(result[n] ** 2 for n in SPEED))
+        at = _held(speed > bounds.speed_m_s, time, bounds.held_s)
+        if at is not None:
+            found.append((at, f"a speed of {speed[at]:.1f} m/s", bounds.speed_m_s, float(speed[at]), "m/s"))
+    if not found:
+        return None
+    at, what, bound, value, unit = min(found)
+    crossing = {"at_s": float(time[at]), "what": what, "bound": bound, "value": value, "unit": unit}
+    peaks = {n: float(np.max(np.abs(result[n]))) for n in CONTROLLER if n in names}
+    if peaks:
+        crossing["controller_peak"] = peaks
+    return crossing
+
+
+def unchecked(result) -> list[str]:
+    """The signals a bound reads that ``result`` did not record (its bound is then not checked)."""
+    wanted = [n for pair in ROLL_PITCH for n in pair] + list(ALTITUDE) + list(SPEED)
+    return [n for n in wanted if n not in set(result.names)]
+
+
+def message(scenario: str, crossing: dict, settings: list[str]) -> str:
+    """The warning of a run that diverged: when and how, the bound, the settings it ran with.
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name.
+    crossing : dict
+        What :func:`first_crossing` found.
+    settings : list of str
+        The options off their defaults and the block parameters set, ``key=value``.
+    """
+    peaks = crossing.get("controller_peak", {})
+    torque = max((v for n, v in peaks.items() if n.startswith("Controller.tau")), default=None)
+    asked = f"; the controller asked for up to {torque:.3g} N.m" if torque is not None else ""
+    given = ", ".join(settings) if settings else "the default settings"
+    return (f"{scenario} diverged at t = {crossing['at_s']:.2f} s: {crossing['what']} (bound {crossing['bound']:g} "
+            f"{crossing['unit']}){asked}. The loop is unstable with {given}; its numbers describe a crash, not the "
+            "controller or the estimator")

@@ -1,0 +1,66 @@
+"""Item 5: an interrupted or refused calibration leaves its files with their ``metrics.json``, or
+nothing: a signal while the files are written lets them finish (metrics.json last), a signal
+while the flights are read leaves no folder, and neither does a refusal."""
+
+import json
+import signal
+
+import pytest
+from conftest import send_self
+
+import scenarios.flightlog.command
+from calibration.flight import autopilot
+from scenarios.cli import main as cli
+from tests.flightlog_synthetic import write_log
+
+MODELS = ["--models", "current"]
+
+
+@pytest.fixture
+def flight(tmp_path):
+    path = tmp_path / "flight.log"
+    write_log(path, duration=20.0)
+    return path
+
+
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_files_are_written_keeps_them_all_with_metrics_json(flight, tmp_path, monkeypatch,
+                                                                               number, capsys):
+    write = autopilot.write_ardupilot
+
+    def signalled(params, path):
+        send_self(number)  # as the first parameter file is written
+        write(params, path)
+
+    monkeypatch.setattr(autopilot, "write_ardupilot", signalled)
+    out = tmp_path / "cal"
+    assert cli(["calibrate", str(flight), "--out", str(out), *MODELS]) == 128 + number
+    capsys.readouterr()
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "completed"
+    assert sorted(p.name for p in out.iterdir()) == sorted(metrics["files"])  # every file listed, whole
+    assert autopilot.read_parameters(out / "ardupilot.parm")["COMPASS_MOTCT"] == 2
+
+
+def test_a_signal_while_the_flights_are_read_leaves_no_folder(flight, tmp_path, monkeypatch, capsys):
+    load = scenarios.flightlog.command.load
+
+    def signalled(path, verb):
+        log = load(path, verb)
+        send_self(signal.SIGINT)
+        return log
+
+    monkeypatch.setattr(scenarios.flightlog.command, "load", signalled)
+    out = tmp_path / "cal"
+    assert cli(["calibrate", str(flight), "--out", str(out), *MODELS]) == 130
+    capsys.readouterr()
+    assert not out.exists()
+
+
+def test_a_refused_calibration_leaves_no_folder(tmp_path, capsys):
+    log = tmp_path / "notes.log"
+    log.write_text("take-off at noon\n")
+    out = tmp_path / "cal"
+    assert cli(["calibrate", str(log), "--out", str(out)]) == 2
+    assert "unknown log format" in capsys.readouterr().err
+    assert not out.exists()
