@@ -8,6 +8,7 @@ STAMP := $(VENV)/.installed
 .PHONY: setup fmus demo test kernels digests references lint bench fuzz docs clean
 
 $(STAMP): pyproject.toml
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 12))' || { echo "quadcosim needs Python 3.12 or newer; $(PYTHON) is $$($(PYTHON) -V 2>&1). Install 3.12 (pyenv install 3.12, uv python install 3.12, or conda create -n quadcosim python=3.12) and run make PYTHON=python3.12" >&2; exit 1; }
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e ".[dev,docs]"

@@ -15,6 +15,7 @@ from estimators.filters import (
     CORRECTIONS,
     DEFAULT_GAINS,
     DEFAULT_TIME_CONSTANTS,
+    GAIN_MEANINGS,
     LAB_GAINS,
     RECOMMENDED,
     QuaternionEstim,
@@ -26,5 +27,5 @@ from estimators.filters import (
     score,
 )
 
-__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "DEFAULT_TIME_CONSTANTS", "LAB_GAINS", "RECOMMENDED", "QuaternionEstim",
-           "estimate", "explicit_gains", "gain_grid", "parse_corrections", "references", "score"]
+__all__ = ["CORRECTIONS", "DEFAULT_GAINS", "DEFAULT_TIME_CONSTANTS", "GAIN_MEANINGS", "LAB_GAINS", "RECOMMENDED",
+           "QuaternionEstim", "estimate", "explicit_gains", "gain_grid", "parse_corrections", "references", "score"]

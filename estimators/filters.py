@@ -169,6 +169,15 @@ LAB_GAINS = {
     "explicit": {"k1": 0.2, "k2": 0.2, "kP": 1.0, "kI": 0.0},
     "passive": {"k1": 1.0, "k2": 1.0, "kP": 1.0, "kI": 1.0},
 }
+#: Unit and meaning of each filter's gains (the names :data:`DEFAULT_GAINS` and :data:`LAB_GAINS` use).
+GAIN_MEANINGS = {
+    "linear": {"k1": ("1/s", "roll gain"), "k2": ("1/s", "pitch gain"), "k3": ("1/s", "yaw gain")},
+    "explicit": {"k1": ("1", "accelerometer weight (Mahony's Kp = kP k1)"), "k2": ("1", "magnetometer weight"),
+                 "kP": ("1/s", "proportional gain"), "kI": ("1/s^2", "bias gain; 0 turns the bias estimate off")},
+    "passive": {"k1": ("1", "weight of the tilt part of the correction"),
+                "k2": ("1", "weight of the heading part of the correction"),
+                "kP": ("1/s", "proportional gain"), "kI": ("1/s^2", "bias gain; 0 turns the bias estimate off")},
+}
 CORRECTIONS = {
     "heading_only": 1.0,
     "acc_tolerance": 2.0,  # m/s^2

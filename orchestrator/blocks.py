@@ -249,15 +249,24 @@ class Constant(Block):
         y[:] = self.values
 
 
+def is_path(model) -> bool:
+    """Whether ``model`` is an FMU file's path rather than a built model's name."""
+    from orchestrator.fmu import is_fmu_file
+
+    return model is not None and is_fmu_file(model)
+
+
 class FMUBlock:
-    """A block backed by a built FMU.
+    """A block backed by an FMU: a built plant model, or any FMI 2.0 Co-Simulation FMU by path.
 
     Parameters
     ----------
     name : str
         Block name (the lab's diagram names: ``Quadrotor``, ``MotorMagnetics``, ``IMU``).
-    model : str, optional
-        FMU model name; defaults to ``name``.
+    model : str or pathlib.Path, optional
+        A built model's name (``"IMU"``), or the path of an FMU file of any exporter
+        (``"my_motor.fmu"``: OpenModelica, Dymola, Simulink, pythonfmu, ...); defaults to ``name``.
+        Its real inputs and outputs become the block's, by their variable names.
     parameters : dict, optional
         Parameter overrides, by FMU variable name.
     period : int
@@ -265,22 +274,24 @@ class FMUBlock:
     """
 
     def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
-        from fmus import fmu_path
-        from orchestrator.fmu import model_description
+        from orchestrator.fmu import fmu_file, model_description
 
         if int(period) != period or period < 1:
             raise ValueError(f"{name}: period must be a positive integer number of macro steps, not {period}")
         self.name = name
-        self.model = model or name
+        self.path = fmu_file(model or name)
+        self.model = str(self.path) if is_path(model) else (model or name)  # a file: its absolute path
         self.parameters = dict(parameters or {})
         self.period = int(period)
-        description = model_description(fmu_path(self.model))
+        description = model_description(self.path)
         variables = description.modelVariables
         self.inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
         self.outputs = tuple(v.name for v in variables if v.causality == "output" and v.type == "Real")
         self.parameter_names = tuple(v.name for v in variables if v.causality == "parameter")
         self.units = {v.name: v.unit or getattr(v.declaredType, "unit", None) or ""  # labels the results
                       for v in variables if v.name in self.outputs}
+        self.input_units = {v.name: v.unit or getattr(v.declaredType, "unit", None) or ""
+                            for v in variables if v.name in self.inputs}
         unknown = set(self.parameters) - set(self.parameter_names)
         if unknown:
             from orchestrator.fmu import nearest

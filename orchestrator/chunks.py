@@ -139,8 +139,7 @@ class ChunkRunner:
                                     keep=[rows]))
             return
         if type(block).compiled is not Block.compiled:
-            status(f"{block.name}: loading its compiled step (numba compiles it on the first run after an "
-                   "installation or a change of its source, which can take a minute)")
+            status(f"{block.name}: loading its compiled step")  # a compile, when one happens, is announced
         compiled = block.compiled()
         if compiled is None:
             self._python(period, entry.phase.run, block)

@@ -173,10 +173,21 @@ def figure(system, title: str | None = None):
     _draw_blocks(ax, system, order, constants, box)
     for arrow in arrows:
         _draw_arrow(ax, arrow, column)
-    heading = f"{len(order)} blocks, {len(system.connections)} connections, macro step {system.dt * 1e3:g} ms"
+    links_drawn = sum(1 for dst, src in system.connections.items() if src.split(".", 1)[0] in order)
+    heading = f"{blocks_text(system)}, {links_drawn} connections, macro step {system.dt * 1e3:g} ms"
     faults = [f"{f.kind} fault on the input {f.target}, {f.start:g}-{f.stop:g} s" for f in system.faults]
     ax.set_title("\n".join([*([title] if title else []), heading, *faults]), fontsize=9, pad=8)
     return fig
+
+
+def blocks_text(system) -> str:
+    """The system's blocks as counted everywhere (the diagram's heading, a run's status line):
+    ``"6 blocks"``, with ``" and 4 constants tying off inputs"`` when it holds such ties (they
+    are noted inside the blocks they feed, not drawn)."""
+    ties = sum(1 for b in system.blocks.values() if isinstance(b, Constant) and b.ties)
+    drawn = len(system.blocks) - ties
+    return f"{drawn} block{'s' * (drawn != 1)}" + (f" and {ties} constant{'s' * (ties != 1)} tying off inputs"
+                                                    if ties else "")
 
 
 def _wiring(system):
@@ -324,7 +335,7 @@ def _draw_blocks(ax, system, order, constants, box):
         shade = "#dbe8f5" if isinstance(block, FMUBlock) else "#f3f3f3"
         ax.add_patch(FancyBboxPatch((x, -box / 2), WIDTH, box, boxstyle="round,pad=0.02",
                                     facecolor=shade, edgecolor="#333333", zorder=2))
-        kind = f"FMU {block.model}" if isinstance(block, FMUBlock) else type(block).__name__
+        kind = f"FMU {Path(block.model).name}" if isinstance(block, FMUBlock) else type(block).__name__
         rate = f", every {block.period} steps" if block.period > 1 else ""
         ax.text(x + WIDTH / 2, 0.12 * box, name, ha="center", va="center", fontsize=10, weight="bold", zorder=3)
         ax.text(x + WIDTH / 2, -0.12 * box, kind + rate, ha="center", va="center", fontsize=7, zorder=3)

@@ -135,6 +135,50 @@ class ParameterRefused(FMUError, ValueError):
 _descriptions: dict[tuple, object] = {}
 
 
+def is_fmu_file(model) -> bool:
+    """Whether ``model`` names an FMU file (``"my_motor.fmu"``, a path) rather than a built model."""
+    return str(model).lower().endswith(".fmu")
+
+
+def fmu_file(model) -> Path:
+    """The FMU file of ``model``: a built model by name (:func:`fmus.fmu_path`), or a path to any
+    FMI 2.0 Co-Simulation FMU, made absolute.
+
+    Parameters
+    ----------
+    model : str or pathlib.Path
+        ``"IMU"``, or ``"my_motor.fmu"``, ``"models/motor.fmu"``.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    FileNotFoundError
+        No file at the path given (the message names it, from the current folder).
+    ValueError
+        The file is not an FMI 2.0 FMU for Co-Simulation (the message says what it is).
+    """
+    if not is_fmu_file(model):
+        return fmu_path(model)
+    path = Path(model).expanduser().absolute()
+    if not path.is_file():
+        raise FileNotFoundError(f"FMU file {model} not found (looked at {path}); give the path of an .fmu file, or "
+                                "a built model's name (IMU, Quadrotor, MotorMagnetics)")
+    try:
+        description = model_description(path)
+    except Exception as error:  # fmpy raises several kinds on a file that is not an FMU
+        raise ValueError(f"{model} is not a readable FMU: {error}") from None
+    if not str(description.fmiVersion).startswith("2."):
+        raise ValueError(f"{model} is an FMI {description.fmiVersion} FMU; the master runs FMI 2.0 FMUs (export "
+                         "for FMI 2.0 Co-Simulation)")
+    if description.coSimulation is None:
+        raise ValueError(f"{model} is an FMI 2.0 Model Exchange FMU only; the master runs Co-Simulation FMUs "
+                         "(export for FMI 2.0 Co-Simulation, with its own solver)")
+    return path
+
+
 def model_description(path):
     """fmpy's model description of the FMU file ``path``, parsed once per version of the file
     (its path, modification time and size): a sweep's members share it rather than each
@@ -194,7 +238,7 @@ class FMUInstance:
 
     def __init__(self, model: str, parameters: dict | None = None, name: str | None = None,
                  start_time: float = 0.0):
-        path = Path(model) if str(model).endswith(".fmu") else fmu_path(model)
+        path = fmu_file(model)
         self.path = path
         self.name = name or path.stem
         self.time = start_time

@@ -41,15 +41,17 @@ def fmu_parameters(model: str) -> dict:
     dict
         Name to fmpy's variable (``type``, ``start``, ``unit``, ``description``).
     """
-    from fmus import fmu_path
-    from orchestrator.fmu import model_description
+    from orchestrator.fmu import fmu_file, model_description
 
-    description = model_description(fmu_path(model))
+    description = model_description(fmu_file(model))
     return {v.name: v for v in description.modelVariables if v.causality == "parameter"}
 
 
 def model_notes(model: str) -> tuple[dict, dict]:
-    """``ALIASES`` and ``SWITCHED`` of ``fmus/<model>/variables.py`` (empty if none)."""
+    """``ALIASES`` and ``SWITCHED`` of ``fmus/<model>/variables.py`` (empty if none, as for an
+    FMU file of the user's)."""
+    if model.lower().endswith(".fmu") or not model.isidentifier():
+        return {}, {}
     try:
         module = importlib.import_module(f"fmus.{model}.variables")
     except ImportError:

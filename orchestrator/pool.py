@@ -65,13 +65,10 @@ def acquire(model: str, parameters: dict | None = None, name: str | None = None,
     -------
     orchestrator.fmu.FMUInstance
     """
-    from pathlib import Path
-
-    from fmus import fmu_path
-    from orchestrator.fmu import FMUInstance
+    from orchestrator.fmu import FMUInstance, fmu_file
 
     if _enabled:
-        path = Path(model) if str(model).endswith(".fmu") else fmu_path(model)
+        path = fmu_file(model)
         with _lock:
             stack = _idle.get(_key(path))
             instance = stack.pop() if stack else None

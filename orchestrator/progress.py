@@ -18,7 +18,7 @@ import time
 #: each quarter of the simulated time.
 PIPE_LINES = 4
 
-_state = {"on": False, "started": 0.0, "stream": None}
+_state = {"on": False, "started": 0.0, "stream": None, "bar": None}
 
 
 @contextlib.contextmanager
@@ -50,12 +50,30 @@ def _stream():
     return _state["stream"] or sys.stderr
 
 
+def say(text: str, stream=None) -> None:
+    """Print ``text`` as a line of its own on ``stream`` (standard error by default): above a
+    progress bar being drawn there, never inside it (the bar is redrawn below the line).
+
+    Parameters
+    ----------
+    text : str
+        One line, without its newline.
+    stream : file, optional
+        Where to write; the stream of :func:`reporting`, or standard error.
+    """
+    stream = stream or _stream()
+    bar, drawn_on = _state["bar"] or (None, None)
+    if bar is not None and drawn_on is stream:
+        bar.write(text, file=stream)  # clears the bar's line, writes, redraws the bar
+    else:
+        print(text, file=stream, flush=True)
+
+
 def status(text: str) -> None:
     """Print one short status line, ``[  2.1 s] text``, with the wall time since
-    :func:`reporting` began; nothing outside it."""
+    :func:`reporting` began; nothing outside it (:func:`say` writes it, above a bar)."""
     if _state["on"]:
-        stream = _stream()
-        print(f"[{time.perf_counter() - _state['started']:5.1f} s] {text}", file=stream, flush=True)
+        say(f"[{time.perf_counter() - _state['started']:5.1f} s] {text}")
 
 
 class Every:
@@ -109,6 +127,7 @@ class Progress:
             self.bar = tqdm(total=self.total, file=self.stream, desc=label, unit="s sim", dynamic_ncols=True,
                             bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s "
                                        "[{elapsed}<{remaining}]")
+            _state["bar"] = (self.bar, self.stream)
 
     def update(self, seconds: float) -> None:
         """Advance by ``seconds`` of simulated time (s)."""
@@ -133,6 +152,8 @@ class Progress:
     def close(self) -> None:
         """End the bar's line (after a failure, at the fraction reached)."""
         if self.bar is not None:
+            if (_state["bar"] or (None,))[0] is self.bar:
+                _state["bar"] = None
             self.bar.close()
             self.bar = None
 

@@ -645,6 +645,7 @@ def _write_array(archive: zipfile.ZipFile, name: str, values: np.ndarray):
             np.lib.format.write_array(member, values, allow_pickle=False)
         return
     header = np.lib.format.header_data_from_array_1_0(values)
+    header["fortran_order"] = False  # the bytes below are in C order, whatever the layout of values
     with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
         try:
             np.lib.format.write_array_header_1_0(member, header)

@@ -28,6 +28,11 @@ class Option:
     classes: bool = False  # beside the choices, a block class of the user's, "module:Class"
     files: str | None = None  # beside the choices, a file of this suffix (".csv"), read by the scenario
     applies: str | None = None  # "other=a,b": the option acts only when option `other` is a or b
+    #: A word that stands for a value the scenario chooses (``kI = "lab"``: the chosen estimator's lab
+    #: value); the option then takes that word or a number (float). The default is the word, shown
+    #: as it is everywhere (``quadcosim list``, ``metrics.json``, the result files, ``sweep.csv``)
+    #: until the scenario resolves it (:attr:`Scenario.resolve`).
+    marker: str | None = None
 
     @property
     def unit(self) -> str | None:
@@ -57,6 +62,10 @@ class Option:
             Not a valid value; the message says what is expected.
         """
         default = self.default
+        if self.marker is not None:
+            if str(text).strip().lower() == self.marker:
+                return self.marker
+            default = 0.0  # otherwise a number
         try:
             if isinstance(default, bool):
                 if str(text).lower() in ("1", "true", "on", "yes"):
@@ -74,7 +83,8 @@ class Option:
             else:
                 value = str(text)
         except ValueError:
-            raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}") from None
+            also = f" (or {self.marker})" if self.marker is not None else ""
+            raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}{also}") from None
         file = self.files is not None and str(value).lower().endswith(self.files)
         if self.choices and value not in self.choices and not (self.classes and ":" in value) and not file:
             other = " or module:Class (a block of your own)" if self.classes else ""
@@ -94,7 +104,7 @@ class Scenario:
     report: object  # (result, options, out_dir) -> metrics dict
     duration: object = None  # (options) -> seconds
     extra: dict = field(default_factory=dict)
-    resolve: object = None  # (options) -> the options as used: a default marker (kI = -1) replaced by its value
+    resolve: object = None  # (options) -> the options as used: a marker (kI = "lab") replaced by its value
 
     def used(self, options: dict) -> dict:
         """``options`` as the run uses them: every default marker replaced by the value it stands for."""
@@ -165,8 +175,9 @@ class Scenario:
         return values
 
 
-    def system(self, options: dict, estimator=None):
-        """The system of these options: built, then its block parameters set.
+    def system(self, options: dict, estimator=None, fmus: dict | None = None):
+        """The system of these options: built, its FMU blocks replaced by ``fmus``, then its
+        block parameters set.
 
         Parameters
         ----------
@@ -176,6 +187,10 @@ class Scenario:
         estimator : Block or class, optional
             A block of the user's in the place of ``Quaternion_estim`` (see
             :mod:`estimators.contract`), for a scenario with an ``estimator`` option.
+        fmus : dict, optional
+            Block name to an FMU file of the user's with the same interface, put in that
+            block's place (:func:`orchestrator.replace.replace_fmu` checks it); the system's
+            ``replaced`` says which, with what the new FMU did not take over (also warned).
 
         Raises
         ------
@@ -191,6 +206,16 @@ class Scenario:
             system = self.build(options, estimator=estimator)
         else:
             system = self.build(options)
+        system.replaced = {}
+        for block, path in (fmus or {}).items():
+            import warnings
+
+            from orchestrator.replace import replace_fmu
+
+            new, notes = replace_fmu(system, block, path)
+            system.replaced[block] = {"fmu": str(new.path), "notes": notes}
+            for note in notes:
+                warnings.warn(note, stacklevel=2)
         settings = {k: v for k, v in options.items() if "." in k}
         derived = self.extra.get("derived", {})
         for key in settings:
@@ -257,7 +282,7 @@ def get(name: str) -> Scenario:
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
         record=None, formats=("npz",), overwrite: bool = False, estimator=None, compress: bool = False,
-        stream: bool = False, blocks=None):
+        stream: bool = False, blocks=None, fmus: dict | None = None):
     """Run scenario ``name``; write results, metrics and figures into ``out_dir`` if given.
 
     Parameters
@@ -295,6 +320,10 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     blocks : dict, optional
         Blocks of the user's in the place of the scenario's, by name (``{"Controller":
         MyController()}``), each wired as the block it replaces (:meth:`orchestrator.System.replace`).
+    fmus : dict, optional
+        Block name to the path of an FMU of the user's with the same interface, in that block's
+        place (``{"MotorMagnetics": "my_motor.fmu"}``; :meth:`Scenario.system`); recorded in
+        ``metrics["replaced_blocks"]``.
 
     Returns
     -------
@@ -339,8 +368,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
                         remove_if_empty(out)
                     raise
             with (files.tracking() if files else contextlib.nullcontext()):
-                return _run_tracked(name, settings, files, base, made, (faults, estimator, record, stream, blocks),
-                                    progress)
+                given = (faults, estimator, record, stream, blocks, fmus)
+                return _run_tracked(name, settings, files, base, made, given, progress)
         except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
                 raise
@@ -392,12 +421,14 @@ def _run_phases(scenario, options, base, files, given, progress):
     from orchestrator.progress import status
     from scenarios.metrics import metric_units
 
-    name, (faults, estimator, record, stream, blocks) = scenario.name, given
-    system, duration, kept, saved = _build(scenario, options, base, files, (faults, estimator, blocks), stream,
-                                           record)
+    name, (faults, estimator, record, stream, blocks, fmus) = scenario.name, given
+    system, duration, kept, saved = _build(scenario, options, base, files, (faults, estimator, blocks, fmus),
+                                           stream, record)
     if files:
         files.phase, files.stream = "running", _open_stream(files, stream)
-    status(f"{name}: starting {duration:g} s of simulated time ({len(system.blocks)} blocks)")
+    from orchestrator.diagram import blocks_text
+
+    status(f"{name}: starting {duration:g} s of simulated time ({blocks_text(system)})")
     try:
         result = system.run(duration, decimation=base["decimation"], progress=progress, record=kept,
                             stream=files.stream if files else None)
@@ -416,7 +447,7 @@ def _run_phases(scenario, options, base, files, given, progress):
     if files is not None:
         files.phase = "saving the record"
         status(f"{name}: writing {', '.join(f'results.{f}' for f in files.formats)} "
-               f"({len(saved) if saved else len(result.names)} signals, {len(result)} samples)")
+               f"({_signals_text(saved, result.names)}, {len(result)} samples)")
         files.keep_record(result, saved, files.stream)
         if files.not_written:  # a full disk, or no memory left for a writer: metrics.json says which
             raise files.failed("; ".join(f"{file} not written: {why}" for file, why in files.not_written.items()))
@@ -437,6 +468,14 @@ def _run_phases(scenario, options, base, files, given, progress):
 
         warnings.warn(message(name, metrics["diverged"], _settings_given(scenario, options)), stacklevel=2)
     return result, metrics
+
+
+def _signals_text(saved, recorded) -> str:
+    """The signals written, counted as ``metrics.json`` counts them (``signals_recorded``)."""
+    if not saved or len(saved) == len(recorded):
+        return f"{len(recorded)} signals"
+    return (f"{len(saved)} of the {len(recorded)} signals recorded; the others follow from them "
+            "(metrics.json: signals_not_saved)")
 
 
 def _divergence(scenario, result, options) -> dict:
@@ -484,16 +523,18 @@ def _open_stream(files, stream: bool):
 
 def _build(scenario, options, base, files, users, stream, record):
     """The system, its duration (s), the signals recorded and those written (``base`` takes
-    the options as used and the duration); ``users`` holds the faults, the user's estimator and
-    blocks. A refusal removes what this run wrote."""
+    the options as used, the duration and the FMUs replaced); ``users`` holds the faults, the
+    user's estimator, blocks and FMUs. A refusal removes what this run wrote."""
     from orchestrator.progress import status
 
-    faults, estimator, blocks = users
+    faults, estimator, blocks, fmus = users
     if files:
         files.phase = "building the system"
     status(f"{scenario.name}: building the system")
     try:
-        system = scenario.system(options, estimator=estimator)
+        system = scenario.system(options, estimator=estimator, fmus=fmus)
+        if system.replaced:
+            base["replaced_blocks"] = system.replaced
         for block_name, block in (blocks or {}).items():
             system.replace(block_name, block)
         for fault in faults:

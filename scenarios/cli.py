@@ -52,9 +52,14 @@ def _list(args) -> int:
     if args.parameters:
         from fmus import MODELS
         from fmus.build import table
+        from scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines
 
+        if args.parameters in PYTHON_BLOCKS:
+            print("\n".join(parameter_lines(args.parameters)))
+            return 0
         if args.parameters not in MODELS:
-            print(f"unknown model {args.parameters!r}; models: {', '.join(MODELS)}", file=sys.stderr)
+            print(f"unknown model {args.parameters!r}; FMUs: {', '.join(MODELS)}; Python blocks: "
+                  f"{', '.join(PYTHON_BLOCKS)}", file=sys.stderr)
             return 2
         from orchestrator.parameters import model_notes
 
@@ -120,6 +125,19 @@ def _parse_fault(text: str):
     return Fault(parts[0], parts[1], numbers["START"], numbers["STOP"], numbers.get("VALUE"))
 
 
+def _fmus(given) -> dict:
+    """``--fmu NAME=PATH`` pairs as a dict, block name to FMU file."""
+    fmus = {}
+    for text in given or []:
+        name, eq, path = text.partition("=")
+        if not eq or not name.strip() or not path.strip():
+            raise ValueError(f"--fmu {text!r}: write BLOCK=PATH, e.g. MotorMagnetics=my_motor.fmu")
+        if not Path(path.strip()).is_file():
+            raise ValueError(f"--fmu {text}: no file {path.strip()} (from {Path.cwd()})")
+        fmus[name.strip()] = path.strip()
+    return fmus
+
+
 def _positive_int(text: str) -> int:
     try:
         value = int(text)
@@ -153,11 +171,15 @@ def _run_reporting(args) -> int:
 
     out = Path(args.out) if args.out else _default_out(args.scenario, args.overwrite)
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
+    from scenarios.plant import figure_format
+
     try:
         faults = [_parse_fault(f) for f in args.fault or []]
-        _, metrics = scenarios.run(args.scenario, _settings(args), out, progress=True, faults=faults,
-                                   decimation=args.decimation, record=args.record, formats=formats,
-                                   overwrite=args.overwrite, compress=args.compress, stream=args.stream)
+        with figure_format(args.figures):
+            _, metrics = scenarios.run(args.scenario, _settings(args), out, progress=True, faults=faults,
+                                       decimation=args.decimation, record=args.record, formats=formats,
+                                       overwrite=args.overwrite, compress=args.compress, stream=args.stream,
+                                       fmus=_fmus(args.fmu))
     except RunInterrupted as error:
         print(f"quadcosim run {args.scenario}: {error}", file=sys.stderr)
         print(f"what was recorded ({len(error.result)} samples) and metrics.json are in {out}/", file=sys.stderr)
@@ -180,7 +202,10 @@ def _run_reporting(args) -> int:
     for key, value in shown.items():
         print(f"  {key}: {text(value)}")
     _print_warnings(warnings)
-    print(f"results ({', '.join(formats)}), metrics.json and figures in {out}/")
+    figures = [name for name in metrics.get("figures") or [] if isinstance(name, str)]
+    drawn = [p.name for p in sorted(out.glob("diagram.*"))] + figures
+    print(f"results ({', '.join(formats)}), metrics.json" + (f" and {', '.join(drawn)}" if drawn else "")
+          + f" in {out}/" + (" (no report figures: see report above)" if "report" in metrics else ""))
     if metrics.get("status") == "diverged":  # warned above, naming the settings
         print(f"quadcosim run {args.scenario}: the run diverged (metrics.json: status diverged); its record and "
               f"figures are in {out}/", file=sys.stderr)
@@ -236,9 +261,10 @@ def _diagram(args) -> int:
         except (KeyError, ValueError) as error:
             print(error.args[0] if error.args else error, file=sys.stderr)
             return 2
-        status(f"{args.scenario}: drawing the wiring ({len(system.blocks)} blocks)")
+        from orchestrator.diagram import blocks_text
         from orchestrator.files import figure_file
 
+        status(f"{args.scenario}: drawing the wiring ({blocks_text(system)})")
         try:
             out = figure_file(args.out, "diagram.png", Path("results") / args.scenario)
             path = draw(system, out, scenario.title(options))
@@ -272,8 +298,10 @@ def _bench(args) -> int:
 
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
+    from scenarios.shown import PlainHelp
+
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+                                formatter_class=PlainHelp)
     sub = p.add_subparsers(dest="command", required=True)
     build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
                            "references (into build/ in a source checkout, a per-user cache when installed; a run "
@@ -281,21 +309,30 @@ def parser() -> argparse.ArgumentParser:
     build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
-    listing.add_argument("--parameters", metavar="MODEL", help="list the parameters of an FMU instead")
+    listing.add_argument("--parameters", metavar="MODEL",
+                         help="list the parameters of a block instead, with units and defaults: an FMU (IMU, "
+                              "Quadrotor, MotorMagnetics, ...) or a Python block (Controller, Quaternion_estim)")
     listing.set_defaults(func=_list)
     _add_run(sub)
     diagram = sub.add_parser("diagram", help="draw the wiring of a scenario")
-    diagram.add_argument("scenario")
-    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE")
+    diagram.add_argument("scenario", help="a scenario name (quadcosim list shows them)")
+    diagram.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
+                         help="scenario options or block parameters, as for run (the wiring may depend on them: "
+                              "magnetic=on adds the motors' field)")
     diagram.add_argument("--estimator", metavar="MODULE:CLASS", help="your own estimator block (as for run)")
     diagram.add_argument("--out", help="PNG or SVG file (default results/SCENARIO/diagram.png; a folder takes "
                          "diagram.png)")
     diagram.set_defaults(func=_diagram)
     bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
                                          "pytest plugin")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"))
-    bench.add_argument("--json", action="store_true")
-    bench.add_argument("--seconds", type=float, default=5.0)
+    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"),
+                       help="what to time: master (the co-simulation loop, the default), infrared (the IR "
+                            "calibration's cost per update), sweep (40 closed-loop runs on Dask) or pytest (the "
+                            "pytest plugin's fixtures)")
+    bench.add_argument("--json", action="store_true",
+                       help="print the measurements as one JSON object on standard output instead of a table")
+    bench.add_argument("--seconds", type=float, default=5.0, metavar="S",
+                       help="simulated time of each timed run of the master suite (s, default 5)")
     bench.set_defaults(func=_bench)
     findings = sub.add_parser("findings", add_help=False,
                               help="run the README's findings, write findings.json, rewrite the README's numbers "
@@ -317,7 +354,8 @@ def parser() -> argparse.ArgumentParser:
 def _add_run(sub):
     """The ``run`` sub-command, added to the sub-parsers ``sub``."""
     run = sub.add_parser("run", help="run a scenario")
-    run.add_argument("scenario")
+    run.add_argument("scenario", help="a scenario name: tp, open-loop, rig, static-cal, metge, ... "
+                                      "(quadcosim list shows them and their options)")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="KEY=VALUE",
                      help="scenario options, several after one flag (estimator=explicit k1=0.2), or block "
                           "parameters: IMU.gyro_noise_density=0.001, IMU.gyro_bias=0.01,0,0 (units: quadcosim list "
@@ -330,6 +368,10 @@ def _add_run(sub):
                                    "--overwrite")
     run.add_argument("--fault", action="append", metavar="TARGET:KIND:START:STOP[:VALUE]",
                      help="fault on the connection into TARGET; KIND is offset, scale, stuck, noise or dropout")
+    run.add_argument("--fmu", action="append", metavar="BLOCK=PATH",
+                     help="put an FMU of your own (any FMI 2.0 Co-Simulation exporter) in the place of a plant "
+                          "block: MotorMagnetics=my_motor.fmu; its inputs and outputs are checked against the "
+                          "block's by name and unit, mismatches listed")
     run.add_argument("--overwrite", action="store_true", help="replace the results already in the --out folder")
     run.add_argument("--decimation", type=_positive_int, default=1, metavar="N",
                      help="record every N-th macro step (default 1)")
@@ -339,6 +381,9 @@ def _add_run(sub):
                           "that follow from others, listed in metrics.json)")
     run.add_argument("--format", default="npz", metavar="npz,mat,csv",
                      help="result files to write, comma-separated: npz (NumPy, the default), mat (MATLAB), csv")
+    run.add_argument("--figures", choices=("png", "svg", "pdf"), default="png",
+                     help="format of the report's figures: png (120 dpi, the default), svg or pdf (vector, for a "
+                          "report or a thesis)")
     run.add_argument("--compress", action="store_true",
                      help="compress the npz and mat files (about a third smaller, many times slower to write)")
     run.add_argument("--stream", action="store_true",
@@ -358,7 +403,9 @@ def _add_flight_logs(sub):
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    print(f"quadcosim: warning: {message}", file=sys.stderr)
+    from orchestrator.progress import say
+
+    say(f"quadcosim: warning: {message}", sys.stderr)  # above a progress bar, never inside it
 
 
 def main(argv=None) -> int:
@@ -395,7 +442,16 @@ def entry() -> None:
     (:func:`orchestrator.interrupts.leave`)."""
     from orchestrator.interrupts import leave
 
-    leave(main())
+    try:
+        code = main()
+        sys.stdout.flush()  # here, not at exit: a reader gone (| head) is then seen below
+    except BrokenPipeError:  # the reader of our output left (quadcosim list | head -1): no traceback
+        import os
+        import signal
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
+        code = 128 + signal.SIGPIPE  # as a program that the pipe's signal ended
+    leave(code)
 
 
 if __name__ == "__main__":

@@ -34,8 +34,10 @@ def _on_compile(event):
         return
     _announced = True
     name = getattr(getattr(event.data.get("dispatcher"), "py_func", None), "__qualname__", "a step")
-    print(f"quadcosim: compiling numba code ({name} first), once, into numba's cache; this takes a while "
-          "(`quadcosim build` does it ahead)", file=sys.stderr, flush=True)
+    from orchestrator.progress import say
+
+    say(f"quadcosim: compiling numba code ({name} first), once, into numba's cache; this takes a while "
+        "(`quadcosim build` does it ahead)", sys.stderr)
 
 
 def announce_compiles() -> None:

@@ -69,8 +69,8 @@ OPTIONS = {
     "regime": Option("default", "the vehicle's own ESC cables and a free set swinging 0.13, or 'paper': one common "
                                 "lead (every motor's field up, -z_B) and a free set swinging 0.25, the regime of the "
                                 "paper's free set", choices=("default", "paper")),
-    "free_swing": Option(-1.0, "amplitude of each of the free set's three sines (1); -1: the regime's (0.13 "
-                               "default, 0.25 paper)"),
+    "free_swing": Option("regime", "amplitude of each of the free set's three sines (1); regime: the regime's "
+                                   "(0.13 default, 0.25 paper)", minimum=0.0, marker="regime"),
     "free_speed": Option(1.0, "the free set's frequencies times this (1)", minimum=0.01),
 }
 #: Swing (1) of each of the free set's three sines, by regime.
@@ -149,7 +149,7 @@ def schedule(o: dict, set_number: int, sweeps: bool = True) -> tuple[list[tuple[
 
 def free_swing(o: dict) -> float:
     """Amplitude (1) of each of the free set's three sines: option ``free_swing``, or the regime's."""
-    return REGIME_SWING[o["regime"]] if o["free_swing"] == -1.0 else o["free_swing"]
+    return REGIME_SWING[o["regime"]] if o["free_swing"] == "regime" else o["free_swing"]
 
 
 def free_commands(o: dict, t: np.ndarray) -> np.ndarray:
@@ -289,8 +289,6 @@ def build(o: dict) -> System:
     parse_orders(o["orders"])
     if abs(round(1.0 / (o["mag_rate"] * o["dt"])) * o["mag_rate"] * o["dt"] - 1.0) > 1e-9:
         raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
-    if not (o["free_swing"] == -1.0 or o["free_swing"] >= 0):
-        raise ValueError(f"option free_swing = {o['free_swing']} must be at least 0 (or -1 for the regime's)")
     clash = sorted(set(regime_settings(o)) & set(block_settings(o)))
     if clash:
         raise ValueError(f"regime={o['regime']} sets {', '.join(clash)} (one common lead): leave them out, or "

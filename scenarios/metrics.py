@@ -34,7 +34,7 @@ def unit_of_name(name: str) -> str | None:
 def option_unit(help_text: str) -> str | None:
     """The unit of an option: the first parentheses of its help text that hold one.
 
-    ``"macro step (s)"`` -> ``"s"``; ``"bias gain (1/s^2); -1 for the default"`` -> ``"1/s^2"``;
+    ``"macro step (s)"`` -> ``"s"``; ``"bias gain (1/s^2); lab: the lab's value"`` -> ``"1/s^2"``;
     ``"accelerometer weight (1; Mahony's Kp = kP k1)"`` -> ``"1"``; None when no parentheses
     hold a unit (prose, a file name, a list of values).
 

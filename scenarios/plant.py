@@ -8,6 +8,9 @@ vector, or left for the caller to connect.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+
 import numpy as np
 
 from orchestrator import FMUBlock, System
@@ -85,8 +88,31 @@ def angle_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.arctan2(cross, np.einsum("ij,ij->i", a, b))
 
 
+#: The format of the reports' figures (``quadcosim run --figures``): png (120 dpi), svg or pdf.
+FIGURE_FORMAT = contextvars.ContextVar("figure_format", default="png")
+
+
+@contextlib.contextmanager
+def figure_format(name: str):
+    """Within it, the reports write their figures as ``name`` (png, svg or pdf) files.
+
+    Parameters
+    ----------
+    name : {"png", "svg", "pdf"}
+        The format; the suffix of each figure file.
+    """
+    if name not in ("png", "svg", "pdf"):
+        raise ValueError(f"figure format {name!r}: give png, svg or pdf")
+    token = FIGURE_FORMAT.set(name)
+    try:
+        yield
+    finally:
+        FIGURE_FORMAT.reset(token)
+
+
 def save_figure(figure, out_dir, name: str):
-    """Save ``figure`` as ``out_dir / name`` (PNG, 120 dpi) and close it.
+    """Save ``figure`` as ``out_dir / name`` (PNG, 120 dpi; or the format of :func:`figure_format`,
+    which replaces the suffix of ``name``) and close it.
 
     Parameters
     ----------
@@ -111,8 +137,8 @@ def save_figure(figure, out_dir, name: str):
     from orchestrator.files import save_figure as save_atomically
     from orchestrator.progress import status
 
-    path = out_dir / name
-    status(f"figure {name}")
+    path = (out_dir / name).with_suffix("." + FIGURE_FORMAT.get())
+    status(f"figure {path.name}")
     try:
         figure.tight_layout()
         save_atomically(figure, path, dpi=120)  # a temporary name, fsync, rename: never a truncated figure

@@ -84,7 +84,85 @@ def _label(folder: Path) -> str:
     return folder.name or str(folder)
 
 
-def plot(run, signals, out=None) -> Path:
+#: Figure formats of ``--format``: the file's suffix.
+FORMATS = ("png", "svg", "pdf")
+
+
+def signal_lines(run) -> list[str]:
+    """The signals a finished run recorded, as ``quadcosim plot RUN`` lists them: each vector
+    once (its components in brackets), then the scalar signals, each with its unit.
+
+    Parameters
+    ----------
+    run : str or pathlib.Path
+        The run's folder or its ``results.npz``.
+
+    Returns
+    -------
+    list of str
+        A heading, then one line per vector or signal: ``IMU.acc [x, y, z] (m/s2)``.
+    """
+    from orchestrator.result import vector_groups
+
+    result, folder = load(run)
+    units = result.meta.get("units", {})
+    vectors = vector_groups(result.names)
+    in_vector = {name for members in vectors.values() for name in members}
+
+    def unit(members):
+        found = {units.get(m) or "unit unknown" for m in members}
+        return found.pop() if len(found) == 1 else "mixed units"
+
+    span = result.time[-1] - result.time[0]
+    lines = [f"{folder}: {len(result.names)} signals, {len(result)} samples over {span:g} s "
+             "(plot a vector by its name, or any component):"]
+    for vector, members in vectors.items():
+        tails = ", ".join(m.rsplit(".", 1)[1][len(vector.rsplit(".", 1)[1]):].lstrip("_") for m in members)
+        lines.append(f"  {vector} [{tails}] ({unit(members)})")
+    for name in result.names:
+        if name not in in_vector:
+            lines.append(f"  {name} ({unit([name])})")
+    return lines
+
+
+def _degrees(unit: str | None) -> str | None:
+    """The unit in degrees of an angle or angular rate unit (``rad/s`` -> ``deg/s``), else None."""
+    if unit == "rad" or (unit or "").startswith("rad/"):
+        return "deg" + unit[3:]
+    return None
+
+
+def _draw(ax, result, signal: str, deg: bool, label_prefix: str = ""):
+    """``signal`` of ``result`` on ``ax``: its name as the axes' title, its unit as the y label
+    (a label that always fits the axes' height), in degrees with ``deg`` when it is an angle."""
+    units = result.meta.get("units", {})
+    found = {units.get(m) or None for m in result.columns(signal)}
+    unit = found.pop() if len(found) == 1 else None
+    in_degrees = _degrees(unit) if deg else None
+    if in_degrees:
+        result.plot(signal, ax=ax, scale=180.0 / 3.141592653589793, unit=in_degrees, label_prefix=label_prefix)
+    else:
+        result.plot(signal, ax=ax, label_prefix=label_prefix)
+    ax.set_ylabel(in_degrees or unit or "unit unknown")
+    ax.set_title(printable(signal), loc="left", fontsize=9)
+
+
+def _with_format(out, figure_format: str | None):
+    """The ``--out`` given, made to agree with ``--format``: a file without a figure suffix takes
+    the format's, a folder is kept (the default name carries the format), another figure suffix
+    is refused."""
+    if not out or not figure_format or Path(out).is_dir():
+        return out
+    path = Path(out)
+    suffix = path.suffix.lstrip(".").lower()
+    if suffix == figure_format:
+        return path
+    if suffix in FORMATS:
+        raise ValueError(f"--out {out} and --format {figure_format} disagree: give one of them")
+    return path.with_name(f"{path.name}.{figure_format}")
+
+
+def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
     """One figure of a finished run: each signal (or vector) on its own axes, against time.
 
     Parameters
@@ -95,6 +173,10 @@ def plot(run, signals, out=None) -> Path:
         Signal or vector names.
     out : str or pathlib.Path, optional
         PNG, SVG or PDF file; ``plot-<first signal>.png`` in the run's folder by default.
+    deg : bool
+        Draw angles (rad) and angular rates (rad/s, rad/s2) in degrees; other signals as they are.
+    figure_format : {"png", "svg", "pdf"}, optional
+        The file's format when ``out`` has no suffix or is not given (default png).
 
     Returns
     -------
@@ -103,8 +185,9 @@ def plot(run, signals, out=None) -> Path:
     """
     import matplotlib.pyplot as plt
 
-    name = f"plot-{signals[0]}.png"
-    path = figure_file(out, name, None) if out else None  # a path given is checked before the run is read
+    name = f"plot-{signals[0]}.{figure_format or 'png'}"
+    # a path given is checked before the run is read
+    path = figure_file(_with_format(out, figure_format), name, None) if out else None
     result, folder = load(run)
     path = path or figure_file(None, name, folder)
     for signal in signals:
@@ -112,17 +195,17 @@ def plot(run, signals, out=None) -> Path:
     fig, axes = plt.subplots(len(signals), 1, sharex=True, squeeze=False, layout="constrained",
                              figsize=(AXES_SIZE[0], AXES_SIZE[1] * len(signals)))
     for ax, signal in zip(axes[:, 0], signals, strict=True):
-        result.plot(signal, ax=ax)
+        _draw(ax, result, signal, deg)
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
-    fig.suptitle(printable(f"{_label(folder)}: {', '.join(signals)}"), fontsize=10)
+    fig.suptitle(printable(_label(folder)), fontsize=10)
     try:
         return save_figure(fig, path, dpi=120)
     finally:
         plt.close(fig)
 
 
-def compare(runs, signal: str, out=None) -> Path:
+def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
     """One signal of several finished runs on one figure, one curve per run (per component for a
     vector, on its own axes).
 
@@ -134,6 +217,10 @@ def compare(runs, signal: str, out=None) -> Path:
         Signal or vector name, recorded by every run.
     out : str or pathlib.Path, optional
         PNG, SVG or PDF file; ``compare-<signal>.png`` in the current folder by default.
+    deg : bool
+        Draw an angle (rad) or angular rate (rad/s) in degrees.
+    figure_format : {"png", "svg", "pdf"}, optional
+        The file's format when ``out`` has no suffix or is not given (default png).
 
     Returns
     -------
@@ -142,7 +229,7 @@ def compare(runs, signal: str, out=None) -> Path:
     """
     import matplotlib.pyplot as plt
 
-    path = figure_file(out, f"compare-{signal}.png", Path("."))
+    path = figure_file(_with_format(out, figure_format), f"compare-{signal}.{figure_format or 'png'}", Path("."))
     loaded = [load(run) for run in runs]
     for result, folder in loaded:
         _check(result, folder, signal)
@@ -152,7 +239,7 @@ def compare(runs, signal: str, out=None) -> Path:
     for ax, component in zip(axes[:, 0], components, strict=True):
         for result, folder in loaded:
             if component in result.names:
-                result.plot(component, ax=ax, label_prefix=f"{_label(folder)}: ")
+                _draw(ax, result, component, deg, label_prefix=f"{_label(folder)}: ")
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
     fig.suptitle(printable(f"{signal}: {' vs '.join(_label(folder) for _, folder in loaded)}"), fontsize=10)
@@ -173,7 +260,10 @@ def plot_command(args) -> int:
     import sys
 
     try:
-        print(plot(args.run, args.signals, args.out))
+        if not args.signals:
+            print("\n".join(signal_lines(args.run)))
+            return 0
+        print(plot(args.run, args.signals, args.out, deg=args.deg, figure_format=args.format))
     except ValueError as error:  # OutputRefused among them
         print(f"quadcosim plot: {error}", file=sys.stderr)
         return 2
@@ -199,7 +289,7 @@ def compare_command(args) -> int:
         print("quadcosim compare: give two runs or more, then the signal: compare RUN RUN SIGNAL", file=sys.stderr)
         return 2
     try:
-        print(compare(runs, signal, args.out))
+        print(compare(runs, signal, args.out, deg=args.deg, figure_format=args.format))
     except ValueError as error:  # OutputRefused among them
         print(f"quadcosim compare: {error}", file=sys.stderr)
         return 2
@@ -211,10 +301,11 @@ def compare_command(args) -> int:
 
 def add_arguments(sub):
     """The ``plot`` and ``compare`` sub-commands, added to the sub-parsers ``sub``."""
-    plotting = sub.add_parser("plot", help="signals of a finished run against time")
+    plotting = sub.add_parser("plot", help="signals of a finished run against time (no signal: list them)")
     plotting.add_argument("run", help="the run's folder (its --out) or its results.npz")
-    plotting.add_argument("signals", nargs="+", metavar="SIGNAL", help="signal or vector names (IMU.acc)")
-    plotting.add_argument("--out", help="PNG/SVG/PDF file (default RUN/plot-SIGNAL.png)")
+    plotting.add_argument("signals", nargs="*", metavar="SIGNAL",
+                          help="signal or vector names (IMU.acc); none: list the run's signals and their units")
+    _add_figure_options(plotting, "RUN/plot-SIGNAL.png")
     plotting.set_defaults(func=plot_command)
     comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure",
                                usage="quadcosim compare [-h] [--out FILE] RUN RUN [RUN...] SIGNAL\n"
@@ -222,5 +313,14 @@ def add_arguments(sub):
     comparing.add_argument("items", nargs="+", metavar="RUN... SIGNAL",
                            help="two run folders or more (or their results.npz), then a signal or vector name")
     comparing.add_argument("--signal", help="the signal, when given apart: then every positional is a run")
-    comparing.add_argument("--out", help="PNG/SVG/PDF file (default compare-SIGNAL.png here)")
+    _add_figure_options(comparing, "compare-SIGNAL.png in the current folder")
     comparing.set_defaults(func=compare_command)
+
+
+def _add_figure_options(parser, default: str):
+    parser.add_argument("--out", help=f"PNG, SVG or PDF file (default {default})")
+    parser.add_argument("--format", choices=FORMATS, default=None,
+                        help="figure format: png (120 dpi), svg or pdf (vector, for a report or a thesis); "
+                             "default png, or the suffix of --out")
+    parser.add_argument("--deg", action="store_true",
+                        help="angles (rad) and angular rates (rad/s) in degrees; other signals as they are")

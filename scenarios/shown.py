@@ -3,8 +3,10 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 import numbers
+import re
 
 #: Significant digits of a measured figure on the screen (a metric, a rate, an error): five, so
 #: that a run prints every figure the README quotes from it at the README's precision (the tilt
@@ -40,3 +42,41 @@ def shown(value, digits: int = MEASURED_DIGITS) -> str:
     if isinstance(value, list | tuple):
         return "[" + ", ".join(shown(v, digits) for v in value) + "]"
     return str(value)
+
+
+_ROLE = re.compile(r":(?:data|mod|func|class|meth|attr|obj|ref|doc):`~?([^`<]*?)(?:\s*<[^>]*>)?`")
+_LITERAL = re.compile(r"``([^`]+)``")
+
+
+def plain(text: str) -> str:
+    """reST of a docstring as plain text for a terminal: ``\\`\\`x\\`\\``` -> ``x``,
+    ``:data:\\`scenarios.findings.GROUPS\\``` -> ``scenarios.findings.GROUPS``.
+
+    Parameters
+    ----------
+    text : str
+        Text with reST inline markup.
+
+    Returns
+    -------
+    str
+        The text without it.
+    """
+    return _LITERAL.sub(r"\1", _ROLE.sub(r"\1", text))
+
+
+class PlainHelp(argparse.RawDescriptionHelpFormatter):
+    """An argparse formatter that prints the description as written (its line breaks kept) and
+    the whole help without reST markup (:func:`plain`).
+
+    Parameters
+    ----------
+    prog : str
+        The program's name, as argparse gives it.
+    indent_increment, max_help_position, width : int, optional
+        argparse's layout settings (characters).
+    """
+
+    def format_help(self) -> str:
+        """The help text, plain (:func:`plain`)."""
+        return plain(super().format_help())

@@ -106,6 +106,24 @@ def duration(o: dict) -> float:
     return o["duration"]
 
 
+def _readings_panel(ax, points, colour: str, what: str, reach: float):
+    """Magnetometer readings ``points`` (uT) as a 3-D cloud on ``ax``, the axes from ``-reach`` to
+    ``reach`` (uT), titled with ``what`` and the range of their norm."""
+    from matplotlib.ticker import MaxNLocator
+
+    norm = np.linalg.norm(points, axis=1)
+    ax.scatter(*points.T, s=1, color=colour)
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(-reach, reach))
+    ax.set_box_aspect((1.0, 1.0, 1.0))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # four ticks a side: the default eight collide in 3-D
+        axis.set_major_locator(MaxNLocator(4, symmetric=True))
+    ax.tick_params(labelsize=7, pad=0)
+    ax.set_xlabel("x (µT)", labelpad=2)
+    ax.set_ylabel("y (µT)", labelpad=2)
+    ax.set_zlabel("z (µT)", labelpad=2)
+    ax.set_title(f"{what} readings, |m| from {norm.min():.1f} to {norm.max():.1f} µT", fontsize=9)
+
+
 def report(result, o, out) -> dict:
     """Fit ``A``, ``b_s`` to the magnetometer samples of ``result``; compare with the truth; write
     ``static.json`` and the figure into ``out`` (none when None); return the figures of merit.
@@ -130,15 +148,7 @@ def report(result, o, out) -> dict:
     # raw and corrected on axes of their own, to the same scale: drawn on one axes, either hides the other
     for panel, (points, colour, what) in enumerate(((raw_uT, "C0", "raw"), (corrected_uT, "C1", "corrected")),
                                                    start=1):
-        norm = np.linalg.norm(points, axis=1)
-        ax = fig.add_subplot(1, 3, panel, projection="3d")
-        ax.scatter(*points.T, s=1, color=colour)
-        ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(-reach, reach))
-        ax.set_box_aspect((1.0, 1.0, 1.0))
-        ax.set_xlabel("x (µT)")
-        ax.set_ylabel("y (µT)")
-        ax.set_zlabel("z (µT)")
-        ax.set_title(f"{what} readings, |m| from {norm.min():.1f} to {norm.max():.1f} µT", fontsize=9)
+        _readings_panel(fig.add_subplot(1, 3, panel, projection="3d"), points, colour, what, reach)
     ax2 = fig.add_subplot(1, 3, 3)
     ax2.plot(np.degrees(yaw), heading_raw, label="uncorrected")
     ax2.plot(np.degrees(yaw), heading, label="corrected")

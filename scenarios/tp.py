@@ -62,8 +62,8 @@ OPTIONS = {
     "k2": Option(0.2, "explicit filter: magnetometer weight (1)", minimum=0.0, applies="estimator=explicit"),
     "kP": Option(1.0, "explicit and passive: proportional gain (1/s)", minimum=0.0,
                  applies="estimator=explicit,passive"),
-    "kI": Option(-1.0, "bias gain (1/s^2); -1 for the default: 0 (explicit), 1 (passive)",
-                 applies="estimator=explicit,passive"),
+    "kI": Option("lab", "bias gain (1/s^2); lab: the lab's value, 0 (explicit), 1 (passive)", minimum=0.0,
+                 applies="estimator=explicit,passive", marker="lab"),
     "corrections": Option("off", "explicit/passive: disturbance-aware corrections, on, off or names (a,b)",
                           applies="estimator=explicit,passive"),
     "duration": Option(20.0, "simulated time (s)", minimum=0.01),
@@ -82,7 +82,7 @@ def estimator_gains(o: dict) -> dict:
     (1/s); ``k1``, ``k2`` (weights of gravity and field), ``kP`` (1/s) and ``kI`` (1/s^2) for the
     explicit filter; ``kP`` and ``kI`` for the passive one; none for ``vqf`` and ``madgwick``
     (their packages' defaults) and for a user's block (``module:Class``, its gains its own).
-    ``kI = -1`` takes the lab's value.
+    ``kI = "lab"`` takes the lab's value.
 
     Parameters
     ----------
@@ -99,17 +99,18 @@ def estimator_gains(o: dict) -> dict:
         return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
     if kind in ("vqf", "madgwick") or ":" in kind:
         return {}  # the packages' defaults; a user's block holds its own
-    ki = o["kI"] if o["kI"] >= 0 else LAB_GAINS[kind]["kI"]
+    ki = LAB_GAINS[kind]["kI"] if o["kI"] == "lab" else o["kI"]
     if kind == "explicit":
         return {"k1": o["k1"], "k2": o["k2"], "kP": o["kP"], "kI": ki}
     return {"k1": LAB_GAINS[kind]["k1"], "k2": LAB_GAINS[kind]["k2"], "kP": o["kP"], "kI": ki}
 
 
 def resolve(o: dict) -> dict:
-    """The options as used: ``kI = -1`` replaced by the bias gain the estimator uses (1/s^2), or
-    None for an estimator without one (linear, vqf, madgwick)."""
+    """The options as used: ``kI = "lab"`` replaced by the bias gain the estimator uses (1/s^2);
+    kept as the word for an estimator without one (linear, vqf, madgwick), as any option that
+    acts on nothing keeps its value."""
     kind = o["estimator"]
-    return o | {"kI": estimator_gains(o).get("kI") if kind in ("explicit", "passive") else None}
+    return o | ({"kI": estimator_gains(o)["kI"]} if kind in ("explicit", "passive") else {})
 
 
 #: Signals tp's result files leave out by default (recorded all the same; ``--record all``
@@ -150,11 +151,9 @@ def build(o: dict, estimator=None) -> System:
     Raises
     ------
     ValueError
-        ``kI`` negative (but -1), ``imu_rate`` not a divisor of ``1 / dt``, or a user's
+        ``imu_rate`` not a divisor of ``1 / dt``, or a user's
         estimator that cannot be loaded or breaks the contract.
     """
-    if o["kI"] < 0 and o["kI"] != -1.0:
-        raise ValueError(f"option kI={o['kI']} must be non-negative (or -1 for the default)")
     period = round(1.0 / (o["imu_rate"] * o["dt"]))
     if period < 1 or abs(period * o["dt"] * o["imu_rate"] - 1.0) > 1e-9:
         raise ValueError(f"imu_rate = {o['imu_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")

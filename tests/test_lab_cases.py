@@ -68,7 +68,7 @@ def test_estimate_fed_control_flies_with_noise_and_bias(estimator, flight):
     expected = np.array(ESTIMATE_FED[(estimator, flight)])
     for seed in SEEDS:
         result, m = run(estimator=estimator, flight=flight, feedback="estimate", noise=True, bias=True,
-                        kI=0.3 if estimator == "explicit" else -1.0, duration=15.0, seed=seed)
+                        kI=0.3 if estimator == "explicit" else "lab", duration=15.0, seed=seed)
         tilt = np.degrees(np.abs(np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]]))).max()
         measured = np.array([max(m["rms_error_deg"]), max(m["tracking_rms_deg"]), tilt])
         print(estimator, flight, seed, measured.round(3))

@@ -73,7 +73,7 @@ def test_a_20_s_tp_run_writes_its_record_uncompressed_and_matlab_reads_units_and
     assert mat["units"]["Quadrotor"][0, 0]["omega_x"][0, 0][0] == "rad/s"
     options = mat["options"][0, 0]
     assert options["estimator"][0] == "explicit" and options["noise"][0, 0]
-    assert options["kI"][0, 0] == LAB_GAINS["explicit"]["kI"]  # the gain used, not the -1 marker
+    assert options["kI"][0, 0] == LAB_GAINS["explicit"]["kI"]  # the gain used, not the word lab
     print(f"20 s tp: {total / 1e6:.2f} MB written: {written}")
 
 
@@ -111,8 +111,8 @@ def test_the_default_out_never_replaces_earlier_results(tmp_path, monkeypatch, c
     assert not (tmp_path / "results" / "open-loop-3").exists()
 
 
-@pytest.mark.parametrize("text, unit", [("macro step (s)", "s"), ("bias gain (1/s^2); -1 for the default: 0 "
-                                         "(explicit)", "1/s^2"), ("weight (1; Mahony's Kp = kP k1)", "1"),
+@pytest.mark.parametrize("text, unit", [("macro step (s)", "s"), ("bias gain (1/s^2); lab: the lab's value, "
+                                         "0 (explicit)", "1/s^2"), ("weight (1; Mahony's Kp = kP k1)", "1"),
                                         ("gravity alone (an ablation)", None), ("bias (0.02, -0.01) rad/s", None),
                                         ("profile (scenarios/flight/profiles.py)", None)])
 def test_option_units_come_from_their_help(text, unit):

@@ -6,6 +6,9 @@
   walk-through is made by the command beside it.
 - the FMUs' variable tables, generated from ``fmus/<Model>/variables.py`` into
   ``docs/_generated/fmu_variables.md`` when the build starts.
+- a check of the built pages: Markdown that did not render (a literal backtick in the text, a
+  findings marker shown as text) is a warning, so ``sphinx -W`` fails on it. A line that
+  starts with a findings marker is read by Markdown as raw HTML, and its backticks then show.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import contextlib
 import hashlib
 import io
 import json
+import re
 import shlex
 from pathlib import Path
 
@@ -102,8 +106,53 @@ def _variable_tables(app):
         target.write_text(text)
 
 
+_VERBATIM = re.compile(r"<(pre|code|script|style|kbd|tt|textarea)\b.*?</\1>", re.S | re.I)
+_COMMENT = re.compile(r"<!--.*?-->", re.S)
+_TAG = re.compile(r"<[^>]+>")
+_ARTICLE = re.compile(r"<article\b.*?</article>", re.S)
+
+
+def unrendered(html: str) -> list[str]:
+    """What of a built page's text is Markdown that did not render: each literal backtick and
+    each findings marker shown as text, with the words around it.
+
+    Parameters
+    ----------
+    html : str
+        A page as Sphinx wrote it.
+
+    Returns
+    -------
+    list of str
+        One excerpt per fault; empty for a clean page.
+    """
+    article = _ARTICLE.search(html)
+    text = _TAG.sub(" ", _COMMENT.sub(" ", _VERBATIM.sub(" ", article.group(0) if article else html)))
+    faults = []
+    for match in re.finditer(r"`|&lt;!--\s*/?findings", text):
+        excerpt = " ".join(text[max(0, match.start() - 60):match.end() + 60].split())
+        faults.append(excerpt.replace("&lt;", "<").replace("&gt;", ">"))
+    return faults
+
+
+def _check_rendered(app, exception):
+    """Warn (an error under ``-W``) on every page whose text holds unrendered Markdown."""
+    if exception is not None or app.builder.format != "html":
+        return
+    from sphinx.util import logging
+
+    logger = logging.getLogger(__name__)
+    for page in sorted(Path(app.outdir).rglob("*.html")):
+        if {"_modules", "_static", "_sources"} & set(page.relative_to(app.outdir).parts):
+            continue
+        for fault in unrendered(page.read_text(encoding="utf-8", errors="replace")):
+            logger.warning(f"{page.relative_to(app.outdir)}: Markdown not rendered (a line that starts with a "
+                           f"findings marker is raw HTML to Markdown): ...{fault}...")
+
+
 def setup(app):
-    """Register the directive and the generated pages."""
+    """Register the directive, the generated pages and the check of the built pages."""
     app.add_directive("quadcosim-run", QuadcosimRun)
     app.connect("builder-inited", _variable_tables)
+    app.connect("build-finished", _check_rendered)
     return {"parallel_read_safe": False, "version": "1"}

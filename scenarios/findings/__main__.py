@@ -20,8 +20,10 @@ from scenarios.findings import readme
 
 def parser() -> argparse.ArgumentParser:
     """The command's argument parser."""
+    from scenarios.shown import PlainHelp
+
     p = argparse.ArgumentParser(prog="quadcosim findings", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+                                formatter_class=PlainHelp)
     p.add_argument("groups", nargs="*", metavar="GROUP",
                    help=f"groups to run (default all: {', '.join(findings.GROUPS)})")
     p.add_argument("--quick", action="store_true", help="each group's fast subset (seconds to a minute)")

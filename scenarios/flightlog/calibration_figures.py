@@ -21,26 +21,50 @@ def _pyplot():
     return plt
 
 
+#: Bins of the regressor (equal widths over its 1st to 99th percentile) in which the residual's
+#: median and quartiles are drawn, each of at least RESIDUAL_BIN_SAMPLES samples.
+RESIDUAL_BINS, RESIDUAL_BIN_SAMPLES = 12, 20
+
+
+def _binned(x: np.ndarray, y: np.ndarray):
+    """Centres of the bins of ``x`` holding enough samples, and the 25th, 50th and 75th
+    percentiles of ``y`` in each."""
+    edges = np.linspace(*np.percentile(x, [1, 99]), RESIDUAL_BINS + 1)
+    which = np.searchsorted(edges, x, side="right") - 1
+    centres, quartiles = [], []
+    for b in range(RESIDUAL_BINS):
+        inside = which == b
+        if inside.sum() >= RESIDUAL_BIN_SAMPLES:
+            centres.append(0.5 * (edges[b] + edges[b + 1]))
+            quartiles.append(np.percentile(y[inside], [25, 50, 75]))
+    return np.array(centres), np.array(quartiles).reshape(-1, 3)
+
+
 def residual_figure(parts, fitted, name: str, path, title: str):
     """Residual field (uT, body axes) after the Earth field and offset alone, and after the model
     ``fitted`` (named ``name``), against its regressor, on the held-out ``parts``, into ``path``;
-    ``title`` heads the figure."""
+    ``title`` heads the figure. Each is drawn as its samples (faint) and, over them, its median
+    and quartiles in bins of the regressor, so the two clouds stay apart where they overlap."""
     plt = _pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True, constrained_layout=True)
-    for p in parts:
-        x = p.current() if name == "current" else p.throttle()
-        before = earth_and_offset(p.rotation, p.raw, p.earth).residual[0]
-        after = earth_and_offset(p.rotation, p.raw - fitted.predict(p), p.earth).residual[0]
-        for k, ax in enumerate(axes):
-            ax.plot(x, -before[:, k] * TESLA_TO_UT, ".", ms=2, color="0.6", label="Earth field and offset only")
-            ax.plot(x, -after[:, k] * TESLA_TO_UT, ".", ms=2, color="C3", label=f"with the {name} model")
+    x = np.concatenate([p.current() if name == "current" else p.throttle() for p in parts])
+    before = np.concatenate([earth_and_offset(p.rotation, p.raw, p.earth).residual[0] for p in parts])
+    after = np.concatenate([earth_and_offset(p.rotation, p.raw - fitted.predict(p), p.earth).residual[0]
+                            for p in parts])
+    styles = ((before, "0.35", "Earth field and offset only", "--"), (after, "C3", f"with the {name} model", "-"))
     for k, ax in enumerate(axes):
+        for residual, colour, label, line in styles:
+            y = -residual[:, k] * TESLA_TO_UT
+            ax.plot(x, y, ".", ms=1.5, color=colour, alpha=0.12, rasterized=True)
+            centres, q = _binned(x, y)
+            ax.fill_between(centres, q[:, 0], q[:, 2], color=colour, alpha=0.25, lw=0)
+            ax.plot(centres, q[:, 1], line, color=colour, lw=2, label=f"{label}: median, quartiles")
+        ax.axhline(0.0, color="k", lw=0.6)
         ax.set_xlabel("battery current (A)" if name == "current" else "collective throttle (1)")
         ax.set_title(f"body {'xyz'[k]}")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("field left unexplained (uT)")
-    handles, labels = axes[0].get_legend_handles_labels()
-    axes[0].legend(handles[:2], labels[:2], markerscale=5, fontsize=8)
+    axes[0].legend(fontsize=8, loc="best")
     fig.suptitle(printable(title), fontsize=10)
     try:
         save_figure(fig, path, dpi=110)

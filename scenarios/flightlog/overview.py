@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +10,8 @@ import numpy as np
 from orchestrator.files import printable, save_figure
 
 TESLA_TO_UT = 1e6
+#: Legends stand right of their axes, where they cover no trace.
+LEGEND = {"loc": "upper left", "bbox_to_anchor": (1.005, 1.0), "fontsize": 7, "frameon": False, "borderaxespad": 0.0}
 
 
 def _euler_deg(q: np.ndarray) -> np.ndarray:
@@ -39,8 +42,9 @@ def plot_overview(log, out) -> Path:
         ax.plot(compass.time - t0, np.linalg.norm(compass.field, axis=1) * TESLA_TO_UT, "k", lw=0.8,
                 label="|field| as logged")
         where = {True: "external", False: "internal", None: ""}[compass.external]
-        ax.set_ylabel(f"{compass.name} {where}\n(uT, body FRD)")
-        ax.legend(loc="upper right", ncol=4, fontsize=7)
+        name = textwrap.fill(f"{compass.name} {where}".strip().replace(".", ". "), 24).replace(". ", ".")
+        ax.set_ylabel(f"{name}\n(uT, body FRD)", fontsize=9)  # a topic name longer than the axes, wrapped
+        ax.legend(**LEGEND)
     if not log.compasses:
         axes[0].text(0.5, 0.5, "no magnetometer in this log", ha="center", transform=axes[0].transAxes)
     ax = axes[-3]
@@ -58,14 +62,14 @@ def plot_overview(log, out) -> Path:
         for n in range(log.motors.commands.shape[1]):
             ax.plot(log.motors.time - t0, log.motors.commands[:, n], lw=0.6, label=f"motor {n + 1}")
         ax.plot(log.motors.time - t0, log.motors.throttle, "k", lw=1.0, label="throttle (mean)")
-        ax.legend(loc="upper right", ncol=5, fontsize=7)
+        ax.legend(**LEGEND)
     ax.set_ylabel("command (1)")
     ax = axes[-1]
     if log.attitude is not None:
         euler = _euler_deg(log.attitude.q)
         for k, name in enumerate(("roll", "pitch", "yaw")):
             ax.plot(log.attitude.time - t0, euler[:, k], lw=0.8, label=name)
-        ax.legend(loc="upper right", ncol=3, fontsize=7)
+        ax.legend(**LEGEND)
     ax.set_ylabel(f"attitude (deg)\n{log.attitude.source if log.attitude else 'none logged'}")
     ax.set_xlabel("time from the first sample (s)")
     sim = ", SIMULATOR" if log.simulator else ""

@@ -1,0 +1,56 @@
+"""The parameters of the Python blocks, as ``quadcosim list --parameters MODEL`` shows them.
+
+An FMU's parameters come from its variable table; a Python block's from the tables its module
+declares: the controller's gains (:data:`scenarios.flight.GAINS`) and each attitude filter's
+gains (:data:`estimators.GAIN_MEANINGS`, defaults :data:`estimators.LAB_GAINS` as ``tp`` runs
+them and :data:`estimators.DEFAULT_GAINS` as :func:`estimators.estimate` runs them).
+"""
+
+from __future__ import annotations
+
+#: Python blocks with a parameter table, by the name they take in a system.
+PYTHON_BLOCKS = ("Controller", "Quaternion_estim")
+
+
+def parameter_lines(model: str) -> list[str]:
+    """The lines ``quadcosim list --parameters MODEL`` prints for a Python block.
+
+    Parameters
+    ----------
+    model : str
+        A name of :data:`PYTHON_BLOCKS`.
+
+    Returns
+    -------
+    list of str
+        A heading that says how to set them, then one line per parameter: name, default, unit
+        in brackets, meaning.
+    """
+    from scenarios.shown import PARAMETER_DIGITS, shown
+
+    if model == "Controller":
+        from scenarios.flight import GAINS
+
+        lines = ["Controller gains (set one in tp with --set Controller.NAME=VALUE; in Python, "
+                 "Controller(gains={NAME: VALUE})):"]
+        for name, (default, unit, meaning) in GAINS.items():
+            lines.append(f"  {name:10s} = {shown(default, PARAMETER_DIGITS):10}{'[' + unit + ']':10s} {meaning}")
+        return lines
+    from estimators import DEFAULT_GAINS, GAIN_MEANINGS, LAB_GAINS
+    from estimators.reference import DEFAULT_GAINS as REFERENCE_GAINS
+
+    lines = ["Quaternion_estim gains, by estimator: tp's default (the lab's values; tp sets them with its options "
+             "k, k1, k2, kP, kI) and the default of estimators.estimate (recordings); in Python, "
+             "QuaternionEstim(KIND, gains={NAME: VALUE}):"]
+    for kind, meanings in GAIN_MEANINGS.items():
+        lines.append(f"  {kind}:")
+        for name, (unit, meaning) in meanings.items():
+            lab, recordings = shown(LAB_GAINS[kind][name], PARAMETER_DIGITS), shown(DEFAULT_GAINS[kind][name],
+                                                                                    PARAMETER_DIGITS)
+            lines.append(f"    {name:4s} tp {lab:8} recordings {recordings:12}{'[' + unit + ']':9s} {meaning}")
+    lines.append("  madgwick:")
+    lines.append(f"    beta tp {shown(REFERENCE_GAINS['madgwick']['beta'], PARAMETER_DIGITS):8} "
+                 f"recordings {shown(REFERENCE_GAINS['madgwick']['beta'], PARAMETER_DIGITS):12}{'[rad/s]':9s} "
+                 "gradient step (the ahrs package's default)")
+    lines.append("  vqf: the vqf package's own parameters (tauAcc, tauMag, ...; see its documentation)")
+    return lines
