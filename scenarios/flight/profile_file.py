@@ -30,6 +30,7 @@ from orchestrator.fmu import nearest
 
 TIME_COLUMN = "t"
 MAX_PROFILE_BYTES = 100_000_000  # a profile is a table of setpoints, not a recording
+BYTES_PER_MB = 1_000_000  # for the size in the refusal
 ANGLES = ("theta_d1", "theta_d2", "theta_d3")
 DEGREE_SUFFIX = "_deg"
 RAD_PER_DEG = math.pi / 180.0  # rad per degree, for the columns given in degrees
@@ -79,8 +80,8 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
     if not path.is_file():  # a FIFO would block the read, a folder cannot be read
         raise ValueError(f"flight={path}: not a regular file; a setpoint profile is a CSV file with a header row")
     if path.stat().st_size > MAX_PROFILE_BYTES:
-        raise ValueError(f"flight={path}: {path.stat().st_size / 1e6:.0f} MB, not a setpoint profile (a CSV of "
-                         f"at most {MAX_PROFILE_BYTES / 1e6:.0f} MB)")
+        raise ValueError(f"flight={path}: {path.stat().st_size / BYTES_PER_MB:.0f} MB, not a setpoint profile (a CSV "
+                         f"of at most {MAX_PROFILE_BYTES / BYTES_PER_MB:.0f} MB)")
     try:
         # utf-8-sig: a spreadsheet's "CSV UTF-8" begins with a byte-order mark, not part of the header
         with path.open(newline="", encoding="utf-8-sig") as handle:

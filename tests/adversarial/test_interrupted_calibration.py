@@ -51,8 +51,15 @@ def test_a_signal_while_the_flights_are_read_leaves_no_folder(flight, tmp_path, 
         return log
 
     monkeypatch.setattr(scenarios.flightlog.command, "load", signalled)
+    # Python's own Ctrl-C handler, whatever an earlier test of the session left installed: once in a
+    # loaded full run this signal was lost (exit 0); a handler leaking between tests is suspected, unproven
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     out = tmp_path / "cal"
-    assert cli(["calibrate", str(flight), "--out", str(out), *MODELS]) == 130
+    try:
+        code = cli(["calibrate", str(flight), "--out", str(out), *MODELS])
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert code == 130
     capsys.readouterr()
     assert not out.exists()
 
