@@ -164,7 +164,7 @@ class ReferenceLoop:
 
 
 def _control(block) -> _Control:
-    from scenarios.flight.controller import PARAMETERS
+    from flight.controller import PARAMETERS
 
     values = dict(zip(PARAMETERS, block.parameters, strict=True))
     return _Control(*[values[name] for name in _CONTROL_NAMES], (_double * 16)(*block.mixer_inverse.ravel()))

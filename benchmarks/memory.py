@@ -39,7 +39,7 @@ def measure(duration: float, decimation: int, folder: Path) -> dict:
     """Peak RSS and recorded bytes of one ``tp`` run of ``duration`` s recording every
     ``decimation``-th step, with its results written under ``folder``."""
     out = folder / f"tp-{duration:g}-{decimation}"
-    command = [sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", f"duration={duration}",
+    command = [sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", f"duration={duration}",
                "--decimation", str(decimation), "--out", str(out), "--format", "npz", "--overwrite"]
     peak = peak_rss(command)
     with np.load(out / "results.npz") as saved:

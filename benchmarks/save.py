@@ -83,7 +83,7 @@ def stream_peak(durations=(60.0, 3600.0)) -> dict:
     peaks = {}
     for duration in durations:
         with tempfile.TemporaryDirectory() as folder:
-            peaks[duration] = peak_rss([sys.executable, "-m", "scenarios.cli", "run", "tp", "--set",
+            peaks[duration] = peak_rss([sys.executable, "-m", "quadcosim.main", "run", "tp", "--set",
                                         f"duration={duration:g}", "bench_supply=on", "--stream", "--out",
                                         str(Path(folder) / "run")]) / 1e6
     return {"peak_mb": peaks, "ratio": peaks[max(durations)] / peaks[min(durations)]}

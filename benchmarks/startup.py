@@ -1,6 +1,6 @@
 """Start-up time of the command line: wall time of ``quadcosim list``, ``quadcosim --help`` and others.
 
-Each command runs in a fresh interpreter (``python -m scenarios.cli ...``) ``repeats`` times;
+Each command runs in a fresh interpreter (``python -m quadcosim.main ...``) ``repeats`` times;
 the median and the spread (min, max) of the wall times are printed, and the modules among
 :data:`HEAVY` that the command imported::
 
@@ -27,7 +27,7 @@ _REPORT = ("import atexit, os, sys, json\n"
            "    with open(os.environ['QUADCOSIM_IMPORTED'], 'w') as f:\n"
            "        json.dump(sorted(m for m in sys.modules), f)\n"
            "atexit.register(_report)\n"
-           "from scenarios.cli import main\n"
+           "from quadcosim.main import main\n"
            "sys.argv[0] = 'quadcosim'\n"
            "sys.exit(main())\n")
 
@@ -78,7 +78,7 @@ def wall_times(args: list[str], repeats: int) -> tuple[list[float], list[float]]
     for _ in range(repeats):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         started = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "scenarios.cli", *args], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([sys.executable, "-m", "quadcosim.main", *args], check=True, stdout=subprocess.DEVNULL)
         walls.append(time.perf_counter() - started)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)

@@ -55,7 +55,7 @@ def measure(members: int = 10_000, workers: int = 2, duration: float = 5.0) -> d
         ``client_rss_growth_per_member_kb`` (last sample less the first, over the members, kB),
         counts and times.
     """
-    from scenarios.sweep import engine, grid, table
+    from studies.sweep import engine, grid, table
 
     settings = [s for s in SETTINGS if not s.startswith("duration=")] + [f"duration={duration:g}"]
     plan = grid.plan("tp", settings=settings, seeds=str(members))

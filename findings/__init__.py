@@ -1,6 +1,6 @@
 """The README's findings: every number it states, measured by code and kept in ``findings.json``.
 
-A *group* is a module ``scenarios.findings.<group>`` with ``compute(quick: bool = False) ->
+A *group* is a module ``findings.<group>`` with ``compute(quick: bool = False) ->
 list[dict]``; each dict is one finding:
 
 - ``name``: dotted, starting with the group (``flight.tilt.accelerometer_tilt_deg``);
@@ -14,9 +14,9 @@ with the same values (CI compares them with the committed ones). A group whose d
 (a dataset not shipped) raises :class:`Skipped` (a ``FileNotFoundError`` counts the same): it is
 reported as skipped, and its committed values are kept.
 
-Adding a group is one line in :data:`GROUPS`. ``python -m scenarios.findings`` (or ``quadcosim
+Adding a group is one line in :data:`GROUPS`. ``python -m findings`` (or ``quadcosim
 findings``) runs the groups, writes ``findings.json`` at the repository's root and rewrites the
-README's numbers from it (:mod:`scenarios.findings.readme`).
+README's numbers from it (:mod:`findings.readme`).
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ GROUPS = (
     "log_info",
 )
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 #: The committed findings, at the repository's root.
 FINDINGS_FILE = ROOT / "findings.json"
 KEYS = ("name", "value", "unit", "command", "tolerance", "digits")
@@ -167,13 +167,13 @@ def compute_group(group: str, quick: bool = False) -> list[dict]:
     """
     if group not in GROUPS:
         raise KeyError(f"unknown findings group {group!r}; groups: {', '.join(GROUPS)}")
-    module = importlib.import_module(f"scenarios.findings.{group}")
+    module = importlib.import_module(f"findings.{group}")
     try:
         found = module.compute(quick=quick)
     except FileNotFoundError as missing:
         raise Skipped(f"data absent: {missing}") from missing
     if not isinstance(found, list):
-        raise FindingError(f"scenarios.findings.{group}.compute returned {type(found).__name__}, not a list")
+        raise FindingError(f"findings.{group}.compute returned {type(found).__name__}, not a list")
     checked = [check(f, group) for f in found]
     names = [f["name"] for f in checked]
     repeated = sorted({n for n in names if names.count(n) > 1})
@@ -203,7 +203,7 @@ def load(path=FINDINGS_FILE) -> dict[str, dict]:
         return {f["name"]: f for f in data["findings"]}
     except (ValueError, KeyError, TypeError, OSError) as error:
         raise FindingError(f"{path}: not a findings file ({error}); regenerate it with "
-                           "`python -m scenarios.findings`") from None
+                           "`python -m findings`") from None
 
 
 def save(findings: dict[str, dict], path=FINDINGS_FILE) -> Path:
@@ -212,7 +212,7 @@ def save(findings: dict[str, dict], path=FINDINGS_FILE) -> Path:
 
     order = {g: i for i, g in enumerate(GROUPS)}
     rows = sorted(findings.values(), key=lambda f: (order.get(f["group"], len(order)), f["name"]))
-    return write_json(path, {"about": "The README's numbers, measured by `python -m scenarios.findings`; each "
+    return write_json(path, {"about": "The README's numbers, measured by `python -m findings`; each "
                                       "`command` prints its value. tolerance: absolute, in unit; digits: decimals "
                                       "the README prints.",
                              "findings": [{k: f[k] for k in (*KEYS, "group")} for f in rows]})

@@ -1,11 +1,11 @@
-"""``python -m scenarios.findings`` (or ``quadcosim findings``): run the README's findings.
+"""``python -m findings`` (or ``quadcosim findings``): run the README's findings.
 
-Runs every group of :data:`scenarios.findings.GROUPS` (or those named), prints each finding
+Runs every group of :data:`findings.GROUPS` (or those named), prints each finding
 with its command, writes ``findings.json`` and rewrites the README's numbers from it. A
 skipped group (its data absent) keeps its committed values and is said so. ``--check``
 writes nothing and exits 1 when a value moved by more than its tolerance. ``--verify-commands``
 runs each finding's command as written and exits 1 when one does not print its findings
-(:mod:`scenarios.findings.commands`).
+(:mod:`findings.commands`).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import argparse
 import sys
 from pathlib import Path
 
-import scenarios.findings as findings
-from scenarios.findings import readme
+import findings as findings
+from findings import readme
 
 
 def parser() -> argparse.ArgumentParser:
@@ -47,7 +47,7 @@ def run(groups, quick: bool) -> tuple[list[dict], dict[str, str]]:
     Parameters
     ----------
     groups : sequence of str
-        Groups of :data:`scenarios.findings.GROUPS`.
+        Groups of :data:`findings.GROUPS`.
     quick : bool
         Each group's fast subset.
     """
@@ -80,7 +80,7 @@ def verify_commands(committed: dict, groups, timeout, matching: str = "") -> int
     matching : str
         Only the commands containing this text (all when empty).
     """
-    from scenarios.findings import commands
+    from findings import commands
 
     results = commands.verify_all(committed, groups, timeout, report=lambda line: print(line, flush=True),
                                   matching=matching)

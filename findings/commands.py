@@ -1,4 +1,4 @@
-"""Each finding's command, run as written, prints its value: ``python -m scenarios.findings --verify-commands``.
+"""Each finding's command, run as written, prints its value: ``python -m findings --verify-commands``.
 
 A finding's ``command`` is what a user types, from the repository's root, to see its number. This
 module runs every distinct command of the chosen findings exactly as written and reads its
@@ -8,7 +8,7 @@ value within ``max(tolerance, half a unit of its last printed decimal)``.
 How a command is run:
 
 - it is split as a shell would (:func:`shlex.split`); ``quadcosim`` is the console script next to
-  the running interpreter (``python -m scenarios.cli`` when there is none), ``python`` the running
+  the running interpreter (``python -m quadcosim.main`` when there is none), ``python`` the running
   interpreter;
 - in a fresh temporary folder, so that what it writes (``results/...``, its ``--out``) stays out of
   the repository, with the repository's root on ``PYTHONPATH`` (its modules import as they do from
@@ -30,7 +30,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from scenarios.findings import ROOT
+from findings import ROOT
 
 LOGS_VARIABLE = "QUADCOSIM_FLIGHT_LOGS"  # the folder the commands name logs/
 DATA_VARIABLE = "QUADCOSIM_REAL_DATA"  # the folder the commands name DATA
@@ -86,7 +86,7 @@ def by_command(findings: dict[str, dict], groups=None) -> dict[str, list[dict]]:
     Parameters
     ----------
     findings : dict
-        Name -> finding (:func:`scenarios.findings.load`).
+        Name -> finding (:func:`findings.load`).
     groups : sequence of str, optional
         Groups to keep.
     """
@@ -132,7 +132,7 @@ def program(words: list[str]) -> list[str]:
     """
     if words[0] == "quadcosim":
         script = Path(sys.executable).parent / "quadcosim"
-        return [str(script), *words[1:]] if script.exists() else [sys.executable, "-m", "scenarios.cli", *words[1:]]
+        return [str(script), *words[1:]] if script.exists() else [sys.executable, "-m", "quadcosim.main", *words[1:]]
     if words[0] in ("python", "python3"):
         return [sys.executable, *words[1:]]
     raise ValueError(f"not a quadcosim or python command: {shlex.join(words)}")
@@ -149,9 +149,9 @@ def _data(words: list[str]) -> tuple[list[str], str]:
 
 
 def _rewrites(words: list[str]) -> str:
-    """Why the command ``words`` may not be run here ('' if it may): ``python -m scenarios.findings``
+    """Why the command ``words`` may not be run here ('' if it may): ``python -m findings``
     (``quadcosim findings``) without ``--check`` rewrites the repository's findings.json and pages."""
-    runs_findings = words[:3] == ["python", "-m", "scenarios.findings"] or words[:2] == ["quadcosim", "findings"]
+    runs_findings = words[:3] == ["python", "-m", "findings"] or words[:2] == ["quadcosim", "findings"]
     if runs_findings and "--check" not in words:
         return "it would rewrite findings.json and the pages: a finding's command must only print (add --check)"
     return ""
@@ -228,7 +228,7 @@ def verify_all(findings: dict[str, dict], groups=None, timeout: float | None = N
     Parameters
     ----------
     findings : dict
-        Name -> finding (:func:`scenarios.findings.load`).
+        Name -> finding (:func:`findings.load`).
     groups : sequence of str, optional
         Groups to verify (all when None).
     timeout : float, optional

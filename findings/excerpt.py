@@ -3,7 +3,7 @@ it rests before it moves, by BROAD's own movement phases (``python -m estimators
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from findings import finding
 
 COMMAND = "python -m estimators.recording"
 

@@ -30,7 +30,7 @@ def costs(log, compass: int) -> dict:
     compensation alone) and under each of :data:`WRONG_RULES`, every one applied with the log's
     own firmware rules."""
     from calibration.flight.export import choose
-    from orchestrator.logs import ardupilot
+    from flightlogs import ardupilot
     from scenarios.flightlog.calibrate import split_parts
 
     right = split_parts([log], [], compass)

@@ -29,10 +29,10 @@ EXPORTS = [("a", 0), ("a", 1), ("b", 0), ("b", 1), ("c", 0), ("c", 1), ("erlebra
 REPLAYED = ("explicit", "vqf")
 # the internal compass of the three quad flights and the Erle-Brain's: what each wrong firmware rule costs
 ABLATIONS = [("a", 1), ("b", 1), ("c", 1), ("erlebrain", 0)]
-ABLATION = "python -m scenarios.findings flightlogs"  # a function of the group, not a command's output
+ABLATION = "python -m findings flightlogs"  # a function of the group, not a command's output
 PERCENT = 100.0
 # the means over the flights: the group prints them (and, with --check, writes nothing)
-MEANS = "python -m scenarios.findings flightlogs --check"
+MEANS = "python -m findings flightlogs --check"
 
 
 def _name(key: str) -> str:
@@ -70,7 +70,7 @@ def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
     """Each flight's last half scored on a fit to its first half (and, with ``cross``, each
     flight scored on a fit to the two others)."""
     from calibration.flight import calibrate
-    from orchestrator.logs import read_log
+    from flightlogs import read_log
     from scenarios.flightlog.calibrate import split_parts
 
     logs = {k: read_log(_path(k)) for k in flights}
@@ -120,7 +120,7 @@ def _exports(keys) -> list[dict]:
     import json
     import tempfile
 
-    from scenarios.cli import main
+    from quadcosim.main import main
 
     found = []
     for key, compass in keys:
@@ -138,9 +138,9 @@ def _exports(keys) -> list[dict]:
 
 def _ablations() -> list[dict]:
     """The heading error (deg RMS, score part) of the export under the right rules and under each
-    wrong one, applied as the log's firmware applies it (:mod:`scenarios.findings.flightlog_ablation`)."""
-    from orchestrator.logs import read_log
-    from scenarios.findings.flightlog_ablation import costs
+    wrong one, applied as the log's firmware applies it (:mod:`findings.flightlog_ablation`)."""
+    from findings.flightlog_ablation import costs
+    from flightlogs import read_log
 
     found = []
     for key, compass in ABLATIONS:

@@ -9,7 +9,7 @@ group is skipped.
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from findings import finding
 
 COMMAND = "python -m fmus.agreement"
 TOLERANCE_PPM = 0.01  # ppm: deterministic figures, printed to 2 decimals

@@ -3,7 +3,7 @@ gravity alone, and without rotor drag (two ``quadcosim run gain-study`` runs, mi
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from findings import finding
 
 PERCENT = 100.0
 GRAVITY = {"closed_accelerometer": "gravity"}

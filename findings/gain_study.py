@@ -6,7 +6,7 @@ closed loops of 120 s on Dask): about 4 minutes idle, 10 loaded. Nothing here is
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from findings import finding
 
 RUN = "quadcosim run gain-study"
 PERCENT = 100.0

@@ -1,10 +1,10 @@
 """Findings of the in-flight infrared calibration: the estimators' errors, the fault detection, the cost.
 
-``quadcosim run ir-calibration`` in five cases, ``python -m scenarios.ir_detection --quick``
+``quadcosim run ir-calibration`` in five cases, ``python -m studies.ir_detection --quick``
 (IR +100 counts and GPS +0.1 rad/s over 40 fresh flights each, 200 fresh fault-free flights:
-the quick subset CI re-checks), ``python -m scenarios.ir_detectability --explain`` and
+the quick subset CI re-checks), ``python -m studies.ir_detectability --explain`` and
 ``--ramps`` (the small faults in the filter's innovations, ramped faults), ``python -m
-scenarios.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
+studies.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
 infrared`` (the operation count; its timings are not findings).
 """
 
@@ -14,13 +14,13 @@ import math
 
 import numpy as np
 
-from scenarios.findings import command, finding
+from findings import command, finding
 
 RUN = "quadcosim run ir-calibration"
-DETECTION = "python -m scenarios.ir_detection"
-DETECTABILITY = "python -m scenarios.ir_detectability"
+DETECTION = "python -m studies.ir_detection"
+DETECTABILITY = "python -m studies.ir_detectability"
 BENCH = "quadcosim bench infrared"
-SLIDES = "python -m scenarios.ir_slides"
+SLIDES = "python -m studies.ir_slides"
 UNIT = {"ir": "count", "gps": "rad/s"}
 CASES = {"drift": {}, "no_drift": {"drift": False}, "no_gps_resetting": {"gps_resetting": False},
          "faults": {"faults": "both"}, "faults_ungated": {"faults": "both", "gating": False}}
@@ -64,7 +64,7 @@ def errors() -> list[dict]:
 
 
 def _case(label: str, s: dict, command: str) -> list[dict]:
-    """The findings of one fault case of :func:`scenarios.ir_detection.summary`."""
+    """The findings of one fault case of :func:`studies.ir_detection.summary`."""
     found = [finding(f"{label}.flights", s["flights"], "1", command, 0.0, 0)]
     for key in ("right", "ended_early", "standing"):
         p = s[key]
@@ -80,7 +80,7 @@ def _case(label: str, s: dict, command: str) -> list[dict]:
 
 
 def _clean(label: str, c: dict, command: str) -> list[dict]:
-    """The findings of the fault-free fleet of :func:`scenarios.ir_detection.summary`."""
+    """The findings of the fault-free fleet of :func:`studies.ir_detection.summary`."""
     fa = c["false_alarms"]
     return [finding(f"{label}.flights", c["flights"], "1", command, 0.0, 0),
             finding(f"{label}.hours", c["hours"], "h", command, 0.05, 1),
@@ -91,8 +91,8 @@ def _clean(label: str, c: dict, command: str) -> list[dict]:
 
 def detection_quick() -> list[dict]:
     """CI's re-check: IR +100 counts and GPS +0.1 rad/s over the 40 fresh flights each of
-    :data:`scenarios.ir_detection.QUICK`, and its 200 fault-free flights."""
-    from scenarios import ir_detection
+    :data:`studies.ir_detection.QUICK`, and its 200 fault-free flights."""
+    from studies import ir_detection
 
     result, command = ir_detection.quick(), f"{DETECTION} --quick"
     found = []
@@ -104,7 +104,7 @@ def detection_quick() -> list[dict]:
 def detectability() -> list[dict]:
     """Why the small faults escape the CUSUMs on the filter's own innovations (seed 1), and how
     slow a fault may come before it passes for drift (seed 1)."""
-    from scenarios import ir_detectability
+    from studies import ir_detectability
 
     e = ir_detectability.explain()
     free = e["fault_free"]
@@ -130,8 +130,8 @@ def detectability() -> list[dict]:
 def limits() -> list[dict]:
     """The detectability limit: the residual's noise, the predicted smallest offset found in
     99 % of flights, and per size the measured share declared on the right sensor and the delay
-    within which 99 % were (fresh seeds of :data:`scenarios.ir_detectability.MEASURED`)."""
-    from scenarios import ir_detectability
+    within which 99 % were (fresh seeds of :data:`studies.ir_detectability.MEASURED`)."""
+    from studies import ir_detectability
 
     result, command = ir_detectability.limits(jobs=2), f"{DETECTABILITY} --jobs 2"
     f = result["figures"]
@@ -152,8 +152,8 @@ def limits() -> list[dict]:
 
 def comparison() -> list[dict]:
     """The slides' Kalman/regression comparison in their terms (bank angle, degrees) and in turn
-    rate, with its ablation, as the mean over the fresh flights of :data:`scenarios.ir_slides.SEEDS`."""
-    from scenarios import ir_slides
+    rate, with its ablation, as the mean over the fresh flights of :data:`studies.ir_slides.SEEDS`."""
+    from studies import ir_slides
 
     found = []
     for label, entry in ir_slides.table().items():

@@ -6,7 +6,7 @@ scenarios.ablation`` (it prints it). The quick subset: the default ``tp`` run (a
 
 from __future__ import annotations
 
-from scenarios.findings import command, finding
+from findings import command, finding
 
 RUN = "quadcosim run tp"
 ABLATION = "python -m scenarios.ablation"

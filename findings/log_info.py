@@ -1,16 +1,16 @@
 """Findings of what the quad's three flight logs hold: battery current range and logging rates.
 
-``quadcosim log info logs/FLIGHT`` prints them (:mod:`orchestrator.logs.info`): the battery
+``quadcosim log info logs/FLIGHT`` prints them (:mod:`flightlogs.info`): the battery
 current's range (A) and the rates (Hz) of the internal compass (``MAG2``, the one the
 documentation calibrates) and of the motor outputs. The logs are read from
-``$QUADCOSIM_FLIGHT_LOGS`` (see :mod:`scenarios.findings.flightlogs`); without it the group is
+``$QUADCOSIM_FLIGHT_LOGS`` (see :mod:`findings.flightlogs`); without it the group is
 skipped. Reading three logs takes seconds: the quick subset is the whole group.
 """
 
 from __future__ import annotations
 
-from scenarios.findings import finding
-from scenarios.findings.flightlogs import FLIGHTS, _path, _shown
+from findings import finding
+from findings.flightlogs import FLIGHTS, _path, _shown
 
 COMPASS = 1  # the internal compass, MAG2
 CURRENT_TOLERANCE_A = 0.06  # A: read from the log; the command prints 1 decimal (a half-way value rounds either way)
@@ -23,10 +23,10 @@ def flight(key: str) -> list[dict]:
     Parameters
     ----------
     key : str
-        A flight of :data:`scenarios.findings.flightlogs.FLIGHTS`.
+        A flight of :data:`findings.flightlogs.FLIGHTS`.
     """
-    from orchestrator.logs import read_log
-    from orchestrator.logs.info import summary
+    from flightlogs import read_log
+    from flightlogs.info import summary
 
     info = summary(read_log(_path(key)))
     command = f"quadcosim log info {_shown(key)}"

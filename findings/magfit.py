@@ -22,7 +22,7 @@ target, from the World Magnetic Model at that fix. Such a compass is reported wi
 
 MAVProxy is an optional extra (``pip install "quadcosim[peers]"``): without it the group is
 skipped, saying so. The logs are read from ``$QUADCOSIM_FLIGHT_LOGS`` (see
-:mod:`scenarios.findings.flightlogs`).
+:mod:`findings.flightlogs`).
 """
 
 from __future__ import annotations
@@ -36,8 +36,8 @@ import tempfile
 import types
 from pathlib import Path
 
-from scenarios.findings import Skipped
-from scenarios.findings.flightlogs import EXPORTS, _path, _shown
+from findings import Skipped
+from findings.flightlogs import EXPORTS, _path, _shown
 
 MAVPROXY = "1.8.75"  # the MAVProxy release whose magfit is run (pinned in the `peers` extra)
 INSTALL = 'pip install "quadcosim[peers]"'
@@ -49,7 +49,7 @@ PANEL = {"Attitude": "ATT", "Lattitude": 0.0, "Longitude": 0.0, "BatteryNum": 1,
          "DiagonalMax": 1.2, "OffDiagMin": -0.2, "OffDiagMax": 0.2, "CMOT": False, "CMOT NoChange": False,
          "CMOT Max": 10.0}
 # the findings print their values; this command prints them all (and, with --check, writes nothing)
-COMMAND = "python -m scenarios.findings magfit --check"
+COMMAND = "python -m findings magfit --check"
 PRINTED = re.compile(r"^(COMPASS_\w+) (-?\d+(?:\.\d+)?)$")
 
 
@@ -230,8 +230,8 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
 
     from calibration.flight.autopilot import write_ardupilot
     from calibration.flight.export import score_parameters
-    from orchestrator.logs import read_log
-    from scenarios.cli import main
+    from flightlogs import read_log
+    from quadcosim.main import main
     from scenarios.flightlog.calibrate import split_parts
 
     path = _path(key)
@@ -283,7 +283,7 @@ def findings_of(key: str, compass: int, settings=tuple(SETTINGS)) -> list[dict]:
     Parameters
     ----------
     key : str
-        The log's key in :mod:`scenarios.findings.flightlogs` (``a``, ``b``, ``c``, ``erlebrain``).
+        The log's key in :mod:`findings.flightlogs` (``a``, ``b``, ``c``, ``erlebrain``).
     compass : int
         The compass, from 0 in the log's order.
     settings : tuple of str

@@ -133,7 +133,7 @@ def problems(path, findings: dict[str, dict]) -> list[str]:
     path : str or pathlib.Path
         A Markdown page.
     findings : dict
-        Name -> finding (:func:`scenarios.findings.load`).
+        Name -> finding (:func:`findings.load`).
 
     Returns
     -------
@@ -152,8 +152,8 @@ def problems(path, findings: dict[str, dict]) -> list[str]:
             if not any(matches(token, f) for f in scoped):
                 line = passage.line + passage.text.count("\n", 0, offset)
                 lines.append(f"{passage.path.name}:{line}: {token} is no finding of {', '.join(passage.scope)} "
-                             "(a measured number: add it to its group in scenarios/findings/ and run "
-                             "`python -m scenarios.findings`; an input: put it in a code span)")
+                             "(a measured number: add it to its group in findings/ and run "
+                             "`python -m findings`; an input: put it in a code span)")
         for f in unprinted(scoped, [token for _, token in shown]):
             lines.append(f"{where}: {f['name']} = {printed(f)} {f['unit']} is not printed in the passage "
                          f"{', '.join(passage.scope)} (its command: {f['command']})")
@@ -228,7 +228,7 @@ def strays(path) -> list[str]:
             continue
         line = masked.count("\n", 0, offset) + 1
         lines.append(f"{path.name}:{line}: {token} is stated outside a findings passage (a measured number: "
-                     "add it to a group in scenarios/findings/ and put it in a `<!-- findings:NAME -->` passage; "
+                     "add it to a group in findings/ and put it in a `<!-- findings:NAME -->` passage; "
                      "an input: a code span or an `<!-- inputs -->` passage)")
     return lines
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from scenarios.findings import finding
+from findings import finding
 
 RUN = "quadcosim run tp"
 STREAM = "python -m benchmarks.save --stream-peak"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from findings import finding
 
 RUN = "quadcosim run rig"
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from scenarios.findings import finding
+from findings import finding
 
 BENCH = "quadcosim bench --json"
 STARTUP = "python -m benchmarks.startup"

@@ -15,7 +15,7 @@ same sweep: ``quick`` returns none.
 
 from __future__ import annotations
 
-from scenarios.findings import finding
+from findings import finding
 
 BENCH = "quadcosim bench sweep"
 STUDY_MEMBERS = 1000
@@ -116,7 +116,7 @@ def study(members: int = STUDY_MEMBERS, workers: int = STUDY_WORKERS) -> dict:
     import subprocess
     import sys
 
-    from scenarios.findings import ROOT
+    from findings import ROOT
 
     command = [sys.executable, "-m", "benchmarks.study", "--members", str(members), "--workers", str(workers), "--json"]
     done = subprocess.run(command, capture_output=True, text=True, cwd=ROOT)

@@ -1,15 +1,15 @@
 """Flight: the controller, the mixer and the flight profiles of the closed loop.
 
-- :mod:`scenarios.flight.controller`: ``Controller``, attitude, altitude and position-hold
+- :mod:`flight.controller`: ``Controller``, attitude, altitude and position-hold
   control law (a block like the others);
-- :mod:`scenarios.flight.mixer`: thrust and torques to rotor speeds (quad-X allocation) and
+- :mod:`flight.mixer`: thrust and torques to rotor speeds (quad-X allocation) and
   rotor speeds to ESC commands (the motors' steady-state map of :mod:`fmus.vehicle`);
-- :mod:`scenarios.flight.profiles`: the setpoint tables of the lab's flight profiles.
+- :mod:`flight.profiles`: the setpoint tables of the lab's flight profiles.
 """
 
-from scenarios.flight.controller import GAINS, SETPOINT, Controller
-from scenarios.flight.mixer import allocation_matrix, esc_command
-from scenarios.flight.profiles import FLIGHTS, initial_state, profile, profile_at
+from flight.controller import GAINS, SETPOINT, Controller
+from flight.mixer import allocation_matrix, esc_command
+from flight.profiles import FLIGHTS, initial_state, profile, profile_at
 
 __all__ = ["FLIGHTS", "GAINS", "SETPOINT", "Controller", "allocation_matrix", "esc_command", "initial_state", "profile",
            "profile_at"]

@@ -25,9 +25,9 @@ Law, per sample of period ``dt``:
   whole loop at 100 Hz, a yaw loop above 11 rad/s is unstable: at 12 rad/s an 18 Hz
   oscillation grows until the motor currents reach zero, where free-wheeling ESCs hold them
   (the ESC commands stay inside [0, 1]: 0.35 to 0.58 in non-stationary flight); 8 rad/s is
-  quiet, and so is 12 rad/s at 1 kHz (:mod:`scenarios.flight.yaw_loop` measures it);
+  quiet, and so is 12 rad/s at 1 kHz (:mod:`studies.yaw_loop` measures it);
 - altitude: ``a_z = kp_z (z_d - p_z) - kd_z v_z``, ``T = m (g - a_z) / R33``;
-- mixer: ``[T_1..T_4] = M^-1 [T, tau]`` (:func:`scenarios.flight.mixer.allocation_matrix`),
+- mixer: ``[T_1..T_4] = M^-1 [T, tau]`` (:func:`flight.mixer.allocation_matrix`),
   each rotor thrust saturated to ``[0, T_max]``, ``omega_n = sqrt(T_n / k_f)``, and the ESC
   command from the motors' steady-state map at the present battery voltage, saturated to
   ``[0, 1]``.
@@ -44,10 +44,10 @@ import numpy as np
 from numba import njit
 
 from estimators.core import euler_to_quaternion
+from flight.mixer import allocation_matrix, esc_command
 from fmus import vehicle
 from orchestrator.blocks import Block
 from orchestrator.fmu import nearest
-from scenarios.flight.mixer import allocation_matrix, esc_command
 
 SETPOINT = ("theta_d1", "theta_d2", "theta_d3", "x_d", "y_d", "z_d", "hold")
 INPUTS = SETPOINT + ("q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "p_x", "p_y", "p_z",
@@ -277,8 +277,8 @@ def _compiled_step():
         from numba import carray, cfunc
 
         from estimators import core
+        from flight import mixer
         from orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
-        from scenarios.flight import mixer
 
         sources = source_fingerprint(core, mixer, vehicle)  # the files the law calls into: in the cache key
 

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.optimize import curve_fit
 
-from scenarios.flight import profiles, trim
+from flight import profiles, trim
 
 SETTLED_AFTER_STEP = 1.0  # s after the step: the attitude loop has settled (0.3 s), the lag alone remains
 FIT_START_TAU = 4.0  # s, first guess of the fitted time constant (the default vehicle's is 4.25 s)

@@ -9,7 +9,7 @@ The file has a header row and one row per time, for example::
 
 - ``t`` (s): strictly increasing times; before the first row the first row holds, after the
   last the last.
-- any of :data:`scenarios.flight.SETPOINT`: ``theta_d1, theta_d2, theta_d3`` (roll, pitch, yaw,
+- any of :data:`flight.SETPOINT`: ``theta_d1, theta_d2, theta_d3`` (roll, pitch, yaw,
   rad; or in degrees with the suffix ``_deg``), ``x_d, y_d, z_d`` (m, NED: up is negative),
   ``hold`` (1: hold the horizontal position ``x_d, y_d``; 0: fly the roll and pitch
   setpoints). A column left out is 0.
@@ -76,7 +76,7 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
     path = Path(path)
     if not path.exists():
         raise ValueError(f"flight={path}: no such file (a setpoint profile is a CSV file with a header row; "
-                         "see scenarios/flight/profile_file.py)")
+                         "see flight/profile_file.py)")
     if not path.is_file():  # a FIFO would block the read, a folder cannot be read
         raise ValueError(f"flight={path}: not a regular file; a setpoint profile is a CSV file with a header row")
     if path.stat().st_size > MAX_PROFILE_BYTES:

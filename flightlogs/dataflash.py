@@ -7,7 +7,7 @@ What ArduPilot logs, and how it is turned into the project's conventions:
   frame, in milligauss, *after* the compass's corrections, with the offsets ``Ofs``
   (``COMPASS_OFS*``) and the motor compensation ``MOfs`` logged beside it. The raw field is
   recovered sample by sample in the order of the log's firmware version
-  (:func:`orchestrator.logs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter 3.5,
+  (:func:`flightlogs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter 3.5,
   ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later).
 - ``GPS``: the position and date the Earth field model is evaluated at (3D fixes only).
 - ``CTUN.ThO`` (``ThrOut`` in 0..1000 in older firmware): ``motors->get_throttle()``, the throttle
@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.logs import ardupilot
-from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
+from flightlogs import ardupilot
+from flightlogs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
 
 MILLIGAUSS = 1e-7  # T
 CENTI = 0.01
@@ -60,10 +60,10 @@ def _reader(path: Path, text: bool):
 
 def _collect(path: Path, text: bool):
     """Rows of the wanted messages (type -> list of dicts), the formats, the parameters, what
-    pymavlink printed while it read (:class:`orchestrator.logs.noise.Noise`) and the bytes the
+    pymavlink printed while it read (:class:`flightlogs.noise.Noise`) and the bytes the
     last message lacks."""
+    from flightlogs.noise import captured
     from orchestrator.interrupts import surfaced
-    from orchestrator.logs.noise import captured
 
     rows: dict[str, list] = {}
     with surfaced(), captured() as noise:

@@ -10,7 +10,7 @@ How PX4's logged topics differ from ArduPilot's messages:
 - No motor-compensation offsets are logged: PX4 adds ``CAL_MAGn_*COMP`` times the throttle or
   the current inside the calibration step, so the raw topic is the field before it.
 - The calibration slot ``CAL_MAGn`` of a sensor is the one whose ``CAL_MAGn_ID`` is its
-  ``device_id`` (:func:`orchestrator.logs.px4.slot`); the raw field stays in the sensor's frame and
+  ``device_id`` (:func:`flightlogs.px4.slot`); the raw field stays in the sensor's frame and
   :attr:`Compass.rotation` carries ``CAL_MAGn_ROT`` or the board's rotation into the body frame.
 - ``vehicle_gps_position``: the position and date of the Earth field model; the thrust setpoint's
   norm (``vehicle_thrust_setpoint``, or ``actuator_controls_0.control[3]`` in older logs) is the
@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.logs import px4
-from orchestrator.logs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
+from flightlogs import px4
+from flightlogs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
 
 GAUSS = 1e-4  # T
 MICRO = 1e-6
@@ -227,8 +227,8 @@ def read_ulog(path: Path) -> FlightLog:
     """Read the PX4 ULog at ``path``."""
     from pyulog import ULog
 
+    from flightlogs.noise import captured
     from orchestrator.interrupts import surfaced
-    from orchestrator.logs.noise import captured
 
     with surfaced(), captured() as noise:  # pyulog prints its warnings on standard output
         try:

@@ -337,11 +337,11 @@ def parser() -> argparse.ArgumentParser:
     findings = sub.add_parser("findings", add_help=False,
                               help="run the README's findings, write findings.json, rewrite the README's numbers "
                                    "(quadcosim findings --help)")
-    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.findings
+    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to findings
     from scenarios import run_plots
 
     run_plots.add_arguments(sub)
-    from scenarios.sweep import command as sweep
+    from studies.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
         .set_defaults(func=sweep.sweep)
@@ -422,7 +422,7 @@ def main(argv=None) -> int:
             final = argv is None  # the process's own command line, not a call from Python
             argv = sys.argv[1:] if argv is None else list(argv)
             if argv[:1] == ["findings"]:  # its own parser: its options, --help included, are its own
-                from scenarios.findings.__main__ import main as findings
+                from findings.__main__ import main as findings
 
                 return findings(argv[1:])
             args = parser().parse_args(argv)

@@ -1,7 +1,7 @@
 """The parameters of the Python blocks, as ``quadcosim list --parameters MODEL`` shows them.
 
 An FMU's parameters come from its variable table; a Python block's from the tables its module
-declares: the controller's gains (:data:`scenarios.flight.GAINS`) and each attitude filter's
+declares: the controller's gains (:data:`flight.GAINS`) and each attitude filter's
 gains (:data:`estimators.GAIN_MEANINGS`, defaults :data:`estimators.LAB_GAINS` as ``tp`` runs
 them and :data:`estimators.DEFAULT_GAINS` as :func:`estimators.estimate` runs them).
 """
@@ -29,7 +29,7 @@ def parameter_lines(model: str) -> list[str]:
     from scenarios.shown import PARAMETER_DIGITS, shown
 
     if model == "Controller":
-        from scenarios.flight import GAINS
+        from flight import GAINS
 
         lines = ["Controller gains (set one in tp with --set Controller.NAME=VALUE; in Python, "
                  "Controller(gains={NAME: VALUE})):"]

@@ -23,7 +23,7 @@ clamped, so the Earth field is constant in the sensor frame.
   regime of the paper's free set: one common lead (every motor's field along one direction,
   up, as the current loops of a power board below the sensor make it), its gains scaled so
   that a one-motor sweep deflects the field as much as on the default vehicle (the sets keep
-  their error), and a free set swinging 0.25. :mod:`scenarios.metge_free` measures what each
+  their error), and a free set swinging 0.25. :mod:`studies.metge_free` measures what each
   ingredient does.
 """
 
@@ -37,7 +37,7 @@ import numpy as np
 from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
 from fmus import vehicle
 from orchestrator import System, Table, portable
-from orchestrator.files import write_json, write_text
+from orchestrator.files import write_json
 from orchestrator.parameters import apply
 from orchestrator.progress import status
 from scenarios import Option, Scenario
@@ -662,80 +662,3 @@ def add_compensator(system: System, mode: str, path: str, estimator: str = "Quat
     system.connect("MotorMagnetics.u_batt", "MagCompensator.u_batt")
     system.connect("MagCompensator.magneto", f"{estimator}.magneto")
     return block
-
-
-# --- the closed loop: yaw error per estimator and compensation --------------------------
-
-STUDY_ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
-
-
-def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), estimators=tuple(STUDY_ESTIMATORS),
-              duration: float = 20.0, noise: bool = True) -> dict:
-    """``tp`` with the field of the motor currents off, then on with each compensation; the
-    estimators' yaw RMS error (deg) for each, written to ``out/yaw_study.json`` and ``.md``.
-    ``calibration_path``: the calibration file; ``flights``, ``estimators``: those compared;
-    ``duration`` (s) and ``noise``: of every run."""
-    import scenarios
-
-    out = Path(out)
-    table = {}
-    cases = [("off", "none")] + [("on", mode) for mode in COMPENSATIONS]
-    for flight in flights:
-        for estimator in estimators:
-            for magnetic, mode in cases:
-                settings = {"estimator": estimator, "flight": flight, "noise": noise, "duration": duration,
-                            "magnetic": magnetic == "on", "compensation": mode,
-                            "calibration": calibration_path if mode != "none" else "",
-                            **STUDY_ESTIMATORS[estimator]}
-                _, m = scenarios.run("tp", settings)
-                key = "magnetic_off" if magnetic == "off" else mode
-                table.setdefault(flight, {}).setdefault(estimator, {})[key] = m["rms_error_deg"][2]
-                print(f"{flight:14s} {estimator:9s} {key:13s} yaw RMS {m['rms_error_deg'][2]:8.3f} deg", flush=True)
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "yaw_study.json", table)
-    columns = ["magnetic_off", *COMPENSATIONS]
-    lines = []
-    for flight, rows in table.items():
-        lines += [f"### {flight}", "", "| estimator | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
-        lines += [f"| {e} | " + " | ".join(f"{r[c]:.3f}" for c in columns) + " |" for e, r in rows.items()]
-        lines.append("")
-    write_text(out / "yaw_study.md", "\n".join(lines))
-    return table
-
-
-def main(argv=None):
-    """Command line of the studies: ``python -m scenarios.metge --calibration FILE --out DIR``
-    (the yaw study), ``--robustness --out DIR`` (:mod:`scenarios.metge_robustness`) or
-    ``--free-set --out DIR`` (:mod:`scenarios.metge_free`).
-    ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description="Yaw error of each estimator with the motor field compensated "
-                                                 "(--calibration), the compensation on perturbed plants "
-                                                 "(--robustness), or the free set's ablation (--free-set).")
-    parser.add_argument("--calibration", help="calibration file, e.g. from quadcosim run metge (the yaw study)")
-    parser.add_argument("--robustness", nargs="*", metavar="CASE",
-                        help="the robustness study (every case, or those named)")
-    parser.add_argument("--free-set", nargs="*", metavar="CASE",
-                        help="the free set's ablation (scenarios/metge_free.py; every case, or those named)")
-    parser.add_argument("--out", required=True, help="output folder")
-    parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
-    parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
-    args = parser.parse_args(argv)
-    for chosen, name in ((args.free_set, "metge_free"), (args.robustness, "metge_robustness")):
-        if chosen is not None:  # a study of its own module, with its cases
-            import importlib
-
-            study = importlib.import_module(f"scenarios.{name}")
-            unknown = set(chosen) - set(study.cases())
-            if unknown:
-                parser.error(f"unknown case {', '.join(sorted(unknown))}; cases: {', '.join(study.cases())}")
-            study.study(args.out, chosen or None)
-            return
-    if not args.calibration:
-        parser.error("give --calibration FILE (the yaw study), --robustness or --free-set")
-    yaw_study(args.out, args.calibration, estimators=tuple(args.estimators.split(",")), duration=args.duration)
-
-
-if __name__ == "__main__":
-    main()

@@ -50,7 +50,7 @@ _LITERAL = re.compile(r"``([^`]+)``")
 
 def plain(text: str) -> str:
     """reST of a docstring as plain text for a terminal: ``\\`\\`x\\`\\``` -> ``x``,
-    ``:data:\\`scenarios.findings.GROUPS\\``` -> ``scenarios.findings.GROUPS``.
+    ``:data:\\`findings.GROUPS\\``` -> ``findings.GROUPS``.
 
     Parameters
     ----------

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from scenarios.flight import profiles, trim
+from flight import profiles, trim
 
 
 def accelerometer_tilt_deg(acc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

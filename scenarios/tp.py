@@ -14,6 +14,9 @@ import numpy as np
 
 from estimators import LAB_GAINS, QuaternionEstim, parse_corrections
 from estimators.core import euler_to_quaternion
+from flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
+from flight.controller import SETPOINT_UNITS
+from flight.profile_file import FileProfile, is_profile_file
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
@@ -29,9 +32,6 @@ from scenarios.figures import (
     title_lines,
     wrapped_curve,
 )
-from scenarios.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
-from scenarios.flight.controller import SETPOINT_UNITS
-from scenarios.flight.profile_file import FileProfile, is_profile_file
 from scenarios.metge import add_compensator, vehicle_settings
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
@@ -40,8 +40,8 @@ BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
 OPTIONS = {
     "estimator": Option("linear", "attitude estimator, or module:Class (a block of your own: estimators/contract.py)",
                         choices=("linear", "explicit", "passive", "vqf", "madgwick"), classes=True),
-    "flight": Option("quasi", "flight profile (scenarios/flight/profiles.py), or a setpoint profile in a CSV file "
-                              "(scenarios/flight/profile_file.py)", choices=FLIGHTS, files=".csv"),
+    "flight": Option("quasi", "flight profile (flight/profiles.py), or a setpoint profile in a CSV file "
+                              "(flight/profile_file.py)", choices=FLIGHTS, files=".csv"),
     "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)", applies="flight=tilt"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
     "noise": Option(False, "IMU white noise"),
@@ -329,7 +329,7 @@ def _predictions(result, o) -> dict:
 def _flight_findings(result, o) -> dict:
     """What the flight shows of the drag model: the tilt step's lag and speed (``flight=tilt``),
     the tilt into a steady wind and the position held (a wind on a position-holding flight)."""
-    from scenarios.flight import measured
+    from flight import measured
 
     found = {}
     if o["flight"] == "tilt":

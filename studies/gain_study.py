@@ -163,7 +163,7 @@ def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
     ``out``/closed-loop if given); and the failures, as (gain, error)."""
     import shutil
 
-    from scenarios.sweep import engine, grid, named
+    from studies.sweep import engine, grid, named
 
     plan = grid.plan_of_cases("tp", {f"k={k:.6g}": closed_loop_options(float(k), o) for k in gains})
     with tempfile.TemporaryDirectory() as scratch:

@@ -1,6 +1,6 @@
 """The default vehicle at hover, simulated: trim, motor time constant, and what follows from them.
 
-``python -m scenarios.hover`` prints the figures the documentation states about the default
+``python -m studies.hover`` prints the figures the documentation states about the default
 vehicle (``fmus/vehicle.py``):
 
 - the MotorMagnetics FMU driven at the hover command (:func:`fmus.vehicle.hover_command`) for
@@ -10,7 +10,7 @@ vehicle (``fmus/vehicle.py``):
 - the yaw actuator's spin-up reaction over the rate drag torque, ``J_r / (2 k_m omega tau)``: the
   rotors' reaction to their own acceleration ``J_r dω/dt`` against the change of ``k_m ω²``
   during the first time constant;
-- the drag model's predictions (:mod:`scenarios.flight.trim`): the velocity time constant of
+- the drag model's predictions (:mod:`flight.trim`): the velocity time constant of
   rotor drag at hover and the pitch of the ``quasi`` cruise.
 """
 
@@ -52,8 +52,8 @@ def figures() -> dict:
         and the ``quasi`` cruise's ``cruise_speed_m_s`` (m/s) and ``cruise_pitch_deg`` (deg, nose
         down positive).
     """
+    from flight import profiles, trim
     from orchestrator.fmu import FMUInstance
-    from scenarios.flight import profiles, trim
 
     command = vehicle.hover_command()
     fmu = FMUInstance("MotorMagnetics")
@@ -86,7 +86,7 @@ def main(argv=None) -> int:
     int
         Exit status, 0.
     """
-    argparse.ArgumentParser(prog="python -m scenarios.hover", description=__doc__.splitlines()[0]).parse_args(argv)
+    argparse.ArgumentParser(prog="python -m studies.hover", description=__doc__.splitlines()[0]).parse_args(argv)
     f = figures()
     print(f"hover: ESC command {f['command']:.3f}, rotor speed {f['omega_rad_s']:.2f} rad/s, "
           f"current {f['current_a']:.3f} A per motor")

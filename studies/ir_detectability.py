@@ -21,7 +21,7 @@ sqrt(E) / sigma`` exceeds ``sqrt(2 significance)`` by the normal's 99 % quantile
 a floor: its increments ``d / s - k`` (``s`` the filter's model deviation of the residual,
 ``k`` the allowance) must reach its threshold. :func:`measured` flies fleets of fresh seeds
 with offsets from below to above that limit and gives the delay within which 99 % of them were
-declared on the right sensor. ``python -m scenarios.ir_detectability`` prints both and draws
+declared on the right sensor. ``python -m studies.ir_detectability`` prints both and draws
 ``detectability.png``.
 
 ``--explain`` shows, on one flight, why the filter's own innovations miss small offsets (it
@@ -41,7 +41,7 @@ import numpy as np
 from calibration.infrared import EKFSettings
 from calibration.infrared.layout import RING_SIZE
 from scenarios.ir_calibration import FAULT_SAMPLES, GPS_FAULT, IR_FAULT, RATE, episodes
-from scenarios.ir_detection import TUNING, fleet, fly, kalman
+from studies.ir_detection import TUNING, fleet, fly, kalman
 
 SAMPLES = 8000
 SETTLED_S = 30.0  # s: the spreads are taken after the filter has converged
@@ -312,7 +312,7 @@ def calibrate(clean=(1, 9000), faults=(1, 300)) -> dict:
 
 
 def main(argv=None) -> int:
-    """``python -m scenarios.ir_detectability [--explain | --ramps | --calibrate] [--out DIR] [--jobs N]``.
+    """``python -m studies.ir_detectability [--explain | --ramps | --calibrate] [--out DIR] [--jobs N]``.
 
     Parameters
     ----------

@@ -2,8 +2,8 @@
 
 Judged on fleets of flights it was never tuned on.
 
-``python -m scenarios.ir_detection`` flies the ``ir-calibration`` flight (8000 samples at
-20 Hz, drift on) in batch (:mod:`scenarios.ir_fleet`, the InfraredSensor's arithmetic on
+``python -m studies.ir_detection`` flies the ``ir-calibration`` flight (8000 samples at
+20 Hz, drift on) in batch (:mod:`studies.ir_fleet`, the InfraredSensor's arithmetic on
 arrays), one fault at a time at the slides' onsets and length (IR from 60 s, GPS from 280 s,
 2000 samples), over a fleet of seeds per fault kind and size, and fault-free flights over
 another; it prints for each case the rates with their 95 % intervals (Clopper-Pearson for a
@@ -87,7 +87,7 @@ def kalman(flight: dict, settings: EKFSettings | None = None) -> dict:
 def fly(seed: int, sensor: str = "none", size: float = 0.0) -> dict:
     """The ``ir-calibration`` flight of ``seed`` with one fault of ``size`` on ``sensor``
     (``"ir"``, count; ``"gps"``, rad/s; ``"none"``), in batch."""
-    from scenarios.ir_fleet import fly as batch
+    from studies.ir_fleet import fly as batch
 
     return batch(seed, SAMPLES, faults=sensor, ir_fault=size, gps_fault=size)
 
@@ -243,7 +243,7 @@ def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=FRESH, clean=ABLATI
 
 
 def main(argv=None) -> int:
-    """``python -m scenarios.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--jobs N] [--out FILE]``.
+    """``python -m studies.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--jobs N] [--out FILE]``.
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """The lab's matrix in one go: every ``tp`` case of the report, and the checks against analysis.
 
-    quadcosim sweep lab-matrix --out results/lab-matrix      (or python -m scenarios.lab_matrix)
+    quadcosim sweep lab-matrix --out results/lab-matrix      (or python -m studies.lab_matrix)
 
 A named sweep: its members run on Dask like any sweep (``--workers``, ``--scheduler``,
 ``--resume``); each case leaves its own folder (figures, metrics.json, results) under
@@ -206,7 +206,7 @@ def markdown(summary: dict) -> str:
 
 
 def main(argv=None) -> int:
-    """Command line ``python -m scenarios.lab_matrix``: run the matrix as the named sweep
+    """Command line ``python -m studies.lab_matrix``: run the matrix as the named sweep
     ``lab-matrix`` and print its summary.
 
     Parameters
@@ -220,9 +220,9 @@ def main(argv=None) -> int:
     int
         The sweep's exit status (0: every member completed).
     """
-    from scenarios.sweep import command
+    from studies.sweep import command
 
-    parser = argparse.ArgumentParser(prog="python -m scenarios.lab_matrix", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m studies.lab_matrix", description=__doc__.splitlines()[0])
     parser.add_argument("--out", help="output folder (default results/lab-matrix, or results/lab-matrix-N when that "
                                       "holds an earlier matrix)")
     parser.add_argument("--workers", help="local Dask worker processes (default: the CPUs)")
@@ -238,10 +238,10 @@ def main(argv=None) -> int:
 
 
 def _sweep():
-    from scenarios.sweep.named import NamedSweep
+    from studies.sweep.named import NamedSweep
 
     return NamedSweep("lab-matrix", "tp", cases, "every tp case of the lab report, and the checks against analysis",
-                      summarise=summarise, extra_metrics="scenarios.lab_matrix:late_mean_error", keep_results=True)
+                      summarise=summarise, extra_metrics="studies.lab_matrix:late_mean_error", keep_results=True)
 
 
 SWEEP = _sweep()

@@ -21,7 +21,7 @@ seed draws other frequencies and phases for the commands, and other noise):
 - the bound: the largest angle by which the default vehicle's cables can turn the Earth
   field at steady state, and with every supply current anywhere up to the ESC's limit.
 
-``python -m scenarios.metge --free-set --out DIR`` prints the table and writes
+``python -m studies.metge --free-set --out DIR`` prints the table and writes
 ``free_set.json``; :func:`study` does it from Python.
 """
 

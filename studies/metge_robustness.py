@@ -13,7 +13,7 @@ sweeps) and scores the compensation on the free set of another:
   weaker magnets (back-EMF constant -5 %), a cable moved (every field gain +10 %), an older
   battery (internal resistance x3).
 
-``python -m scenarios.metge --robustness --out DIR`` writes ``robustness.json`` and prints the
+``python -m studies.metge --robustness --out DIR`` writes ``robustness.json`` and prints the
 table; :func:`study` does it from Python.
 """
 

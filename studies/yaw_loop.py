@@ -17,7 +17,7 @@ The ablation case ``100hz_24_hover_no_reaction`` removes the rotors' reaction to
 acceleration (``J_r domega/dt``) from the rigid body: what makes the yaw actuator's first
 tens of milliseconds stronger than ``k_m omega^2`` says, and the 100 Hz loop unstable.
 
-``python -m scenarios.flight.yaw_loop`` prints the cases of :func:`study`.
+``python -m studies.yaw_loop`` prints the cases of :func:`study`.
 """
 
 from __future__ import annotations

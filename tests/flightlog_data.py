@@ -23,12 +23,12 @@ def path(name: str) -> Path:
 
 @cache
 def _read(name: str):
-    from orchestrator.logs import read_log
+    from flightlogs import read_log
 
     return read_log(FOLDER / name)
 
 
 def log(name: str):
-    """The :class:`orchestrator.logs.FlightLog` of the shared log ``name``, read once."""
+    """The :class:`flightlogs.FlightLog` of the shared log ``name``, read once."""
     path(name)
     return _read(name)

@@ -20,10 +20,10 @@ ALLOWED = {
     # to find built FMUs only: the package's locating functions, not its build or its models
     "orchestrator": ("fmus",),
     # the block contract, and the plant's constants (vehicle, sensor densities)
-    # and the flight-log reading layer (orchestrator.logs), which replay and calibration share,
+    # and the flight-log reading layer (flightlogs), which replay and calibration share,
     # and the one writer of every file the project writes (orchestrator.files)
-    "estimators": ("orchestrator.blocks", "orchestrator.logs.", "orchestrator.files", "fmus.", "calibration."),
-    "calibration": ("orchestrator.blocks", "orchestrator.logs.", "orchestrator.files", "fmus.", "estimators."),
+    "estimators": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus.", "calibration."),
+    "calibration": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus.", "estimators."),
     "scenarios": tuple(f"{p}." for p in PACKAGES),
     "benchmarks": tuple(f"{p}." for p in PACKAGES),
 }
@@ -87,7 +87,7 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     import tomllib
 
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    assert project["project"]["scripts"]["quadcosim"] == "scenarios.cli:entry"
+    assert project["project"]["scripts"]["quadcosim"] == "quadcosim.main:entry"
     assert "benchmarks*" in project["tool"]["setuptools"]["packages"]["find"]["include"]
     assert not (ROOT / "orchestrator" / "cli.py").exists()
     assert not list((ROOT / "orchestrator").glob("bench*.py"))
@@ -102,7 +102,7 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     ("fmus", "orchestrator.fmu", False),
     ("estimators", "orchestrator.blocks", True),
     ("estimators", "orchestrator.system", False),
-    ("calibration", "orchestrator.logs.model", True),
+    ("calibration", "flightlogs.model", True),
     ("calibration", "orchestrator.fmu", False),
     ("estimators", "scenarios.plant", False),
     ("scenarios", "benchmarks.master", True),

@@ -30,7 +30,7 @@ def test_metge_table1_and_the_motor_dynamics(tmp_path):
     fast; the directions within 0.28 deg (calibration 1)."""
     from calibration import Calibration
     from scenarios.metge import SCENARIO, errors_deg
-    from scenarios.metge_free import free_run
+    from studies.metge_free import free_run
 
     settings = {"levels": 6, "free": 6.0}
     _, m = scenarios.run("metge", settings, out_dir=tmp_path)
@@ -61,7 +61,7 @@ def test_the_paper_regime_reproduces_the_papers_free_set_and_the_default_does_no
     """regime=paper (one common lead, swing 0.25): the uncompensated free set within a fifth
     of the paper's 55.9 deg on every seed of the ablation (58.9-63.1 measured, mean 61.5); the
     default regime's is 12.0-13.6 (mean 12.9), 4.8 times smaller."""
-    from scenarios.metge_free import SEEDS, uncompensated_free_deg
+    from studies.metge_free import SEEDS, uncompensated_free_deg
 
     paper, default = np.array(uncompensated_free_deg({"regime": "paper"})), np.array(uncompensated_free_deg({}))
     print(f"uncompensated free set (deg): regime=paper {paper.round(2)}, default {default.round(2)}")

@@ -150,9 +150,9 @@ def test_the_cached_compiled_steps_follow_the_files_they_call_into():
     """numba reuses a cached function while its own file is unchanged; the compiled steps hold a
     fingerprint of the files they call into (estimators/core.py, ...) in their cache key."""
     from estimators import core, filters
+    from flight import controller, mixer
     from fmus import vehicle
     from orchestrator.blocks import source_fingerprint
-    from scenarios.flight import controller, mixer
 
     for function, modules in ((filters._compiled_step(), (core,)),
                               (controller._compiled_step(), (core, mixer, vehicle))):

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
+from flight import SETPOINT
+from flight.profile_file import FileProfile
+from quadcosim.main import main
 from scenarios import run as run_scenario
-from scenarios.cli import main
 from scenarios.figures import angle_curve
-from scenarios.flight import SETPOINT
-from scenarios.flight.profile_file import FileProfile
 from scenarios.shown import PARAMETER_DIGITS, shown
-from scenarios.sweep.command import default_out
+from studies.sweep.command import default_out
 
 
 def test_set_reaches_a_named_controller_gain_and_records_it(tmp_path, capsys):

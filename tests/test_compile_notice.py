@@ -32,7 +32,7 @@ def test_a_compilation_prints_one_line_once(capsys):
 
 def test_after_the_build_a_run_loads_every_step_from_the_cache(tmp_path):
     # `make test` runs `quadcosim build` first, which compiles every step (compiled.compile_all)
-    done = subprocess.run([sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", "duration=0.2",
+    done = subprocess.run([sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", "duration=0.2",
                            "estimator=explicit", "--out", str(tmp_path / "tp")], capture_output=True, text=True,
                           timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]

@@ -13,7 +13,7 @@ from helpers import documentation
 import scenarios
 from estimators.contract import REQUIRED, AttitudeEstimator
 from orchestrator import Block, Result, System
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 

@@ -13,9 +13,9 @@ import pytest
 from scipy.io import loadmat
 
 from estimators import DEFAULT_GAINS, LAB_GAINS
+from flight import GAINS
+from quadcosim.main import main, parser
 from scenarios import get
-from scenarios.cli import main, parser
-from scenarios.flight import GAINS
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +60,7 @@ def test_the_default_bias_gain_is_one_word_everywhere(finished_run, tmp_path, ca
     assert main(["run", "tp", "--set", "duration=0.2", "--format", "npz,mat", "--out", str(linear)]) == 0
     metrics = json.loads((linear / "metrics.json").read_text())
     assert metrics["options"]["kI"] == "lab" == loadmat(linear / "results.mat")["options"]["kI"][0, 0][0]
-    from scenarios.sweep import table
+    from studies.sweep import table
 
     table.write([table.row({"member": 0, "options": get("tp").parse(None)})], tmp_path)
     csv = (tmp_path / "sweep.csv").read_text().splitlines()
@@ -133,7 +133,7 @@ def test_every_argument_has_help():
     missing = [" ".join(path + (a.dest,)) for path, a in _arguments(parser())
                if not a.help and a.dest != "rest"]  # findings' arguments: its own parser, below
     assert missing == []
-    from scenarios.findings.__main__ import parser as findings
+    from findings.__main__ import parser as findings
 
     assert [a.dest for _, a in _arguments(findings()) if not a.help] == []
 
@@ -142,7 +142,7 @@ def test_help_is_plain_text(capsys):
     with pytest.raises(SystemExit):
         main(["findings", "--help"])
     text = capsys.readouterr().out
-    assert "quadcosim findings" in text and "scenarios.findings.GROUPS" in text
+    assert "quadcosim findings" in text and "findings.GROUPS" in text
     assert "``" not in text and ":data:" not in text and ":mod:" not in text
     with pytest.raises(SystemExit):
         main(["--help"])
@@ -151,7 +151,7 @@ def test_help_is_plain_text(capsys):
 
 def test_a_reader_that_leaves_early_gets_no_traceback():
     """``quadcosim list --parameters IMU | head -1``: the first line, and no BrokenPipeError."""
-    command = f"'{sys.executable}' -m scenarios.cli list --parameters IMU | head -1"
+    command = f"'{sys.executable}' -m quadcosim.main list --parameters IMU | head -1"
     done = subprocess.run(["bash", "-o", "pipefail", "-c", command], capture_output=True, text=True, timeout=120)
     assert done.stdout.startswith("IMU parameters") and done.stdout.count("\n") == 1
     assert "Traceback" not in done.stderr and "BrokenPipe" not in done.stderr, done.stderr

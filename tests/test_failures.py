@@ -9,7 +9,7 @@ import pytest
 import scenarios
 from fmus import FMUNotFoundError
 from orchestrator import Block, FMUBlock, SimulationError, System, Table
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 class Source(Block):

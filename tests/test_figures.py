@@ -17,7 +17,9 @@ def drawn(monkeypatch, module_name: str) -> dict:
     """Keep the figures a scenario module saves, by file name, instead of closing them."""
     import importlib
 
-    module = importlib.import_module(f"scenarios.{module_name}")
+    import scenarios
+
+    module = importlib.import_module(scenarios._MODULES.get(module_name.replace("_", "-"), f"scenarios.{module_name}"))
     figures = {}
 
     def keep(figure, out_dir, name):
@@ -197,8 +199,8 @@ def test_sweep_plot_axes_carry_units(tmp_path):
     the sweep and what it held fixed (from sweep.json)."""
     import json
 
-    from scenarios.sweep import figure
-    from scenarios.sweep.command import _plot_context
+    from studies.sweep import figure
+    from studies.sweep.command import _plot_context
 
     assert figure.metric_unit("rms_error_deg[0]") == "deg" and figure.metric_unit("bias_convergence_s") == "s"
     assert figure.metric_unit("real_time_factor") == ""

@@ -15,15 +15,15 @@ import types
 import pytest
 from helpers import documentation
 
-import scenarios.findings as findings
-from scenarios.findings import readme
-from scenarios.findings.__main__ import main as findings_main
+import findings as findings
+from findings import readme
+from findings.__main__ import main as findings_main
 
 COMMITTED = findings.load()
 
 
 def test_findings_file_is_committed_and_well_formed():
-    assert COMMITTED, "findings.json is missing: run `python -m scenarios.findings`"
+    assert COMMITTED, "findings.json is missing: run `python -m findings`"
     for f in COMMITTED.values():
         assert findings.check(f, f["group"]) == f
         assert f["group"] in findings.GROUPS
@@ -151,7 +151,7 @@ def groups(monkeypatch):
         raise FileNotFoundError("no recordings in /data/broad (set QUADCOSIM_DATA)")
 
     for name, compute in (("present", measured), ("absent", absent)):
-        monkeypatch.setitem(sys.modules, f"scenarios.findings.{name}", types.SimpleNamespace(compute=compute))
+        monkeypatch.setitem(sys.modules, f"findings.{name}", types.SimpleNamespace(compute=compute))
     monkeypatch.setattr(findings, "GROUPS", ("present", "absent"))
 
 
@@ -168,7 +168,7 @@ def test_a_group_without_its_data_is_skipped_and_keeps_its_committed_values(grou
 
 
 def test_a_malformed_finding_is_refused_naming_it(monkeypatch):
-    monkeypatch.setitem(sys.modules, "scenarios.findings.bad", types.SimpleNamespace(
+    monkeypatch.setitem(sys.modules, "findings.bad", types.SimpleNamespace(
         compute=lambda quick=False: [{"name": "bad.z", "value": float("nan"), "unit": "", "command": "c",
                                       "tolerance": 0, "digits": 1}]))
     monkeypatch.setattr(findings, "GROUPS", ("bad",))
@@ -189,7 +189,7 @@ def test_quick_findings_reproduce_the_committed_values(group):
 
 
 # commands run as written and checked to print their findings in CI: the fast ones (seconds each;
-# `python -m scenarios.findings --verify-commands` runs them all, the robustness study included)
+# `python -m findings --verify-commands` runs them all, the robustness study included)
 PRINT_CHECKED = ("flight.tilt.", "flight.tilt_without_drag.", "flight.wind.tilt", "rig.", "lab.linear_quasi_gt.",
                  "lab.ablation.ideal_", "lab.passive_convergence.reel.k100.",
                  "lab.triad_bias.times_true.", "infrared.slides.", "flight.wind.offset_",
@@ -198,7 +198,7 @@ PRINT_CHECKED = ("flight.tilt.", "flight.tilt_without_drag.", "flight.wind.tilt"
 
 
 def _checked_commands() -> dict[str, list[dict]]:
-    from scenarios.findings import commands
+    from findings import commands
 
     return {c: found for c, found in commands.by_command(COMMITTED).items()
             if any(f["name"].startswith(PRINT_CHECKED) for f in found)}
@@ -207,7 +207,7 @@ def _checked_commands() -> dict[str, list[dict]]:
 @pytest.mark.slow
 @pytest.mark.parametrize("command", sorted(_checked_commands()))
 def test_a_findings_command_run_as_written_prints_its_findings(command):
-    from scenarios.findings import commands
+    from findings import commands
 
     verified = commands.verify(command, _checked_commands()[command])
     if verified.status == "skipped":
@@ -220,7 +220,7 @@ def _finding(name: str, value: float, tolerance: float, digits: int, command: st
 
 
 def test_verifier_reads_a_value_printed_at_its_digits_or_within_its_tolerance():
-    from scenarios.findings import commands
+    from findings import commands
 
     out = "  wind_tilt_final_deg: 4.1179\n  rms_error_deg: [0, 0.012224, -3.5e-05]\n  ratio 12%"
     found = [_finding("g.tilt", 4.117926, 5e-5, 4), _finding("g.rms", 0.0122216, 1e-5, 4),
@@ -232,9 +232,9 @@ def test_verifier_reads_a_value_printed_at_its_digits_or_within_its_tolerance():
 
 
 def test_verifier_refuses_a_command_that_rewrites_the_findings_and_skips_absent_data(monkeypatch):
-    from scenarios.findings import commands
+    from findings import commands
 
-    refused = commands.verify("python -m scenarios.findings flight", [_finding("g.a", 1.0, 0.1, 1)])
+    refused = commands.verify("python -m findings flight", [_finding("g.a", 1.0, 0.1, 1)])
     assert refused.status == "failed" and "--check" in refused.detail and refused.missing == ["g.a"]
     monkeypatch.delenv("QUADCOSIM_REAL_DATA", raising=False)
     absent = commands.verify("python -m benchmarks.real_recordings DATA", [_finding("g.b", 1.0, 0.1, 1)])
@@ -244,7 +244,7 @@ def test_verifier_refuses_a_command_that_rewrites_the_findings_and_skips_absent_
 
 
 def test_verifier_runs_a_command_in_a_scratch_folder_and_names_what_it_does_not_print(tmp_path):
-    from scenarios.findings import commands
+    from findings import commands
 
     printed = "quadcosim list --parameters IMU"  # prints the IMU's parameters: the gyro bias default 0
     verified = commands.verify(printed, [_finding("g.zero", 0.0, 0.0, 0, printed),
@@ -254,7 +254,7 @@ def test_verifier_runs_a_command_in_a_scratch_folder_and_names_what_it_does_not_
 
 
 def test_the_readme_states_the_default_result_format():
-    from scenarios.cli import parser
+    from quadcosim.main import parser
 
     default = parser().parse_args(["run", "tp"]).format
     stated = re.search(r"`--format\s+npz,mat,csv` the files written \(default `([^`]*)` alone\)", documentation())

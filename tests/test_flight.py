@@ -1,12 +1,12 @@
-"""Controller, mixer and flight profiles (scenarios.flight)."""
+"""Controller, mixer and flight profiles (flight)."""
 
 import numpy as np
 import pytest
 
 import scenarios
+from flight import GAINS, Controller, allocation_matrix, esc_command, initial_state, profile, profiles, trim
+from flight import controller as law
 from fmus import vehicle
-from scenarios.flight import GAINS, Controller, allocation_matrix, esc_command, initial_state, profile, profiles, trim
-from scenarios.flight import controller as law
 from scenarios.testing.assertions import assert_bounds
 
 
@@ -144,7 +144,7 @@ def test_a_12_rad_s_yaw_loop_at_100_hz_rings_until_the_free_wheeling_currents_re
     and so does 24 rad/s at 100 Hz without the rotors' reaction torque (Quadrotor.J_r = 0): the
     cause. Measured: ringing 2.2e-2 N m at 18.5 Hz; commands 0.403-0.508 in hover, 0.347-0.582
     in non-stationary flight; the hover current 3.78 A when quiet."""
-    from scenarios.flight.yaw_loop import QUIET_NM, yaw_loop
+    from studies.yaw_loop import QUIET_NM, yaw_loop
 
     ringing, flying = yaw_loop(100.0, 12.0), yaw_loop(100.0, 12.0, "nonstationary")
     quiet, fast = yaw_loop(100.0, 8.0), yaw_loop(1000.0, 12.0)

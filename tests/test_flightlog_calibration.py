@@ -10,8 +10,8 @@ from helpers import documentation
 from calibration import Calibration, StaticCalibration, compensate
 from calibration.flight import autopilot, calibrate, flight_data
 from calibration.flight.calibrate import _field_model
-from orchestrator.logs import ardupilot, px4
-from scenarios.cli import main
+from flightlogs import ardupilot, px4
+from quadcosim.main import main
 from tests.flightlog_data import ERLE, PX4, QUAD, log, path
 from tests.flightlog_synthetic import write_log
 
@@ -135,7 +135,7 @@ def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, 
 
 def test_the_command_lines_defaults_are_the_calibrations_names():
     from calibration.flight import MODELS
-    from scenarios.cli import parser
+    from quadcosim.main import parser
 
     args = parser().parse_args(["calibrate", "flight.log", "--out", "out"])
     assert tuple(args.models) == MODELS and args.attitude == "auto"

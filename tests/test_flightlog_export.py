@@ -9,8 +9,8 @@ import pytest
 
 from calibration.flight import flight_data
 from calibration.flight.autopilot import read_parameters
-from orchestrator.logs import read_log
-from scenarios.cli import main
+from flightlogs import read_log
+from quadcosim.main import main
 from tests.flightlog_synthetic import write_log
 from tests.flightlog_ulog_synthetic import write_ulog
 

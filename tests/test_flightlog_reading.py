@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from orchestrator.logs import LogError, read_log
-from orchestrator.logs.info import summary
+from flightlogs import LogError, read_log
+from flightlogs.info import summary
 from tests.flightlog_data import ERLE, PX4, QUAD, log, path
 
 # WMM 2015 at the quad's GPS position (42.356 N, 71.299 W), October 2015: 51.9 uT total
@@ -106,7 +106,7 @@ def test_unknown_empty_truncated_and_corrupt_logs_are_named(tmp_path):
 
 
 def test_log_info_and_plot_commands(tmp_path, capsys):
-    from scenarios.cli import main
+    from quadcosim.main import main
 
     assert main(["log", "info", str(path(QUAD[1]))]) == 0
     shown = capsys.readouterr().out

@@ -62,7 +62,7 @@ def test_the_explicit_filters_inclination_on_a_flight_is_set_by_its_correction_t
 def test_tp_flies_a_calibration_made_on_a_real_flight(tmp_path):
     import json
 
-    from scenarios.cli import main
+    from quadcosim.main import main
 
     out = tmp_path / "cal"
     assert main(["calibrate", str(path(QUAD[1])), "--compass", "1", "--out", str(out),

@@ -70,8 +70,8 @@ def test_gated_filter_declares_attributes_and_survives_both_faults(both_faults):
 
 def test_no_false_alarm_on_100_fresh_fault_free_flights():
     """Seeds no setting was chosen on, flown in batch (the FMU's arithmetic): 0 declared in 11.1
-    flight-hours (``python -m scenarios.ir_detection`` judges 500)."""
-    from scenarios.ir_detection import fleet
+    flight-hours (``python -m studies.ir_detection`` judges 500)."""
+    from studies.ir_detection import fleet
 
     rows = fleet("none", 0.0, range(50_100_000, 50_100_100))
     declared = sum(r["declarations"] for r in rows)

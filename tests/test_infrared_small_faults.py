@@ -9,7 +9,7 @@ import pytest
 
 from calibration.infrared import EKFSettings, Estimator
 from scenarios.ir_calibration import episodes, fault_report, simulate_flight
-from scenarios.ir_detection import fleet, fly
+from studies.ir_detection import fleet, fly
 
 SEEDS = range(50_000_000, 50_000_020)  # fresh: flown in batch (the FMU's arithmetic), 20 per case
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 SCANNED = ("fmus/*/model.c", "fmus/c/*.c", "fmus/c/*.h", "fmus/*.py", "fmus/*/variables.py",
-           "scenarios/flight/**/*.py", "scenarios/flight/**/*.c", "estimators/**/*.py", "estimators/**/*.c")
+           "flight/**/*.py", "flight/**/*.c", "estimators/**/*.py", "estimators/**/*.c")
 FORMULA = {0, 1, 2, 0.5}  # the only bare numbers of formulas
 COUNTS = {3: "axes of space", 4: "components of a quaternion", 9: "entries of a 3 x 3 matrix"}
 LARGEST_INDEX = 9  # integer subscripts up to this are positions inside a vector, quaternion or matrix

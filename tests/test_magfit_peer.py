@@ -3,8 +3,8 @@ parameters scored on the held-out part as quadcosim's export is; or the reason i
 
 import pytest
 
-import scenarios.findings as findings
-from scenarios.findings import magfit
+import findings as findings
+from findings import magfit
 from tests import flightlog_data
 
 

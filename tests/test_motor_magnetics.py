@@ -5,7 +5,7 @@ import pytest
 
 from fmus import vehicle
 from orchestrator.fmu import FMUInstance
-from scenarios.hover import figures
+from studies.hover import figures
 
 OUT = ["omega_r1", "i1", "i2", "i3", "i4", "u_batt", "i_batt", "soc", "b_d_x", "b_d_y", "b_d_z",
        *[f"b_d{n}_{a}" for n in range(1, 5) for a in "xyz"], *[f"i_s{n}" for n in range(1, 5)],

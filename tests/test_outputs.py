@@ -11,7 +11,7 @@ from scipy.io import loadmat
 from estimators import LAB_GAINS
 from orchestrator import Result
 from orchestrator.result import matrix_shape, vector_groups
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 def test_vectors_are_grouped_by_name():
@@ -114,7 +114,7 @@ def test_the_default_out_never_replaces_earlier_results(tmp_path, monkeypatch, c
 @pytest.mark.parametrize("text, unit", [("macro step (s)", "s"), ("bias gain (1/s^2); lab: the lab's value, "
                                          "0 (explicit)", "1/s^2"), ("weight (1; Mahony's Kp = kP k1)", "1"),
                                         ("gravity alone (an ablation)", None), ("bias (0.02, -0.01) rad/s", None),
-                                        ("profile (scenarios/flight/profiles.py)", None)])
+                                        ("profile (flight/profiles.py)", None)])
 def test_option_units_come_from_their_help(text, unit):
     from scenarios.metrics import option_unit
 

@@ -83,7 +83,7 @@ def test_status_lines_only_while_reporting():
 def test_a_120_s_run_writes_at_most_15_lines_to_a_pipe(tmp_path):
     """Acceptance 5, on the open loop (the cheapest 120 s run): every line of standard error, status
     lines included, and no carriage return."""
-    process = subprocess.run([sys.executable, "-m", "scenarios.cli", "run", "open-loop", "--set", "duration=120",
+    process = subprocess.run([sys.executable, "-m", "quadcosim.main", "run", "open-loop", "--set", "duration=120",
                               "--out", str(tmp_path / "run")], capture_output=True, text=True, cwd=ROOT,
                              env=os.environ | {"COLUMNS": "80"}, timeout=600)
     assert process.returncode == 0, process.stderr

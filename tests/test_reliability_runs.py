@@ -26,7 +26,7 @@ import scenarios
 from orchestrator import Block, Fault, FMUBlock, Result, SimulationError, System, Table
 from orchestrator.files import atomic_path
 from orchestrator.interrupts import Terminated, first_only
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -82,7 +82,7 @@ def test_an_interrupted_run_saves_what_it_recorded_and_leaves_no_temporary_files
     # recorded) are interrupted as soon as the progress bar shows simulated time past 0: the
     # signal lands inside the loop however loaded, or fast, the machine is.
     duration = 7200
-    command = [sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", f"duration={duration}",
+    command = [sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", f"duration={duration}",
                "--set", "bench_supply=on", "--decimation", "1000", "--out", str(out),
                "--format", "npz,mat"]
 
@@ -382,7 +382,7 @@ def test_every_command_in_the_readme_runs(command, tmp_path, monkeypatch, capsys
 
 
 def test_the_help_fault_example_runs(tmp_path, capsys):
-    from scenarios.cli import _parse_fault
+    from quadcosim.main import _parse_fault
 
     with pytest.raises(ValueError) as error:
         _parse_fault("IMU.omega_x")

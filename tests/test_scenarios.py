@@ -9,7 +9,7 @@ import pytest
 from scipy.stats import spearmanr
 
 import scenarios
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 from scenarios.plant import angle_between
 from scenarios.rig import phases
 

@@ -5,7 +5,7 @@ twofold tolerance, ratios a tighter one."""
 
 import pytest
 
-from scenarios.findings import speed, sweep_cost
+from findings import speed, sweep_cost
 
 BENCH = {"open_loop_over_c": 1.03, "open_loop_over_c_spread": [0.92, 1.05], "closed_loop_over_c": 1.18,
          "closed_loop_over_c_spread": [1.1, 1.2], "fmu_step_over_equations": 1.06,

@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 
 from fmus import MODELS
-from scenarios import sweep
-from scenarios.sweep import command, table
-from scenarios.sweep.engine import worker_state
+from studies import sweep
+from studies.sweep import command, table
+from studies.sweep.engine import worker_state
 
 ROOT = Path(__file__).resolve().parent.parent
 GRID = ["--grid", "k=0.05,0.2,1e5", "--set", "duration=0.5", "--set", "noise=on", "--seeds", "4"]
@@ -76,7 +76,7 @@ def test_one_and_two_workers_give_the_same_table(reference, tmp_path):
 def test_killed_sweep_resumes_to_the_same_table(reference, tmp_path):
     _, _, uninterrupted = reference
     out = tmp_path / "killed"
-    process = subprocess.Popen([sys.executable, "-m", "scenarios.sweep", "tp", *GRID, "--workers", "1",
+    process = subprocess.Popen([sys.executable, "-m", "studies.sweep", "tp", *GRID, "--workers", "1",
                                 "--out", str(out), "--quiet"], cwd=tmp_path, start_new_session=True,
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
@@ -255,8 +255,8 @@ def test_gain_study_options_are_checked_before_any_run(settings, message, monkey
 
 
 def test_lab_matrix_is_a_named_sweep_of_every_case():
-    from scenarios import lab_matrix
-    from scenarios.sweep import named
+    from studies import lab_matrix
+    from studies.sweep import named
 
     plan = named.get("lab-matrix").plan(["noise=on"])
     labels = [m.label for m in plan.members]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from orchestrator import Constant, FMUBlock, System
-from scenarios.cli import main
+from quadcosim.main import main
 
 MOTOR = "FirstOrderMotor"
 TAU, OMEGA_MAX = 0.03, 1000.0  # s, rad/s: the motor model's defaults (tests/user_fmus/first_order_motor.py)

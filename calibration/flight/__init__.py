@@ -1,4 +1,4 @@
-"""Magnetometer calibration from real flights (logs read by :mod:`orchestrator.logs`).
+"""Magnetometer calibration from real flights (logs read by :mod:`flightlogs`).
 
 For one compass, the raw field (before the autopilot's own corrections) is explained as the
 Earth field rotated into the body frame, an offset, and the field of the motor currents::

@@ -1,6 +1,6 @@
 """Parameter files: ArduPilot's (``NAME,VALUE`` lines, as Mission Planner loads them) and PX4's
 (QGroundControl's tab-separated format). The parameters themselves, and how each firmware applies
-them, are in :mod:`orchestrator.logs.ardupilot` and :mod:`orchestrator.logs.px4`.
+them, are in :mod:`flightlogs.ardupilot` and :mod:`flightlogs.px4`.
 """
 
 from __future__ import annotations

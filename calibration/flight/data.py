@@ -35,11 +35,11 @@ def rotation_of(euler: np.ndarray) -> np.ndarray:
 def board_quaternions(log, trim: bool = True) -> np.ndarray:
     """The attitude (T, 4) of the frame the autopilot's sensors are rotated into, at the log's
     attitude instants: ArduPilot's ``ATT`` is the vehicle's, the board's turned by ``AHRS_TRIM``,
-    which is added back (:func:`orchestrator.logs.ardupilot.trim_rotation`); PX4 rotates its
+    which is added back (:func:`flightlogs.ardupilot.trim_rotation`); PX4 rotates its
     sensors into the vehicle's frame itself. ``trim=False`` ignores the trim (an ablation)."""
     from scipy.spatial.transform import Rotation
 
-    from orchestrator.logs import ardupilot
+    from flightlogs import ardupilot
 
     q = log.attitude.q
     if not trim or log.autopilot != "ArduPilot":
@@ -83,7 +83,7 @@ class FlightData:
     euler : (T, 3) array
         The log's roll, pitch and yaw (rad) at ``time``: tilt compensation and the reference heading.
     motors, battery :
-        The log's :class:`orchestrator.logs.Motors` and :class:`orchestrator.logs.Battery` (or None).
+        The log's :class:`flightlogs.Motors` and :class:`flightlogs.Battery` (or None).
     log : FlightLog
         The log itself.
     compass : int
@@ -148,13 +148,13 @@ class FlightData:
 
 def fused(log, compass: int) -> bool:
     """Whether the log's heading fuses compass ``compass``: ArduPilot's ``COMPASS_PRIMARY``, PX4's first."""
-    from orchestrator.logs import ardupilot
+    from flightlogs import ardupilot
 
     return compass == (ardupilot.fused_compass(log.params) if log.autopilot == "ArduPilot" else 0)
 
 
 def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: bool = True) -> FlightData:
-    """Align compass ``compass`` of the :class:`orchestrator.logs.FlightLog` ``log`` for calibration.
+    """Align compass ``compass`` of the :class:`flightlogs.FlightLog` ``log`` for calibration.
 
     ``attitude`` chooses the rotation that removes the Earth field: ``"gyro"`` takes roll and pitch
     from the log and integrates the heading from the gyro (see :func:`gyro_heading`), so the heading
@@ -170,7 +170,7 @@ def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: boo
         No such compass, no motors, attitude or IMU in the log (named), sensors that share no span
         of time, too few compass samples in the span they share, or an unknown ``attitude``.
     """
-    from orchestrator.logs import LogError
+    from flightlogs import LogError
 
     if attitude not in ATTITUDES:
         raise CalibrationError(f"attitude {attitude!r} must be one of {', '.join(ATTITUDES)}")

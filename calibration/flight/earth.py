@@ -35,7 +35,7 @@ class EarthField:
 
 
 def model_field(position) -> tuple[EarthField | None, str]:
-    """The World Magnetic Model's field at ``position`` (a :class:`orchestrator.logs.Position`, or
+    """The World Magnetic Model's field at ``position`` (a :class:`flightlogs.Position`, or
     None), and a line saying what was used or why not."""
     if position is None:
         return None, ("no GPS fix in the log: the Earth field is left free per flight, so the z offset and the "

@@ -3,7 +3,7 @@
 :func:`score_parameters` is the one judge of a parameter set: any ArduPilot or PX4 parameters
 (this project's export, the log's own, a file another tool wrote), loaded on top of the log's
 parameters and applied to the raw field exactly as the log's firmware applies them
-(:mod:`orchestrator.logs.ardupilot`, :mod:`orchestrator.logs.px4`), on the held-out parts. It
+(:mod:`flightlogs.ardupilot`, :mod:`flightlogs.px4`), on the held-out parts. It
 returns the heading error against the log's attitude and the share of the field residual the
 parameters' motor compensation explains.
 
@@ -24,7 +24,7 @@ import numpy as np
 from calibration.flight.evaluate import heading_error, tilt_compensated_heading
 from calibration.flight.linear import earth_and_offset, fit_linear
 from calibration.static import CalibrationError
-from orchestrator.logs import ardupilot, px4
+from flightlogs import ardupilot, px4
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
 MOTOR_MODELS = ("current", "motors", "throttle")  # the export's motor compensation, in this order of preference

@@ -50,7 +50,7 @@ calibration *held* from before (:func:`consistency`).
   with the cloud's drift too) and ``alt_level`` (remember the calibration from before a change
   the fit saw but could not confirm, and take a later opposite change back to it for the end of
   an absorbed offset rather than a fault: it also takes real faults for returns).
-  ``scenarios/ir_detection.py`` measures each choice.
+  ``studies/ir_detection.py`` measures each choice.
 """
 
 from __future__ import annotations

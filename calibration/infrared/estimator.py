@@ -180,7 +180,7 @@ class EKFSettings:
         (``delta_b + delta_a u + beta t``) before a fault is declared. Set on the tuning seeds:
         on the fault-free flights of seeds 1 to 9000 the largest was 10.3; in the first 5 s of
         a GPS +0.1 rad/s offset on seeds 1 to 300 the smallest 25.0
-        (``python -m scenarios.ir_detectability --calibrate``).
+        (``python -m studies.ir_detectability --calibrate``).
     sd_a_held : float
         Prior standard deviation of the held calibration's error of ``a`` (count per rad/s)
         in that test: the largest error of the filter's ``a`` 10 samples old on the fault-free

@@ -33,7 +33,7 @@ def _run(command: str) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
-    from scenarios.cli import main
+    from quadcosim.main import main
 
     out = GENERATED / "runs" / hashlib.sha256(command.encode()).hexdigest()[:16]
     metrics = out / "metrics.json"

@@ -28,7 +28,7 @@ PARAMETER_FILES = {"ArduPilot": "ardupilot.parm", "PX4": "px4.params"}
 
 
 def _logs(files, verb: str) -> list:
-    from scenarios.flightlog.command import load
+    from scenarios.flightlog.reading import load
 
     return [load(f, verb) for f in files]
 
@@ -114,7 +114,7 @@ def _rule(args, part):
     """ArduPilot's rules for the export: the log's firmware, or --firmware's."""
     if args.firmware is None:
         return None
-    from orchestrator.logs import ardupilot
+    from flightlogs import ardupilot
 
     version = ardupilot.parse_version(f"ArduCopter V{args.firmware}")
     if version is None:
@@ -364,10 +364,10 @@ def _numeric(call, sources, also=(ValueError,)):
     """``call()``, a numerical library's failure (``LinAlgError``, ``FloatingPointError``,
     ``IndexError`` and the classes ``also``) named with the flights ``sources``, its cause and the
     fix; the project's own refusals (:class:`~calibration.static.CalibrationError`,
-    :class:`~orchestrator.logs.LogError`, ...) pass unchanged."""
+    :class:`~flightlogs.LogError`, ...) pass unchanged."""
     from calibration.static import CalibrationError
+    from flightlogs import LogError
     from orchestrator.files import OutputRefused
-    from orchestrator.logs import LogError
 
     try:
         return call()

@@ -7,25 +7,13 @@ import json
 import sys
 from pathlib import Path
 
-
-def load(path, verb: str):
-    """The :class:`orchestrator.logs.FlightLog` at ``path``, with a simulator log and corruption read
-    past announced on standard error, prefixed by ``verb``; raises ``LogError``."""
-    from orchestrator.logs import read_log
-
-    log = read_log(path)
-    if log.simulator:
-        print(f"quadcosim {verb}: warning: {path} is a simulator (SITL) log; its sensors are simulated, not "
-              "a real vehicle's", file=sys.stderr)
-    for warning in log.warnings:
-        print(f"quadcosim {verb}: warning: {path}: {warning}", file=sys.stderr)
-    return log
+from scenarios.flightlog.reading import load
 
 
 def info(args) -> int:
     """``quadcosim log info FILE [--json]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
-    from orchestrator.logs import LogError
-    from orchestrator.logs.info import summary, text
+    from flightlogs import LogError
+    from flightlogs.info import summary, text
 
     try:
         found = summary(load(args.file, "log info"))
@@ -39,8 +27,8 @@ def info(args) -> int:
 def plot(args) -> int:
     """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); 2 on a bad
     log or output path, 1 when the figure could not be written (a full disk)."""
+    from flightlogs import LogError
     from orchestrator.files import OutputRefused, figure_file
-    from orchestrator.logs import LogError
     from scenarios.flightlog.overview import plot_overview
 
     try:

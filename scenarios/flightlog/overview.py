@@ -24,7 +24,7 @@ def _euler_deg(q: np.ndarray) -> np.ndarray:
 
 
 def plot_overview(log, out) -> Path:
-    """Draw the overview of ``log`` (:class:`orchestrator.logs.FlightLog`) into the figure file ``out``
+    """Draw the overview of ``log`` (:class:`flightlogs.FlightLog`) into the figure file ``out``
     (its format from its suffix, written atomically: :func:`orchestrator.files.save_figure`): each
     compass's raw field (uT), battery current (A) and voltage (V), motor commands and throttle
     (1), and the autopilot's roll, pitch and yaw (deg), on the log's clock (s)."""

@@ -32,7 +32,7 @@ REFERENCE_NOTE = ("differences from the autopilot's own attitude estimate, a ref
 def _uniform(log, compass: int):
     from scipy.spatial.transform import Rotation, Slerp
 
-    from orchestrator.logs import LogError
+    from flightlogs import LogError
 
     imu = log.imus[0]
     chosen = log.compass(compass)
@@ -72,12 +72,12 @@ def _fields(log, compass: int, time):
 
 def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMATORS)) -> dict:
     """Run every estimator of :data:`ESTIMATORS` on the log at ``path`` (or an already read
-    :class:`orchestrator.logs.FlightLog`) with compass ``compass``, without and with the
+    :class:`flightlogs.FlightLog`) with compass ``compass``, without and with the
     compensation; heading and inclination RMS differences (deg) from the log's attitude over the
     second half of the flight (at least ``settle_s`` (s) after the start); ``kinds``: the
     estimators run (names of :data:`ESTIMATORS`)."""
     from estimators import estimate
-    from orchestrator.logs import FlightLog, read_log
+    from flightlogs import FlightLog, read_log
 
     log = path if isinstance(path, FlightLog) else read_log(path)
     log.require("a replay", "imu", "attitude", "compass", "motors")
@@ -119,8 +119,8 @@ def _replayed(log, compass: int) -> dict:
     """:func:`replay_log` of the read ``log``, a numerical library's failure named with the file,
     its likely cause and the fix."""
     from calibration.static import CalibrationError
+    from flightlogs import LogError
     from orchestrator.files import OutputRefused
-    from orchestrator.logs import LogError
 
     try:
         return replay_log(log, compass)
@@ -138,7 +138,7 @@ def run(args) -> int:
     full disk: nothing is left under its name)."""
     from calibration.static import CalibrationError
     from orchestrator.files import output_file, write_json
-    from scenarios.flightlog.command import load
+    from scenarios.flightlog.reading import load
 
     try:
         if args.json:

@@ -4,7 +4,7 @@ from orchestrator.interrupts import exit_code, leave  # the standard library alo
 
 if __name__ == "__main__":
     try:
-        from scenarios.sweep.command import main
+        from studies.sweep.command import main
 
         code = main()
     except KeyboardInterrupt as interrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep

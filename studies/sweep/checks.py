@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from scenarios.sweep.grid import ChainedMembers, GridMembers, Plan
+from studies.sweep.grid import ChainedMembers, GridMembers, Plan
 
 #: Dimensions with up to this many values are probed value by value.
 PROBED_VALUES = 32

@@ -1,4 +1,4 @@
-"""``quadcosim sweep`` and ``quadcosim sweep-plot`` (also ``python -m scenarios.sweep``).
+"""``quadcosim sweep`` and ``quadcosim sweep-plot`` (also ``python -m studies.sweep``).
 
     quadcosim sweep tp --grid k=0.01:10:log12 --grid estimator=linear,explicit \\
         --set duration=5 --seeds 4 --workers 2 --out results/k-sweep
@@ -34,7 +34,7 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
                    help="also retry members that raised or gave a NaN (members are deterministic)")
     p.add_argument("--results", action="store_true", help="keep each member's results and figures (large)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
-    from scenarios.sweep.grid import MAX_MEMBERS
+    from studies.sweep.grid import MAX_MEMBERS
 
     p.add_argument("--max-members", type=int, default=MAX_MEMBERS, metavar="N",
                    help=f"refuse a plan of more members (default {MAX_MEMBERS:,}); counted before any is made")
@@ -53,7 +53,7 @@ def add_plot_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def _stored_plan(out: Path):
-    from scenarios.sweep.grid import Plan, stored_members
+    from studies.sweep.grid import Plan, stored_members
 
     path = out / "sweep.json"
     try:
@@ -98,7 +98,7 @@ def default_out(base: Path, resume: bool, label: str) -> Path:
 def make_plan(args):
     """The plan the parsed arguments ``args`` describe (a named sweep, a grid, or the stored one
     on --resume)."""
-    from scenarios.sweep import grid, named
+    from studies.sweep import grid, named
 
     out = Path(args.out) if args.out else default_out(Path("results") / f"sweep-{args.scenario}", args.resume,
                                                       f"quadcosim sweep {args.scenario}")
@@ -128,7 +128,7 @@ def sweep(args) -> int:
         Exit code: 0 when every member finished well, 1 when any failed, 2 for bad arguments,
         128 + the signal when interrupted.
     """
-    from scenarios.sweep import engine, named
+    from studies.sweep import engine, named
 
     try:
         if args.workers is not None and args.workers < 1:
@@ -160,7 +160,7 @@ def _plot_context(folder: Path) -> tuple[dict, str, dict]:
     the options held fixed, and what its metrics' components are (``rms_error_deg[0]``: roll),
     from the sweep's ``sweep.json`` (nothing without one)."""
     import scenarios
-    from scenarios.sweep.figure import option_unit
+    from studies.sweep.figure import option_unit
 
     try:
         stored = json.loads((folder / "sweep.json").read_text())
@@ -183,7 +183,7 @@ def sweep_plot(args) -> int:
     int
         Exit code: 0, 2 for a missing table or column or a figure path refused, 1 for a full disk.
     """
-    from scenarios.sweep import figure, table
+    from studies.sweep import figure, table
 
     try:
         columns = table.read(args.table)
@@ -209,13 +209,13 @@ def sweep_plot(args) -> int:
 
 
 def main(argv=None) -> int:
-    """``python -m scenarios.sweep``: the same as ``quadcosim sweep``; returns its exit code.
+    """``python -m studies.sweep``: the same as ``quadcosim sweep``; returns its exit code.
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
     try:
         with terminate_as_interrupt():
-            p = add_arguments(argparse.ArgumentParser(prog="python -m scenarios.sweep", description=__doc__,
+            p = add_arguments(argparse.ArgumentParser(prog="python -m studies.sweep", description=__doc__,
                                                       formatter_class=argparse.RawDescriptionHelpFormatter))
             return sweep(p.parse_args(argv))
     except KeyboardInterrupt as interrupt:  # while loading or planning: nothing to keep yet

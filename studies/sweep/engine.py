@@ -38,8 +38,8 @@ from pathlib import Path
 from distributed import WorkerPlugin
 
 from orchestrator.files import atomic_path, write_text
-from scenarios.sweep import table
-from scenarios.sweep.grid import Member, Plan, stored_members
+from studies.sweep import table
+from studies.sweep.grid import Member, Plan, stored_members
 
 #: Keys of a scenario's metrics that are not metrics of a member.
 NOT_METRICS = ("scenario", "options", "figures", "units", "injected_faults")
@@ -389,7 +389,7 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     Parameters
     ----------
     plan : Plan
-        The scenario and its members (:func:`scenarios.sweep.plan`).
+        The scenario and its members (:func:`studies.sweep.plan`).
     out : path
         Sweep folder (see the module documentation).
     workers : int, optional
@@ -422,12 +422,12 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     ------
     SweepError
         The folder does not match the plan, or holds no sweep to resume.
-    scenarios.sweep.checks.MemberRefused
-        A member's values would fail (:func:`scenarios.sweep.checks.check`); nothing was run.
+    studies.sweep.checks.MemberRefused
+        A member's values would fail (:func:`studies.sweep.checks.check`); nothing was run.
     """
     if retries < 0:
         raise SweepError(f"retries = {retries} must be zero or more")
-    from scenarios.sweep import checks
+    from studies.sweep import checks
 
     checks.check(plan)  # before the folder is written and the cluster started
     sweep = _Sweep(plan, Path(out), resume)

@@ -96,7 +96,7 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     Parameters
     ----------
     columns : dict
-        A sweep table as columns (:func:`scenarios.sweep.read_table`).
+        A sweep table as columns (:func:`studies.sweep.read_table`).
     metric, x, by : str
         Column names: a metric, the option along the horizontal axis, the option that splits
         the members into curves (optional).

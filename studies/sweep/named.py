@@ -48,7 +48,7 @@ class NamedSweep:
 
     def plan(self, settings=()):
         """The sweep's plan, with ``settings`` (``["duration=5", ...]``) applied to every case."""
-        from scenarios.sweep.grid import plan_of_cases, split_assignment
+        from studies.sweep.grid import plan_of_cases, split_assignment
 
         fixed = dict(split_assignment(s, "--set") for s in settings)
         cases = {label: options | fixed for label, options in self.cases().items()}
@@ -60,9 +60,9 @@ def registry() -> dict[str, NamedSweep]:
     sweeps = {}
     for module in MODULES:
         try:
-            found = getattr(importlib.import_module(f"scenarios.{module}"), "SWEEP", None)
+            found = getattr(importlib.import_module(f"studies.{module}"), "SWEEP", None)
         except ModuleNotFoundError as error:
-            if error.name != f"scenarios.{module}":
+            if error.name != f"studies.{module}":
                 raise
             continue
         if found is not None:
@@ -93,7 +93,7 @@ def records(plan, out) -> list[dict]:
     member order."""
     import json
 
-    from scenarios.sweep.engine import member_folder
+    from studies.sweep.engine import member_folder
 
     return [json.loads((member_folder(Path(out), m.index) / "metrics.json").read_text()) for m in plan.members]
 

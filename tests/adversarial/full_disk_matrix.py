@@ -64,7 +64,7 @@ def tmpfs(folder: Path, size: int):
 
 
 def command_line(name: str, log: Path, out: Path) -> list[str]:
-    return [sys.executable, "-m", "scenarios.cli", *(a.format(log=log, out=out) for a in COMMANDS[name])]
+    return [sys.executable, "-m", "quadcosim.main", *(a.format(log=log, out=out) for a in COMMANDS[name])]
 
 
 def invoke(name: str, log: Path, out: Path) -> tuple[int, str, float]:

@@ -7,7 +7,7 @@ UTF-8) through ``log info``, ``log info --json``, ``log plot``, ``log replay`` a
 refused outputs; CSV setpoint profiles; ``--set`` gains; ``findings``; interrupts (SIGINT and
 SIGTERM at several delays); two processes on one output folder; full disks.
 
-The cheap cases run in this process (``scenarios.cli.main``), each under an alarm: an exception
+The cheap cases run in this process (``quadcosim.main.main``), each under an alarm: an exception
 that escapes is a traceback, an alarm a hang. Interrupts, concurrency and full disks run as
 processes. Every case's exit code must be 0, 1, 2, 130 or 143 (as the exit-code table says),
 with no traceback and within its time limit.
@@ -63,7 +63,7 @@ class Sweep:
 
     def cli(self, surface: str, what: str, argv: list[str], limit: float = IN_PROCESS_LIMIT_S) -> dict:
         """``quadcosim ARGV`` in this process, under an alarm."""
-        from scenarios.cli import main
+        from quadcosim.main import main
 
         out, err = io.StringIO(), io.StringIO()
         started = time.perf_counter()
@@ -95,7 +95,7 @@ class Sweep:
                 signal_after: tuple[float, int] | None = None, cwd: Path | None = None) -> dict:
         """``quadcosim ARGV`` as a process; ``signal_after`` (seconds, signal) interrupts it."""
         started = time.perf_counter()
-        child = subprocess.Popen([sys.executable, "-m", "scenarios.cli", *map(str, argv)], cwd=cwd or ROOT,
+        child = subprocess.Popen([sys.executable, "-m", "quadcosim.main", *map(str, argv)], cwd=cwd or ROOT,
                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                  env=os.environ | {"MPLBACKEND": "Agg"})
         return self.finish(surface, what, argv, child, started, limit, signal_after)
@@ -451,7 +451,7 @@ def sweep_concurrency(s: Sweep, logs: list[tuple[str, Path]]):
             for k, argv in enumerate((first, second)):
                 if k:
                     time.sleep(stagger)
-                children.append(subprocess.Popen([sys.executable, "-m", "scenarios.cli",
+                children.append(subprocess.Popen([sys.executable, "-m", "quadcosim.main",
                                                   *(str(a).format(out=out) for a in argv)], cwd=ROOT,
                                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                                  env=os.environ | {"MPLBACKEND": "Agg"}))

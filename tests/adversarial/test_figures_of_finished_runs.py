@@ -11,8 +11,8 @@ import pytest
 from conftest import SHORT_TP
 
 import scenarios.outputs
-from scenarios.cli import main as cli
-from scenarios.cli import parser
+from quadcosim.main import main as cli
+from quadcosim.main import parser
 from tests.flightlog_synthetic import write_log
 
 SIGNAL = "Quadrotor.theta1"

@@ -6,8 +6,8 @@ import types
 
 import pytest
 
-import scenarios.findings as findings
-from scenarios.findings.__main__ import main as findings_main
+import findings as findings
+from findings.__main__ import main as findings_main
 
 
 def test_an_installed_copy_is_refused_and_left_as_it_was(tmp_path, monkeypatch, capsys):
@@ -24,7 +24,7 @@ def test_a_check_of_groups_whose_data_are_all_absent_fails(tmp_path, monkeypatch
     def absent(quick=False):
         raise FileNotFoundError("no recordings in /data/broad (set QUADCOSIM_DATA)")
 
-    monkeypatch.setitem(sys.modules, "scenarios.findings.absent", types.SimpleNamespace(compute=absent))
+    monkeypatch.setitem(sys.modules, "findings.absent", types.SimpleNamespace(compute=absent))
     monkeypatch.setattr(findings, "GROUPS", ("absent",))
     out = tmp_path / "findings.json"
     findings.save({}, out)
@@ -36,7 +36,7 @@ def test_a_check_of_groups_whose_data_are_all_absent_fails(tmp_path, monkeypatch
 
 @pytest.mark.parametrize("argv", [["--check"], ["--no-readme"]])
 def test_a_checkout_still_runs(argv, tmp_path, monkeypatch, capsys):
-    monkeypatch.setitem(sys.modules, "scenarios.findings.present", types.SimpleNamespace(
+    monkeypatch.setitem(sys.modules, "findings.present", types.SimpleNamespace(
         compute=lambda quick=False: [findings.finding("present.x", 2.5, "s", "quadcosim run x", 0.1, 1)]))
     monkeypatch.setattr(findings, "GROUPS", ("present",))
     out = tmp_path / "findings.json"

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
 MODELS = ["--models", "current", "throttle"]

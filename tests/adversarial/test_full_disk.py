@@ -15,8 +15,8 @@ import scenarios.outputs  # noqa: E402
 from orchestrator import Result  # noqa: E402
 from orchestrator.diagram import draw  # noqa: E402
 from orchestrator.files import DiskFull  # noqa: E402
+from quadcosim.main import main as cli  # noqa: E402
 from scenarios import get  # noqa: E402
-from scenarios.cli import main as cli  # noqa: E402
 from scenarios.plant import save_figure  # noqa: E402
 
 

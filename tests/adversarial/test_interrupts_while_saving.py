@@ -10,7 +10,7 @@ from conftest import SHORT_TP, assert_whole, metrics_of, send_self
 
 import orchestrator.result
 from orchestrator import Result
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 @pytest.mark.parametrize("sent, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])

@@ -8,7 +8,7 @@ import pytest
 import scipy.optimize
 
 import scenarios.flightlog.replay
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
 

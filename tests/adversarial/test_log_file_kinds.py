@@ -8,8 +8,8 @@ import time
 
 import pytest
 
-import orchestrator.logs
-from scenarios.cli import main as cli
+import flightlogs
+from quadcosim.main import main as cli
 
 
 @pytest.fixture
@@ -60,4 +60,4 @@ def test_files_no_reader_can_finish_are_refused_at_once(tmp_path, capsys, deadli
 
 
 def test_the_size_limit_is_one_gigabyte():
-    assert orchestrator.logs.MAX_LOG_BYTES == 1_000_000_000
+    assert flightlogs.MAX_LOG_BYTES == 1_000_000_000

@@ -11,7 +11,7 @@ import time
 import pytest
 from conftest import send_self
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 from tests.flightlog_data import ERLE, path
 from tests.flightlog_synthetic import write_log
 from tests.flightlog_ulog_synthetic import write_ulog

@@ -51,7 +51,7 @@ def test_a_run_beyond_ulimit_v_is_refused_before_it_starts_naming_the_limit(tmp_
         resource.setrlimit(resource.RLIMIT_AS, (3_000_000 * 1024, resource.RLIM_INFINITY))  # ulimit -v 3000000
 
     out = tmp_path / "run"
-    command = [sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", "duration=3600", "bench_supply=on",
+    command = [sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", "duration=3600", "bench_supply=on",
                "--out", str(out)]
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, preexec_fn=limited, timeout=300,
                           env=os.environ | {"PYTHONWARNINGS": "ignore"})

@@ -11,7 +11,7 @@ import matplotlib.figure
 import pytest
 from conftest import SHORT_TP, metrics_of, mounted
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
 CALIBRATION = ["--models", "current"]

@@ -4,7 +4,7 @@ figure titles and messages show the bytes that do not decode as U+FFFD, never a 
 import json
 import os
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
 

@@ -11,7 +11,7 @@ import pytest
 from conftest import ROOT, SHORT_TP, assert_whole
 
 from orchestrator.files import LOCK_NAME, FolderBusy, folder_lock, free_folder, held_by
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 HOLDER = textwrap.dedent("""
     import sys, time

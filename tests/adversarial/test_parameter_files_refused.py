@@ -8,7 +8,7 @@ import os
 import pytest
 
 from calibration.flight.autopilot import read_parameters
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 @pytest.mark.parametrize(("content", "named"), [

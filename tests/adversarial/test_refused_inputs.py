@@ -7,7 +7,7 @@ import json
 import pytest
 from conftest import SHORT_TP, metrics_of
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 @pytest.mark.parametrize("settings, words", [

@@ -7,7 +7,7 @@ import math
 import pytest
 from conftest import assert_whole
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 @pytest.mark.parametrize("gain", ["5000", "1e300"])

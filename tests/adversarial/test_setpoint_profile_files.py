@@ -3,7 +3,7 @@ naming both columns, and a file that is not UTF-8 is named as such (not as "utf-
 
 import pytest
 
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 RUN = ["run", "tp", "--set", "duration=0.2"]
 
@@ -30,8 +30,8 @@ def test_a_latin_1_profile_is_named_as_not_utf_8(tmp_path, capsys):
 
 
 def test_a_spreadsheets_byte_order_mark_is_not_part_of_the_header(tmp_path):
-    from scenarios.flight import SETPOINT
-    from scenarios.flight.profile_file import read_profile
+    from flight import SETPOINT
+    from flight.profile_file import read_profile
 
     marked = tmp_path / "marked.csv"
     marked.write_text("t,z_d\n0,0\n2,-1.5\n", encoding="utf-8-sig")  # "CSV UTF-8" of a spreadsheet

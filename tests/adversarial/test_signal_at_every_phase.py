@@ -58,7 +58,7 @@ def interrupt_at(out, marker: str, delay: float, sent: int, second: float | None
     """Run ``tp`` (120 s) into ``out``, send ``sent`` ``delay`` s after ``marker`` shows on its
     standard error (and a SIGINT ``second`` s later); its exit code and standard error."""
     errors = out.with_suffix(".err")
-    command = [sys.executable, "-m", "scenarios.cli", "run", "tp", "--set", "duration=120", "--out", str(out)]
+    command = [sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", "duration=120", "--out", str(out)]
     with errors.open("w") as stderr:
         process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=stderr, cwd=ROOT)
         try:

@@ -10,7 +10,7 @@ from conftest import mounted
 from scipy.io import loadmat
 
 from orchestrator import Result
-from scenarios.cli import main as cli
+from quadcosim.main import main as cli
 
 
 @pytest.fixture

@@ -8,8 +8,8 @@ from conftest import assert_whole
 import orchestrator.stream
 from orchestrator import Result
 from orchestrator.stream import StreamWriter
+from quadcosim.main import main as cli
 from scenarios import get
-from scenarios.cli import main as cli
 
 
 @pytest.mark.parametrize("master", ["chunk", "step"])

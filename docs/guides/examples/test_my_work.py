@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from estimators.contract import AttitudeEstimator
-from scenarios.flight import Controller
+from flight import Controller
 from scenarios.testing import (
     assert_attitude_error,
     assert_bias_converges,
