@@ -9,7 +9,6 @@ that the sources shipped in the FMU are known to build.
 
 from __future__ import annotations
 
-import importlib
 import os
 import shutil
 import subprocess
@@ -17,7 +16,7 @@ import sys
 import zipfile
 from pathlib import Path
 
-from fmus import MODELS, default_fmu_dir
+from fmus import MODELS, default_fmu_dir, model_variables
 from fmus.airframe import c_header as airframe_header
 
 HERE = Path(__file__).resolve().parent
@@ -43,7 +42,7 @@ def table(model: str):
     fmus.variables.Table
         ``fmus.<model>.variables.TABLE``.
     """
-    return importlib.import_module(f"fmus.{model}.variables").TABLE
+    return model_variables(model).TABLE
 
 
 def _fmi_header_dir() -> Path:

@@ -31,7 +31,7 @@ from orchestrator.blocks import Block, Constant, Table
 from orchestrator.calls import _pack, runner_library
 from orchestrator.faults import apply_faults
 from orchestrator.fmu import FMUError
-from orchestrator.plan import RECORD
+from orchestrator.program import RECORD
 from orchestrator.progress import status
 
 OP_BLOCK, OP_TABLE, OP_RECORD, OP_PYTHON = 3, 4, 5, 6
@@ -72,7 +72,7 @@ def _gathers(pairs: list[tuple[int, int, int]]):
 
 def _runs(slots: list[int]) -> list[tuple[int, int, int]]:
     """Copies gathering bus ``slots`` into a vector, one per run of consecutive slots."""
-    from orchestrator.plan import consecutive
+    from orchestrator.program import consecutive
 
     return [(i, slots[i], j - i) for i, j in consecutive(slots)]
 

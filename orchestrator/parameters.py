@@ -16,7 +16,6 @@ such as the controller's gains (``Controller.kp_yaw``).
 
 from __future__ import annotations
 
-import importlib
 import math
 import numbers
 import re
@@ -50,12 +49,11 @@ def fmu_parameters(model: str) -> dict:
 def model_notes(model: str) -> tuple[dict, dict]:
     """``ALIASES`` and ``SWITCHED`` of ``fmus/<model>/variables.py`` (empty if none, as for an
     FMU file of the user's)."""
-    if model.lower().endswith(".fmu") or not model.isidentifier():
+    from fmus import MODELS, model_variables
+
+    if model not in MODELS:
         return {}, {}
-    try:
-        module = importlib.import_module(f"fmus.{model}.variables")
-    except ImportError:
-        return {}, {}
+    module = model_variables(model)
     return dict(getattr(module, "ALIASES", {})), dict(getattr(module, "SWITCHED", {}))
 
 

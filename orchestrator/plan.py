@@ -9,7 +9,7 @@ Building a plan (:class:`Plan`), in order:
 1. :meth:`Plan._lay_out_bus`: a slot per block output, then a slot per fault (several faults
    on one input form a chain, each reading the slot of the one before: they compose in the
    order they were injected);
-2. :meth:`Plan._plan_recording`: the recorded signals, as :class:`Copy` slices from the bus
+2. :meth:`Plan._plan_recording`: the recorded signals, as :class:`~orchestrator.program.Copy` slices from the bus
    into a row of a preallocated array;
 3. :meth:`Plan._wire_blocks`, block by block in dependency order:
 
@@ -20,11 +20,11 @@ Building a plan (:class:`Plan`), in order:
      consecutive slots share one :class:`~orchestrator.calls.SetInputs` call that reads straight
      from the bus;
    - a Python block (:meth:`Plan._wire_python`) gets a view of its output slots, and its
-     inputs as a view of the bus when their slots are consecutive, or as :class:`Copy` slices;
+     inputs as a view of the bus when their slots are consecutive, or as :class:`~orchestrator.program.Copy` slices;
    - consecutive FMU blocks with one period and no fault share one batch: one call into the C
      runner (:func:`orchestrator.calls.batch`) per group per step.
 
-Running (:meth:`Plan.run`), per macro step ``n`` at ``t_n``: the :class:`Phase` entries of
+Running (:meth:`Plan.run`), per macro step ``n`` at ``t_n``: the :class:`~orchestrator.program.Phase` entries of
 phase A, due at ``n``, in order; the bus is recorded (every ``decimation`` steps) and checked for
 NaN and Inf; the phase B entries due at ``n``. The same plan, read from :attr:`Plan.program`, is
 run either by the chunk runner (:class:`orchestrator.chunks.ChunkRunner`, compiled, the default)
@@ -47,36 +47,9 @@ from orchestrator.errors import RunInterrupted, SimulationError
 from orchestrator.faults import FaultTap, apply_faults, describe, suspects
 from orchestrator.fmu import FMUError
 from orchestrator.interrupts import signal_name, signal_number
+from orchestrator.program import RECORD, Entry, Phase, copies, input_runs
 from orchestrator.progress import Progress
 from orchestrator.result import Result, check_record_fits, signal_units
-
-
-class Copy(NamedTuple):
-    """One slice copy ``vector[into] = bus[source]`` (a named tuple: unpacked in the loop)."""
-
-    into: slice
-    source: slice
-
-
-class Phase(NamedTuple):
-    """A function of time (s) run every ``period`` macro steps."""
-
-    period: int
-    run: Callable[[float], None]
-
-
-class Entry(NamedTuple):
-    """One phase as the chunk runner reads it: the FMI ``calls`` of a batch or a Python
-    ``block`` (its inputs and outputs found in the plan), the faults applied first, and the
-    per-step form ``phase``. The entry :data:`RECORD` stands for the recording and the check."""
-
-    phase: Phase | None
-    calls: tuple
-    taps: tuple
-    block: Block | None
-
-
-RECORD = Entry(None, (), (), None)
 
 
 class _BatchPart(NamedTuple):
@@ -87,41 +60,6 @@ class _BatchPart(NamedTuple):
 
 class _Failure(Exception):
     """A check in the loop failed (a non-finite signal)."""
-
-
-def consecutive(slots: list[int]) -> list[tuple[int, int]]:
-    """Index ranges ``[i, j)`` of ``slots`` over which each slot is the previous one plus one."""
-    ranges, i = [], 0
-    while i < len(slots):
-        j = i + 1
-        while j < len(slots) and slots[j] == slots[j - 1] + 1:
-            j += 1
-        ranges.append((i, j))
-        i = j
-    return ranges
-
-
-def copies(slots: list[int]) -> tuple[Copy, ...]:
-    """The slice copies that gather bus ``slots`` into a vector, in order."""
-    return tuple(Copy(slice(i, j), slice(slots[i], slots[j - 1] + 1)) for i, j in consecutive(slots))
-
-
-def input_runs(refs: list[tuple[int, int]]) -> list[tuple[np.ndarray, int]]:
-    """Split (value reference, bus slot) pairs into runs of consecutive slots.
-
-    Parameters
-    ----------
-    refs : list of (int, int)
-        Value reference of each input and the bus slot it reads.
-
-    Returns
-    -------
-    list of (ndarray, int)
-        Value references (uint32) of each run and the bus slot of its first member.
-    """
-    refs = sorted(refs, key=lambda r: r[1])
-    slots = [slot for _, slot in refs]
-    return [(np.array([vr for vr, _ in refs[i:j]], dtype=np.uint32), slots[i]) for i, j in consecutive(slots)]
 
 
 #: A record this large (bytes) is touched once before the loop. A smaller one is served by the

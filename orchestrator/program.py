@@ -1,0 +1,78 @@
+"""The program a run plan is compiled into, as both runners read it: the slice copies between
+the bus and the blocks, the phases run per macro step, and the entries of the chunk runner.
+
+:class:`orchestrator.plan.Plan` builds it; :class:`orchestrator.chunks.ChunkRunner` and the
+plan's own step loop run it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+
+from orchestrator.blocks import Block
+
+
+class Copy(NamedTuple):
+    """One slice copy ``vector[into] = bus[source]`` (a named tuple: unpacked in the loop)."""
+
+    into: slice
+    source: slice
+
+
+class Phase(NamedTuple):
+    """A function of time (s) run every ``period`` macro steps."""
+
+    period: int
+    run: Callable[[float], None]
+
+
+class Entry(NamedTuple):
+    """One phase as the chunk runner reads it: the FMI ``calls`` of a batch or a Python
+    ``block`` (its inputs and outputs found in the plan), the faults applied first, and the
+    per-step form ``phase``. The entry :data:`RECORD` stands for the recording and the check."""
+
+    phase: Phase | None
+    calls: tuple
+    taps: tuple
+    block: Block | None
+
+
+RECORD = Entry(None, (), (), None)
+
+
+def consecutive(slots: list[int]) -> list[tuple[int, int]]:
+    """Index ranges ``[i, j)`` of ``slots`` over which each slot is the previous one plus one."""
+    ranges, i = [], 0
+    while i < len(slots):
+        j = i + 1
+        while j < len(slots) and slots[j] == slots[j - 1] + 1:
+            j += 1
+        ranges.append((i, j))
+        i = j
+    return ranges
+
+
+def copies(slots: list[int]) -> tuple[Copy, ...]:
+    """The slice copies that gather bus ``slots`` into a vector, in order."""
+    return tuple(Copy(slice(i, j), slice(slots[i], slots[j - 1] + 1)) for i, j in consecutive(slots))
+
+
+def input_runs(refs: list[tuple[int, int]]) -> list[tuple[np.ndarray, int]]:
+    """Split (value reference, bus slot) pairs into runs of consecutive slots.
+
+    Parameters
+    ----------
+    refs : list of (int, int)
+        Value reference of each input and the bus slot it reads.
+
+    Returns
+    -------
+    list of (ndarray, int)
+        Value references (uint32) of each run and the bus slot of its first member.
+    """
+    refs = sorted(refs, key=lambda r: r[1])
+    slots = [slot for _, slot in refs]
+    return [(np.array([vr for vr, _ in refs[i:j]], dtype=np.uint32), slots[i]) for i, j in consecutive(slots)]
