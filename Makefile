@@ -23,10 +23,12 @@ demo: fmus
 	$(BIN)/quadcosim run tp --out results/tp --overwrite
 	@echo "quadcosim is installed in $(VENV): activate it with  . $(VENV)/bin/activate  (or call $(BIN)/quadcosim)"
 
+# The suite on both cores (pytest-xdist): the FMU pool, the numba cache and every test's files are
+# per worker process or per test.
 test: fmus
 	$(BIN)/ruff check .
 	$(MAKE) docs
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2
 
 # The trajectory references and the findings' quick check under kernels other than this CPU's
 # own (OpenBLAS's oldest, numba's generic target, numpy's SIMD dispatch off, libm without FMA):
