@@ -6,6 +6,9 @@
   walk-through is made by the command beside it.
 - the FMUs' variable tables, generated from ``fmus/<Model>/variables.py`` into
   ``docs/_generated/fmu_variables.md`` when the build starts.
+- the notebooks: ``notebooks/*.py`` (jupytext's percent format) written as
+  ``docs/_generated/notebooks/*.ipynb`` when the build starts, for myst-nb to execute (with its
+  cache) and render with their figures.
 - a check of the built pages: Markdown that did not render (a literal backtick in the text, a
   findings marker shown as text) is a warning, so ``sphinx -W`` fails on it. A line that
   starts with a findings marker is read by Markdown as raw HTML, and its backticks then show.
@@ -106,6 +109,23 @@ def _variable_tables(app):
         target.write_text(text)
 
 
+NOTEBOOKS = HERE.parent / "notebooks"
+
+
+def _notebooks(app):
+    """``_generated/notebooks/NAME.ipynb`` of each ``notebooks/NAME.py``, rewritten only when it
+    changes (so that Sphinx and myst-nb's cache see an unchanged notebook as unchanged)."""
+    import jupytext
+
+    target = GENERATED / "notebooks"
+    target.mkdir(parents=True, exist_ok=True)
+    for source in sorted(NOTEBOOKS.glob("*.py")):
+        text = jupytext.writes(jupytext.read(source), fmt="ipynb")
+        path = target / f"{source.stem}.ipynb"
+        if not path.is_file() or path.read_text() != text:
+            path.write_text(text)
+
+
 _VERBATIM = re.compile(r"<(pre|code|script|style|kbd|tt|textarea)\b.*?</\1>", re.S | re.I)
 _COMMENT = re.compile(r"<!--.*?-->", re.S)
 _TAG = re.compile(r"<[^>]+>")
@@ -154,5 +174,6 @@ def setup(app):
     """Register the directive, the generated pages and the check of the built pages."""
     app.add_directive("quadcosim-run", QuadcosimRun)
     app.connect("builder-inited", _variable_tables)
+    app.connect("builder-inited", _notebooks)
     app.connect("build-finished", _check_rendered)
     return {"parallel_read_safe": False, "version": "1"}
