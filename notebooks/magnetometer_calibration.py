@@ -31,7 +31,6 @@ import tempfile
 from pathlib import Path
 
 import matplotlib.pyplot as plt
-import numpy as np
 from IPython.display import Image, display
 
 import scenarios
@@ -85,3 +84,8 @@ print("identified motor dynamics (calibration 1):")
 print(f"  rate {dynamics['rate']:.1f} 1/s, drag {dynamics['drag']:.3f} 1/(V s), "
       f"winding-voltage limit {dynamics['limit']:.2f} V, free-wheeling ESC: {dynamics['freewheel']}")
 print("  field gain per motor (uT/V):", ", ".join(f"{1e6 * g:.1f}" for g in dynamics["gain"]))
+
+# %% [markdown]
+# What to see: one first-order lag for the four motors (rate, drag, the ESC's limit) and one
+# field gain per motor: the field its current makes at the magnetometer, per volt of its
+# winding.
