@@ -110,12 +110,31 @@ def _variable_tables(app):
 
 
 NOTEBOOKS = HERE.parent / "notebooks"
+#: The packages a notebook calls: an execution older than their newest source is stale.
+PACKAGES = ("fmus", "orchestrator", "estimators", "calibration", "scenarios", "benchmarks")
+
+
+def newest_source(root: Path = HERE.parent) -> float:
+    """The newest modification time (s since the epoch) of the packages' Python sources."""
+    return max(p.stat().st_mtime for package in PACKAGES for p in (root / package).rglob("*.py"))
 
 
 def _notebooks(app):
     """``_generated/notebooks/NAME.ipynb`` of each ``notebooks/NAME.py``, rewritten only when it
-    changes (so that Sphinx and myst-nb's cache see an unchanged notebook as unchanged)."""
+    changes (so that Sphinx and myst-nb's cache see an unchanged notebook as unchanged), and the
+    cached executions older than the packages' sources dropped: myst-nb's cache knows only a
+    notebook's own code, and a change of the package must run the notebooks again."""
+    import calendar
+
     import jupytext
+    from jupyter_cache import get_cache
+
+    cache_path = Path(app.config.nb_execution_cache_path)
+    if cache_path.is_dir():
+        cache, newest = get_cache(cache_path), newest_source()
+        for record in cache.list_cache_records():
+            if calendar.timegm(record.created.utctimetuple()) <= newest:
+                cache.remove_cache(record.pk)
 
     target = GENERATED / "notebooks"
     target.mkdir(parents=True, exist_ok=True)
