@@ -235,9 +235,11 @@ def strays(path) -> list[str]:
 
 
 def pages(root) -> list[Path]:
-    """The README and the pages under ``docs/`` of the repository at ``root``."""
+    """The README and the pages under ``docs/`` of the repository at ``root``, those the docs
+    build writes (``_build``, ``_generated``: a run's own ``table1.md``) left out."""
     root = Path(root)
-    return [root / "README.md", *sorted((root / "docs").rglob("*.md"))]
+    return [root / "README.md", *sorted(p for p in (root / "docs").rglob("*.md")
+                                        if not {"_build", "_generated"} & set(p.relative_to(root).parts))]
 
 
 def rewrite(path, old: dict[str, dict], new: dict[str, dict]) -> list[str]:
