@@ -77,4 +77,11 @@ def add_arguments(parser):
     replayed.add_argument("--compass", type=int, default=0, help="compass to use, from 0 in the log's order")
     replayed.add_argument("--json", help="also write the result to this JSON file")
     replayed.set_defaults(func=replay.run)
+    from scenarios.flightlog import example
+
+    made = sub.add_parser("example", help="write three small synthetic flight logs to try these commands on "
+                          "(ArduPilot text logs: example-a.log, example-b.log, example-c.log)")
+    made.add_argument("out", help="folder to write them into (created)")
+    made.add_argument("--seconds", type=float, default=40.0, metavar="S", help="length of each flight (s, default 40)")
+    made.set_defaults(func=example.command)
     return parser
