@@ -62,7 +62,8 @@ def add_arguments(parser):
     shown = sub.add_parser("info", help="what the log holds: sensors, rates, duration, vehicle, firmware, "
                            "simulator or not, current sensor or not")
     shown.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
-    shown.add_argument("--json", action="store_true", help="print the summary as JSON")
+    shown.add_argument("--json", action="store_true", help="print the summary as JSON on standard output, in "
+                       "place of the text")
     shown.set_defaults(func=info)
     drawn = sub.add_parser("plot", help="an overview figure: field, current, throttle and attitude")
     drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
@@ -75,7 +76,10 @@ def add_arguments(parser):
                               "compensation, against the autopilot's attitude (a reference, not the truth)")
     replayed.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
     replayed.add_argument("--compass", type=int, default=0, help="compass to use, from 0 in the log's order")
-    replayed.add_argument("--json", help="also write the result to this JSON file")
+    from scenarios.output_options import add_json_flag
+
+    add_json_flag(replayed, "print the result as JSON on standard output, in place of the table")
+    replayed.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
     replayed.set_defaults(func=replay.run)
     from scenarios.flightlog import example
 
