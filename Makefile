@@ -24,10 +24,12 @@ demo: fmus
 	@echo "quadcosim is installed in $(VENV): activate it with  . $(VENV)/bin/activate  (or call $(BIN)/quadcosim)"
 
 # JupyterLab on the notebooks (the `notebooks` extra, installed on first use); jupytext opens
-# the .py files as notebooks.
+# the .py files as notebooks. LAB_ARGS passes options to it (in a container, as root:
+# make lab LAB_ARGS="--allow-root --no-browser --ip=0.0.0.0").
+LAB_ARGS ?=
 lab: fmus
 	$(BIN)/python -c 'import jupyterlab' 2>/dev/null || $(BIN)/pip install --quiet -e ".[notebooks]"
-	$(BIN)/jupyter lab notebooks
+	$(BIN)/jupyter lab $(LAB_ARGS) notebooks
 
 test: fmus
 	$(BIN)/ruff check .
