@@ -19,7 +19,15 @@ import sys
 
 class JsonFlag(argparse.Action):
     """``--json``: a flag (``True``); ``--json FILE``, the old spelling, sets ``out`` to ``FILE``
-    instead, with a deprecation message on standard error."""
+    instead, with a deprecation message on standard error.
+
+    Parameters
+    ----------
+    option_strings, dest
+        As argparse gives them to every action.
+    out_dest : str
+        The attribute ``--json FILE`` sets (that of ``--out``).
+    """
 
     def __init__(self, option_strings, dest, out_dest: str = "out", **kwargs):
         self.out_dest = out_dest
@@ -35,14 +43,29 @@ class JsonFlag(argparse.Action):
 
 
 def add_json_flag(parser, help_text: str, out_dest: str = "out"):
-    """Add ``--json`` (:class:`JsonFlag`) to ``parser``; ``out_dest``: where ``--json FILE`` goes."""
+    """Add ``--json`` (:class:`JsonFlag`) to ``parser``, described by ``help_text``; ``out_dest``:
+    the attribute ``--json FILE`` (the old spelling) sets."""
     parser.add_argument("--json", action=JsonFlag, out_dest=out_dest, metavar="",
                         help=help_text + " (--json FILE, the old spelling, is --out FILE)")
 
 
 def default_folder(command: str, name: str, overwrite: bool):
     """``results/NAME``, or with earlier results there (and no ``overwrite``) the next free
-    ``results/NAME-N``, said on standard error, as ``quadcosim run`` does."""
+    ``results/NAME-N``, said on standard error, as ``quadcosim run`` does.
+
+    Parameters
+    ----------
+    command : str
+        The sub-command, named in the message (``calibrate``).
+    name : str
+        The folder's name under ``results/``.
+    overwrite : bool
+        ``--overwrite`` given: the folder itself, its results to be replaced.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     from pathlib import Path
 
     from orchestrator.files import free_folder, holds_results

@@ -83,7 +83,7 @@ def _rotation(euler: np.ndarray) -> np.ndarray:
 
 
 def write_flight(path, k: int = 0, duration: float = 40.0, seed: int = 1) -> Path:
-    """Write flight ``k`` (0, 1, 2 for a, b, c) of :data:`duration` seconds to ``path``.
+    """Write flight ``k`` (0, 1, 2 for a, b, c), ``duration`` seconds long, to ``path``.
 
     Parameters
     ----------
@@ -146,16 +146,38 @@ def write_flight(path, k: int = 0, duration: float = 40.0, seed: int = 1) -> Pat
 
 
 def write_examples(folder, duration: float = 40.0) -> list[Path]:
-    """The three example flights, ``example-a.log`` to ``example-c.log``, written into ``folder``
-    (created); returns their paths."""
+    """The three example flights, ``example-a.log`` to ``example-c.log``.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Where they are written (created).
+    duration : float
+        Length of each flight (s).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The three files.
+    """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     return [write_flight(folder / f"example-{name}.log", k, duration) for k, name in enumerate(FLIGHTS)]
 
 
 def command(args) -> int:
-    """``quadcosim log example OUT``: write the example logs into the folder ``OUT``; 2 when it
-    cannot be written (a file in its place, no permission)."""
+    """``quadcosim log example OUT``: write the example logs into the folder ``OUT``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``out`` (the folder) and ``seconds`` (each flight's length, s).
+
+    Returns
+    -------
+    int
+        0, or 2 when the folder cannot be written (a file in its place, no permission).
+    """
     import sys
 
     try:
