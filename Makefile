@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup fmus demo test kernels digests references lint bench fuzz docs clean
+.PHONY: setup fmus demo lab test kernels digests references lint bench fuzz docs clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 12))' || { echo "quadcosim needs Python 3.12 or newer; $(PYTHON) is $$($(PYTHON) -V 2>&1). Install 3.12 (pyenv install 3.12, uv python install 3.12, or conda create -n quadcosim python=3.12) and run make PYTHON=python3.12" >&2; exit 1; }
@@ -23,10 +23,20 @@ demo: fmus
 	$(BIN)/quadcosim run tp --out results/tp --overwrite
 	@echo "quadcosim is installed in $(VENV): activate it with  . $(VENV)/bin/activate  (or call $(BIN)/quadcosim)"
 
+# JupyterLab on the notebooks (the `notebooks` extra, installed on first use); jupytext opens
+# the .py files as notebooks. LAB_ARGS passes options to it (in a container, as root:
+# make lab LAB_ARGS="--allow-root --no-browser --ip=0.0.0.0").
+LAB_ARGS ?=
+lab: fmus
+	$(BIN)/python -c 'import jupyterlab' 2>/dev/null || $(BIN)/pip install --quiet -e ".[notebooks]"
+	$(BIN)/jupyter lab $(LAB_ARGS) notebooks
+
+# The suite on both cores (pytest-xdist): the FMU pool, the numba cache and every test's files are
+# per worker process or per test.
 test: fmus
 	$(BIN)/ruff check .
 	$(MAKE) docs
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2
 
 # The trajectory references and the findings' quick check under kernels other than this CPU's
 # own (OpenBLAS's oldest, numba's generic target, numpy's SIMD dispatch off, libm without FMA):

@@ -8,8 +8,9 @@ finding names or name prefixes (a group, ``metge``, or part of one, ``flight.til
   (rounded: within half a unit of the last decimal);
 - every finding of its scope is printed in it at least once;
 - a number that is not a finding is an input or a citation: it sits in a code span
-  (`` `tilt_deg=5` ``), in square brackets (a paper's value, ``[11.1]``), or after a reference
-  word (``eq. 9``, ``Table 1``).
+  (`` `tilt_deg=5` ``), in math (``$2 k_m \\omega$``, ``$$...$$``: a formula's constants), in
+  square brackets (a paper's value, ``[11.1]``), or after a reference word (``eq. 9``,
+  ``Table 1``).
 
 So a finding whose value moves by more than its rounding parts from the README, and the test
 fails. :func:`rewrite` replaces, in every passage, each number printed from an old value by the
@@ -31,7 +32,7 @@ BEGIN = re.compile(r"<!--\s*findings:\s*([^>]*?)\s*-->")
 END = "<!-- /findings -->"
 # a number not glued to a word (x100, 3S, 2x2 are not numbers here); a sign when it stands alone
 NUMBER = re.compile(r"(?<![\w.\-−+])([+\-−]?)(\d+(?:\.\d+)?(?:e[+\-]?\d+)?)(?![\w.]*\w)")
-CODE_OR_CITATION = re.compile(r"`[^`]*`|\[[^\]]*\]\(?[^)\s]*\)?|<!--.*?-->")
+CODE_OR_CITATION = re.compile(r"`[^`]*`|(?s:\$\$.*?\$\$)|\$[^$\n]+\$|\[[^\]]*\]\(?[^)\s]*\)?|<!--.*?-->")
 # a number after one of these words cites a reference (eq. 9, Table 1): it is not checked
 CITED = ("eq.", "eqs.", "Table", "Figure", "Fig.", "section", "Section")
 # outside findings passages: inputs passages, fenced code, enumerations, years, versions
@@ -234,9 +235,11 @@ def strays(path) -> list[str]:
 
 
 def pages(root) -> list[Path]:
-    """The README and the pages under ``docs/`` of the repository at ``root``."""
+    """The README and the pages under ``docs/`` of the repository at ``root``, those the docs
+    build writes (``_build``, ``_generated``: a run's own ``table1.md``) left out."""
     root = Path(root)
-    return [root / "README.md", *sorted((root / "docs").rglob("*.md"))]
+    return [root / "README.md", *sorted(p for p in (root / "docs").rglob("*.md")
+                                        if not {"_build", "_generated"} & set(p.relative_to(root).parts))]
 
 
 def rewrite(path, old: dict[str, dict], new: dict[str, dict]) -> list[str]:

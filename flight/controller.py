@@ -46,6 +46,7 @@ from numba import njit
 from estimators.core import euler_to_quaternion
 from flight.mixer import allocation_matrix, esc_command
 from fmus import vehicle
+from orchestrator import portable
 from orchestrator.blocks import Block
 from orchestrator.fmu import nearest
 
@@ -219,7 +220,7 @@ class Controller(Block):
     def __init__(self, name: str = "Controller", period: int = 1, gains: dict | None = None):
         super().__init__(name, period)
         self.parameters = parameters(gains)
-        self.mixer_inverse = np.linalg.inv(allocation_matrix())
+        self.mixer_inverse = portable.inverse(allocation_matrix())  # LAPACK's bits differ by CPU
 
     def named_parameters(self) -> dict:
         """The gains (:data:`GAINS`) by name, their present values; ``--set Controller.kp_yaw=50``

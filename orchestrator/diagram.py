@@ -127,7 +127,9 @@ def draw(system, path, title: str | None = None) -> Path:
     """
     import matplotlib
 
-    matplotlib.use("Agg")
+    from orchestrator.files import headless_backend
+
+    headless_backend()
     import matplotlib.pyplot as plt
 
     fig = figure(system, title)

@@ -368,6 +368,23 @@ def figure_file(given, name: str, folder) -> Path:
     return path
 
 
+#: Backends that draw without a window: kept as they are by :func:`headless_backend`.
+_WINDOWLESS = ("agg", "pdf", "svg", "ps", "pgf", "cairo", "template")
+
+
+def headless_backend() -> None:
+    """Make matplotlib draw without a window (Agg) unless it already does: a figure written to a
+    file must not open one, nor need a display. A notebook's inline backend (and any other
+    windowless one) is kept, so that the notebook's own figures still show after a run drew its
+    report."""
+    import matplotlib
+
+    backend = matplotlib.get_backend().lower()
+    if "inline" in backend or backend in _WINDOWLESS or backend.startswith("module://"):
+        return
+    matplotlib.use("Agg")
+
+
 def save_figure(figure, path, **options) -> Path:
     """``figure.savefig(path)``, atomically; a suffix matplotlib does not write is refused
     (:func:`figure_format`) before anything is written."""

@@ -1,4 +1,5 @@
-"""Elementary functions that give the same bits on every CPU, for the input profiles of a run.
+"""Elementary functions and a small inverse that give the same bits on every CPU, for what a run
+computes once before it starts (input profiles, the mixer).
 
 numpy evaluates ``sin`` or ``arctan`` of an array with whichever kernel the CPU offers: on a
 CPU with AVX-512 its wheels call Intel's SVML (``__svml_sin8``, ``__svml_atan8``), elsewhere the
@@ -10,6 +11,10 @@ These functions use only additions, multiplications, divisions and square roots,
 rounds the same way everywhere, in a fixed order: their result depends on the argument alone.
 They are accurate to a few ulp, which a profile does not notice. They are for profiles computed
 once before a run, not for a step's hot path.
+
+LAPACK's inverse is no better: OpenBLAS picks its kernels by CPU (its AVX-512 ones on a CPU that
+has them), and the inverse of the quad-X's allocation matrix comes out a few ulp apart between
+them; :func:`inverse` solves in plain Python floats, in a fixed order.
 """
 
 from __future__ import annotations
@@ -106,3 +111,56 @@ def arctan(x) -> np.ndarray:
     for n in range(_ATAN_TERMS, 0, -1):
         series = 1.0 / (2 * n + 1) - z * series  # u (1 - z/3 + z^2/5 - ...)
     return 8.0 * (u - u * z * series)
+
+
+def inverse(matrix) -> np.ndarray:
+    """Inverse of a small square matrix, with the same bits on every CPU.
+
+    LU factorisation with partial pivoting (the largest magnitude first, the lowest row on a tie),
+    then one forward and one back substitution per column of the identity, in Python floats: each
+    operation rounded once, in a fixed order, whatever BLAS kernels or FMA units the CPU has.
+    For matrices of a few rows computed once (a mixer), not for large systems.
+
+    Parameters
+    ----------
+    matrix : array_like
+        ``(n, n)`` finite values.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n, n)`` float64 inverse.
+
+    Raises
+    ------
+    ValueError
+        If the matrix is not square and finite, or is singular (a zero pivot).
+    """
+    a = np.asarray(matrix, dtype=float)
+    if a.ndim != 2 or a.shape[0] != a.shape[1] or not np.isfinite(a).all():
+        raise ValueError(f"inverse needs a finite square matrix, got shape {a.shape}")
+    n = a.shape[0]
+    lu = a.tolist()
+    order = list(range(n))
+    for k in range(n):
+        pivot = max(range(k, n), key=lambda i: (abs(lu[i][k]), -i))
+        if lu[pivot][k] == 0.0:
+            raise ValueError(f"the matrix is singular (no pivot in column {k}): it has no inverse")
+        lu[k], lu[pivot] = lu[pivot], lu[k]
+        order[k], order[pivot] = order[pivot], order[k]
+        for i in range(k + 1, n):
+            lu[i][k] /= lu[k][k]
+            for j in range(k + 1, n):
+                lu[i][j] -= lu[i][k] * lu[k][j]
+    result = np.empty((n, n))
+    for column in range(n):
+        y = [1.0 if order[i] == column else 0.0 for i in range(n)]
+        for i in range(n):
+            for j in range(i):
+                y[i] -= lu[i][j] * y[j]
+        for i in reversed(range(n)):
+            for j in range(i + 1, n):
+                y[i] -= lu[i][j] * y[j]
+            y[i] /= lu[i][i]
+        result[:, column] = y
+    return result

@@ -167,6 +167,10 @@ def summarize(time, truth: dict, estimates: dict, windows) -> dict:
     close = (np.abs(kalman["a"] - a) <= 0.05 * np.abs(a)) & (np.abs(kalman["b"] - b) <= 0.05 * np.abs(b))
     for sensor, _onset, end, _ in windows:
         after = (time >= end) & (time <= end + 10.0)
+        if not after.any():  # the flight ended before the fault did: no recovery to measure
+            recovery.append({"sensor": sensor, "back_within_5_percent_s": None,
+                             "a_error_percent_at_end_plus_10_s": None, "b_error_percent_at_end_plus_10_s": None})
+            continue
         # back within 5 % and staying there until 10 s after the end
         inside = close[after]
         bad = np.flatnonzero(~inside)

@@ -232,7 +232,11 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--declination", type=float, default=0.0, metavar="DEG", help="the field's declination")
     parser.add_argument("--align-heading", action="store_true", help="remove a constant heading offset")
     parser.add_argument("--rate", type=float, help="sampling rate (Hz), if the file has none")
-    parser.add_argument("--json", help="write the result here")
+    from scenarios.output_options import add_json_flag
+
+    add_json_flag(parser, "the result as JSON on standard output (always, for a recording; in place of the table "
+                          "for a flight log)")
+    parser.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
     parser.add_argument("--from-tp", metavar="RESULTS_DIR", help="write a recording from a tp run's results")
     parser.add_argument("--write", metavar="RECORDING", help="with --from-tp: the recording to write")
     parser.add_argument("--compass", type=int, default=0, help="flight logs: the compass, from 0 in the log's order")
@@ -258,7 +262,7 @@ def main(argv=None) -> int:
     if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
         from scenarios.flightlog import replay as flight
 
-        return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json))
+        return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json, out=args.out))
     try:
         if args.from_tp:
             if not args.write:
@@ -282,8 +286,8 @@ def main(argv=None) -> int:
                                                                  result["gains_in_force"].items()), file=sys.stderr)
     text = json.dumps(result, indent=2, default=float)
     print(text)
-    if args.json:
-        write_text(args.json, text + "\n")
+    if args.out:
+        write_text(args.out, text + "\n")
     return 0
 
 

@@ -162,8 +162,10 @@ def _with_format(out, figure_format: str | None):
     return path.with_name(f"{path.name}.{figure_format}")
 
 
-def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
-    """One figure of a finished run: each signal (or vector) on its own axes, against time.
+def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = None,
+         tracking: bool = False) -> Path:
+    """One figure of a finished run: each signal (or vector) on its own axes, against time; with
+    ``tracking``, the signals together on one axes (per component), a setpoint and its response.
 
     Parameters
     ----------
@@ -177,21 +179,36 @@ def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = 
         Draw angles (rad) and angular rates (rad/s, rad/s2) in degrees; other signals as they are.
     figure_format : {"png", "svg", "pdf"}, optional
         The file's format when ``out`` has no suffix or is not given (default png).
+    tracking : bool
+        Draw the signals on shared axes: the k-th component of each on the k-th axes
+        (``Setpoint.theta_d`` and ``Quadrotor.theta``: roll, pitch and yaw, setpoint against
+        response). The signals must have as many components and one unit.
 
     Returns
     -------
     pathlib.Path
         The file written.
+
+    Raises
+    ------
+    ValueError
+        A signal the run did not record; with ``tracking``, fewer than two signals, or signals of
+        different sizes or units (named).
     """
     import matplotlib.pyplot as plt
 
-    name = f"plot-{signals[0]}.{figure_format or 'png'}"
+    if tracking and len(signals) < 2:
+        raise ValueError("--tracking draws two signals or more on one axes (a setpoint and its response: "
+                         "Setpoint.theta_d Quadrotor.theta); give at least two")
+    name = f"{'tracking' if tracking else 'plot'}-{signals[0]}.{figure_format or 'png'}"
     # a path given is checked before the run is read
     path = figure_file(_with_format(out, figure_format), name, None) if out else None
     result, folder = load(run)
     path = path or figure_file(None, name, folder)
     for signal in signals:
         _check(result, folder, signal)
+    if tracking:
+        return _tracking(result, folder, signals, path, deg)
     fig, axes = plt.subplots(len(signals), 1, sharex=True, squeeze=False, layout="constrained",
                              figsize=(AXES_SIZE[0], AXES_SIZE[1] * len(signals)))
     for ax, signal in zip(axes[:, 0], signals, strict=True):
@@ -199,6 +216,38 @@ def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = 
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
     fig.suptitle(printable(_label(folder)), fontsize=10)
+    try:
+        return save_figure(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def _tracking(result, folder: Path, signals, path: Path, deg: bool) -> Path:
+    """:func:`plot`'s ``tracking`` view: the k-th component of every signal on the k-th axes."""
+    import matplotlib.pyplot as plt
+
+    columns = [result.columns(signal) for signal in signals]
+    sizes = {len(c) for c in columns}
+    if len(sizes) > 1:
+        told = ", ".join(f"{s} ({len(c)})" for s, c in zip(signals, columns, strict=True))
+        raise ValueError(f"--tracking draws component against component: the signals differ in size ({told}); "
+                         "give vectors of one size, or single components (Setpoint.theta_d2 Quadrotor.theta2)")
+    units = result.meta.get("units", {})
+    found = {units.get(m) or None for c in columns for m in c}
+    if len(found) > 1:
+        told = ", ".join(f"{s} ({units.get(c[0]) or 'unit unknown'})" for s, c in zip(signals, columns, strict=True))
+        raise ValueError(f"--tracking draws the signals on one y axis: their units differ ({told})")
+    fig, axes = plt.subplots(sizes.pop(), 1, sharex=True, squeeze=False, layout="constrained",
+                             figsize=(AXES_SIZE[0], AXES_SIZE[1] * len(columns[0])))
+    for k, ax in enumerate(axes[:, 0]):
+        for j, component in enumerate(c[k] for c in columns):
+            _draw(ax, result, component, deg)
+            ax.lines[-1].set_linestyle("--" if j == 0 else "-")  # the first (the setpoint) dashed
+        ax.set_title(printable(" vs ".join(c[k] for c in columns)), loc="left", fontsize=9)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1), fontsize=8)
+    for ax in axes[:-1, 0]:
+        ax.set_xlabel("")
+    fig.suptitle(printable(f"{_label(folder)}: {' and '.join(signals)}"), fontsize=10)
     try:
         return save_figure(fig, path, dpi=120)
     finally:
@@ -263,7 +312,8 @@ def plot_command(args) -> int:
         if not args.signals:
             print("\n".join(signal_lines(args.run)))
             return 0
-        print(plot(args.run, args.signals, args.out, deg=args.deg, figure_format=args.format))
+        print(plot(args.run, args.signals, args.out, deg=args.deg, figure_format=args.format,
+                   tracking=args.tracking))
     except ValueError as error:  # OutputRefused among them
         print(f"quadcosim plot: {error}", file=sys.stderr)
         return 2
@@ -306,6 +356,10 @@ def add_arguments(sub):
     plotting.add_argument("signals", nargs="*", metavar="SIGNAL",
                           help="signal or vector names (IMU.acc); none: list the run's signals and their units")
     _add_figure_options(plotting, "RUN/plot-SIGNAL.png")
+    plotting.add_argument("--tracking", action="store_true",
+                          help="the signals on shared axes, component by component: a setpoint against its "
+                               "response (plot RUN Setpoint.theta_d Quadrotor.theta --tracking --deg); the first "
+                               "is dashed")
     plotting.set_defaults(func=plot_command)
     comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure",
                                usage="quadcosim compare [-h] [--out FILE] RUN RUN [RUN...] SIGNAL\n"

@@ -44,9 +44,10 @@ SAMPLES = 8000
 #: seeds the settings were chosen on or a design looked at: the first fault-free 9999 and fault seeds 1-300, then
 #: fleets flown to judge an earlier design and looked at before its last change (so tuning seeds now)
 TUNING = ((1, 9999), (1_000_000, 1_000_999), (2_000_000, 2_008_999), (3_000_000, 3_000_039), (3_100_000, 3_100_199),
-          (3_200_000, 3_200_199), (4_000_000, 4_000_199), (4_100_000, 4_100_049), (5_000_000, 5_000_010))
-FRESH = (10_000_000, 10_000_999)  # per fault case: 1000 flights, flown once, after the design was frozen
-FRESH_CLEAN = (20_000_000, 20_004_499)  # fault-free: 4500 flights, 500 flight-hours
+          (3_200_000, 3_200_199), (4_000_000, 4_000_199), (4_100_000, 4_100_049), (5_000_000, 5_000_010),
+          (10_000_000, 10_000_999), (20_000_000, 20_004_499))
+FRESH = (60_000_000, 60_000_999)  # per fault case: 1000 flights, flown once, after the design was frozen
+FRESH_CLEAN = (61_000_000, 61_004_499)  # fault-free: 4500 flights, 500 flight-hours
 QUICK = {"faults": (30_000_000, 30_000_039), "clean": (30_100_000, 30_100_199)}  # CI's fresh subset
 CASES = (("ir", 100.0), ("gps", 0.1))  # the smallest offsets the detector is designed for
 LARGER = (("ir", 200.0), ("ir", 400.0), ("ir", 1200.0), ("gps", 0.2), ("gps", 0.3), ("gps", 1.5))
@@ -72,6 +73,11 @@ ABLATIONS = {
     "present_ir_off": {"now_h": math.inf},
     "decisive_100": {"decisive": 100.0},
     "alt_level_10": {"alt_level": 10.0},
+    "alt_not_ended": {"alt_ended": False},
+    "alt_not_innovation": {"alt_innovation": False},
+    "alt_restart": {"alt_restart": True},
+    "alt_moved_25": {"alt_moved": 25.0},
+    "alt_moved_25_fraction_0_25": {"alt_moved": 25.0, "alt_fraction": 0.25},
     "earlier_design": EARLIER,
 }
 ABLATION_CASES = (("ir", 100.0), ("gps", 0.1), ("ir", 50.0), ("ir", 1200.0))

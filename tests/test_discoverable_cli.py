@@ -236,3 +236,38 @@ def test_the_run_names_the_figures_it_wrote_and_counts_as_metrics_json_counts(tm
     recorded, left_out = metrics["signals_recorded"], len(metrics["signals_not_saved"])
     assert f"({recorded - left_out} of the {recorded} signals recorded;" in captured.err
     assert "and diagram.png, roll_pitch.png, yaw.png in" in captured.out.strip().splitlines()[-1]
+
+
+def test_tracking_draws_setpoint_and_response_on_one_axes_in_degrees(finished_run, tmp_path, capsys, monkeypatch):
+    """``plot RUN Setpoint.theta_d Quadrotor.theta --tracking --deg``: roll, pitch and yaw each on
+    one axes, the setpoint (dashed) and the response, in degrees, the unit on the y axis."""
+    from orchestrator import Result
+    from scenarios import run_plots
+
+    drawn = {}
+    real_save = run_plots.save_figure
+
+    def keep(fig, path, **kw):
+        drawn["axes"] = [(ax.get_ylabel(), [(line.get_label(), line.get_linestyle(), line.get_ydata())
+                                              for line in ax.lines]) for ax in fig.axes if ax.lines]
+        return real_save(fig, path, **kw)
+
+    monkeypatch.setattr(run_plots, "save_figure", keep)
+    assert main(["plot", str(finished_run), "Setpoint.theta_d", "Quadrotor.theta", "--tracking", "--deg",
+                 "--out", str(tmp_path / "tracking.png")]) == 0
+    assert (tmp_path / "tracking.png").read_bytes()[:4] == b"\x89PNG"
+    result = Result.load(finished_run)
+    assert len(drawn["axes"]) == 3
+    for k, (unit, lines) in enumerate(drawn["axes"], start=1):
+        assert unit == "deg"
+        assert [(label, style) for label, style, _ in lines] == [(f"Setpoint.theta_d{k}", "--"),
+                                                                 (f"Quadrotor.theta{k}", "-")]
+        for (_, _, y), name in zip(lines, (f"Setpoint.theta_d{k}", f"Quadrotor.theta{k}"), strict=True):
+            assert np.max(np.abs(y)) == pytest.approx(np.degrees(np.max(np.abs(result[name]))), rel=1e-9)
+    capsys.readouterr()
+    assert main(["plot", str(finished_run), "Setpoint.theta_d", "IMU.acc", "--tracking"]) == 2
+    assert "units differ (Setpoint.theta_d (rad), IMU.acc (m/s2))" in capsys.readouterr().err
+    assert main(["plot", str(finished_run), "Setpoint.theta_d", "Quadrotor.theta2", "--tracking"]) == 2
+    assert "differ in size" in capsys.readouterr().err
+    assert main(["plot", str(finished_run), "Quadrotor.theta", "--tracking"]) == 2
+    assert "at least two" in capsys.readouterr().err

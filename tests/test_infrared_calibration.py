@@ -105,7 +105,7 @@ def test_non_finite_input_and_bad_covariance_are_refused():
         EKFSettings(sd_ir=0.0)
 
 
-GATED_MAX_OPERATIONS = 208  # the gated filter with its detectors (GLR with drift), counted by cost.py
+GATED_MAX_OPERATIONS = 212  # the gated filter with its detectors (GLR with drift), counted by cost.py
 
 
 def test_gated_filter_costs_less_than_the_slides_300_operations_on_a_fault_free_flight():
@@ -140,3 +140,14 @@ def test_fault_sizes_are_options_recorded_with_the_declarations():
     (fault,) = metrics["faults"]
     assert {"sensor", "onset_s", "declared_s", "cleared_s"} <= set(fault) and fault["sensor"] == "ir"
     assert fault["onset_s"] < fault["declared_s"] <= fault["onset_s"] + 2.0 and metrics["false_alarms"] == 0
+
+
+def test_a_flight_that_ends_during_a_fault_is_reported_not_a_crash():
+    """The IR fault runs from 60 s to 160 s: a 100 s flight ends inside it. The fault is still
+    declared; its recovery is not measured (None), since the flight ended first."""
+    _, metrics = scenarios.run("ir-calibration", {"faults": "ir", "duration": 100.0})
+    (fault,) = metrics["faults"]
+    assert fault["sensor"] == "ir" and fault["onset_s"] < fault["declared_s"] <= fault["onset_s"] + 2.0
+    (recovery,) = metrics["recovery"]
+    assert recovery == {"sensor": "ir", "back_within_5_percent_s": None, "a_error_percent_at_end_plus_10_s": None,
+                        "b_error_percent_at_end_plus_10_s": None}

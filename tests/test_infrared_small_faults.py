@@ -87,3 +87,19 @@ def test_consistency_settings_are_checked():
         EKFSettings(significance=0.0)
     with pytest.raises(ValueError, match="end_significance"):
         EKFSettings(end_significance=-1.0)
+
+
+#: Flights of the tuning seeds where, before the return test, an offset whose declaration ended
+#: early was absorbed into the calibration, and its end was then declared as a fault that never
+#: cleared (``python -m studies.ir_detection`` with ``alt_ended`` and ``alt_innovation`` off).
+ABSORBED = (("gps", 0.1, (1_000_367, 10_000_284, 10_000_971)), ("ir", 100.0, (1_000_771, 10_000_509)))
+
+
+@pytest.mark.parametrize(("sensor", "size", "seeds"), ABSORBED)
+def test_the_end_of_an_absorbed_offset_leaves_no_fault_standing(sensor, size, seeds):
+    after = fleet(sensor, size, seeds)
+    assert [row["seed"] for row in after if row["standing"]] == []
+    assert all(row["right"] for row in after)
+    # without the return test, every one of them is left standing
+    before = fleet(sensor, size, seeds, {"alt_ended": False, "alt_innovation": False})
+    assert [row["seed"] for row in before if row["standing"]] == list(seeds)

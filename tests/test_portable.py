@@ -62,3 +62,18 @@ def test_the_bits_do_not_depend_on_the_machines_kernels():
     assert here[:2] == other[:2]  # ours: the same bits
     if " fma " in Path("/proc/cpuinfo").read_text():
         assert here[2:] != other[2:]  # numpy's own: other bits, so the change of kernels took effect
+
+
+def test_the_inverse_inverts_and_refuses_a_singular_matrix():
+    from flight.mixer import allocation_matrix
+
+    mixer = allocation_matrix()
+    inverse = portable.inverse(mixer)
+    assert np.abs(inverse @ mixer - np.eye(4)).max() <= 2 * np.spacing(1.0)  # measured 2.3e-16
+    assert np.abs(inverse - np.linalg.inv(mixer)).max() <= 2 * np.spacing(np.abs(inverse).max())  # measured 1 ulp
+    shuffled = np.random.default_rng(3).normal(size=(5, 5))
+    assert np.abs(portable.inverse(shuffled) @ shuffled - np.eye(5)).max() < 3e-15  # measured 1.5e-15
+    with pytest.raises(ValueError, match="singular"):
+        portable.inverse([[1.0, 2.0], [2.0, 4.0]])
+    with pytest.raises(ValueError, match="square"):
+        portable.inverse(np.ones((2, 3)))

@@ -45,11 +45,22 @@ calibration *held* from before (:func:`consistency`).
   offsets without the turn's lag, which made them declare faults in hard turns). When one
   declares a fault, ``a`` and ``b`` are set back to their values at the last sample where every
   statistic was zero.
+- **The end of an absorbed offset** (``alt_ended``): when a declaration ends, the calibration
+  it held, from before the offset, is remembered for longer than an offset lasts
+  (:func:`_remember_alt`). If the end came early, the filter absorbs the rest of the offset; when
+  the offset then stops, the change back is taken for a return to that calibration (it is put
+  back, no fault declared, :func:`_returned`) rather than for a new fault, which, ``a`` and
+  ``b`` held at the absorbed calibration, would never clear. Tested on the faults of both the
+  consistency residual and the innovations' CUSUMs (``alt_innovation``).
 - **Options measured and left off**: ``decisive`` (declare on the better shape whatever the
   fit, once the CUSUM's statistic is that strong: under a frozen calibration the statistic grows
   with the cloud's drift too) and ``alt_level`` (remember the calibration from before a change
   the fit saw but could not confirm, and take a later opposite change back to it for the end of
-  an absorbed offset rather than a fault: it also takes real faults for returns).
+  an absorbed offset rather than a fault: it also takes real faults for returns), and
+  likewise ``alt_restart`` (the calibration of a run that outlasts the ring) and ``alt_moved``
+  (the calibration of 10 s before a fast move of ``a`` and ``b``): both end missed offsets
+  without a fault, and both remember the cloud's calibration, which a real GPS fault 10 s after
+  the cloud's exit then returns to.
   ``studies/ir_detection.py`` measures each choice.
 """
 
@@ -64,9 +75,20 @@ from calibration.infrared.layout import (
     A_SAFE,
     ALT_A,
     ALT_B,
+    ALT_CHECK,
+    ALT_ENDED,
+    ALT_FRACTION,
+    ALT_INNOVATION,
     ALT_LEFT,
     ALT_LEVEL,
     ALT_LIFE,
+    ALT_MOVED,
+    ALT_NEEDS_RUN,
+    ALT_RESTART,
+    ALT_RUN,
+    ALT_SHIFT,
+    ALT_SPAN,
+    ALT_WAIT,
     ANCHOR,
     B_SAFE,
     COMPLETE,
@@ -229,7 +251,7 @@ def consistency(s, c, ir_pair, gps):
         index = int(s[ANCHOR])
     else:
         if c[FREEZE] > 0.5 and running:  # too long a run to keep its calibration: it starts again
-            _run_over(s, c)
+            _run_over(s, c, True)
             for j in range(CUSUM_SIZE):
                 s[CUSUM_CONS + j] = 0.0
         index = count - int(c[HELD_LAG])
@@ -246,32 +268,85 @@ def consistency(s, c, ir_pair, gps):
 
 
 @njit(cache=True)
-def _run_over(s, c):
-    """The consistency CUSUM's run ends (its statistic back to zero, or restarted) without a
-    fault declared: if the attribution saw an abrupt change in it (a log-likelihood of at least
-    ``c[ALT_LEVEL]``) that it could not confirm, the filter has absorbed it, and the calibration
-    the run was held against, from before it, is remembered for ``c[ALT_LIFE]`` samples
-    (:func:`_returned`)."""
-    if s[HELD_FAULT] < 0.5 and s[RUN_PEAK] >= c[ALT_LEVEL] and int(s[PAST_COUNT]) - int(s[ANCHOR]) < PAST_SIZE:
+def _run_over(s, c, restarted):
+    """The consistency CUSUM's run ends (its statistic back to zero, or ``restarted`` after
+    outlasting the ring of past calibrations) without a fault declared. The filter has absorbed
+    what the run saw if the attribution saw an abrupt change in it (a log-likelihood of at least
+    ``c[ALT_LEVEL]``) that it could not confirm, or (with ``c[ALT_RESTART]``) if the residual
+    stayed off the calibration the run was held against for as long as the ring lasts: that
+    calibration, from before the change, is remembered (:func:`_remember_alt`)."""
+    peaked = s[RUN_PEAK] >= c[ALT_LEVEL] or (restarted and c[ALT_RESTART] > 0.5)
+    if s[HELD_FAULT] < 0.5 and peaked and int(s[PAST_COUNT]) - int(s[ANCHOR]) < PAST_SIZE:
         held = PAST + int(s[ANCHOR]) % PAST_SIZE
-        s[ALT_A], s[ALT_B] = s[held], s[held + PAST_SIZE]
-        s[ALT_LEFT] = c[ALT_LIFE]
+        _remember_alt(s, c, s[held], s[held + PAST_SIZE], False)
     s[RUN_PEAK] = 0.0
 
 
 @njit(cache=True)
-def _returned(s, c, size):
-    """Whether the change about to be declared, of normalised ``size`` in the ring, brings the
-    sensors back to the calibration remembered by :func:`_run_over`: an offset the filter
-    absorbed earlier, ending. Against that calibration the residual would be ``d + delta``,
-    ``d`` the change and ``delta`` the two calibrations' difference at the present turn rate;
-    it is a return when that is less than half of ``d``."""
+def _remember_alt(s, c, a, b, force):
+    """Remember the calibration ``a``, ``b`` from before a change the filter may have absorbed,
+    for ``c[ALT_LIFE]`` samples (longer than an offset lasts), so that the offset's end is taken
+    for a return to it rather than a new fault (:func:`_returned`). A calibration already
+    remembered is kept unless ``force`` (a declaration ended: the calibration it held is the one
+    from before the offset). ``c[ALT_WAIT]`` samples later it is forgotten if ``a`` and ``b``
+    have not moved ``c[ALT_SHIFT]`` away from it (:func:`_check_alt`): nothing was absorbed."""
+    if s[ALT_LEFT] > 0.0 and not force:
+        return
+    s[ALT_A], s[ALT_B] = a, b
+    s[ALT_LEFT] = c[ALT_LIFE]
+    s[ALT_CHECK] = c[ALT_WAIT]
+
+
+@njit(cache=True)
+def _check_alt(s, c):
+    """One sample of the remembered calibration's life (:func:`_remember_alt`): forgotten when
+    it is over, or when ``a`` and ``b`` have not moved from it by ``c[ALT_SHIFT]`` (count, at the
+    present turn rate) ``c[ALT_WAIT]`` samples after it was remembered. With none remembered,
+    the oldest calibration of the ring of past ones is, if ``a`` and ``b`` have moved from it by
+    ``c[ALT_MOVED]`` (count, at the present turn rate): an offset missed, being absorbed."""
+    count = int(s[PAST_COUNT])
+    if s[ALT_RUN] > 0.0:
+        s[ALT_RUN] -= 1.0
+    seen = s[ALT_RUN] > 0.0 or c[ALT_NEEDS_RUN] < 0.5  # the residual saw a change (a drift the filter follows unseen)
+    if seen and count >= PAST_SIZE and (s[ALT_LEFT] <= 0.0 or c[ALT_LIFE] - s[ALT_LEFT] >= PAST_SIZE):
+        # a and b moved fast, no fault declared: the filter may be absorbing an offset (the latest such move wins)
+        old = PAST + (count - PAST_SIZE + 1) % PAST_SIZE  # remembered: the oldest, before the move's start
+        recent = PAST + (count - int(c[ALT_SPAN])) % PAST_SIZE
+        moved = (s[A] - s[recent]) * s[HELD_GPS] + s[B] - s[recent + PAST_SIZE]
+        away = abs((s[A] - s[ALT_A]) * s[HELD_GPS] + s[B] - s[ALT_B])  # a move back to the one remembered keeps it
+        before = abs((s[old] - s[ALT_A]) * s[HELD_GPS] + s[old + PAST_SIZE] - s[ALT_B])
+        if abs(moved) >= c[ALT_MOVED] and (s[ALT_LEFT] <= 0.0 or away > before - 0.5 * abs(moved)):
+            _remember_alt(s, c, s[old], s[old + PAST_SIZE], True)
+            s[ALT_CHECK] = 0.0  # it has moved already
+    if s[ALT_LEFT] <= 0.0:
+        return
+    s[ALT_LEFT] -= 1.0
+    if s[ALT_CHECK] > 0.0:
+        s[ALT_CHECK] -= 1.0
+        moved = (s[A] - s[ALT_A]) * s[HELD_GPS] + s[B] - s[ALT_B]
+        if s[ALT_CHECK] <= 0.0 and abs(moved) < c[ALT_SHIFT]:
+            s[ALT_LEFT] = 0.0
+
+
+@njit(cache=True)
+def _returned(s, c, d, a, b):
+    """Whether the change ``d`` (count, in the consistency residual) about to be declared, seen
+    against the calibration ``a``, ``b``, brings the sensors back to the calibration remembered
+    (:func:`_remember_alt`): an offset the filter absorbed earlier, ending. Against that
+    calibration the residual would be ``d + delta``, ``delta`` the two calibrations' difference
+    at the present turn rate; it is a return when that is less than ``c[ALT_FRACTION]`` of ``d``."""
     if s[ALT_LEFT] <= 0.0:
         return False
-    ref = PAST + (int(s[PAST_COUNT]) - n_ring(s)) % PAST_SIZE
-    d = size * math.sqrt(s[GATE_CONS])
-    delta = (s[ref] - s[ALT_A]) * s[HELD_GPS] + s[ref + PAST_SIZE] - s[ALT_B]
-    return abs(d + delta) < 0.5 * abs(d)
+    delta = (a - s[ALT_A]) * s[HELD_GPS] + b - s[ALT_B]
+    return abs(d + delta) < c[ALT_FRACTION] * abs(d)
+
+
+@njit(cache=True)
+def _take_back(s, c):
+    """A return recognised (:func:`_returned`): the remembered calibration back, no fault."""
+    s[A], s[B] = s[ALT_A], s[ALT_B]
+    s[ALT_LEFT] = 0.0
+    reopen(s, c)
 
 
 @njit(cache=True)
@@ -569,6 +644,8 @@ def _end_ir(s, c, pair_seen):
 @njit(cache=True)
 def _ended(s, c, flag):
     """End the fault ``flag``: detectors restarted, a and b reopened."""
+    if c[ALT_ENDED] > 0.5:  # a and b were held from before the offset: if it lasts on, the filter absorbs it now
+        _remember_alt(s, c, s[A], s[B], True)
     s[flag] = 0.0
     s[CONS_OFFSET] = 0.0
     s[HELD_FAULT] = 0.0
@@ -616,8 +693,7 @@ def detect(s, c, gps_seen, pair_seen, raw_seen):
     if s[IR_FAULT] > 0.5:
         _end_ir(s, c, pair_seen)
         return
-    if s[ALT_LEFT] > 0.0:
-        s[ALT_LEFT] -= 1.0
+    _check_alt(s, c)
     if s[HOLD] > 0.0:
         s[HOLD] -= 1.0
         pair_seen = False
@@ -636,12 +712,13 @@ def detect(s, c, gps_seen, pair_seen, raw_seen):
             if _quiet(s):
                 s[A_SAFE], s[B_SAFE] = s[A], s[B]
             return
-        if _returned(s, c, size):  # the end of an offset absorbed earlier: its calibration back, no fault
-            s[A], s[B] = s[ALT_A], s[ALT_B]
-            s[ALT_LEFT] = 0.0
-            reopen(s, c)
+        ref = PAST + (int(s[PAST_COUNT]) - n_ring(s)) % PAST_SIZE  # the calibration the ring is seen against
+        if _returned(s, c, size * math.sqrt(s[GATE_CONS]), s[ref], s[ref + PAST_SIZE]):
+            _take_back(s, c)  # the end of an offset absorbed earlier: its calibration back, no fault
         else:
             _declare_held(s, c, sensor, size, onset)
+    elif c[ALT_INNOVATION] > 0.5 and _returned(s, c, _innovation_step(s, gps, pair, now, ir), s[A_SAFE], s[B_SAFE]):
+        _take_back(s, c)
     else:
         _declare(s, c, gps, pair, now, ir)
     s[END_STAT] = 0.0
@@ -693,12 +770,23 @@ def _held(s, c, pair_seen):
     _remember(s, s[HELD_IR] - s[CONS_OFFSET], s[HELD_GPS], s[GATE_CONS])
     running = s[CUSUM_CONS + G_UP] > 0.0 or s[CUSUM_CONS + G_DOWN] > 0.0
     held = cusum(s, CUSUM_CONS, s[NU_CONS], s[GATE_CONS], c[CONS_K], c[CONS_H])
+    if held > -1.0:
+        s[ALT_RUN] = PAST_SIZE
     if running and held == -1.0:
-        _run_over(s, c)
+        _run_over(s, c, False)
     if held == -1.0 and s[HELD_FAULT] < 0.5:  # its statistic is zero: no offset shows, the residual is noise and drift
         z = s[NU_CONS] / math.sqrt(s[GATE_CONS])
         s[HELD_SCALE] += c[SCALE_GAIN] * (z * z - s[HELD_SCALE])
     return held
+
+
+@njit(cache=True)
+def _innovation_step(s, gps, pair, now, ir):
+    """The change (count, in the consistency residual) that the CUSUM of the GPS, the paired IR
+    or the present IR (how far each is over its threshold) would declare (:func:`_declare`)."""
+    if gps > ir:
+        return -s[A_SAFE] * run_mean(s, CUSUM_GPS)
+    return run_mean(s, CUSUM_PAIR) if pair > now else run_mean(s, CUSUM_NOW)
 
 
 @njit(cache=True)

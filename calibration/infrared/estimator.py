@@ -23,8 +23,17 @@ from calibration.infrared.filters import (
 )
 from calibration.infrared.layout import (
     A_SAFE,
+    ALT_ENDED,
+    ALT_FRACTION,
+    ALT_INNOVATION,
     ALT_LEVEL,
     ALT_LIFE,
+    ALT_MOVED,
+    ALT_NEEDS_RUN,
+    ALT_RESTART,
+    ALT_SHIFT,
+    ALT_SPAN,
+    ALT_WAIT,
     ANCHOR,
     B_SAFE,
     COMPLETE,
@@ -213,6 +222,29 @@ class EKFSettings:
         calibration from before it remembered for ``alt_life`` samples, so that a later change
         back to it is taken for the end of an offset the filter absorbed, not for a fault
         (``inf``: never; it takes real faults for returns too).
+    alt_ended : bool
+        When a fault's declaration ends, remember the calibration it held (from before the
+        offset) for ``alt_life`` samples: if the offset lasts on, the filter absorbs it, and its
+        end is then taken for a return to that calibration, not for a new fault that would never
+        clear.
+    alt_restart : bool
+        Remember the calibration a consistency run was held against when the run outlasts the
+        ring of past calibrations (off: the cloud's ramps leave calibrations that real faults
+        then return to).
+    alt_moved, alt_span : float, int
+        Remember the calibration of 10 s before when ``a`` and ``b`` move by ``alt_moved``
+        counts (at the present turn rate) within ``alt_span`` samples, the consistency CUSUM
+        having run (``alt_needs_run``): a missed offset being absorbed (``inf``, the default:
+        never; the filter's catching up after the cloud takes real faults for returns).
+    alt_shift, alt_wait : float, int
+        A remembered calibration is forgotten ``alt_wait`` samples later if ``a`` and ``b`` have
+        not moved ``alt_shift`` counts from it (at the present turn rate): nothing was absorbed.
+    alt_innovation : bool
+        Test the faults the innovations' CUSUMs declare for such a return too (else only those
+        of the consistency residual).
+    alt_fraction : float
+        A change is a return when, against the remembered calibration, the residual after it is
+        less than this fraction of the change.
     scale_gain : float
         Weight per sample of the running mean square of the normalised consistency residual
         while its CUSUM is zero (1 / samples): the spread the attribution scales by.
@@ -268,6 +300,15 @@ class EKFSettings:
     decisive: float = math.inf
     alt_level: float = math.inf
     alt_life: int = 4000
+    alt_ended: bool = True
+    alt_restart: bool = False
+    alt_shift: float = 15.0
+    alt_wait: int = 200
+    alt_innovation: bool = True
+    alt_moved: float = math.inf
+    alt_needs_run: bool = True
+    alt_span: int = 40
+    alt_fraction: float = 0.5
     scale_gain: float = 0.01
     end_h: float = 10.0
     size_gain: float = 0.05
@@ -286,6 +327,13 @@ class EKFSettings:
             if not value > 0.0 or math.isnan(value):
                 raise ValueError(f"{name} = {value!r} must be positive (inf where it turns a detector off); "
                                  "the detector needs a positive allowance and threshold")
+        for name in ("alt_shift", "alt_moved", "alt_fraction"):
+            if not getattr(self, name) >= 0.0:
+                raise ValueError(f"{name} = {getattr(self, name)!r} must be >= 0 (inf: never)")
+        for name, top in (("alt_wait", math.inf), ("alt_span", PAST_SIZE - 1)):
+            value = getattr(self, name)
+            if int(value) != value or not 0 <= value <= top:
+                raise ValueError(f"{name} = {value!r} must be a whole number of samples in [0, {top}]")
         if int(self.held_lag) != self.held_lag or not 1 <= self.held_lag < PAST_SIZE - RING_SIZE:
             raise ValueError(f"held_lag = {self.held_lag!r} must be a whole number of samples in "
                              f"[1, {PAST_SIZE - RING_SIZE})")
@@ -314,6 +362,9 @@ class EKFSettings:
         c[ALT_LEVEL], c[ALT_LIFE], c[SD_DRIFT] = self.alt_level, self.alt_life, self.sd_drift
         c[END_SIGNIFICANCE], c[COMPLETE] = self.end_significance, self.complete
         c[END_TURN] = float(self.end_healthy)
+        c[ALT_ENDED], c[ALT_RESTART], c[ALT_INNOVATION] = self.alt_ended, self.alt_restart, self.alt_innovation
+        c[ALT_SHIFT], c[ALT_WAIT], c[ALT_MOVED] = self.alt_shift, self.alt_wait, self.alt_moved
+        c[ALT_NEEDS_RUN], c[ALT_FRACTION], c[ALT_SPAN] = self.alt_needs_run, self.alt_fraction, self.alt_span
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c

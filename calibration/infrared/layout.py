@@ -35,7 +35,9 @@ SETTLING = 62  # samples before the end test of a fault watches the residual: it
 # is kept for, and the largest attribution log-likelihood of the CUSUM's present run
 ALT_A, ALT_B, ALT_LEFT, RUN_PEAK = 63, 64, 65, 66
 END_LLR = 67  # the end test's log-likelihood at this sample, of a step back at least half the offset
-RING = 68
+ALT_CHECK = 68  # samples left before the remembered calibration is kept only if a and b have moved away from it
+ALT_RUN = 69  # samples left for which the consistency CUSUM ran lately (a ring's span after its last run)
+RING = 70
 RING_SIZE = 60  # samples: 3 s at 20 Hz, the onset of the fault and the GPS window's ramp
 PAST_COUNT = RING + 3 * RING_SIZE
 PAST = PAST_COUNT + 1
@@ -61,7 +63,16 @@ CONS_K, CONS_H, MARGIN, RAMP, HELD_LAG, SCALE_GAIN, SIGNIFICANCE, SD_A_HELD = ra
 FREEZE, DECISIVE, TURN_MODE, END_MODE, RAW_SEEN, ALT_LEVEL, ALT_LIFE, SD_DRIFT = range(25, 33)
 # and whether the end test takes the turn rate of the sensor held healthy (1) or the attribution's (0)
 END_SIGNIFICANCE, COMPLETE, END_TURN = 33, 34, 35
-EKF_CONFIG_SIZE = 36
+# what leaves a calibration remembered for the end of an absorbed offset (ALT_LEVEL above): a fault's declaration
+# ending (1) and a consistency run outlasting the ring of past calibrations (1); how far a and b must have moved
+# from it (count, at the present turn rate) ALT_WAIT samples later for it to be kept; whether a fault the
+# innovations' CUSUMs declare is tested for such a return too (1); how far (count, at the present turn rate) a and b
+# must move within the ring of past calibrations, no fault declared, for the oldest there to be remembered; whether
+# that needs the consistency CUSUM to have run meanwhile (1); the fraction of a change its return may miss by
+# and the span (samples) within which a and b must move that far (a cloud's drift is slower, an absorbed offset fast)
+ALT_ENDED, ALT_RESTART, ALT_SHIFT, ALT_WAIT, ALT_INNOVATION, ALT_MOVED, ALT_NEEDS_RUN, ALT_FRACTION = range(36, 44)
+ALT_SPAN = 44
+EKF_CONFIG_SIZE = 45
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 

@@ -6,6 +6,9 @@
   walk-through is made by the command beside it.
 - the FMUs' variable tables, generated from ``fmus/<Model>/variables.py`` into
   ``docs/_generated/fmu_variables.md`` when the build starts.
+- the notebooks: ``notebooks/*.py`` (jupytext's percent format) written as
+  ``docs/_generated/notebooks/*.ipynb`` when the build starts, for myst-nb to execute (with its
+  cache) and render with their figures.
 - a check of the built pages: Markdown that did not render (a literal backtick in the text, a
   findings marker shown as text) is a warning, so ``sphinx -W`` fails on it. A line that
   starts with a findings marker is read by Markdown as raw HTML, and its backticks then show.
@@ -28,21 +31,42 @@ HERE = Path(__file__).resolve().parent.parent
 GENERATED = HERE / "_generated"
 
 
-def _run(command: str) -> Path:
-    """The folder of ``quadcosim COMMAND``'s results, running it first if not done yet."""
-    import matplotlib
+DONE = ".docs-done"  # written into a command's folder once it and its follow-up succeeded
 
-    matplotlib.use("Agg")
+
+def _call(argv: list[str]) -> None:
+    """``quadcosim ARGV`` in this process; its output shown only if it fails."""
     from quadcosim.main import main
 
-    out = GENERATED / "runs" / hashlib.sha256(command.encode()).hexdigest()[:16]
+    told = io.StringIO()
+    with contextlib.redirect_stdout(told), contextlib.redirect_stderr(told):
+        code = main(argv)
+    if code != 0:
+        raise RuntimeError(f"quadcosim {shlex.join(argv)} exited {code}:\n{told.getvalue()[-2000:]}")
+
+
+def _run(command: str, then: str | None = None, name: str | None = None) -> Path:
+    """The folder of ``quadcosim COMMAND``'s results (its ``--out``), running it first if not
+    done yet, then ``then`` (a command with ``{out}`` standing for that folder); ``name``: the
+    folder's own name, as figure titles show it (``k-sweep``)."""
+    import shutil
+
+    import matplotlib
+
+    matplotlib.use("Agg")  # this process draws into files (MPLBACKEND names the notebooks' kernels' backend)
+    out = GENERATED / "runs" / hashlib.sha256(f"{command}\n{then}\n{name}".encode()).hexdigest()[:16]
+    out = out / name if name else out
     metrics = out / "metrics.json"
-    if not (metrics.is_file() and json.loads(metrics.read_text()).get("status") == "completed"):
-        told = io.StringIO()  # the run's lines go to the error only if it fails
-        with contextlib.redirect_stdout(told), contextlib.redirect_stderr(told):
-            code = main([*shlex.split(command), "--out", str(out), "--overwrite"])
-        if code != 0:
-            raise RuntimeError(f"quadcosim {command} exited {code}:\n{told.getvalue()[-2000:]}")
+    done = (out / DONE).is_file() or (then is None and metrics.is_file()
+                                       and json.loads(metrics.read_text()).get("status") == "completed")
+    if not done:
+        shutil.rmtree(out.parent if name else out, ignore_errors=True)
+        out.mkdir(parents=True)  # a folder as --out (diagram's takes diagram.png in it)
+        argv = shlex.split(command)
+        _call([*argv, "--out", str(out)] + (["--overwrite"] if argv[0] == "run" else []))
+        if then:
+            _call(shlex.split(then.format(out=shlex.quote(str(out)))))
+        (out / DONE).write_text(f"{command}\n{then or ''}\n")
     return out
 
 
@@ -53,18 +77,27 @@ def _shown(value, digits: int | None = None) -> str:
 
 
 class QuadcosimRun(Directive):
-    """``quadcosim-run``: the argument is the command after ``quadcosim``; options ``figure`` (a
-    file the run writes, ``roll_pitch.png`` by default) and ``metrics`` (comma-separated names of
-    ``metrics.json`` to print)."""
+    """``quadcosim-run``: the argument is the command after ``quadcosim`` (its ``--out`` is added);
+    options ``figure`` (a file the run writes, ``roll_pitch.png`` by default), ``metrics``
+    (comma-separated names of ``metrics.json`` to print), ``then`` (a second command on the
+    results, ``{out}`` standing for their folder: ``plot {out} Setpoint.theta_d Quadrotor.theta
+    --tracking``) and ``out`` (the folder as the page shows it, ``results/NAME``; shown only with
+    ``then``)."""
 
     required_arguments = 1
     final_argument_whitespace = True
-    option_spec = {"figure": directives.unchanged, "metrics": directives.unchanged}
+    option_spec = {"figure": directives.unchanged, "metrics": directives.unchanged, "then": directives.unchanged,
+                   "out": directives.unchanged}
 
     def run(self):
-        command = self.arguments[0]
-        out = _run(command)
-        shown = [nodes.literal_block(text=f"quadcosim {command}", language="sh")]
+        command, then = self.arguments[0], self.options.get("then")
+        folder = self.options.get("out", "results/run")
+        out = _run(command, then, Path(folder).name if then else None)
+        if then:
+            text = f"quadcosim {command} --out {folder}\nquadcosim {then.format(out=folder)}"
+        else:
+            text = f"quadcosim {command}"
+        shown = [nodes.literal_block(text=text, language="sh")]
         names = [n.strip() for n in self.options.get("metrics", "").split(",") if n.strip()]
         if names:
             metrics = json.loads((out / "metrics.json").read_text())
@@ -104,6 +137,42 @@ def _variable_tables(app):
     text = "\n".join(lines)
     if not target.is_file() or target.read_text() != text:
         target.write_text(text)
+
+
+NOTEBOOKS = HERE.parent / "notebooks"
+#: The packages a notebook calls: an execution older than their newest source is stale.
+PACKAGES = ("fmus", "orchestrator", "estimators", "calibration", "scenarios", "benchmarks")
+
+
+def newest_source(root: Path = HERE.parent) -> float:
+    """The newest modification time (s since the epoch) of the packages' Python sources."""
+    return max(p.stat().st_mtime for package in PACKAGES for p in (root / package).rglob("*.py"))
+
+
+def _notebooks(app):
+    """``_generated/notebooks/NAME.ipynb`` of each ``notebooks/NAME.py``, rewritten only when it
+    changes (so that Sphinx and myst-nb's cache see an unchanged notebook as unchanged), and the
+    cached executions older than the packages' sources dropped: myst-nb's cache knows only a
+    notebook's own code, and a change of the package must run the notebooks again."""
+    import calendar
+
+    import jupytext
+    from jupyter_cache import get_cache
+
+    cache_path = Path(app.config.nb_execution_cache_path)
+    if cache_path.is_dir():
+        cache, newest = get_cache(cache_path), newest_source()
+        for record in cache.list_cache_records():
+            if calendar.timegm(record.created.utctimetuple()) <= newest:
+                cache.remove_cache(record.pk)
+
+    target = GENERATED / "notebooks"
+    target.mkdir(parents=True, exist_ok=True)
+    for source in sorted(NOTEBOOKS.glob("*.py")):
+        text = jupytext.writes(jupytext.read(source), fmt="ipynb")
+        path = target / f"{source.stem}.ipynb"
+        if not path.is_file() or path.read_text() != text:
+            path.write_text(text)
 
 
 _VERBATIM = re.compile(r"<(pre|code|script|style|kbd|tt|textarea)\b.*?</\1>", re.S | re.I)
@@ -154,5 +223,6 @@ def setup(app):
     """Register the directive, the generated pages and the check of the built pages."""
     app.add_directive("quadcosim-run", QuadcosimRun)
     app.connect("builder-inited", _variable_tables)
+    app.connect("builder-inited", _notebooks)
     app.connect("build-finished", _check_rendered)
     return {"parallel_read_safe": False, "version": "1"}

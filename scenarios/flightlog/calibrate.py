@@ -290,8 +290,13 @@ def run(args) -> int:
     are written, so that an interrupt leaves them all with their ``metrics.json``, or nothing."""
     from calibration.flight import calibrate
     from calibration.static import CalibrationError
+    from scenarios.output_options import default_folder
 
-    out = Path(args.out)
+    if not args.out:
+        first = (args.files or args.train or [None])[0]
+        if first is not None:
+            args.out = str(default_folder("calibrate", f"calibrate-{Path(first).stem}", args.overwrite))
+    out = Path(args.out or "results/calibrate")
     try:
         _check_choices(args)
         _check_out(out, args.overwrite)  # before the flights are read; again, held, before writing
@@ -414,7 +419,8 @@ def add_arguments(parser):
     """The ``calibrate`` verb's options on ``parser`` (an argparse parser); returns it."""
     parser.add_argument("files", nargs="*", metavar="FILE", help="PX4 .ulg, ArduPilot .bin or .log flights")
     parser.add_argument("--compass", type=int, default=0, help="compass to calibrate, from 0 in the log's order")
-    parser.add_argument("--out", required=True, help="folder for the results")
+    parser.add_argument("--out", help="folder for the results (default results/calibrate-FLIGHT, FLIGHT the first "
+                                      "flight's name, or results/calibrate-FLIGHT-N when that holds results)")
     parser.add_argument("--test-fraction", type=float, default=None,
                         help="last fraction of each flight kept for testing (default 0.5 for one flight; several "
                              "flights hold out the last one)")

@@ -13,9 +13,9 @@ TESLA_TO_UT = 1e6
 
 
 def _pyplot():
-    import matplotlib
+    from orchestrator.files import headless_backend
 
-    matplotlib.use("Agg")
+    headless_backend()
     import matplotlib.pyplot as plt
 
     return plt

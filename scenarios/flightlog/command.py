@@ -50,7 +50,8 @@ def add_arguments(parser):
     shown = sub.add_parser("info", help="what the log holds: sensors, rates, duration, vehicle, firmware, "
                            "simulator or not, current sensor or not")
     shown.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
-    shown.add_argument("--json", action="store_true", help="print the summary as JSON")
+    shown.add_argument("--json", action="store_true", help="print the summary as JSON on standard output, in "
+                       "place of the text")
     shown.set_defaults(func=info)
     drawn = sub.add_parser("plot", help="an overview figure: field, current, throttle and attitude")
     drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
@@ -63,6 +64,16 @@ def add_arguments(parser):
                               "compensation, against the autopilot's attitude (a reference, not the truth)")
     replayed.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
     replayed.add_argument("--compass", type=int, default=0, help="compass to use, from 0 in the log's order")
-    replayed.add_argument("--json", help="also write the result to this JSON file")
+    from scenarios.output_options import add_json_flag
+
+    add_json_flag(replayed, "print the result as JSON on standard output, in place of the table")
+    replayed.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
     replayed.set_defaults(func=replay.run)
+    from scenarios.flightlog import example
+
+    made = sub.add_parser("example", help="write three small synthetic flight logs to try these commands on "
+                          "(ArduPilot text logs: example-a.log, example-b.log, example-c.log)")
+    made.add_argument("out", help="folder to write them into (created)")
+    made.add_argument("--seconds", type=float, default=40.0, metavar="S", help="length of each flight (s, default 40)")
+    made.set_defaults(func=example.command)
     return parser

@@ -28,9 +28,9 @@ def plot_overview(log, out) -> Path:
     (its format from its suffix, written atomically: :func:`orchestrator.files.save_figure`): each
     compass's raw field (uT), battery current (A) and voltage (V), motor commands and throttle
     (1), and the autopilot's roll, pitch and yaw (deg), on the log's clock (s)."""
-    import matplotlib
+    from orchestrator.files import headless_backend
 
-    matplotlib.use("Agg")
+    headless_backend()
     import matplotlib.pyplot as plt
 
     t0 = log.start

@@ -133,24 +133,32 @@ def _replayed(log, compass: int) -> dict:
 
 
 def run(args) -> int:
-    """``quadcosim log replay FILE [--compass N] [--json OUT]`` (``args`` from argparse); 2 on bad
+    """``quadcosim log replay FILE [--compass N] [--json] [--out FILE]`` (``args`` from argparse):
+    the table, or with ``--json`` the result as JSON, on standard output, and with ``--out`` the
+    result written as JSON there; 2 on bad
     input (a log, an option or an output path refused), 1 when the JSON could not be written (a
     full disk: nothing is left under its name)."""
     from calibration.static import CalibrationError
     from orchestrator.files import output_file, write_json
     from scenarios.flightlog.reading import load
 
+    out = getattr(args, "out", None)
     try:
-        if args.json:
-            output_file(args.json)  # refused before the replay, not after it
+        if out:
+            output_file(out)  # refused before the replay, not after it
         result = _replayed(load(args.file, "log replay"), args.compass)
     except (CalibrationError, ValueError) as error:  # LogError and OutputRefused among them
         print(f"quadcosim log replay: {error}", file=sys.stderr)
         return 2
-    print(text(result))
-    if args.json:
+    if getattr(args, "json", False) is True:
+        import json
+
+        print(json.dumps(result, indent=2, default=float))
+    else:
+        print(text(result))
+    if out:
         try:
-            write_json(args.json, result)
+            write_json(out, result)
         except OSError as error:
             print(f"quadcosim log replay: failed: {error}", file=sys.stderr)
             return 1
