@@ -100,7 +100,7 @@ def yaw(quick: bool = False) -> list[dict]:
     """The yaw loop's cases (a ringing one's ringing and its frequency; every one's command and
     current ranges), the largest quiet loop at 100 Hz and the first whose commands reach a
     bound; ``quick``: the 100 Hz cases alone (a second each)."""
-    from flight import yaw_loop
+    from studies import yaw_loop
 
     found = []
     for name, rate, w, flight, settings in yaw_loop.CASES:
