@@ -4,8 +4,8 @@
   (``log info --json``, ``log replay --json``, ``bench --json``).
 - ``--out PATH`` is where a command writes its files (a folder, or the one file it writes), and
   every command that writes files has a default under ``results/`` (``run``:
-  ``results/SCENARIO``; ``calibrate``: ``results/calibrate-FLIGHT``; ``log plot``:
-  ``results/logs/``), never replaced unasked.
+  ``results/SCENARIO``; ``calibrate``: ``results/calibrate-FLIGHT``; ``compare``:
+  ``results/compare-SIGNAL.png``; ``log plot``: ``results/logs/``), never replaced unasked.
 
 The old spelling ``--json FILE`` (``log replay``, ``python -m scenarios.replay``) still works: it
 means ``--out FILE`` and says so on standard error.

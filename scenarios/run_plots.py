@@ -84,6 +84,32 @@ def _label(folder: Path) -> str:
     return folder.name or str(folder)
 
 
+#: Where ``quadcosim compare`` writes its figure when no ``--out`` is given.
+COMPARE_FOLDER = Path("results")
+
+
+def _run_labels(folders) -> list[str]:
+    """Each run's name in a legend: its folder's name, or its path where two names are alike
+    (``a/tp`` and ``b/tp``)."""
+    names = [_label(folder) for folder in folders]
+    return [str(folder) if names.count(name) > 1 else name for folder, name in zip(folders, names, strict=True)]
+
+
+def _free_file(path: Path) -> Path:
+    """``path`` if no file is there, else the first free ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ...,
+    said on standard error: a default figure never replaces an earlier one."""
+    import sys
+
+    candidate, number = path, 1
+    while candidate.exists():
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    if candidate != path:
+        print(f"quadcosim compare: {path} is there; writing {candidate} (--out FILE chooses the file, --overwrite "
+              f"replaces {path})", file=sys.stderr)
+    return candidate
+
+
 #: Figure formats of ``--format``: the file's suffix.
 FORMATS = ("png", "svg", "pdf")
 
@@ -254,7 +280,8 @@ def _tracking(result, folder: Path, signals, path: Path, deg: bool) -> Path:
         plt.close(fig)
 
 
-def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str | None = None) -> Path:
+def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str | None = None,
+            overwrite: bool = False) -> Path:
     """One signal of several finished runs on one figure, one curve per run (per component for a
     vector, on its own axes).
 
@@ -265,11 +292,15 @@ def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str |
     signal : str
         Signal or vector name, recorded by every run.
     out : str or pathlib.Path, optional
-        PNG, SVG or PDF file; ``compare-<signal>.png`` in the current folder by default.
+        PNG, SVG or PDF file, replaced if it is there (asked for). By default
+        ``results/compare-<signal>.png``, or with a figure there (and no ``overwrite``) the next
+        free ``results/compare-<signal>-N.png``, said on standard error.
     deg : bool
         Draw an angle (rad) or angular rate (rad/s) in degrees.
     figure_format : {"png", "svg", "pdf"}, optional
         The file's format when ``out`` has no suffix or is not given (default png).
+    overwrite : bool
+        Replace the default file rather than take the next free name.
 
     Returns
     -------
@@ -278,20 +309,28 @@ def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str |
     """
     import matplotlib.pyplot as plt
 
-    path = figure_file(_with_format(out, figure_format), f"compare-{signal}.{figure_format or 'png'}", Path("."))
+    name = f"compare-{signal}.{figure_format or 'png'}"
+    if out:
+        path = figure_file(_with_format(out, figure_format), name, None)
+    else:
+        path = figure_file(None, name, COMPARE_FOLDER)
+        path = path if overwrite else _free_file(path)
     loaded = [load(run) for run in runs]
     for result, folder in loaded:
         _check(result, folder, signal)
+    labels = _run_labels([folder for _, folder in loaded])
     components = loaded[0][0].columns(signal)
     fig, axes = plt.subplots(len(components), 1, sharex=True, squeeze=False, layout="constrained",
                              figsize=(AXES_SIZE[0], AXES_SIZE[1] * len(components)))
     for ax, component in zip(axes[:, 0], components, strict=True):
-        for result, folder in loaded:
+        for (result, _), label in zip(loaded, labels, strict=True):
             if component in result.names:
-                _draw(ax, result, component, deg, label_prefix=f"{_label(folder)}: ")
+                _draw(ax, result, component, deg)
+                ax.lines[-1].set_label(printable(label))  # the component is the axes' title already
+        ax.legend(fontsize=7, loc="best")
     for ax in axes[:-1, 0]:
         ax.set_xlabel("")
-    fig.suptitle(printable(f"{signal}: {' vs '.join(_label(folder) for _, folder in loaded)}"), fontsize=10)
+    fig.suptitle(printable(f"{signal}: {' vs '.join(labels)}"), fontsize=10)
     try:
         return save_figure(fig, path, dpi=120)
     finally:
@@ -339,7 +378,8 @@ def compare_command(args) -> int:
         print("quadcosim compare: give two runs or more, then the signal: compare RUN RUN SIGNAL", file=sys.stderr)
         return 2
     try:
-        print(compare(runs, signal, args.out, deg=args.deg, figure_format=args.format))
+        print(compare(runs, signal, args.out, deg=args.deg, figure_format=args.format,
+                      overwrite=args.overwrite))
     except ValueError as error:  # OutputRefused among them
         print(f"quadcosim compare: {error}", file=sys.stderr)
         return 2
@@ -362,12 +402,15 @@ def add_arguments(sub):
                                "is dashed")
     plotting.set_defaults(func=plot_command)
     comparing = sub.add_parser("compare", help="one signal of several finished runs on one figure",
-                               usage="quadcosim compare [-h] [--out FILE] RUN RUN [RUN...] SIGNAL\n"
-                                     "       quadcosim compare [-h] [--out FILE] --signal SIGNAL RUN RUN [RUN...]")
+                               usage="quadcosim compare [-h] [--out FILE] [--overwrite] RUN RUN [RUN...] SIGNAL\n"
+                                     "       quadcosim compare [-h] [--out FILE] [--overwrite] --signal SIGNAL RUN RUN "
+                                     "[RUN...]")
     comparing.add_argument("items", nargs="+", metavar="RUN... SIGNAL",
                            help="two run folders or more (or their results.npz), then a signal or vector name")
     comparing.add_argument("--signal", help="the signal, when given apart: then every positional is a run")
-    _add_figure_options(comparing, "compare-SIGNAL.png in the current folder")
+    _add_figure_options(comparing, "results/compare-SIGNAL.png, or the next free -N name")
+    comparing.add_argument("--overwrite", action="store_true",
+                           help="replace results/compare-SIGNAL.png rather than take the next free name")
     comparing.set_defaults(func=compare_command)
 
 

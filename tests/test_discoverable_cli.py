@@ -271,3 +271,37 @@ def test_tracking_draws_setpoint_and_response_on_one_axes_in_degrees(finished_ru
     assert "differ in size" in capsys.readouterr().err
     assert main(["plot", str(finished_run), "Quadrotor.theta", "--tracking"]) == 2
     assert "at least two" in capsys.readouterr().err
+
+
+def test_compare_writes_under_results_never_replacing_and_names_the_runs_alone(finished_run, tmp_path, capsys,
+                                                                               monkeypatch):
+    """``compare`` without ``--out``: ``results/compare-SIGNAL.png``, then the next free name
+    (said), ``--overwrite`` replaces; each legend entry names a run, not the component again
+    (the component is the axes' title)."""
+    import scenarios.run_plots as run_plots
+
+    legends = []
+
+    def keep_legends(fig, path, **options):
+        legends.append([[t.get_text() for t in ax.get_legend().get_texts()] for ax in fig.axes])
+        return save_figure(fig, path, **options)
+
+    save_figure = run_plots.save_figure
+    monkeypatch.setattr(run_plots, "save_figure", keep_legends)
+    monkeypatch.chdir(tmp_path)
+    other = tmp_path / "other" / finished_run.name  # a second run of the same folder name
+    other.parent.mkdir()
+    other.symlink_to(finished_run)
+    signal = "Quaternion_estim.theta_est"
+    assert main(["compare", str(finished_run), str(other), signal]) == 0
+    first = tmp_path / "results" / f"compare-{signal}.png"
+    assert capsys.readouterr().out.strip() == str(first.relative_to(tmp_path)) and first.stat().st_size > 10_000
+    assert legends[0] == [[str(finished_run), str(other)]] * 3
+    assert main(["compare", str(finished_run), str(other), signal]) == 0
+    told = capsys.readouterr()
+    assert told.out.strip().endswith(f"compare-{signal}-2.png") and "--overwrite" in told.err
+    stamp = first.stat().st_mtime_ns
+    assert main(["compare", "--overwrite", str(finished_run), str(finished_run.parent / "x"), signal]) == 2
+    assert main(["compare", "--overwrite", str(finished_run), str(other), signal]) == 0
+    assert capsys.readouterr().out.strip() == str(first.relative_to(tmp_path)) and first.stat().st_mtime_ns > stamp
+    assert {p.name for p in first.parent.iterdir()} == {first.name, f"compare-{signal}-2.png"}
