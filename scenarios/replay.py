@@ -4,7 +4,7 @@
         [--corrections on|off|NAMES] [--ry reel|triad] [--discretisation exp|euler]
         [--initial triad] [--q0 Q0,Q1,Q2,Q3] [--b0 BX,BY,BZ] [--frame ned|enu]
         [--field-from-data SECONDS] [--dip DEG] [--declination DEG] [--align-heading]
-        [--rate HZ] [--json OUT]
+        [--rate HZ] [--json] [--out FILE] [--figure FILE]
     python -m scenarios.replay results/tp            # a tp run's results folder, as it is
     python -m scenarios.replay --from-tp RESULTS_DIR --write RECORDING
     python -m scenarios.replay FLIGHT.ulg|.bin|.log [--compass N] [--json OUT]
@@ -17,7 +17,8 @@ The recording is read by :mod:`estimators.recording` (``.npz``, ``.mat``, ``.csv
 mag, rate, optional reference quaternion and scored samples). With a reference, the
 quaternion-error RMSE (total, inclination, heading; degrees) over the scored samples is
 printed, the metric of :func:`estimators.score`. The gains and correction settings in force
-(defaults filled in) are printed and written with the errors (``gains_in_force``).
+(defaults filled in) are printed and written with the errors (``gains_in_force``). ``--figure
+FILE`` draws the errors sample by sample against time (PNG, SVG or PDF).
 
 A ``tp`` run's results folder (or its ``results.npz``) is read as a recording directly: the
 IMU's samples, the true attitude as reference, the samples after the run's settling time as
@@ -83,7 +84,7 @@ def _value(text: str):
 
 def replay(data: dict, estimator: str | None = None, gains: dict | None = None, corrections=None,
            initial: str | None = None, frame: str | None = None, field_from_data_s: float = 0.0,
-           align_heading: bool = False, **options) -> dict:
+           align_heading: bool = False, keep_estimate: bool = False, **options) -> dict:
     """Run an estimator on a loaded recording (see :func:`estimators.recording.load`).
 
     Settings not given come from the recording's ``meta`` (a ``tp`` run's), then from the
@@ -95,8 +96,10 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
     (``"triad"`` or None): as :func:`estimators.estimate` takes them; ``frame``: ``"ned"`` or
     ``"enu"``; ``field_from_data_s`` (s): take the field's dip and norm from that first stretch
     of the data (0: the lab's field); ``align_heading``: remove the constant heading offset
-    before scoring; ``options``: any other option of :func:`estimators.estimate` (``ry``,
-    ``discretisation``, ``q0``, ``b0``, ``dip``, ``declination``; angles in rad).
+    before scoring; ``keep_estimate``: also return the estimate (``q``, (N, 4), body to inertial)
+    and the gravity vector of the scoring (``gravity``, m/s^2), for :func:`draw_errors`;
+    ``options``: any other option of :func:`estimators.estimate` (``ry``, ``discretisation``,
+    ``q0``, ``b0``, ``dip``, ``declination``; angles in rad).
     """
     meta = data["meta"].get("estimator", {})
     kind = estimator or meta.get("kind", "explicit")
@@ -123,11 +126,76 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
     out = estimate(kind, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], dt=1.0 / data["rate"],
                    gains=settings["gains"], corrections=False if kind == "linear" else corrections_used,
                    ry=settings["ry"], discretisation=settings["discretisation"], initial=settings["initial"],
-                   q0=settings["q0"], b0=settings["b0"], outputs=(), reference=data["quat"], scored=data["scored"],
-                   align_heading=align_heading, **refs)
+                   q0=settings["q0"], b0=settings["b0"], outputs=("q",) if keep_estimate else (),
+                   reference=data["quat"], scored=data["scored"], align_heading=align_heading, **refs)
     errors = {k: float(v[0]) for k, v in out.get("errors", {}).items()}
-    return {"estimator": kind, **settings, "frame": frame, "dip_deg": None if dip is None else math.degrees(dip),
-            "gains_in_force": gains_in_force(kind, settings["gains"], corrections_used), "errors": errors}
+    result = {"estimator": kind, **settings, "frame": frame, "dip_deg": None if dip is None else math.degrees(dip),
+              "gains_in_force": gains_in_force(kind, settings["gains"], corrections_used), "errors": errors}
+    if keep_estimate:
+        result.update(q=out["q"][0], gravity=np.asarray(refs["gravity"], dtype=float))
+    return result
+
+
+def draw_errors(data: dict, result: dict, path, title: str = "") -> Path:
+    """The estimate's errors against the recording's reference, sample by sample: inclination
+    and heading (deg) against time, the samples scored unshaded, each curve's RMS over them in
+    its legend (the figures ``errors`` holds).
+
+    Parameters
+    ----------
+    data : dict
+        The recording, as :func:`load_any` returns it (with a reference ``quat``).
+    result : dict
+        :func:`replay`'s result, with ``keep_estimate=True``.
+    path : str or pathlib.Path
+        PNG, SVG or PDF file.
+    title : str
+        The figure's title (the recording's name).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    ValueError
+        A recording without a reference attitude: there is no error to draw.
+    """
+    import matplotlib.pyplot as plt
+
+    from estimators.core import error_angles
+    from orchestrator.files import figure_file, headless_backend, save_figure
+
+    reference = data.get("quat")
+    if reference is None or not len(reference):
+        raise ValueError("--figure draws the errors against the recording's reference attitude, and this "
+                         "recording has none (a quat column or array); drop --figure")
+    path = figure_file(path, "replay.png", None)
+    offset = math.radians(result["errors"].get("heading_offset_deg", 0.0))
+    angles = np.degrees([error_angles(q, r, result["gravity"], offset) if np.all(np.isfinite(r)) else (np.nan,) * 3
+                         for q, r in zip(result["q"], reference, strict=True)])
+    time = np.arange(len(angles)) / data["rate"]
+    headless_backend()
+    fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9.0, 5.2), layout="constrained")
+    scored = np.asarray(data["scored"], dtype=bool).reshape(-1) if data.get("scored") is not None else None
+    shaded = scored is not None and not scored.all()
+    for ax, column, name in ((axes[0], 1, "inclination"), (axes[1], 2, "heading")):
+        rms = result["errors"].get(f"{name}_rmse_deg")
+        ax.plot(time, angles[:, column], lw=0.8)
+        if shaded:
+            ax.fill_between(time, 0, 1, where=~scored, transform=ax.get_xaxis_transform(), color="0.9")
+        over = " over the scored samples (unshaded)" if shaded else ""
+        ax.set_title(f"{name} error of {result['estimator']}" + ("" if rms is None else f": RMS {rms:.3g} deg{over}"),
+                     loc="left", fontsize=9)  # a title, not a legend, covers no curve
+        ax.set_ylabel("deg")
+        ax.grid(True, alpha=0.3)
+    axes[1].set_xlabel("time (s)")
+    fig.suptitle(title, fontsize=10)
+    try:
+        return save_figure(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
@@ -237,6 +305,9 @@ def _parser() -> argparse.ArgumentParser:
     add_json_flag(parser, "the result as JSON on standard output (always, for a recording; in place of the table "
                           "for a flight log)")
     parser.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
+    parser.add_argument("--figure", metavar="FILE",
+                        help="also draw the inclination and heading errors against time (PNG, SVG or PDF; needs "
+                             "a reference attitude)")
     parser.add_argument("--from-tp", metavar="RESULTS_DIR", help="write a recording from a tp run's results")
     parser.add_argument("--write", metavar="RECORDING", help="with --from-tp: the recording to write")
     parser.add_argument("--compass", type=int, default=0, help="flight logs: the compass, from 0 in the log's order")
@@ -276,9 +347,16 @@ def main(argv=None) -> int:
             raise ValueError(f"--set takes GAIN=VALUE, not {args.set}")
         gains = {k.strip(): _value(v) for k, v in pairs} if pairs else None
         corrections = None if args.corrections is None else parse_corrections(args.corrections)
+        if args.figure:
+            from orchestrator.files import figure_file
+
+            figure_file(args.figure, "replay.png", None)  # a path refused before the replay runs
         data = load_any(args.recording, rate=args.rate)
         result = replay(data, args.estimator, gains, corrections, args.initial, args.frame, args.field_from_data,
-                        args.align_heading, **_options(args))
+                        args.align_heading, keep_estimate=bool(args.figure), **_options(args))
+        if args.figure:
+            print(f"figure: {draw_errors(data, result, args.figure, Path(args.recording).name)}", file=sys.stderr)
+            del result["q"], result["gravity"]
     except (ValueError, FileNotFoundError, OSError) as error:
         print(f"replay: {error}", file=sys.stderr)
         return 2

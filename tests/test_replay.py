@@ -80,3 +80,37 @@ def test_replay_command_line(tmp_path, capsys):
     assert result["errors"]["total_rmse_deg"] < 2.5  # 1.94 deg measured: a 1 s run, the start of convergence
     assert replay.main([str(tmp_path / "missing.npz")]) == 2
     assert "no recording at" in capsys.readouterr().err
+
+
+def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch):
+    """``--figure``: inclination and heading errors sample by sample, whose RMS over the scored
+    samples is the reported one; a recording without a reference, or a figure suffix matplotlib
+    does not write, is refused naming the fix."""
+    import orchestrator.files
+
+    drawn = []
+
+    def keep(fig, path, **options):
+        drawn.append([(ax.lines[0].get_ydata(), ax.get_title(loc="left")) for ax in fig.axes])
+        return saved(fig, path, **options)
+
+    saved = orchestrator.files.save_figure
+    monkeypatch.setattr(orchestrator.files, "save_figure", keep)
+    run, metrics = scenarios.run("tp", {"estimator": "explicit", "flight": "nonstationary", "noise": True,
+                                        "duration": 3.0}, tmp_path / "run")
+    drawn.clear()  # the run's own report figures
+    assert replay.main([str(tmp_path / "run"), "--figure", str(tmp_path / "errors.png")]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert (tmp_path / "errors.png").stat().st_size > 10_000 and "q" not in result
+    scored = run.time >= min(metrics["settle_s"], 1.5)
+    assert len(drawn) == 1
+    for (values, title), name in zip(drawn[0], ("inclination", "heading"), strict=True):
+        rms = float(np.sqrt(np.mean(np.asarray(values)[scored] ** 2)))
+        assert rms == pytest.approx(result["errors"][f"{name}_rmse_deg"], rel=1e-9, abs=1e-12)
+        assert title.startswith(f"{name} error of explicit: RMS")
+    assert replay.main([str(tmp_path / "run"), "--figure", str(tmp_path / "errors.xyz")]) == 2
+    assert "errors.xyz" in capsys.readouterr().err
+    np.savez(tmp_path / "plain.npz", gyro=np.zeros((50, 3)), acc=np.tile([0.0, 0.0, -9.81], (50, 1)),
+             mag=np.tile([0.2, 0.0, 0.4], (50, 1)), rate=100.0)
+    assert replay.main([str(tmp_path / "plain.npz"), "--figure", str(tmp_path / "none.png")]) == 2
+    assert "has none" in capsys.readouterr().err and not (tmp_path / "none.png").exists()
