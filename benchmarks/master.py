@@ -26,6 +26,7 @@ import json
 import statistics
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -253,14 +254,84 @@ def main(argv=None) -> int:
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per measurement")
     parser.add_argument("--repeats", type=int, default=3, help="measurements of each loop")
+    parser.add_argument("--out", help="also draw the figures: a PNG, SVG or PDF file, or a folder (bench.png)")
     args = parser.parse_args(argv)
+    path = None
+    if args.out:
+        from orchestrator.files import OutputRefused, figure_file
+
+        try:
+            path = figure_file(args.out, "bench.png", None)  # refused before minutes of timing
+        except OutputRefused as error:
+            print(f"quadcosim bench: {error}", file=sys.stderr)
+            return 2
     figures = measure(args.seconds, args.repeats)
     if args.json:
         print(json.dumps(figures))
     else:
         for key, value in figures.items():
             print(f"{key:28s} {value:12.4g}" if isinstance(value, float) else f"{key:28s} {value}")
+    if path is not None:
+        print(f"figure: {draw(figures, path)}", file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+#: The loops :func:`draw` sets side by side: label, the orchestrator's key, the C reference's key.
+DRAWN_LOOPS = (("open loop\n(three FMUs)", "open_loop_us_per_step", "open_loop_c_us_per_step"),
+               ("closed loop tp\n(FMUs, filter, controller)", "closed_loop_us_per_step", "closed_loop_c_us_per_step"),
+               ("three fmi2DoStep\n(FMI against equations)", "fmu_steps_us", "equations_steps_us"))
+
+
+def draw(figures: dict, path) -> Path:
+    """The figures of :func:`measure` as bars: µs per macro step of each loop, the orchestrator
+    (or the FMUs) beside its C reference, the ratio above; and the batch path's million filter
+    updates per second.
+
+    Parameters
+    ----------
+    figures : dict
+        :func:`measure`'s result.
+    path : str or pathlib.Path
+        PNG, SVG or PDF file.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    import matplotlib.pyplot as plt
+
+    from orchestrator.files import headless_backend, save_figure
+
+    headless_backend()
+    fig, (steps, batch) = plt.subplots(1, 2, figsize=(10.0, 3.8), layout="constrained",
+                                       gridspec_kw={"width_ratios": (3, 2)})
+    x = np.arange(len(DRAWN_LOOPS))
+    ours = [figures[key] for _, key, _ in DRAWN_LOOPS]
+    theirs = [figures[key] for _, _, key in DRAWN_LOOPS]
+    steps.bar(x - 0.2, ours, 0.4, label="orchestrator (Python, C chunks) / FMUs")
+    steps.bar(x + 0.2, theirs, 0.4, label="C reference / equations called from C")
+    for k, (a, b) in enumerate(zip(ours, theirs, strict=True)):
+        steps.annotate(f"x {a / b:.2f}", (k, max(a, b)), xytext=(0, 3), textcoords="offset points", ha="center",
+                       fontsize=8)
+    steps.set_xticks(x, [label for label, _, _ in DRAWN_LOOPS], fontsize=8)
+    steps.set_ylabel("CPU time per macro step (µs)")
+    steps.set_ylim(0, 1.25 * max(ours + theirs))
+    steps.legend(fontsize=8, loc="upper left")
+    steps.set_title("stepping loops, same models, same data", loc="left", fontsize=9)
+    names = ("numba,\none thread", "C,\none thread", f"numba,\n{figures.get('parallel_threads', 2)} threads")
+    rates = [figures[key] / 1e6 for key in ("batch_updates_per_s", "batch_c_updates_per_s",
+                                            "parallel_batch_updates_per_s")]
+    batch.bar(range(3), rates, 0.6, color=["C0", "C1", "C2"])
+    batch.set_xticks(range(3), names, fontsize=8)
+    batch.set_ylabel("million filter updates per second")
+    batch.set_title("batch path, explicit filter", loc="left", fontsize=9)
+    for ax in (steps, batch):
+        ax.grid(True, axis="y", alpha=0.3)
+    try:
+        return save_figure(fig, Path(path), dpi=120)
+    finally:
+        plt.close(fig)
 
 
 if __name__ == "__main__":

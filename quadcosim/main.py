@@ -279,6 +279,10 @@ def _diagram(args) -> int:
 
 
 def _bench(args) -> int:
+    if args.out and args.suite != "master":
+        print(f"quadcosim bench {args.suite}: --out draws the master suite's figures only; drop --out, or run "
+              "quadcosim bench --out FILE", file=sys.stderr)
+        return 2
     if args.suite == "infrared":
         from benchmarks import infrared
 
@@ -293,7 +297,8 @@ def _bench(args) -> int:
         return pytest_cost.main(["--json"] if args.json else [])
     from benchmarks import master as bench
 
-    return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)])
+    return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)]
+                      + (["--out", args.out] if args.out else []))
 
 
 def parser() -> argparse.ArgumentParser:
@@ -333,6 +338,8 @@ def parser() -> argparse.ArgumentParser:
                        help="print the measurements as one JSON object on standard output instead of a table")
     bench.add_argument("--seconds", type=float, default=5.0, metavar="S",
                        help="simulated time of each timed run of the master suite (s, default 5)")
+    bench.add_argument("--out", metavar="FILE",
+                       help="the master suite: also draw its figures (PNG, SVG or PDF file, or a folder: bench.png)")
     bench.set_defaults(func=_bench)
     findings = sub.add_parser("findings", add_help=False,
                               help="run the README's findings, write findings.json, rewrite the README's numbers "
