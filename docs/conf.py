@@ -18,6 +18,10 @@ html_theme = "pydata_sphinx_theme"
 html_title = "quadcosim"
 html_theme_options = {"navigation_depth": 2, "show_toc_level": 2}
 myst_enable_extensions = ["colon_fence", "dollarmath"]
+# equations as MathML, made at build time (docs/_ext): they show offline, with no script
+html_math_renderer = "mathml"
+html_static_path = ["_static"]
+html_css_files = ["mathml.css"]
 # The notebooks (notebooks/*.py, made .ipynb in _generated/notebooks/ when the build starts) run
 # once, into a cache under _build/ that tests/test_notebooks.py reads: a notebook is executed
 # again only when its code changes (or the cache is cleared, as on a fresh clone).
