@@ -4,6 +4,8 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+# setuptools' BuildBackendWarning on every editable install is information (README), not a fault
+QUIET_EDITABLE := PYTHONWARNINGS="ignore:Editable installation"
 
 .PHONY: setup fmus demo lab test kernels digests references lint bench fuzz docs clean
 
@@ -11,7 +13,7 @@ $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 12))' || { echo "quadcosim needs Python 3.12 or newer; $(PYTHON) is $$($(PYTHON) -V 2>&1). Install 3.12 (pyenv install 3.12, uv python install 3.12, or conda create -n quadcosim python=3.12) and run make PYTHON=python3.12" >&2; exit 1; }
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e ".[dev,docs]"
+	$(QUIET_EDITABLE) $(BIN)/pip install --quiet -e ".[dev,docs]"
 	touch $(STAMP)
 
 setup: $(STAMP)
@@ -28,7 +30,7 @@ demo: fmus
 # make lab LAB_ARGS="--allow-root --no-browser --ip=0.0.0.0").
 LAB_ARGS ?=
 lab: fmus
-	$(BIN)/python -c 'import jupyterlab' 2>/dev/null || $(BIN)/pip install --quiet -e ".[notebooks]"
+	$(BIN)/python -c 'import jupyterlab' 2>/dev/null || $(QUIET_EDITABLE) $(BIN)/pip install --quiet -e ".[notebooks]"
 	$(BIN)/jupyter lab $(LAB_ARGS) notebooks
 
 # The suite on both cores (pytest-xdist): the FMU pool, the numba cache and every test's files are
