@@ -26,9 +26,10 @@ demo: fmus
 	@echo "quadcosim is installed in $(VENV): activate it with  . $(VENV)/bin/activate  (or call $(BIN)/quadcosim)"
 
 # JupyterLab on the notebooks (the `notebooks` extra, installed on first use); jupytext opens
-# the .py files as notebooks. LAB_ARGS passes options to it (in a container, as root:
-# make lab LAB_ARGS="--allow-root --no-browser --ip=0.0.0.0").
-LAB_ARGS ?=
+# the .py files as notebooks. LAB_ARGS passes options to it; as root (a container) it starts
+# with --allow-root --no-browser, which JupyterLab otherwise refuses to start without
+# (reach it from outside with LAB_ARGS="--allow-root --no-browser --ip=0.0.0.0").
+LAB_ARGS ?= $(if $(filter 0,$(shell id -u)),--allow-root --no-browser,)
 lab: fmus
 	$(BIN)/python -c 'import jupyterlab' 2>/dev/null || $(QUIET_EDITABLE) $(BIN)/pip install --quiet -e ".[notebooks]"
 	$(BIN)/jupyter lab $(LAB_ARGS) notebooks
