@@ -14,6 +14,7 @@
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim replay RECORDING [--estimator KIND] [--figure FILE]   an estimator on a recorded file, scored
   quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
   quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
   quadcosim findings [GROUP...] [--quick] [--check]   the README's numbers, measured into findings.json
@@ -341,6 +342,10 @@ def parser() -> argparse.ArgumentParser:
     bench.add_argument("--out", metavar="FILE",
                        help="the master suite: also draw its figures (PNG, SVG or PDF file, or a folder: bench.png)")
     bench.set_defaults(func=_bench)
+    replay = sub.add_parser("replay", add_help=False,
+                            help="any estimator on a recorded IMU file or a tp run's folder, scored against its "
+                                 "reference attitude (quadcosim replay --help)")
+    replay.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.replay
     findings = sub.add_parser("findings", add_help=False,
                               help="run the README's findings, write findings.json, rewrite the README's numbers "
                                    "(quadcosim findings --help)")
@@ -432,6 +437,10 @@ def main(argv=None) -> int:
                 from findings.__main__ import main as findings
 
                 return findings(argv[1:])
+            if argv[:1] == ["replay"]:  # the replay's parser, shared with python -m scenarios.replay
+                from scenarios.replay import main as replay
+
+                return replay(argv[1:], prog="quadcosim replay")
             args = parser().parse_args(argv)
             args.final = final
             if args.command in ("run", "sweep", "bench", "build"):

@@ -1,6 +1,6 @@
 """Replay: any estimator on a recorded IMU file, scored against its reference attitude.
 
-    python -m scenarios.replay RECORDING [--estimator explicit] [--set kP=0.5 ...]
+    quadcosim replay RECORDING [--estimator explicit]     (or python -m scenarios.replay) [--set kP=0.5 ...]
         [--corrections on|off|NAMES] [--ry reel|triad] [--discretisation exp|euler]
         [--initial triad] [--q0 Q0,Q1,Q2,Q3] [--b0 BX,BY,BZ] [--frame ned|enu]
         [--field-from-data SECONDS] [--dip DEG] [--declination DEG] [--align-heading]
@@ -280,8 +280,8 @@ def _vector(text: str, size: int, label: str) -> list:
     return values
 
 
-def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m scenarios.replay", description=__doc__.splitlines()[0])
+def _parser(prog: str = "python -m scenarios.replay") -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording, or a tp run's results folder")
     parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")
     parser.add_argument("--set", action="append", default=[], metavar="GAIN=VALUE",
@@ -325,10 +325,11 @@ def _options(args) -> dict:
     return options
 
 
-def main(argv=None) -> int:
+def main(argv=None, prog: str = "python -m scenarios.replay") -> int:
     """Command line (see the module docstring); returns the exit status (2 on bad input).
-    ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    parser = _parser()
+    ``argv``: the arguments (default ``sys.argv[1:]``); ``prog``: the command as its messages
+    name it (``quadcosim replay``)."""
+    parser = _parser(prog)
     args = parser.parse_args(argv)
     if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
         from scenarios.flightlog import replay as flight

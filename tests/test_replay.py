@@ -83,10 +83,11 @@ def test_replay_command_line(tmp_path, capsys):
 
 
 def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch):
-    """``--figure``: inclination and heading errors sample by sample, whose RMS over the scored
+    """``quadcosim replay --figure``: inclination and heading errors sample by sample, whose RMS over the scored
     samples is the reported one; a recording without a reference, or a figure suffix matplotlib
     does not write, is refused naming the fix."""
     import orchestrator.files
+    from quadcosim.main import main as quadcosim
 
     drawn = []
 
@@ -99,7 +100,7 @@ def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch
     run, metrics = scenarios.run("tp", {"estimator": "explicit", "flight": "nonstationary", "noise": True,
                                         "duration": 3.0}, tmp_path / "run")
     drawn.clear()  # the run's own report figures
-    assert replay.main([str(tmp_path / "run"), "--figure", str(tmp_path / "errors.png")]) == 0
+    assert quadcosim(["replay", str(tmp_path / "run"), "--figure", str(tmp_path / "errors.png")]) == 0
     result = json.loads(capsys.readouterr().out)
     assert (tmp_path / "errors.png").stat().st_size > 10_000 and "q" not in result
     scored = run.time >= min(metrics["settle_s"], 1.5)
@@ -114,3 +115,6 @@ def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch
              mag=np.tile([0.2, 0.0, 0.4], (50, 1)), rate=100.0)
     assert replay.main([str(tmp_path / "plain.npz"), "--figure", str(tmp_path / "none.png")]) == 2
     assert "has none" in capsys.readouterr().err and not (tmp_path / "none.png").exists()
+    with pytest.raises(SystemExit):
+        quadcosim(["replay"])
+    assert "quadcosim replay: error: give a RECORDING" in capsys.readouterr().err
