@@ -359,7 +359,7 @@ def main(argv=None, prog: str = "python -m scenarios.replay") -> int:
             print(f"figure: {draw_errors(data, result, args.figure, Path(args.recording).name)}", file=sys.stderr)
             del result["q"], result["gravity"]
     except (ValueError, FileNotFoundError, OSError) as error:
-        print(f"replay: {error}", file=sys.stderr)
+        print(f"{prog}: {error}", file=sys.stderr)
         return 2
     print(f"{result['estimator']}: gains in force " + ", ".join(f"{k}={v:g}" for k, v in
                                                                  result["gains_in_force"].items()), file=sys.stderr)
