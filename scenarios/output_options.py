@@ -5,7 +5,9 @@
 - ``--out PATH`` is where a command writes its files (a folder, or the one file it writes), and
   every command that writes files has a default under ``results/`` (``run``:
   ``results/SCENARIO``; ``calibrate``: ``results/calibrate-FLIGHT``; ``compare``:
-  ``results/compare-SIGNAL.png``; ``log plot``: ``results/logs/``), never replaced unasked.
+  ``results/compare-SIGNAL.png``; ``log plot``: ``results/logs/``; ``plot``: the run's folder),
+  never replaced unasked: a default file taken takes the next free ``-N`` name
+  (:func:`free_file`), a default folder the next free ``-N`` folder (:func:`default_folder`).
 
 The old spelling ``--json FILE`` (``log replay``, ``python -m scenarios.replay``) still works: it
 means ``--out FILE`` and says so on standard error.
@@ -78,3 +80,31 @@ def default_folder(command: str, name: str, overwrite: bool):
         print(f"quadcosim {command}: {base}/ holds earlier results ({', '.join(holds_results(base))}); writing to "
               f"{out}/ (--out DIR chooses the folder, --overwrite replaces {base}/)", file=sys.stderr)
     return out
+
+
+def free_file(path, command: str):
+    """``path`` if no file is there, else the first free ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ...,
+    said on standard error: a command's default figure never replaces an earlier one.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The default file.
+    command : str
+        The sub-command, named in the message (``compare``, ``log plot``).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from pathlib import Path
+
+    path = Path(path)
+    candidate, number = path, 1
+    while candidate.exists():
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    if candidate != path:
+        print(f"quadcosim {command}: {path} is there; writing {candidate} (--out FILE chooses the file, --overwrite "
+              f"replaces {path})", file=sys.stderr)
+    return candidate

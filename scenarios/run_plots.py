@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 from orchestrator.files import figure_file, printable, save_figure
+from scenarios.output_options import free_file
 
 RESULTS_FILE = "results.npz"
 #: Width and height (inches) of one signal's axes.
@@ -95,21 +96,6 @@ def _run_labels(folders) -> list[str]:
     return [str(folder) if names.count(name) > 1 else name for folder, name in zip(folders, names, strict=True)]
 
 
-def _free_file(path: Path) -> Path:
-    """``path`` if no file is there, else the first free ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ...,
-    said on standard error: a default figure never replaces an earlier one."""
-    import sys
-
-    candidate, number = path, 1
-    while candidate.exists():
-        number += 1
-        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
-    if candidate != path:
-        print(f"quadcosim compare: {path} is there; writing {candidate} (--out FILE chooses the file, --overwrite "
-              f"replaces {path})", file=sys.stderr)
-    return candidate
-
-
 #: Figure formats of ``--format``: the file's suffix.
 FORMATS = ("png", "svg", "pdf")
 
@@ -189,7 +175,7 @@ def _with_format(out, figure_format: str | None):
 
 
 def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = None,
-         tracking: bool = False) -> Path:
+         tracking: bool = False, overwrite: bool = False) -> Path:
     """One figure of a finished run: each signal (or vector) on its own axes, against time; with
     ``tracking``, the signals together on one axes (per component), a setpoint and its response.
 
@@ -200,7 +186,9 @@ def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = 
     signals : sequence of str
         Signal or vector names.
     out : str or pathlib.Path, optional
-        PNG, SVG or PDF file; ``plot-<first signal>.png`` in the run's folder by default.
+        PNG, SVG or PDF file, replaced if it is there (asked for). By default
+        ``plot-<first signal>.png`` in the run's folder, or with a figure there (and no
+        ``overwrite``) the next free ``plot-<first signal>-N.png``, said on standard error.
     deg : bool
         Draw angles (rad) and angular rates (rad/s, rad/s2) in degrees; other signals as they are.
     figure_format : {"png", "svg", "pdf"}, optional
@@ -209,6 +197,8 @@ def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = 
         Draw the signals on shared axes: the k-th component of each on the k-th axes
         (``Setpoint.theta_d`` and ``Quadrotor.theta``: roll, pitch and yaw, setpoint against
         response). The signals must have as many components and one unit.
+    overwrite : bool
+        Replace the default file rather than take the next free name.
 
     Returns
     -------
@@ -230,7 +220,9 @@ def plot(run, signals, out=None, deg: bool = False, figure_format: str | None = 
     # a path given is checked before the run is read
     path = figure_file(_with_format(out, figure_format), name, None) if out else None
     result, folder = load(run)
-    path = path or figure_file(None, name, folder)
+    if path is None:
+        path = figure_file(None, name, folder)
+        path = path if overwrite else free_file(path, "plot")
     for signal in signals:
         _check(result, folder, signal)
     if tracking:
@@ -314,7 +306,7 @@ def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str |
         path = figure_file(_with_format(out, figure_format), name, None)
     else:
         path = figure_file(None, name, COMPARE_FOLDER)
-        path = path if overwrite else _free_file(path)
+        path = path if overwrite else free_file(path, "compare")
     loaded = [load(run) for run in runs]
     for result, folder in loaded:
         _check(result, folder, signal)
@@ -352,7 +344,7 @@ def plot_command(args) -> int:
             print("\n".join(signal_lines(args.run)))
             return 0
         print(plot(args.run, args.signals, args.out, deg=args.deg, figure_format=args.format,
-                   tracking=args.tracking))
+                   tracking=args.tracking, overwrite=args.overwrite))
     except ValueError as error:  # OutputRefused among them
         print(f"quadcosim plot: {error}", file=sys.stderr)
         return 2
@@ -395,7 +387,9 @@ def add_arguments(sub):
     plotting.add_argument("run", help="the run's folder (its --out) or its results.npz")
     plotting.add_argument("signals", nargs="*", metavar="SIGNAL",
                           help="signal or vector names (IMU.acc); none: list the run's signals and their units")
-    _add_figure_options(plotting, "RUN/plot-SIGNAL.png")
+    _add_figure_options(plotting, "RUN/plot-SIGNAL.png, or the next free -N name")
+    plotting.add_argument("--overwrite", action="store_true",
+                          help="replace RUN/plot-SIGNAL.png rather than take the next free name")
     plotting.add_argument("--tracking", action="store_true",
                           help="the signals on shared axes, component by component: a setpoint against its "
                                "response (plot RUN Setpoint.theta_d Quadrotor.theta --tracking --deg); the first "

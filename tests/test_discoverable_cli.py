@@ -305,3 +305,28 @@ def test_compare_writes_under_results_never_replacing_and_names_the_runs_alone(f
     assert main(["compare", "--overwrite", str(finished_run), str(other), signal]) == 0
     assert capsys.readouterr().out.strip() == str(first.relative_to(tmp_path)) and first.stat().st_mtime_ns > stamp
     assert {p.name for p in first.parent.iterdir()} == {first.name, f"compare-{signal}-2.png"}
+
+
+def test_plot_and_log_plot_defaults_never_replace_an_earlier_figure(finished_run, tmp_path, capsys, monkeypatch):
+    """``plot RUN SIGNAL`` and ``log plot FILE`` without ``--out``: a second figure of the same
+    name takes the next free ``-2`` name (said); ``--overwrite`` replaces the first."""
+    monkeypatch.chdir(tmp_path)
+    first = finished_run / "plot-Quadrotor.theta2.png"
+    first.unlink(missing_ok=True)
+    for name in ("plot-Quadrotor.theta2-2.png", "plot-Quadrotor.theta2-3.png"):
+        (finished_run / name).unlink(missing_ok=True)
+    assert main(["plot", str(finished_run), "Quadrotor.theta2"]) == 0
+    assert capsys.readouterr().out.strip() == str(first)
+    assert main(["plot", str(finished_run), "Quadrotor.theta2", "--deg"]) == 0
+    told = capsys.readouterr()
+    assert told.out.strip() == str(finished_run / "plot-Quadrotor.theta2-2.png") and "--overwrite" in told.err
+    assert main(["plot", str(finished_run), "Quadrotor.theta2", "--overwrite"]) == 0
+    assert capsys.readouterr().out.strip() == str(first)
+    assert main(["log", "example", "logs"]) == 0
+    overview = tmp_path / "results" / "logs" / "example-a-overview.png"
+    assert main(["log", "plot", "logs/example-a.log"]) == 0
+    assert main(["log", "plot", "logs/example-a.log"]) == 0
+    assert overview.is_file() and overview.with_name("example-a-overview-2.png").is_file()
+    stamp = overview.stat().st_mtime_ns
+    assert main(["log", "plot", "logs/example-a.log", "--overwrite"]) == 0
+    assert overview.stat().st_mtime_ns > stamp and not overview.with_name("example-a-overview-3.png").exists()

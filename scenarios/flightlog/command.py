@@ -33,6 +33,10 @@ def plot(args) -> int:
 
     try:
         out = figure_file(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
+        if not args.out and not args.overwrite:
+            from scenarios.output_options import free_file
+
+            out = free_file(out, "log plot")
         log = load(args.file, "log plot")
         print(plot_overview(log, out))
     except (LogError, OutputRefused) as error:
@@ -56,7 +60,10 @@ def add_arguments(parser):
     drawn = sub.add_parser("plot", help="an overview figure: field, current, throttle and attitude")
     drawn.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
     drawn.add_argument("--out", help="figure file to write, .png, .svg or .pdf (default "
-                       "results/logs/NAME-overview.png; a folder takes NAME-overview.png)")
+                       "results/logs/NAME-overview.png, or the next free -N name; a folder takes "
+                       "NAME-overview.png)")
+    drawn.add_argument("--overwrite", action="store_true",
+                       help="replace results/logs/NAME-overview.png rather than take the next free name")
     drawn.set_defaults(func=plot)
     from scenarios.flightlog import replay
 
