@@ -21,6 +21,7 @@ from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
+from scenarios.compensation import COMPENSATIONS, add_compensator
 from scenarios.divergence import Bounds
 from scenarios.figures import (
     angle_curve,
@@ -32,7 +33,6 @@ from scenarios.figures import (
     title_lines,
     wrapped_curve,
 )
-from scenarios.metge import add_compensator, vehicle_settings
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
@@ -71,8 +71,8 @@ OPTIONS = {
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
     "imu_rate": Option(1000.0, "IMU and estimator rate (Hz)", minimum=1.0),
     "seed": Option(1, "IMU noise seed", applies="noise=true"),
-    "compensation": Option("none", "field of the motor currents compensated (scenarios/metge.py)",
-                           choices=("none", "static", "metge", "dynamic")),
+    "compensation": Option("none", "field of the motor currents compensated (scenarios/compensation.py)",
+                           choices=COMPENSATIONS),
     "calibration": Option("", "calibration file (JSON) for the compensation; empty: made on the clamped rig"),
 }
 
@@ -202,7 +202,7 @@ def build(o: dict, estimator=None) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
-    add_compensator(system, o["compensation"], o["calibration"], settings=vehicle_settings(o))
+    add_compensator(system, o["compensation"], o["calibration"], o)
     return system
 
 

@@ -443,3 +443,16 @@ def add_arguments(parser):
     parser.add_argument("--overwrite", action="store_true", help="replace the results already in --out")
     parser.set_defaults(func=run)
     return parser
+
+
+def main(argv) -> int:
+    """``quadcosim calibrate ARGV...`` called from Python (the findings run it so): its exit code.
+
+    Parameters
+    ----------
+    argv : list of str
+        The verb's arguments, without ``calibrate`` itself.
+    """
+    import argparse
+
+    return run(add_arguments(argparse.ArgumentParser(prog="quadcosim calibrate")).parse_args(argv))
