@@ -11,12 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from estimators import kinds
 from orchestrator.files import write_json, write_text
 from scenarios.compensation import COMPENSATIONS
 
 # --- the closed loop: yaw error per estimator and compensation --------------------------
 
-STUDY_ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+STUDY_ESTIMATORS = kinds.compared()
 
 
 def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), estimators=tuple(STUDY_ESTIMATORS),
