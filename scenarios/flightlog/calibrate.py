@@ -407,6 +407,7 @@ def _check_choices(args):
 
     if args.attitude not in ATTITUDES:
         raise ValueError(f"--attitude {args.attitude!r} must be one of {', '.join(ATTITUDES)}")
+    args.models = list(MODELS) if args.models is None else args.models
     unknown = [m for m in args.models if m not in MODELS]
     if unknown:
         raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
@@ -430,8 +431,9 @@ def add_arguments(parser):
                         help="attitude removing the Earth field: auto (default: gyro for the compass the log's heading "
                              "fuses, log for the others), gyro (roll and pitch from the log, heading integrated from "
                              "the gyro) or log")
-    parser.add_argument("--models", nargs="+", default=["current", "throttle", "motors", "metge", "dynamic"],
-                        help="models to fit: current, throttle, motors, metge, dynamic (default all)")
+    parser.add_argument("--models", nargs="+", default=None,
+                        help="models to fit (default: every model of calibration/flight/catalogue.py; an unknown "
+                             "name lists them)")
     parser.add_argument("--earth", default="model",
                         help="Earth field: model (default: the World Magnetic Model at the log's GPS position and "
                              "date; free without a GPS fix) or free (fitted per flight)")
