@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 
 FIGURES = ("residual.png", "heading.png")
-PARAMETER_FILES = {"ArduPilot": "ardupilot.parm", "PX4": "px4.params"}
 
 
 def _logs(files, verb: str) -> list:
@@ -193,13 +192,14 @@ def _figures(train, test, fitted, model, attitude) -> tuple:
 def _export(args, split: Split, metrics: dict) -> tuple:
     """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
     described in ``metrics["export"]``; (autopilot, file name, parameters)."""
+    from calibration.flight.autopilot import AUTOPILOTS
     from calibration.flight.export import choose, log_parameters, rules_of, score_parameters
 
     train, score = split.train, split.score
     rule = _rule(args, split.test[0])
     params, chosen = choose(split.fit, split.choice, rule)
     autopilot = train[0].log.autopilot
-    name = PARAMETER_FILES[autopilot]
+    name = AUTOPILOTS[autopilot].file
     exported = score_parameters(score, params, rule)
     flown = score_parameters(score, log_parameters(score[0], params), rule)
     firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
