@@ -99,3 +99,73 @@ def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
     assert found["listed"] == ["dummy: a clock alone"]
     assert found["ran"][0] == 0 and abs(found["ran"][1] - 0.3) < 1e-9
     assert {"dummy", "gain-study"} <= set(found["names"])
+
+
+# --- the maintainers' checklists (docs/guides/maintainers.md) -------------------------------
+
+CHECKLISTS = ROOT / "docs" / "guides" / "maintainers.md"
+
+
+def _section(title: str) -> str:
+    text = CHECKLISTS.read_text()
+    start = text.index(f"## {title}\n")
+    end = text.find("\n## ", start + 1)
+    return text[start:end if end > 0 else None]
+
+
+def _paths(section: str) -> list[str]:
+    """The repository paths a checklist names (in backquotes, with a folder)."""
+    import re
+
+    return [p for p in re.findall(r"`([\w<>./-]+/[\w<>./-]+)`", section) if "." in p.rsplit("/", 1)[-1]]
+
+
+def test_every_file_a_checklist_names_exists():
+    """``<Model>`` stands for each plant model; a path of the new member's own name is skipped."""
+    from fmus import MODELS
+
+    missing = []
+    for path in _paths(CHECKLISTS.read_text()):
+        if "<name>" in path:
+            continue
+        for model in MODELS if "<Model>" in path else [None]:
+            concrete = path.replace("<Model>", model) if model else path
+            if not (ROOT / concrete).exists():
+                missing.append(concrete)
+    assert missing == []
+
+
+def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
+    from fmus import MODELS
+
+    section = _paths(_section("Adding a sensor FMU"))
+    for required in ("fmus/<Model>/model.c", "fmus/<Model>/variables.py", "fmus/<Model>/__init__.py",
+                     "fmus/models.py", "fmus/QuadCoSim/<Model>.mo", "fmus/QuadCoSim/package.order",
+                     "tests/test_variable_tables.py", "docs/guides/fmus.md"):
+        assert required in section, required
+    build = (ROOT / "fmus" / "build.py").read_text()
+    assert 'HERE / model / "model.c"' in build  # what the build compiles of a model
+    assert 'f"fmus.{model}.variables"' in (ROOT / "fmus" / "models.py").read_text()  # its table
+    from tests.test_variable_tables import INPUTS
+
+    order = (ROOT / "fmus" / "QuadCoSim" / "package.order").read_text().split()
+    table = (ROOT / "docs" / "guides" / "fmus.md").read_text()
+    for model in MODELS:  # each step, done for every model there is
+        assert model in order and model in INPUTS and f"| `{model}` |" in table, model
+
+
+def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_extend():
+    """The registry line of each dummy test is the one its checklist names."""
+    from calibration.flight import catalogue
+    from estimators import kinds
+
+    estimator = _section("Adding an estimator")
+    assert Path(kinds.__file__).relative_to(ROOT).as_posix() in _paths(estimator)
+    assert "estimators/contract.py" in _paths(estimator) and "`KINDS`" in estimator
+    model = _section("Adding a flight-log model or autopilot")
+    assert Path(catalogue.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`MODELS`" in model
+    from calibration.flight import autopilot
+
+    assert Path(autopilot.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`AUTOPILOTS`" in model
+    scenario = _section("Adding a scenario")
+    assert "scenarios/catalogue.py" in _paths(scenario) and "`MODULES`" in scenario
