@@ -147,7 +147,10 @@ def _violations() -> list[str]:
                     bad.append(f"{where}:{line} loads a module by a name computed whole; name it, or declare "
                                "the place in LOADS_BY_NAME with what it loads")
             elif not _allowed(package, module, modules):
-                bad.append(f"{where}:{line} {'loads' if module.endswith(COMPUTED) else 'imports'} {module}")
+                shown = module  # the module, not the attribute taken from it
+                while shown not in modules and "." in shown and not shown.endswith(COMPUTED):
+                    shown = shown.rsplit(".", 1)[0]
+                bad.append(f"{where}:{line} {'loads' if module.endswith(COMPUTED) else 'imports'} {shown}")
     return bad
 
 
