@@ -2,7 +2,9 @@
 
 The ``.npz`` and ``.mat`` files are compressed and carry the signals' units and the run's
 options; vector signals (``IMU.acc``, ``Quadrotor.q``) are stored as N x k arrays and the
-rotation matrix ``IMU.R_reel`` as N x 3 x 3.
+rotation matrix ``IMU.R_reel`` as N x 3 x 3. A record streamed to disk as the run went
+(:mod:`orchestrator.stream` writes it) is read back by :class:`StreamedResult`, one signal at a
+time; :meth:`Result.load` reads either.
 """
 
 from __future__ import annotations
