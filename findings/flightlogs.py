@@ -120,13 +120,13 @@ def _exports(keys) -> list[dict]:
     import json
     import tempfile
 
-    from quadcosim.main import main
+    from scenarios.flightlog.calibrate import main as calibrate
 
     found = []
     for key, compass in keys:
         with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stdout(io.StringIO()), \
                 contextlib.redirect_stderr(io.StringIO()):
-            main(["calibrate", str(_path(key)), "--compass", str(compass), "--out", folder, "--overwrite"])
+            calibrate([str(_path(key)), "--compass", str(compass), "--out", folder, "--overwrite"])
             export = json.loads((Path(folder) / "metrics.json").read_text())["export"]
         command = export_command(key, compass)
         name = f"export.{key}{compass}"

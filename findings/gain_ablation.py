@@ -21,6 +21,7 @@ def compute(quick: bool = False) -> list[dict]:
     if quick:
         return []
     import scenarios
+    import studies  # noqa: F401  (registers gain-study)
 
     gravity = scenarios.run("gain-study", GRAVITY)[1]["closed_loop_relative_difference"]
     no_drag = scenarios.run("gain-study", NO_DRAG)[1]["closed_loop_relative_difference"]

@@ -23,6 +23,7 @@ def compute(quick: bool = False) -> list[dict]:
     if quick:
         return []
     import scenarios
+    import studies  # noqa: F401  (registers gain-study)
 
     m = scenarios.run("gain-study", {})[1]
     gains, difference = m["gains"], m["closed_loop_relative_difference"]

@@ -231,7 +231,7 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
     from calibration.flight.autopilot import write_ardupilot
     from calibration.flight.export import score_parameters
     from flightlogs import read_log
-    from quadcosim.main import main
+    from scenarios.flightlog.calibrate import main as calibrate
     from scenarios.flightlog.calibrate import split_parts
 
     path = _path(key)
@@ -257,8 +257,7 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
             write_ardupilot(params, file)
             out = Path(folder) / setting
             with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-                code = main(["calibrate", str(path), "--compass", str(compass), "--score", str(file), "--out",
-                             str(out)])
+                code = calibrate([str(path), "--compass", str(compass), "--score", str(file), "--out", str(out)])
             if code:
                 raise RuntimeError(f"quadcosim calibrate --score {file} failed on {path} (exit {code})")
             metrics = json.loads((out / "metrics.json").read_text())

@@ -13,10 +13,12 @@ import math
 import os
 from pathlib import Path
 
+from estimators import kinds
+
 COMMAND = "python -m benchmarks.real_recordings DATA"
 CHOOSE = "python -m benchmarks.tuning DATA"
 LARGE = "mahony"  # the filter whose failures on single recordings the documentation counts
-FILTERS = {"explicit": "explicit", "passive": "passive", "vqf": "VQF", "madgwick": "Madgwick", "mahony": "Mahony"}
+FILTERS = {name: kinds.KINDS[name].label for name in ("explicit", "passive", "vqf", "madgwick", "mahony")}
 METRICS = {"total_rmse_deg": "total", "heading_rmse_deg": "heading", "inclination_rmse_deg": "inclination"}
 TOLERANCE_DEG = 0.005  # deg: the figures are deterministic; printed to 2 decimals
 DIGITS = 2

@@ -18,27 +18,11 @@ import functools
 import os
 from pathlib import Path
 
-MODELS = ("Quadrotor", "MotorMagnetics", "IMU", "InfraredSensor")
+from fmus.models import MODELS, model_variables  # noqa: F401  (the package's names)
 
 
 class FMUNotFoundError(FileNotFoundError):
     """A built FMU is missing."""
-
-
-def model_variables(model: str):
-    """The variable table module of one of :data:`MODELS` (``fmus/<model>/variables.py``: its
-    ``TABLE``, and its ``ALIASES`` and ``SWITCHED`` if it declares them).
-
-    Raises
-    ------
-    KeyError
-        ``model`` is not one of :data:`MODELS`.
-    """
-    import importlib
-
-    if model not in MODELS:
-        raise KeyError(f"unknown model {model!r}; models: {', '.join(MODELS)}")
-    return importlib.import_module(f"fmus.{model}.variables")
 
 
 def _checkout() -> Path | None:

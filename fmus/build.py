@@ -12,12 +12,11 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import sys
 import zipfile
 from pathlib import Path
 
-from fmus import MODELS, default_fmu_dir, model_variables
 from fmus.airframe import c_header as airframe_header
+from fmus.models import MODELS, model_variables
 
 HERE = Path(__file__).resolve().parent
 CFLAGS = ["-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden"]
@@ -125,13 +124,13 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     return fmu
 
 
-def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) -> list[Path]:
+def build_all(out_dir: Path, models=MODELS, verbose: bool = True) -> list[Path]:
     """Build every plant FMU.
 
     Parameters
     ----------
-    out_dir : pathlib.Path, optional
-        Output folder; :func:`fmus.default_fmu_dir` by default.
+    out_dir : pathlib.Path
+        Output folder (:func:`fmus.default_fmu_dir`, where a run looks for the FMUs).
     models : sequence of str
         Model names (folders under ``fmus/``); all of :data:`fmus.MODELS` by default.
     verbose : bool
@@ -142,7 +141,7 @@ def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) 
     list of pathlib.Path
         The ``.fmu`` files.
     """
-    out_dir = Path(out_dir or default_fmu_dir())
+    out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     built = []
     for model in models:
@@ -151,9 +150,3 @@ def build_all(out_dir: Path | None = None, models=MODELS, verbose: bool = True) 
             print(f"built {built[-1]}")
     return built
 
-
-if __name__ == "__main__":
-    try:
-        build_all(sys.argv[1] if len(sys.argv) > 1 else None)
-    except BuildError as error:
-        sys.exit(str(error))

@@ -21,7 +21,7 @@ import numbers
 import re
 
 from orchestrator.fmu import nearest
-from orchestrator.result import expand
+from orchestrator.signals import expand
 
 _NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(.*)", re.IGNORECASE)
 _NOT_PARAMETERS = ("name", "period", "feedthrough", "inputs", "outputs")

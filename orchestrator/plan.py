@@ -49,7 +49,8 @@ from orchestrator.fmu import FMUError
 from orchestrator.interrupts import signal_name, signal_number
 from orchestrator.program import RECORD, Entry, Phase, copies, input_runs
 from orchestrator.progress import Progress
-from orchestrator.result import Result, check_record_fits, signal_units
+from orchestrator.result import Result, check_record_fits
+from orchestrator.signals import signal_units
 
 
 class _BatchPart(NamedTuple):
@@ -376,7 +377,7 @@ class Plan:
         -------
         orchestrator.Result
             Time in s from ``t0``, one column per recorded signal; for a streamed record, read
-            back from its folder (:class:`orchestrator.stream.StreamedResult`).
+            back from its folder (:class:`orchestrator.result.StreamedResult`).
         """
         if self.stream is not None:
             return self._streamed(error)
@@ -398,7 +399,7 @@ class Plan:
                 "constant_inputs": self.constant_inputs}
 
     def _streamed(self, error: str | None) -> Result:
-        from orchestrator.stream import StreamedResult
+        from orchestrator.result import StreamedResult
 
         if self.recorded > self.record_first:
             self.flush()

@@ -2,14 +2,15 @@
 
 The ``.npz`` and ``.mat`` files are compressed and carry the signals' units and the run's
 options; vector signals (``IMU.acc``, ``Quadrotor.q``) are stored as N x k arrays and the
-rotation matrix ``IMU.R_reel`` as N x 3 x 3.
+rotation matrix ``IMU.R_reel`` as N x 3 x 3. A record streamed to disk as the run went
+(:mod:`orchestrator.stream` writes it) is read back by :class:`StreamedResult`, one signal at a
+time; :meth:`Result.load` reads either.
 """
 
 from __future__ import annotations
 
 import csv
 import json
-import re
 import zipfile
 from pathlib import Path
 
@@ -17,6 +18,7 @@ import numpy as np
 
 from orchestrator.files import atomic_path, json_text
 from orchestrator.fmu import nearest
+from orchestrator.signals import expand, matrix_shape, vector_groups
 
 #: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.
 FORMATS = ("npz", "mat", "csv")
@@ -26,81 +28,6 @@ CSV_BYTES_PER_VALUE = 25
 
 #: What a run writes when no format is asked for: the NumPy archive alone.
 DEFAULT_FORMATS = ("npz",)
-
-# a component: "acc_x" (axis after an underscore), "q0", "omega_r1", "R_reel_11" (index)
-_COMPONENT = re.compile(r"^(?P<base>.+?)(?:_(?P<axis>[xyz])|_?(?P<index>\d+))$")
-
-
-def vector_groups(names) -> dict[str, list[str]]:
-    """The vectors among signal names, each with its components in order.
-
-    Components are ``NAME_x``, ``NAME_y``, ``NAME_z`` or ``NAME0``, ``NAME1``, ... (``NAME_1``
-    too) of one block; at least two make a vector. A vector whose name is itself a signal is
-    left out.
-
-    Parameters
-    ----------
-    names : sequence of str
-        ``"Block.signal"`` names.
-
-    Returns
-    -------
-    dict of str to list of str
-        ``{"IMU.acc": ["IMU.acc_x", "IMU.acc_y", "IMU.acc_z"], "IMU.R_reel": [...9 names], ...}``
-        in the order of first appearance.
-    """
-    groups: dict[str, list[tuple]] = {}
-    for name in names:
-        block, dot, signal = name.partition(".")
-        match = _COMPONENT.match(signal)
-        if dot and match:
-            key = "xyz".index(match["axis"]) if match["axis"] else int(match["index"])
-            groups.setdefault(f"{block}.{match['base']}", []).append((key, name))
-    taken = set(names)
-    return {vector: [name for _, name in sorted(members)] for vector, members in groups.items()
-            if len(members) > 1 and vector not in taken}
-
-
-def matrix_shape(components: list[str]) -> tuple[int, ...]:
-    """``(3, 3)`` for the nine components ``_11`` to ``_33`` of a rotation matrix, row by row;
-    ``(k,)`` for any other vector of ``k`` components."""
-    indices = [_COMPONENT.match(c.partition(".")[2])["index"] for c in components]
-    if len(components) == 9 and indices == [f"{i}{j}" for i in "123" for j in "123"]:
-        return (3, 3)
-    return (len(components),)
-
-
-def signal_units(blocks, names) -> dict[str, str]:
-    """The unit of each recorded signal, from its block: an FMU's model description, or the
-    ``units`` dictionary a Python block declares (``""`` where none is known).
-
-    Parameters
-    ----------
-    blocks : dict of str to block
-        The system's blocks by name (``System.blocks``).
-    names : sequence of str
-        Recorded ``"Block.signal"`` names.
-
-    Returns
-    -------
-    dict of str to str
-        Unit of each name, e.g. ``{"IMU.acc_x": "m/s2"}``.
-    """
-    units = {}
-    for name in names:
-        block, _, signal = name.partition(".")
-        units[name] = str(getattr(blocks.get(block), "units", {}).get(signal, "") or "")
-    return units
-
-
-def available_memory() -> int | None:
-    """Memory a run may take (bytes): the smallest of the machine's available memory, the
-    address space left under ``ulimit -v`` and the room left in the control group (see
-    :func:`orchestrator.memory.available`); None where none is known."""
-    from orchestrator.memory import available
-
-    return available()[0]
-
 
 #: Share of the available memory a record may take: the rest is for the scenario's report.
 RECORD_SHARE = 0.8
@@ -183,38 +110,6 @@ def run_extremes(y: np.ndarray, size: int) -> np.ndarray:
     lows += starts
     highs += starts
     return np.concatenate([np.minimum(lows, highs), np.maximum(lows, highs)])
-
-
-def expand(name: str, available) -> list[str]:
-    """Names a signal name stands for: itself, or its components.
-
-    ``"IMU.acc"`` stands for ``IMU.acc_x``, ``IMU.acc_y``, ``IMU.acc_z``;
-    ``"MotorMagnetics.omega_r"`` for ``omega_r1`` to ``omega_r4``; ``"Quadrotor.q"`` for
-    ``q0`` to ``q3``; ``"IMU.R_reel"`` for ``R_reel_11`` to ``R_reel_33``.
-
-    Parameters
-    ----------
-    name : str
-        A signal or vector name.
-    available : sequence of str
-        The names to choose from.
-
-    Returns
-    -------
-    list of str
-        The matching names, in the order of ``available``; empty if none.
-    """
-    available = list(available)
-    if name in available:
-        return [name]
-    members = [s for s in available if s.startswith(name) and _is_component(s[len(name):])]
-    return members
-
-
-def _is_component(suffix: str) -> bool:
-    if suffix.startswith("_"):
-        suffix = suffix[1:]
-    return bool(suffix) and (suffix in ("x", "y", "z") or suffix.isdigit())
 
 
 class Result:
@@ -487,8 +382,6 @@ class Result:
         Result
             The record (read lazily, one signal at a time, from a stream folder).
         """
-        from orchestrator.stream import FOLDER, StreamedResult
-
         path = Path(path)
         if path.is_dir() and (path / FOLDER).is_dir():
             path = path / FOLDER
@@ -630,6 +523,128 @@ class Result:
 
 #: Rows gathered at a time when a column of the record is written (a few MB at most).
 WRITE_ROWS = 2 ** 16
+
+
+#: The folder name of a streamed record inside a run's output folder.
+FOLDER = "results.stream"
+
+
+class DamagedRecord(ValueError):
+    """A streamed record whose chunks are missing or whose description is unreadable."""
+
+
+def _check_chunks(folder: Path, chunk_files: list[Path], meta: dict):
+    """Refuse a stream whose chunks are not ``chunk-000000.npy`` onwards without a gap, or fewer
+    than its finished ``meta.json`` lists (chunks removed, or a copy cut short)."""
+    expected = [f"chunk-{k:06d}.npy" for k in range(len(chunk_files))]
+    gaps = [e for e, found in zip(expected, chunk_files, strict=True) if found.name != e]
+    listed = meta.get("chunks") if meta.get("ended") else None
+    if gaps or (listed is not None and len(chunk_files) < listed):
+        missing = gaps[0] if gaps else f"chunk-{len(chunk_files):06d}.npy"
+        count = f"{listed} chunks ({meta.get('samples')} samples)" if listed is not None else "its chunks"
+        raise DamagedRecord(f"{folder}: the streamed record is damaged: its meta.json lists {count}, "
+                            f"{len(chunk_files)} are there ({missing} is missing); it cannot be read whole")
+
+
+class StreamedResult(Result):
+    """A record read from a stream folder; a signal is read from disk when asked for.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        A folder written by :class:`StreamWriter` (complete, or cut short: its whole chunks
+        are read).
+    """
+
+    def __init__(self, folder):
+        folder = Path(folder)
+        try:
+            meta = json.loads((folder / "meta.json").read_text())
+            names = meta.pop("names")
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
+            raise DamagedRecord(f"{folder}: its meta.json is damaged ({type(error).__name__}: {error})") from None
+        self.folder = folder
+        self.chunk_files = sorted(folder.glob("chunk-*.npy"))
+        if meta.get("ended"):
+            self.chunk_files = self.chunk_files[:meta["chunks"]]
+        _check_chunks(folder, self.chunk_files, meta)
+        error = meta.pop("error", None)
+        lengths = [self._chunk(path).shape[1] for path in self.chunk_files]  # from the headers alone
+        time = np.empty(sum(lengths))
+        at = 0
+        for path, length in zip(self.chunk_files, lengths, strict=True):  # one chunk mapped at a time
+            time[at:at + length] = self._chunk(path)[0]
+            at += length
+        super().__init__(time, names, None, meta, error)
+
+    @staticmethod
+    def _chunk(path: Path) -> np.ndarray:
+        return np.load(path, mmap_mode="r")
+
+    def _column(self, index: int) -> np.ndarray:
+        """One signal, gathered from every chunk (row ``1 + index`` of each)."""
+        column = np.empty(len(self.time))
+        at = 0
+        for path in self.chunk_files:
+            values = self._chunk(path)[1 + index]
+            column[at:at + len(values)] = values
+            at += len(values)
+        return column
+
+    @property
+    def data(self) -> np.ndarray:
+        """Every signal as one samples x signals array (read whole: for small records)."""
+        whole = np.empty((len(self.time), len(self.names)))
+        for k in range(len(self.names)):
+            whole[:, k] = self._column(k)
+        return whole
+
+    @data.setter
+    def data(self, value):
+        if value is not None:
+            raise AttributeError("a streamed record is read from its folder; it cannot be replaced")
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name == "time":
+            return self.time
+        members = self.columns(name)
+        if len(members) == 1 and members[0] == name:
+            return self._column(self._index[name])
+        return np.stack([self._column(self._index[m]) for m in members], axis=1)
+
+    def windows(self):
+        """One :class:`Result` per chunk, read one at a time (see :meth:`Result.windows`)."""
+        for path in self.chunk_files:
+            block = np.load(path)
+            yield Result(block[0], self.names, block[1:].T, self.meta, self.error)
+
+    def envelope(self, of, points: int = 2000) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`orchestrator.result.envelope` of ``of(window)``, chunk by chunk: the runs
+        are those of the whole record, and a run that spans two chunks is carried over, so the
+        samples kept are those of the envelope of the whole curve.
+
+        Parameters
+        ----------
+        of : callable
+            A window (one chunk, a :class:`Result`) to the values drawn at its samples.
+        points : int
+            Runs of samples (each keeps its minimum and maximum).
+        """
+        n = len(self.time)
+        if n <= 2 * points:
+            return envelope(self.time, of(self), points)
+        size = -(-n // points)
+        times, values = [], []
+        carry_t, carry_y = np.empty(0), np.empty(0)
+        for window in self.windows():
+            t, y = np.concatenate([carry_t, window.time]), np.concatenate([carry_y, of(window)])
+            full = len(y) // size * size
+            keep = run_extremes(y[:full], size)
+            keep.sort()
+            times.append(t[keep])
+            values.append(y[keep])
+            carry_t, carry_y = t[full:], y[full:]
+        return np.concatenate([*times, carry_t]), np.concatenate([*values, carry_y])
 
 
 def _write_array(archive: zipfile.ZipFile, name: str, values: np.ndarray):

@@ -28,7 +28,8 @@ from orchestrator.errors import AlgebraicLoopError, SimulationError  # noqa: F40
 from orchestrator.faults import Fault
 from orchestrator.fmu import nearest
 from orchestrator.plan import Plan
-from orchestrator.result import Result, expand
+from orchestrator.result import Result
+from orchestrator.signals import expand
 
 
 class System:

@@ -30,11 +30,12 @@ from pathlib import Path
 
 
 def _build(args) -> int:
+    from fmus import default_fmu_dir
     from fmus.build import BuildError, build_all
     from orchestrator.calls import RunnerBuildError, build_runner
 
     try:
-        build_all(args.out)
+        build_all(args.out or default_fmu_dir())
         print(f"built {build_runner()}")
         from benchmarks import build_references
 
@@ -304,6 +305,7 @@ def _bench(args) -> int:
 
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
+    import studies  # noqa: F401  (registers the studies' scenarios in the catalogue the verbs read)
     from scenarios.shown import PlainHelp
 
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,

@@ -9,17 +9,11 @@ figures and returns its metrics. :func:`run` does the rest: results (``results.n
 from __future__ import annotations
 
 import contextlib
-import importlib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-# scenario name -> the module declaring it: a look-up imports that module alone. The gain study
-# runs a sweep of tp, so it stands with the studies, a floor above; it is named here, and loaded
-# only when asked for.
-_MODULES = {"open-loop": "scenarios.open_loop", "rig": "scenarios.rig", "tp": "scenarios.tp",
-            "gain-study": "studies.gain_study", "static-cal": "scenarios.static_cal", "metge": "scenarios.metge",
-            "ir-calibration": "scenarios.ir_calibration"}
+from scenarios.catalogue import get, names, registry
 
 
 @dataclass
@@ -244,45 +238,6 @@ def _split(text: str) -> tuple[str, str]:
     return key.strip(), value.strip()
 
 
-def names() -> tuple[str, ...]:
-    """The scenarios' names, without importing any scenario module."""
-    return tuple(_MODULES)
-
-
-def registry() -> dict[str, Scenario]:
-    """Every scenario, by name (imports every scenario module; :func:`get` imports one)."""
-    return {name: get(name) for name in _MODULES}
-
-
-def get(name: str) -> Scenario:
-    """The scenario called ``name``, importing its module only.
-
-    Parameters
-    ----------
-    name : str
-        Scenario name, e.g. ``"tp"`` (see :func:`names`).
-
-    Returns
-    -------
-    Scenario
-        The scenario's declaration.
-
-    Raises
-    ------
-    KeyError
-        Unknown name; the message names the nearest. A listed module that is missing, or
-        that declares another name, is an error, not a gap.
-    """
-    if name not in _MODULES:
-        from orchestrator.fmu import nearest
-
-        raise KeyError(f"unknown scenario {name!r}.{nearest(name, _MODULES)} Scenarios: {', '.join(_MODULES)}.")
-    scenario = importlib.import_module(_MODULES[name]).SCENARIO
-    if scenario.name != name:
-        raise RuntimeError(f"{_MODULES[name]} declares {scenario.name!r}, registered as {name!r}")
-    return scenario
-
-
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
         record=None, formats=("npz",), overwrite: bool = False, estimator=None, compress: bool = False,
         stream: bool = False, blocks=None, fmus: dict | None = None):
@@ -356,7 +311,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         try:
             with held():  # a signal while the folder is made is raised once the run can record it
                 _check_formats(formats, stream, out_dir)
-                if name not in _MODULES:
+                if name not in names():
                     get(name)  # refused (the nearest names given) before any folder is made
                 made = out_dir is not None and not Path(out_dir).exists()
                 out = prepare_out_dir(out_dir, overwrite, lock) if out_dir else None
@@ -422,7 +377,7 @@ def _run_phases(scenario, options, base, files, given, progress):
     user's blocks."""
     from orchestrator import SimulationError
     from orchestrator.progress import status
-    from scenarios.metrics import metric_units
+    from scenarios.metrics import FAULT_UNITS, metric_units
 
     name, (faults, estimator, record, stream, blocks, fmus) = scenario.name, given
     system, duration, kept, saved = _build(scenario, options, base, files, (faults, estimator, blocks, fmus),
@@ -519,7 +474,8 @@ def _open_stream(files, stream: bool):
     """The writer of ``results.stream/`` when the record is streamed, else None."""
     if not stream:
         return None
-    from orchestrator.stream import FOLDER, StreamWriter
+    from orchestrator.result import FOLDER
+    from orchestrator.stream import StreamWriter
 
     return StreamWriter(files.out / FOLDER)
 
@@ -620,10 +576,6 @@ def fault_record(fault) -> dict:
     """
     return {"target": fault.target, "kind": fault.kind, "start": fault.start, "stop": fault.stop,
             "value": fault.value, "seed": fault.seed}
-
-
-#: The units of :func:`fault_record`'s fields, as ``metrics.json`` states them.
-FAULT_UNITS = "start, stop: s (stop null: no end); value: the target's unit (scale: a factor)"
 
 
 def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | None, list[str] | None]:

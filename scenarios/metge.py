@@ -596,9 +596,7 @@ SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS,
                     duration=duration, extra={"record": RECORD, "derived": DERIVED})
 
 
-# --- the compensation in the closed loop (``tp --set compensation=...``) ----------------
-
-COMPENSATIONS = ("none", "static", "metge", "dynamic")
+# --- the rig calibration a closed loop's compensation uses (scenarios.compensation) -----
 
 
 @functools.lru_cache(maxsize=4)
@@ -625,40 +623,3 @@ def rig_calibration(orders: str = "4,1", levels: int = 8, settings: tuple = ()) 
         runs.append(RigRun(recorded, o, 1))
     status("identifying the field model (eqs. 5 to 8) and the motors' dynamics")
     return calibrate(RigSet(runs), parse_orders(orders), None, o["mag_rate"], "set 1, made for tp")
-
-
-def magnetometer_rate(system: System) -> float:
-    """Rate (Hz) at which the system's IMU samples and holds its magnetometer."""
-    from fmpy import read_model_description
-
-    from fmus import fmu_path
-
-    imu = system.blocks["IMU"]
-    starts = {v.name: v.start for v in read_model_description(str(fmu_path(imu.model))).modelVariables}
-    for name in ("mag_sample_rate", "sample_rate"):
-        if name in starts:
-            return float(imu.parameters.get(name, starts[name]))
-    raise KeyError("the IMU declares no magnetometer rate (mag_sample_rate or sample_rate)")
-
-
-def add_compensator(system: System, mode: str, path: str, estimator: str = "Quaternion_estim",
-                    settings: tuple = ()):
-    """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
-    ``mode = "none"``): commands from the controller, voltage from the battery, ``b_d``
-    refreshed at the magnetometer's sample instants. ``path``: a calibration file, or empty for
-    :func:`rig_calibration` of the vehicle of ``settings`` (:func:`vehicle_settings`).
-    ``system``: the tp system; ``estimator``: the name of its block."""
-    from calibration import MagCompensator
-
-    if mode == "none":
-        if path:
-            raise ValueError(f"calibration={path} is given with compensation=none, which uses no calibration: "
-                             "choose compensation=static, metge or dynamic, or leave calibration empty")
-        return None
-    calibration = Calibration.load(path, motors=4) if path else rig_calibration(settings=settings)
-    block = system.add(MagCompensator(calibration, mode, sample_rate=magnetometer_rate(system)))
-    system.connect("IMU.magneto", "MagCompensator.magneto")
-    system.connect("Controller.c", "MagCompensator.c")
-    system.connect("MotorMagnetics.u_batt", "MagCompensator.u_batt")
-    system.connect("MagCompensator.magneto", f"{estimator}.magneto")
-    return block

@@ -150,8 +150,7 @@ class RunFiles:
         return kept
 
     def _write(self, metrics: dict):
-        from scenarios import FAULT_UNITS
-        from scenarios.metrics import metric_units
+        from scenarios.metrics import FAULT_UNITS, metric_units
 
         declared = metrics.get("units") or {}
         metrics = metrics | {"units": metric_units(metrics, declared) | self.units | {"injected_faults": FAULT_UNITS}}
@@ -304,7 +303,8 @@ class RunFiles:
         from collections import Counter
 
         from orchestrator.memory import writers_peak
-        from orchestrator.result import check_record_fits, vector_groups
+        from orchestrator.result import check_record_fits
+        from orchestrator.signals import vector_groups
 
         groups = vector_groups(saved)
         if not stream:

@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from estimators import estimate, parse_corrections, recording
+from estimators import estimate, kinds, parse_corrections, recording
 from orchestrator.files import write_text
 
 FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
@@ -121,7 +121,7 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
         field = field_from_data(data["acc"], data["mag"], max(1, int(field_from_data_s * data["rate"])))
         dip, norm = (field["dip"] if dip is None else dip), field["norm"]
     refs = references(frame, dip, norm, declination)
-    filtered = kind in ("linear", "explicit", "passive")
+    filtered = kind in kinds.KINDS and kinds.KINDS[kind].lab
     corrections_used = settings["corrections"] if kind != "linear" and filtered else None
     out = estimate(kind, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], dt=1.0 / data["rate"],
                    gains=settings["gains"], corrections=False if kind == "linear" else corrections_used,

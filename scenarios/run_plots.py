@@ -60,7 +60,7 @@ def load(run) -> tuple:
 
 
 def _holds_record(folder: Path) -> bool:
-    from orchestrator.stream import FOLDER
+    from orchestrator.result import FOLDER
 
     return (folder / RESULTS_FILE).exists() or (folder / FOLDER).is_dir() or (folder / "meta.json").exists()
 
@@ -114,7 +114,7 @@ def signal_lines(run) -> list[str]:
     list of str
         A heading, then one line per vector or signal: ``IMU.acc [x, y, z] (m/s2)``.
     """
-    from orchestrator.result import vector_groups
+    from orchestrator.signals import vector_groups
 
     result, folder = load(run)
     units = result.meta.get("units", {})

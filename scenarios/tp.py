@@ -12,7 +12,7 @@ from functools import partial
 
 import numpy as np
 
-from estimators import LAB_GAINS, QuaternionEstim, parse_corrections
+from estimators import LAB_GAINS, QuaternionEstim, kinds, parse_corrections
 from estimators.core import euler_to_quaternion
 from flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from flight.controller import SETPOINT_UNITS
@@ -21,6 +21,7 @@ from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
 from scenarios.ablation import GravityOnly
+from scenarios.compensation import COMPENSATIONS, add_compensator
 from scenarios.divergence import Bounds
 from scenarios.figures import (
     angle_curve,
@@ -32,14 +33,13 @@ from scenarios.figures import (
     title_lines,
     wrapped_curve,
 )
-from scenarios.metge import add_compensator, vehicle_settings
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
 
 OPTIONS = {
     "estimator": Option("linear", "attitude estimator, or module:Class (a block of your own: estimators/contract.py)",
-                        choices=("linear", "explicit", "passive", "vqf", "madgwick"), classes=True),
+                        choices=kinds.streaming(), classes=True),
     "flight": Option("quasi", "flight profile (flight/profiles.py), or a setpoint profile in a CSV file "
                               "(flight/profile_file.py)", choices=FLIGHTS, files=".csv"),
     "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)", applies="flight=tilt"),
@@ -71,8 +71,8 @@ OPTIONS = {
     "dt": Option(1e-3, "macro step (s)", minimum=1e-5),
     "imu_rate": Option(1000.0, "IMU and estimator rate (Hz)", minimum=1.0),
     "seed": Option(1, "IMU noise seed", applies="noise=true"),
-    "compensation": Option("none", "field of the motor currents compensated (scenarios/metge.py)",
-                           choices=("none", "static", "metge", "dynamic")),
+    "compensation": Option("none", "field of the motor currents compensated (scenarios/compensation.py)",
+                           choices=COMPENSATIONS),
     "calibration": Option("", "calibration file (JSON) for the compensation; empty: made on the clamped rig"),
 }
 
@@ -97,7 +97,7 @@ def estimator_gains(o: dict) -> dict:
     kind = o["estimator"]
     if kind == "linear":
         return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
-    if kind in ("vqf", "madgwick") or ":" in kind:
+    if kind not in kinds.KINDS or not kinds.KINDS[kind].lab:
         return {}  # the packages' defaults; a user's block holds its own
     ki = LAB_GAINS[kind]["kI"] if o["kI"] == "lab" else o["kI"]
     if kind == "explicit":
@@ -110,7 +110,7 @@ def resolve(o: dict) -> dict:
     kept as the word for an estimator without one (linear, vqf, madgwick), as any option that
     acts on nothing keeps its value."""
     kind = o["estimator"]
-    return o | ({"kI": estimator_gains(o)["kI"]} if kind in ("explicit", "passive") else {})
+    return o | ({"kI": estimator_gains(o)["kI"]} if kind in kinds.with_bias() else {})
 
 
 #: Signals tp's result files leave out by default (recorded all the same; ``--record all``
@@ -175,12 +175,14 @@ def build(o: dict, estimator=None) -> System:
     if o["accelerometer"] == "gravity":
         system.connect("Quadrotor.q", "GravityOnly.q")
     q0 = euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)
-    if estimator is not None or ":" in o["estimator"]:
+    registered = kinds.KINDS.get(o["estimator"])
+    if estimator is not None or registered is None or registered.block:  # a block of its own
         from estimators import contract
 
         if estimator is not None:
             o["estimator"] = contract.label(estimator)
-        estimator = system.add(contract.adopt(estimator if estimator is not None else o["estimator"], period,
+        spec = estimator if estimator is not None else registered.block if registered else o["estimator"]
+        estimator = system.add(contract.adopt(spec, period,
                                               q0=q0, available=system.blocks["IMU"].outputs))
     else:
         estimator = system.add(QuaternionEstim(o["estimator"], estimator_gains(o), period=period,
@@ -202,7 +204,7 @@ def build(o: dict, estimator=None) -> System:
     system.connect("Quadrotor.v", "Controller.v")
     system.connect("MotorMagnetics.u_batt", "Controller.u_batt")
     system.connect("Controller.c", "MotorMagnetics.c")
-    add_compensator(system, o["compensation"], o["calibration"], settings=vehicle_settings(o))
+    add_compensator(system, o["compensation"], o["calibration"], o)
     return system
 
 
@@ -312,7 +314,7 @@ def _predictions(result, o) -> dict:
     """What the linearised analyses (:mod:`estimators.analysis`) predict for this run's gyro bias:
     the passive filter's bias-convergence time (s), the explicit filter's steady error without
     bias estimate (deg, roll, pitch, yaw); nothing without a bias or for the other filters."""
-    if not o["bias"] or o["estimator"] not in ("explicit", "passive"):
+    if not o["bias"] or o["estimator"] not in kinds.with_bias():
         return {}
     from estimators import analysis
 
@@ -428,13 +430,13 @@ def estimator_text(o: dict, name: str | None = None) -> str:
     str
         ``"explicit filter (k1 = 0.2, k2 = 0.2, kP = 1 1/s, kI = 0.1 1/s^2)"``.
     """
-    if name or ":" in o["estimator"]:  # a user's block, module:Class
+    if name or o["estimator"] not in kinds.KINDS or kinds.KINDS[o["estimator"]].block:  # a block of its own
         return f"estimator {name or o['estimator']}"
     kind = o["estimator"]
     gains = estimator_gains(o)
     if kind == "linear":
         text = f"k = {gains['k1']:g} 1/s"
-    elif kind in ("explicit", "passive"):
+    elif kind in kinds.with_bias():
         parts = [f"k1 = {gains['k1']:g}", f"k2 = {gains['k2']:g}"] if kind == "explicit" else []
         parts += [f"kP = {gains['kP']:g} 1/s", f"kI = {gains['kI']:g} 1/s\u00b2"]
         text = ", ".join(parts)

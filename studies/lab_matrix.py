@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from estimators import analysis, score
+from estimators import analysis, kinds, score
 from fmus.IMU.variables import LAB_GYRO_BIAS
 from orchestrator.files import write_json, write_text
 
@@ -58,7 +58,7 @@ CASES = {
                                                 "feedback": "estimate", "flight": "hover"},
 }
 # the published filters beside the lab's, in the same closed loop (estimate-fed, noise, gyro bias)
-COMPARED = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+COMPARED = kinds.compared()
 COMPARISON = {f"compare-{kind}-{flight}": {"estimator": kind, "flight": flight, "feedback": "estimate", "noise": True,
                                            "bias": True, **options}
               for flight in ("quasi", "nonstationary") for kind, options in COMPARED.items()}

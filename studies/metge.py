@@ -11,12 +11,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from estimators import kinds
 from orchestrator.files import write_json, write_text
-from scenarios.metge import COMPENSATIONS
+from scenarios.compensation import COMPENSATIONS
 
 # --- the closed loop: yaw error per estimator and compensation --------------------------
 
-STUDY_ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+STUDY_ESTIMATORS = kinds.compared()
 
 
 def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), estimators=tuple(STUDY_ESTIMATORS),
@@ -72,11 +73,10 @@ def main(argv=None):
     parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
     parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
     args = parser.parse_args(argv)
-    for chosen, name in ((args.free_set, "metge_free"), (args.robustness, "metge_robustness")):
-        if chosen is not None:  # a study of its own module, with its cases
-            import importlib
+    from studies import metge_free, metge_robustness
 
-            study = importlib.import_module(f"studies.{name}")
+    for chosen, study in ((args.free_set, metge_free), (args.robustness, metge_robustness)):
+        if chosen is not None:  # a study of its own module, with its cases
             unknown = set(chosen) - set(study.cases())
             if unknown:
                 parser.error(f"unknown case {', '.join(sorted(unknown))}; cases: {', '.join(study.cases())}")

@@ -182,7 +182,7 @@ def flying(cal: Calibration) -> dict:
     and against the field at the start (a motors-off reference taken as a clamped rig takes
     it); and the attitude's own share (the true field against its start)."""
     import scenarios
-    from scenarios.metge import magnetometer_rate
+    from scenarios.compensation import magnetometer_rate
 
     tp = scenarios.get("tp")
     rate = magnetometer_rate(tp.build(tp.parse(FLIGHT)))

@@ -20,7 +20,7 @@ def built_fmus():
     if missing:
         from fmus.build import build_all
 
-        build_all(verbose=False)
+        build_all(default_fmu_dir(), verbose=False)
     return default_fmu_dir()
 
 

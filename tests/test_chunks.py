@@ -7,6 +7,7 @@ import pytest
 from numba import carray, cfunc
 
 import scenarios
+import studies  # noqa: F401  (registers gain-study in the scenarios' catalogue)
 from orchestrator import Block, FMUBlock, SimulationError, System, Table
 from orchestrator.blocks import COMPILED_SIGNATURE, CompiledStep
 from orchestrator.chunks import CHUNK_STEPS

@@ -17,9 +17,11 @@ def drawn(monkeypatch, module_name: str) -> dict:
     """Keep the figures a scenario module saves, by file name, instead of closing them."""
     import importlib
 
-    import scenarios
+    import studies  # noqa: F401  (registers gain-study)
+    from scenarios import catalogue
 
-    module = importlib.import_module(scenarios._MODULES.get(module_name.replace("_", "-"), f"scenarios.{module_name}"))
+    registered = catalogue.registrations().get(module_name.replace("_", "-"))
+    module = importlib.import_module(registered[0] if registered else f"scenarios.{module_name}")
     figures = {}
 
     def keep(figure, out_dir, name):

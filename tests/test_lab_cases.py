@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import scenarios
+import studies  # noqa: F401  (registers gain-study in the scenarios' catalogue)
 from estimators import analysis
 from fmus.IMU.variables import LAB_GYRO_BIAS as LAB_BIAS
 from scenarios.testing.assertions import assert_bias_converges, assert_bounds

@@ -10,7 +10,7 @@ from scipy.io import loadmat
 
 from estimators import LAB_GAINS
 from orchestrator import Result
-from orchestrator.result import matrix_shape, vector_groups
+from orchestrator.signals import matrix_shape, vector_groups
 from quadcosim.main import main as cli
 
 

@@ -26,7 +26,7 @@ def test_a_scenario_look_up_imports_that_scenario_alone():
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout
     imported = ast.literal_eval(out)
     assert "scenarios.open_loop" in imported
-    others = [module for name, module in scenarios._MODULES.items() if name != "open-loop"]
+    others = [module for name, (module, _) in scenarios.catalogue.registrations().items() if name != "open-loop"]
     assert [m for m in others if m in imported] == []
     assert scenarios.names() == tuple(scenarios.registry())
     with pytest.raises(KeyError, match="Did you mean tp"):

@@ -5,6 +5,8 @@ them, are in :mod:`flightlogs.ardupilot` and :mod:`flightlogs.px4`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 
@@ -28,9 +30,35 @@ def write_px4(params: dict, path) -> None:
     write_text(path, "".join(lines))
 
 
+@dataclass(frozen=True)
+class Autopilot:
+    """An autopilot the export writes parameters for.
+
+    Attributes
+    ----------
+    name : str
+        As a flight log names it (:attr:`flightlogs.FlightLog.autopilot`).
+    file : str
+        The parameter file the export writes in the results folder.
+    write : callable
+        ``(params, path)``: the parameters in the autopilot's file format.
+    """
+
+    name: str
+    file: str
+    write: Callable[[dict, object], None]
+
+
+#: The autopilots, one line each: a flight log of one of them is exported in its own file.
+AUTOPILOTS = {autopilot.name: autopilot for autopilot in (
+    Autopilot("ArduPilot", "ardupilot.parm", write_ardupilot),
+    Autopilot("PX4", "px4.params", write_px4),
+)}
+
+
 def write_parameters(autopilot: str, params: dict, path) -> None:
-    """``params`` in the file format of ``autopilot`` (``ArduPilot`` or ``PX4``) at ``path``."""
-    (write_px4 if autopilot == "PX4" else write_ardupilot)(params, path)
+    """``params`` in the file format of ``autopilot`` (a name of :data:`AUTOPILOTS`) at ``path``."""
+    AUTOPILOTS[autopilot].write(params, path)
 
 
 FLOAT32_MAX = 3.4028234663852886e38  # the largest value of the autopilots' 32-bit float parameters

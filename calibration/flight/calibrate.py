@@ -8,24 +8,20 @@ import numpy as np
 
 from calibration.dynamic import MotorFieldModel
 from calibration.file import Calibration
-from calibration.flight.dynamic import DynamicModel
+from calibration.flight import catalogue
 from calibration.flight.evaluate import score
 from calibration.flight.linear import earth_and_offset
-from calibration.flight.models import LinearModel, MetgeModel, Refused
+from calibration.flight.models import Refused
 from calibration.static import CalibrationError, StaticCalibration, fit_static, sphere_coverage
 
-MODELS = ("current", "throttle", "motors", "metge", "dynamic")
+MODELS = catalogue.MODELS  # by name, in the order they are fitted (read when a calibration runs)
 MIN_COVERAGE = 0.5  # share of the 80 sphere cells the Earth field must visit in the body frame
-# the model the calibration file carries: the first of these the flights identify (an a-priori order,
-# richest first, not a choice on the scores)
-FILE_PREFERENCE = ("metge", "motors", "throttle")
 
 
 def _fit_models(train, names) -> tuple[dict, dict]:
     fitted, refused = {}, {}
     for name in names:
-        model = (LinearModel(name) if name in ("current", "throttle", "motors")
-                 else MetgeModel(fitted.get("motors")) if name == "metge" else DynamicModel(fitted.get("metge")))
+        model = catalogue.MODELS[name].build(fitted)
         reason = model.refusal(train)
         if reason is None:
             try:
@@ -75,7 +71,9 @@ def _static(train, best, offsets, soft_iron) -> tuple[StaticCalibration, dict]:
 
 def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel | None]:
     """The preferred identified model in the file's form (eqs. 3, 4 of Metge et al.)."""
-    for name in FILE_PREFERENCE:
+    # the first the flights identify of those the file can carry (an a-priori order, richest
+    # first, not a choice on the scores)
+    for name in catalogue.preferred("in_file"):
         if name not in fitted:
             continue
         if name == "metge":
@@ -89,13 +87,15 @@ def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel
     return None, None
 
 
-def calibrate(train, test, names=MODELS, attitude: str = "auto") -> tuple[dict, Calibration, dict]:
+def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Calibration, dict]:
     """Fit on the ``train`` parts, score on the ``test`` parts (lists of FlightData of one compass);
-    ``names`` the models tried, ``attitude`` the attitude the parts were built with (recorded).
+    ``names`` the models tried (default every model of :data:`MODELS`), ``attitude`` the
+    attitude the parts were built with (recorded).
 
     Returns the metrics (JSON-ready), the :class:`calibration.Calibration` for the file and the
     fitted models by name (:class:`calibration.flight.models.Fitted`).
     """
+    names = tuple(MODELS) if names is None else names
     fitted, refused = _fit_models(train, names)
     for name, reason in _unscorable(fitted, test).items():  # fitted on the training flights, not testable
         refused[name] = reason

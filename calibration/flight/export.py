@@ -21,13 +21,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from calibration.flight import catalogue
 from calibration.flight.evaluate import heading_error, tilt_compensated_heading
 from calibration.flight.linear import earth_and_offset, fit_linear
 from calibration.static import CalibrationError
 from flightlogs import ardupilot, px4
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
-MOTOR_MODELS = ("current", "motors", "throttle")  # the export's motor compensation, in this order of preference
 # every firmware's motor compensation switched off (ArduPilot's COMPASS_MOTCT and COMPASS_PMOT_EN, PX4's
 # CAL_MAG_COMP_TYP): the baseline of the explained share
 MOTOR_OFF = {"COMPASS_MOTCT": 0, "COMPASS_PMOT_EN": 0, "CAL_MAG_COMP_TYP": 0}
@@ -137,7 +137,7 @@ def motor_models(part, rule=None) -> tuple[str, ...]:
     ``throttle``, and ``motors`` (``COMPASS_PMOT``) on ArduPilot 4.0 and later's first compass
     (``rule`` overriding the log's version)."""
     if not is_px4(part) and rules_of(part, rule).per_motor and part.log.compasses[part.compass].slot == 0:
-        return MOTOR_MODELS
+        return catalogue.preferred("autopilot")
     return ("current", "throttle")
 
 
@@ -274,8 +274,9 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     exported and kept: offsets, then motor compensation, then soft iron, each fitted on ``train``
     and kept only when it lowers the heading error on the ``choice`` parts (the motor compensation
     also needs a positive explained share there). The export's score belongs on parts neither has
-    seen. ``rule`` overrides ArduPilot's version rules; ``models`` (names of :data:`MOTOR_MODELS`)
-    restricts the motor compensations tried (default: all the firmware has).
+    seen. ``rule`` overrides ArduPilot's version rules; ``models`` (names of the models an
+    autopilot can carry, :mod:`calibration.flight.catalogue`) restricts the motor compensations
+    tried (default: all the firmware has).
 
     Raises
     ------

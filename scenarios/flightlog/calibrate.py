@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 
 FIGURES = ("residual.png", "heading.png")
-PARAMETER_FILES = {"ArduPilot": "ardupilot.parm", "PX4": "px4.params"}
 
 
 def _logs(files, verb: str) -> list:
@@ -193,13 +192,14 @@ def _figures(train, test, fitted, model, attitude) -> tuple:
 def _export(args, split: Split, metrics: dict) -> tuple:
     """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
     described in ``metrics["export"]``; (autopilot, file name, parameters)."""
+    from calibration.flight.autopilot import AUTOPILOTS
     from calibration.flight.export import choose, log_parameters, rules_of, score_parameters
 
     train, score = split.train, split.score
     rule = _rule(args, split.test[0])
     params, chosen = choose(split.fit, split.choice, rule)
     autopilot = train[0].log.autopilot
-    name = PARAMETER_FILES[autopilot]
+    name = AUTOPILOTS[autopilot].file
     exported = score_parameters(score, params, rule)
     flown = score_parameters(score, log_parameters(score[0], params), rule)
     firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
@@ -407,6 +407,7 @@ def _check_choices(args):
 
     if args.attitude not in ATTITUDES:
         raise ValueError(f"--attitude {args.attitude!r} must be one of {', '.join(ATTITUDES)}")
+    args.models = list(MODELS) if args.models is None else args.models
     unknown = [m for m in args.models if m not in MODELS]
     if unknown:
         raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
@@ -430,8 +431,9 @@ def add_arguments(parser):
                         help="attitude removing the Earth field: auto (default: gyro for the compass the log's heading "
                              "fuses, log for the others), gyro (roll and pitch from the log, heading integrated from "
                              "the gyro) or log")
-    parser.add_argument("--models", nargs="+", default=["current", "throttle", "motors", "metge", "dynamic"],
-                        help="models to fit: current, throttle, motors, metge, dynamic (default all)")
+    parser.add_argument("--models", nargs="+", default=None,
+                        help="models to fit (default: every model of calibration/flight/catalogue.py; an unknown "
+                             "name lists them)")
     parser.add_argument("--earth", default="model",
                         help="Earth field: model (default: the World Magnetic Model at the log's GPS position and "
                              "date; free without a GPS fix) or free (fitted per flight)")
@@ -443,3 +445,16 @@ def add_arguments(parser):
     parser.add_argument("--overwrite", action="store_true", help="replace the results already in --out")
     parser.set_defaults(func=run)
     return parser
+
+
+def main(argv) -> int:
+    """``quadcosim calibrate ARGV...`` called from Python (the findings run it so): its exit code.
+
+    Parameters
+    ----------
+    argv : list of str
+        The verb's arguments, without ``calibrate`` itself.
+    """
+    import argparse
+
+    return run(add_arguments(argparse.ArgumentParser(prog="quadcosim calibrate")).parse_args(argv))

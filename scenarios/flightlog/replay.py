@@ -23,8 +23,10 @@ import sys
 
 import numpy as np
 
+from estimators import kinds
+
 MIN_SAMPLES = 100  # IMU samples a replay needs: half of them, the second, are scored
-ESTIMATORS = {"linear": {}, "explicit": {}, "passive": {"ry": "triad"}, "vqf": {}, "madgwick": {}}
+ESTIMATORS = kinds.compared(batch=True)  # estimator -> its settings (estimators/kinds.py)
 REFERENCE_NOTE = ("differences from the autopilot's own attitude estimate, a reference and not the truth "
                   "(it fuses the primary compass itself)")
 

@@ -2,6 +2,7 @@
 nothing: a signal while the files are written lets them finish (metrics.json last), a signal
 while the flights are read leaves no folder, and neither does a refusal."""
 
+import dataclasses
 import json
 import signal
 
@@ -26,13 +27,13 @@ def flight(tmp_path):
 @pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_while_the_files_are_written_keeps_them_all_with_metrics_json(flight, tmp_path, monkeypatch,
                                                                                number, capsys):
-    write = autopilot.write_ardupilot
+    ardupilot = autopilot.AUTOPILOTS["ArduPilot"]
 
     def signalled(params, path):
         send_self(number)  # as the first parameter file is written
-        write(params, path)
+        ardupilot.write(params, path)
 
-    monkeypatch.setattr(autopilot, "write_ardupilot", signalled)
+    monkeypatch.setitem(autopilot.AUTOPILOTS, "ArduPilot", dataclasses.replace(ardupilot, write=signalled))
     out = tmp_path / "cal"
     assert cli(["calibrate", str(flight), "--out", str(out), *MODELS]) == 128 + number
     capsys.readouterr()

@@ -14,7 +14,7 @@ from conftest import ROOT
 
 from orchestrator import Result
 from orchestrator.memory import cgroup_left, writers_peak
-from orchestrator.result import vector_groups
+from orchestrator.signals import vector_groups
 
 GIB = 2 ** 30
 

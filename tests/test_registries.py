@@ -1,0 +1,171 @@
+"""One registry per closed set of names: a dummy member added as a maintainer would add one, a
+file (``tests/registry_dummies/``) and one registry line, is seen everywhere the set is read.
+
+Each test runs a fresh interpreter that adds the registry line before anything reads the
+registry, exactly as the line would stand in the registry's module, then drives the command line.
+"""
+
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+DUMMIES = Path(__file__).resolve().parent / "registry_dummies"
+
+
+def _with_line(registry_line: str, body: str, tmp_path: Path) -> dict:
+    """Run ``body`` after ``registry_line`` in a fresh interpreter (the dummies importable, the
+    working folder ``tmp_path``); what ``body`` leaves in ``found`` (a dict)."""
+    script = "\n".join([
+        "import contextlib, io, json, sys",
+        f"sys.path[:0] = [{str(DUMMIES)!r}, {str(ROOT)!r}]",
+        textwrap.dedent(registry_line),
+        "found = {}",
+        "def cli(*argv):",
+        "    from quadcosim.main import main",
+        "    out = io.StringIO()",
+        "    with contextlib.redirect_stdout(out):",
+        "        code = main(list(argv))",
+        "    return code, out.getvalue()",
+        textwrap.dedent(body),
+        "print(json.dumps(found))",
+    ])
+    done = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
+    found = _with_line('''
+        from estimators import kinds
+        kinds.KINDS["gyro-only"] = kinds.Kind("gyro-only", "gyro only", batch=False, block="dummy_estimator:GyroOnly")
+    ''', '''
+        code, listing = cli("list")
+        found["listed"] = [line for line in listing.splitlines() if line.strip().startswith("estimator ")][0]
+        code, _ = cli("run", "tp", "--set", "estimator=gyro-only", "--set", "duration=0.2", "--out", "out")
+        metrics = json.load(open("out/metrics.json"))
+        found["ran"] = [code, metrics["options"]["estimator"], metrics["rms_error_deg"]]
+        import scenarios, studies.lab_matrix, studies.metge
+        from scenarios.flightlog import replay
+        found["choices"] = list(scenarios.get("tp").options["estimator"].choices)
+        found["compared"] = [list(studies.lab_matrix.COMPARED), list(studies.metge.STUDY_ESTIMATORS)]
+        found["replayed"] = list(replay.ESTIMATORS)
+    ''', tmp_path)
+    assert "|gyro-only)" in found["listed"]  # quadcosim list: tp's estimator choices
+    assert found["ran"][:2] == [0, "gyro-only"] and found["ran"][2]  # run and scored
+    assert found["choices"][-1] == "gyro-only"
+    assert all(compared[-1] == "gyro-only" for compared in found["compared"])  # the comparisons run it
+    assert "gyro-only" not in found["replayed"]  # a block alone: no batch path for recorded arrays
+
+
+def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
+    from tests.flightlog_synthetic import write_log
+
+    log = tmp_path / "flight.bin"
+    write_log(log, duration=40.0)
+    found = _with_line('''
+        from calibration.flight import catalogue
+        from dummy_model import Nothing
+        catalogue.MODELS["nothing"] = catalogue.Model("nothing", lambda fitted: Nothing(), preference=5)
+    ''', '''
+        code, _ = cli("calibrate", "flight.bin", "--out", "out")
+        metrics = json.load(open("out/metrics.json"))
+        found["default"] = [code, sorted(metrics["models"])]
+        code, _ = cli("calibrate", "flight.bin", "--models", "nothing", "current", "--out", "chosen")
+        metrics = json.load(open("chosen/metrics.json"))
+        found["chosen"] = [code, sorted(metrics["models"]), metrics["models"]["nothing"]["explained_test"]]
+        from calibration.flight import catalogue
+        found["orders"] = [list(catalogue.preferred("in_file")), list(catalogue.preferred("autopilot"))]
+    ''', tmp_path)
+    assert found["default"][0] == 0 and "nothing" in found["default"][1]  # --models' default: every model
+    assert found["chosen"][:2] == [0, ["current", "nothing"]] and abs(found["chosen"][2]) < 1e-9
+    assert "nothing" not in found["orders"][0] + found["orders"][1]  # neither the file nor an autopilot carries it
+
+
+def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
+    found = _with_line('''
+        from scenarios.catalogue import register
+        register("dummy", "dummy_scenario", "studies")
+    ''', '''
+        code, listing = cli("list")
+        found["listed"] = [line for line in listing.splitlines() if line.startswith("dummy:")]
+        code, _ = cli("run", "dummy", "--set", "duration=0.3", "--out", "out")
+        found["ran"] = [code, json.load(open("out/metrics.json"))["final_time_s"]]
+        import scenarios
+        found["names"] = list(scenarios.names())
+    ''', tmp_path)
+    assert found["listed"] == ["dummy: a clock alone"]
+    assert found["ran"][0] == 0 and abs(found["ran"][1] - 0.3) < 1e-9
+    assert {"dummy", "gain-study"} <= set(found["names"])
+
+
+# --- the maintainers' checklists (docs/guides/maintainers.md) -------------------------------
+
+CHECKLISTS = ROOT / "docs" / "guides" / "maintainers.md"
+
+
+def _section(title: str) -> str:
+    text = CHECKLISTS.read_text()
+    start = text.index(f"## {title}\n")
+    end = text.find("\n## ", start + 1)
+    return text[start:end if end > 0 else None]
+
+
+def _paths(section: str) -> list[str]:
+    """The repository paths a checklist names (in backquotes, with a folder)."""
+    import re
+
+    return [p for p in re.findall(r"`([\w<>./-]+/[\w<>./-]+)`", section) if "." in p.rsplit("/", 1)[-1]]
+
+
+def test_every_file_a_checklist_names_exists():
+    """``<Model>`` stands for each plant model; a path of the new member's own name is skipped."""
+    from fmus import MODELS
+
+    missing = []
+    for path in _paths(CHECKLISTS.read_text()):
+        if "<name>" in path:
+            continue
+        for model in MODELS if "<Model>" in path else [None]:
+            concrete = path.replace("<Model>", model) if model else path
+            if not (ROOT / concrete).exists():
+                missing.append(concrete)
+    assert missing == []
+
+
+def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
+    from fmus import MODELS
+
+    section = _paths(_section("Adding a sensor FMU"))
+    for required in ("fmus/<Model>/model.c", "fmus/<Model>/variables.py", "fmus/<Model>/__init__.py",
+                     "fmus/models.py", "fmus/QuadCoSim/<Model>.mo", "fmus/QuadCoSim/package.order",
+                     "tests/test_variable_tables.py", "docs/guides/fmus.md"):
+        assert required in section, required
+    build = (ROOT / "fmus" / "build.py").read_text()
+    assert 'HERE / model / "model.c"' in build  # what the build compiles of a model
+    assert 'f"fmus.{model}.variables"' in (ROOT / "fmus" / "models.py").read_text()  # its table
+    from tests.test_variable_tables import INPUTS
+
+    order = (ROOT / "fmus" / "QuadCoSim" / "package.order").read_text().split()
+    table = (ROOT / "docs" / "guides" / "fmus.md").read_text()
+    for model in MODELS:  # each step, done for every model there is
+        assert model in order and model in INPUTS and f"| `{model}` |" in table, model
+
+
+def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_extend():
+    """The registry line of each dummy test is the one its checklist names."""
+    from calibration.flight import catalogue
+    from estimators import kinds
+
+    estimator = _section("Adding an estimator")
+    assert Path(kinds.__file__).relative_to(ROOT).as_posix() in _paths(estimator)
+    assert "estimators/contract.py" in _paths(estimator) and "`KINDS`" in estimator
+    model = _section("Adding a flight-log model or autopilot")
+    assert Path(catalogue.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`MODELS`" in model
+    from calibration.flight import autopilot
+
+    assert Path(autopilot.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`AUTOPILOTS`" in model
+    scenario = _section("Adding a scenario")
+    assert "scenarios/catalogue.py" in _paths(scenario) and "`MODULES`" in scenario
