@@ -10,8 +10,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 GUIDES = ROOT / "docs" / "guides"
-#: Reference pages among the guides: looked up, not walked through, and so without a figure.
-REFERENCES = {"runs-reference.md"}
+#: Reference pages among the guides: looked up, not walked through, and so without a figure (the
+#: runs' machinery; the maintainers' checklists of files to touch).
+REFERENCES = {"runs-reference.md", "maintainers.md"}
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 from quadcosim_docs import mathml, unrendered  # noqa: E402
 
