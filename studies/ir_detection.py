@@ -23,8 +23,9 @@ The seeds: :data:`TUNING` are those the detector's settings were chosen on (and 
 was looked at on); :data:`FRESH` (per fault case) and :data:`FRESH_CLEAN` (fault-free) are
 disjoint from them and were flown only to score the design once frozen.
 
-``--ablation`` scores each design choice of :mod:`calibration.infrared.detection` by flying the
-same fresh fleets with it undone (:data:`ABLATIONS`), and the earlier design as a whole.
+``--ablation`` scores each design choice of :mod:`calibration.infrared.detection` by flying
+fleets of tuning seeds (:data:`ABLATION_FAULTS`, :data:`ABLATION_CLEAN`: an ablation is looked
+at) with it undone (:data:`ABLATIONS`), and the earlier design as a whole.
 ``--quick`` is the small fresh set CI re-checks (:data:`QUICK`). ``--figure DIR`` draws a GPS
 offset missed from its start and its end (:func:`missed_figure`); ``--plateau`` undoes each part
 of the test that takes such an end for a return (:func:`plateau_ablation`, tuning seeds).
