@@ -275,7 +275,7 @@ def main(argv=None) -> int:
                                         f"with --ablation, tuning seeds {ABLATION_FAULTS[0]}:{ABLATION_FAULTS[1]})")
     parser.add_argument("--clean", help=f"seeds of the fault-free flights, FIRST:LAST (default {FRESH_CLEAN[0]}:"
                                         f"{FRESH_CLEAN[1]}; with --ablation {ABLATION_CLEAN[0]}:{ABLATION_CLEAN[1]})")
-    parser.add_argument("--ablation", action="store_true", help="each design choice undone (on the fresh fleets)")
+    parser.add_argument("--ablation", action="store_true", help="each design choice undone (on tuning seeds)")
     parser.add_argument("--quick", action="store_true", help="the small fresh set CI re-checks")
     parser.add_argument("--larger", action="store_true", help="also the larger offsets and those below the design")
     parser.add_argument("--plateau", action="store_true", help="the plateau test's parts undone (tuning seeds)")
