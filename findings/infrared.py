@@ -4,6 +4,7 @@
 (IR +100 counts and GPS +0.1 rad/s over 40 fresh flights each, 200 fresh fault-free flights:
 the quick subset CI re-checks), ``python -m studies.ir_detectability --explain`` and
 ``--ramps`` (the small faults in the filter's innovations, ramped faults), ``python -m
+studies.ir_detection --plateau`` (the return test's ablation, tuning seeds), ``python -m
 studies.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
 infrared`` (the operation count; its timings are not findings).
 """
@@ -114,6 +115,21 @@ def detection_fresh() -> list[dict]:
     return found + _clean("infrared.fresh.fault_free", result["clean"], command)
 
 
+def plateau() -> list[dict]:
+    """The test that takes the end of an offset missed from its start for a return, each part
+    undone alone, on the tuning fleets of :data:`studies.ir_detection.PLATEAU_SEEDS` pooled."""
+    from studies import ir_detection
+
+    command, found = f"{DETECTION} --plateau", []
+    for label, cases in ir_detection.plateau_ablation().items():
+        for case, s in cases.items():
+            name = f"infrared.plateau.{label}.{case.replace('.', '_')}"
+            found += [finding(f"{name}.flights", s["flights"], "1", command, 0.0, 0),
+                      finding(f"{name}.right", s["right"]["k"], "1", command, 1.0, 0),
+                      finding(f"{name}.standing", s["standing"]["k"], "1", command, 1.0, 0)]
+    return found
+
+
 def detectability() -> list[dict]:
     """Why the small faults escape the CUSUMs on the filter's own innovations (seed 1), and how
     slow a fault may come before it passes for drift (seed 1)."""
@@ -193,4 +209,5 @@ def compute(quick: bool = False) -> list[dict]:
     """Every infrared finding; ``quick``: the small fresh fleets CI re-checks (:func:`detection_quick`)."""
     if quick:
         return detection_quick()
-    return errors() + detection_quick() + detection_fresh() + detectability() + limits() + comparison() + cost()
+    return (errors() + detection_quick() + detection_fresh() + plateau() + detectability() + limits() + comparison()
+            + cost())

@@ -23,9 +23,12 @@ The seeds: :data:`TUNING` are those the detector's settings were chosen on (and 
 was looked at on); :data:`FRESH` (per fault case) and :data:`FRESH_CLEAN` (fault-free) are
 disjoint from them and were flown only to score the design once frozen.
 
-``--ablation`` scores each design choice of :mod:`calibration.infrared.detection` by flying the
-same fresh fleets with it undone (:data:`ABLATIONS`), and the earlier design as a whole.
-``--quick`` is the small fresh set CI re-checks (:data:`QUICK`).
+``--ablation`` scores each design choice of :mod:`calibration.infrared.detection` by flying
+fleets of tuning seeds (:data:`ABLATION_FAULTS`, :data:`ABLATION_CLEAN`: an ablation is looked
+at) with it undone (:data:`ABLATIONS`), and the earlier design as a whole.
+``--quick`` is the small fresh set CI re-checks (:data:`QUICK`). ``--figure DIR`` draws a GPS
+offset missed from its start and its end (:func:`missed_figure`); ``--plateau`` undoes each part
+of the test that takes such an end for a return (:func:`plateau_ablation`, tuning seeds).
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ import argparse
 import math
 import sys
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
 import numpy as np
 
@@ -45,9 +49,9 @@ SAMPLES = 8000
 #: fleets flown to judge an earlier design and looked at before its last change (so tuning seeds now)
 TUNING = ((1, 9999), (1_000_000, 1_000_999), (2_000_000, 2_008_999), (3_000_000, 3_000_039), (3_100_000, 3_100_199),
           (3_200_000, 3_200_199), (4_000_000, 4_000_199), (4_100_000, 4_100_049), (5_000_000, 5_000_010),
-          (10_000_000, 10_000_999), (20_000_000, 20_004_499))
-FRESH = (60_000_000, 60_000_999)  # per fault case: 1000 flights, flown once, after the design was frozen
-FRESH_CLEAN = (61_000_000, 61_004_499)  # fault-free: 4500 flights, 500 flight-hours
+          (10_000_000, 10_000_999), (20_000_000, 20_004_499), (60_000_000, 60_000_999), (61_000_000, 61_004_499))
+FRESH = (70_000_000, 70_000_999)  # per fault case: 1000 flights, flown once, after the design was frozen
+FRESH_CLEAN = (71_000_000, 71_004_499)  # fault-free: 4500 flights, 500 flight-hours
 QUICK = {"faults": (30_000_000, 30_000_039), "clean": (30_100_000, 30_100_199)}  # CI's fresh subset
 CASES = (("ir", 100.0), ("gps", 0.1))  # the smallest offsets the detector is designed for
 LARGER = (("ir", 200.0), ("ir", 400.0), ("ir", 1200.0), ("gps", 0.2), ("gps", 0.3), ("gps", 1.5))
@@ -78,10 +82,18 @@ ABLATIONS = {
     "alt_restart": {"alt_restart": True},
     "alt_moved_25": {"alt_moved": 25.0},
     "alt_moved_25_fraction_0_25": {"alt_moved": 25.0, "alt_fraction": 0.25},
+    "plateau_off": {"plateau": 0},
+    "plateau_300": {"plateau": 300},
+    "plateau_1200": {"plateau": 1200},
+    "plateau_match_0_25": {"plateau_match": 0.25},
+    "plateau_flat_uncapped": {"plateau_flat_max": math.inf},
+    "plateau_unsettled_kept": {"plateau_settled": math.inf},
+    "return_hold_off": {"return_hold": False},
     "earlier_design": EARLIER,
 }
 ABLATION_CASES = (("ir", 100.0), ("gps", 0.1), ("ir", 50.0), ("ir", 1200.0))
-ABLATION_CLEAN = (2_000_000, 2_001_999)  # fault-free flights of the ablation: 2000 of the fresh ones
+ABLATION_FAULTS = (10_000_000, 10_000_999)  # per fault case of the ablation: tuning seeds, never the fresh ones
+ABLATION_CLEAN = (2_000_000, 2_001_999)  # fault-free flights of the ablation: 2000 tuning ones
 
 
 def kalman(flight: dict, settings: EKFSettings | None = None) -> dict:
@@ -235,11 +247,12 @@ def _hours_per(rate: float) -> str:
     return "inf" if rate == 0 else f"{1.0 / rate:.0f}"
 
 
-def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=FRESH, clean=ABLATION_CLEAN, jobs: int = 1,
+def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=ABLATION_FAULTS, clean=ABLATION_CLEAN, jobs: int = 1,
              echo: bool = True) -> dict:
-    """Each design choice undone alone (:data:`ABLATIONS`), on the fresh fleets of ``cases``
-    and the fault-free flights of ``clean``: label -> :func:`study`. ``variants`` maps a label to
-    the settings it overrides; ``jobs`` and ``echo`` as for :func:`study`."""
+    """Each design choice undone alone (:data:`ABLATIONS`), on the fleets of ``cases`` over the
+    seeds ``fresh`` (tuning seeds by default: an ablation is looked at) and the fault-free
+    flights of ``clean``: label -> :func:`study`. ``variants`` maps a label to the settings it
+    overrides; ``jobs`` and ``echo`` as for :func:`study`."""
     out = {}
     for label, overrides in variants.items():
         if echo:
@@ -249,7 +262,8 @@ def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=FRESH, clean=ABLATI
 
 
 def main(argv=None) -> int:
-    """``python -m studies.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--jobs N] [--out FILE]``.
+    """``python -m studies.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--plateau] [--figure DIR]
+    [--jobs N] [--out FILE]``.
 
     Parameters
     ----------
@@ -257,25 +271,38 @@ def main(argv=None) -> int:
         The arguments (the process's if None).
     """
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fresh", default=f"{FRESH[0]}:{FRESH[1]}", help="seeds of each fault case, FIRST:LAST")
-    parser.add_argument("--clean", default=f"{FRESH_CLEAN[0]}:{FRESH_CLEAN[1]}",
-                        help="seeds of the fault-free flights, FIRST:LAST")
-    parser.add_argument("--ablation", action="store_true", help="each design choice undone (on the fresh fleets)")
+    parser.add_argument("--fresh", help=f"seeds of each fault case, FIRST:LAST (default {FRESH[0]}:{FRESH[1]}; "
+                                        f"with --ablation, tuning seeds {ABLATION_FAULTS[0]}:{ABLATION_FAULTS[1]})")
+    parser.add_argument("--clean", help=f"seeds of the fault-free flights, FIRST:LAST (default {FRESH_CLEAN[0]}:"
+                                        f"{FRESH_CLEAN[1]}; with --ablation {ABLATION_CLEAN[0]}:{ABLATION_CLEAN[1]})")
+    parser.add_argument("--ablation", action="store_true", help="each design choice undone (on tuning seeds)")
     parser.add_argument("--quick", action="store_true", help="the small fresh set CI re-checks")
     parser.add_argument("--larger", action="store_true", help="also the larger offsets and those below the design")
+    parser.add_argument("--plateau", action="store_true", help="the plateau test's parts undone (tuning seeds)")
+    parser.add_argument("--figure", metavar="DIR", help="draw missed_offset.png (a missed GPS offset's end) into DIR")
     parser.add_argument("--jobs", type=int, default=1, help="processes (default 1)")
     parser.add_argument("--out", help="write the results to this JSON file")
     args = parser.parse_args(argv)
+    faults, free = (ABLATION_FAULTS, ABLATION_CLEAN) if args.ablation else (FRESH, FRESH_CLEAN)
     try:
-        fresh = tuple(int(x) for x in args.fresh.split(":"))
-        clean = tuple(int(x) for x in args.clean.split(":"))
+        fresh = tuple(int(x) for x in args.fresh.split(":")) if args.fresh else faults
+        clean = tuple(int(x) for x in args.clean.split(":")) if args.clean else free
         if len(fresh) != 2 or len(clean) != 2:
             raise ValueError
     except ValueError:
         parser.error("write the seeds as FIRST:LAST, e.g. 1000000:1000999")
     if args.jobs < 1:
         parser.error(f"--jobs {args.jobs}: give at least one process")
-    if args.quick:
+    if args.figure:
+        print(f"figure: {missed_figure(args.figure)}")
+        return 0
+    if args.plateau:
+        result = plateau_ablation(jobs=args.jobs)
+        for label, cases in result.items():
+            for case, s in cases.items():
+                print(f"[{label}] {case}: on the right sensor {_rate(s['right'])}; left standing "
+                      f"{_rate(s['standing'])}", flush=True)
+    elif args.quick:
         result = quick(echo=True)
     elif args.ablation:
         last = min(clean[1], clean[0] + ABLATION_CLEAN[1] - ABLATION_CLEAN[0])
@@ -298,6 +325,65 @@ def quick(echo: bool = False) -> dict:
     return study((("ir", 100.0), ("gps", 0.1)), QUICK["faults"], QUICK["clean"], echo=echo)
 
 
+#: the plateau test's parts undone alone (label -> settings), each on the cases it bears on
+PLATEAU_ABLATION = {
+    "designed": ({}, (("gps", 0.1), ("ir", 100.0), ("gps", 0.3))),
+    "plateau_off": ({"plateau": 0}, (("gps", 0.1),)),
+    "return_hold_off": ({"return_hold": False}, (("ir", 100.0),)),
+    "flat_uncapped": ({"plateau_flat_max": math.inf}, (("gps", 0.3),)),
+    "unsettled_kept": ({"plateau_flat_max": math.inf, "plateau_settled": math.inf}, (("ir", 100.0), ("gps", 0.3))),
+    "match_0_25": ({"plateau_match": 0.25}, (("gps", 0.1),)),
+}
+PLATEAU_SEEDS = ((10_000_000, 10_000_999), (60_000_000, 60_000_999))  # tuning: the ablation is looked at
+
+
+def plateau_ablation(variants=PLATEAU_ABLATION, seeds=PLATEAU_SEEDS, jobs: int = 1) -> dict:
+    """The plateau test's parts undone alone, on the tuning fleets ``seeds`` ((first, last)
+    each) pooled: label -> case -> :func:`summary`. ``variants`` maps a label to the settings it
+    overrides and the ``(sensor, size)`` cases it is flown on; ``jobs`` processes. A return test
+    only ever withdraws a declaration, so fault-free flights, which declare none, cannot move."""
+    out = {}
+    for label, (overrides, cases) in variants.items():
+        out[label] = {}
+        for sensor, size in cases:
+            rows = [row for first, last in seeds
+                    for row in fleet(sensor, size, range(first, last + 1), overrides, jobs)]
+            out[label][f"{sensor}_{size:g}"] = summary(rows, sensor)
+    return out
+
+
+def missed_figure(out, seed: int = 60_000_178, size: float = 0.1):
+    """``missed_offset.png``: a GPS offset of ``size`` (rad/s) missed from its start on the flight
+    of ``seed`` (tuning), with the plateau test and without (``plateau=0``): the filter's ``b``
+    against the true one (count), and the GPS fault it declares; returns its path. ``out`` is
+    the folder."""
+    import matplotlib.pyplot as plt
+
+    from scenarios.plant import save_figure
+
+    flight = fly(seed, "gps", size)
+    time = flight["time"]
+    ((_, onset, end, _),) = fault_windows("gps", size, size)
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 5), sharex=True, height_ratios=(3, 1))
+    for label, overrides, style in (("plateau test (the design)", {}, "-"), ("plateau=0", {"plateau": 0}, "--")):
+        estimate = kalman(flight, EKFSettings(**overrides))
+        top.plot(time, estimate["b"] - flight["b"], style, lw=1, label=f"filter's b - true b, {label}")
+        bottom.plot(time, estimate["gps_fault"], style, lw=1, label=label)
+    for ax in (top, bottom):
+        ax.axvspan(onset, end, color="tab:red", alpha=0.1, label="GPS offset" if ax is top else None)
+        ax.grid(alpha=0.3)
+    top.axhline(-EKFSettings().a0 * size, color="k", lw=0.6, ls=":", label="the offset in counts, -a0 x offset")
+    top.set_ylabel("count")
+    top.set_ylim(-40, 80)
+    top.legend(fontsize=7, loc="upper left")
+    bottom.set_ylabel("GPS fault declared")
+    bottom.set_xlabel("time (s)")
+    bottom.legend(fontsize=7, loc="upper left")
+    top.set_title(f"GPS +{size:g} rad/s from {onset:g} s missed from its start (seed {seed}): the filter absorbs it; "
+                  "its end is a return, not a new fault", fontsize=8)
+    return save_figure(fig, Path(out), "missed_offset.png")
+
+
 def one_fault(sensor: str, size: float, seed: int = 1, settings: EKFSettings | None = None) -> dict:
     """The declaration of one fault of ``size`` on ``sensor`` in the flight of ``seed``
     (:func:`outcome`, and the ``turn_rate_error_std_deg_s`` after 30 s), under the filter's
@@ -310,7 +396,7 @@ def one_fault(sensor: str, size: float, seed: int = 1, settings: EKFSettings | N
 
 
 __all__ = ["ABLATIONS", "CASES", "FRESH", "FRESH_CLEAN", "QUICK", "TUNING", "ablation", "fleet", "one_fault",
-           "outcome", "per_hour", "proportion", "quick", "study", "summary"]
+           "missed_figure", "outcome", "per_hour", "plateau_ablation", "proportion", "quick", "study", "summary"]
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -85,6 +85,10 @@ def test_streaming_runs_the_batch_arithmetic_through_a_small_gps_fault():
 def test_consistency_settings_are_checked():
     with pytest.raises(ValueError, match="significance"):
         EKFSettings(significance=0.0)
+    with pytest.raises(ValueError, match="slow ring"):
+        EKFSettings(plateau=3000)
+    with pytest.raises(ValueError, match="plateau_match"):
+        EKFSettings(plateau_match=-0.1)
     with pytest.raises(ValueError, match="end_significance"):
         EKFSettings(end_significance=-1.0)
 
@@ -100,6 +104,37 @@ def test_the_end_of_an_absorbed_offset_leaves_no_fault_standing(sensor, size, se
     after = fleet(sensor, size, seeds)
     assert [row["seed"] for row in after if row["standing"]] == []
     assert all(row["right"] for row in after)
-    # without the return test, every one of them is left standing
-    before = fleet(sensor, size, seeds, {"alt_ended": False, "alt_innovation": False})
+    # without the return tests, every one of them is left standing (the plateau test alone ends 1,000,367's)
+    before = fleet(sensor, size, seeds, {"alt_ended": False, "alt_innovation": False, "plateau": 0})
     assert [row["seed"] for row in before if row["standing"]] == list(seeds)
+
+
+#: Flights of the tuning seeds where a GPS +0.1 rad/s offset was missed from its start, absorbed
+#: into the calibration, and its end declared as a fault that never cleared (before the plateau
+#: test: ``python -m studies.ir_detection`` with ``plateau=0``).
+MISSED = (1_000_182, 1_000_549, 1_000_648, 10_000_438, 10_000_667, 10_000_742, 60_000_178, 60_000_228, 60_000_787)
+
+
+def test_the_end_of_an_offset_missed_from_its_start_leaves_no_fault_standing():
+    after = fleet("gps", 0.1, MISSED)
+    assert [row["seed"] for row in after if row["standing"] or row["at_end"] or row["other"]] == []
+    # without the plateau test, every one of them is left standing
+    before = fleet("gps", 0.1, MISSED, {"plateau": 0})
+    assert [row["seed"] for row in before if row["standing"]] == list(MISSED)
+
+
+def test_after_an_ir_return_its_window_is_not_declared_anew():
+    """Seed 10,000,725 (tuning), IR +100: the declaration ends early, the end is recognised as a
+    return, and the paired window, still holding offset samples, was declared as a new fault."""
+    assert not fleet("ir", 100.0, (10_000_725,))[0]["standing"]
+    assert fleet("ir", 100.0, (10_000_725,), {"return_hold": False})[0]["standing"]
+
+
+#: Tuning flights where a GPS +0.3 rad/s fault 10 s after the cloud's exit was taken for a return
+#: when the plateau could stray by half the change (60 counts, about the cloud's full cover).
+AFTER_CLOUD = (10_000_168, 10_000_535, 10_000_726, 10_000_936)
+
+
+def test_a_gps_fault_after_the_cloud_is_no_return():
+    assert all(row["right"] for row in fleet("gps", 0.3, AFTER_CLOUD))
+    assert not any(row["right"] for row in fleet("gps", 0.3, AFTER_CLOUD, {"plateau_flat_max": 1e9}))

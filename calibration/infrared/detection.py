@@ -52,6 +52,17 @@ calibration *held* from before (:func:`consistency`).
   back, no fault declared, :func:`_returned`) rather than for a new fault, which, ``a`` and
   ``b`` held at the absorbed calibration, would never clear. Tested on the faults of both the
   consistency residual and the innovations' CUSUMs (``alt_innovation``).
+- **The end of an offset missed from its start** (``plateau``): no declaration ever held a
+  calibration for it, so nothing is remembered; the filter absorbed it in a few seconds and sat
+  at the absorbed calibration until it ended. A slow ring keeps ``a`` and ``b`` once a second
+  for 160 s; a change about to be declared is taken for a return when, at the present turn
+  rate, those calibrations show a plateau at the present one for at least 30 s and, just before
+  it, a calibration the change brings the sensors back to (:func:`_plateau_return`). The
+  cloud's ramps and the filter's catching up after them leave no plateau that long before a
+  GPS fault 10 s after the cloud's exit, and the plateau may stray by a bounded number of counts
+  only, whatever the change, so that a large fault does not take the cloud's full cover for one.
+  After any return the paired IR is left unwatched for the GPS window's span
+  (``return_hold``): after an IR offset's end the window still holds offset samples.
 - **Options measured and left off**: ``decisive`` (declare on the better shape whatever the
   fit, once the CUSUM's statistic is that strong: under a frozen calibration the statistic grows
   with the cloud's drift too) and ``alt_level`` (remember the calibration from before a change
@@ -148,8 +159,16 @@ from calibration.infrared.layout import (
     PB0,
     PBB,
     PBR,
+    PLATEAU_FLAT,
+    PLATEAU_FLAT_MAX,
+    PLATEAU_MATCH,
+    PLATEAU_MIN,
+    PLATEAU_MOVE,
+    PLATEAU_SKIP,
+    PLATEAU_VAR,
     PRR,
     RAMP,
+    RETURN_HOLD,
     RG,
     RI,
     RI1,
@@ -163,6 +182,10 @@ from calibration.infrared.layout import (
     SETTLING,
     SIGNIFICANCE,
     SIZE_GAIN,
+    SLOW,
+    SLOW_COUNT,
+    SLOW_EVERY,
+    SLOW_SIZE,
     SUM_DOWN,
     SUM_UP,
     TURN_MODE,
@@ -342,16 +365,56 @@ def _returned(s, c, d, a, b):
 
 
 @njit(cache=True)
+def _plateau_return(s, c, d, a, b):
+    """Whether the change ``d`` (count, in the consistency residual) about to be declared, seen
+    against the calibration ``a``, ``b``, ends an offset the filter absorbed unseen: the slow
+    ring of past calibrations (one per second) shows, at the present turn rate, a plateau at
+    ``a``, ``b`` (within ``c[PLATEAU_FLAT]`` of ``|d|``) for at least ``c[PLATEAU_MIN]`` entries
+    before the newest ``c[PLATEAU_SKIP]`` (the change itself), and within ``c[PLATEAU_MOVE]``
+    entries before that plateau a calibration the change brings the sensors back to (against
+    it the residual would be ``d`` minus their difference, less than ``c[PLATEAU_MATCH]`` of
+    ``|d|``): the absorbed offset's start, a move of ``-d``. That calibration is left in
+    ``ALT_A``, ``ALT_B`` (:func:`_take_back`). The cloud's ramps and the filter's catching up
+    after them leave no plateau that long before the GPS fault that follows."""
+    if c[PLATEAU_MIN] <= 0.0:
+        return False
+    count = int(s[SLOW_COUNT])
+    n = count if count < SLOW_SIZE else SLOW_SIZE
+    u = s[HELD_GPS]
+    flat, match = min(c[PLATEAU_FLAT] * abs(d), c[PLATEAU_FLAT_MAX]), c[PLATEAU_MATCH] * abs(d)
+    m = int(c[PLATEAU_SKIP])
+    while m < n:  # back along the plateau, newest first
+        slot = SLOW + (count - 1 - m) % SLOW_SIZE
+        if not abs((s[slot] - a) * u + s[slot + SLOW_SIZE] - b) <= flat:  # nan too: not learnt then
+            break
+        m += 1
+    if m - c[PLATEAU_SKIP] < c[PLATEAU_MIN]:
+        return False
+    last = m + int(c[PLATEAU_MOVE])
+    while m < n and m < last:  # the move that made it: does it start from where d returns to?
+        slot = SLOW + (count - 1 - m) % SLOW_SIZE
+        if abs((s[slot] - a) * u + s[slot + SLOW_SIZE] - b - d) < match:
+            s[ALT_A], s[ALT_B] = s[slot], s[slot + SLOW_SIZE]
+            return True
+        m += 1
+    return False
+
+
+@njit(cache=True)
 def _take_back(s, c):
     """A return recognised (:func:`_returned`): the remembered calibration back, no fault."""
     s[A], s[B] = s[ALT_A], s[ALT_B]
     s[ALT_LEFT] = 0.0
     reopen(s, c)
+    if c[RETURN_HOLD] > 0.5:  # an IR offset's end: the paired window still holds offset samples
+        s[HOLD] = c[WINDOW_SPAN]
 
 
 @njit(cache=True)
-def remember_calibration(s):
-    """Keep this sample's ``a``, ``b`` and their covariance in the ring of past calibrations."""
+def remember_calibration(s, c):
+    """Keep this sample's ``a``, ``b`` and their covariance in the ring of past calibrations,
+    and once a second ``a`` and ``b`` in the slow ring (``nan`` while the variance of ``b`` is
+    above ``c[PLATEAU_VAR]``: not learnt yet, so neither a plateau nor where a change returns to)."""
     count = int(s[PAST_COUNT])
     slot = PAST + count % PAST_SIZE
     s[slot] = s[A]
@@ -360,6 +423,13 @@ def remember_calibration(s):
     s[slot + 3 * PAST_SIZE] = s[PAB]
     s[slot + 4 * PAST_SIZE] = s[PBB]
     s[PAST_COUNT] = count + 1
+    if count % SLOW_EVERY == 0:  # the slow ring (:func:`_plateau_return`)
+        slow = int(s[SLOW_COUNT])
+        slot = SLOW + slow % SLOW_SIZE
+        learnt = s[PBB] <= c[PLATEAU_VAR]
+        s[slot] = s[A] if learnt else math.nan
+        s[slot + SLOW_SIZE] = s[B] if learnt else math.nan
+        s[SLOW_COUNT] = slow + 1
 
 
 @njit(cache=True)
@@ -713,11 +783,14 @@ def detect(s, c, gps_seen, pair_seen, raw_seen):
                 s[A_SAFE], s[B_SAFE] = s[A], s[B]
             return
         ref = PAST + (int(s[PAST_COUNT]) - n_ring(s)) % PAST_SIZE  # the calibration the ring is seen against
-        if _returned(s, c, size * math.sqrt(s[GATE_CONS]), s[ref], s[ref + PAST_SIZE]):
+        d, a, b = size * math.sqrt(s[GATE_CONS]), s[ref], s[ref + PAST_SIZE]
+        if _returned(s, c, d, a, b) or _plateau_return(s, c, d, a, b):
             _take_back(s, c)  # the end of an offset absorbed earlier: its calibration back, no fault
         else:
             _declare_held(s, c, sensor, size, onset)
-    elif c[ALT_INNOVATION] > 0.5 and _returned(s, c, _innovation_step(s, gps, pair, now, ir), s[A_SAFE], s[B_SAFE]):
+    elif c[ALT_INNOVATION] > 0.5 and (_returned(s, c, _innovation_step(s, gps, pair, now, ir), s[A_SAFE], s[B_SAFE])
+                                      or _plateau_return(s, c, _innovation_step(s, gps, pair, now, ir), s[A_SAFE],
+                                                         s[B_SAFE])):
         _take_back(s, c)
     else:
         _declare(s, c, gps, pair, now, ir)

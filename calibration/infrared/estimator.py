@@ -86,6 +86,13 @@ from calibration.infrared.layout import (
     PB0,
     PBB,
     PBR,
+    PLATEAU_FLAT,
+    PLATEAU_FLAT_MAX,
+    PLATEAU_MATCH,
+    PLATEAU_MIN,
+    PLATEAU_MOVE,
+    PLATEAU_SKIP,
+    PLATEAU_VAR,
     PRR,
     QA,
     QB,
@@ -97,6 +104,7 @@ from calibration.infrared.layout import (
     REG_RATE,
     REG_SIZE,
     REJECTED,
+    RETURN_HOLD,
     RG,
     RI,
     RI1,
@@ -110,6 +118,8 @@ from calibration.infrared.layout import (
     SD_DRIFT,
     SIGNIFICANCE,
     SIZE_GAIN,
+    SLOW_EVERY,
+    SLOW_SIZE,
     STATUS,
     TURN_MODE,
     WINDOW_SPAN,
@@ -245,6 +255,28 @@ class EKFSettings:
     alt_fraction : float
         A change is a return when, against the remembered calibration, the residual after it is
         less than this fraction of the change.
+    plateau, plateau_skip, plateau_move : int
+        The end of an offset missed from its start, which no declaration ever held a calibration
+        for: a change about to be declared is taken for a return when the calibrations of the
+        last 160 s (one a second) show, at the present turn rate, a plateau at the present one
+        for at least ``plateau`` samples (0: never), the newest ``plateau_skip`` samples left
+        out (the change itself), and, within ``plateau_move`` samples before it, the
+        calibration the change brings the sensors back to (:func:`~calibration.infrared.
+        detection._plateau_return`). The cloud and the filter's catching up after it leave no
+        plateau that long before the GPS fault that follows.
+    plateau_flat, plateau_flat_max : float
+        How far the plateau's calibrations may stray from the present one (count, at the present
+        turn rate): this fraction of the change, at most ``plateau_flat_max`` counts (a large
+        change would take the cloud's full cover for a plateau).
+    plateau_match : float
+        How far (a fraction of the change) the calibration before the move may be from the one
+        the change returns to.
+    plateau_settled : float
+        A calibration whose variance of ``b`` exceeds this fraction of the initial one
+        (``sd_b0^2``) is no plateau nor a return's end (the filter's first seconds).
+    return_hold : bool
+        After a return, leave the paired IR unwatched for the GPS window's span: after an IR
+        offset's end the window still holds offset samples, which would be declared anew.
     scale_gain : float
         Weight per sample of the running mean square of the normalised consistency residual
         while its CUSUM is zero (1 / samples): the spread the attribution scales by.
@@ -309,6 +341,14 @@ class EKFSettings:
     alt_needs_run: bool = True
     alt_span: int = 40
     alt_fraction: float = 0.5
+    plateau: int = 600
+    plateau_skip: int = 200
+    plateau_move: int = 300
+    plateau_flat: float = 0.5
+    plateau_match: float = 0.5
+    plateau_settled: float = 0.1
+    plateau_flat_max: float = 20.0
+    return_hold: bool = True
     scale_gain: float = 0.01
     end_h: float = 10.0
     size_gain: float = 0.05
@@ -327,10 +367,16 @@ class EKFSettings:
             if not value > 0.0 or math.isnan(value):
                 raise ValueError(f"{name} = {value!r} must be positive (inf where it turns a detector off); "
                                  "the detector needs a positive allowance and threshold")
-        for name in ("alt_shift", "alt_moved", "alt_fraction"):
+        for name in ("alt_shift", "alt_moved", "alt_fraction", "plateau_flat", "plateau_flat_max", "plateau_match",
+                     "plateau_settled"):
             if not getattr(self, name) >= 0.0:
                 raise ValueError(f"{name} = {getattr(self, name)!r} must be >= 0 (inf: never)")
-        for name, top in (("alt_wait", math.inf), ("alt_span", PAST_SIZE - 1)):
+        span = self.plateau + self.plateau_skip + self.plateau_move
+        if span > SLOW_EVERY * SLOW_SIZE:
+            raise ValueError(f"plateau + plateau_skip + plateau_move = {span} samples: the slow ring of past "
+                             f"calibrations holds {SLOW_EVERY * SLOW_SIZE}")
+        for name, top in (("alt_wait", math.inf), ("alt_span", PAST_SIZE - 1), ("plateau", math.inf),
+                          ("plateau_skip", math.inf), ("plateau_move", math.inf)):
             value = getattr(self, name)
             if int(value) != value or not 0 <= value <= top:
                 raise ValueError(f"{name} = {value!r} must be a whole number of samples in [0, {top}]")
@@ -365,6 +411,11 @@ class EKFSettings:
         c[ALT_ENDED], c[ALT_RESTART], c[ALT_INNOVATION] = self.alt_ended, self.alt_restart, self.alt_innovation
         c[ALT_SHIFT], c[ALT_WAIT], c[ALT_MOVED] = self.alt_shift, self.alt_wait, self.alt_moved
         c[ALT_NEEDS_RUN], c[ALT_FRACTION], c[ALT_SPAN] = self.alt_needs_run, self.alt_fraction, self.alt_span
+        c[PLATEAU_SKIP], c[PLATEAU_MIN] = self.plateau_skip // SLOW_EVERY, self.plateau // SLOW_EVERY
+        c[PLATEAU_MOVE], c[PLATEAU_FLAT], c[PLATEAU_MATCH] = (self.plateau_move // SLOW_EVERY, self.plateau_flat,
+                                                              self.plateau_match)
+        c[PLATEAU_VAR] = self.plateau_settled * self.sd_b0**2
+        c[PLATEAU_FLAT_MAX], c[RETURN_HOLD] = self.plateau_flat_max, self.return_hold
         c[LAG], c[RI1] = self.sd_lag**2, self.sd_ir_sample**2
         c[PA0], c[PB0] = self.sd_a0**2, self.sd_b0**2
         return c

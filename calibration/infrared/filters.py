@@ -197,7 +197,7 @@ def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
         if raw_seen and gps_available:
             consistency(s, c, watched, gps)
         detect(s, c, gps_available, have_pair, raw_seen)
-        remember_calibration(s)
+        remember_calibration(s, c)
     _finish(s, ir_now)
 
 

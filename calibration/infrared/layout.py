@@ -43,7 +43,13 @@ PAST_COUNT = RING + 3 * RING_SIZE
 PAST = PAST_COUNT + 1
 PAST_SIZE = 200  # samples: the calibrations a frozen run may be held against (10 s at 20 Hz)
 PAST_FIELDS = 5
-EKF_SIZE = PAST + PAST_FIELDS * PAST_SIZE
+# the slow ring of past calibrations: a and b once every SLOW_EVERY samples, for longer than an offset lasts, so that
+# the end of an offset the filter absorbed unseen is told from a new fault by the plateau it leaves behind
+SLOW_COUNT = PAST + PAST_FIELDS * PAST_SIZE
+SLOW = SLOW_COUNT + 1
+SLOW_EVERY = 20  # samples: 1 s at 20 Hz
+SLOW_SIZE = 160  # entries: 160 s, longer than an offset (100 s) and the move that absorbed it
+EKF_SIZE = SLOW + 2 * SLOW_SIZE
 # EKF configuration c: process noise variances per sample, measurement variances, gate, detectors.
 # WINDOW_SPAN: delay + window of the GPS pairing (samples), set by the estimator.
 QA, QB, QR, RG, RI, GAMMA2, LAG, RI1, PA0, PB0 = range(10)
@@ -72,7 +78,15 @@ END_SIGNIFICANCE, COMPLETE, END_TURN = 33, 34, 35
 # and the span (samples) within which a and b must move that far (a cloud's drift is slower, an absorbed offset fast)
 ALT_ENDED, ALT_RESTART, ALT_SHIFT, ALT_WAIT, ALT_INNOVATION, ALT_MOVED, ALT_NEEDS_RUN, ALT_FRACTION = range(36, 44)
 ALT_SPAN = 44
-EKF_CONFIG_SIZE = 45
+# the end of an offset absorbed unseen (the slow ring above): the entries (s) newest that the plateau skips (the
+# change itself), the plateau's least length and the longest move before it (entries), and the fractions of the
+# change by which the plateau may stray from the present calibration and the calibration before the move may miss
+# the one the change returns to (0 length: off), and the variance of b (count^2) above which a calibration, not
+# yet learnt, enters the slow ring as none; the most (count) the plateau may stray by whatever the change, and
+# whether the paired IR is left unwatched for the GPS window's span after a return (1: it may still hold the offset)
+PLATEAU_SKIP, PLATEAU_MIN, PLATEAU_MOVE, PLATEAU_FLAT, PLATEAU_MATCH, PLATEAU_VAR = range(45, 51)
+PLATEAU_FLAT_MAX, RETURN_HOLD = 51, 52
+EKF_CONFIG_SIZE = 53
 # status codes
 OK, LOST_PD, ZERO_GAIN = 0.0, 1.0, 2.0
 
