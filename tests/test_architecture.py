@@ -358,9 +358,6 @@ LONG_MODULES = {
     # the filters' reference: the module's docstring is the 110-line description of every
     # correction the code below switches, which the docs include whole
     "estimators/filters.py": 743,
-    # the detector's CUSUM, its attribution fit and its end are one state machine over one ring
-    # of samples, documented at the top as one algorithm
-    "calibration/infrared/detection.py": 831,
 }
 
 

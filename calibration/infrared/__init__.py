@@ -47,15 +47,8 @@ Units: turn rate rad/s, IR in counts, ``a`` in counts per rad/s.
 """
 
 from calibration.infrared.cost import SLIDES_OPERATIONS, SLIDES_PROCESSOR, SLIDES_RATE, cost
-from calibration.infrared.estimator import (
-    METHODS,
-    CalibrationError,
-    EKFSettings,
-    Estimator,
-    InfraredCalibration,
-    RegressionSettings,
-    RLSSettings,
-)
+from calibration.infrared.estimator import METHODS, CalibrationError, Estimator, InfraredCalibration
+from calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
 
 __all__ = ["METHODS", "SLIDES_OPERATIONS", "SLIDES_PROCESSOR", "SLIDES_RATE", "CalibrationError", "EKFSettings",
            "Estimator", "InfraredCalibration", "RLSSettings", "RegressionSettings", "cost"]

@@ -13,8 +13,9 @@ import math
 
 import numpy as np
 
-from calibration.infrared.estimator import CalibrationError, EKFSettings, Estimator, _finite
+from calibration.infrared.estimator import CalibrationError, Estimator, _finite
 from calibration.infrared.filters import buffer_size
+from calibration.infrared.settings import EKFSettings
 
 SLIDES_OPERATIONS = 300  # per iteration, counted by the slides
 SLIDES_RATE = 20.0  # Hz
@@ -111,9 +112,9 @@ class _CountedMath:
 
 
 def _modules():
-    from calibration.infrared import detection, estimator, filters
+    from calibration.infrared import attribution, detection, estimator, filters
 
-    return (filters, detection, estimator)
+    return (filters, detection, attribution, estimator)
 
 
 def _count_operations(estimator, ir, gps, use) -> np.ndarray:
@@ -128,7 +129,7 @@ def _count_operations(estimator, ir, gps, use) -> np.ndarray:
                     setattr(module, name, value.py_func)
             saved.append((module, "math", module.__dict__.get("math", _REAL_MATH)))
             module.math = _CountedMath
-        _, _, runner = _modules()
+        runner = _modules()[-1]  # the estimator, whose _sample steps the rest
         state = [_Counted(v) for v in estimator._initial]
         config = [_Counted(v) for v in estimator.config]
         buffer = [_Counted(0.0) for _ in range(buffer_size(estimator.delay, estimator.window))]
