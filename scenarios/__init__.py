@@ -575,7 +575,15 @@ def _draw(scenario, system, options, files):
 
         files.phase = "drawing the wiring diagram"
         status(f"{scenario.name}: wiring diagram")
-        draw(system, files.out / "diagram.png", scenario.title(options))
+        draw(system, files.out / "diagram.png", scenario.title(options), cache=diagram_cache())
+
+
+def diagram_cache() -> Path:
+    """Where runs keep the wiring diagrams they drew, by a digest of the wiring
+    (:func:`orchestrator.diagram.wiring_key`): ``diagrams/`` beside the built FMUs."""
+    from fmus import build_root
+
+    return build_root() / "diagrams"
 
 
 def _report(scenario, result, options, files, record) -> dict:
