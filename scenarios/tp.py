@@ -140,8 +140,8 @@ def build(o: dict, estimator=None) -> System:
         Parsed options (``quadcosim list`` shows them with their units).
     estimator : orchestrator.Block or class, optional
         An estimator of the user's in the place of ``Quaternion_estim`` (see
-        :mod:`estimators.contract`); ``o["estimator"]`` then names it, ``module:Class``.
-        ``o["estimator"] = "module:Class"`` does the same from the options.
+        :mod:`estimators.contract`; :meth:`scenarios.Scenario.prepare` names it in the options,
+        ``module:Class``). ``o["estimator"] = "module:Class"`` does the same from the options.
 
     Returns
     -------
@@ -178,8 +178,6 @@ def build(o: dict, estimator=None) -> System:
     if estimator is not None or ":" in o["estimator"]:
         from estimators import contract
 
-        if estimator is not None:
-            o["estimator"] = contract.label(estimator)
         estimator = system.add(contract.adopt(estimator if estimator is not None else o["estimator"], period,
                                               q0=q0, available=system.blocks["IMU"].outputs))
     else:
