@@ -611,10 +611,13 @@ def _draw(scenario, system, options, files):
 
 def diagram_cache() -> Path:
     """Where runs keep the wiring diagrams they drew, by a digest of the wiring
-    (:func:`orchestrator.diagram.wiring_key`): ``diagrams/`` beside the built FMUs."""
+    (:func:`orchestrator.diagram.wiring_key`): ``$QUADCOSIM_DIAGRAM_CACHE`` if set, else
+    ``diagrams/`` beside the built FMUs."""
+    import os
+
     from fmus import build_root
 
-    return build_root() / "diagrams"
+    return Path(os.environ.get("QUADCOSIM_DIAGRAM_CACHE") or build_root() / "diagrams")
 
 
 def _report(scenario, result, options, files, record) -> dict:
