@@ -28,6 +28,7 @@ class Options(dict):
     """
 
     def _refuse(self, *args, **kwargs):
+        """Refused: the options are read-only once parsed (raises :class:`TypeError`)."""
         raise TypeError("a run's options are read-only once parsed: make a new mapping (options | {key: value})")
 
     __setitem__ = __delitem__ = __ior__ = _refuse
