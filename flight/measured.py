@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import curve_fit
 
 from flight import profiles, trim
 
@@ -66,6 +65,8 @@ def tilt_step(result, tilt: float, rotor_drag: bool) -> dict:
              "speed_final_m_s": float(np.linalg.norm(result["Quadrotor.v"][-1]))}
     window = result.time > profiles.STEP_TIME + SETTLED_AFTER_STEP
     if rotor_drag and np.count_nonzero(window) > FIT_PARAMETERS:
+        from scipy.optimize import curve_fit  # here: every tp report imports this module
+
         def lag(t, final, amplitude, tau):
             return final - amplitude * np.exp(-(t - profiles.STEP_TIME) / tau)
 

@@ -101,7 +101,78 @@ def wind_hover_tilt(wind_speed: float, mass: float = vehicle.MASS, thrust_coeff:
 
     if w == 0.0:
         return 0.0, mass * g
-    from scipy.optimize import brentq  # imported where used: start-up
-
-    tilt = brentq(horizontal, 0.0, LARGEST_TRIM_TILT, xtol=1e-14)
+    tilt = brent_root(horizontal, 0.0, LARGEST_TRIM_TILT, xtol=1e-14)
     return tilt, thrust_of(tilt)
+
+
+#: Relative tolerance of :func:`brent_root`, 4 machine epsilons (``scipy.optimize.brentq``'s default).
+BRENT_RTOL = 4 * 2.220446049250313e-16
+BRENT_ITERATIONS = 100  # most iterations of :func:`brent_root` (``brentq``'s default)
+
+
+def brent_root(f, a: float, b: float, xtol: float = 2e-12, rtol: float = BRENT_RTOL,
+               iterations: int = BRENT_ITERATIONS) -> float:
+    """A root of ``f`` bracketed by ``a`` and ``b``: Brent's method, step for step as
+    ``scipy.optimize.brentq`` takes it, so the same bits (a test holds the two equal).
+
+    Every ``quasi`` flight trims its cruise at start-up; importing ``scipy.optimize`` for
+    this one root cost more CPU than a 2 s run simulates.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``, of opposite signs at ``a`` and ``b``.
+    a, b : float
+        The bracket (the unit of ``x``).
+    xtol, rtol : float
+        Absolute (the unit of ``x``) and relative (1) tolerance on the root.
+    iterations : int
+        Most iterations.
+
+    Returns
+    -------
+    float
+        The root.
+
+    Raises
+    ------
+    ValueError
+        ``f(a)`` and ``f(b)`` of one sign, or no convergence within ``iterations``.
+    """
+    xpre, xcur = float(a), float(b)
+    xblk = fblk = spre = scur = 0.0
+    fpre, fcur = float(f(xpre)), float(f(xcur))
+    if fpre == 0:
+        return xpre
+    if fcur == 0:
+        return xcur
+    if math.copysign(1.0, fpre) == math.copysign(1.0, fcur):
+        raise ValueError("f(a) and f(b) must have different signs")
+    for _ in range(iterations):
+        if fpre != 0 and fcur != 0 and math.copysign(1.0, fpre) != math.copysign(1.0, fcur):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):  # the best estimate is the one of least |f|
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (xtol + rtol * abs(xcur)) / 2
+        sbis = (xblk - xcur) / 2
+        if fcur == 0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:  # interpolate
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:  # extrapolate
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):  # a good short step
+                spre, scur = scur, stry
+            else:  # bisect
+                spre = scur = sbis
+        else:  # bisect
+            spre = scur = sbis
+        xpre, fpre = xcur, fcur
+        xcur += scur if abs(scur) > delta else (delta if sbis > 0 else -delta)
+        fcur = float(f(xcur))
+    raise ValueError(f"no root found within {iterations} iterations")

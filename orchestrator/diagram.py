@@ -19,7 +19,7 @@ from functools import partial
 from pathlib import Path
 
 from orchestrator.blocks import Constant, FMUBlock
-from orchestrator.files import save_figure
+from orchestrator.files import atomic_path, save_figure
 
 # Layout, in axis units (one unit is INCH inches on the page): a block's box, the spacing of the
 # columns, the spacing of the lanes above and below the row.
@@ -107,7 +107,7 @@ class Arrow:
         return self.side * (self.box / 2 + LANE * (self.lane + 1))
 
 
-def draw(system, path, title: str | None = None) -> Path:
+def draw(system, path, title: str | None = None, cache: Path | None = None) -> Path:
     """Draw the wiring of ``system`` into ``path`` (PNG or SVG, by suffix).
 
     Parameters
@@ -119,12 +119,25 @@ def draw(system, path, title: str | None = None) -> Path:
     title : str, optional
         First line of the title (e.g. the scenario and its key options); the second gives
         the counts of blocks and connections and the macro step.
+    cache : pathlib.Path, optional
+        Folder of drawings by :func:`wiring_key`: a wiring drawn before is copied from there
+        rather than drawn again (matplotlib's drawing costs more CPU than a short run's
+        loop); a new one is drawn and kept there. A cache that cannot be written is skipped.
 
     Returns
     -------
     pathlib.Path
         ``path``.
     """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    kept = cache / f"{wiring_key(system, title)}{path.suffix.lower()}" if cache is not None else None
+    if kept is not None and kept.is_file():
+        import shutil
+
+        with atomic_path(path) as temporary:
+            shutil.copyfile(kept, temporary)
+        return path
     import matplotlib
 
     from orchestrator.files import headless_backend
@@ -133,14 +146,70 @@ def draw(system, path, title: str | None = None) -> Path:
     import matplotlib.pyplot as plt
 
     fig = figure(system, title)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     try:
         with matplotlib.rc_context({"svg.fonttype": "none"}):  # SVG text stays text
             save_figure(fig, path, dpi=130, bbox_inches="tight", pad_inches=0.15)
     finally:
         plt.close(fig)
+    if kept is not None:
+        _keep(path, kept)
     return path
+
+
+def wiring_key(system, title: str | None = None) -> str:
+    """A digest of everything :func:`figure` draws of ``system`` (blocks, arrows, ties, faults,
+    title) and of what draws it (this module's source, matplotlib's version): two systems of
+    one key have one picture.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+    title : str, optional
+        The title's first line, as given to :func:`draw`.
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits (SHA-256).
+    """
+    import hashlib
+    from importlib.metadata import version
+
+    order, links, constants = _wiring(system)
+    blocks = [(name, isinstance(system.blocks[name], FMUBlock), _kind(system.blocks[name]),
+               system.blocks[name].period) for name in order]
+    faults = [(f.kind, f.target, f.start, f.stop) for f in system.faults]
+    ties = [(b, list(v.items())) for b, v in constants.items()]  # in their order: it places what is drawn
+    drawn = repr((title, blocks, list(links.items()), ties, list(system.connections.items()), blocks_text(system),
+                  system.dt, faults, version("matplotlib")))
+    digest = hashlib.sha256(Path(__file__).read_bytes())
+    digest.update(drawn.encode())
+    return digest.hexdigest()
+
+
+def _keep(path: Path, kept: Path) -> None:
+    """Copy the drawing ``path`` into the cache as ``kept``, whole or not at all; a cache that
+    cannot be written (read-only, full) is left as it is."""
+    import os
+    import shutil
+    import tempfile
+
+    try:
+        kept.parent.mkdir(parents=True, exist_ok=True)
+        handle, name = tempfile.mkstemp(prefix=".", suffix=kept.suffix, dir=kept.parent)
+        os.close(handle)
+        try:
+            shutil.copyfile(path, name)
+            os.replace(name, kept)  # another process drawing the same wiring writes the same picture
+        finally:
+            Path(name).unlink(missing_ok=True)
+    except OSError:
+        pass
+
+
+def _kind(block) -> str:
+    """What a block's box says it is: its FMU's file name, or its Python class."""
+    return f"FMU {Path(block.model).name}" if isinstance(block, FMUBlock) else type(block).__name__
 
 
 def figure(system, title: str | None = None):
@@ -337,7 +406,7 @@ def _draw_blocks(ax, system, order, constants, box):
         shade = "#dbe8f5" if isinstance(block, FMUBlock) else "#f3f3f3"
         ax.add_patch(FancyBboxPatch((x, -box / 2), WIDTH, box, boxstyle="round,pad=0.02",
                                     facecolor=shade, edgecolor="#333333", zorder=2))
-        kind = f"FMU {Path(block.model).name}" if isinstance(block, FMUBlock) else type(block).__name__
+        kind = _kind(block)
         rate = f", every {block.period} steps" if block.period > 1 else ""
         ax.text(x + WIDTH / 2, 0.12 * box, name, ha="center", va="center", fontsize=10, weight="bold", zorder=3)
         ax.text(x + WIDTH / 2, -0.12 * box, kind + rate, ha="center", va="center", fontsize=7, zorder=3)

@@ -20,6 +20,7 @@ import math
 import numbers
 import re
 
+from orchestrator.blocks import FMUBlock
 from orchestrator.fmu import nearest
 from orchestrator.signals import expand
 
@@ -89,7 +90,7 @@ def resolve(system, target: str, value) -> dict:
     if block is None:
         raise KeyError(f"unknown block {block_name!r} in {target!r}.{nearest(block_name, system.blocks)} "
                        f"Blocks: {', '.join(system.blocks)}.")
-    if not hasattr(block, "parameter_names"):
+    if not isinstance(block, FMUBlock):
         return {name: _python_value(block, name, value)}
     variables = fmu_parameters(block.model)
     aliases, _ = model_notes(block.model)
@@ -103,7 +104,7 @@ def resolve(system, target: str, value) -> dict:
 
 
 def apply(system, settings: dict, options: dict | None = None) -> dict:
-    """Set block parameters on ``system`` before its run.
+    """Set block parameters on ``system`` before its run: :func:`resolve_all`, then :func:`set_all`.
 
     Parameters
     ----------
@@ -124,12 +125,51 @@ def apply(system, settings: dict, options: dict | None = None) -> dict:
     KeyError, ValueError
         As :func:`resolve`; or a parameter set while the switch it needs is off.
     """
-    resolved = {}
-    for target, value in settings.items():
-        block_name = target.partition(".")[0]
-        values = resolve(system, target, value)
-        block = system.blocks[block_name]
-        if hasattr(block, "parameter_names"):
+    return set_all(system, resolve_all(system, settings), options)
+
+
+def resolve_all(system, settings: dict) -> dict[str, dict]:
+    """Every setting resolved (:func:`resolve`), once: ``{"Block.parameter": {name: value}}``.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+    settings : dict
+        ``{"Block.parameter": value}``.
+
+    Returns
+    -------
+    dict
+        Each target to its parameter values within the block, one entry per component.
+    """
+    return {target: resolve(system, target, value) for target, value in settings.items()}
+
+
+def set_all(system, resolved: dict[str, dict], options: dict | None = None) -> dict:
+    """Set resolved parameter values (:func:`resolve_all`) on ``system``'s blocks.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+    resolved : dict
+        ``{"Block.parameter": {name: value}}``.
+    options : dict, optional
+        ``{"Block.parameter": "option"}``, named in messages (see :func:`apply`).
+
+    Returns
+    -------
+    dict
+        The values set, as they will be used: a number, or a list for a vector.
+
+    Raises
+    ------
+    ValueError
+        A parameter set while the switch it needs is off.
+    """
+    used = {}
+    for target, values in resolved.items():
+        block = system.blocks[target.partition(".")[0]]
+        if isinstance(block, FMUBlock):
             block.parameters.update(values)
         else:
             named = block.named_parameters() if hasattr(block, "named_parameters") else {}
@@ -138,16 +178,16 @@ def apply(system, settings: dict, options: dict | None = None) -> dict:
                     block.set_named_parameter(name, v)
                 else:
                     setattr(block, name, v)
-        resolved[target] = list(values.values()) if len(values) > 1 else next(iter(values.values()))
-    for target in settings:
+        used[target] = list(values.values()) if len(values) > 1 else next(iter(values.values()))
+    for target in resolved:
         _check_switch(system, target, options or {})
-    return resolved
+    return used
 
 
 def _check_switch(system, target: str, options: dict):
     block_name, _, name = target.partition(".")
     block = system.blocks[block_name]
-    if not hasattr(block, "parameter_names"):
+    if not isinstance(block, FMUBlock):
         return
     aliases, switched = model_notes(block.model)
     name = aliases.get(name, name)

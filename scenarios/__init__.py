@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import contextlib
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from scenarios.catalogue import get, names, registry
+from scenarios.state import Build, Duration, Extra, Options, Prepared, Report, Resolve, RunRequest
 
 
 @dataclass
@@ -97,11 +99,11 @@ class Scenario:
     name: str
     description: str
     options: dict[str, Option]
-    build: object  # (options) -> System
-    report: object  # (result, options, out_dir) -> metrics dict
-    duration: object = None  # (options) -> seconds
-    extra: dict = field(default_factory=dict)
-    resolve: object = None  # (options) -> the options as used: a marker (kI = "lab") replaced by its value
+    build: Build  # (options, estimator=None) -> System
+    report: Report  # (result, options, out_dir) -> metrics dict
+    duration: Duration | None = None  # (options) -> seconds, when no option "duration" says it
+    extra: Extra = field(default_factory=dict)
+    resolve: Resolve | None = None  # (options) -> the options as used: a marker (kI = "lab") replaced by its value
 
     def used(self, options: dict) -> dict:
         """``options`` as the run uses them: every default marker replaced by the value it stands for."""
@@ -150,12 +152,12 @@ class Scenario:
                    if key not in self.options or value != self.options[key].default]  # or Block.parameter
         return f"{self.name}: " + (", ".join(changed) if changed else "default options")
 
-    def parse(self, settings: dict | list | None) -> dict:
+    def parse(self, settings: dict | list | None) -> Options:
         """Options with defaults, from ``settings`` ``{"k": v}`` or ``["k=v", ...]`` (None: all
-        defaults); refuses unknown keys.
+        defaults); refuses unknown keys. The options returned are read-only (:class:`Options`).
 
         A key ``Block.parameter`` sets a block parameter (``IMU.gyro_noise_density``); it is
-        kept as given and checked against the block when :meth:`system` builds the system.
+        kept as given and checked against the block when :meth:`prepare` builds the system.
         """
         values = {k: o.default for k, o in self.options.items()}
         pairs = settings.items() if isinstance(settings, dict) else [_split(s) for s in settings or []]
@@ -169,25 +171,50 @@ class Scenario:
                 raise ValueError(f"unknown option {key!r} for scenario {self.name}.{nearest(key, self.options)} "
                                  f"Options: {', '.join(self.options)} (see `quadcosim list`).")
             values[key] = self.options[key].parse(key, text)
-        return values
+        return Options(values)
 
 
-    def system(self, options: dict, estimator=None, fmus: dict | None = None):
-        """The system of these options: built, its FMU blocks replaced by ``fmus``, then its
-        block parameters set.
+    def system(self, options: Mapping, estimator=None, fmus: dict | None = None):
+        """The system of these options (:meth:`prepare`'s, its block parameters set).
 
         Parameters
         ----------
-        options : dict
-            From :meth:`parse`. Its ``Block.parameter`` entries are set on the built system
-            (checked against the FMU's variable table) and replaced by the values used.
+        options : mapping
+            From :meth:`parse`.
+        estimator : Block or class, optional
+            A block of the user's in the place of ``Quaternion_estim``.
+        fmus : dict, optional
+            Block name to an FMU file of the user's put in that block's place.
+
+        Returns
+        -------
+        orchestrator.System
+        """
+        return self.prepare(options, estimator, fmus).system
+
+    def prepare(self, options: Mapping, estimator=None, fmus: dict | None = None) -> Prepared:
+        """The system of these options: built, its FMU blocks replaced by ``fmus``, then its
+        block parameters resolved once and set; and the options as the run uses them.
+
+        Parameters
+        ----------
+        options : mapping
+            From :meth:`parse` (left as it is). Its ``Block.parameter`` entries are checked
+            against the built system (the FMU's variable table, or the Python block) and set.
         estimator : Block or class, optional
             A block of the user's in the place of ``Quaternion_estim`` (see
-            :mod:`estimators.contract`), for a scenario with an ``estimator`` option.
+            :mod:`estimators.contract`), for a scenario with an ``estimator`` option; the
+            options name it (``module:Class``).
         fmus : dict, optional
             Block name to an FMU file of the user's with the same interface, put in that
             block's place (:func:`orchestrator.replace.replace_fmu` checks it); the system's
             ``replaced`` says which, with what the new FMU did not take over (also warned).
+
+        Returns
+        -------
+        Prepared
+            The system, the options as read by the run (:attr:`Prepared.options`: each
+            ``Block.parameter`` as set) and as stated in ``metrics.json`` (:attr:`Prepared.used`).
 
         Raises
         ------
@@ -195,11 +222,14 @@ class Scenario:
             An unknown block or parameter, a bad value, or a parameter the scenario sets from
             one of its options (the message names that option).
         """
-        from orchestrator.parameters import apply, resolve
+        from orchestrator.parameters import resolve_all, set_all
 
         if estimator is not None:
             if "estimator" not in self.options:
                 raise ValueError(f"scenario {self.name} has no estimator to replace; {_with_estimator()}")
+            from estimators import contract
+
+            options = Options(options | {"estimator": contract.label(estimator)})
             system = self.build(options, estimator=estimator)
         else:
             system = self.build(options)
@@ -213,17 +243,17 @@ class Scenario:
             system.replaced[block] = {"fmu": str(new.path), "notes": notes}
             for note in notes:
                 warnings.warn(note, stacklevel=2)
-        settings = {k: v for k, v in options.items() if "." in k}
         derived = self.extra.get("derived", {})
-        for key in settings:
+        resolved = resolve_all(system, {k: v for k, v in options.items() if "." in k})
+        for key, values in resolved.items():
             block = key.partition(".")[0]
-            for name in resolve(system, key, settings[key]):
+            for name in values:
                 option = derived.get(f"{block}.{name}")
                 if option is not None:
                     raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
                                      f"use --set {option}=... instead of {key}")
-        options.update(apply(system, settings, derived))
-        return system
+        options = Options(options | set_all(system, resolved, derived))
+        return Prepared(system, options, self.used(options))
 
 
 def _with_estimator() -> str:
@@ -326,16 +356,16 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
                         remove_if_empty(out)
                     raise
             with (files.tracking() if files else contextlib.nullcontext()):
-                given = (faults, estimator, record, stream, blocks, fmus)
-                return _run_tracked(name, settings, files, base, made, given, progress)
+                request = RunRequest(tuple(faults), estimator, record, stream, blocks, fmus, decimation)
+                return _run_tracked(name, settings, files, base, made, request, progress)
         except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
                 raise
             with files.tracking():
-                raise files.interrupted(interrupt, files.saved, files.stream) from None
+                raise files.interrupted(interrupt) from None
 
 
-def _run_tracked(name, settings, files, base, made, given, progress):
+def _run_tracked(name: str, settings, files, base: dict, made: bool, request: RunRequest, progress: bool):
     """The run of :func:`run` once its folder is made: load, then :func:`_run_phases`; an
     interrupt in any phase becomes :class:`orchestrator.RunInterrupted`, a refusal leaves the
     folder as it was."""
@@ -345,11 +375,11 @@ def _run_tracked(name, settings, files, base, made, given, progress):
         base["options"] = dict(options)
         if files:
             files.units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
-        return _run_phases(scenario, options, base, files, given, progress)
+        return _run_phases(scenario, options, base, files, request, progress)
     except KeyboardInterrupt as interrupt:  # outside the loop: loading, building, drawing, saving, reporting
         if files is None:
             raise
-        raise files.interrupted(interrupt, files.saved, files.stream) from None
+        raise files.interrupted(interrupt) from None
     except (KeyError, ValueError):  # refused before the run: the folder is left as it was
         if files is not None and files.result is None:
             files.refused(remove_folder=made)
@@ -371,28 +401,28 @@ def _check_formats(formats, stream: bool, out_dir):
                          "--format (other formats can be written afterwards: Result.load(folder).save(...))")
 
 
-def _run_phases(scenario, options, base, files, given, progress):
+def _run_phases(scenario: Scenario, options: Options, base: dict, files, request: RunRequest, progress: bool):
     """Build, draw, run, save and report, each phase named in ``files`` for ``metrics.json``;
-    ``given`` holds the faults, the user's estimator, the signals to record, ``stream`` and the
-    user's blocks."""
+    ``request`` holds the faults, the user's estimator, blocks and FMUs, the signals to record
+    and ``stream``."""
     from orchestrator import SimulationError
     from orchestrator.progress import status
     from scenarios.metrics import FAULT_UNITS, metric_units
 
-    name, (faults, estimator, record, stream, blocks, fmus) = scenario.name, given
-    system, duration, kept, saved = _build(scenario, options, base, files, (faults, estimator, blocks, fmus),
-                                           stream, record)
+    name = scenario.name
+    prepared, duration, kept, saved = _build(scenario, options, base, files, request)
+    system, options = prepared.system, prepared.options
     if files:
-        files.phase, files.stream = "running", _open_stream(files, stream)
+        files.phase, files.stream = "running", _open_stream(files, request.stream)
     from orchestrator.diagram import blocks_text
 
     status(f"{name}: starting {duration:g} s of simulated time ({blocks_text(system)})")
     try:
-        result = system.run(duration, decimation=base["decimation"], progress=progress, record=kept,
+        result = system.run(duration, decimation=request.decimation, progress=progress, record=kept,
                             stream=files.stream if files else None)
     except SimulationError as error:
         if files is not None:
-            files.stopped(error, saved, files.stream)
+            files.stopped(error)
         raise
     except (KeyError, ValueError):  # refused as the run was set up (a value an FMU refused, memory)
         if files is not None:
@@ -406,13 +436,13 @@ def _run_phases(scenario, options, base, files, given, progress):
         files.phase = "saving the record"
         status(f"{name}: writing {', '.join(f'results.{f}' for f in files.formats)} "
                f"({_signals_text(saved, result.names)}, {len(result)} samples)")
-        files.keep_record(result, saved, files.stream)
+        files.keep_record(result)
         if files.not_written:  # a full disk, or no memory left for a writer: metrics.json says which
             raise files.failed("; ".join(f"{file} not written: {why}" for file, why in files.not_written.items()))
         metrics |= files.record_megabytes()
         files.phase = "reporting (metrics and figures)"
     status(f"{name}: report" + (" (metrics and figures)" if files else " (metrics)"))
-    metrics |= _report(scenario, result, options, files, record)
+    metrics |= _report(scenario, result, options, files, request.record)
     declared = scenario.extra.get("units", {}) | (metrics.get("units") or {})  # for names that carry none
     option_units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
     metrics["units"] = metric_units(metrics, declared) | option_units | {"injected_faults": FAULT_UNITS}
@@ -480,39 +510,39 @@ def _open_stream(files, stream: bool):
     return StreamWriter(files.out / FOLDER)
 
 
-def _build(scenario, options, base, files, users, stream, record):
-    """The system, its duration (s), the signals recorded and those written (``base`` takes
-    the options as used, the duration and the FMUs replaced); ``users`` holds the faults, the
-    user's estimator, blocks and FMUs. A refusal removes what this run wrote."""
+def _build(scenario: Scenario, options: Options, base: dict, files, request: RunRequest):
+    """The prepared system (:meth:`Scenario.prepare`), its duration (s), the signals recorded and
+    those written (``base`` takes the options as used, the duration and the FMUs replaced). A
+    refusal removes what this run wrote."""
     from orchestrator.progress import status
 
-    faults, estimator, blocks, fmus = users
     if files:
         files.phase = "building the system"
     status(f"{scenario.name}: building the system")
     try:
-        system = scenario.system(options, estimator=estimator, fmus=fmus)
+        prepared = scenario.prepare(options, estimator=request.estimator, fmus=request.fmus)
+        system = prepared.system
         if system.replaced:
             base["replaced_blocks"] = system.replaced
-        for block_name, block in (blocks or {}).items():
+        for block_name, block in (request.blocks or {}).items():
             system.replace(block_name, block)
-        for fault in faults:
+        for fault in request.faults:
             system.inject(fault)
-        duration = scenario.duration(options) if scenario.duration else options["duration"]
-        _check_decimation(base["decimation"], duration, system.dt)
-        base |= {"options": scenario.used(options), "duration_s": duration}
-        kept, saved = _signals_kept(scenario, system, record, base)
+        duration = scenario.duration(prepared.options) if scenario.duration else prepared.options["duration"]
+        _check_decimation(request.decimation, duration, system.dt)
+        base |= {"options": prepared.used, "duration_s": duration}
+        kept, saved = _signals_kept(scenario, system, request.record, base)
         if files:
             files.saved = saved
             recorded = _recorded_names(system, kept)
-            rows = int(round(duration / system.dt)) // base["decimation"] + 1
-            files.check_room(rows, recorded, saved or recorded, base["decimation"], stream)
-            _draw(scenario, system, options, files)
+            rows = int(round(duration / system.dt)) // request.decimation + 1
+            files.check_room(rows, recorded, saved or recorded, request.decimation, request.stream)
+            _draw(scenario, system, prepared.options, files)
     except (KeyError, ValueError):
         if files:
             files.refused()
         raise
-    return system, duration, kept, saved
+    return prepared, duration, kept, saved
 
 
 def _check_decimation(decimation: int, duration: float, dt: float):
@@ -531,7 +561,18 @@ def _draw(scenario, system, options, files):
 
         files.phase = "drawing the wiring diagram"
         status(f"{scenario.name}: wiring diagram")
-        draw(system, files.out / "diagram.png", scenario.title(options))
+        draw(system, files.out / "diagram.png", scenario.title(options), cache=diagram_cache())
+
+
+def diagram_cache() -> Path:
+    """Where runs keep the wiring diagrams they drew, by a digest of the wiring
+    (:func:`orchestrator.diagram.wiring_key`): ``$QUADCOSIM_DIAGRAM_CACHE`` if set, else
+    ``diagrams/`` beside the built FMUs."""
+    import os
+
+    from fmus import build_root
+
+    return Path(os.environ.get("QUADCOSIM_DIAGRAM_CACHE") or build_root() / "diagrams")
 
 
 def _report(scenario, result, options, files, record) -> dict:

@@ -81,8 +81,9 @@ class RunFiles:
             yield self
 
     # ------------------------------------------------------------------ the record
-    def keep_record(self, result: Result, signals=None, stream=None):
-        """Write the record in every format, signals held back until it is safe.
+    def keep_record(self, result: Result):
+        """Write the record in every format (the signals of :attr:`saved`), signals held back until
+        it is safe; with :attr:`stream`, close the record already streamed to disk instead.
 
         A format that does not fit (on the disk, or in memory) is left out, the reason noted
         in :attr:`not_written`; the others are written all the same.
@@ -90,11 +91,10 @@ class RunFiles:
         Parameters
         ----------
         result : orchestrator.Result
-        signals : list of str, optional
-            The signals written (all by default).
-        stream : orchestrator.stream.StreamWriter, optional
-            The record already streamed to disk: it is closed, and no other file written.
         """
+        self._keep(result, self.saved, self.stream)
+
+    def _keep(self, result: Result, signals, stream):
         self.result = result
         started = time.process_time()
         with held():
@@ -165,28 +165,24 @@ class RunFiles:
             finally:
                 self.reserve.release()
 
-    def stopped(self, error: SimulationError, signals=None, stream=None, complete: bool = False):
-        """Keep what a failed or interrupted run recorded, and a ``metrics.json`` saying where
-        it stopped, in which phase and what was kept.
+    def stopped(self, error: SimulationError, complete: bool = False):
+        """Keep what a failed or interrupted run recorded (the signals of :attr:`saved`, or its
+        :attr:`stream`), and a ``metrics.json`` saying where it stopped, in which phase and what
+        was kept.
 
         Parameters
         ----------
         error : orchestrator.SimulationError
             What stopped the run; its ``result`` is what was recorded (None: nothing).
-        signals : list of str, optional
-            The signals the files hold.
-        stream : orchestrator.stream.StreamWriter, optional
-            The record's stream, with ``--stream``.
         complete : bool
             The loop had ended: the record is whole.
         """
         partial = error.result if error.result is not None else empty_result()
-        if not partial.names:  # stopped before the loop: an empty record, every format
-            signals = None
+        signals = self.saved if partial.names else None  # stopped before the loop: an empty record, every format
         if not self.record_saved:
             partial.meta |= {"scenario": {"name": self.base["scenario"], "options": self.base["options"]},
                              "faults": self.base["injected_faults"]}
-            self.keep_record(partial, signals, stream)
+            self._keep(partial, signals, self.stream)
         interrupted = isinstance(error, RunInterrupted)
         record = self.result if self.result is not None else partial
         done = {"status": "interrupted" if interrupted else "failed", "error": str(error),
@@ -198,7 +194,7 @@ class RunFiles:
             done["interrupted_by"] = signal_name(error.signal_number)
         self._write(self.base | done | self._files())
 
-    def interrupted(self, interrupt: BaseException, signals=None, stream=None) -> RunInterrupted:
+    def interrupted(self, interrupt: BaseException) -> RunInterrupted:
         """Keep what was recorded when a signal stopped the run outside its loop (building,
         drawing, reporting), and say so in ``metrics.json``.
 
@@ -206,10 +202,6 @@ class RunFiles:
         ----------
         interrupt : KeyboardInterrupt
             The interrupt raised (:class:`orchestrator.interrupts.Terminated` for SIGTERM).
-        signals : list of str, optional
-            The signals the files hold.
-        stream : orchestrator.stream.StreamWriter, optional
-            The record's stream, with ``--stream``.
 
         Returns
         -------
@@ -220,7 +212,7 @@ class RunFiles:
         message = f"interrupted by {signal_name(number)} while {self.phase}"
         record = self.result if self.result is not None else empty_result()
         error = RunInterrupted(message, record, number)
-        self.stopped(error, signals, stream, complete=self.result is not None)
+        self.stopped(error, complete=self.result is not None)
         return error
 
     def failed(self, message: str) -> SimulationError:
@@ -257,7 +249,7 @@ class RunFiles:
         """
         what = str(error) if isinstance(error, DiskFull) else f"{type(error).__name__}: {error}"
         failure = SimulationError(f"{what} (while {self.phase})", self.result)
-        self.stopped(failure, self.saved, self.stream, complete=self.result is not None)
+        self.stopped(failure, complete=self.result is not None)
         return failure
 
     def refused(self, remove_folder: bool = False):

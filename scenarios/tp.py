@@ -140,8 +140,8 @@ def build(o: dict, estimator=None) -> System:
         Parsed options (``quadcosim list`` shows them with their units).
     estimator : orchestrator.Block or class, optional
         An estimator of the user's in the place of ``Quaternion_estim`` (see
-        :mod:`estimators.contract`); ``o["estimator"]`` then names it, ``module:Class``.
-        ``o["estimator"] = "module:Class"`` does the same from the options.
+        :mod:`estimators.contract`; :meth:`scenarios.Scenario.prepare` names it in the options,
+        ``module:Class``). ``o["estimator"] = "module:Class"`` does the same from the options.
 
     Returns
     -------
@@ -179,8 +179,6 @@ def build(o: dict, estimator=None) -> System:
     if estimator is not None or registered is None or registered.block:  # a block of its own
         from estimators import contract
 
-        if estimator is not None:
-            o["estimator"] = contract.label(estimator)
         spec = estimator if estimator is not None else registered.block if registered else o["estimator"]
         estimator = system.add(contract.adopt(spec, period,
                                               q0=q0, available=system.blocks["IMU"].outputs))

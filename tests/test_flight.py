@@ -161,3 +161,28 @@ def test_a_12_rad_s_yaw_loop_at_100_hz_rings_until_the_free_wheeling_currents_re
     for case in (quiet, fast, no_reaction):
         assert case["ringing_nm"] < QUIET_NM
         assert case["current_min_a"] == pytest.approx(hover_current, rel=1e-3)
+
+
+def test_the_trim_root_is_scipys_brentq_to_the_bit():
+    """The cruise trim solves its root without importing scipy.optimize (start-up), by the same
+    steps: every winds' tilt, and a few other roots, equal brentq's bits."""
+    import math
+
+    from scipy.optimize import brentq
+
+    roots = [(lambda x: x * x - 2.0, 0.0, 3.0), (lambda x: math.cos(x) - x, 0.0, 1.0),
+             (lambda x: x ** 3 - 2.0 * x - 5.0, 2.0, 3.0), (lambda x: math.exp(x) - 10.0, -5.0, 10.0),
+             (lambda x: math.atan(x - 0.3), -10.0, 1e3)]
+    for f, a, b in roots:
+        for xtol in (2e-12, 1e-14, 1e-3):
+            assert trim.brent_root(f, a, b, xtol) == brentq(f, a, b, xtol=xtol)
+    for wind in np.linspace(0.05, 20.0, 40):
+        tilt, thrust = trim.wind_hover_tilt(wind)
+        original = trim.brent_root
+        try:
+            trim.brent_root = lambda f, a, b, xtol: brentq(f, a, b, xtol=xtol)
+            assert (tilt, thrust) == trim.wind_hover_tilt(wind)
+        finally:
+            trim.brent_root = original
+    with pytest.raises(ValueError, match="different signs"):
+        trim.brent_root(lambda x: x * x + 1.0, -1.0, 1.0)

@@ -197,6 +197,34 @@ def test_set_input_refuses_a_connected_input_as_connect_does():
     assert free.run(0.002)["Probe.y"].tolist() == [2.5, 2.5, 2.5]
 
 
+def test_a_wiring_drawn_before_is_copied_from_the_diagram_cache(tmp_path, monkeypatch):
+    from orchestrator import diagram
+
+    def system(gain):
+        s = System()
+        s.add(Ramp("Source"))
+        s.add(Probe("Probe"))
+        if gain:
+            s.set_input("Probe.u", gain)  # a tie in the place of the arrow
+        else:
+            s.connect("Source.y", "Probe.u")
+        return s
+
+    cache = tmp_path / "cache"
+    first = diagram.draw(system(0), tmp_path / "a" / "diagram.png", "t", cache=cache)
+    assert [p.name for p in cache.iterdir()] == [diagram.wiring_key(system(0), "t") + ".png"]
+    monkeypatch.setattr(diagram, "figure", lambda *a: pytest.fail("drawn again"))
+    second = diagram.draw(system(0), tmp_path / "b" / "diagram.png", "t", cache=cache)
+    assert second.read_bytes() == first.read_bytes()
+    keys = {diagram.wiring_key(system(0), "t"), diagram.wiring_key(system(0), "other title"),
+            diagram.wiring_key(system(2.5), "t")}
+    assert len(keys) == 3  # another title or another wiring: another picture
+    monkeypatch.undo()
+    blocked = tmp_path / "a file"  # a cache that cannot be written: drawn all the same
+    blocked.write_text("")
+    assert diagram.draw(system(2.5), tmp_path / "c.png", "t", cache=blocked / "diagrams").is_file()
+
+
 def test_diagram_draws_a_tied_input_with_its_value_and_no_block(tmp_path):
     from orchestrator.diagram import _wiring
 

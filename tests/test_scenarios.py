@@ -68,3 +68,33 @@ def test_readme_script_runs():
 def test_listed(name, capsys):
     assert cli(["list"]) == 0
     assert name in capsys.readouterr().out
+
+
+def test_a_set_block_parameter_is_resolved_once_and_the_parsed_options_stay_as_parsed(monkeypatch, tmp_path):
+    """``--set Controller.kp_yaw=50`` from the command line to ``metrics.json``: parsed into
+    read-only options, resolved once against the built system, set on the block by its type,
+    and stated as set; the options parsed are never changed in place."""
+    import json
+    import pickle
+
+    from orchestrator import parameters
+
+    resolved = []
+    original = parameters.resolve
+    monkeypatch.setattr(parameters, "resolve",
+                        lambda system, target, value: resolved.append(target) or original(system, target, value))
+    tp = scenarios.get("tp")
+    options = tp.parse(["duration=0.05", "Controller.kp_yaw=50"])
+    with pytest.raises(TypeError, match="read-only"):
+        options["k"] = 1.0
+    assert pickle.loads(pickle.dumps(options)) == options and type(options | {"k": 1.0}) is dict
+    prepared = tp.prepare(options)
+    assert resolved == ["Controller.kp_yaw"]
+    assert options["Controller.kp_yaw"] == "50"  # as given
+    assert prepared.options["Controller.kp_yaw"] == prepared.used["Controller.kp_yaw"] == 50.0
+    assert prepared.system.blocks["Controller"].named_parameters()["kp_yaw"] == 50.0
+    assert prepared.used["kI"] == "lab" and prepared.options["k"] == 0.05
+    resolved.clear()
+    assert cli(["run", "tp", "--set", "duration=0.05", "Controller.kp_yaw=50", "--out", str(tmp_path / "run")]) == 0
+    assert resolved == ["Controller.kp_yaw"]
+    assert json.loads((tmp_path / "run" / "metrics.json").read_text())["options"]["Controller.kp_yaw"] == 50.0

@@ -31,3 +31,11 @@ def test_a_scenario_look_up_imports_that_scenario_alone():
     assert scenarios.names() == tuple(scenarios.registry())
     with pytest.raises(KeyError, match="Did you mean tp"):
         scenarios.get("tpp")
+
+
+def test_a_short_tp_run_imports_no_optimiser(tmp_path):
+    """The cruise trim and the report's drag findings import scipy.optimize only where used:
+    a default ``tp`` run (flight quasi, no wind) imports none of it (start-up)."""
+    imported = imported_modules(["run", "tp", "--set", "duration=0.05", "--out", str(tmp_path / "tp")])
+    assert "scipy.optimize" not in imported
+    assert "matplotlib" in imported  # its report's figures, drawn

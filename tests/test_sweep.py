@@ -220,6 +220,61 @@ def test_table_flattening_and_round_trip(tmp_path):
     assert not list(tmp_path.glob(".*tmp"))
 
 
+def test_rows_kept_on_disk_write_the_table_of_the_rows_in_member_order(tmp_path):
+    """Rows that finish out of order, with other columns and kinds of value, give the table that
+    the whole rows in member order give: the same columns in the same order, each of the type
+    pyarrow infers for the whole column (text where kinds cannot share one), the same values."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    def record(i, status="ok", **metrics):
+        return {"member": i, "label": f"seed={i}", "status": status, "error": None if status == "ok" else "x",
+                "attempts": 1, "wall_s": 0.5, "worker": "0", "options": {"seed": i, "k": 0.1}, "metrics": metrics}
+
+    records = [record(3, rms=[0.1, 0.2], late=1), record(0, "failed"), record(5, rms=[0.3, 0.4], mixed="text"),
+               record(1, rms=[0.5, math.nan], mixed=2.5, huge=2 ** 70), record(2, rms=[0.6, 0.7], mixed=True)]
+    kept = table.Rows(6, tmp_path)
+    for r in records:
+        kept.add(r["member"], table.row(r))
+    kept.add(0, table.row(record(0, rms=[0.8, 0.9])))  # a failed member run again
+    kept.write(tmp_path)
+    again = [r for r in records if r["member"] != 0] + [record(0, rms=[0.8, 0.9])]
+    rows = sorted((table.row(r) for r in again), key=lambda r: r["member"])
+    written = pq.read_table(tmp_path / "sweep.parquet")
+    assert written.column_names == table.columns_of(rows) == kept.names()
+    for name in written.column_names:
+        values = [r.get(name) for r in rows]
+        try:
+            expected = pa.array(values)
+        except (pa.ArrowInvalid, pa.ArrowTypeError, TypeError, OverflowError):
+            expected = pa.array([None if v is None else v if isinstance(v, str) else json.dumps(v) for v in values])
+        assert written.schema.field(name).type == expected.type, name
+        assert written.column(name).to_pylist() == expected.to_pylist() or name == "rms[1]", name
+    assert (len(kept), kept.ok, kept.failures) == (5, 5, {})
+    kept.close()
+
+
+def test_the_rows_of_a_large_sweep_take_bytes_per_member_in_memory(tmp_path):
+    """The table's rows go to disk: memory keeps where each is, 17 bytes a member, and per
+    column its kinds (``python -m benchmarks.sweep_memory`` measures a whole sweep's client)."""
+    import tracemalloc
+
+    members = 20_000
+    row = table.row({"member": 0, "label": "x", "status": "ok", "error": None, "options": {"seed": 1, "k": 0.1},
+                     "metrics": {"rms": [0.1, 0.2, 0.3], "steady": 1.5, "figures": None}})
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        kept = table.Rows(members, tmp_path)
+        for i in range(members):
+            kept.add(i, row | {"member": i, "label": f"seed={i}", "steady": i * 0.5})
+        grown = (tracemalloc.get_traced_memory()[0] - before) / members
+    finally:
+        tracemalloc.stop()
+    kept.close()
+    assert grown < 25  # bytes per member (measured: 18; 17 of them say where each row is and how it ended)
+
+
 def test_figure_pools_seeds_and_groups(tmp_path):
     columns = {"member": list(range(8)), "status": ["ok"] * 7 + ["failed"],
                "k": [0.1, 0.1, 1.0, 1.0, 0.1, 0.1, 1.0, 1.0], "estimator": ["linear"] * 4 + ["explicit"] * 4,

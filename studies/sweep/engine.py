@@ -277,8 +277,9 @@ def _finished_record(path: Path) -> dict | None:
         return None
 
 
-def _prepare_folder(plan: Plan, out: Path, resume: bool) -> dict[int, dict]:
-    """Check the sweep folder against the plan; the finished members' records when resuming."""
+def _prepare_folder(plan: Plan, out: Path, resume: bool) -> table.Rows:
+    """Check the sweep folder against the plan; the table's rows, holding the finished members'
+    when resuming (read one at a time)."""
     stored_path = out / "sweep.json"
     if stored_path.exists():
         try:
@@ -292,13 +293,13 @@ def _prepare_folder(plan: Plan, out: Path, resume: bool) -> dict[int, dict]:
     out.mkdir(parents=True, exist_ok=True)
     (out / "members").mkdir(exist_ok=True)
     _write_json(stored_path, json.loads(json.dumps(plan.to_json(), default=float)))
-    records = {}
+    rows = table.Rows(len(plan.members), out)
     if resume:
         for path in sorted((out / "members").glob("*/metrics.json")):
             index = int(path.parent.name) if path.parent.name.isdigit() else -1
             if 0 <= index < len(plan.members) and (record := _finished_record(path)) is not None:
-                records[index] = record
-    return records
+                rows.add(index, table.row(record, plan.varied))
+    return rows
 
 
 def _save_member(out: Path, member: Member, record: dict, attempts: int, scenario: str) -> dict:
@@ -449,10 +450,9 @@ class _Sweep:
 
     def __init__(self, plan: Plan, out: Path, resume: bool):
         self.plan, self.out = plan, out
-        records = _prepare_folder(plan, out, resume)
-        self.finished = {i for i, r in records.items() if r["status"] == "ok"}
-        self.rows = {i: table.row(r, plan.varied) for i, r in records.items()}
-        self.left = len(plan.members) - len(self.finished)
+        self.rows = _prepare_folder(plan, out, resume)  # on disk, member by member: the client stays flat
+        self.skipped = self.rows.ok
+        self.left = len(plan.members) - self.skipped
         self.started = time.perf_counter()
         self.interrupted, self.ran, self.workers, self.startup = 0, 0, 0, 0.0
         self.streamed, self.shutdown = 0.0, 0.0
@@ -462,7 +462,7 @@ class _Sweep:
         # Rewriting the table costs time proportional to its size: keep it under 5 % of the run.
         if force or time.perf_counter() - self.last_write >= 20 * self.write_cost:
             t = time.perf_counter()
-            table.write(list(self.rows.values()), self.out)
+            self.rows.write(self.out)
             self.last_write, self.write_cost = time.perf_counter(), time.perf_counter() - t
 
     def stream(self, client, retries, retry_errors, keep_results, extra_metrics, progress):
@@ -482,7 +482,7 @@ class _Sweep:
 
         # Members go out in a bounded window, topped up as they finish: the client's futures and
         # the scheduler's tasks stay as many however large the plan.
-        todo = (m for m in self.plan.members if m.index not in self.finished)
+        todo = (m for m in self.plan.members if not self.rows.finished(m.index))
         window = max(IN_FLIGHT_PER_WORKER * self.workers, IN_FLIGHT_LEAST)
 
         def top_up():
@@ -500,7 +500,7 @@ class _Sweep:
                     continue
                 top_up()
                 saved = _save_member(self.out, member, record, attempt, self.plan.scenario)
-                self.rows[member.index] = table.row(saved, self.plan.varied)
+                self.rows.add(member.index, table.row(saved, self.plan.varied))
                 self.ran += 1
                 bar.update(record["status"] != "ok")
                 self.flush()
@@ -516,9 +516,9 @@ class _Sweep:
 
     def summary(self) -> Summary:
         rows = self.rows
-        ok = sum(r["status"] == "ok" for r in rows.values())
-        failures = sorted((i, r["label"], r["error"]) for i, r in rows.items() if r["status"] != "ok")
-        return Summary(self.out, len(self.plan.members), ok, len(failures), self.ran, len(self.finished),
+        failures = sorted((i, label, error) for i, (label, error) in rows.failures.items())
+        rows.close()
+        return Summary(self.out, len(self.plan.members), rows.ok, len(failures), self.ran, self.skipped,
                        time.perf_counter() - self.started, self.workers, self.startup, self.shutdown, self.interrupted,
                        failures)
 

@@ -7,7 +7,6 @@ then renamed), so that a reader, or a sweep killed at any moment, never sees hal
 from __future__ import annotations
 
 import csv
-import io
 import json
 import math
 from pathlib import Path
@@ -63,12 +62,165 @@ def columns_of(rows: list[dict]) -> list[str]:
     return list(names)
 
 
-def _arrow_column(values: list) -> pa.Array:
-    try:
-        return pa.array(values)
-    except (pa.ArrowInvalid, pa.ArrowTypeError, TypeError, OverflowError):
-        return pa.array([None if v is None else json.dumps(v, default=str) if not isinstance(v, str) else v
-                         for v in values])
+#: Rows converted to Arrow at a time when the Parquet file is written.
+BATCH_ROWS = 4096
+_EMPTY, _OK, _FAILED = 0, 1, 2  # a member's state in :class:`Rows`
+
+
+class Rows:
+    """The rows of a sweep's table, kept on disk as members finish, not in memory.
+
+    Each row goes, as one JSON line, to an unnamed temporary file in the sweep folder (gone
+    with the process, however it ends); memory keeps 17 bytes per member of the plan (where
+    its row is, and whether it finished well) and, per column, where it first appears and the
+    kinds of value it holds. :meth:`write` streams the table in member order from that file, so
+    a sweep's client stays flat however many members it has.
+
+    Parameters
+    ----------
+    size : int
+        Members of the plan (indices 0 to ``size - 1``).
+    folder : pathlib.Path
+        Where the temporary file lives (the sweep folder).
+    """
+
+    def __init__(self, size: int, folder: Path):
+        import tempfile
+        from array import array
+
+        self._file = tempfile.TemporaryFile(dir=folder)
+        self._offset = array("q", bytes(8 * size))  # where each member's line starts, bytes
+        self._length = array("q", bytes(8 * size))  # its length, bytes
+        self._state = bytearray(size)  # _EMPTY, _OK or _FAILED
+        self._columns: dict[str, tuple[int, int]] = {}  # name -> (first member holding it, position in its row)
+        self._kinds: dict[str, dict] = {}  # name -> value type -> a value of it (ints: the least and largest)
+        self._replaced = False  # a row was replaced since the columns were counted
+        self.ok = 0
+        self.failures: dict[int, tuple[str, str | None]] = {}  # failed member -> (label, error)
+
+    def __len__(self) -> int:
+        return self.ok + len(self.failures)
+
+    def finished(self, index: int) -> bool:
+        """Whether member ``index`` finished well."""
+        return self._state[index] == _OK
+
+    def add(self, index: int, row: dict) -> None:
+        """Keep member ``index``'s row (:func:`row`), in the place of one it had."""
+        line = json.dumps(row, default=_plain_value).encode() + b"\n"
+        self._file.seek(0, 2)
+        self._offset[index], self._length[index] = self._file.tell(), len(line)
+        self._file.write(line)
+        if self._state[index] == _OK:
+            self.ok -= 1
+        self._replaced |= self._state[index] != _EMPTY  # what the row it replaces held may be gone
+        self.failures.pop(index, None)
+        if row["status"] == "ok":
+            self._state[index] = _OK
+            self.ok += 1
+        else:
+            self._state[index] = _FAILED
+            self.failures[index] = (row.get("label"), row.get("error"))
+        self._note(index, row)
+
+    def _note(self, index: int, row: dict) -> None:
+        """Count the columns of member ``index``'s row: where each first appears, its kinds of value."""
+        for position, (name, value) in enumerate(row.items()):
+            first = self._columns.get(name)
+            if first is None or index < first[0]:
+                self._columns[name] = (index, position)
+            kinds = self._kinds.setdefault(name, {})
+            kind = type(value)
+            if kind is int:
+                least, largest = kinds.get(int, (value, value))
+                kinds[int] = (min(least, value), max(largest, value))
+            elif kind not in kinds:
+                kinds[kind] = value
+
+    def names(self) -> list[str]:
+        """Every column, in the order of :func:`columns_of` over the rows in member order."""
+        if self._replaced:  # counted again from the rows kept, one at a time
+            self._file.flush()
+            self._columns, self._kinds, self._replaced = {}, {}, False
+            for index, state in enumerate(self._state):
+                if state != _EMPTY:
+                    self._note(index, self._read(index))
+        return sorted(self._columns, key=self._columns.__getitem__)
+
+    def _read(self, index: int) -> dict:
+        self._file.seek(self._offset[index])
+        return json.loads(self._file.read(self._length[index]))
+
+    def __iter__(self):
+        """The rows, in member order, read back one at a time."""
+        self._file.flush()
+        for index, state in enumerate(self._state):
+            if state != _EMPTY:
+                yield self._read(index)
+
+    def _arrow_type(self, name: str):
+        """The Arrow type ``pyarrow.array`` infers for the whole column ``name``, found from one value
+        of each kind it holds (the least and the largest integer), or None where values of kinds
+        Arrow cannot hold in one column make it a column of text (JSON)."""
+        samples = [None]
+        for kind, value in self._kinds[name].items():
+            samples += list(value) if kind is int else [value]
+        try:
+            return pa.array(samples).type
+        except (pa.ArrowInvalid, pa.ArrowTypeError, TypeError, OverflowError):
+            return None
+
+    def write(self, out: Path) -> None:
+        """Write ``sweep.csv`` and ``sweep.parquet`` in ``out``, each atomically, streamed from
+        the rows on disk."""
+        names = self.names()
+
+        def csv_file(path):
+            with open(path, "w", newline="") as handle:
+                writer = csv.writer(handle)
+                writer.writerow(names)
+                for r in self:
+                    writer.writerow(["" if r.get(n) is None else repr(r[n]) if isinstance(r[n], float) else r[n]
+                                     for n in names])
+
+        def parquet_file(path):
+            types = {n: self._arrow_type(n) for n in names}
+            schema = pa.schema([(n, pa.string() if t is None else t) for n, t in types.items()])
+            with pq.ParquetWriter(path, schema) as writer:
+                batch = []
+                for r in self:
+                    batch.append(r)
+                    if len(batch) == BATCH_ROWS:
+                        writer.write_table(_arrow_batch(batch, types, schema))
+                        batch = []
+                if batch:
+                    writer.write_table(_arrow_batch(batch, types, schema))
+
+        _replace(out / "sweep.csv", csv_file)
+        _replace(out / "sweep.parquet", parquet_file)
+
+    def close(self) -> None:
+        """Remove the rows' temporary file."""
+        self._file.close()
+
+
+def _plain_value(value):
+    """A NumPy scalar as the Python number it holds; anything else as its text."""
+    return value.item() if hasattr(value, "item") else str(value)
+
+
+def _text(value):
+    return None if value is None else json.dumps(value, default=str) if not isinstance(value, str) else value
+
+
+def _arrow_batch(rows: list[dict], types: dict, schema) -> pa.Table:
+    """Rows as an Arrow table of ``schema``: each column of its type, or as text (``types[n]`` None)."""
+    columns = {}
+    for name, kind in types.items():
+        values = [r.get(name) for r in rows]
+        columns[name] = pa.array([_text(v) for v in values], type=pa.string()) if kind is None else \
+            pa.array(values, type=kind)
+    return pa.table(columns, schema=schema)
 
 
 def _replace(path: Path, write):
@@ -78,24 +230,13 @@ def _replace(path: Path, write):
 
 def write(rows: list[dict], out: Path) -> None:
     """Write the ``rows`` as ``sweep.csv`` and ``sweep.parquet`` in ``out``, each atomically."""
-    rows = sorted(rows, key=lambda r: r["member"])
-    names = columns_of(rows)
-
-    def csv_file(path):
-        buffer = io.StringIO()
-        writer = csv.writer(buffer)
-        writer.writerow(names)
+    kept = Rows(max((r["member"] for r in rows), default=-1) + 1, out)
+    try:
         for r in rows:
-            writer.writerow(["" if r.get(n) is None else repr(r[n]) if isinstance(r[n], float) else r[n]
-                             for n in names])
-        path.write_text(buffer.getvalue())
-
-    def parquet_file(path):
-        table = pa.table({n: _arrow_column([r.get(n) for r in rows]) for n in names})
-        pq.write_table(table, path)
-
-    _replace(out / "sweep.csv", csv_file)
-    _replace(out / "sweep.parquet", parquet_file)
+            kept.add(r["member"], r)
+        kept.write(out)
+    finally:
+        kept.close()
 
 
 def read(path) -> dict[str, list]:

@@ -11,6 +11,7 @@ import matplotlib.figure
 import pytest
 from conftest import SHORT_TP, metrics_of, mounted
 
+import scenarios
 from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
@@ -28,6 +29,7 @@ def test_a_full_disk_while_the_diagram_is_drawn_leaves_metrics_json(tmp_path, mo
         return savefig(figure, path, *args, **kwargs)
 
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", filling)
+    monkeypatch.setattr(scenarios, "diagram_cache", lambda: tmp_path / "diagrams")  # empty: the wiring is drawn
     out = tmp_path / "run"
     assert cli([*SHORT_TP, "--out", str(out)]) == 1
     assert f"no space left in {out}/ to write diagram.png" in capsys.readouterr().err

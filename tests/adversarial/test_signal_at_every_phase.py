@@ -6,6 +6,7 @@ Each point is a phase's status line on standard error and a delay after it; the 
 at a time in child processes. Five points run by default, all twenty with the slow tests. (A
 progress line on a pipe shows after the loop's first chunk, then at each quarter.)"""
 
+import os
 import re
 import signal
 import subprocess
@@ -59,8 +60,10 @@ def interrupt_at(out, marker: str, delay: float, sent: int, second: float | None
     standard error (and a SIGINT ``second`` s later); its exit code and standard error."""
     errors = out.with_suffix(".err")
     command = [sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", "duration=120", "--out", str(out)]
+    # an empty diagram cache: the wiring is drawn, so that a signal can reach the drawing phase
+    env = os.environ | {"QUADCOSIM_DIAGRAM_CACHE": str(out.with_suffix(".diagrams"))}
     with errors.open("w") as stderr:
-        process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=stderr, cwd=ROOT)
+        process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=stderr, cwd=ROOT, env=env)
         try:
             deadline = time.monotonic() + 300
             while not shown(marker, errors.read_text()) and process.poll() is None and time.monotonic() < deadline:

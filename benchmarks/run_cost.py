@@ -1,0 +1,103 @@
+"""What a short run costs against a long one: the CPU of ``quadcosim run tp`` for 2 s and 320 s of flight.
+
+``python -m benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--json]``
+
+Each run is the command a user types, ``quadcosim run tp --set duration=D --out DIR
+--overwrite``, in a fresh interpreter: its CPU (user and system, ``resource.getrusage`` of the
+finished child) is the whole run, the interpreter's start, the imports, the system built, the
+wiring diagram, the loop, the record written, the report and its figures. One warm-up run first
+fills numba's cache and the diagram cache, as any earlier run on the machine has. The short
+and the long run alternate, so that a load on the machine weighs on both alike; the ratio of
+each pair is printed, then the median of the ratios.
+
+A short run costs what it simulates when the ratio approaches ``short / long``; what stays
+above that is the start-up every run pays (the imports, numba's target, matplotlib's figures).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+SHORT_S, LONG_S = 2.0, 320.0  # simulated seconds of the two runs compared
+
+
+def run_cpu(duration: float, out: Path) -> float:
+    """CPU seconds (user + system) of ``quadcosim run tp`` for ``duration`` s of flight, in a
+    fresh interpreter, writing into ``out``.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time (s).
+    out : pathlib.Path
+        The run's output folder (replaced).
+
+    Returns
+    -------
+    float
+        CPU of the whole process (s).
+    """
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run([sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", f"duration={duration:g}",
+                    "--out", str(out), "--overwrite"], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+
+
+def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3) -> dict:
+    """CPU of ``repeats`` pairs of runs, short then long, and the ratio of each pair.
+
+    Parameters
+    ----------
+    short, long : float
+        Simulated time of the two runs (s).
+    repeats : int
+        Pairs measured.
+
+    Returns
+    -------
+    dict
+        ``short_cpu_s`` and ``long_cpu_s`` (s, one per pair), ``ratios`` (1, one per pair),
+        ``median_ratio`` (1) and ``simulated_ratio`` (``short / long``, the floor).
+    """
+    with tempfile.TemporaryDirectory() as folder:
+        run_cpu(short, Path(folder) / "warm-up")  # numba's cache and the diagram cache, as after any run
+        shorts, longs = [], []
+        for _ in range(repeats):
+            shorts.append(run_cpu(short, Path(folder) / "short"))
+            longs.append(run_cpu(long, Path(folder) / "long"))
+    ratios = [s / lo for s, lo in zip(shorts, longs, strict=True)]
+    return {"short_s": short, "long_s": long, "short_cpu_s": shorts, "long_cpu_s": longs, "ratios": ratios,
+            "median_ratio": statistics.median(ratios), "simulated_ratio": short / long}
+
+
+def main(argv=None) -> int:
+    """Print the CPU of each run and the ratios; returns 0. ``argv``: the arguments (default
+    ``sys.argv[1:]``)."""
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.run_cost", description=__doc__.splitlines()[0])
+    parser.add_argument("--short", type=float, default=SHORT_S, help="simulated time of the short run (s, default 2)")
+    parser.add_argument("--long", type=float, default=LONG_S, help="simulated time of the long run (s, default 320)")
+    parser.add_argument("--repeats", type=int, default=3, help="pairs of runs measured (default 3)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    figures = measure(args.short, args.long, args.repeats)
+    if args.json:
+        print(json.dumps(figures))
+        return 0
+    for k, (s, lo, r) in enumerate(zip(figures["short_cpu_s"], figures["long_cpu_s"], figures["ratios"],
+                                       strict=True)):
+        print(f"pair {k + 1}: {args.short:g} s run {s:.2f} s CPU, {args.long:g} s run {lo:.2f} s CPU, ratio {r:.3f}")
+    print(f"median ratio {figures['median_ratio']:.3f} (the simulated time's ratio: {figures['simulated_ratio']:.3f})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

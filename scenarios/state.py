@@ -1,0 +1,113 @@
+"""A run's state, typed: the options as parsed (read-only), what the caller asks beside them, and
+the system as built with the options as it uses them.
+
+``--set Controller.kp_yaw=50`` is read once (:meth:`scenarios.Scenario.parse`, into
+:class:`Options`), resolved once against the built system and set on its block
+(:meth:`scenarios.Scenario.prepare`, into :class:`Prepared`), and written to ``metrics.json``
+from :attr:`Prepared.used`; nothing on the way changes the options in place.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, TypedDict
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from orchestrator import Result, System
+
+
+class Options(dict):
+    """A scenario's options as parsed: option name (or ``Block.parameter``) to value, read-only.
+
+    A mapping like any dict for reading (``o["k"]``, ``o | {...}``, ``dict(o)``, JSON); any
+    change in place raises :class:`TypeError`: a step that uses other values makes a new
+    mapping (``o | {"k": 2.0}``), so what was parsed stays what was asked.
+    """
+
+    def _refuse(self, *args, **kwargs):
+        """Refused: the options are read-only once parsed (raises :class:`TypeError`)."""
+        raise TypeError("a run's options are read-only once parsed: make a new mapping (options | {key: value})")
+
+    __setitem__ = __delitem__ = __ior__ = _refuse
+    clear = pop = popitem = setdefault = update = _refuse
+
+    def __reduce__(self):
+        return Options, (dict(self),)
+
+
+@dataclass(frozen=True)
+class RunRequest:
+    """What a caller of :func:`scenarios.run` asks beside the options.
+
+    Parameters
+    ----------
+    faults : tuple of orchestrator.Fault
+        Injected on their connections.
+    estimator : Block or class, optional
+        A block of the user's in the place of ``Quaternion_estim``.
+    record : list of str, optional
+        Signals to keep (``["all"]``: every output).
+    stream : bool
+        Write the record in chunks as the run goes.
+    blocks : dict, optional
+        Blocks of the user's in the place of the scenario's, by name.
+    fmus : dict, optional
+        Block name to an FMU file of the user's put in that block's place.
+    decimation : int
+        Keep every N-th macro step.
+    """
+
+    faults: tuple = ()
+    estimator: Any = None
+    record: list | None = None
+    stream: bool = False
+    blocks: dict | None = None
+    fmus: dict | None = None
+    decimation: int = 1
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A scenario's system built from its options, block parameters set.
+
+    Parameters
+    ----------
+    system : orchestrator.System
+    options : Options
+        The options as the run reads them: as parsed, with the user's estimator named
+        (``module:Class``) and each ``Block.parameter`` as set (a number, or a list for a vector).
+    used : dict
+        ``options`` with every default marker replaced by the value it stands for
+        (:meth:`scenarios.Scenario.used`): what ``metrics.json`` states.
+    """
+
+    system: System
+    options: Options
+    used: dict = field(default_factory=dict)
+
+
+#: ``build(options, estimator=None) -> System``: a scenario's system from its options.
+Build = Callable[..., "System"]
+#: ``report(result, options, out) -> dict``: a scenario's metrics (and figures into ``out``, a folder or None).
+Report = Callable[["Result", Mapping, "Path | None"], dict]
+#: ``duration(options) -> float``: the simulated time (s) when no ``duration`` option says it.
+Duration = Callable[[Mapping], float]
+#: ``resolve(options) -> dict``: the options with every default marker replaced by its value.
+Resolve = Callable[[Mapping], dict]
+
+
+class Extra(TypedDict, total=False):
+    """What a scenario declares beside its options and hooks (:attr:`scenarios.Scenario.extra`), each
+    key optional."""
+
+    diagram: bool  # its wiring diagram drawn with each run's results
+    title: Callable[[Mapping], str]  # the diagram's title from the options
+    derived: dict[str, str]  # "Block.parameter" -> the option that sets it (--set refuses the parameter)
+    record: list[str]  # the signals recorded (default: every output)
+    unrecorded: list[str]  # recorded for the report, left out of the result files
+    components: dict[str, tuple[str, ...]]  # a list metric's components, named (roll, pitch, yaw)
+    divergence: Any  # scenarios.divergence.Bounds: the flight's bounds, a run beyond them diverged
+    units: dict[str, str]  # units of metrics whose names carry none
