@@ -1,6 +1,6 @@
 """What a short run costs against a long one: the CPU of ``quadcosim run tp`` for 2 s and 320 s of flight.
 
-``python -m benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--json]``
+``python -m benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--in-process] [--json]``
 
 Each run is the command a user types, ``quadcosim run tp --set duration=D --out DIR
 --overwrite``, in a fresh interpreter: its CPU (user and system, ``resource.getrusage`` of the
@@ -9,6 +9,11 @@ wiring diagram, the loop, the record written, the report and its figures. One wa
 fills numba's cache and the diagram cache, as any earlier run on the machine has. The short
 and the long run alternate, so that a load on the machine weighs on both alike; the ratio of
 each pair is printed, then the median of the ratios.
+
+With ``--in-process`` the runs are :func:`scenarios.run` calls in this one process, after a
+first run that paid the imports: what a run costs in a notebook, a test session or a sweep's
+worker, where the interpreter, numba and matplotlib are loaded once. Each run still builds its
+system, draws (or copies) its wiring, writes its record and draws its report.
 
 A short run costs what it simulates when the ratio approaches ``short / long``; what stays
 above that is the start-up every run pays (the imports, numba's target, matplotlib's figures).
@@ -23,6 +28,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 SHORT_S, LONG_S = 2.0, 320.0  # simulated seconds of the two runs compared
@@ -52,7 +58,30 @@ def run_cpu(duration: float, out: Path) -> float:
     return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
 
 
-def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3) -> dict:
+def run_cpu_in_process(duration: float, out: Path) -> float:
+    """CPU seconds of :func:`scenarios.run` of ``tp`` for ``duration`` s of flight in this process,
+    writing into ``out`` (replaced), as ``quadcosim run`` writes.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time (s).
+    out : pathlib.Path
+        The run's output folder (replaced).
+
+    Returns
+    -------
+    float
+        CPU of this process during the run (s, every thread).
+    """
+    import scenarios
+
+    started = time.process_time()
+    scenarios.run("tp", {"duration": duration}, out_dir=out, overwrite=True)
+    return time.process_time() - started
+
+
+def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3, in_process: bool = False) -> dict:
     """CPU of ``repeats`` pairs of runs, short then long, and the ratio of each pair.
 
     Parameters
@@ -61,6 +90,8 @@ def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3) -> d
         Simulated time of the two runs (s).
     repeats : int
         Pairs measured.
+    in_process : bool
+        Runs in this process (:func:`run_cpu_in_process`), not each in a fresh interpreter.
 
     Returns
     -------
@@ -68,12 +99,13 @@ def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3) -> d
         ``short_cpu_s`` and ``long_cpu_s`` (s, one per pair), ``ratios`` (1, one per pair),
         ``median_ratio`` (1) and ``simulated_ratio`` (``short / long``, the floor).
     """
+    cpu = run_cpu_in_process if in_process else run_cpu
     with tempfile.TemporaryDirectory() as folder:
-        run_cpu(short, Path(folder) / "warm-up")  # numba's cache and the diagram cache, as after any run
+        cpu(short, Path(folder) / "warm-up")  # numba's and the diagram's caches (and, in process, the imports)
         shorts, longs = [], []
         for _ in range(repeats):
-            shorts.append(run_cpu(short, Path(folder) / "short"))
-            longs.append(run_cpu(long, Path(folder) / "long"))
+            shorts.append(cpu(short, Path(folder) / "short"))
+            longs.append(cpu(long, Path(folder) / "long"))
     ratios = [s / lo for s, lo in zip(shorts, longs, strict=True)]
     return {"short_s": short, "long_s": long, "short_cpu_s": shorts, "long_cpu_s": longs, "ratios": ratios,
             "median_ratio": statistics.median(ratios), "simulated_ratio": short / long}
@@ -86,9 +118,11 @@ def main(argv=None) -> int:
     parser.add_argument("--short", type=float, default=SHORT_S, help="simulated time of the short run (s, default 2)")
     parser.add_argument("--long", type=float, default=LONG_S, help="simulated time of the long run (s, default 320)")
     parser.add_argument("--repeats", type=int, default=3, help="pairs of runs measured (default 3)")
+    parser.add_argument("--in-process", action="store_true",
+                        help="runs as scenarios.run calls in this process, after one that paid the imports")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
-    figures = measure(args.short, args.long, args.repeats)
+    figures = measure(args.short, args.long, args.repeats, args.in_process)
     if args.json:
         print(json.dumps(figures))
         return 0
