@@ -10,16 +10,19 @@ holds both signals back: the save finishes, and the first signal held is raised 
 block ends. A second Ctrl-C, pressed because the first seemed slow, cannot cut the save short.
 
 Python drops an exception raised inside a finaliser or a weakref callback (matplotlib's
-figures run many as they are freed) after printing it, and an extension module whose making is
-interrupted can be left broken (pybind11 turns the interrupt into an ImportError). A signal
-whose interrupt would be dropped, or that arrives during an import, is signalled again once
-that is over (:func:`_dropped`, :func:`_handle`): it is raised late, never lost.
+figures run many as they are freed) after printing it; the finaliser of a file object clears
+an exception of its ``close`` without a word (fmpy's zip members are closed so while a model
+description is read); and an extension module whose making is interrupted can be left broken
+(pybind11 turns the interrupt into an ImportError). A signal whose interrupt would be dropped,
+that lands in a file's ``close`` or that arrives during an import, is signalled again once that
+is over (:func:`_dropped`, :func:`_handle`): it is raised late, never lost.
 """
 
 from __future__ import annotations
 
 import _thread
 import contextlib
+import io
 import signal
 import sys
 import threading
@@ -162,11 +165,23 @@ def _importing(frame) -> bool:
     return False
 
 
+def _closing(frame) -> bool:
+    """Whether the code at ``frame`` runs inside the ``close`` of a file object, which its
+    finaliser may be running: an exception raised there is then cleared, unreported."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "close" and code.co_argcount and isinstance(frame.f_locals.get(code.co_varnames[0]),
+                                                                       io.IOBase):
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _busy(frame) -> bool:
     """Whether a signal handled in the main thread at ``frame`` could not be raised there:
-    :func:`_dropped` is running, or the main thread is importing (an extension module stopped in
-    its making can be left broken)."""
-    return _state.dropping or _importing(frame)
+    :func:`_dropped` is running, the main thread is importing (an extension module stopped in
+    its making can be left broken) or closing a file (its finaliser would clear the interrupt)."""
+    return _state.dropping or _importing(frame) or _closing(frame)
 
 
 def _dropped(unraisable):

@@ -3,6 +3,7 @@ for memory, out-of-range seeds, FMU warnings. Each case checks the message, the 
 what is left on disk."""
 
 import gc
+import io
 import json
 import os
 import re
@@ -52,6 +53,27 @@ def test_a_signal_landing_in_a_weakref_callback_is_raised_once_the_callback_is_o
                     after.append(time.monotonic())
     assert reference() is None and 0 < len(after) and after[-1] < deadline
     assert sys.unraisablehook is hook and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+@pytest.mark.parametrize("sent, raised", [(signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, Terminated)])
+def test_a_signal_landing_in_a_file_closed_by_its_finaliser_is_raised_once_it_is_closed(sent, raised):
+    # A file object's finaliser clears an exception of its close() without a word: fmpy's zip
+    # members closed so while a model description was read let a SIGTERM end a run with exit 0.
+    class Member(io.RawIOBase):
+        def close(self):
+            signal.raise_signal(sent)  # the handler runs inside
+            super().close()
+
+    after = []
+    with pytest.raises(raised):
+        with first_only():
+            member = Member()
+            del member  # its finaliser closes it, and clears what close() raises
+            deadline = time.monotonic() + 1.0
+            while time.monotonic() < deadline:  # ordinary code: the signal is raised here
+                after.append(time.monotonic())
+    assert 0 < len(after) and after[-1] < deadline
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_a_signal_during_an_import_is_raised_once_the_module_is_made(tmp_path, monkeypatch):
