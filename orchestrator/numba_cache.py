@@ -30,19 +30,35 @@ KEEP = 4
 
 ROOT = Path(__file__).resolve().parent.parent  # the folder holding the packages (checkout or site-packages)
 
-_digests: dict[tuple[str, Path], tuple[tuple, str]] = {}  # (package, root) -> (stat signature, digest)
-_current: dict[str, Path] = {}  # package -> its folder, while numba decorates one module's functions
+_digests: dict[tuple[str, Path], tuple[tuple, bytes]] = {}  # (package, root) -> (stat signature, digest)
+_current: dict[str, Path] = {}  # package -> its folder, until numba comes back to a module (a reload)
+_fresh: set[tuple[str, Path]] = set()  # packages whose digest has been checked since then
+_decorated: set[str] = set()  # the files whose functions numba has decorated in this process
 _last_file: list[str | None] = [None]
+_relative: dict[str, Path | None] = {}  # a function's file -> its path under ROOT (None: outside)
 _used: set[Path] = set()  # folders marked used by this process
 
 
-def _files(root: Path, packages) -> list[Path]:
-    found = []
-    for package in packages:
-        for folder, subfolders, names in os.walk(root / package):
-            subfolders[:] = sorted(s for s in subfolders if s != "__pycache__")
-            found += [Path(folder, name) for name in sorted(names) if name.endswith(".py")]
-    return found
+def _package_digest(package: str, root: Path) -> bytes:
+    """SHA-256 of the relative paths and bytes of the ``.py`` files of one package, re-read only
+    when a file's size or modification time (ns) has changed since this process read it."""
+    if (package, root) in _fresh:
+        return _digests[(package, root)][1]
+    files = []
+    for folder, subfolders, names in os.walk(root / package):
+        subfolders[:] = sorted(s for s in subfolders if s != "__pycache__")
+        files += [Path(folder, name) for name in sorted(names) if name.endswith(".py")]
+    signature = tuple((path, stat.st_mtime_ns, stat.st_size) for path in files for stat in [path.stat()])
+    known = _digests.get((package, root))
+    _fresh.add((package, root))
+    if known is not None and known[0] == signature:
+        return known[1]
+    digest = hashlib.sha256()
+    for path in files:
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes())
+    _digests[(package, root)] = (signature, digest.digest())
+    return _digests[(package, root)][1]
 
 
 def source_digest(package: str, root: Path = ROOT) -> str:
@@ -59,20 +75,12 @@ def source_digest(package: str, root: Path = ROOT) -> str:
     -------
     str
         16 hex digits of the SHA-256 of the relative paths and bytes of every ``.py`` file of
-        ``package`` and of the floors below it. Re-read only when a file's size or modification
-        time (ns) has changed since this process last read it.
+        ``package`` and of the floors below it.
     """
-    files = _files(root, FLOORS[:FLOORS.index(package) + 1])
-    signature = tuple((path, stat.st_mtime_ns, stat.st_size) for path in files for stat in [path.stat()])
-    known = _digests.get((package, root))
-    if known is not None and known[0] == signature:
-        return known[1]
     digest = hashlib.sha256()
-    for path in files:
-        digest.update(path.relative_to(root).as_posix().encode() + b"\0")
-        digest.update(path.read_bytes())
-    _digests[(package, root)] = (signature, digest.hexdigest()[:16])
-    return _digests[(package, root)][1]
+    for below in FLOORS[:FLOORS.index(package) + 1]:
+        digest.update(_package_digest(below, root))
+    return digest.hexdigest()[:16]
 
 
 def cache_root() -> Path:
@@ -110,6 +118,18 @@ def _folder(package: str, root: Path) -> Path:
     return folder
 
 
+def _relative_path(py_file: str) -> Path | None:
+    """``py_file``'s path under :data:`ROOT` if it is in a package of :data:`FLOORS`, else None."""
+    if py_file not in _relative:
+        try:
+            relative = Path(py_file).resolve().relative_to(ROOT)
+        except ValueError:
+            relative = None
+        ok = relative is not None and len(relative.parts) > 1 and relative.parts[0] in FLOORS
+        _relative[py_file] = relative if ok else None
+    return _relative[py_file]
+
+
 def _locator_class():
     from numba.core import caching, config
 
@@ -129,14 +149,14 @@ def _locator_class():
         def from_function(cls, py_func, py_file):
             if config.CACHE_DIR:  # the user's own folder: numba's locator
                 return None
-            try:
-                relative = Path(py_file).resolve().relative_to(ROOT)
-            except ValueError:
+            relative = _relative_path(py_file)
+            if relative is None:
                 return None
-            if len(relative.parts) < 2 or relative.parts[0] not in FLOORS:
-                return None
-            if _last_file[0] != py_file:  # another module (or one reloaded): look at the sources again
-                _current.clear()
+            if _last_file[0] != py_file:
+                if py_file in _decorated:  # a module decorated again (reloaded): the sources may have changed
+                    _current.clear()
+                    _fresh.clear()
+                _decorated.add(py_file)
                 _last_file[0] = py_file
             path = _folder(relative.parts[0], ROOT) / relative.parent
             self = cls(py_func, py_file, path)
