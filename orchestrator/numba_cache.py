@@ -171,8 +171,9 @@ _installed: list = []
 
 def install() -> None:
     """Make numba cache the project's compiled functions by their sources (this module's
-    docstring); idempotent. Called by every module holding cached numba code before it
-    decorates, since numba chooses a function's cache folder when it decorates it."""
+    docstring); idempotent. Called before any of the project's cached functions is decorated
+    (numba chooses a function's cache folder then): by the ``__init__`` of the packages holding
+    them, or by the module itself (``tests/test_architecture.py`` checks it)."""
     if _installed:
         return
     from numba.core import caching
