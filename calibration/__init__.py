@@ -9,6 +9,11 @@
   (:mod:`calibration.compensator`).
 """
 
+from orchestrator import numba_cache
+
+# before the modules below decorate their functions: numba picks a function's cache folder then
+numba_cache.install()
+
 from calibration.compensator import MagCompensator, compensate
 from calibration.dynamic import MotorFieldModel, Sweep, fit_dynamic, order_study
 from calibration.file import Calibration

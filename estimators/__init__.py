@@ -11,6 +11,11 @@
 - :mod:`estimators.analysis`: python-control analyses of the gains.
 """
 
+from orchestrator import numba_cache
+
+# before the modules below decorate their functions: numba picks a function's cache folder then
+numba_cache.install()
+
 from estimators.filters import (
     CORRECTIONS,
     DEFAULT_GAINS,

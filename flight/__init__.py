@@ -7,6 +7,11 @@
 - :mod:`flight.profiles`: the setpoint tables of the lab's flight profiles.
 """
 
+from orchestrator import numba_cache
+
+# before the modules below decorate their functions: numba picks a function's cache folder then
+numba_cache.install()
+
 from flight.controller import GAINS, SETPOINT, Controller
 from flight.mixer import allocation_matrix, esc_command
 from flight.profiles import FLIGHTS, initial_state, profile, profile_at

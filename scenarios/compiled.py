@@ -1,7 +1,8 @@
 """The numba-compiled code (estimators, controller, compensator, IR calibration), compiled ahead.
 
 numba compiles a function the first time it is called with new argument types and keeps the
-machine code in its on-disk cache (``cache=True``), where later processes load it. Without
+machine code in its on-disk cache (``cache=True``; placed and keyed by its sources by
+:mod:`orchestrator.numba_cache`), where later processes load it. Without
 this module the first run after installing would sit silent for tens of seconds while that
 happens. :func:`compile_all` (run by ``quadcosim build``, so by ``make demo``) calls every
 compiled step once, the way the scenarios call them, so that runs load them from the cache;

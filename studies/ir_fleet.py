@@ -25,7 +25,10 @@ import numpy as np
 from numba import njit
 
 from fmus.build import table
+from orchestrator import numba_cache
 from scenarios.ir_calibration import RATE, bank_profile, fault_windows
+
+numba_cache.install()  # before any decorator: numba picks a function's cache folder then
 
 _MASK = (1 << 64) - 1
 GOLDEN, MIX1, MIX2, SECOND = 0x9E3779B97F4A7C15, 0xBF58476D1CE4E5B9, 0x94D049BB133111EB, 0xD1B54A32D192ED03

@@ -41,8 +41,9 @@ ALLOWED = {
     # the one writer of every file, and Ctrl-C surfaced while a reader holds the process
     "flightlogs": ("orchestrator.files", "orchestrator.interrupts"),
     # the block contract, the plant's constants, the flight-log reading layer and the one writer
-    "estimators": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus."),
-    "calibration": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus."),
+    # and numba's cache keyed by the sources (installed by the package before its modules decorate)
+    "estimators": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus.", "orchestrator.numba_cache"),
+    "calibration": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus.", "orchestrator.numba_cache"),
     # the controller: the block contract, the plant, the estimators' quaternion arithmetic
     "flight": ("fmus.", "orchestrator.", "estimators."),
     "scenarios": _below("scenarios"),
@@ -341,6 +342,58 @@ def test_the_build_ships_every_header_a_source_includes():
     build = (ROOT / "fmus" / "build.py").read_text()
     included = set().union(*C_INCLUDES.values()) - GENERATED_HEADERS - FMI_HEADERS
     assert [h for h in sorted(included) if f'"{h}"' not in build] == []
+
+
+# --- numba's cache ---------------------------------------------------------------------------
+
+
+def _caches_numba_code(tree: ast.Module) -> int | None:
+    """First line of a ``cache=True`` keyword (a numba decorator's) in the module, or None."""
+    lines = [node.value.lineno for node in ast.walk(tree) if isinstance(node, ast.keyword) and node.arg == "cache"
+             and isinstance(node.value, ast.Constant) and node.value.value is True]
+    return min(lines, default=None)
+
+
+def _install_line(tree: ast.Module) -> int | None:
+    """Line of the module's top-level ``numba_cache.install()``, or None."""
+    for node in tree.body:
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Call) and \
+                ast.unparse(node.value.func) == "numba_cache.install":
+            return node.lineno
+    return None
+
+
+def _package_installs_first(init: Path) -> bool:
+    """The package's ``__init__`` installs numba_cache's locator before it imports its own modules."""
+    tree = ast.parse(init.read_text())
+    package = _module_of(init)
+    own = [node.lineno for node in tree.body if isinstance(node, ast.ImportFrom)
+           and (node.module or "").startswith(package + ".")]
+    line = _install_line(tree)
+    return line is not None and line < min(own, default=line + 1)
+
+
+def test_cached_numba_code_is_keyed_by_its_sources():
+    """numba picks a function's cache folder when it decorates it: a module holding cached numba
+    code installs :mod:`orchestrator.numba_cache`'s locator before its first decorator, or a
+    package it is in does before importing its modules; and it is on a floor the key covers."""
+    from orchestrator import numba_cache
+
+    assert numba_cache.FLOORS == FLOORS[:len(numba_cache.FLOORS)]
+    bad = []
+    for path in _sources():
+        tree = ast.parse(path.read_text())
+        first = _caches_numba_code(tree)
+        if first is None:
+            continue
+        where = path.relative_to(ROOT)
+        if where.parts[0] not in numba_cache.FLOORS:
+            bad.append(f"{where}: above the floors numba_cache.FLOORS keys")
+        own = _install_line(tree)
+        packages = [ROOT.joinpath(*where.parts[:k], "__init__.py") for k in range(1, len(where.parts))]
+        if not (own is not None and own < first) and not any(_package_installs_first(p) for p in packages):
+            bad.append(f"{where}:{first} caches numba code with no numba_cache.install() before it")
+    assert not bad, "\n".join(bad)
 
 
 # --- sizes ----------------------------------------------------------------------------------

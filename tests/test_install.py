@@ -1,7 +1,7 @@
 """The package as a user installs it: a wheel built from this checkout (through its sdist),
 installed into a fresh virtual environment outside the checkout, runs a short scenario from an
-unrelated folder, builds its FMUs into the per-user cache (never into ``site-packages``) and
-compiles the benchmark's C references from the sources it ships.
+unrelated folder, builds its FMUs and numba's cache into the per-user cache (never into
+``site-packages``) and compiles the benchmark's C references from the sources it ships.
 
 The environment is made with ``uv`` (a pinned development dependency) so that the install takes
 seconds; its dependencies are resolved from ``pyproject.toml`` with the development
@@ -31,10 +31,9 @@ def _uv() -> str:
 
 def _clean_env(cache: Path) -> dict:
     """The process environment less anything pointing at this checkout or its environment."""
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith("QUADCOSIM_") and k not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")}
-    env.update(XDG_CACHE_HOME=str(cache), UV_PYTHON_DOWNLOADS="never", MPLBACKEND="Agg",
-               NUMBA_CACHE_DIR=str(cache / "numba"))
+    dropped = ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME", "NUMBA_CACHE_DIR")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("QUADCOSIM_") and k not in dropped}
+    env.update(XDG_CACHE_HOME=str(cache), UV_PYTHON_DOWNLOADS="never", MPLBACKEND="Agg")
     return env
 
 
@@ -93,6 +92,10 @@ def test_quadcosim_run_tp_from_an_unrelated_folder(installed, tmp_path):
     built = {p.name for p in (cache / "quadcosim" / "0.1.0" / "fmus").glob("*.fmu")}
     assert {"Quadrotor.fmu", "MotorMagnetics.fmu", "IMU.fmu"} <= built
     assert not (site / "build").exists()
+    # numba's cache of the package's code: in the user's cache, keyed by the sources, none in site-packages
+    compiled = {p.name.split("-")[0] for p in (cache / "quadcosim" / "0.1.0" / "numba").iterdir()}
+    assert {"estimators", "flight"} <= compiled
+    assert not list(site.rglob("*.nbi"))
 
 
 def test_the_benchmark_references_compile_from_the_installed_sources(installed, tmp_path):
