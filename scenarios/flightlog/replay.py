@@ -53,8 +53,10 @@ def _uniform(log, compass: int):
     return time, dt, gyro, acc, reference
 
 
-def _fields(log, compass: int, time):
-    """The compass at ``time`` without and with the compensation fitted on the first half, and the notes."""
+def _fields(log, compass: int, time, model_offsets: bool = True):
+    """The compass at ``time`` without and with the compensation fitted on the first half, and the
+    model's name; ``model_offsets``: the model with the offsets fitted with it (False: with the
+    log's, which count the motors' mean field twice; an ablation)."""
     from dataclasses import replace
 
     from calibration import compensate
@@ -73,7 +75,7 @@ def _fields(log, compass: int, time):
     model = metrics["calibration_model"]
     if model is None:
         return without, without, model
-    if metrics["static"]["source"] == "log":
+    if model_offsets and metrics["static"]["source"] == "log":
         # the model goes with the offsets fitted with it: the log's already hold the motors' mean field,
         # which the model's vectors then remove a second time (a constant bias in the body frame)
         offsets = np.mean(fitted[model].extra["nuisance"][:, 3:], axis=0)
