@@ -46,6 +46,7 @@ GROUPS = (
     "records",
     "excerpt",
     "log_info",
+    "example_replay",
 )
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -10,7 +10,8 @@ How a log is replayed:
 - the first IMU, resampled to a uniform period (its median sample spacing), gives gyro and
   specific force; the compass (``--compass``) is interpolated to the same instants;
 - the compensation is calibrated on the first half of the flight (:func:`calibration.flight.calibrate`)
-  and applied by :func:`calibration.compensate` (eq. 9 of Metge et al.); without it, only the
+  and applied by :func:`calibration.compensate` (eq. 9 of Metge et al.) with the offsets fitted
+  with its model (the log's offsets already hold the motors' mean field); without it, only the
   log's offsets are removed;
 - the Earth field in NED is the compass's field rotated by the log's attitude, averaged over the
   first half; every estimator starts from the TRIAD attitude of the first sample;
@@ -52,14 +53,18 @@ def _uniform(log, compass: int):
     return time, dt, gyro, acc, reference
 
 
-def _fields(log, compass: int, time):
-    """The compass at ``time`` without and with the compensation fitted on the first half, and the notes."""
+def _fields(log, compass: int, time, model_offsets: bool = True):
+    """The compass at ``time`` without and with the compensation fitted on the first half, and the
+    model's name; ``model_offsets``: the model with the offsets fitted with it (False: with the
+    log's, which count the motors' mean field twice; an ablation)."""
+    from dataclasses import replace
+
     from calibration import compensate
     from calibration.flight import calibrate, flight_data
 
     data = flight_data(log, compass)
     train, test = data.split(0.5)
-    metrics, calibration, _ = calibrate([train], [test], ("current", "throttle", "motors", "metge"))
+    metrics, calibration, fitted = calibrate([train], [test], ("current", "throttle", "motors", "metge"))
     raw = np.column_stack([np.interp(time, data.time, data.raw[:, k]) for k in range(3)])
     motors = log.motors
     commands = np.column_stack([np.interp(time, motors.time, motors.commands[:, n])
@@ -68,8 +73,14 @@ def _fields(log, compass: int, time):
                else np.full(len(time), np.nan))
     without = compensate(calibration, time, raw, commands, voltage, "static")
     model = metrics["calibration_model"]
-    with_model = without if model is None else compensate(calibration, time, raw, commands, voltage, "metge")
-    return without, with_model, model
+    if model is None:
+        return without, without, model
+    if model_offsets and metrics["static"]["source"] == "log":
+        # the model goes with the offsets fitted with it: the log's already hold the motors' mean field,
+        # which the model's vectors then remove a second time (a constant bias in the body frame)
+        offsets = np.mean(fitted[model].extra["nuisance"][:, 3:], axis=0)
+        calibration = replace(calibration, static=replace(calibration.static, b_s=offsets))
+    return without, compensate(calibration, time, raw, commands, voltage, "metge"), model
 
 
 def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMATORS)) -> dict:
