@@ -97,3 +97,31 @@ def test_the_replay_s_compensation_leaves_no_constant_field_and_helps_the_filter
     # the linear filter's own traits (magnetic north, body rates as Euler-angle rates) hold it at 4.65 deg
     # (findings.example_replay removes them: 0.47 deg); 7.12 with the log's offsets
     assert result["linear"]["with"]["heading_rms_deg"] < 5.5
+
+
+def test_the_calibration_file_pairs_its_model_with_the_offsets_fitted_with_it(ran):
+    from scipy.spatial.transform import Rotation
+
+    from calibration import Calibration, compensate
+    from calibration.flight import flight_data
+    from flightlogs import read_log
+    from scenarios.flightlog import replay
+
+    folder, _ = ran
+    metrics = json.loads((folder / "results" / "cal" / "metrics.json").read_text())
+    calibration = Calibration.load(folder / "results" / "cal" / "calibration.json")
+    log = read_log(folder / "logs" / "example-a.log")
+    time, _, _, _, reference = replay._uniform(log, 1)
+    data = flight_data(log, 1)
+    raw = np.column_stack([np.interp(time, data.time, data.raw[:, k]) for k in range(3)])
+    commands = np.column_stack([np.interp(time, log.motors.time, log.motors.commands[:, n])
+                                for n in range(log.motors.commands.shape[1])])
+    voltage = np.interp(time, log.battery.time, log.battery.voltage)
+    compensated = compensate(calibration, time, raw, commands, voltage, "metge")
+    truth = np.einsum("tji,j->ti", Rotation.from_quat(reference, scalar_first=True).as_matrix(), example.earth_field())
+    # the log's offsets are kept (the flight turns about the vertical), and the file carries the model's
+    # own offsets beside it: 0.30 uT left in the body frame; with the log's, which already hold the
+    # motors' mean field, 4.4 uT (the model's field at the mean throttle counted twice)
+    assert metrics["static"]["source"] == "log" and metrics["calibration_model"] is not None
+    assert np.linalg.norm(np.mean(compensated - truth, axis=0)) < 0.5e-6
+    assert not np.allclose(calibration.static.b_s, log.compasses[1].offsets)

@@ -4,6 +4,8 @@ interference model fitted on training flights and scored on held-out ones, and t
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from calibration.dynamic import MotorFieldModel
@@ -69,6 +71,52 @@ def _static(train, best, offsets, soft_iron) -> tuple[StaticCalibration, dict]:
     return static, {"source": "flight", "coverage": coverage, "reason": "fitted on the flight's rotations"}
 
 
+def model_offsets(fitted) -> np.ndarray:
+    """The offsets (3,), T, fitted together with a motor model: its per-flight offsets averaged.
+
+    Parameters
+    ----------
+    fitted : calibration.flight.models.Fitted
+        A fitted model whose ``extra["nuisance"]`` holds each flight's Earth field and offsets (P, 6), T.
+
+    Returns
+    -------
+    numpy.ndarray
+        The offsets (3,), T, that go with the model's vectors.
+    """
+    return np.mean(fitted.extra["nuisance"][:, 3:], axis=0)
+
+
+def paired_static(static: StaticCalibration, notes: dict, chosen: str | None, fitted: dict) -> StaticCalibration:
+    """The hard and soft iron that go with the motor model ``chosen``.
+
+    When the log's offsets are kept (``notes["source"] == "log"``) and a model is chosen, its own
+    offsets replace them: the log's were set with the motors running, so they already hold the
+    motors' mean field, which the model's vectors would remove a second time (a constant field in
+    the body frame). Offsets fitted on the flight's rotations (with the interference removed) and
+    a calibration without a model are returned unchanged.
+
+    Parameters
+    ----------
+    static : calibration.static.StaticCalibration
+        Hard iron ``b_s`` (3,), T, and soft iron ``A`` (3, 3) from :func:`_static`.
+    notes : dict
+        :func:`_static`'s notes (``source``: ``"log"`` or ``"flight"``).
+    chosen : str or None
+        The motor model the calibration carries (:func:`_field_model`).
+    fitted : dict
+        The fitted models by name.
+
+    Returns
+    -------
+    calibration.static.StaticCalibration
+        ``static``, its offsets (T) those fitted with ``chosen`` when the log's were kept.
+    """
+    if chosen is None or notes["source"] != "log":
+        return static
+    return replace(static, b_s=model_offsets(fitted[chosen]))
+
+
 def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel | None]:
     """The preferred identified model in the file's form (eqs. 3, 4 of Metge et al.)."""
     # the first the flights identify of those the file can carry (an a-priori order, richest
@@ -118,6 +166,9 @@ def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Ca
     best = max(fitted, key=lambda name: models[name]["explained_train"], default=None)
     static, static_notes = _static(train, fitted.get(best), compass.offsets, compass.soft_iron)
     static_notes["interference_removed"] = best
+    static = paired_static(static, static_notes, chosen, fitted)
+    if chosen is not None and static_notes["source"] == "log":
+        static_notes["offsets"] = f"those fitted with the {chosen} model (the log's hold the motors' mean field)"
     baseline = score(None, test)
     metrics = {"train": sorted({p.source for p in train}), "test": sorted({p.source for p in test}),
                "attitude": attitude,

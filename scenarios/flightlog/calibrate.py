@@ -220,7 +220,9 @@ def _report(metrics: dict) -> list[str]:
     lines += [f"Earth field: {note}" for note in metrics["earth_field"]]
     if metrics["mounting"]:
         lines.append(f"yaw mounting: {metrics['mounting']['note']}")
-    lines.append(f"hard and soft iron (calibration.json): {metrics['static']['reason']}")
+    static = metrics["static"]
+    lines.append(f"hard and soft iron (calibration.json): {static['reason']}"
+                 + (f"; beside the model, the offsets are {static['offsets']}" if "offsets" in static else ""))
     lines.append("models fitted here, each scored with the Earth field and offset fitted again on the test part "
                  "(an analysis; the export is scored below):")
     for name, m in metrics["models"].items():

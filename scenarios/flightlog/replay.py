@@ -64,23 +64,25 @@ def _fields(log, compass: int, time, model_offsets: bool = True):
 
     data = flight_data(log, compass)
     train, test = data.split(0.5)
-    metrics, calibration, fitted = calibrate([train], [test], ("current", "throttle", "motors", "metge"))
+    # the calibration pairs its model with the offsets fitted with it when the log's are kept
+    # (calibration.flight.calibrate.paired_static); without the model, the log's offsets
+    metrics, calibration, _ = calibrate([train], [test], ("current", "throttle", "motors", "metge"))
     raw = np.column_stack([np.interp(time, data.time, data.raw[:, k]) for k in range(3)])
     motors = log.motors
     commands = np.column_stack([np.interp(time, motors.time, motors.commands[:, n])
                                 for n in range(motors.commands.shape[1])])
     voltage = (np.interp(time, log.battery.time, log.battery.voltage) if log.battery is not None
                else np.full(len(time), np.nan))
-    without = compensate(calibration, time, raw, commands, voltage, "static")
     model = metrics["calibration_model"]
+    unpaired = calibration
+    if model is not None and metrics["static"]["source"] == "log":
+        log_offsets = np.asarray(log.compasses[compass].offsets, dtype=float)
+        unpaired = replace(calibration, static=replace(calibration.static, b_s=log_offsets))
+    without = compensate(unpaired, time, raw, commands, voltage, "static")
     if model is None:
         return without, without, model
-    if model_offsets and metrics["static"]["source"] == "log":
-        # the model goes with the offsets fitted with it: the log's already hold the motors' mean field,
-        # which the model's vectors then remove a second time (a constant bias in the body frame)
-        offsets = np.mean(fitted[model].extra["nuisance"][:, 3:], axis=0)
-        calibration = replace(calibration, static=replace(calibration.static, b_s=offsets))
-    return without, compensate(calibration, time, raw, commands, voltage, "metge"), model
+    return without, compensate(calibration if model_offsets else unpaired, time, raw, commands, voltage,
+                               "metge"), model
 
 
 def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMATORS)) -> dict:
