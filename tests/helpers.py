@@ -30,10 +30,15 @@ def rotation(q):
 
 
 def exit_worker_on_large_gain(result, options):
-    """Sweep extra metric for tests: the worker process dies (as on a crash) when k > 1000."""
+    """Sweep extra metric for tests: the worker process dies (as on a crash) when k > 1000, two
+    seconds after its member began to be scored, so that the member run before it on the same
+    one-thread worker has reported and handed back its result by then (a worker that dies holds
+    them lost, and they are run again: a race on a loaded machine)."""
     import os
+    import time
 
     if options["k"] > 1000:
+        time.sleep(2.0)
         os._exit(3)
     return {}
 
