@@ -24,9 +24,14 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import warnings
 from pathlib import Path
+
+# Before numpy loads: numpy and scipy each bring an OpenBLAS that starts a thread per core and
+# spins them at load, about 0.3 s of CPU a command, for matrices of 3 x 3 here. A user's setting wins.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def _build(args) -> int:
@@ -464,7 +469,6 @@ def entry() -> None:
         code = main()
         sys.stdout.flush()  # here, not at exit: a reader gone (| head) is then seen below
     except BrokenPipeError:  # the reader of our output left (quadcosim list | head -1): no traceback
-        import os
         import signal
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit

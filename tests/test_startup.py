@@ -18,6 +18,23 @@ def test_listing_and_help_import_no_heavy_package(command):
     if command == ["list"]:
         assert "studies.gain_study" in imported  # the hook saw the options of every scenario
     assert [m for m in NOT_FOR_LISTING if m in imported] == []
+    if command == ["--help"]:  # the parser names the verbs; their estimators load when one is run
+        assert "numba" not in imported and "estimators" not in imported
+
+
+@pytest.mark.parametrize("given, seen", [(None, "1"), ("3", "3")])
+def test_the_command_starts_one_blas_thread_unless_told(given, seen):
+    """numpy's and scipy's OpenBLAS spin a thread per core at load: the command asks for one
+    before numpy loads; a user's own setting is kept."""
+    import os
+
+    environment = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given:
+        environment["OPENBLAS_NUM_THREADS"] = given
+    code = ("import sys, quadcosim.main, os; assert 'numpy' not in sys.modules, 'numpy before the setting'; "
+            "print(os.environ['OPENBLAS_NUM_THREADS'])")
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, env=environment)
+    assert out.stdout.strip() == seen
 
 
 def test_a_scenario_look_up_imports_that_scenario_alone():

@@ -48,6 +48,14 @@ def plot(args) -> int:
     return 0
 
 
+def replay(args) -> int:
+    """``quadcosim log replay FILE`` (:func:`scenarios.flightlog.replay.run`), imported when called:
+    the estimators (and numba) load for a replay, not for every command's parser."""
+    from scenarios.flightlog import replay as replayed
+
+    return replayed.run(args)
+
+
 def add_arguments(parser):
     """The ``log`` verb's sub-commands on ``parser`` (an argparse parser); returns it."""
     sub = parser.add_subparsers(dest="log_command", required=True)
@@ -65,8 +73,6 @@ def add_arguments(parser):
     drawn.add_argument("--overwrite", action="store_true",
                        help="replace results/logs/NAME-overview.png rather than take the next free name")
     drawn.set_defaults(func=plot)
-    from scenarios.flightlog import replay
-
     replayed = sub.add_parser("replay", help="the project's estimators on the log, without and with the "
                               "compensation, against the autopilot's attitude (a reference, not the truth)")
     replayed.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
@@ -75,7 +81,7 @@ def add_arguments(parser):
 
     add_json_flag(replayed, "print the result as JSON on standard output, in place of the table")
     replayed.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
-    replayed.set_defaults(func=replay.run)
+    replayed.set_defaults(func=replay)
     from scenarios.flightlog import example
 
     made = sub.add_parser("example", help="write three small synthetic flight logs to try these commands on "
