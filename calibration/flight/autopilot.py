@@ -1,6 +1,8 @@
-"""Parameter files: ArduPilot's (``NAME,VALUE`` lines, as Mission Planner loads them) and PX4's
-(QGroundControl's tab-separated format). The parameters themselves, and how each firmware applies
-them, are in :mod:`flightlogs.ardupilot` and :mod:`flightlogs.px4`.
+"""The autopilots a flight calibration exports for, one line each in :data:`AUTOPILOTS`: what
+each firmware does with the parameters (applies them to the raw field, names them, which motor
+compensations it has) and its parameter file, ArduPilot's (``NAME,VALUE`` lines, as Mission
+Planner loads them) or PX4's (QGroundControl's tab-separated format). The firmware arithmetic
+itself is in :mod:`flightlogs.ardupilot` and :mod:`flightlogs.px4`.
 """
 
 from __future__ import annotations
@@ -8,6 +10,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+
+from flightlogs import ardupilot, px4
 
 
 def write_ardupilot(params: dict, path) -> None:
@@ -30,9 +34,63 @@ def write_px4(params: dict, path) -> None:
     write_text(path, "".join(lines))
 
 
+def rules_of(part, override=None) -> ardupilot.Rules:
+    """The ArduPilot rules of ``part``'s firmware (a :class:`calibration.flight.data.FlightData`'s
+    log banner), or ``override`` (a :class:`flightlogs.ardupilot.Rules`)."""
+    return override or ardupilot.log_rules(part.log.firmware)
+
+
+def _compass(part):
+    return part.log.compasses[part.compass]
+
+
+def _ardupilot_apply(part, params, inputs, rule):
+    return ardupilot.apply(params, _compass(part).slot, rules_of(part, rule), part.raw, inputs["current"],
+                           inputs["throttle"], inputs["commands"], inputs["voltage"])
+
+
+def _px4_apply(part, params, inputs, rule):
+    compass = _compass(part)
+    return px4.apply(params, compass.slot, bool(compass.external), part.raw, inputs["current"], inputs["throttle"])
+
+
+def _ardupilot_parameters(part, candidate, rule):
+    return ardupilot.parameters(_compass(part).slot, rules_of(part, rule), candidate.offset, candidate.correction,
+                                candidate.model, candidate.K)
+
+
+def _px4_parameters(part, candidate, rule):
+    return px4.parameters(_compass(part).slot, candidate.offset, candidate.correction,
+                          None if candidate.model == "motors" else candidate.model, candidate.K)
+
+
+def _ardupilot_models(part, rule):
+    from calibration.flight import catalogue
+
+    if rules_of(part, rule).per_motor and _compass(part).slot == 0:  # COMPASS_PMOT: 4.0 and later, first compass
+        return catalogue.preferred("autopilot")
+    return ("current", "throttle")
+
+
+def _px4_models(part, rule):
+    return ("current", "throttle")
+
+
+def _ardupilot_scale(part, rule):
+    return {f"COMPASS_SCALE{ardupilot.suffix(_compass(part).slot)}": 1.0} if rules_of(part, rule).scale else {}
+
+
+def _no_scale(part, rule):
+    return {}
+
+
 @dataclass(frozen=True)
 class Autopilot:
-    """An autopilot the export writes parameters for.
+    """An autopilot the export writes parameters for, and how its firmware uses them.
+
+    Each callable takes ``part`` (a :class:`calibration.flight.data.FlightData` of one compass of
+    one of this autopilot's logs) and, last, ``rule``: a :class:`flightlogs.ardupilot.Rules`
+    overriding the firmware version the log names (None: the log's).
 
     Attributes
     ----------
@@ -42,18 +100,45 @@ class Autopilot:
         The parameter file the export writes in the results folder.
     write : callable
         ``(params, path)``: the parameters in the autopilot's file format.
+    apply : callable
+        ``(part, params, inputs, rule)``: the body-frame field (T, 3) (T) the firmware reports
+        from the part's raw field with ``params`` (all of them, the log's included) and
+        ``inputs`` (``current`` (A), ``throttle`` (0..1), ``commands`` (0..1), ``voltage`` (V)).
+    parameters : callable
+        ``(part, candidate, rule)``: a :class:`calibration.flight.export.Candidate` as the
+        firmware's parameters of the part's compass (name: value, the firmware's units).
+    motor_models : callable
+        ``(part, rule)``: the motor compensations the firmware has for the part's compass, names
+        of :data:`calibration.flight.catalogue.MODELS`.
+    scale_reset : callable
+        ``(part, rule)``: parameters to reset when a fitted soft iron is exported (it carries the
+        scale).
+    firmware : callable
+        ``(part, rule)``: the firmware as the export's metrics name it.
     """
 
     name: str
     file: str
     write: Callable[[dict, object], None]
+    apply: Callable
+    parameters: Callable
+    motor_models: Callable
+    scale_reset: Callable
+    firmware: Callable
 
 
 #: The autopilots, one line each: a flight log of one of them is exported in its own file.
 AUTOPILOTS = {autopilot.name: autopilot for autopilot in (
-    Autopilot("ArduPilot", "ardupilot.parm", write_ardupilot),
-    Autopilot("PX4", "px4.params", write_px4),
+    Autopilot("ArduPilot", "ardupilot.parm", write_ardupilot, _ardupilot_apply, _ardupilot_parameters,
+              _ardupilot_models, _ardupilot_scale, lambda part, rule: rules_of(part, rule).name),
+    Autopilot("PX4", "px4.params", write_px4, _px4_apply, _px4_parameters, _px4_models, _no_scale,
+              lambda part, rule: part.log.firmware),
 )}
+
+
+def autopilot_of(part) -> Autopilot:
+    """The :class:`Autopilot` of ``part``'s log."""
+    return AUTOPILOTS[part.log.autopilot]
 
 
 def write_parameters(autopilot: str, params: dict, path) -> None:

@@ -118,20 +118,12 @@ def paired_static(static: StaticCalibration, notes: dict, chosen: str | None, fi
 
 
 def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel | None]:
-    """The preferred identified model in the file's form (eqs. 3, 4 of Metge et al.)."""
+    """The preferred identified model in the file's form (:attr:`catalogue.Model.to_file`)."""
     # the first the flights identify of those the file can carry (an a-priori order, richest
     # first, not a choice on the scores)
     for name in catalogue.preferred("in_file"):
-        if name not in fitted:
-            continue
-        if name == "metge":
-            return name, fitted[name].extra["field"]
-        K = fitted[name].extra["K"]
-        vectors = np.repeat(K / motors, motors, axis=0) if name == "throttle" else K  # throttle = mean command
-        norms = np.linalg.norm(vectors, axis=1)
-        safe = np.where(norms > 0, norms, 1.0)
-        v = np.where(norms[:, None] > 0, vectors / safe[:, None], np.array([1.0, 0.0, 0.0]))
-        return name, MotorFieldModel(v, norms[:, None], (1, 0))
+        if name in fitted:
+            return name, catalogue.MODELS[name].to_file(fitted[name], motors)
     return None, None
 
 

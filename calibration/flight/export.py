@@ -21,11 +21,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from calibration.flight import catalogue
+from calibration.flight.autopilot import autopilot_of
 from calibration.flight.evaluate import heading_error, tilt_compensated_heading
 from calibration.flight.linear import earth_and_offset, fit_linear
 from calibration.static import CalibrationError
-from flightlogs import ardupilot, px4
+from flightlogs import ardupilot
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
 # every firmware's motor compensation switched off (ArduPilot's COMPASS_MOTCT and COMPASS_PMOT_EN, PX4's
@@ -41,26 +41,10 @@ def _inputs(part) -> dict:
             "commands": part.commands(), "voltage": part.voltage()}
 
 
-def is_px4(part) -> bool:
-    """Whether ``part``'s log is a PX4 log (else ArduPilot)."""
-    return part.log.autopilot == "PX4"
-
-
-def rules_of(part, override=None) -> ardupilot.Rules:
-    """The ArduPilot rules of ``part``'s firmware, or ``override`` (a :class:`ardupilot.Rules`)."""
-    return override or ardupilot.log_rules(part.log.firmware)
-
-
 def apply_parameters(part, params: dict, rule=None) -> np.ndarray:
     """The body-frame field (T, 3) (T) the log's firmware reports from ``part``'s raw field with
     ``params`` loaded on top of the log's own parameters; ``rule`` overrides ArduPilot's version rules."""
-    merged = {**part.log.params, **params}
-    x = _inputs(part)
-    compass = part.log.compasses[part.compass]
-    if is_px4(part):
-        return px4.apply(merged, compass.slot, bool(compass.external), part.raw, x["current"], x["throttle"])
-    return ardupilot.apply(merged, compass.slot, rules_of(part, rule), part.raw, x["current"], x["throttle"],
-                           x["commands"], x["voltage"])
+    return autopilot_of(part).apply(part, {**part.log.params, **params}, _inputs(part), rule)
 
 
 def score_parameters(parts, params: dict, rule=None) -> dict:
@@ -133,12 +117,10 @@ def _motor_regressors(part, model: str) -> np.ndarray | None:
 
 
 def motor_models(part, rule=None) -> tuple[str, ...]:
-    """The motor compensations ``part``'s firmware has for its compass: ``current`` and
-    ``throttle``, and ``motors`` (``COMPASS_PMOT``) on ArduPilot 4.0 and later's first compass
-    (``rule`` overriding the log's version)."""
-    if not is_px4(part) and rules_of(part, rule).per_motor and part.log.compasses[part.compass].slot == 0:
-        return catalogue.preferred("autopilot")
-    return ("current", "throttle")
+    """The motor compensations ``part``'s firmware has for its compass (:class:`Autopilot`'s
+    ``motor_models``): ``current`` and ``throttle``, and ``motors`` (``COMPASS_PMOT``) on ArduPilot
+    4.0 and later's first compass (``rule`` overriding the log's version)."""
+    return autopilot_of(part).motor_models(part, rule)
 
 
 def fit_motor(train, model: str | None):
@@ -207,12 +189,7 @@ def fit_soft_iron(train, model, K) -> tuple[np.ndarray, np.ndarray] | str:
 def parameters_of(part, candidate: Candidate, rule=None) -> dict:
     """``candidate`` as the parameters of ``part``'s firmware (compass's own slot; ``rule`` overriding
     ArduPilot's version)."""
-    compass = part.log.compasses[part.compass]
-    if is_px4(part):
-        return px4.parameters(compass.slot, candidate.offset, candidate.correction,
-                              None if candidate.model == "motors" else candidate.model, candidate.K)
-    return ardupilot.parameters(compass.slot, rules_of(part, rule), candidate.offset, candidate.correction,
-                                candidate.model, candidate.K)
+    return autopilot_of(part).parameters(part, candidate, rule)
 
 
 def log_parameters(part, names) -> dict:
@@ -257,9 +234,7 @@ def _soft_iron_trial(first, soft, chosen, rule, trial, log_motor) -> tuple[dict,
     as parameters and their score."""
     A, b = soft
     candidate = Candidate(b, np.linalg.inv(A), chosen.model if chosen else None, chosen.K if chosen else None)
-    slot = first.log.compasses[first.compass].slot
-    scale = {} if is_px4(first) or not rules_of(first, rule).scale else {
-        f"COMPASS_SCALE{ardupilot.suffix(slot)}": 1.0}  # the fitted soft iron carries the scale
+    scale = autopilot_of(first).scale_reset(first, rule)  # the fitted soft iron carries the scale
     return trial(candidate, (log_motor if chosen is None else {}) | scale)
 
 

@@ -193,7 +193,7 @@ def _export(args, split: Split, metrics: dict) -> tuple:
     """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
     described in ``metrics["export"]``; (autopilot, file name, parameters)."""
     from calibration.flight.autopilot import AUTOPILOTS
-    from calibration.flight.export import choose, log_parameters, rules_of, score_parameters
+    from calibration.flight.export import choose, log_parameters, score_parameters
 
     train, score = split.train, split.score
     rule = _rule(args, split.test[0])
@@ -202,7 +202,7 @@ def _export(args, split: Split, metrics: dict) -> tuple:
     name = AUTOPILOTS[autopilot].file
     exported = score_parameters(score, params, rule)
     flown = score_parameters(score, log_parameters(score[0], params), rule)
-    firmware = train[0].log.firmware if autopilot == "PX4" else rules_of(train[0], rule).name
+    firmware = AUTOPILOTS[autopilot].firmware(train[0], rule)
     metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
                          "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
                          "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"],
