@@ -52,12 +52,16 @@ def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
         found["choices"] = list(scenarios.get("tp").options["estimator"].choices)
         found["compared"] = [list(studies.lab_matrix.COMPARED), list(studies.metge.STUDY_ESTIMATORS)]
         found["replayed"] = list(replay.ESTIMATORS)
+        from scenarios.registries import estimator_rows
+        found["documented"] = [row for row in estimator_rows() if row[0] == "`gyro-only`"]
     ''', tmp_path)
     assert "|gyro-only)" in found["listed"]  # quadcosim list: tp's estimator choices
     assert found["ran"][:2] == [0, "gyro-only"] and found["ran"][2]  # run and scored
     assert found["choices"][-1] == "gyro-only"
     assert all(compared[-1] == "gyro-only" for compared in found["compared"])  # the comparisons run it
     assert "gyro-only" not in found["replayed"]  # a block alone: no batch path for recorded arrays
+    # the docs' table (docs/_generated/registries.md): closed loop, no batch path, its own block
+    assert found["documented"] == [["`gyro-only`", "gyro only", "", "", "yes", "", "yes", "`dummy_estimator:GyroOnly`"]]
 
 
 def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
@@ -78,10 +82,13 @@ def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
         found["chosen"] = [code, sorted(metrics["models"]), metrics["models"]["nothing"]["explained_test"]]
         from calibration.flight import catalogue
         found["orders"] = [list(catalogue.preferred("in_file")), list(catalogue.preferred("autopilot"))]
+        from scenarios.registries import model_rows
+        found["documented"] = [row[0] for row in model_rows()]
     ''', tmp_path)
     assert found["default"][0] == 0 and "nothing" in found["default"][1]  # --models' default: every model
     assert found["chosen"][:2] == [0, ["current", "nothing"]] and abs(found["chosen"][2]) < 1e-9
     assert "nothing" not in found["orders"][0] + found["orders"][1]  # neither the file nor an autopilot carries it
+    assert found["documented"][-2:] == ["`dynamic`", "`nothing`"]  # the docs' table, by its rank
 
 
 def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
@@ -95,10 +102,13 @@ def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
         found["ran"] = [code, json.load(open("out/metrics.json"))["final_time_s"]]
         import scenarios
         found["names"] = list(scenarios.names())
+        from scenarios.registries import scenario_rows
+        found["documented"] = [row for row in scenario_rows() if row[0] == "`dummy`"]
     ''', tmp_path)
     assert found["listed"] == ["dummy: a clock alone"]
     assert found["ran"][0] == 0 and abs(found["ran"][1] - 0.3) < 1e-9
     assert {"dummy", "gain-study"} <= set(found["names"])
+    assert found["documented"] == [["`dummy`", "a clock alone", "`dummy_scenario`"]]  # the docs' table
 
 
 # --- the maintainers' checklists (docs/guides/maintainers.md) -------------------------------

@@ -167,6 +167,19 @@ def _variable_tables(app):
         target.write_text(text)
 
 
+def _registry_tables(app):
+    """``_generated/registries.md``: the estimators, interference models, autopilots and scenarios,
+    read from their registries (:mod:`scenarios.registries`)."""
+    import studies  # noqa: F401  (registers its scenarios, as the command line does)
+    from scenarios.registries import tables
+
+    GENERATED.mkdir(exist_ok=True)
+    target = GENERATED / "registries.md"
+    text = tables()
+    if not target.is_file() or target.read_text() != text:
+        target.write_text(text)
+
+
 NOTEBOOKS = HERE.parent / "notebooks"
 #: The packages a notebook calls: an execution older than their newest source is stale.
 PACKAGES = ("fmus", "orchestrator", "estimators", "calibration", "scenarios", "benchmarks")
@@ -304,6 +317,7 @@ def setup(app):
     app.add_directive("quadcosim-run", QuadcosimRun)
     app.add_html_math_renderer("mathml", (_visit_math, None), (_visit_displaymath, None))
     app.connect("builder-inited", _variable_tables)
+    app.connect("builder-inited", _registry_tables)
     app.connect("builder-inited", _notebooks)
     app.connect("build-finished", _check_rendered)
     return {"parallel_read_safe": False, "version": "1"}

@@ -49,8 +49,9 @@ def plot(args) -> int:
 
 
 def replay(args) -> int:
-    """``quadcosim log replay FILE`` (:func:`scenarios.flightlog.replay.run`), imported when called:
-    the estimators (and numba) load for a replay, not for every command's parser."""
+    """``quadcosim log replay FILE`` (``args`` from :func:`add_arguments`, handed to
+    :func:`scenarios.flightlog.replay.run`), imported when called: the estimators (and numba)
+    load for a replay, not for every command's parser."""
     from scenarios.flightlog import replay as replayed
 
     return replayed.run(args)

@@ -1,0 +1,84 @@
+"""The package's closed sets of names as Markdown tables, read from their registries.
+
+- the estimators, :data:`estimators.kinds.KINDS`;
+- the interference models a flight calibration fits, :data:`calibration.flight.catalogue.MODELS`;
+- the autopilots the export writes parameters for, :data:`calibration.flight.autopilot.AUTOPILOTS`;
+- the scenarios, :mod:`scenarios.catalogue` (those a higher floor registers too, once imported).
+
+The documentation's page of these sets is :func:`tables`, written when the site is built: a
+member added by its registry line is listed there as in ``quadcosim list`` and the command
+line's choices.
+"""
+
+from __future__ import annotations
+
+
+def _yes(flag: bool) -> str:
+    return "yes" if flag else ""
+
+
+def _row(cells) -> str:
+    return "| " + " | ".join(str(cell).replace("|", "\\|") for cell in cells) + " |"
+
+
+def _table(header, rows) -> list[str]:
+    return [_row(header), _row(["---"] * len(header)), *(_row(row) for row in rows), ""]
+
+
+def estimator_rows() -> list[tuple]:
+    """One row per estimator: name, label, lab filter, gyro bias, closed loop, recorded arrays,
+    compared, its own block (none: :class:`estimators.QuaternionEstim` builds it by name)."""
+    from estimators.kinds import KINDS
+
+    return [(f"`{kind.name}`", kind.label, _yes(kind.lab), _yes(kind.bias), _yes(kind.streaming), _yes(kind.batch),
+             "" if kind.compared is None else ", ".join(f"{k}={v}" for k, v in kind.compared.items()) or "yes",
+             f"`{kind.block}`" if kind.block else "")
+            for kind in KINDS.values()]
+
+
+def model_rows() -> list[tuple]:
+    """One row per interference model, richest first: name, rank, calibration file, autopilots."""
+    from calibration.flight.catalogue import MODELS
+
+    ordered = sorted(MODELS.values(), key=lambda model: model.preference)
+    return [(f"`{model.name}`", model.preference, _yes(model.in_file), _yes(model.autopilot)) for model in ordered]
+
+
+def autopilot_rows() -> list[tuple]:
+    """One row per autopilot: name, the parameter file written."""
+    from calibration.flight.autopilot import AUTOPILOTS
+
+    return [(autopilot.name, f"`{autopilot.file}`") for autopilot in AUTOPILOTS.values()]
+
+
+def scenario_rows() -> list[tuple]:
+    """One row per registered scenario: name, description, module (imports every scenario)."""
+    from scenarios.catalogue import registrations, registry
+
+    modules = registrations()
+    return [(f"`{name}`", scenario.description, f"`{modules[name][0]}`") for name, scenario in registry().items()]
+
+
+def tables() -> str:
+    """The four sets as one Markdown page (a heading, then a table per set)."""
+    lines = ["# What the package names", "",
+             "Generated from the registries when the site is built; each set is extended by one line in the "
+             "module named (see {doc}`../guides/maintainers`).", "",
+             "## Estimators", "", "`estimators/kinds.py`, read by a scenario's `estimator` choices, the comparisons "
+             "and the replays. Columns: one of the lab's filters (gains `k1`, `k2`, `kP`, `kI`); a gyro bias "
+             "estimated; runs in a closed loop; runs on recorded arrays (the batch path); in the comparisons (with "
+             "these settings); its own block (without one, `estimators.QuaternionEstim` builds the filter by its "
+             "name).", ""]
+    lines += _table(("name", "label", "lab", "bias", "loop", "batch", "compared", "block"),
+                    estimator_rows())
+    lines += ["## Interference models", "", "`calibration/flight/catalogue.py`, richest first: `quadcosim calibrate "
+              "--models`, the calibration file and the autopilots' parameters carry the first they can that the "
+              "flights identify.", ""]
+    lines += _table(("name", "rank", "calibration file", "autopilots"), model_rows())
+    lines += ["## Autopilots", "", "`calibration/flight/autopilot.py`: a flight log of one is exported in its own "
+              "parameter file.", ""]
+    lines += _table(("name", "parameter file"), autopilot_rows())
+    lines += ["## Scenarios", "", "`scenarios/catalogue.py` (and `register` from a higher floor): `quadcosim run`, "
+              "`quadcosim list`, sweeps.", ""]
+    lines += _table(("name", "description", "module"), scenario_rows())
+    return "\n".join(lines)
