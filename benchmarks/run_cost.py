@@ -1,6 +1,6 @@
 """What a short run costs against a long one: the CPU of ``quadcosim run tp`` for 2 s and 320 s of flight.
 
-``python -m benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--in-process] [--json]``
+``python -m benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--in-process] [--parts] [--json]``
 
 Each run is the command a user types, ``quadcosim run tp --set duration=D --out DIR
 --overwrite``, in a fresh interpreter: its CPU (user and system, ``resource.getrusage`` of the
@@ -17,6 +17,8 @@ system, draws (or copies) its wiring, writes its record and draws its report.
 
 A short run costs what it simulates when the ratio approaches ``short / long``; what stays
 above that is the start-up every run pays (the imports, numba's target, matplotlib's figures).
+``--parts`` measures what a fresh interpreter pays to load each of them (:data:`PARTS`), and
+the ratio the two runs' medians would have without numba's and matplotlib's loading.
 """
 
 from __future__ import annotations
@@ -111,6 +113,85 @@ def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3, in_p
             "median_ratio": statistics.median(ratios), "simulated_ratio": short / long}
 
 
+#: What a fresh ``quadcosim run tp`` loads before it simulates, each part in a fresh interpreter
+#: on top of the ones before it (with the command line's one BLAS thread).
+PARTS = (
+    ("the interpreter", "pass"),
+    ("numpy and fmpy", "import numpy, fmpy"),
+    ("numba and the two compiled steps from its cache",
+     "import estimators.filters as e, flight.controller as c; e._compiled_step(); c._compiled_step()"),
+    ("matplotlib's pyplot", "import matplotlib; matplotlib.use('agg'); import matplotlib.pyplot"),
+)
+
+
+def statement_cpu(statement: str, repeats: int = 5) -> float:
+    """Median CPU seconds (user + system) of a fresh interpreter running ``statement``.
+
+    Parameters
+    ----------
+    statement : str
+        Python code, as for ``python -c``.
+    repeats : int
+        Interpreters started.
+
+    Returns
+    -------
+    float
+        CPU of the whole process (s).
+    """
+    import os
+
+    environment = {**os.environ, "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")}
+    spent = []
+    for _ in range(repeats):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([sys.executable, "-c", statement], check=True, env=environment)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        spent.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return statistics.median(spent)
+
+
+def parts(repeats: int = 5) -> list[tuple[str, float]]:
+    """The CPU each of :data:`PARTS` adds to a fresh interpreter (s), in order.
+
+    Parameters
+    ----------
+    repeats : int
+        Interpreters started for each part (the median is kept).
+
+    Returns
+    -------
+    list of (str, float)
+        The part's name and its CPU (s), the cumulated statement's less the one before it.
+    """
+    added, statement, before = [], "", 0.0
+    for name, code in PARTS:
+        statement = f"{statement}; {code}" if statement else code
+        cumulated = statement_cpu(statement, repeats)
+        added.append((name, cumulated - before))
+        before = cumulated
+    return added
+
+
+def without_loading(figures: dict) -> dict:
+    """The ratio of the medians of the short and the long runs' CPU, each less what loading
+    numba (and its compiled steps) and matplotlib costs a fresh interpreter.
+
+    Parameters
+    ----------
+    figures : dict
+        :func:`measure`'s figures of fresh commands, with ``parts_cpu_s`` (:func:`parts`, as a dict).
+
+    Returns
+    -------
+    dict
+        ``ratio_without_numba_and_matplotlib_loading`` (1).
+    """
+    loaded = sum(cpu for name, cpu in figures["parts_cpu_s"].items() if name in (PARTS[2][0], PARTS[3][0]))
+    short, long = statistics.median(figures["short_cpu_s"]), statistics.median(figures["long_cpu_s"])
+    return {"ratio_without_numba_and_matplotlib_loading": (short - loaded) / (long - loaded)}
+
+
 def main(argv=None) -> int:
     """Print the CPU of each run and the ratios; returns 0. ``argv``: the arguments (default
     ``sys.argv[1:]``)."""
@@ -120,9 +201,16 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=3, help="pairs of runs measured (default 3)")
     parser.add_argument("--in-process", action="store_true",
                         help="runs as scenarios.run calls in this process, after one that paid the imports")
+    parser.add_argument("--parts", action="store_true",
+                        help="also the CPU of what a fresh run loads before it simulates (the interpreter, numpy "
+                             "and fmpy, numba and its compiled steps, matplotlib), and the ratio without the "
+                             "last two")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
     figures = measure(args.short, args.long, args.repeats, args.in_process)
+    if args.parts:
+        figures["parts_cpu_s"] = dict(parts())
+        figures |= without_loading(figures)
     if args.json:
         print(json.dumps(figures))
         return 0
@@ -130,6 +218,11 @@ def main(argv=None) -> int:
                                        strict=True)):
         print(f"pair {k + 1}: {args.short:g} s run {s:.2f} s CPU, {args.long:g} s run {lo:.2f} s CPU, ratio {r:.3f}")
     print(f"median ratio {figures['median_ratio']:.3f} (the simulated time's ratio: {figures['simulated_ratio']:.3f})")
+    if args.parts:
+        for name, cpu in figures["parts_cpu_s"].items():
+            print(f"  loading {name}: {cpu:.2f} s CPU")
+        print(f"ratio of the medians less numba's and matplotlib's loading: "
+              f"{figures['ratio_without_numba_and_matplotlib_loading']:.3f}")
     return 0
 
 

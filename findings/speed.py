@@ -1,5 +1,6 @@
 """Findings of the speed page: the master against its C references, the batch path, the FMI
-shell's cost, the command line's start-up and a ``tp`` run's wall time.
+shell's cost, the command line's start-up, a ``tp`` run's wall time and what a short run costs
+against a long one.
 
 One run of each benchmark (``quadcosim bench --json``: :func:`benchmarks.master.measure`;
 ``python -m benchmarks.startup``: :func:`benchmarks.startup.measure`, for ``list``, ``--help``
@@ -23,6 +24,10 @@ STARTUP = "python -m benchmarks.startup"
 TP_OUT = "/tmp/quadcosim-tp"
 TP_RUNS = 3
 TP = f"python -m benchmarks.startup --repeats {TP_RUNS} -- run tp --out {TP_OUT} --overwrite"
+RUN_COST = "python -m benchmarks.run_cost --parts"
+RUN_COST_IN_PROCESS = "python -m benchmarks.run_cost --in-process"
+# The ratio of a 2 s run's CPU to a 320 s run's moved from 0.43 to 0.51 between pairs of one run.
+RUN_COST_TOLERANCE = 0.1
 MILLION = 1e6
 THOUSAND = 1e3
 # Medians of the loop ratios moved by up to about 0.15 between runs at load averages 1 to 20.
@@ -99,14 +104,39 @@ def startup_findings(startup: dict, tp: dict) -> list[dict]:
             _timing("startup.tp_wall_s", next(iter(tp.values()))["median_s"], "s", TP, 1, WALL_SWING)]
 
 
+def run_cost_findings(fresh: dict, in_process: dict) -> list[dict]:
+    """What a short run costs against a long one (:func:`benchmarks.run_cost.measure`): the
+    median ratio of fresh commands and of runs in one process, what numba and matplotlib cost a
+    fresh interpreter to load, and the fresh ratio without that loading.
+
+    Parameters
+    ----------
+    fresh : dict
+        Figures of fresh commands, with ``parts_cpu_s`` (``--parts``).
+    in_process : dict
+        Figures of runs in one process (``--in-process``).
+    """
+    parts = fresh["parts_cpu_s"]
+    return [finding("speed.run_cost.ratio", fresh["median_ratio"], "1", RUN_COST, RUN_COST_TOLERANCE, 3),
+            finding("speed.run_cost.ratio_without_loading", fresh["ratio_without_numba_and_matplotlib_loading"],
+                    "1", RUN_COST, RUN_COST_TOLERANCE, 3),
+            _timing("run_cost.numba_s", parts["numba and the two compiled steps from its cache"], "s", RUN_COST, 2),
+            _timing("run_cost.matplotlib_s", parts["matplotlib's pyplot"], "s", RUN_COST, 2),
+            finding("speed.run_cost.in_process_ratio", in_process["median_ratio"], "1", RUN_COST_IN_PROCESS,
+                    RUN_COST_TOLERANCE, 3)]
+
+
 def compute(quick: bool = False) -> list[dict]:
     """Every figure of the speed page, from one run of each benchmark. ``quick``: none (timings
     are not re-checked)."""
     if quick:
         return []
-    from benchmarks import master, startup
+    from benchmarks import master, run_cost, startup
 
     bench = master.measure()
     with tempfile.TemporaryDirectory() as folder:
         tp = startup.measure([["run", "tp", "--out", str(Path(folder) / "tp"), "--overwrite"]], TP_RUNS)
-    return bench_findings(bench) + startup_findings(startup.measure(), tp)
+    fresh = run_cost.measure() | {"parts_cpu_s": dict(run_cost.parts())}
+    fresh |= run_cost.without_loading(fresh)
+    return (bench_findings(bench) + startup_findings(startup.measure(), tp)
+            + run_cost_findings(fresh, run_cost.measure(in_process=True)))
