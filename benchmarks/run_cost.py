@@ -18,7 +18,7 @@ system, draws (or copies) its wiring, writes its record and draws its report.
 A short run costs what it simulates when the ratio approaches ``short / long``; what stays
 above that is the start-up every run pays (the imports, numba's target, matplotlib's figures).
 ``--parts`` measures what a fresh interpreter pays to load each of them (:data:`PARTS`), and
-the ratio the two runs' medians would have without numba's and matplotlib's loading.
+the ratio of each pair with numba's and matplotlib's loading taken off both runs.
 """
 
 from __future__ import annotations
@@ -113,15 +113,17 @@ def measure(short: float = SHORT_S, long: float = LONG_S, repeats: int = 3, in_p
             "median_ratio": statistics.median(ratios), "simulated_ratio": short / long}
 
 
-#: What a fresh ``quadcosim run tp`` loads before it simulates, each part in a fresh interpreter
-#: on top of the ones before it (with the command line's one BLAS thread).
-PARTS = (
-    ("the interpreter", "pass"),
-    ("numpy and fmpy", "import numpy, fmpy"),
-    ("numba and the two compiled steps from its cache",
-     "import estimators.filters as e, flight.controller as c; e._compiled_step(); c._compiled_step()"),
-    ("matplotlib's pyplot", "import matplotlib; matplotlib.use('agg'); import matplotlib.pyplot"),
-)
+#: What a fresh ``quadcosim run tp`` loads before it simulates, by name: what it is, and the
+#: statement a fresh interpreter runs on top of those before it (with the command's one BLAS thread).
+PARTS = {
+    "interpreter": ("the interpreter", "pass"),
+    "numpy": ("numpy and fmpy", "import numpy, fmpy"),
+    "numba": ("the estimators and the controller, with numba and their two compiled steps from its cache",
+              "import estimators.filters as e, flight.controller as c; e._compiled_step(); c._compiled_step()"),
+    "matplotlib": ("matplotlib's pyplot", "import matplotlib; matplotlib.use('agg'); import matplotlib.pyplot"),
+}
+#: The parts :func:`without_loading` takes off both runs: what only the compiled steps and the figures need.
+DEFERRABLE = ("numba", "matplotlib")
 
 
 def statement_cpu(statement: str, repeats: int = 5) -> float:
@@ -151,8 +153,8 @@ def statement_cpu(statement: str, repeats: int = 5) -> float:
     return statistics.median(spent)
 
 
-def parts(repeats: int = 5) -> list[tuple[str, float]]:
-    """The CPU each of :data:`PARTS` adds to a fresh interpreter (s), in order.
+def parts(repeats: int = 5) -> dict[str, float]:
+    """The CPU each of :data:`PARTS` adds to a fresh interpreter (s).
 
     Parameters
     ----------
@@ -161,35 +163,41 @@ def parts(repeats: int = 5) -> list[tuple[str, float]]:
 
     Returns
     -------
-    list of (str, float)
-        The part's name and its CPU (s), the cumulated statement's less the one before it.
+    dict
+        By the names of :data:`PARTS`, in order: the CPU of the statements up to that part's less
+        that of those before it (s).
     """
-    added, statement, before = [], "", 0.0
-    for name, code in PARTS:
+    added, statement, before = {}, "", 0.0
+    for name, (_, code) in PARTS.items():
         statement = f"{statement}; {code}" if statement else code
         cumulated = statement_cpu(statement, repeats)
-        added.append((name, cumulated - before))
+        added[name] = cumulated - before
         before = cumulated
     return added
 
 
 def without_loading(figures: dict) -> dict:
-    """The ratio of the medians of the short and the long runs' CPU, each less what loading
-    numba (and its compiled steps) and matplotlib costs a fresh interpreter.
+    """The median, over the pairs, of the short run's CPU over the long run's, each less what
+    loading the :data:`DEFERRABLE` parts costs a fresh interpreter.
 
     Parameters
     ----------
     figures : dict
-        :func:`measure`'s figures of fresh commands, with ``parts_cpu_s`` (:func:`parts`, as a dict).
+        :func:`measure`'s figures of fresh commands, with ``parts_cpu_s`` (:func:`parts`).
 
     Returns
     -------
     dict
-        ``ratio_without_numba_and_matplotlib_loading`` (1).
+        ``ratio_without_loading`` (1) and ``deferrable_cpu_s`` (s, what was taken off each run).
     """
-    loaded = sum(cpu for name, cpu in figures["parts_cpu_s"].items() if name in (PARTS[2][0], PARTS[3][0]))
-    short, long = statistics.median(figures["short_cpu_s"]), statistics.median(figures["long_cpu_s"])
-    return {"ratio_without_numba_and_matplotlib_loading": (short - loaded) / (long - loaded)}
+    loaded = sum(figures["parts_cpu_s"][name] for name in DEFERRABLE)
+    if loaded >= min(figures["short_cpu_s"]):
+        raise RuntimeError(f"loading numba and matplotlib took {loaded:.2f} s, more than a whole short run "
+                           f"({min(figures['short_cpu_s']):.2f} s): the machine's load moved between the "
+                           "measurements; run again")
+    ratios = [(short - loaded) / (long - loaded)
+              for short, long in zip(figures["short_cpu_s"], figures["long_cpu_s"], strict=True)]
+    return {"ratio_without_loading": statistics.median(ratios), "deferrable_cpu_s": loaded}
 
 
 def main(argv=None) -> int:
@@ -203,13 +211,15 @@ def main(argv=None) -> int:
                         help="runs as scenarios.run calls in this process, after one that paid the imports")
     parser.add_argument("--parts", action="store_true",
                         help="also the CPU of what a fresh run loads before it simulates (the interpreter, numpy "
-                             "and fmpy, numba and its compiled steps, matplotlib), and the ratio without the "
-                             "last two")
+                             "and fmpy, the estimators and the controller with numba and their compiled steps, "
+                             "matplotlib), and the ratio with the last two taken off both runs")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
+    if args.parts and args.in_process:
+        parser.error("--parts measures fresh interpreters, which runs in one process do not start: give one of them")
     figures = measure(args.short, args.long, args.repeats, args.in_process)
     if args.parts:
-        figures["parts_cpu_s"] = dict(parts())
+        figures["parts_cpu_s"] = parts()
         figures |= without_loading(figures)
     if args.json:
         print(json.dumps(figures))
@@ -220,9 +230,9 @@ def main(argv=None) -> int:
     print(f"median ratio {figures['median_ratio']:.3f} (the simulated time's ratio: {figures['simulated_ratio']:.3f})")
     if args.parts:
         for name, cpu in figures["parts_cpu_s"].items():
-            print(f"  loading {name}: {cpu:.2f} s CPU")
-        print(f"ratio of the medians less numba's and matplotlib's loading: "
-              f"{figures['ratio_without_numba_and_matplotlib_loading']:.3f}")
+            print(f"  loading {PARTS[name][0]}: {cpu:.2f} s CPU")
+        print(f"median ratio, each run less those two loads ({figures['deferrable_cpu_s']:.2f} s): "
+              f"{figures['ratio_without_loading']:.3f}")
     return 0
 
 

@@ -29,10 +29,6 @@ import sys
 import warnings
 from pathlib import Path
 
-# Before numpy loads: numpy and scipy each bring an OpenBLAS that starts a thread per core and
-# spins them at load, about 0.3 s of CPU a command, for matrices of 3 x 3 here. A user's setting wins.
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
 
 def _build(args) -> int:
     from fmus import default_fmu_dir
@@ -463,6 +459,10 @@ def main(argv=None) -> int:
 def entry() -> None:
     """The ``quadcosim`` program: :func:`main`, then exit with its code
     (:func:`orchestrator.interrupts.leave`)."""
+    # Before numpy loads: numpy and scipy each bring an OpenBLAS that starts a thread per core and
+    # spins it at load, CPU a command spends for nothing on its small matrices. A user's setting
+    # wins; a program that imports this module is left as it is.
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     from orchestrator.interrupts import leave
 
     try:

@@ -37,7 +37,7 @@ def estimator_rows() -> list[tuple]:
 
 
 def model_rows() -> list[tuple]:
-    """One row per interference model, richest first: name, rank, calibration file, autopilots."""
+    """One row per interference model, richest first: name, rank, calibration file, an autopilot."""
     from calibration.flight.catalogue import MODELS
 
     ordered = sorted(MODELS.values(), key=lambda model: model.preference)
@@ -73,8 +73,9 @@ def tables() -> str:
                     estimator_rows())
     lines += ["## Interference models", "", "`calibration/flight/catalogue.py`, richest first: `quadcosim calibrate "
               "--models`, the calibration file and the autopilots' parameters carry the first they can that the "
-              "flights identify.", ""]
-    lines += _table(("name", "rank", "calibration file", "autopilots"), model_rows())
+              "flights identify. An autopilot carries a model when its firmware has that compensation for the "
+              "compass (`motors`: ArduPilot `4.0` and later, first compass).", ""]
+    lines += _table(("name", "rank", "calibration file", "an autopilot"), model_rows())
     lines += ["## Autopilots", "", "`calibration/flight/autopilot.py`: a flight log of one is exported in its own "
               "parameter file.", ""]
     lines += _table(("name", "parameter file"), autopilot_rows())

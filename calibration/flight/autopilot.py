@@ -35,8 +35,8 @@ def write_px4(params: dict, path) -> None:
 
 
 def rules_of(part, override=None) -> ardupilot.Rules:
-    """The ArduPilot rules of ``part``'s firmware (a :class:`calibration.flight.data.FlightData`'s
-    log banner), or ``override`` (a :class:`flightlogs.ardupilot.Rules`)."""
+    """The ArduPilot rules of the firmware named by the banner of ``part``'s log (``part``: a
+    :class:`calibration.flight.data.FlightData`), or ``override`` (a :class:`flightlogs.ardupilot.Rules`)."""
     return override or ardupilot.log_rules(part.log.firmware)
 
 
@@ -84,13 +84,34 @@ def _no_scale(part, rule):
     return {}
 
 
+def _ardupilot_firmware(part, rule):
+    return rules_of(part, rule).name
+
+
+def _px4_firmware(part, rule):
+    return part.log.firmware
+
+
+def _first_compass(params):
+    return 0  # PX4's heading fuses its first magnetometer
+
+
+def _ardupilot_motor_key(name: str) -> bool:
+    return name.startswith("COMPASS_") and "MOT" in name  # not every COMPASS_*: offsets and soft iron
+
+
+def _px4_motor_key(name: str) -> bool:
+    return name.startswith("CAL_MAG") and "COMP" in name
+
+
 @dataclass(frozen=True)
 class Autopilot:
     """An autopilot the export writes parameters for, and how its firmware uses them.
 
-    Each callable takes ``part`` (a :class:`calibration.flight.data.FlightData` of one compass of
-    one of this autopilot's logs) and, last, ``rule``: a :class:`flightlogs.ardupilot.Rules`
-    overriding the firmware version the log names (None: the log's).
+    The callables ``apply`` to ``firmware`` take ``part`` (a
+    :class:`calibration.flight.data.FlightData` of one compass of one of this autopilot's logs)
+    and, last, ``rule``: a :class:`flightlogs.ardupilot.Rules` overriding the firmware version
+    the log names (None: the log's); it is ArduPilot's, and the PX4 functions ignore it.
 
     Attributes
     ----------
@@ -105,8 +126,10 @@ class Autopilot:
         from the part's raw field with ``params`` (all of them, the log's included) and
         ``inputs`` (``current`` (A), ``throttle`` (0..1), ``commands`` (0..1), ``voltage`` (V)).
     parameters : callable
-        ``(part, candidate, rule)``: a :class:`calibration.flight.export.Candidate` as the
-        firmware's parameters of the part's compass (name: value, the firmware's units).
+        ``(part, candidate, rule)``: a :class:`calibration.flight.export.Candidate` (hard iron
+        ``offset`` (T), soft-iron inverse ``correction`` (1), motor ``model`` and its field ``K``
+        (T per unit of the model's input: A, throttle or motor command)) as the firmware's
+        parameters of the part's compass, name: value in the firmware's units.
     motor_models : callable
         ``(part, rule)``: the motor compensations the firmware has for the part's compass, names
         of :data:`calibration.flight.catalogue.MODELS`.
@@ -114,7 +137,17 @@ class Autopilot:
         ``(part, rule)``: parameters to reset when a fitted soft iron is exported (it carries the
         scale).
     firmware : callable
-        ``(part, rule)``: the firmware as the export's metrics name it.
+        ``(part, rule)``: the firmware as the export's metrics name it (str): ArduPilot's rules
+        (the version, or ``--firmware``'s), PX4's log banner.
+    motor_off : dict
+        The parameters that switch the firmware's motor compensation off.
+    is_motor_key : callable
+        ``(name)``: whether a parameter name is one of the motor compensation's.
+    fused_compass : callable
+        ``(params)``: the compass (0-based) the firmware's heading fuses.
+    board_trim : callable or None
+        ``(params)``: the rotation (3, 3) from the vehicle to the board that the logged attitude
+        leaves out (ArduPilot's ``AHRS_TRIM``); None: the logged attitude is the sensors' frame's.
     """
 
     name: str
@@ -125,14 +158,19 @@ class Autopilot:
     motor_models: Callable
     scale_reset: Callable
     firmware: Callable
+    motor_off: dict
+    is_motor_key: Callable[[str], bool]
+    fused_compass: Callable[[dict], int]
+    board_trim: Callable | None = None
 
 
 #: The autopilots, one line each: a flight log of one of them is exported in its own file.
 AUTOPILOTS = {autopilot.name: autopilot for autopilot in (
     Autopilot("ArduPilot", "ardupilot.parm", write_ardupilot, _ardupilot_apply, _ardupilot_parameters,
-              _ardupilot_models, _ardupilot_scale, lambda part, rule: rules_of(part, rule).name),
-    Autopilot("PX4", "px4.params", write_px4, _px4_apply, _px4_parameters, _px4_models, _no_scale,
-              lambda part, rule: part.log.firmware),
+              _ardupilot_models, _ardupilot_scale, _ardupilot_firmware, {"COMPASS_MOTCT": 0, "COMPASS_PMOT_EN": 0},
+              _ardupilot_motor_key, ardupilot.fused_compass, ardupilot.trim_rotation),
+    Autopilot("PX4", "px4.params", write_px4, _px4_apply, _px4_parameters, _px4_models, _no_scale, _px4_firmware,
+              {"CAL_MAG_COMP_TYP": 0}, _px4_motor_key, _first_compass),
 )}
 
 

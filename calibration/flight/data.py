@@ -39,12 +39,13 @@ def board_quaternions(log, trim: bool = True) -> np.ndarray:
     sensors into the vehicle's frame itself. ``trim=False`` ignores the trim (an ablation)."""
     from scipy.spatial.transform import Rotation
 
-    from flightlogs import ardupilot
+    from calibration.flight.autopilot import AUTOPILOTS
 
     q = log.attitude.q
-    if not trim or log.autopilot != "ArduPilot":
+    board_trim = AUTOPILOTS[log.autopilot].board_trim
+    if not trim or board_trim is None:
         return q
-    board = Rotation.from_quat(q, scalar_first=True) * Rotation.from_matrix(ardupilot.trim_rotation(log.params))
+    board = Rotation.from_quat(q, scalar_first=True) * Rotation.from_matrix(board_trim(log.params))
     return board.as_quat(scalar_first=True)
 
 
@@ -147,10 +148,11 @@ class FlightData:
 
 
 def fused(log, compass: int) -> bool:
-    """Whether the log's heading fuses compass ``compass``: ArduPilot's ``COMPASS_PRIMARY``, PX4's first."""
-    from flightlogs import ardupilot
+    """Whether the log's heading fuses compass ``compass``: ArduPilot's ``COMPASS_PRIMARY``, PX4's first
+    (:class:`calibration.flight.autopilot.Autopilot`'s ``fused_compass``)."""
+    from calibration.flight.autopilot import AUTOPILOTS
 
-    return compass == (ardupilot.fused_compass(log.params) if log.autopilot == "ArduPilot" else 0)
+    return compass == AUTOPILOTS[log.autopilot].fused_compass(log.params)
 
 
 def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: bool = True) -> FlightData:

@@ -28,9 +28,6 @@ from calibration.static import CalibrationError
 from flightlogs import ardupilot
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
-# every firmware's motor compensation switched off (ArduPilot's COMPASS_MOTCT and COMPASS_PMOT_EN, PX4's
-# CAL_MAG_COMP_TYP): the baseline of the explained share
-MOTOR_OFF = {"COMPASS_MOTCT": 0, "COMPASS_PMOT_EN": 0, "CAL_MAG_COMP_TYP": 0}
 
 
 def _inputs(part) -> dict:
@@ -74,7 +71,7 @@ def score_parameters(parts, params: dict, rule=None) -> dict:
         corrected = apply_parameters(p, params, rule)
         errors.append(heading_error(tilt_compensated_heading(corrected, p.euler), p.euler[:, 2]))
         attitude = p.rotation @ np.asarray(p.log.compasses[p.compass].rotation).T  # body to NED
-        uncompensated = apply_parameters(p, {**params, **MOTOR_OFF}, rule)
+        uncompensated = apply_parameters(p, {**params, **autopilot_of(p).motor_off}, rule)  # the explained share's base
         base_cost += earth_and_offset(attitude, uncompensated, p.earth).cost
         cost += earth_and_offset(attitude, corrected, p.earth).cost
     return {"heading_rms_deg": float(np.degrees(np.sqrt(np.mean(np.concatenate(errors) ** 2)))),
@@ -197,11 +194,11 @@ def log_parameters(part, names) -> dict:
     return {n: part.log.params[n] for n in names if n in part.log.params}
 
 
-def _motor_keys(params: dict) -> dict:
-    """The motor-compensation entries of ``params``: ArduPilot's ``COMPASS_*MOT*`` and PX4's
-    ``CAL_MAG*COMP*`` (not every ``COMPASS_*``, which would carry the log's offsets and soft iron)."""
-    return {k: v for k, v in params.items()
-            if (k.startswith("COMPASS_") and "MOT" in k) or (k.startswith("CAL_MAG") and "COMP" in k)}
+def _motor_keys(part, params: dict) -> dict:
+    """The motor-compensation entries of ``params`` for ``part``'s firmware (:class:`Autopilot`'s
+    ``is_motor_key``: ArduPilot's ``COMPASS_*MOT*``, PX4's ``CAL_MAG*COMP*``)."""
+    is_motor_key = autopilot_of(part).is_motor_key
+    return {k: v for k, v in params.items() if is_motor_key(k)}
 
 
 def _motor_trials(train, rule, trial, held, log_soft, models=None) -> dict:
@@ -272,7 +269,7 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     best, best_score = dict(flown), score_parameters(choice, flown, rule)
     kept = {"offsets": "log", "motor": "log", "soft_iron": "log"}
     offsets = np.asarray(compass.offsets, dtype=float)
-    log_motor = _motor_keys(flown)
+    log_motor = _motor_keys(first, flown)
 
     def trial(candidate: Candidate, motor: dict | None = None) -> tuple[dict, dict]:
         params = parameters_of(first, candidate, rule) | (motor or {})

@@ -1,5 +1,6 @@
 """``quadcosim log info FILE``, ``quadcosim log plot FILE``: what a flight log holds, in text and in
-one figure."""
+one figure; ``quadcosim log replay FILE``: the estimators on it (:mod:`scenarios.flightlog.replay`);
+``quadcosim log example FOLDER``: three synthetic logs to try them on."""
 
 from __future__ import annotations
 
