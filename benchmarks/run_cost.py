@@ -18,7 +18,7 @@ system, draws (or copies) its wiring, writes its record and draws its report.
 A short run costs what it simulates when the ratio approaches ``short / long``; what stays
 above that is the start-up every run pays (the imports, numba's target, matplotlib's figures).
 ``--parts`` measures what a fresh interpreter pays to load each of them (:data:`PARTS`), and
-the ratio of each pair with numba's and matplotlib's loading taken off both runs.
+the ratio of each pair with numba's or matplotlib's loading, or both, taken off both runs.
 """
 
 from __future__ import annotations
@@ -122,8 +122,9 @@ PARTS = {
               "import estimators.filters as e, flight.controller as c; e._compiled_step(); c._compiled_step()"),
     "matplotlib": ("matplotlib's pyplot", "import matplotlib; matplotlib.use('agg'); import matplotlib.pyplot"),
 }
-#: The parts :func:`without_loading` takes off both runs: what only the compiled steps and the figures need.
-DEFERRABLE = ("numba", "matplotlib")
+#: The loads :func:`without_loading` takes off both runs, alone and together: what only the
+#: compiled steps and the figures need.
+ABLATIONS = {"numba": ("numba",), "matplotlib": ("matplotlib",), "both": ("numba", "matplotlib")}
 
 
 def statement_cpu(statement: str, repeats: int = 5) -> float:
@@ -178,7 +179,7 @@ def parts(repeats: int = 5) -> dict[str, float]:
 
 def without_loading(figures: dict) -> dict:
     """The median, over the pairs, of the short run's CPU over the long run's, each less what
-    loading the :data:`DEFERRABLE` parts costs a fresh interpreter.
+    loading some of :data:`PARTS` costs a fresh interpreter: each of :data:`ABLATIONS`.
 
     Parameters
     ----------
@@ -188,16 +189,19 @@ def without_loading(figures: dict) -> dict:
     Returns
     -------
     dict
-        ``ratio_without_loading`` (1) and ``deferrable_cpu_s`` (s, what was taken off each run).
+        ``ratio_without`` (1): by the names of :data:`ABLATIONS`, the median ratio with those
+        loads taken off both runs of each pair.
     """
-    loaded = sum(figures["parts_cpu_s"][name] for name in DEFERRABLE)
-    if loaded >= min(figures["short_cpu_s"]):
-        raise RuntimeError(f"loading numba and matplotlib took {loaded:.2f} s, more than a whole short run "
-                           f"({min(figures['short_cpu_s']):.2f} s): the machine's load moved between the "
-                           "measurements; run again")
-    ratios = [(short - loaded) / (long - loaded)
-              for short, long in zip(figures["short_cpu_s"], figures["long_cpu_s"], strict=True)]
-    return {"ratio_without_loading": statistics.median(ratios), "deferrable_cpu_s": loaded}
+    ratios = {}
+    for ablation, names in ABLATIONS.items():
+        loaded = sum(figures["parts_cpu_s"][name] for name in names)
+        if loaded >= min(figures["short_cpu_s"]):
+            raise RuntimeError(f"loading {' and '.join(names)} took {loaded:.2f} s, more than a whole short run "
+                               f"({min(figures['short_cpu_s']):.2f} s): the machine's load moved between the "
+                               "measurements; run again")
+        ratios[ablation] = statistics.median((short - loaded) / (long - loaded) for short, long in
+                                             zip(figures["short_cpu_s"], figures["long_cpu_s"], strict=True))
+    return {"ratio_without": ratios}
 
 
 def main(argv=None) -> int:
@@ -212,7 +216,7 @@ def main(argv=None) -> int:
     parser.add_argument("--parts", action="store_true",
                         help="also the CPU of what a fresh run loads before it simulates (the interpreter, numpy "
                              "and fmpy, the estimators and the controller with numba and their compiled steps, "
-                             "matplotlib), and the ratio with the last two taken off both runs")
+                             "matplotlib), and the ratio with the last two taken off both runs, each and together")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
     if args.parts and args.in_process:
@@ -231,8 +235,8 @@ def main(argv=None) -> int:
     if args.parts:
         for name, cpu in figures["parts_cpu_s"].items():
             print(f"  loading {PARTS[name][0]}: {cpu:.2f} s CPU")
-        print(f"median ratio, each run less those two loads ({figures['deferrable_cpu_s']:.2f} s): "
-              f"{figures['ratio_without_loading']:.3f}")
+        for ablation, ratio in figures["ratio_without"].items():
+            print(f"median ratio, each run less the load of {' and '.join(ABLATIONS[ablation])}: {ratio:.3f}")
     return 0
 
 

@@ -119,8 +119,8 @@ def run_cost_findings(fresh: dict, in_process: dict) -> list[dict]:
     """
     parts = fresh["parts_cpu_s"]
     return [finding("speed.run_cost.ratio", fresh["median_ratio"], "1", RUN_COST, RUN_COST_TOLERANCE, 3),
-            finding("speed.run_cost.ratio_without_loading", fresh["ratio_without_loading"], "1", RUN_COST,
-                    RUN_COST_TOLERANCE, 3),
+            *(finding(f"speed.run_cost.ratio_without_{ablation}", ratio, "1", RUN_COST, RUN_COST_TOLERANCE, 3)
+              for ablation, ratio in fresh["ratio_without"].items()),
             _timing("run_cost.numba_s", parts["numba"], "s", RUN_COST, 2),
             _timing("run_cost.matplotlib_s", parts["matplotlib"], "s", RUN_COST, 2),
             finding("speed.run_cost.in_process_ratio", in_process["median_ratio"], "1", RUN_COST_IN_PROCESS,
