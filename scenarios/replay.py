@@ -16,9 +16,10 @@ attitude (a reference, not the truth).
 The recording is read by :mod:`estimators.recording` (``.npz``, ``.mat``, ``.csv``: gyro, acc,
 mag, rate, optional reference quaternion and scored samples). With a reference, the
 quaternion-error RMSE (total, inclination, heading; degrees) over the scored samples is
-printed, the metric of :func:`estimators.score`. The gains and correction settings in force
-(defaults filled in) are printed and written with the errors (``gains_in_force``). ``--figure
-FILE`` draws the errors sample by sample against time (PNG, SVG or PDF).
+printed, the metric of :func:`estimators.score`, with the gains and correction settings in force
+(defaults filled in; :func:`summary`); ``--json`` prints every setting and the errors as JSON
+instead, ``--out FILE`` writes that JSON (``gains_in_force`` among it). ``--figure FILE`` draws
+the errors sample by sample against time (PNG, SVG or PDF).
 
 A ``tp`` run's results folder (or its ``results.npz``) is read as a recording directly: the
 IMU's samples, the true attitude as reference, the samples after the run's settling time as
@@ -302,8 +303,8 @@ def _parser(prog: str = "python -m scenarios.replay") -> argparse.ArgumentParser
     parser.add_argument("--rate", type=float, help="sampling rate (Hz), if the file has none")
     from scenarios.output_options import add_json_flag
 
-    add_json_flag(parser, "the result as JSON on standard output (always, for a recording; in place of the table "
-                          "for a flight log)")
+    add_json_flag(parser, "the result as JSON on standard output, in place of the summary (of a recording) or the "
+                          "table (of a flight log)")
     parser.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
     parser.add_argument("--figure", metavar="FILE",
                         help="also draw the inclination and heading errors against time (PNG, SVG or PDF; needs "
@@ -361,13 +362,50 @@ def main(argv=None, prog: str = "python -m scenarios.replay") -> int:
     except (ValueError, FileNotFoundError, OSError) as error:
         print(f"{prog}: {error}", file=sys.stderr)
         return 2
-    print(f"{result['estimator']}: gains in force " + ", ".join(f"{k}={v:g}" for k, v in
-                                                                 result["gains_in_force"].items()), file=sys.stderr)
     text = json.dumps(result, indent=2, default=float)
-    print(text)
+    print(text if args.json else summary(result, args.recording))
     if args.out:
         write_text(args.out, text + "\n")
     return 0
+
+
+def summary(result: dict, recording: str) -> str:
+    """What a replay found, in a few lines: the estimator and its settings, the gains in force and
+    the errors against the reference (deg) when the recording has one.
+
+    Parameters
+    ----------
+    result : dict
+        :func:`replay`'s result.
+    recording : str
+        The recording replayed, as the user named it.
+    """
+    from estimators import CORRECTIONS
+
+    def shown(values: dict) -> str:
+        return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v}" for k, v in values.items())
+
+    kind = kinds.KINDS.get(result["estimator"])
+    named = ("frame",) if kind is None or not kind.lab else ("discretisation", "frame")
+    named = ("ry", *named) if result["estimator"] == "passive" else named
+    settings = [f"{k} {result[k]}" for k in named if result.get(k) is not None]
+    in_force = result["gains_in_force"]
+    gains = {k: v for k, v in in_force.items() if k not in CORRECTIONS}
+    lines = [f"{result['estimator']} on {recording} ({', '.join(settings)})",
+             f"  gains in force: {shown(gains) if gains else 'the published filter defaults'}"]
+    corrections = {k: v for k, v in in_force.items() if k in CORRECTIONS and v}
+    if any(k in CORRECTIONS for k in in_force):
+        lines.append(f"  corrections: {shown(corrections) if corrections else 'off'}")
+    errors = result["errors"]
+    if errors:
+        lines.append(f"  quaternion error RMS (deg): total {errors['total_rmse_deg']:.2f}, inclination "
+                     f"{errors['inclination_rmse_deg']:.2f}, heading {errors['heading_rmse_deg']:.2f}"
+                     + (f" (constant heading offset {errors['heading_offset_deg']:.2f} removed)"
+                        if errors.get("heading_offset_deg") else ""))
+    else:
+        lines.append("  no reference attitude in the recording: nothing scored")
+    lines.append("  (--json prints every setting as JSON; --out FILE writes it)")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -66,6 +66,13 @@ def test_replay_command_line(tmp_path, capsys):
     settle = json.loads((tmp_path / "run" / "metrics.json").read_text())["settle_s"]
     reported = score(run["Quaternion_estim.q_est"], run["Quadrotor.q"], run.time >= min(settle, 0.5))
     assert same["estimator"] == "madgwick" and same["gains_in_force"] == {"beta": 0.041}
+    capsys.readouterr()
+    assert replay.main([str(tmp_path / "run")]) == 0  # without --json: a few lines, the same numbers
+    shown = capsys.readouterr().out.splitlines()
+    errors = same["errors"]
+    assert shown[:3] == [f"madgwick on {tmp_path / 'run'} (frame ned)", "  gains in force: beta=0.041",
+                         f"  quaternion error RMS (deg): total {errors['total_rmse_deg']:.2f}, inclination "
+                         f"{errors['inclination_rmse_deg']:.2f}, heading {errors['heading_rmse_deg']:.2f}"]
     # the same arithmetic but for the kernels' rounding: under 1e-9 deg with this CPU's OpenBLAS kernels,
     # 6.9e-9 with OPENBLAS_CORETYPE=Prescott NUMBA_CPU_NAME=generic
     assert abs(same["errors"]["total_rmse_deg"] - reported["total_rmse_deg"]) < 2e-8
@@ -100,7 +107,7 @@ def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch
     run, metrics = scenarios.run("tp", {"estimator": "explicit", "flight": "nonstationary", "noise": True,
                                         "duration": 3.0}, tmp_path / "run")
     drawn.clear()  # the run's own report figures
-    assert quadcosim(["replay", str(tmp_path / "run"), "--figure", str(tmp_path / "errors.png")]) == 0
+    assert quadcosim(["replay", str(tmp_path / "run"), "--figure", str(tmp_path / "errors.png"), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert (tmp_path / "errors.png").stat().st_size > 10_000 and "q" not in result
     scored = run.time >= min(metrics["settle_s"], 1.5)
