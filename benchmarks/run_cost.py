@@ -25,13 +25,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from benchmarks.startup import child_times
 
 SHORT_S, LONG_S = 2.0, 320.0  # simulated seconds of the two runs compared
 
@@ -52,12 +53,8 @@ def run_cpu(duration: float, out: Path) -> float:
     float
         CPU of the whole process (s).
     """
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", f"duration={duration:g}",
-                    "--out", str(out), "--overwrite"], check=True, stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+    return child_times([sys.executable, "-m", "quadcosim.main", "run", "tp", "--set", f"duration={duration:g}",
+                        "--out", str(out), "--overwrite"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)[1]
 
 
 def run_cpu_in_process(duration: float, out: Path) -> float:
@@ -145,13 +142,8 @@ def statement_cpu(statement: str, repeats: int = 5) -> float:
     import os
 
     environment = {**os.environ, "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", "1")}
-    spent = []
-    for _ in range(repeats):
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        subprocess.run([sys.executable, "-c", statement], check=True, env=environment)
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        spent.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
-    return statistics.median(spent)
+    return statistics.median(child_times([sys.executable, "-c", statement], env=environment)[1]
+                             for _ in range(repeats))
 
 
 def parts(repeats: int = 5) -> dict[str, float]:

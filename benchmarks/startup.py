@@ -57,6 +57,31 @@ def imported_modules(args: list[str], env: dict | None = None) -> set[str]:
             return set(json.load(f))
 
 
+def child_times(argv: list[str], **options) -> tuple[float, float]:
+    """Wall and CPU times (s) of one child process ``argv``, run to its end (a non-zero exit raises).
+
+    Parameters
+    ----------
+    argv : list of str
+        The program and its arguments.
+    **options
+        For :func:`subprocess.run` (``env``, ``stdout``, ``stderr``).
+
+    Returns
+    -------
+    wall, cpu : float
+        Its wall time, and its CPU (user + system of the finished child), s.
+    """
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    started = time.perf_counter()
+    subprocess.run(argv, check=True, **options)
+    wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+
+
 def wall_times(args: list[str], repeats: int) -> tuple[list[float], list[float]]:
     """Wall and CPU times (s) of ``repeats`` runs of ``quadcosim ARGS``, each in a fresh interpreter.
 
@@ -72,17 +97,9 @@ def wall_times(args: list[str], repeats: int) -> tuple[list[float], list[float]]
     walls, cpus : list of float
         One wall time and one CPU time (user + system of the child) per run, s.
     """
-    import resource
-
-    walls, cpus = [], []
-    for _ in range(repeats):
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        started = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "quadcosim.main", *args], check=True, stdout=subprocess.DEVNULL)
-        walls.append(time.perf_counter() - started)
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
-    return walls, cpus
+    times = [child_times([sys.executable, "-m", "quadcosim.main", *args], stdout=subprocess.DEVNULL)
+             for _ in range(repeats)]
+    return [wall for wall, _ in times], [cpu for _, cpu in times]
 
 
 #: The commands timed by default: ``quadcosim list`` and ``quadcosim --help``.

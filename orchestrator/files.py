@@ -658,16 +658,24 @@ def holds_results(out) -> list[str]:
     return [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
 
 
+def first_free(path, taken, file: bool = False) -> Path:
+    """``path`` (str or pathlib.Path) unless ``taken(path)`` (a callable of a pathlib.Path), else the
+    first of ``NAME-2``, ``NAME-3``, ... that is not taken; a ``file`` keeps its suffix last
+    (``STEM-2.SUFFIX``). Returns the pathlib.Path."""
+    path = Path(path)
+    candidate, number = path, 1
+    while taken(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}" if file else f"{path.name}-{number}")
+    return candidate
+
+
 def free_folder(base) -> Path:
     """``base`` if it holds no results, else the first of ``base-2``, ``base-3``, ... that
     holds none and that no other process is writing: a default output folder never replaces
     earlier results."""
-    base = Path(base)
-    candidate, number = base, 1
-    while holds_results(candidate) or (candidate.exists() and not candidate.is_dir()) or held_by(candidate):
-        number += 1
-        candidate = base.with_name(f"{base.name}-{number}")
-    return candidate
+    return first_free(base, lambda candidate: holds_results(candidate) or held_by(candidate)
+                      or (candidate.exists() and not candidate.is_dir()))
 
 
 def _listed_files(out: Path) -> list[str]:

@@ -99,11 +99,10 @@ def free_file(path, command: str):
     """
     from pathlib import Path
 
+    from orchestrator.files import first_free
+
     path = Path(path)
-    candidate, number = path, 1
-    while candidate.exists():
-        number += 1
-        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    candidate = first_free(path, Path.exists, file=True)
     if candidate != path:
         print(f"quadcosim {command}: {path} is there; writing {candidate} (--out FILE chooses the file, --overwrite "
               f"replaces {path})", file=sys.stderr)

@@ -85,10 +85,10 @@ def default_out(base: Path, resume: bool, label: str) -> Path:
     """
     if resume:
         return base
-    candidate, number = base, 1
-    while (candidate / "sweep.json").exists() or (candidate.exists() and not candidate.is_dir()):
-        number += 1
-        candidate = base.with_name(f"{base.name}-{number}")
+    from orchestrator.files import first_free
+
+    candidate = first_free(base, lambda folder: (folder / "sweep.json").exists()
+                           or (folder.exists() and not folder.is_dir()))
     if candidate != base:
         print(f"{label}: {base}/ holds an earlier sweep; writing to {candidate}/ (--out DIR chooses the folder, "
               f"--resume continues {base}/)", file=sys.stderr)
