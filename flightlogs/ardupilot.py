@@ -237,8 +237,109 @@ def trim_rotation(params: dict) -> np.ndarray:
 
 
 def fused_compass(params: dict) -> int:
-    """The compass the attitude estimator fuses (``COMPASS_PRIMARY`` in ``params``, 0-based)."""
-    return int(params.get("COMPASS_PRIMARY", 0))
+    """The compass the attitude estimator fuses, 0-based in the log's order: ``COMPASS_PRIMARY`` up to
+    Copter 3.6; from 4.0, which has no such parameter, the first in priority order whose
+    ``COMPASS_USEn`` is set (``Compass::get_first_usable``), ``MAG`` instance ``I`` being that order."""
+    if "COMPASS_PRIMARY" in params or not any(f"COMPASS_PRIO{n}_ID" in params for n in (1, 2, 3)):
+        return int(params.get("COMPASS_PRIMARY", 0))
+    return next((p for p in range(MAX_SLOTS) if in_use(params, p)), 0)
+
+
+MAX_SLOTS = 3  # COMPASS_MAX_INSTANCES: the compasses with a calibration (COMPASS_OFS, OFS2, OFS3)
+#: ``enum Rotation`` (``libraries/AP_Math/rotations.h``) by value, those a compass or board is usually set to.
+ROTATIONS = {0: "NONE", 1: "YAW_45", 2: "YAW_90", 3: "YAW_135", 4: "YAW_180", 5: "YAW_225", 6: "YAW_270",
+             7: "YAW_315", 8: "ROLL_180", 9: "ROLL_180_YAW_45", 10: "ROLL_180_YAW_90", 11: "ROLL_180_YAW_135",
+             12: "PITCH_180", 13: "ROLL_180_YAW_225", 14: "ROLL_180_YAW_270", 15: "ROLL_180_YAW_315",
+             24: "PITCH_90", 25: "PITCH_270", 100: "CUSTOM"}
+
+
+def slot_of(params: dict, priority: int) -> int:
+    """The parameter slot (0-based: ``COMPASS_OFS``, ``OFS2``, ``OFS3``...) of the compass that Copter 4.x
+    logs as ``MAG`` instance ``priority``.
+
+    ``MAG.I`` is the compass's priority (``Compass::Write_Compass_instance`` logs ``get_field(i)``,
+    read through ``_get_state(Priority(i))``); the parameters belong to a state slot, the one whose
+    ``COMPASS_DEV_IDn`` is the device ``COMPASS_PRIO{priority + 1}_ID`` names
+    (``Compass::_get_state_id``). ``Compass::_reorder_compass_params`` swaps the slots at boot so
+    that they match the priorities, so the two agree on a log unless a device was replaced. Logs
+    without priorities (up to Copter 3.6) number their compasses by slot."""
+    device = int(params.get(f"COMPASS_PRIO{priority + 1}_ID", 0))
+    if device:
+        for slot in range(MAX_SLOTS):
+            if int(params.get(f"COMPASS_DEV_ID{suffix(slot)}", 0)) == device:
+                return slot
+    return priority
+
+
+def priority_of(params: dict, slot: int) -> int | None:
+    """The priority (0-based) of the compass of parameter ``slot``: the ``n`` whose
+    ``COMPASS_PRIO{n+1}_ID`` is its ``COMPASS_DEV_IDn`` (the inverse of :func:`slot_of`); None in a log
+    without priorities (up to Copter 3.6)."""
+    device = int(params.get(f"COMPASS_DEV_ID{suffix(slot)}", 0))
+    if not any(f"COMPASS_PRIO{n + 1}_ID" in params for n in range(MAX_SLOTS)):
+        return None
+    found = [n for n in range(MAX_SLOTS) if device and int(params.get(f"COMPASS_PRIO{n + 1}_ID", 0)) == device]
+    return found[0] if found else slot
+
+
+def in_use(params: dict, priority: int) -> bool:
+    """``COMPASS_USEn`` of the compass at ``priority`` (0-based; absent: used, the firmware's default).
+    From 4.0 the ``USE`` parameters follow the priorities, not the slots (``Compass::_use_for_yaw``
+    is indexed by ``Priority``)."""
+    return bool(params.get(f"COMPASS_USE{suffix(priority)}", 1))
+
+
+def external(params: dict, slot: int) -> bool | None:
+    """``COMPASS_EXTERNAL`` (slot 0) or ``COMPASS_EXTERNn`` of ``slot``; None when not logged."""
+    value = params.get("COMPASS_EXTERNAL" if slot == 0 else f"COMPASS_EXTERN{slot + 1}")
+    return None if value is None else bool(value)
+
+
+def rotation_name(value) -> str:
+    """``enum Rotation``'s name of ``value`` (``6 (YAW_270)``)."""
+    return f"{int(value)} ({ROTATIONS.get(int(value), 'see rotations.h')})"
+
+
+def setup(params: dict, slot: int, priority: int | None, rule: Rules) -> dict:
+    """How the firmware is set up to use the compass of parameter ``slot`` (and ``priority``, 0-based,
+    None before 4.0), as ``log info`` prints it: ``priority`` (1-based; 3.x: whether it is
+    ``COMPASS_PRIMARY``), ``use`` (``COMPASS_USEn``), ``orientation`` (the parameter that rotates it:
+    ``COMPASS_ORIENTn`` for an external compass, ``AHRS_ORIENTATION`` for an internal one,
+    ``AP_Compass_Backend::rotate_field``), ``scale`` (``COMPASS_SCALEn`` as ``correct_field`` applies
+    it) and ``device_id`` (``COMPASS_DEV_IDn``)."""
+    use_index = slot if priority is None else priority
+    outside = external(params, slot)
+    name = orientation_parameter(slot, outside)
+    value = params.get(name, 0)
+    where = {True: "external", False: "internal", None: "location not logged"}[outside]
+    if priority is None:
+        order = "primary" if int(params.get("COMPASS_PRIMARY", 0)) == slot else "secondary"
+    else:
+        order = f"{priority + 1} (COMPASS_PRIO{priority + 1}_ID)"
+    logged = params.get(f"COMPASS_SCALE{suffix(slot)}")
+    scale = (f"{scale_factor(params, slot, rule):.4g} (COMPASS_SCALE{suffix(slot)} = {logged:.4g})"
+             if rule.scale and logged is not None else "none (before Copter 4.0)" if not rule.scale else "1 (not logged)")
+    device = params.get(f"COMPASS_DEV_ID{suffix(slot)}")
+    return {"priority": order, "use": f"{'yes' if in_use(params, use_index) else 'no'} "
+                                      f"(COMPASS_USE{suffix(use_index)} = {int(params.get(f'COMPASS_USE{suffix(use_index)}', 1))})",
+            "orientation": f"{where}, {name} = {rotation_name(value)}", "scale": scale,
+            "parameters": f"slot {slot + 1} (COMPASS_OFS{suffix(slot)}_*)",
+            **({} if device is None else {"device_id": str(int(device))})}
+
+
+def enabling(params: dict, slot: int, priority: int | None) -> dict:
+    """What a compass the log's firmware does not use (``COMPASS_USEn = 0``) needs to be used, as
+    parameters: ``COMPASS_USEn = 1`` (``Compass::use_for_yaw``) and its ``COMPASS_DEV_IDn`` as
+    detected (``Compass::configured`` refuses a compass whose stored device id differs from the
+    detected one, or whose offsets are all zero); empty for a compass in use."""
+    use_index = slot if priority is None else priority
+    if in_use(params, use_index):
+        return {}
+    found = {f"COMPASS_USE{suffix(use_index)}": 1}
+    device = params.get(f"COMPASS_DEV_ID{suffix(slot)}")
+    if device:
+        found[f"COMPASS_DEV_ID{suffix(slot)}"] = int(device)
+    return found
 
 
 def orientation_parameter(compass: int, external: bool | None) -> str:

@@ -3,16 +3,23 @@
 
 What ArduPilot logs, and how it is turned into the project's conventions:
 
-- ``MAG``, ``MAG2``, ``MAG3`` (or ``MAG`` with an instance column ``I``): the field in the body
-  frame, in milligauss, *after* the compass's corrections, with the offsets ``Ofs``
-  (``COMPASS_OFS*``) and the motor compensation ``MOfs`` logged beside it. The raw field is
-  recovered sample by sample in the order of the log's firmware version
-  (:func:`flightlogs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter 3.5,
-  ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later).
-- ``GPS``: the position and date the Earth field model is evaluated at (3D fixes only).
+- ``MAG``, ``MAG2``, ``MAG3`` (up to Copter 3.6), or one ``MAG`` with an instance column ``I``
+  (4.0 and later): the field in the body frame, in milligauss, *after* the compass's corrections,
+  with the offsets ``Ofs`` (``COMPASS_OFS*``) and the motor compensation ``MOfs`` (``MOX..MOZ`` from
+  4.0) logged beside it. The raw field is recovered sample by sample in the order of the log's
+  firmware version (:func:`flightlogs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter
+  3.5, ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later). A 4.x instance ``I`` is the compass's
+  priority; its parameters are those of the slot whose ``COMPASS_DEV_IDn`` is
+  ``COMPASS_PRIO{I+1}_ID`` (:func:`flightlogs.ardupilot.slot_of`).
+- ``PARM``: the parameters (pymavlink's), and from 4.x the firmware's default of each (``Default``).
+- ``GPS`` (the first receiver, ``I = 0`` in 4.x logs): the position and date the Earth field model is
+  evaluated at (3D fixes only).
+- ``ATT``'s ``DesRoll``/``DesPitch`` against ``Roll``/``Pitch``: a crash at the end of a flight
+  (:func:`flightlogs.trim.crash_time`), which is cut off with the logging stalls (:mod:`flightlogs.trim`).
 - ``CTUN.ThO`` (``ThrOut`` in 0..1000 in older firmware): ``motors->get_throttle()``, the throttle
   ``COMPASS_MOTCT = 1`` multiplies.
 - ``IMU``, ``IMU2``, ``IMU3`` (or ``IMU`` with ``I``): rad/s and m/s^2, body frame.
+- ``BAT`` with ``Instance`` (4.x) or ``Inst``: the first battery monitor.
 - ``ATT``: roll, pitch, yaw (degrees, Z-Y-X), the attitude the vehicle flew on.
 - ``RCOU``: PWM (us) per output; motors are normalised with ``MOT_PWM_MIN``/``MOT_PWM_MAX``,
   or, when those are 0 or absent (Copter 3.4 and earlier), the throttle channel's
@@ -28,12 +35,12 @@ from pathlib import Path
 
 import numpy as np
 
-from flightlogs import ardupilot
+from flightlogs import ardupilot, trim
 from flightlogs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
 
 MILLIGAUSS = 1e-7  # T
 CENTI = 0.01
-WANTED = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT", "MSG", "GPS", "CTUN"}
+WANTED = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT", "MSG", "GPS", "CTUN", "PARM"}
 SENSORS = {"MAG", "MAG2", "MAG3", "IMU", "IMU2", "IMU3", "ATT", "RCOU", "CURR", "BAT"}
 GPS_3D_FIX = 3
 GPS_EPOCH = "1980-01-06"  # GPS week 0
@@ -43,6 +50,7 @@ INTEGER_FORMATS = "bBhHiI"
 FRAME_CLASS_MOTORS = {1: 4, 2: 6, 3: 8, 4: 8, 5: 6, 7: 3, 12: 4, 14: 4}
 FRAME_NAME_MOTORS = {"QUAD": 4, "HEXA": 6, "OCTA": 8, "OCTA_QUAD": 8, "Y6": 6, "TRI": 3}
 VOLTAGE_ONLY_MONITOR = 3
+MOTOR1_FUNCTION = 33  # SRV_Channel::k_motor1: SERVOn_FUNCTION of motor 1, 34 of motor 2, ...
 MIN_CURRENT_A = 0.2  # a current sensor that never reads more than this is not wired
 SINGULAR_CONDITION = 1e12  # a soft-iron matrix this ill-conditioned cannot be undone
 ZERO_TAIL_BYTES = 528  # zeros past this at a binary log's end are named (pymavlink reads past fewer)
@@ -143,21 +151,29 @@ def _instances(rows: dict, base: str, key: str = "I") -> list[tuple[str, list]]:
 def _compasses(rows: dict, params: dict, rule: ardupilot.Rules) -> list[Compass]:
     out = []
     for k, (name, group) in enumerate(_instances(rows, "MAG")):
+        instanced = "I" in group[0]
+        priority = int(group[0]["I"]) if instanced else None
+        slot = ardupilot.slot_of(params, priority) if instanced else k
+        motor = ["MOX", "MOY", "MOZ"] if "MOX" in group[0] else ["MOfsX", "MOfsY", "MOfsZ"]
         mag = _columns(group, ["MagX", "MagY", "MagZ"]) * MILLIGAUSS
         ofs = _columns(group, ["OfsX", "OfsY", "OfsZ"]) * MILLIGAUSS
-        mofs = _columns(group, ["MOfsX", "MOfsY", "MOfsZ"]) * MILLIGAUSS
-        matrix = ardupilot.soft_iron(params, k)
-        flag = params.get("COMPASS_EXTERNAL" if k == 0 else f"COMPASS_EXTERN{k + 1}")
-        unusable = _singular(matrix, params, ardupilot.suffix(k))
+        mofs = _columns(group, motor) * MILLIGAUSS
+        matrix = ardupilot.soft_iron(params, slot)
+        unusable = _singular(matrix, params, ardupilot.suffix(slot))
         if unusable:
             raw, inverse = np.full_like(mag, np.nan), np.full((3, 3), np.nan)
         else:
-            raw, inverse = ardupilot.recover_raw(params, k, rule, mag, ofs, mofs), np.linalg.inv(matrix)
-        out.append(Compass(name, _time(group), mag, raw, -np.median(ofs, axis=0),
-                           None if flag is None else bool(flag),
+            raw, inverse = ardupilot.recover_raw(params, slot, rule, mag, ofs, mofs), np.linalg.inv(matrix)
+        out.append(Compass(name, _time(group), mag, raw, -np.median(ofs, axis=0), ardupilot.external(params, slot),
                            f"logged field with the logged offsets, soft iron and motor offsets undone as {rule.name} "
-                           "applies them", inverse, np.eye(3), k, unusable))
+                           "applies them", inverse, np.eye(3), slot, unusable,
+                           ardupilot.setup(params, slot, priority, rule)))
     return out
+
+
+def _defaults(rows: dict) -> dict:
+    """The firmware's default of each parameter (``PARM.Default``, Copter 4.x), name: value."""
+    return {r["Name"]: r["Default"] for r in rows.get("PARM", []) if "Default" in r}
 
 
 def _singular(matrix: np.ndarray, params: dict, suffix: str) -> str:
@@ -175,7 +191,8 @@ def _position(rows: dict) -> Position | None:
     """The median 3D fix of ``GPS`` and its date (GPS week and milliseconds of the week)."""
     import datetime
 
-    group = [r for r in rows.get("GPS", []) if r.get("Status", 0) >= GPS_3D_FIX and r.get("GWk", 0) > 0]
+    group = [r for r in rows.get("GPS", []) if r.get("Status", 0) >= GPS_3D_FIX and r.get("GWk", 0) > 0
+             and r.get("I", 0) == 0]  # the first receiver (4.x logs every one as GPS with an instance I)
     if not group:
         return None
     lat, lon, alt = np.median(_columns(group, ["Lat", "Lng", "Alt"]), axis=0)
@@ -229,12 +246,28 @@ def _motor_count(params: dict, messages: list[str]) -> int:
     return 4
 
 
+def _motor_channels(params: dict, n: int) -> list[int]:
+    """The output channels (1-based) of motors 1 to ``n``: the channel whose ``SERVOn_FUNCTION`` is
+    ``33 + k`` for motor ``k + 1`` (``SRV_Channel::k_motor1`` on, Copter 3.5 and later; the map
+    ``Compass_PerMotor::scaled_output`` reads the motors through), else channels 1 to ``n``."""
+    functions = {int(v): int(name[5:-9]) for name, v in params.items()
+                 if re.fullmatch(r"SERVO\d+_FUNCTION", name)}
+    mapped = [functions.get(MOTOR1_FUNCTION + k) for k in range(n)]
+    return mapped if all(mapped) else list(range(1, n + 1))
+
+
 def _motors(rows: dict, params: dict, messages: list[str], path: Path) -> Motors | None:
     group = rows.get("RCOU")
     if not group:
         return None
     n = _motor_count(params, messages)
-    names = [f"C{k}" if f"C{k}" in group[0] else f"Ch{k}" for k in range(1, n + 1)]
+    channels = _motor_channels(params, n)
+    names = [f"C{k}" if f"C{k}" in group[0] else f"Ch{k}" for k in channels]
+    missing = [name for name in names if name not in group[0]]
+    if missing:
+        raise LogError(f"{path}: the motors' outputs ({', '.join(missing)}, by SERVOn_FUNCTION) are not in RCOU; the "
+                       "log holds " + ", ".join(c for c in group[0] if c.startswith("C")) + ": log every output "
+                       "(RCOU) or fix SERVOn_FUNCTION")
     pwm = _columns(group, names)
     low, high = params.get("MOT_PWM_MIN", 0.0), params.get("MOT_PWM_MAX", 0.0)
     source = "MOT_PWM_MIN/MAX"
@@ -304,5 +337,5 @@ def read_dataflash(path: Path, text: bool) -> FlightLog:
     log = FlightLog(str(path), "dataflash-text" if text else "dataflash-binary", "ArduPilot", firmware, vehicle,
                     simulator, _compasses(rows, params, rule), _imus(rows), _motors(rows, params, messages, path),
                     _battery(rows, formats, params), _attitude(rows), params, warnings, _position(rows),
-                    _throttle(rows))
-    return log
+                    _throttle(rows), _defaults(rows))
+    return trim.trimmed(log, trim.crash_time(rows.get("ATT", [])))

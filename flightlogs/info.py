@@ -17,7 +17,7 @@ def summary(log: FlightLog) -> dict:
     span = common_span(log)
     compasses = [{"index": k, "name": c.name, "samples": len(c.time), "rate_hz": rate(c.time),
                   "external": c.external, "field_norm_T": float(np.median(np.linalg.norm(c.field, axis=1))),
-                  "raw_source": c.raw_source} for k, c in enumerate(log.compasses)]
+                  "raw_source": c.raw_source, "setup": dict(c.setup)} for k, c in enumerate(log.compasses)]
     imus = [{"name": i.name, "samples": len(i.time), "rate_hz": rate(i.time),
              "acc_norm_m_s2": float(np.median(np.linalg.norm(i.acc, axis=1)))} for i in log.imus]
     motors = None if log.motors is None else {
@@ -37,14 +37,18 @@ def summary(log: FlightLog) -> dict:
             "current_sensor": log.battery is not None and log.battery.current is not None,
             "attitude": None if log.attitude is None else {"source": log.attitude.source,
                                                           "rate_hz": rate(log.attitude.time)},
-            "parameters": len(log.params), "warnings": list(log.warnings)}
+            "parameters": len(log.params),
+            "parameters_changed": sorted(n for n, v in log.defaults.items() if n in log.params and log.params[n] != v)
+            if log.defaults else None, "warnings": list(log.warnings)}
 
 
 def text(info: dict) -> str:
     """The ``summary`` dictionary ``info`` as the lines ``quadcosim log info`` prints."""
     lines = [f"{info['file']}: {info['format']}, {info['autopilot']} {info['firmware']}",
              f"  vehicle: {info['vehicle']}; {'SIMULATOR log' if info['simulator'] else 'real hardware'}; "
-             f"{info['duration_s']:.1f} s; {info['parameters']} parameters"]
+             f"{info['duration_s']:.1f} s; {info['parameters']} parameters"
+             + ("" if info.get("parameters_changed") is None else
+                f" ({len(info['parameters_changed'])} set away from the firmware's defaults)")]
     span = info["common_span_s"]
     lines.append("  sensors together: none (their time stamps do not overlap)" if span is None else
                  f"  sensors together: {span[1] - span[0]:.1f} s ({span[0]:.1f} to {span[1]:.1f} s on the log's clock)")
@@ -52,6 +56,8 @@ def text(info: dict) -> str:
         where = {True: "external", False: "internal", None: "location not logged"}[c["external"]]
         lines.append(f"  compass {c['index']} {c['name']}: {c['samples']} samples at {c['rate_hz']:.1f} Hz, {where}, "
                      f"|field| {c['field_norm_T'] * 1e6:.1f} uT")
+        if c.get("setup"):
+            lines.append("    " + "; ".join(f"{name.replace('_', ' ')} {value}" for name, value in c["setup"].items()))
     if not info["compasses"]:
         lines.append("  compass: none logged")
     for i in info["imus"]:

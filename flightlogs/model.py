@@ -47,6 +47,10 @@ class Compass:
         Why the raw field cannot be recovered (a singular soft-iron matrix in the log's
         parameters, named), or empty; ``raw`` is then NaN and the compass is refused for a
         calibration (:meth:`FlightLog.compass`).
+    setup : dict
+        How the autopilot is set up to use it, name: text, as ``log info`` prints it (ArduPilot:
+        priority, use, orientation, scale, parameter slot, device id); empty when the reader says
+        nothing.
     """
 
     name: str
@@ -60,6 +64,7 @@ class Compass:
     rotation: np.ndarray = _default(default_factory=lambda: np.eye(3))
     slot: int = 0
     unusable: str = ""
+    setup: dict = _default(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -165,7 +170,11 @@ class FlightLog:
     throttle : Throttle or None
         The autopilot's own throttle signal, the one its compass compensation multiplies.
     warnings : list of str
-        What was found wrong but could be read past (corruption skipped, a truncated end).
+        What was found wrong but could be read past (corruption skipped, a truncated end), and what
+        was cut off (a crash, a logging stall: :mod:`flightlogs.trim`).
+    defaults : dict
+        The firmware's default of each parameter where the log states it (ArduPilot 4.x's
+        ``PARM.Default``), name: value; empty otherwise.
     """
 
     path: str
@@ -183,6 +192,7 @@ class FlightLog:
     warnings: list[str] = _default(default_factory=list)
     position: Position | None = None
     throttle: Throttle | None = None
+    defaults: dict = _default(default_factory=dict)
 
     @property
     def start(self) -> float:

@@ -11,6 +11,10 @@ FOLDER = ROOT.parent / "shared" / "data" / "flightlogs"
 QUAD = ("quad_2015-10-11_19-53-46.log", "quad_2015-10-11_19-59-09.log", "quad_2015-10-11_20-17-22.log")
 ERLE = "erlebrain_APM_22.bin"
 PX4 = "px4_sample.ulg"
+COPTER43 = "copter43_cubeorange.bin"  # ArduCopter 4.3.6: instanced MAG, COMPASS_PRIOn_ID, COMPASS_SCALE
+COPTER36 = "copter36_three_compasses.bin"  # ArduCopter 3.6.7: three compasses, a stall and a crash
+#: Every shared ArduPilot log (a test over all of them reads this; the PX4 logs are listed apart).
+ARDUPILOT = (*QUAD, ERLE, COPTER36, COPTER43)
 
 
 def path(name: str) -> Path:

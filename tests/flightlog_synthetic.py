@@ -118,7 +118,8 @@ def write_log(path, duration=60.0, simulator=True, seed=1, tumble=1.0, gps=False
                          f"{acc[k, 2]:.4f}"))
         if k % 5 == 0:
             deg = np.degrees(vehicle[k])
-            rows.append((us + 10, f"ATT, {us + 10}, 0, {deg[0]:.3f}, 0, {deg[1]:.3f}, 0, {deg[2] % 360:.3f}"))
+            rows.append((us + 10, f"ATT, {us + 10}, {deg[0]:.3f}, {deg[0]:.3f}, {deg[1]:.3f}, {deg[1]:.3f}, "
+                                  f"{deg[2] % 360:.3f}, {deg[2] % 360:.3f}"))  # the target followed: no crash
             commands = _commands(np.array([t]))[0]
             pwm = PWM_MIN + (PWM_MAX - PWM_MIN) * commands
             rows.append((us + 20, f"RCOU, {us + 20}, " + ", ".join(str(int(v)) for v in np.round(pwm))))

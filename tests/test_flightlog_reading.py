@@ -5,7 +5,7 @@ import pytest
 
 from flightlogs import LogError, read_log
 from flightlogs.info import summary
-from tests.flightlog_data import ERLE, PX4, QUAD, log, path
+from tests.flightlog_data import COPTER36, COPTER43, ERLE, PX4, QUAD, log, path
 
 # WMM 2015 at the quad's GPS position (42.356 N, 71.299 W), October 2015: 51.9 uT total
 BOSTON_FIELD_T = 51.9e-6
@@ -16,7 +16,11 @@ EXPECTED = [
     (QUAD[0], "dataflash-text", ["MAG", "MAG2"], ["IMU", "IMU2"], True, 106.5),
     (QUAD[1], "dataflash-text", ["MAG", "MAG2"], ["IMU", "IMU2"], True, 67.8),
     (QUAD[2], "dataflash-text", ["MAG", "MAG2"], ["IMU", "IMU2"], True, 112.9),
-    (ERLE, "dataflash-binary", ["MAG"], ["IMU"], False, 226.2),
+    # 226.2 s logged: two flights apart by a 26.0 s stall from 37.6 s; the longer (63.6 to 240.2 s) is kept
+    (ERLE, "dataflash-binary", ["MAG"], ["IMU"], False, 176.6),
+    (COPTER43, "dataflash-binary", ["MAG[0]", "MAG[1]"], ["IMU[0]", "IMU[1]", "IMU[2]"], True, 98.0),
+    # 80.5 s logged: the 9.2 s before the 21.2 s stall from 74.8 s and the crash from 143.2 s cut
+    (COPTER36, "dataflash-binary", ["MAG", "MAG2", "MAG3"], ["IMU", "IMU2", "IMU3"], True, 47.2),
     (PX4, "ulog", ["sensor_combined.magnetometer_ga"], ["sensor_combined"], False, 68.9),
 ]
 

@@ -56,12 +56,21 @@ def _px4_apply(part, params, inputs, rule):
 
 def _ardupilot_parameters(part, candidate, rule):
     return ardupilot.parameters(_compass(part).slot, rules_of(part, rule), candidate.offset, candidate.correction,
-                                candidate.model, candidate.K)
+                                candidate.model, candidate.K) | _ardupilot_enabling(part)
 
 
 def _px4_parameters(part, candidate, rule):
     return px4.parameters(_compass(part).slot, candidate.offset, candidate.correction,
                           None if candidate.model == "motors" else candidate.model, candidate.K)
+
+
+def _ardupilot_enabling(part):
+    slot = _compass(part).slot
+    return ardupilot.enabling(part.log.params, slot, ardupilot.priority_of(part.log.params, slot))
+
+
+def _no_enabling(part):
+    return {}
 
 
 def _ardupilot_models(part, rule):
@@ -148,6 +157,10 @@ class Autopilot:
     board_trim : callable or None
         ``(params)``: the rotation (3, 3) from the vehicle to the board that the logged attitude
         leaves out (ArduPilot's ``AHRS_TRIM``); None: the logged attitude is the sensors' frame's.
+    enabling : callable
+        ``(part)``: the parameters a compass the log's firmware does not use needs to be used
+        (ArduPilot's ``COMPASS_USEn`` and ``COMPASS_DEV_IDn``, :func:`flightlogs.ardupilot.enabling`);
+        empty for a compass in use. The export carries them and its notes say so.
     """
 
     name: str
@@ -162,13 +175,14 @@ class Autopilot:
     is_motor_key: Callable[[str], bool]
     fused_compass: Callable[[dict], int]
     board_trim: Callable | None = None
+    enabling: Callable = _no_enabling
 
 
 #: The autopilots, one line each: a flight log of one of them is exported in its own file.
 AUTOPILOTS = {autopilot.name: autopilot for autopilot in (
     Autopilot("ArduPilot", "ardupilot.parm", write_ardupilot, _ardupilot_apply, _ardupilot_parameters,
               _ardupilot_models, _ardupilot_scale, _ardupilot_firmware, {"COMPASS_MOTCT": 0, "COMPASS_PMOT_EN": 0},
-              _ardupilot_motor_key, ardupilot.fused_compass, ardupilot.trim_rotation),
+              _ardupilot_motor_key, ardupilot.fused_compass, ardupilot.trim_rotation, _ardupilot_enabling),
     Autopilot("PX4", "px4.params", write_px4, _px4_apply, _px4_parameters, _px4_models, _no_scale, _px4_firmware,
               {"CAL_MAG_COMP_TYP": 0}, _px4_motor_key, _first_compass),
 )}

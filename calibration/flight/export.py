@@ -261,6 +261,11 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     log_soft = np.linalg.inv(compass.soft_iron)  # the log's correction matrix
     identifiable, why = offsets_identifiable(train)
     notes = {"offsets": why}
+    enabling = autopilot_of(first).enabling(first)
+    if enabling:
+        named = ", ".join(f"{k} = {v}" for k, v in enabling.items())
+        notes["use"] = (f"the log's firmware does not use this compass: the file carries what enabling it needs "
+                        f"({named}); load it only to fly on this compass")
     if zero and not identifiable:
         raise _zero_offsets(first.source, f"and {why}: calibrate it with the field model (log a GPS fix) or with a "
                                           "rotation sweep")
@@ -313,3 +318,26 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
             notes["soft_iron"] = (f"fitted: {found['heading_rms_deg']:.2f} deg on the choice part, not below "
                                   f"{best_score['heading_rms_deg']:.2f} deg: the log's kept")
     return best, {"kept": kept, "notes": notes, "model": kept["motor"] if kept["motor"] != "log" else None}
+
+
+def judge(part, params: dict, exported: dict, flown_params: dict, flown: dict) -> tuple[dict, dict, str | None]:
+    """The parameters to write for ``part``'s compass, their score on the score part and the reason
+    when the log's are kept: the export ``params`` (scored ``exported``, :func:`score_parameters`)
+    goes out only when it beats ``flown_params``, the log's values of the same names (scored
+    ``flown``), on the score part; otherwise the log's values go out, unchanged, and the reason says
+    why (the choice part preferred what the score part does not).
+
+    A compass whose offsets are all zero has nothing to fall back to: the firmware refuses to use it
+    (ArduPilot's ``Compass::configured`` asks for non-zero offsets), so its export goes out, and the
+    reason (or None) says how it compares."""
+    if exported["heading_rms_deg"] <= flown["heading_rms_deg"]:
+        return params, exported, None
+    compass = part.log.compasses[part.compass]
+    versus = (f"the export scores {exported['heading_rms_deg']:.2f} deg on the score part against "
+              f"{flown['heading_rms_deg']:.2f} deg as flown")
+    if not np.any(compass.offsets):
+        return params, exported, (f"{versus}, but the log's offsets are all zero: a compass the firmware does not "
+                                  "accept as calibrated, whose heading hides its hard iron when the vehicle barely "
+                                  "turns; exported")
+    return dict(flown_params), flown, (f"{versus}: the choice part preferred it, the score part does not; the "
+                                       "log's values are kept (the file holds them unchanged)")

@@ -193,15 +193,21 @@ def _export(args, split: Split, metrics: dict) -> tuple:
     """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
     described in ``metrics["export"]``; (autopilot, file name, parameters)."""
     from calibration.flight.autopilot import AUTOPILOTS
-    from calibration.flight.export import choose, log_parameters, score_parameters
+    from calibration.flight.export import choose, judge, log_parameters, score_parameters
 
     train, score = split.train, split.score
     rule = _rule(args, split.test[0])
     params, chosen = choose(split.fit, split.choice, rule)
     autopilot = train[0].log.autopilot
     name = AUTOPILOTS[autopilot].file
-    exported = score_parameters(score, params, rule)
-    flown = score_parameters(score, log_parameters(score[0], params), rule)
+    flown_params = log_parameters(score[0], params)
+    flown = score_parameters(score, flown_params, rule)
+    params, exported, kept_why = judge(score[0], params, score_parameters(score, params, rule), flown_params, flown)
+    if kept_why is not None:
+        chosen["notes"]["judge"] = kept_why
+        if exported is flown:  # the log's values written back
+            chosen = {**chosen, "kept": {group: "log" for group in chosen["kept"]}, "model": None}
+            chosen["notes"].pop("use", None)  # nothing that enables the compass is written
     firmware = AUTOPILOTS[autopilot].firmware(train[0], rule)
     metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
                          "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
