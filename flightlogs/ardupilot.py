@@ -317,11 +317,16 @@ def setup(params: dict, slot: int, priority: int | None, rule: Rules) -> dict:
     else:
         order = f"{priority + 1} (COMPASS_PRIO{priority + 1}_ID)"
     logged = params.get(f"COMPASS_SCALE{suffix(slot)}")
-    scale = (f"{scale_factor(params, slot, rule):.4g} (COMPASS_SCALE{suffix(slot)} = {logged:.4g})"
-             if rule.scale and logged is not None else "none (before Copter 4.0)" if not rule.scale else "1 (not logged)")
+    if not rule.scale:
+        scale = "none (before Copter 4.0)"
+    elif logged is None:
+        scale = "1 (not logged)"
+    else:
+        scale = f"{scale_factor(params, slot, rule):.4g} (COMPASS_SCALE{suffix(slot)} = {logged:.4g})"
     device = params.get(f"COMPASS_DEV_ID{suffix(slot)}")
+    use_name = f"COMPASS_USE{suffix(use_index)}"
     return {"priority": order, "use": f"{'yes' if in_use(params, use_index) else 'no'} "
-                                      f"(COMPASS_USE{suffix(use_index)} = {int(params.get(f'COMPASS_USE{suffix(use_index)}', 1))})",
+                                      f"({use_name} = {int(params.get(use_name, 1))})",
             "orientation": f"{where}, {name} = {rotation_name(value)}", "scale": scale,
             "parameters": f"slot {slot + 1} (COMPASS_OFS{suffix(slot)}_*)",
             **({} if device is None else {"device_id": str(int(device))})}
