@@ -26,10 +26,24 @@ import numpy as np
 FIGURES = ("residual.png", "heading.png")
 
 
-def _logs(files, verb: str) -> list:
+def _logs(files, verb: str, span=None) -> list:
+    """The logs at ``files``, each cut to ``span`` (start, end; s on its clock) when given."""
     from scenarios.flightlog.reading import load
 
-    return [load(f, verb) for f in files]
+    logs = [load(f, verb) for f in files]
+    return logs if span is None else [_spanned(log, span) for log in logs]
+
+
+def _spanned(log, span):
+    """``log`` cut to ``span`` (``--span START END``, s on the log's clock); a span outside it is refused."""
+    from flightlogs import LogError, trim
+
+    start, end = (float(x) for x in span)
+    first, last = log.start, log.start + log.duration
+    if not (end > start and start < last and end > first):
+        raise LogError(f"{log.path}: --span {start:g} {end:g} holds none of the log ({first:.1f} to {last:.1f} s on "
+                       "its clock, as 'quadcosim log info' prints it); give a span inside it")
+    return trim.cut(log, start, end, f"cut to --span {start:g} {end:g} s")
 
 
 @dataclass
@@ -100,9 +114,9 @@ def _split(args) -> Split:
     if args.test_fraction is not None and not 0.0 < args.test_fraction < 1.0:
         raise ValueError(f"--test-fraction {args.test_fraction} must lie strictly between 0 and 1")
     if args.train:
-        train_logs, test_logs = _logs(args.train, "calibrate"), _logs(args.test, "calibrate")
+        train_logs, test_logs = _logs(args.train, "calibrate", args.span), _logs(args.test, "calibrate", args.span)
     else:
-        logs = _logs(args.files, "calibrate")
+        logs = _logs(args.files, "calibrate", args.span)
         train_logs, test_logs = (logs, []) if len(logs) == 1 or args.test_fraction is not None else \
             (logs[:-1], logs[-1:])
     return split_parts(train_logs, test_logs, args.compass, args.attitude, not args.no_trim, args.earth,
@@ -448,6 +462,9 @@ def add_arguments(parser):
     parser.add_argument("--firmware", help="ArduPilot Copter version whose rules the export follows (default: the "
                                            "log's)")
     parser.add_argument("--no-trim", action="store_true", help="ignore AHRS_TRIM (an ablation)")
+    parser.add_argument("--span", nargs=2, type=float, metavar=("START", "END"),
+                        help="use only this span of each log (s on its clock, as 'quadcosim log info' prints it); "
+                             "a crash or logging stall at a flight's end is cut without it")
     parser.add_argument("--score", metavar="PARAMS", help="score this parameter file (.parm, .params) on the "
                                                           "held-out part instead of calibrating")
     parser.add_argument("--overwrite", action="store_true", help="replace the results already in --out")
