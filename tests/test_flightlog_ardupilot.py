@@ -4,6 +4,7 @@ firmware reads and scored with the era's equations written out here (not the pro
 shared ArduPilot log through every command, and the end of a flight cut at a stall or a crash."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -146,6 +147,9 @@ def test_every_shared_ardupilot_log_through_every_command_and_no_export_worse_th
             assert code == 2 and "quadcosim calibrate:" in err and not (out / "ardupilot.parm").exists()
             continue
         export = json.loads((out / "metrics.json").read_text())["export"]
+        if not read_parameters(out / "ardupilot.parm").get("COMPASS_PMOT_EN"):  # the era's equations, written here
+            major, minor = (int(x) for x in re.search(r"Copter V(\d+)\.(\d+)", log.firmware).groups())
+            _check_scores(log, compass, out, (major, minor))
         if np.any(log.compasses[compass].offsets):  # a compass the firmware accepts as calibrated
             assert export["heading_rms_deg"] <= export["as_flown"]["heading_rms_deg"] + 1e-9, (name, compass)
         else:  # nothing to fall back to: exported, and the notes say how it compares

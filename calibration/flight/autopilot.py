@@ -69,10 +69,6 @@ def _ardupilot_enabling(part):
     return ardupilot.enabling(part.log.params, slot, ardupilot.priority_of(part.log.params, slot))
 
 
-def _no_enabling(part):
-    return {}
-
-
 def _ardupilot_models(part, rule):
     from calibration.flight import catalogue
 
@@ -157,10 +153,11 @@ class Autopilot:
     board_trim : callable or None
         ``(params)``: the rotation (3, 3) from the vehicle to the board that the logged attitude
         leaves out (ArduPilot's ``AHRS_TRIM``); None: the logged attitude is the sensors' frame's.
-    enabling : callable
+    enabling : callable or None
         ``(part)``: the parameters a compass the log's firmware does not use needs to be used
         (ArduPilot's ``COMPASS_USEn`` and ``COMPASS_DEV_IDn``, :func:`flightlogs.ardupilot.enabling`);
-        empty for a compass in use. The export carries them and its notes say so.
+        empty for a compass in use; None: the firmware has no such switch. The export carries them
+        and its notes say so.
     """
 
     name: str
@@ -175,7 +172,7 @@ class Autopilot:
     is_motor_key: Callable[[str], bool]
     fused_compass: Callable[[dict], int]
     board_trim: Callable | None = None
-    enabling: Callable = _no_enabling
+    enabling: Callable | None = None
 
 
 #: The autopilots, one line each: a flight log of one of them is exported in its own file.

@@ -241,6 +241,18 @@ def _zero_offsets(source: str, why: str) -> CalibrationError:
                             "written rather than one with zero offsets")
 
 
+def _use_note(part) -> dict:
+    """``{"use": ...}``: what the export carries to enable a compass the log's firmware does not use
+    (:class:`calibration.flight.autopilot.Autopilot`'s ``enabling``); empty for a compass in use."""
+    enabler = autopilot_of(part).enabling
+    enabling = enabler(part) if enabler is not None else {}
+    if not enabling:
+        return {}
+    named = ", ".join(f"{k} = {v}" for k, v in enabling.items())
+    return {"use": f"the log's firmware does not use this compass: the file carries what enabling it needs ({named}); "
+                   "load it only to fly on this compass"}
+
+
 def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     """The parameters to export for the compass of ``train``/``choice`` and the notes saying what was
     exported and kept: offsets, then motor compensation, then soft iron, each fitted on ``train``
@@ -260,12 +272,7 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     zero = not np.any(compass.offsets)
     log_soft = np.linalg.inv(compass.soft_iron)  # the log's correction matrix
     identifiable, why = offsets_identifiable(train)
-    notes = {"offsets": why}
-    enabling = autopilot_of(first).enabling(first)
-    if enabling:
-        named = ", ".join(f"{k} = {v}" for k, v in enabling.items())
-        notes["use"] = (f"the log's firmware does not use this compass: the file carries what enabling it needs "
-                        f"({named}); load it only to fly on this compass")
+    notes = {"offsets": why} | _use_note(first)
     if zero and not identifiable:
         raise _zero_offsets(first.source, f"and {why}: calibrate it with the field model (log a GPS fix) or with a "
                                           "rotation sweep")
