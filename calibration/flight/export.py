@@ -241,16 +241,24 @@ def _zero_offsets(source: str, why: str) -> CalibrationError:
                             "written rather than one with zero offsets")
 
 
-def _use_note(part) -> dict:
-    """``{"use": ...}``: what the export carries to enable a compass the log's firmware does not use
-    (:class:`calibration.flight.autopilot.Autopilot`'s ``enabling``); empty for a compass in use."""
+def _setup_notes(part) -> dict:
+    """The notes of how the compass is set up: ``orientation``, the rotation the export's frame depends
+    on (the offsets and motor vectors are in the frame the firmware rotates the compass into before
+    correcting it, ``AP_Compass_Backend::rotate_field``), and ``use``, what the export carries to
+    enable a compass the log's firmware does not use (:class:`calibration.flight.autopilot.Autopilot`'s
+    ``enabling``); each left out when it does not apply."""
+    notes = {}
+    orientation = part.log.compasses[part.compass].setup.get("orientation")
+    if orientation:
+        notes["orientation"] = (f"{orientation}: the file's offsets and motor vectors are in the frame it rotates the "
+                                "compass into, right only with that orientation")
     enabler = autopilot_of(part).enabling
     enabling = enabler(part) if enabler is not None else {}
-    if not enabling:
-        return {}
-    named = ", ".join(f"{k} = {v}" for k, v in enabling.items())
-    return {"use": f"the log's firmware does not use this compass: the file carries what enabling it needs ({named}); "
-                   "load it only to fly on this compass"}
+    if enabling:
+        named = ", ".join(f"{k} = {v}" for k, v in enabling.items())
+        notes["use"] = (f"the log's firmware does not use this compass: the file carries what enabling it needs "
+                        f"({named}); load it only to fly on this compass")
+    return notes
 
 
 def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
@@ -272,7 +280,7 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     zero = not np.any(compass.offsets)
     log_soft = np.linalg.inv(compass.soft_iron)  # the log's correction matrix
     identifiable, why = offsets_identifiable(train)
-    notes = {"offsets": why} | _use_note(first)
+    notes = {"offsets": why} | _setup_notes(first)
     if zero and not identifiable:
         raise _zero_offsets(first.source, f"and {why}: calibrate it with the field model (log a GPS fix) or with a "
                                           "rotation sweep")
