@@ -246,10 +246,10 @@ def _setup_notes(part) -> dict:
     on (the offsets and motor vectors are in the frame the firmware rotates the compass into before
     correcting it, ``AP_Compass_Backend::rotate_field``), and ``use``, what the export carries to
     enable a compass the log's firmware does not use (:class:`calibration.flight.autopilot.Autopilot`'s
-    ``enabling``); each left out when it does not apply."""
+    ``enabling``); each left out when it does not apply (an orientation ``NONE``: nothing rotated)."""
     notes = {}
-    orientation = part.log.compasses[part.compass].setup.get("orientation")
-    if orientation:
+    orientation = part.log.compasses[part.compass].setup.get("orientation", "")
+    if orientation and "(NONE)" not in orientation:  # a compass not rotated needs no warning
         notes["orientation"] = (f"{orientation}: the file's offsets and motor vectors are in the frame it rotates the "
                                 "compass into, right only with that orientation")
     enabler = autopilot_of(part).enabling
