@@ -154,3 +154,19 @@ def test_every_shared_ardupilot_log_through_every_command_and_no_export_worse_th
             assert export["heading_rms_deg"] <= export["as_flown"]["heading_rms_deg"] + 1e-9, (name, compass)
         else:  # nothing to fall back to: exported, and the notes say how it compares
             assert "judge" not in export["notes"] or "offsets are all zero" in export["notes"]["judge"]
+
+
+def test_a_crash_is_the_first_two_seconds_thirty_degrees_off_target_and_a_shorter_upset_is_not():
+    from flightlogs.trim import crash_time
+
+    def rows(upset_from, upset_s):
+        found = []
+        for k in range(120):  # 12 s of ATT at 10 Hz, the target followed but for the upset
+            t = 0.1 * k
+            roll = 45.0 if upset_from <= t < upset_from + upset_s else 5.0
+            found.append({"TimeUS": int(t * 1e6), "Roll": roll, "Pitch": -3.0, "DesRoll": 5.0, "DesPitch": -3.0})
+        return found
+
+    assert crash_time(rows(8.0, 5.0)) == pytest.approx(8.0)  # 40 deg off from 8 s to the end
+    assert crash_time(rows(3.0, 1.5)) is None  # an upset shorter than CRASH_CHECK_TRIGGER_SEC
+    assert crash_time([{"TimeMS": 0, "Roll": 0.0, "Pitch": 0.0}]) is None  # no target logged: nothing to compare
