@@ -232,6 +232,8 @@ def _report(metrics: dict) -> list[str]:
         lines.append(f"  {name:9s} explained {100 * m['explained_test']:5.1f} % of the test residual "
                      f"({100 * m['explained_train']:.1f} % in training), {m['perturbation_at_hover_T'] * 1e6:.2f} uT "
                      f"at hover, heading moved {m['heading_rms_change_deg']:.2f} deg RMS, delay {m['delay_s']:.2f} s")
+    lines += [f"calibration.json passes over {name}: it {why}"
+              for name, why in metrics.get("calibration_model_passed_over", {}).items()]
     return lines + _export_lines(metrics["export"])
 
 
