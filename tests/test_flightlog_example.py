@@ -133,3 +133,24 @@ def test_the_calibration_file_pairs_its_model_with_the_offsets_fitted_with_it(ra
     assert metrics["static"]["source"] == "log" and metrics["calibration_model"] is not None
     assert np.linalg.norm(np.mean(compensated - truth, axis=0)) < 0.5e-6
     assert not np.allclose(calibration.static.b_s, log.compasses[1].offsets)
+
+
+def test_the_figures_draw_the_quartiles_wherever_the_current_is_and_yaw_wrapped_on_its_own_axis(ran):
+    from flightlogs import read_log
+    from scenarios.flightlog.calibration_figures import RESIDUAL_BIN_SAMPLES, _binned
+    from scenarios.flightlog.overview import _broken_at_wraps, _euler_deg
+
+    folder, _ = ran
+    log = read_log(folder / "logs" / "example-a.log")
+    held_out = log.battery.time > log.battery.time[len(log.battery.time) // 2]
+    current = log.battery.current[held_out]  # 2.9 to 12.1 A; 12 bins of equal width drew 3, centred 4.9 to 7.2 A
+    centres, quartiles = _binned(current, np.sin(current))
+    assert len(centres) >= 8 and quartiles.shape == (len(centres), 3)
+    span = current.max() - current.min()
+    # equal counts of at least 20 samples: the first and last bins' medians lie within 10 % of the ends
+    assert centres[0] - current.min() < 0.1 * span and current.max() - centres[-1] < 0.1 * span
+    assert len(current) // len(centres) >= RESIDUAL_BIN_SAMPLES
+    yaw = _euler_deg(log.attitude.q)[:, 2]
+    assert np.abs(yaw).max() <= 180.0 and np.ptp(np.unwrap(np.radians(yaw))) > np.radians(500)  # 585 deg turned
+    time, drawn = _broken_at_wraps(log.attitude.time, yaw)
+    assert np.isnan(drawn).sum() == 2 and np.nanmax(np.abs(np.diff(drawn))) < 5.0  # two wraps, no line across
