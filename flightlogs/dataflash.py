@@ -29,7 +29,18 @@ from pathlib import Path
 import numpy as np
 
 from flightlogs import ardupilot
-from flightlogs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
+from flightlogs.model import (
+    Attitude,
+    Battery,
+    Compass,
+    FlightLog,
+    Imu,
+    LogError,
+    Motors,
+    Position,
+    Throttle,
+    synthetic_statement,
+)
 
 MILLIGAUSS = 1e-7  # T
 CENTI = 0.01
@@ -305,4 +316,5 @@ def read_dataflash(path: Path, text: bool) -> FlightLog:
                     simulator, _compasses(rows, params, rule), _imus(rows), _motors(rows, params, messages, path),
                     _battery(rows, formats, params), _attitude(rows), params, warnings, _position(rows),
                     _throttle(rows))
+    log.synthetic = synthetic_statement(messages)
     return log

@@ -166,6 +166,9 @@ class FlightLog:
         The autopilot's own throttle signal, the one its compass compensation multiplies.
     warnings : list of str
         What was found wrong but could be read past (corruption skipped, a truncated end).
+    synthetic : str
+        The log's own statement that it is synthetic (a message starting with
+        :data:`SYNTHETIC_MARK`, which ``quadcosim log example`` writes), or empty for a recording.
     """
 
     path: str
@@ -183,6 +186,7 @@ class FlightLog:
     warnings: list[str] = _default(default_factory=list)
     position: Position | None = None
     throttle: Throttle | None = None
+    synthetic: str = ""
 
     @property
     def start(self) -> float:
@@ -254,6 +258,15 @@ class FlightLog:
                            "match (shifted, or parts of different logs); give a log whose sensors were recorded "
                            "together")
         return float(lo), float(hi)
+
+
+#: How a synthetic log says so in its own text messages (ArduPilot ``MSG``): the start of the message.
+SYNTHETIC_MARK = "synthetic flight: "  # no comma: a text log splits its fields on commas
+
+
+def synthetic_statement(messages) -> str:
+    """The first of the log's text ``messages`` (str) that starts with :data:`SYNTHETIC_MARK`, or ``""``."""
+    return next((m for m in messages if str(m).startswith(SYNTHETIC_MARK)), "")
 
 
 #: The messages (ArduPilot) and topics (PX4) that carry each part of a log, named when one is missing.

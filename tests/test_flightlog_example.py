@@ -154,3 +154,23 @@ def test_the_figures_draw_the_quartiles_wherever_the_current_is_and_yaw_wrapped_
     assert np.abs(yaw).max() <= 180.0 and np.ptp(np.unwrap(np.radians(yaw))) > np.radians(500)  # 585 deg turned
     time, drawn = _broken_at_wraps(log.attitude.time, yaw)
     assert np.isnan(drawn).sum() == 2 and np.nanmax(np.abs(np.diff(drawn))) < 5.0  # two wraps, no line across
+
+
+def test_log_info_says_the_example_is_synthetic_from_the_log_itself(ran, capsys):
+    from pymavlink import DFReader
+
+    folder, _ = ran
+    log = folder / "logs" / "example-c.log"
+    reader = DFReader.DFReader_text(str(log))
+    said = []
+    while (message := reader.recv_msg()) is not None:
+        said += [message.Message] if message.get_type() == "MSG" else []
+    assert example.STATEMENT in said  # in the log, read by pymavlink: not inferred from the file's name
+    assert main(["log", "info", str(log)]) == 0
+    shown = capsys.readouterr().out
+    assert "; synthetic flight: written by quadcosim log example (simulated; not recorded); 40.0 s" in shown
+    assert "real hardware" not in shown
+    copy = folder / "flight.log"  # the same flight under another name is still said to be synthetic
+    copy.write_text(log.read_text())
+    assert main(["log", "info", str(copy), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["synthetic"] == example.STATEMENT
