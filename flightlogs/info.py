@@ -17,7 +17,7 @@ def summary(log: FlightLog) -> dict:
     span = common_span(log)
     compasses = [{"index": k, "name": c.name, "samples": len(c.time), "rate_hz": rate(c.time),
                   "external": c.external, "field_norm_T": float(np.median(np.linalg.norm(c.field, axis=1))),
-                  "raw_source": c.raw_source} for k, c in enumerate(log.compasses)]
+                  "raw_source": c.raw_source, "setup": dict(c.setup)} for k, c in enumerate(log.compasses)]
     imus = [{"name": i.name, "samples": len(i.time), "rate_hz": rate(i.time),
              "acc_norm_m_s2": float(np.median(np.linalg.norm(i.acc, axis=1)))} for i in log.imus]
     motors = None if log.motors is None else {
@@ -53,6 +53,8 @@ def text(info: dict) -> str:
         where = {True: "external", False: "internal", None: "location not logged"}[c["external"]]
         lines.append(f"  compass {c['index']} {c['name']}: {c['samples']} samples at {c['rate_hz']:.1f} Hz, {where}, "
                      f"|field| {c['field_norm_T'] * 1e6:.1f} uT")
+        if c.get("setup"):
+            lines.append("    " + "; ".join(f"{name.replace('_', ' ')} {value}" for name, value in c["setup"].items()))
     if not info["compasses"]:
         lines.append("  compass: none logged")
     for i in info["imus"]:

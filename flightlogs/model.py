@@ -47,6 +47,10 @@ class Compass:
         Why the raw field cannot be recovered (a singular soft-iron matrix in the log's
         parameters, named), or empty; ``raw`` is then NaN and the compass is refused for a
         calibration (:meth:`FlightLog.compass`).
+    setup : dict
+        How the autopilot is set up to use it, name: text, as ``log info`` prints it (ArduPilot:
+        priority, use, orientation, scale, parameter slot, device id); empty when the reader says
+        nothing.
     """
 
     name: str
@@ -60,6 +64,7 @@ class Compass:
     rotation: np.ndarray = _default(default_factory=lambda: np.eye(3))
     slot: int = 0
     unusable: str = ""
+    setup: dict = _default(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -276,6 +281,15 @@ MESSAGES = {"ArduPilot": {"compass": "MAG", "imu": "IMU", "attitude": "ATT", "mo
                     "sensor_combined", "attitude": "vehicle_attitude", "motors": "actuator_motors or "
                     "actuator_outputs", "battery": "battery_status"}}
 LOGGING = {"ArduPilot": "LOG_BITMASK", "PX4": "SDLOG_PROFILE"}
+#: How to log a compass faster, by autopilot. PX4's logger (``LoggedTopics::add_default_topics``) logs
+#: ``sensor_mag`` every 1000 ms and ``vehicle_magnetometer`` every 500 ms; the sensor comparison
+#: profile (``SDLogProfileMask::SENSOR_COMPARISON``, bit 6, value 64: ``add_sensor_comparison_topics``)
+#: logs ``sensor_mag`` every 100 ms.
+FASTER_COMPASS = {
+    "PX4": "set SDLOG_PROFILE's sensor comparison bit (64: SDLOG_PROFILE = 65 beside the default profile's 1), "
+           "which logs sensor_mag at 10 Hz, and fly again",
+    "ArduPilot": "log the compass at its full rate (LOG_BITMASK with IMU and compass; ArduPilot logs MAG at 10 Hz "
+                 "or faster) and fly again"}
 PARTS = {"compass": "a magnetometer", "imu": "an IMU", "attitude": "the attitude", "motors": "the motor outputs",
          "battery": "the battery"}
 
