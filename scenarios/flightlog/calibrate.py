@@ -59,14 +59,8 @@ def split_parts(train_logs, test_logs, compass: int, attitude: str = "auto", tri
     with its last ``test_fraction``, default 0.5, held out) and ``test_logs`` (held-out flights, or
     empty), with the ``attitude``, ``trim`` and ``earth`` field (``model`` or ``free``) the command uses."""
     from calibration.flight import flight_data
-    from calibration.flight.data import rate_refusal
     from calibration.flight.earth import align, model_field
-    from calibration.static import CalibrationError
 
-    for log in [*train_logs, *test_logs]:
-        refusal = rate_refusal(log, compass)
-        if refusal:
-            raise CalibrationError(refusal)
     fields, notes = {}, {}
     for log in [*train_logs, *test_logs]:
         fields[log.path], notes[log.path] = (None, "the free Earth field (--earth free)") if earth == "free" \
@@ -111,6 +105,13 @@ def _split(args) -> Split:
         logs = _logs(args.files, "calibrate")
         train_logs, test_logs = (logs, []) if len(logs) == 1 or args.test_fraction is not None else \
             (logs[:-1], logs[-1:])
+    from calibration.flight.data import rate_refusal
+    from calibration.static import CalibrationError
+
+    for log in [*train_logs, *test_logs]:  # the command's floor; split_parts itself fits any rate (a measurement)
+        refusal = rate_refusal(log, args.compass)
+        if refusal:
+            raise CalibrationError(refusal)
     return split_parts(train_logs, test_logs, args.compass, args.attitude, not args.no_trim, args.earth,
                        args.test_fraction)
 
