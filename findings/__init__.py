@@ -48,6 +48,7 @@ GROUPS = (
     "log_info",
     "example_replay",
     "ardupilot_logs",
+    "compass_rate",
 )
 
 ROOT = Path(__file__).resolve().parents[1]

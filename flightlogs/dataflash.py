@@ -36,7 +36,18 @@ from pathlib import Path
 import numpy as np
 
 from flightlogs import ardupilot, trim
-from flightlogs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
+from flightlogs.model import (
+    Attitude,
+    Battery,
+    Compass,
+    FlightLog,
+    Imu,
+    LogError,
+    Motors,
+    Position,
+    Throttle,
+    synthetic_statement,
+)
 
 MILLIGAUSS = 1e-7  # T
 CENTI = 0.01
@@ -338,4 +349,5 @@ def read_dataflash(path: Path, text: bool) -> FlightLog:
                     simulator, _compasses(rows, params, rule), _imus(rows), _motors(rows, params, messages, path),
                     _battery(rows, formats, params), _attitude(rows), params, warnings, _position(rows),
                     _throttle(rows), _defaults(rows))
+    log.synthetic = synthetic_statement(messages)
     return trim.trimmed(log, trim.crash_time(rows.get("ATT", [])))

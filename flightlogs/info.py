@@ -10,8 +10,8 @@ from flightlogs.model import FlightLog, rate
 def summary(log: FlightLog) -> dict:
     """Sensors (instances, samples, rates in Hz, mean field norm in T, mean specific-force norm
     in m/s^2), duration (s), the span every sensor covers (``common_span_s``, s on the log's
-    clock, None when they share none), vehicle, firmware, simulator flag and current sensor of
-    ``log``."""
+    clock, None when they share none), vehicle, firmware, simulator flag, the log's own statement
+    that it is synthetic (empty for a recording) and current sensor of ``log``."""
     from flightlogs.checks import common_span
 
     span = common_span(log)
@@ -31,7 +31,7 @@ def summary(log: FlightLog) -> dict:
                                                                      float(log.battery.current.max())],
         "current_sensor": log.battery.current_sensor}
     return {"file": log.path, "format": log.format, "autopilot": log.autopilot, "firmware": log.firmware,
-            "vehicle": log.vehicle, "simulator": log.simulator, "duration_s": log.duration,
+            "vehicle": log.vehicle, "simulator": log.simulator, "synthetic": log.synthetic, "duration_s": log.duration,
             "common_span_s": None if span is None else list(span),
             "compasses": compasses, "imus": imus, "motors": motors, "battery": battery,
             "current_sensor": log.battery is not None and log.battery.current is not None,
@@ -44,9 +44,10 @@ def summary(log: FlightLog) -> dict:
 
 def text(info: dict) -> str:
     """The ``summary`` dictionary ``info`` as the lines ``quadcosim log info`` prints."""
+    origin = (info["synthetic"] if info.get("synthetic") else
+              "SIMULATOR log" if info["simulator"] else "real hardware")
     lines = [f"{info['file']}: {info['format']}, {info['autopilot']} {info['firmware']}",
-             f"  vehicle: {info['vehicle']}; {'SIMULATOR log' if info['simulator'] else 'real hardware'}; "
-             f"{info['duration_s']:.1f} s; {info['parameters']} parameters"
+             f"  vehicle: {info['vehicle']}; {origin}; {info['duration_s']:.1f} s; {info['parameters']} parameters"
              + ("" if info.get("parameters_changed") is None else
                 f" ({len(info['parameters_changed'])} set away from the firmware's defaults)")]
     span = info["common_span_s"]

@@ -175,6 +175,9 @@ class FlightLog:
     defaults : dict
         The firmware's default of each parameter where the log states it (ArduPilot 4.x's
         ``PARM.Default``), name: value; empty otherwise.
+    synthetic : str
+        The log's own statement that it is synthetic (a message starting with
+        :data:`SYNTHETIC_MARK`, which ``quadcosim log example`` writes), or empty for a recording.
     """
 
     path: str
@@ -193,6 +196,7 @@ class FlightLog:
     position: Position | None = None
     throttle: Throttle | None = None
     defaults: dict = _default(default_factory=dict)
+    synthetic: str = ""
 
     @property
     def start(self) -> float:
@@ -266,6 +270,15 @@ class FlightLog:
         return float(lo), float(hi)
 
 
+#: How a synthetic log says so in its own text messages (ArduPilot ``MSG``): the start of the message.
+SYNTHETIC_MARK = "synthetic flight: "  # no comma: a text log splits its fields on commas
+
+
+def synthetic_statement(messages) -> str:
+    """The first of the log's text ``messages`` (str) that starts with :data:`SYNTHETIC_MARK`, or ``""``."""
+    return next((m for m in messages if str(m).startswith(SYNTHETIC_MARK)), "")
+
+
 #: The messages (ArduPilot) and topics (PX4) that carry each part of a log, named when one is missing.
 MESSAGES = {"ArduPilot": {"compass": "MAG", "imu": "IMU", "attitude": "ATT", "motors": "RCOU",
                           "battery": "BAT or CURR"},
@@ -273,6 +286,15 @@ MESSAGES = {"ArduPilot": {"compass": "MAG", "imu": "IMU", "attitude": "ATT", "mo
                     "sensor_combined", "attitude": "vehicle_attitude", "motors": "actuator_motors or "
                     "actuator_outputs", "battery": "battery_status"}}
 LOGGING = {"ArduPilot": "LOG_BITMASK", "PX4": "SDLOG_PROFILE"}
+#: How to log a compass faster, by autopilot. PX4's logger (``LoggedTopics::add_default_topics``) logs
+#: ``sensor_mag`` every 1000 ms and ``vehicle_magnetometer`` every 500 ms; the sensor comparison
+#: profile (``SDLogProfileMask::SENSOR_COMPARISON``, bit 6, value 64: ``add_sensor_comparison_topics``)
+#: logs ``sensor_mag`` every 100 ms.
+FASTER_COMPASS = {
+    "PX4": "set SDLOG_PROFILE's sensor comparison bit (64: SDLOG_PROFILE = 65 beside the default profile's 1), "
+           "which logs sensor_mag at 10 Hz, and fly again",
+    "ArduPilot": "log the compass at its full rate (LOG_BITMASK with IMU and compass; ArduPilot logs MAG at 10 Hz "
+                 "or faster) and fly again"}
 PARTS = {"compass": "a magnetometer", "imu": "an IMU", "attitude": "the attitude", "motors": "the motor outputs",
          "battery": "the battery"}
 

@@ -19,6 +19,16 @@ From PX4's source, cited by file and function:
   ``CAL_MAG_COMP_TYP = 1`` the thrust setpoint's norm (0..1), with ``2`` (``3``) battery
   instance 0 (1)'s ``current_a`` times 0.001, in kA; 0 while disarmed.
 
+- the priority of a sensor is ``CAL_MAGn_PRIO``, by default ``DEFAULT_EXTERNAL_PRIORITY`` (75) for
+  an external sensor and ``DEFAULT_PRIORITY`` (50) for an internal one (``calibration::Magnetometer``,
+  ``set_external``); ``0`` disables it: ``VehicleMagnetometer`` gives it no vote, and the sensor of
+  the highest priority is the one ``vehicle_magnetometer`` carries;
+- the motor outputs ``actuator_outputs`` are in us between ``PWM_MAIN_MINn``/``PWM_MAIN_MAXn`` (one
+  pair per output, PX4 1.13 and later: ``pwm_out``'s ``module.yaml``, ``standard_params`` min and max),
+  ``PWM_MAIN_MIN``/``PWM_MAIN_MAX`` (1.11, 1.12: ``pwm_out``'s parameters) or ``PWM_MIN``/``PWM_MAX``
+  (1.9, 1.10: ``src/modules/sensors/pwm_params.c``); every one of them defaults to 1000 and 2000 us
+  (:data:`PWM_DEFAULTS`), and a parameter left at its default is not always in a log's parameters.
+
 Fields are in gauss (:data:`GAUSS`).
 """
 
@@ -34,6 +44,36 @@ COMP_TYPE = {"throttle": 1, "current": 2}
 ROTATIONS = {0: (0, 0, 0), 1: (0, 0, 45), 2: (0, 0, 90), 3: (0, 0, 135), 4: (0, 0, 180), 5: (0, 0, 225),
              6: (0, 0, 270), 7: (0, 0, 315), 8: (180, 0, 0), 9: (180, 0, 45), 10: (180, 0, 90), 11: (180, 0, 135),
              12: (0, 180, 0), 13: (180, 0, 225), 14: (180, 0, 270), 15: (180, 0, 315)}
+
+
+PRIORITY_DEFAULTS = {False: 50, True: 75}  # calibration::Magnetometer: DEFAULT_PRIORITY, DEFAULT_EXTERNAL_PRIORITY
+PWM_DEFAULTS = (1000.0, 2000.0)  # us: PWM_MAIN_MIN(n), PWM_MAIN_MAX(n), PWM_MIN, PWM_MAX alike
+#: PWM limit parameters, newest first: per output (``{n}`` the output, from 1), global, PX4 1.9's
+PWM_LIMITS = (("PWM_MAIN_MIN{n}", "PWM_MAIN_MAX{n}"), ("PWM_MAIN_MIN", "PWM_MAIN_MAX"), ("PWM_MIN", "PWM_MAX"))
+
+
+def priority(params: dict, n: int, external: bool) -> int:
+    """The priority (0..100) of the sensor of slot ``n``: ``CAL_MAGn_PRIO`` in ``params``, else the
+    firmware's default for an ``external`` or internal sensor (:data:`PRIORITY_DEFAULTS`); 0 disables it."""
+    value = params.get(f"CAL_MAG{n}_PRIO")
+    return PRIORITY_DEFAULTS[bool(external)] if value is None or not 0 <= int(value) <= 100 else int(value)
+
+
+def pwm_limits(params: dict, outputs: int) -> tuple[np.ndarray, np.ndarray, str]:
+    """The PWM limits (us) of the first ``outputs`` outputs: ``low`` (N,), ``high`` (N,) and the
+    parameters they come from, the first of :data:`PWM_LIMITS` the log holds for every output, else
+    the firmware's defaults (:data:`PWM_DEFAULTS`), said so."""
+    for low_name, high_name in PWM_LIMITS:
+        names = [(low_name.format(n=k + 1), high_name.format(n=k + 1)) for k in range(outputs)]
+        if all(lo in params and hi in params for lo, hi in names):
+            low = np.array([float(params[lo]) for lo, _ in names])
+            high = np.array([float(params[hi]) for _, hi in names])
+            if (low > 0).all() and (high > low).all():
+                shown = f"{low_name}/{high_name}".replace("{n}", "n")
+                return low, high, shown
+    low, high = PWM_DEFAULTS
+    return (np.full(outputs, low), np.full(outputs, high),
+            f"PX4's defaults, {low:.0f}/{high:.0f} us (no PWM_MAIN_MINn/MAXn, PWM_MAIN_MIN/MAX or PWM_MIN/MAX logged)")
 
 
 def rotation_matrix(value: int) -> np.ndarray:

@@ -17,7 +17,9 @@ How PX4's logged topics differ from ArduPilot's messages:
   throttle ``CAL_MAG_COMP_TYP = 1`` multiplies.
 - IMUs: ``sensor_accel`` and ``sensor_gyro`` per instance (newer), or ``sensor_combined``.
 - Motors: ``actuator_motors`` (already 0..1, newer) or ``actuator_outputs`` in us, normalised
-  with ``PWM_MAIN_MIN``/``PWM_MAIN_MAX`` (or ``PWM_MIN``/``PWM_MAX`` in older firmware).
+  output by output with ``PWM_MAIN_MINn``/``PWM_MAIN_MAXn`` (1.13 and later), ``PWM_MAIN_MIN``/``MAX``
+  (1.11, 1.12) or ``PWM_MIN``/``PWM_MAX`` (1.9, 1.10), or PX4's defaults when none is logged
+  (:func:`flightlogs.px4.pwm_limits`).
 - Battery: ``battery_status.voltage_v`` and ``current_a`` (negative when not measured).
 - Attitude: ``vehicle_attitude.q``, scalar first, body FRD to NED: the project's convention.
 - Time stamps are microseconds since boot.
@@ -54,7 +56,22 @@ def _external(params: dict, n: int) -> bool:
     return int(params.get(f"CAL_MAG{n}_ROT", -1)) >= 0
 
 
-def _compasses(ulog, params: dict) -> list[Compass]:
+def _setup(params: dict, n: int, external: bool, device: int | None) -> dict:
+    """What ``log info`` prints of slot ``n``: its priority and use, orientation, scale and device id."""
+    level = px4.priority(params, n, external)
+    logged = f"CAL_MAG{n}_PRIO" in params
+    where = f"CAL_MAG{n}_ROT = {int(params.get(f'CAL_MAG{n}_ROT', 0))}" if external else \
+        f"the board's, SENS_BOARD_ROT = {int(params.get('SENS_BOARD_ROT', 0))}"
+    scale = px4.scale_matrix(params, n)
+    shown = f"{level}" + ("" if logged else " (CAL_MAGn_PRIO not logged: the default of PX4 1.12 and later)")
+    return {"priority": shown,
+            "use": "no (priority 0 disables it)" if level == 0 else "yes", "orientation": where,
+            "scale": "diagonal " + " ".join(f"{v:.4g}" for v in np.diag(scale)) + " (CAL_MAGn_xSCALE)",
+            "slot": f"CAL_MAG{n}", "device_id": str(device) if device else "not logged"}
+
+
+def _raw_compasses(ulog, params: dict) -> list[Compass]:
+    """Every ``sensor_mag`` instance: the field before calibration, in the sensor's frame."""
     out = []
     for d in _topics(ulog, "sensor_mag"):
         raw = _vector(d.data, ["x", "y", "z"]) * GAUSS
@@ -64,43 +81,65 @@ def _compasses(ulog, params: dict) -> list[Compass]:
         offsets = np.array([params.get(f"CAL_MAG{n}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
         matched = f"CAL_MAG{n} matched by device id {device}" if device else f"CAL_MAG{n} by topic order (no device id)"
         source = f"sensor_mag (logged before calibration, sensor frame); {matched}"
+        setup = _setup(params, n, external, device)
         unusable = _unusable(params, n, external)
         if unusable:
             out.append(Compass(f"sensor_mag[{d.multi_id}]", d.data["timestamp"] * MICRO, np.full_like(raw, np.nan),
-                               raw, offsets, external, source, np.full((3, 3), np.nan), np.eye(3), n, unusable))
+                               raw, offsets, external, source, np.full((3, 3), np.nan), np.eye(3), n, unusable,
+                               setup))
             continue
         field = px4.apply(params, n, external, raw)
         out.append(Compass(f"sensor_mag[{d.multi_id}]", d.data["timestamp"] * MICRO, field, raw, offsets, external,
                            source, np.linalg.inv(px4.scale_matrix(params, n)), px4.body_rotation(params, n, external),
-                           n))
-    if out:
-        return out
+                           n, "", setup))
+    return out
+
+
+def _calibrated_sources(ulog) -> list[tuple]:
+    """(name, time (s), field (G), device id or None, topic instance) of every calibrated field logged:
+    ``vehicle_magnetometer`` (the selected sensor, 1.10 and later), else ``sensor_combined.magnetometer_ga``."""
     calibrated = _topics(ulog, "vehicle_magnetometer")
     if calibrated:
-        sources = [(f"vehicle_magnetometer[{d.multi_id}]", d.data["timestamp"] * MICRO,
-                    _vector(d.data, [f"magnetometer_ga[{a}]" for a in range(3)]), d.multi_id) for d in calibrated]
-    else:
-        combined = _topics(ulog, "sensor_combined")
-        if not combined or "magnetometer_ga[0]" not in combined[0].data:
-            return []
-        data = combined[0].data
-        valid = data["magnetometer_timestamp_relative"] != INVALID_RELATIVE
-        time = (data["timestamp"][valid] + data["magnetometer_timestamp_relative"][valid]) * MICRO
-        field = _vector(data, [f"magnetometer_ga[{a}]" for a in range(3)])[valid]
-        time, first = np.unique(time, return_index=True)  # each new sample once
-        sources = [("sensor_combined.magnetometer_ga", time, field[first], 0)]
-    for name, time, field, k in sources:
+        return [(f"vehicle_magnetometer[{d.multi_id}]", d.data["timestamp"] * MICRO,
+                 _vector(d.data, [f"magnetometer_ga[{a}]" for a in range(3)]),
+                 int(d.data["device_id"][0]) if "device_id" in d.data else None, d.multi_id) for d in calibrated]
+    combined = _topics(ulog, "sensor_combined")
+    if not combined or "magnetometer_ga[0]" not in combined[0].data:
+        return []
+    data = combined[0].data
+    valid = data["magnetometer_timestamp_relative"] != INVALID_RELATIVE
+    time = (data["timestamp"][valid] + data["magnetometer_timestamp_relative"][valid]) * MICRO
+    field = _vector(data, [f"magnetometer_ga[{a}]" for a in range(3)])[valid]
+    time, first = np.unique(time, return_index=True)  # each new sample once
+    return [("sensor_combined.magnetometer_ga", time, field[first], None, 0)]
+
+
+def _compasses(ulog, params: dict) -> list[Compass]:
+    """The raw ``sensor_mag`` instances, then each calibrated ``vehicle_magnetometer`` instance (often
+    logged faster: 2 Hz against 1 Hz under the default profile), its calibration undone for the raw
+    field (its slot matched by device id, ``FindCalibrationIndex``); ``sensor_combined``'s field only
+    when neither is logged."""
+    out = _raw_compasses(ulog, params)
+    sources = _calibrated_sources(ulog)
+    if out and sources and sources[0][0].startswith("sensor_combined"):
+        return out
+    for name, time, field, device, instance in sources:
+        k = px4.slot(params, device, instance)
         offsets = np.array([params.get(f"CAL_MAG{k}_{a}OFF", 0.0) for a in "XYZ"]) * GAUSS
         field = field * GAUSS
         external = _external(params, k)
-        undone = f"{name} with CAL_MAG{k}_*OFF, *SCALE, *ODIAG and the rotation undone (no raw topic logged)"
+        undone = f"{name} with CAL_MAG{k}_*OFF, *SCALE, *ODIAG and the rotation undone (no raw topic logged)" \
+            if not out else f"{name} (the selected sensor) with CAL_MAG{k}_*OFF, *SCALE, *ODIAG and the rotation undone"
+        setup = _setup(params, k, external, device)
+        where = external if device else None  # the slot, and so the mounting, known from the device id alone
         unusable = _unusable(params, k, external)
         if unusable:
-            out.append(Compass(name, time, field, np.full_like(field, np.nan), offsets, None, undone,
-                               np.full((3, 3), np.nan), np.eye(3), k, unusable))
+            out.append(Compass(name, time, field, np.full_like(field, np.nan), offsets, where, undone,
+                               np.full((3, 3), np.nan), np.eye(3), k, unusable, setup))
             continue
-        out.append(Compass(name, time, field, px4.recover_raw(params, k, external, field), offsets, None, undone,
-                           np.linalg.inv(px4.scale_matrix(params, k)), px4.body_rotation(params, k, external), k))
+        out.append(Compass(name, time, field, px4.recover_raw(params, k, external, field), offsets, where, undone,
+                           np.linalg.inv(px4.scale_matrix(params, k)), px4.body_rotation(params, k, external), k, "",
+                           setup))
     return out
 
 
@@ -164,6 +203,14 @@ def _thrust(ulog) -> Throttle | None:
 
 
 def _imus(ulog) -> list[Imu]:
+    """``sensor_combined`` (calibrated, body frame, at the IMU's rate) when logged; else each
+    ``sensor_accel``/``sensor_gyro`` instance (1.13 and later log them at 1 Hz in the sensor's frame
+    under the default profile, as ``sensor_mag``)."""
+    combined = _topics(ulog, "sensor_combined")
+    if combined and "gyro_rad[0]" in combined[0].data:
+        data = combined[0].data
+        return [Imu("sensor_combined", data["timestamp"] * MICRO, _vector(data, [f"gyro_rad[{a}]" for a in range(3)]),
+                    _vector(data, [f"accelerometer_m_s2[{a}]" for a in range(3)]))]
     accels, gyros = _topics(ulog, "sensor_accel"), _topics(ulog, "sensor_gyro")
     out = []
     for acc, gyro in zip(accels, gyros, strict=False):
@@ -172,14 +219,7 @@ def _imus(ulog) -> list[Imu]:
         a = _vector(acc.data, ["x", "y", "z"])
         out.append(Imu(f"sensor_gyro/accel[{gyro.multi_id}]", t_gyro, _vector(gyro.data, ["x", "y", "z"]),
                        np.column_stack([np.interp(t_gyro, t_acc, a[:, i]) for i in range(3)])))
-    if out:
-        return out
-    combined = _topics(ulog, "sensor_combined")
-    if not combined:
-        return []
-    data = combined[0].data
-    return [Imu("sensor_combined", data["timestamp"] * MICRO, _vector(data, [f"gyro_rad[{a}]" for a in range(3)]),
-                _vector(data, [f"accelerometer_m_s2[{a}]" for a in range(3)]))]
+    return out
 
 
 def _motors(ulog, params: dict, path: Path) -> Motors | None:
@@ -195,13 +235,9 @@ def _motors(ulog, params: dict, path: Path) -> Motors | None:
         return None
     d = outputs[0].data
     pwm = _vector(d, [f"output[{k}]" for k in range(n)])
-    for low_name, high_name in (("PWM_MAIN_MIN", "PWM_MAIN_MAX"), ("PWM_MIN", "PWM_MAX")):
-        low, high = params.get(low_name, 0.0), params.get(high_name, 0.0)
-        if low > 0 and high > low:
-            return Motors(d["timestamp"] * MICRO, np.clip((pwm - low) / (high - low), 0.0, 1.0), pwm, float(low),
-                          float(high), f"{low_name}/{high_name}")
-    raise LogError(f"{path}: no PWM limits to normalise actuator_outputs (PWM_MAIN_MIN/MAX, PWM_MIN/MAX absent); "
-                   "the log's parameters are incomplete")
+    low, high, source = px4.pwm_limits(params, n)
+    return Motors(d["timestamp"] * MICRO, np.clip((pwm - low) / (high - low), 0.0, 1.0), pwm, float(low.min()),
+                  float(high.max()), source)
 
 
 def _battery(ulog) -> Battery | None:
@@ -241,7 +277,10 @@ def read_ulog(path: Path) -> FlightLog:
     params = dict(ulog.initial_parameters)
     info = ulog.msg_info_dict
     hardware = str(info.get("ver_hw", ""))
-    firmware = f"{info.get('ver_sw_release', info.get('ver_sw', 'version not logged'))} on {hardware}"
+    release = info.get("ver_sw_release")
+    if isinstance(release, int | np.integer):  # major, minor, patch and type packed (``px4_firmware_version``)
+        release = ulog.get_version_info_str() or release
+    firmware = f"{release or info.get('ver_sw', 'version not logged')} on {hardware}"
     simulator = "SITL" in hardware.upper() or hardware.upper().startswith("PX4_SITL") or "SIH" in hardware.upper()
     vehicle = MAV_TYPE_NAMES.get(int(params.get("MAV_TYPE", 0)), f"MAV_TYPE {params.get('MAV_TYPE', '?')}")
     said = noise.summary("pyulog")

@@ -117,12 +117,28 @@ def paired_static(static: StaticCalibration, notes: dict, chosen: str | None, fi
     return replace(static, b_s=model_offsets(fitted[chosen]))
 
 
-def _field_model(fitted: dict, motors: int) -> tuple[str | None, MotorFieldModel | None]:
-    """The preferred identified model in the file's form (:attr:`catalogue.Model.to_file`)."""
+def _field_model(fitted: dict, motors: int, explained: dict | None = None) -> tuple[str | None, MotorFieldModel | None]:
+    """The preferred identified model in the file's form (:attr:`catalogue.Model.to_file`): the first
+    of the a-priori order that helps out of sample.
+
+    Parameters
+    ----------
+    fitted : dict
+        The fitted models by name.
+    motors : int
+        The number of motors of the file.
+    explained : dict, optional
+        Each model's share (1) of the held-out residual it explains; a model that explains none
+        (``<= 0``: it does no better than no model, the file's alternative) is passed over.
+
+    Returns
+    -------
+    name, model : str and calibration.dynamic.MotorFieldModel, or None and None
+    """
     # the first the flights identify of those the file can carry (an a-priori order, richest
-    # first, not a choice on the scores)
+    # first, not a choice on the scores), provided it beats no model on the held-out part
     for name in catalogue.preferred("in_file"):
-        if name in fitted:
+        if name in fitted and (explained is None or explained.get(name, 0.0) > 0.0):
             return name, catalogue.MODELS[name].to_file(fitted[name], motors)
     return None, None
 
@@ -141,7 +157,6 @@ def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Ca
         refused[name] = reason
         del fitted[name]
     compass = train[0].log.compasses[train[0].compass]
-    chosen, field = _field_model(fitted, train[0].motors.commands.shape[1])
     models = {}
     for name in names:
         if name in refused:
@@ -154,6 +169,11 @@ def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Ca
                         "heading_rms_change_deg": on_test["heading_rms_change_deg"],
                         "heading_error_rms_deg": on_test["heading_error_rms_deg"], "delay_s": f.delay,
                         "condition_number": f.condition}
+    explained = {name: m["explained_test"] for name, m in models.items() if "explained_test" in m}
+    chosen, field = _field_model(fitted, train[0].motors.commands.shape[1], explained)
+    passed_over = {name: f"explains {100 * explained[name]:.1f} % of the held-out residual: no better than no model"
+                   for name in catalogue.preferred("in_file")
+                   if name in explained and name != chosen and explained[name] <= 0.0}
     # the ellipsoid is fitted on the field with the interference removed that explains most in training
     best = max(fitted, key=lambda name: models[name]["explained_train"], default=None)
     static, static_notes = _static(train, fitted.get(best), compass.offsets, compass.soft_iron)
@@ -166,7 +186,8 @@ def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Ca
                "attitude": attitude,
                "baseline_rms_test_T": baseline["baseline_rms_T"],
                "heading_error_rms_without_deg": baseline["heading_error_rms_deg"]["without"],
-               "static": {k: v for k, v in static_notes.items()}, "models": models, "calibration_model": chosen}
+               "static": {k: v for k, v in static_notes.items()}, "models": models, "calibration_model": chosen,
+               "calibration_model_passed_over": passed_over}
     calibration = Calibration(train[0].motors.commands.shape[1], static, field,
                               fitted["dynamic"].extra["dynamics"] if "dynamic" in fitted and chosen == "metge"
                               else None, None,

@@ -77,6 +77,13 @@ def align(train, test, fields: dict) -> tuple[list, list, dict]:
     model's. More than :data:`MOUNTING_TOLERANCE_DEG` is reported: a compass mounted at a yaw its
     orientation parameter does not say, or an attitude whose heading is off.
 
+    The free field is fitted with the throttle's field beside it (one vector per unit throttle, the
+    ``throttle`` model's regressor, which every calibrated log has): left out, the motors' field,
+    which the flight's turns sample unevenly, leaks into the free field's heading. On the example
+    logs that leak was -2.1, -0.6 and +0.6 deg (against 0: their attitude is the truth), and the
+    field turned by it left 20 % of the current's horizontal field to the offsets; with the throttle
+    beside it, -0.06, -0.08 and -0.05 deg.
+
     Returns
     -------
     train, test : lists of FlightData
@@ -87,10 +94,12 @@ def align(train, test, fields: dict) -> tuple[list, list, dict]:
     from dataclasses import replace
 
     from calibration.flight.linear import fit_linear
+    from calibration.flight.models import LinearModel
 
     if any(fields.get(p.log.path) is None for p in [*train, *test]):
         return train, test, {}
-    free = fit_linear([(p.rotation, p.raw, np.zeros((len(p.time), 0))) for p in train])
+    throttle = LinearModel("throttle")
+    free = fit_linear([(p.rotation, p.raw, throttle.regressors(p, 0.0)) for p in train])
     offsets = []
     for p, nuisance in zip(train, free.nuisance, strict=True):
         model = fields[p.log.path].ned

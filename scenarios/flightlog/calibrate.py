@@ -119,6 +119,13 @@ def _split(args) -> Split:
         logs = _logs(args.files, "calibrate", args.span)
         train_logs, test_logs = (logs, []) if len(logs) == 1 or args.test_fraction is not None else \
             (logs[:-1], logs[-1:])
+    from calibration.flight.data import rate_refusal
+    from calibration.static import CalibrationError
+
+    for log in [*train_logs, *test_logs]:  # the command's floor; split_parts itself fits any rate (a measurement)
+        refusal = rate_refusal(log, args.compass)
+        if refusal:
+            raise CalibrationError(refusal)
     return split_parts(train_logs, test_logs, args.compass, args.attitude, not args.no_trim, args.earth,
                        args.test_fraction)
 
@@ -252,6 +259,8 @@ def _report(metrics: dict) -> list[str]:
         lines.append(f"  {name:9s} explained {100 * m['explained_test']:5.1f} % of the test residual "
                      f"({100 * m['explained_train']:.1f} % in training), {m['perturbation_at_hover_T'] * 1e6:.2f} uT "
                      f"at hover, heading moved {m['heading_rms_change_deg']:.2f} deg RMS, delay {m['delay_s']:.2f} s")
+    lines += [f"calibration.json passes over {name}: it {why}"
+              for name, why in metrics.get("calibration_model_passed_over", {}).items()]
     return lines + _export_lines(metrics["export"])
 
 

@@ -21,22 +21,20 @@ def _pyplot():
     return plt
 
 
-#: Bins of the regressor (equal widths over its 1st to 99th percentile) in which the residual's
-#: median and quartiles are drawn, each of at least RESIDUAL_BIN_SAMPLES samples.
+#: Bins of the regressor in which the residual's median and quartiles are drawn: equal counts of
+#: samples (at most RESIDUAL_BINS bins, each of at least RESIDUAL_BIN_SAMPLES), so they reach
+#: wherever the samples are; bins of equal width left the tails of a flight's current unbinned.
 RESIDUAL_BINS, RESIDUAL_BIN_SAMPLES = 12, 20
 
 
 def _binned(x: np.ndarray, y: np.ndarray):
-    """Centres of the bins of ``x`` holding enough samples, and the 25th, 50th and 75th
-    percentiles of ``y`` in each."""
-    edges = np.linspace(*np.percentile(x, [1, 99]), RESIDUAL_BINS + 1)
-    which = np.searchsorted(edges, x, side="right") - 1
-    centres, quartiles = [], []
-    for b in range(RESIDUAL_BINS):
-        inside = which == b
-        if inside.sum() >= RESIDUAL_BIN_SAMPLES:
-            centres.append(0.5 * (edges[b] + edges[b + 1]))
-            quartiles.append(np.percentile(y[inside], [25, 50, 75]))
+    """The median of ``x`` in each bin of equal count (sorted by ``x``), and the 25th, 50th and 75th
+    percentiles of ``y`` in each: (B,) and (B, 3); empty with fewer than RESIDUAL_BIN_SAMPLES samples."""
+    order = np.argsort(x, kind="stable")
+    count = min(RESIDUAL_BINS, len(x) // RESIDUAL_BIN_SAMPLES)
+    bins = np.array_split(order, count) if count else []
+    centres = [np.median(x[rows]) for rows in bins]
+    quartiles = [np.percentile(y[rows], [25, 50, 75]) for rows in bins]
     return np.array(centres), np.array(quartiles).reshape(-1, 3)
 
 

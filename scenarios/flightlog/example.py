@@ -11,8 +11,8 @@ attitude; a GPS fix; the parameters a calibration reads.
 
 The flights are simulated here, not recorded: a vehicle rocking in roll and pitch while it turns
 slowly in yaw over a site's Earth field (the World Magnetic Model's at :data:`SITE`), the current
-following the throttle. They are no simulator (SITL) log: nothing in them says so, and
-``quadcosim log info`` reads them as it reads a real vehicle's. The numbers they give are the
+following the throttle. They are no simulator (SITL) log, and no recording either: a text
+message (:data:`STATEMENT`) says so in each, and ``quadcosim log info`` shows it. The numbers they give are the
 synthetic model's, to learn the commands with; the guide's findings are real flights'.
 """
 
@@ -21,6 +21,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
+from flightlogs.model import SYNTHETIC_MARK
 
 #: Earth position of the flights: latitude, longitude (deg), altitude (m), and the date (year).
 SITE = (45.19, 5.72, 210.0)
@@ -35,6 +37,8 @@ DELAY_S = 0.1
 HARD_IRON_T = (np.array([8e-6, -12e-6, 4e-6]), np.array([15e-6, 6e-6, -9e-6]))
 OFFSET_ERROR_T = np.array([0.6e-6, -0.4e-6, 0.3e-6])
 PWM_MIN, PWM_MAX = 1100.0, 1900.0
+#: The text message that says, in the log itself, what wrote it (``quadcosim log info`` shows it).
+STATEMENT = SYNTHETIC_MARK + "written by quadcosim log example (simulated; not recorded)"
 FLIGHTS = ("a", "b", "c")
 FORMATS = [
     ("PARM", "QNf", "TimeUS,Name,Value"), ("MSG", "QZ", "TimeUS,Message"),
@@ -111,7 +115,7 @@ def write_flight(path, k: int = 0, duration: float = 40.0, seed: int = 1) -> Pat
               **{f"COMPASS_OFS{n}_{a}": float(v) for n, ofs in zip(("", "2"), _offsets_mG(), strict=True)
                  for a, v in zip("XYZ", ofs, strict=True)}}
     lines += [f"PARM, 1000, {name}, {value}" for name, value in params.items()]
-    lines += ["MSG, 1100, ArduCopter V4.5.0 (example)", "MSG, 1200, Frame: QUAD/X"]
+    lines += ["MSG, 1100, ArduCopter V4.5.0 (example)", "MSG, 1200, Frame: QUAD/X", f"MSG, 1300, {STATEMENT}"]
     t = np.arange(1.0, 1.0 + duration, 0.02)
     euler, rates, throttle, current = _flight(t, k)
     _, _, _, lagged = _flight(t - DELAY_S, k)

@@ -98,6 +98,11 @@ def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMA
     log.require("a replay", "imu", "attitude", "compass", "motors")
     time, dt, gyro, acc, reference = _uniform(log, compass)
     without, with_model, model = _fields(log, compass, time)
+    from calibration.flight.data import rate_refusal
+
+    refused = rate_refusal(log, compass)
+    if refused:  # a compass logged too slowly for a calibration: replayed without a compensation fitted on it
+        with_model, model = without, None
     half = time[0] + 0.5 * (time[-1] - time[0])
     scored = time >= max(half, time[0] + settle_s)
     first = time < half
@@ -115,12 +120,14 @@ def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMA
             results.setdefault(kind, {})[label] = {"heading_rms_deg": float(errors["heading_rmse_deg"][0]),
                                                    "inclination_rms_deg": float(errors["inclination_rmse_deg"][0])}
     return {"file": log.path, "compass": log.compasses[compass].name, "compensation_model": model,
-            "note": REFERENCE_NOTE, "scored_s": float(scored.sum() * dt), "estimators": results}
+            "compensation_refused": refused or "", "note": REFERENCE_NOTE, "scored_s": float(scored.sum() * dt),
+            "estimators": results}
 
 
 def text(result: dict) -> str:
     """The replay ``result`` as a table."""
-    model = result["compensation_model"] or "none identified"
+    model = result["compensation_model"] or (f"none: {result['compensation_refused']}"
+                                             if result.get("compensation_refused") else "none identified")
     lines = [f"{result['file']} ({result['compass']}), compensation: {model}",
              f"  {result['note']}; over the last {result['scored_s']:.0f} s",
              "  estimator   heading RMS (deg) without / with   inclination RMS (deg) without / with"]
