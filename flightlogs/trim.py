@@ -26,6 +26,7 @@ import numpy as np
 from flightlogs.model import FlightLog
 
 STALL_S = 1.0  # s without an IMU sample: logging stalled (an IMU logs at 10 Hz or more)
+MIN_STRETCH = 10  # samples on each side of a gap for it to be a stall
 CRASH_ANGLE_DEG = 30.0  # Copter::crash_check: CRASH_CHECK_ANGLE_DEVIATION_DEG
 CRASH_TRIGGER_S = 2.0  # Copter::crash_check: CRASH_CHECK_TRIGGER_SEC
 #: The per-sample arrays of each kind of series, beside its ``time``.
@@ -94,8 +95,12 @@ def stalls(log: FlightLog) -> list[tuple[float, float]]:
     series = log.imus[0] if log.imus else log.compasses[0] if log.compasses else None
     if series is None or len(series.time) < 2:
         return []
-    time = np.asarray(series.time)
-    gaps = np.flatnonzero(np.diff(time) >= STALL_S)
+    time = np.asarray(series.time, dtype=float)
+    time = np.sort(time[np.isfinite(time)])  # a damaged stamp (checked later) makes a gap at an end, not a split
+    if len(time) < 2:
+        return []
+    gaps = [k for k in np.flatnonzero(np.diff(time) >= STALL_S)
+            if k + 1 >= MIN_STRETCH and len(time) - k - 1 >= MIN_STRETCH]  # a lone damaged stamp is no stall
     return [(float(time[k]), float(time[k + 1])) for k in gaps]
 
 

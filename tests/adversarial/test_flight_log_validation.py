@@ -75,8 +75,8 @@ def test_a_few_damaged_time_stamps_are_dropped_and_counted(tmp_path, capsys):
 def test_a_singular_soft_iron_matrix_is_refused_naming_its_parameters(tmp_path, capsys):
     def zero_diagonal(line):
         if line.startswith("PARM, 1000, COMPASS_OFS_X"):
-            return [line, "PARM, 1000, COMPASS_DIA_X, 0", "PARM, 1000, COMPASS_DIA_Y, 0",
-                    "PARM, 1000, COMPASS_DIA_Z, 1"]
+            return [line, "PARM, 1000, COMPASS_DIA_X, 0, 0", "PARM, 1000, COMPASS_DIA_Y, 0, 0",
+                    "PARM, 1000, COMPASS_DIA_Z, 1, 0"]  # with the Default column of a 4.x log
         return line
 
     path = _log(tmp_path, "dia.log")
@@ -136,7 +136,18 @@ def test_a_short_shared_span_and_a_gap_are_reported(tmp_path, capsys):
 
     log = _log(tmp_path, "stalled.log", stall, duration=40.0)
     assert cli(["log", "info", str(log), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    # a stall cuts the log to its longest stretch (flightlogs/trim.py): 25 to 40 s, the 9 s before it dropped
+    assert info["warnings"] == ["logging stalls (15.0 s from 10.0 s): the longest stretch between stalls is kept, "
+                                "25.0 to 40.0 s (15.0 s of the 39.0 s logged)"]
+    assert info["duration_s"] == pytest.approx(15.0, abs=0.1)
+
+    def gap(line):  # a gap in the compass alone (10 to 25 s), the IMU logging on: reported, not cut
+        parts = line.split(", ")
+        return None if parts[0] == "MAG" and 10e6 < int(parts[1]) < 25e6 else line
+
+    log = _log(tmp_path, "gap.log", gap, duration=40.0)
+    assert cli(["log", "info", str(log), "--json"]) == 0
     warnings = json.loads(capsys.readouterr().out)["warnings"]
     assert warnings == ["samples stop for a while (two flights in one file, or logging that stalled): MAG[0] 15.1 s "
-                        "from 9.9 s; IMU[0] 15.0 s from 10.0 s; motors 15.1 s from 9.9 s; battery 15.1 s from 9.9 s; "
-                        "attitude 15.1 s from 9.9 s"]
+                        "from 9.9 s"]
