@@ -6,7 +6,10 @@ model's equations use, so a variable is declared once, with its unit and descrip
 
 Value references are assigned per type in table order (FMI 2.0 numbers Real, Integer and
 Boolean variables independently), which is also the index of the variable in the instance's
-arrays ``real``, ``integer`` and ``boolean``.
+arrays ``real``, ``integer`` and ``boolean``. FMI 3.0 numbers all variables in one sequence:
+0 is the independent variable ``time``, then the Real (``Float64``), Integer (``Int32``) and
+Boolean variables follow, each type in table order (:meth:`Table.vr3`; ``fmus/c/fmi3.c``
+numbers them the same way).
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ from xml.sax.saxutils import quoteattr
 
 CAUSALITIES = ("parameter", "input", "output")
 TYPES = ("Real", "Integer", "Boolean")
+#: The FMI 3.0 type of each table type.
+FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
 
 
 @dataclass(frozen=True)
@@ -210,6 +215,26 @@ class Table:
                     f"rows of the variable table, since the C code addresses them as one array; {n} has "
                     f"value reference {present}, not {previous + 1}. Move its rows together.")
 
+    def vr3(self, name: str) -> int:
+        """The FMI 3.0 value reference of variable ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A variable of the table, or ``"time"`` (the independent variable, 0).
+
+        Returns
+        -------
+        int
+            1 + its FMI 2.0 value reference, plus the count of the types before its own (Real,
+            then Integer, then Boolean).
+        """
+        if name == "time":
+            return 0
+        type_ = next(v.type for v in self.variables if v.name == name)
+        before = sum(self.counts[t] for t in TYPES[:TYPES.index(type_)])
+        return 1 + before + self.vr[name]
+
     def of(self, causality: str, type_: str | None = None) -> list[Variable]:
         """The variables of one causality (and type).
 
@@ -238,19 +263,26 @@ class Table:
         return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"quadcosim/{self.model}/{text}")) + "}"
 
     # ----------------------------------------------------------------- modelDescription.xml
-    def model_description(self, source_files: list[str]) -> str:
+    def model_description(self, source_files: list[str], fmi_version: int = 2) -> str:
         """The ``modelDescription.xml`` of the model.
 
         Parameters
         ----------
         source_files : list of str
-            C sources listed for a source FMU.
+            C sources listed for a source FMU (FMI 2.0; FMI 3.0 lists them in
+            :meth:`build_description`).
+        fmi_version : int
+            2 or 3.
 
         Returns
         -------
         str
             The XML text, with SI base units declared for each unit definition.
         """
+        if fmi_version == 3:
+            return self._model_description_fmi3()
+        if fmi_version != 2:
+            raise ValueError(f"FMI version {fmi_version!r}: the build writes FMI 2 and 3")
         index = {v.name: i + 1 for i, v in enumerate(self.variables)}
         inputs = [v.name for v in self.variables if v.causality == "input"]
         units = sorted({v.unit for v in self.variables if v.unit})
@@ -295,6 +327,88 @@ class Table:
         lines.append("</fmiModelDescription>")
         return "\n".join(lines) + "\n"
 
+    def _model_description_fmi3(self) -> str:
+        inputs = [v.name for v in self.variables if v.causality == "input"]
+        units = sorted({v.unit for v in self.variables if v.unit} | {"s"})
+        lines = [
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            "<fmiModelDescription",
+            '  fmiVersion="3.0"',
+            f'  modelName="{self.model}"',
+            f'  instantiationToken="{self.guid}"',
+            f"  description={quoteattr(self.description)}",
+            '  generationTool="quadcosim fmus.build"',
+            '  variableNamingConvention="flat">',
+            f'  <CoSimulation modelIdentifier="{self.model}" canHandleVariableCommunicationStepSize="true"'
+            ' hasEventMode="false"/>',
+            "  <UnitDefinitions>",
+            *[f"    {_unit_definition(u)}" for u in units],
+            "  </UnitDefinitions>",
+            '  <DefaultExperiment startTime="0" stopTime="2" stepSize="0.001"/>',
+            "  <ModelVariables>",
+            '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
+            ' description="simulation time" unit="s"/>',
+        ]
+        for v in self.variables:
+            lines.append(f"    {self._variable_fmi3(v)}")
+        lines.append("  </ModelVariables>")
+        lines.append("  <ModelStructure>")
+        for v in self.of("output"):
+            deps = self._depends(v, inputs)
+            lines.append(f'    <Output valueReference="{self.vr3(v.name)}" '
+                         f'dependencies="{" ".join(str(self.vr3(n)) for n in deps)}" '
+                         f'dependenciesKind="{" ".join("dependent" for _ in deps)}"/>')
+        for v in self.of("output"):
+            lines.append(f'    <InitialUnknown valueReference="{self.vr3(v.name)}"/>')
+        lines.append("  </ModelStructure>")
+        lines.append("</fmiModelDescription>")
+        return "\n".join(lines) + "\n"
+
+    def _variable_fmi3(self, v: Variable) -> str:
+        attrs = [
+            f'name="{v.name}"',
+            f'valueReference="{self.vr3(v.name)}"',
+            f'causality="{v.causality}"',
+            f'variability="{v.fmi_variability}"',
+        ]
+        if v.causality == "parameter":
+            attrs.append('initial="exact"')
+        if v.description:
+            attrs.append(f"description={quoteattr(v.description)}")
+        if v.start is not None:
+            attrs.append(f'start="{_xml_value(v.type, v.start)}"')
+        if v.unit:
+            attrs.append(f'unit="{v.unit}"')
+        if v.min is not None:
+            attrs.append(f'min="{v.min!r}"')
+        if v.max is not None:
+            attrs.append(f'max="{v.max!r}"')
+        return f"<{FMI3_TYPES[v.type]} {' '.join(attrs)}/>"
+
+    def build_description(self, source_files: list[str]) -> str:
+        """The FMI 3.0 ``sources/buildDescription.xml``: how to compile the model from its sources.
+
+        Parameters
+        ----------
+        source_files : list of str
+            The C files to compile (C99), in ``sources/`` beside their headers.
+
+        Returns
+        -------
+        str
+            The XML text.
+        """
+        return "\n".join([
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            '<fmiBuildDescription fmiVersion="3.0">',
+            f'  <BuildConfiguration modelIdentifier="{self.model}">',
+            '    <SourceFileSet language="C99">',
+            *[f'      <SourceFile name="{name}"/>' for name in source_files],
+            "    </SourceFileSet>",
+            "  </BuildConfiguration>",
+            "</fmiBuildDescription>",
+        ]) + "\n"
+
     def _scalar_variable(self, v: Variable) -> list[str]:
         attrs = [
             f'name="{v.name}"',
@@ -328,8 +442,13 @@ class Table:
         return list(v.depends)
 
     # ----------------------------------------------------------------- variables.h
-    def c_header(self) -> str:
+    def c_header(self, fmi_version: int = 2) -> str:
         """The ``variables.h`` the shell and the model's equations include.
+
+        Parameters
+        ----------
+        fmi_version : int
+            2, or 3: the header then defines ``FMI_VERSION`` as 3 for ``shell.h``.
 
         Returns
         -------
@@ -342,6 +461,7 @@ class Table:
             "#ifndef VARIABLES_H",
             "#define VARIABLES_H",
             "",
+            *(["#define FMI_VERSION 3"] if fmi_version == 3 else []),
             '#include "shell.h"',
             "",
             f'#define MODEL_NAME "{self.model}"',

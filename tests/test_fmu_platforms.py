@@ -1,0 +1,181 @@
+"""The plant's FMUs in FMI 2.0 and 3.0, for Linux and Windows: all eight validate, the FMI 3.0 ones
+run in fmpy equal to the FMI 2.0 ones, and the Windows binaries, stepped under Wine by a C driver
+(``tests/fmu_driver.c``), give the Linux binaries' outputs bit for bit."""
+
+import os
+import shutil
+import subprocess
+import zipfile
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pytest
+from fmpy.validation import validate_fmu
+
+from fmus import MODELS, fmu_path
+from fmus.build import PLATFORMS, SOURCE_FILES, windows_compiler
+
+HERE = Path(__file__).resolve().parent
+VERSIONS = (2, 3)
+#: Constant inputs that move every output: rotors near hover, a wind, a tilted and turning body.
+_Q = np.array([0.9, 0.1, -0.2, 0.3]) / np.linalg.norm([0.9, 0.1, -0.2, 0.3])
+ROTORS = {"omega_r1": 495.0, "omega_r2": 500.0, "omega_r3": 490.0, "omega_r4": 505.0}
+INPUTS = {
+    "Quadrotor": ROTORS | {"domega_r1": 3.0, "domega_r3": -2.0, "wind_x": 2.0, "wind_y": -1.0},
+    "MotorMagnetics": {"c1": 0.45, "c2": 0.5, "c3": 0.55, "c4": 0.6},
+    "IMU": ROTORS | {f"q{k}": float(_Q[k]) for k in range(4)} | {
+        "omega_x": 0.1, "omega_y": -0.2, "omega_z": 0.3, "f_x": 0.5, "f_y": -0.3, "f_z": -9.6,
+        "b_d_x": 1e-6, "b_d_y": -2e-6, "b_d_z": 3e-6},
+    "InfraredSensor": {"phi": 0.2},
+}
+STEP = 1e-3
+STEPS = 200  # 0.2 s: the IMU's 200 samples (and 20 of the magnetometer), MotorMagnetics' spin-up
+
+
+def _outputs(description) -> list:
+    return [v for v in description.modelVariables if v.causality == "output"]
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+@pytest.mark.parametrize("model", MODELS)
+def test_validates_with_both_platforms_and_its_sources(model, version):
+    path = fmu_path(model, fmi_version=version)
+    assert validate_fmu(str(path)) == []
+    description = fmpy.read_model_description(str(path))
+    assert description.fmiVersion == f"{version}.0"
+    with zipfile.ZipFile(path) as archive:
+        names = set(archive.namelist())
+    assert f"binaries/{PLATFORMS[version]['linux']}/{model}.so" in names
+    if windows_compiler():
+        assert f"binaries/{PLATFORMS[version]['windows']}/{model}.dll" in names
+    assert {f"sources/{name}" for name in SOURCE_FILES[version]} <= names
+    if version == 3:
+        assert "sources/buildDescription.xml" in names
+        assert [s.sourceFiles for c in description.buildConfigurations for s in c.sourceFileSets] == [
+            list(SOURCE_FILES[3])]
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_fmi3_runs_in_fmpy_equal_to_fmi2(model):
+    runs = [fmpy.simulate_fmu(str(fmu_path(model, fmi_version=v)), stop_time=0.05, step_size=STEP,
+                              start_values=INPUTS[model]) for v in VERSIONS]
+    names = [v.name for v in _outputs(fmpy.read_model_description(str(fmu_path(model))))]
+    assert set(names) <= set(runs[1].dtype.names)
+    moved = 0
+    for name in names:
+        assert np.array_equal(runs[0][name], runs[1][name]), name
+        moved += np.ptp(runs[0][name]) > 0
+    assert moved >= len(names) // 3  # the inputs drive the model: its outputs change
+
+
+def test_fmi3_refuses_what_it_must_name():
+    """An FMI 3.0 instance refuses a wrong token and a bad value reference, with a message."""
+    from fmpy import extract
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi3 import FMU3Slave
+
+    path = fmu_path("Quadrotor", fmi_version=3)
+    description = fmpy.read_model_description(str(path))
+    messages = []
+    fmu = FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)), modelIdentifier="Quadrotor",
+                    instanceName="q")
+    fmu.instantiate(logMessage=lambda env, status, category, message: messages.append(message.decode()))
+    try:
+        fmu.enterInitializationMode()
+        with pytest.raises(FMICallException):
+            fmu.getFloat64([9999])
+        assert any("unknown value reference 9999" in m for m in messages)
+        assert fmu.getFloat64([0]) == [0.0]  # time
+        fmu.exitInitializationMode()
+        fmu.doStep(0.0, STEP)
+        assert fmu.getFloat64([0]) == [STEP]
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+
+
+# ---------------------------------------------------------------- the Windows binaries under Wine
+
+
+def _wine() -> str | None:
+    return shutil.which("wine") or shutil.which("wine64") or next(
+        (p for p in ("/usr/lib/wine/wine64",) if os.access(p, os.X_OK)), None)
+
+
+def _headers() -> Path:
+    return Path(fmpy.__file__).parent / "c-code"
+
+
+def _plan(folder: Path, platform: str, windows_paths: bool) -> tuple[Path, dict]:
+    """The driver's plan for the eight FMUs' binaries of one platform, and their output files."""
+    def native(path: Path) -> str:
+        return "Z:" + str(path).replace("/", "\\") if windows_paths else str(path)
+
+    lines, outputs = [], {}
+    for version in VERSIONS:
+        for model in MODELS:
+            path = fmu_path(model, fmi_version=version)
+            unzipped = folder / f"fmi{version}-{model}"
+            with zipfile.ZipFile(path) as archive:
+                archive.extractall(unzipped)
+            description = fmpy.read_model_description(str(path))
+            by_name = {v.name: v.valueReference for v in description.modelVariables}
+            suffix = ".dll" if platform == "windows" else ".so"
+            library = unzipped / "binaries" / PLATFORMS[version][platform] / f"{model}{suffix}"
+            output = folder / f"{platform}-fmi{version}-{model}.bin"
+            inputs = " ".join(f"{by_name[n]} {value!r}" for n, value in INPUTS[model].items())
+            refs = " ".join(str(v.valueReference) for v in _outputs(description))
+            lines += [f"{version} {native(library)} {model} {description.guid} {STEPS} {STEP!r}",
+                      f"{len(INPUTS[model])} {inputs}", f"{len(_outputs(description))} {refs}", native(output)]
+            outputs[version, model] = (output, len(_outputs(description)))
+    plan = folder / f"{platform}.plan"
+    plan.write_text("\n".join(lines) + "\n")
+    return plan, outputs
+
+
+def _read(output: Path, columns: int) -> np.ndarray:
+    values = np.fromfile(output, dtype="<f8")
+    assert values.size == (STEPS + 1) * columns, output
+    return values.reshape(STEPS + 1, columns)
+
+
+@pytest.fixture(scope="module")
+def linux_outputs(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("linux")
+    driver = folder / "fmu_driver"
+    subprocess.run(["cc", "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-I", str(_headers()),
+                    str(HERE / "fmu_driver.c"), "-ldl", "-o", str(driver)], check=True)
+    plan, outputs = _plan(folder, "linux", windows_paths=False)
+    done = subprocess.run([str(driver), str(plan)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return {key: _read(path, n) for key, (path, n) in outputs.items()}
+
+
+def test_the_linux_binaries_of_both_versions_agree(linux_outputs):
+    for model in MODELS:
+        fmi2, fmi3 = linux_outputs[2, model], linux_outputs[3, model]
+        assert np.isfinite(fmi2).all() and np.array_equal(fmi2, fmi3), model
+        assert (np.ptp(fmi2, axis=0) > 0).sum() >= fmi2.shape[1] // 3, model  # the inputs drive it
+
+
+def test_the_windows_binaries_under_wine_equal_the_linux_ones(linux_outputs, tmp_path):
+    mingw, wine = windows_compiler(), _wine()
+    if not (mingw and wine):
+        pytest.skip("needs mingw-w64 and Wine (Debian: gcc-mingw-w64-x86-64 wine64; `make windows-tools`)")
+    driver = tmp_path / "fmu_driver.exe"
+    subprocess.run([mingw, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-I", str(_headers()),
+                    str(HERE / "fmu_driver.c"), "-o", str(driver)], check=True)
+    plan, outputs = _plan(tmp_path, "windows", windows_paths=True)
+    # one Wine start for all eight (its start-up, not the FMUs, is what takes the time)
+    env = os.environ | {"WINEPREFIX": str(tmp_path / "wine"), "WINEDEBUG": "-all",
+                        "WINEDLLOVERRIDES": "mscoree,mshtml="}
+    try:
+        done = subprocess.run([wine, str(driver), "Z:" + str(plan).replace("/", "\\")], capture_output=True,
+                              text=True, env=env, timeout=300)
+    finally:
+        server = shutil.which("wineserver") or "/usr/lib/wine/wineserver"
+        subprocess.run([server, "-k"], env=env, capture_output=True)
+    assert done.returncode == 0, done.stderr
+    for key, (path, n) in outputs.items():
+        assert np.array_equal(_read(path, n), linux_outputs[key]), key
