@@ -200,8 +200,39 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     return fmu
 
 
-def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=FMI_VERSIONS) -> list[Path]:
-    """Build every plant FMU, in each FMI version.
+def up_to_date(model: str, out_dir: Path, fmi_version: int = 2) -> bool:
+    """Whether ``model``'s FMU of one FMI version needs no rebuild.
+
+    Parameters
+    ----------
+    model : str
+        Model name.
+    out_dir : pathlib.Path
+        The build's output folder.
+    fmi_version : int
+        2 or 3.
+
+    Returns
+    -------
+    bool
+        The FMU is newer than each of its sources (:func:`fmus.fmu_sources`) and holds the binary of
+        each platform this machine builds for (Windows only with mingw-w64).
+    """
+    from fmus import fmu_sources
+
+    fmu = fmu_file(model, out_dir, fmi_version)
+    if not fmu.is_file() or any(s.stat().st_mtime > fmu.stat().st_mtime for s in fmu_sources(model)):
+        return False
+    platforms = ["linux", "windows"] if windows_compiler() else ["linux"]
+    suffix = {"linux": ".so", "windows": ".dll"}
+    with zipfile.ZipFile(fmu) as archive:
+        names = set(archive.namelist())
+    return all(f"binaries/{PLATFORMS[fmi_version][p]}/{model}{suffix[p]}" in names for p in platforms)
+
+
+def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=FMI_VERSIONS,
+              force: bool = False) -> list[Path]:
+    """Build every plant FMU, in each FMI version, that is not up to date.
 
     Parameters
     ----------
@@ -210,20 +241,28 @@ def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=F
     models : sequence of str
         Model names (folders under ``fmus/``); all of :data:`fmus.MODELS` by default.
     verbose : bool
-        Print each FMU's path as it is built.
+        Print each FMU's path as it is built (or found up to date).
     fmi_versions : sequence of int
         FMI versions; 2 and 3 by default.
+    force : bool
+        Rebuild the FMUs that are up to date too (:func:`up_to_date`: newer than their sources,
+        with every binary this machine builds), after a change of compiler say.
 
     Returns
     -------
     list of pathlib.Path
-        The ``.fmu`` files.
+        The ``.fmu`` files, built or up to date.
     """
     out_dir = Path(out_dir)
     built = []
     for fmi_version in fmi_versions:
         fmu_file(models[0], out_dir, fmi_version).parent.mkdir(parents=True, exist_ok=True)
         for model in models:
+            if not force and up_to_date(model, out_dir, fmi_version):
+                built.append(fmu_file(model, out_dir, fmi_version))
+                if verbose:
+                    print(f"up to date {built[-1]}")
+                continue
             built.append(build_fmu(model, out_dir, fmi_version=fmi_version))
             if verbose:
                 print(f"built {built[-1]}")

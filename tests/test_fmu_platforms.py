@@ -179,3 +179,30 @@ def test_the_windows_binaries_under_wine_equal_the_linux_ones(linux_outputs, tmp
     assert done.returncode == 0, done.stderr
     for key, (path, n) in outputs.items():
         assert np.array_equal(_read(path, n), linux_outputs[key]), key
+
+
+def test_without_mingw_the_build_ships_linux_alone_and_says_so_once(tmp_path, monkeypatch, capsys):
+    from fmus import build
+
+    monkeypatch.setenv("CC_WIN64", "no-such-mingw-gcc")
+    build.windows_compiler.cache_clear()
+    try:
+        paths = [build.build_fmu("InfraredSensor", tmp_path, fmi_version=v) for v in VERSIONS]
+    finally:
+        build.windows_compiler.cache_clear()
+    for version, path in zip(VERSIONS, paths, strict=True):
+        with zipfile.ZipFile(path) as archive:
+            platforms = {Path(n).parts[1] for n in archive.namelist() if n.startswith("binaries/")}
+        assert platforms == {PLATFORMS[version]["linux"]}
+    assert capsys.readouterr().err.count("no no-such-mingw-gcc (mingw-w64") == 1
+
+
+def test_an_up_to_date_fmu_is_not_rebuilt(tmp_path):
+    from fmus.build import build_all
+
+    first = build_all(tmp_path, models=("InfraredSensor",), fmi_versions=(3,), verbose=False)
+    stamp = first[0].stat().st_mtime_ns
+    assert build_all(tmp_path, models=("InfraredSensor",), fmi_versions=(3,), verbose=False) == first
+    assert first[0].stat().st_mtime_ns == stamp
+    build_all(tmp_path, models=("InfraredSensor",), fmi_versions=(3,), verbose=False, force=True)
+    assert first[0].stat().st_mtime_ns > stamp
