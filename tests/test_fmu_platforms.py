@@ -14,7 +14,7 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from fmus import MODELS, fmu_path
-from fmus.build import PLATFORMS, SOURCE_FILES, windows_compiler
+from fmus.build import PLATFORMS, SOURCE_FILES, table, windows_compiler
 
 HERE = Path(__file__).resolve().parent
 VERSIONS = (2, 3)
@@ -70,28 +70,51 @@ def test_fmi3_runs_in_fmpy_equal_to_fmi2(model):
 
 
 def test_fmi3_refuses_what_it_must_name():
-    """An FMI 3.0 instance refuses a wrong token and a bad value reference, with a message."""
+    """An FMI 3.0 instance refuses, with a message, what its description rules out."""
     from fmpy import extract
     from fmpy.fmi1 import FMICallException
     from fmpy.fmi3 import FMU3Slave
 
     path = fmu_path("Quadrotor", fmi_version=3)
     description = fmpy.read_model_description(str(path))
+    vr = {v.name: v.valueReference for v in description.modelVariables}
     messages = []
-    fmu = FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)), modelIdentifier="Quadrotor",
-                    instanceName="q")
-    fmu.instantiate(logMessage=lambda env, status, category, message: messages.append(message.decode()))
+
+    def slave():
+        return FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)), modelIdentifier="Quadrotor",
+                         instanceName="q")
+
+    def log(env, status, category, message):
+        messages.append(message.decode())
+
+    with pytest.raises(Exception, match="Failed to instantiate"):
+        slave().instantiate(eventModeUsed=True, logMessage=log)
+    assert any("has no event mode" in m for m in messages)
+    fmu = slave()
+    fmu.instantiate(logMessage=log)
     try:
         fmu.enterInitializationMode()
         with pytest.raises(FMICallException):
             fmu.getFloat64([9999])
-        assert any("unknown value reference 9999" in m for m in messages)
-        assert fmu.getFloat64([0]) == [0.0]  # time
+        assert "unknown value reference 9999" in messages[-1]
+        with pytest.raises(FMICallException):
+            fmu.getFloat64([vr["m"]], nValues=2)
+        assert "2 values for 1 value references" in messages[-1]
+        with pytest.raises(FMICallException):
+            fmu.getInt32([vr["m"]])  # a Float64's reference is no Int32's
+        assert f"unknown value reference {vr['m']}" in messages[-1]
+        mass = next(v.start for v in table("Quadrotor").variables if v.name == "m")
+        assert fmu.getFloat64([0, vr["m"]]) == [0.0, mass]  # time and a parameter in one call
+        fmu.setBoolean([vr["clamped"]], [True])
+        assert fmu.getBoolean([vr["clamped"]]) == [True]
         fmu.exitInitializationMode()
+        with pytest.raises(FMICallException):
+            fmu.setFloat64([vr["m"]], [2.0])
+        assert "parameter m can only be set before initialization ends" in messages[-1]
         fmu.doStep(0.0, STEP)
         assert fmu.getFloat64([0]) == [STEP]
-    finally:
         fmu.terminate()
+    finally:
         fmu.freeInstance()
 
 
