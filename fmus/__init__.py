@@ -19,7 +19,7 @@ import functools
 import os
 from pathlib import Path
 
-from fmus.models import MODELS, model_variables  # noqa: F401  (the package's names)
+from fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
 
 
 class FMUNotFoundError(FileNotFoundError):
@@ -78,26 +78,6 @@ def default_fmu_dir() -> Path:
     """
     env = os.environ.get("QUADCOSIM_FMU_DIR")
     return Path(env) if env else build_root() / "fmus"
-
-
-def fmu_sources(name: str) -> list[Path]:
-    """The files an FMU is built from: its equations and variable table, the shared shell and
-    headers, and the modules that generate its description and constants.
-
-    Parameters
-    ----------
-    name : str
-        Model name (one of :data:`MODELS`).
-
-    Returns
-    -------
-    list of pathlib.Path
-        Existing files only.
-    """
-    here = Path(__file__).resolve().parent
-    shared = [here / f"{module}.py" for module in ("build", "variables", "airframe", "vehicle")]
-    own = [here / name / "model.c", here / name / "variables.py"]
-    return [path for path in [*sorted((here / "c").glob("*")), *shared, *own] if path.is_file()]
 
 
 _checked: set[Path] = set()  # FMUs found up to date by this process: checked once, not at every look-up

@@ -24,7 +24,7 @@ import zipfile
 from pathlib import Path
 
 from fmus.airframe import c_header as airframe_header
-from fmus.models import MODELS, model_variables
+from fmus.models import MODELS, fmu_sources, model_variables
 
 HERE = Path(__file__).resolve().parent
 CFLAGS = ["-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden"]
@@ -218,8 +218,6 @@ def up_to_date(model: str, out_dir: Path, fmi_version: int = 2) -> bool:
         The FMU is newer than each of its sources (:func:`fmus.fmu_sources`) and holds the binary of
         each platform this machine builds for (Windows only with mingw-w64).
     """
-    from fmus import fmu_sources
-
     fmu = fmu_file(model, out_dir, fmi_version)
     if not fmu.is_file() or any(s.stat().st_mtime > fmu.stat().st_mtime for s in fmu_sources(model)):
         return False

@@ -316,9 +316,7 @@ def parser() -> argparse.ArgumentParser:
                            "references (into build/ in a source checkout, a per-user cache when installed; a run "
                            "builds what it needs on first use)")
     build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
-    build.add_argument("--force", action="store_true",
-                       help="rebuild the FMUs that are up to date too (newer than their sources), e.g. after a "
-                            "change of compiler")
+    build.add_argument("--force", action="store_true", help="rebuild the FMUs that are up to date too")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL",
