@@ -56,6 +56,21 @@ def test_validates_with_both_platforms_and_its_sources(model, version):
             list(SOURCE_FILES[3])]
 
 
+def test_the_fmi3_binaries_export_every_function_of_the_standard(tmp_path):
+    """Those of Model Exchange and Scheduled Execution included, which refuse with a message."""
+    import ctypes
+    import re
+
+    header = (_headers() / "fmi3Functions.h").read_text()
+    names = re.findall(r"^\s*FMI3_Export\s+fmi3\w+TYPE\s+(fmi3\w+);", header, re.MULTILINE)
+    assert len(names) > 70
+    for model in MODELS:
+        with zipfile.ZipFile(fmu_path(model, fmi_version=3)) as archive:
+            library = archive.extract(f"binaries/{PLATFORMS[3]['linux']}/{model}.so", tmp_path / model)
+        loaded = ctypes.CDLL(library)
+        assert [n for n in names if not hasattr(loaded, n)] == [], model
+
+
 @pytest.mark.parametrize("model", MODELS)
 def test_fmi3_runs_in_fmpy_equal_to_fmi2(model):
     runs = [fmpy.simulate_fmu(str(fmu_path(model, fmi_version=v)), stop_time=0.05, step_size=STEP,
