@@ -41,8 +41,9 @@ PLATFORMS = {2: {"linux": "linux64", "windows": "win64"}, 3: {"linux": "x86_64-l
 #: The mingw-w64 cross compiler that builds the Windows binaries (Debian: gcc-mingw-w64-x86-64).
 WINDOWS_COMPILER = "x86_64-w64-mingw32-gcc"
 #: Flags of each platform's link beyond CFLAGS: the Windows DLL carries libgcc's helpers (some
-#: models call them) instead of needing libgcc_s_seh-1.dll beside it.
-LINK_FLAGS = {"linux": [], "windows": ["-static-libgcc"]}
+#: models call them) instead of needing libgcc_s_seh-1.dll beside it, and no symbol table (which
+#: would make it four times larger: mingw's C library is linked in).
+LINK_FLAGS = {"linux": [], "windows": ["-static-libgcc", "-s"]}
 
 
 class BuildError(RuntimeError):

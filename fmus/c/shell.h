@@ -3,8 +3,8 @@
  * The shell owns the FMI state machine, get/set by value reference, logging and error
  * statuses. A model provides its variable table (generated variables.h) and the four
  * functions declared at the bottom of this file, in a short model.c. The same sources build
- * both versions: shell.c alone is the FMI 2.0 API; fmi3.c, which includes shell.c, the FMI 3.0
- * one; variables.h of an FMI 3.0 build defines FMI_VERSION as 3.
+ * both versions: the state machine (cosimulation.h) under the FMI 2.0 API (shell.c) or the FMI
+ * 3.0 API (fmi3.c); variables.h of an FMI 3.0 build defines FMI_VERSION as 3.
  */
 #ifndef SHELL_H
 #define SHELL_H
