@@ -244,3 +244,71 @@ def test_an_up_to_date_fmu_is_not_rebuilt(tmp_path):
     assert first[0].stat().st_mtime_ns == stamp
     build_all(tmp_path, models=("InfraredSensor",), fmi_versions=(3,), verbose=False, force=True)
     assert first[0].stat().st_mtime_ns > stamp
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_fmi3_survives_random_calls(model):
+    """Random FMI 3.0 calls, freed instances and null arrays included: every call returns OK,
+    Warning or Error (no crash), a refusal leaves a message, and an OK step gives finite outputs."""
+    import ctypes
+
+    from fmpy import extract
+    from fmpy.fmi3 import FMU3Slave, fmi3ValueReference
+
+    path = fmu_path(model, fmi_version=3)
+    description = fmpy.read_model_description(str(path))
+    outputs = [v.valueReference for v in _outputs(description)]
+    top = max(v.valueReference for v in description.modelVariables)
+    fmu = FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)), modelIdentifier=model,
+                    instanceName="fuzz")
+    messages = []
+    fmu.instantiate(logMessage=lambda env, status, category, message: messages.append(message))
+    f, rng, statuses = fmu.dll, np.random.default_rng(46), []
+    instance, t = fmu.component, 0.0
+
+    def refs(n):
+        drawn = rng.integers(0, top + 3, n) if rng.random() < 0.9 else rng.integers(0, 2**32, n)
+        return (fmi3ValueReference * n)(*drawn.tolist())
+
+    for call in range(3000):
+        kind, n = rng.integers(0, 9), int(rng.integers(0, 4))
+        count = n if rng.random() < 0.9 else n + 1
+        floats = (ctypes.c_double * (n + 1))(*rng.choice([0.5, -1e300, np.nan, np.inf, 3.0], n + 1))
+        before = len(messages)
+        if kind == 0:
+            status = f.fmi3GetFloat64(instance, refs(n), n, floats if rng.random() < 0.95 else None, count)
+        elif kind == 1:
+            status = f.fmi3SetFloat64(instance, refs(n), n, floats, count)
+        elif kind == 2:
+            status = f.fmi3GetInt32(instance, refs(n), n, (ctypes.c_int32 * (n + 1))(), count)
+        elif kind == 3:
+            status = f.fmi3SetBoolean(instance, refs(n), n, (ctypes.c_bool * (n + 1))(True), count)
+        elif kind == 4:
+            status = f.fmi3EnterInitializationMode(instance, False, 0.0, t, False, 0.0)
+        elif kind == 5:
+            status = f.fmi3ExitInitializationMode(instance)
+        elif kind == 6:
+            h = float(rng.choice([1e-3, 0.05, -1e-3, np.nan]))
+            flags, last = [ctypes.c_bool() for _ in range(3)], ctypes.c_double()
+            status = f.fmi3DoStep(instance, t, h, True, *map(ctypes.byref, flags), ctypes.byref(last))
+            if status == 0:
+                t += h
+                values = (ctypes.c_double * len(outputs))()
+                assert f.fmi3GetFloat64(instance, (fmi3ValueReference * len(outputs))(*outputs), len(outputs),
+                                        values, len(outputs)) == 0
+                assert np.isfinite(list(values)).all(), (model, call)
+        elif kind == 7:
+            status, t = f.fmi3Reset(instance), 0.0
+        else:  # a fresh instance, the old one freed: calls on it must be refused, not crash
+            f.fmi3FreeInstance(instance)  # (fmpy's freeInstance would unload the library too)
+            status = f.fmi3Reset(instance)
+            assert status == 3, (model, call)
+            fmu.instantiate(logMessage=lambda env, status, category, message: messages.append(message))
+            instance, t = fmu.component, 0.0
+            continue
+        assert status in (0, 1, 3), (model, call, kind, status)
+        statuses.append(status)
+        if status == 3 and kind != 8:
+            assert len(messages) > before, (model, call, kind)
+    fmu.freeInstance()
+    assert statuses.count(0) > 300 and statuses.count(3) > 300  # both paths were taken
