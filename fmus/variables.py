@@ -141,6 +141,9 @@ class Table:
         Length of the model's continuous state vector (sizes the shell's RK4 scratch).
     extra_vectors : dict of str to tuple of str
         Vectors beyond those the names imply (see :meth:`vectors`).
+    arrays : dict of str to str
+        Real vectors the FMI 3.0 FMU declares as one array variable (``IMU.acc``), with the
+        array's description; FMI 2.0 keeps their scalar members.
     """
 
     model: str
@@ -150,6 +153,7 @@ class Table:
     # Vectors beyond those the names imply (see :meth:`vectors`): name -> member names in order,
     # e.g. the field of each motor, ``b_d1_x ... b_d4_z``, as one 12-vector.
     extra_vectors: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    arrays: dict[str, str] = field(default_factory=dict)
     vr: dict[str, int] = field(init=False)
 
     def __post_init__(self):
@@ -214,6 +218,27 @@ class Table:
                     f"{self.model}: the members of vector {name} ({', '.join(names)}) must be consecutive "
                     f"rows of the variable table, since the C code addresses them as one array; {n} has "
                     f"value reference {present}, not {previous + 1}. Move its rows together.")
+
+    def array_members(self) -> dict[str, list[Variable]]:
+        """The members of each FMI 3.0 array (:attr:`arrays`), in order.
+
+        Raises
+        ------
+        ValueError
+            An array that is not a Real vector of the table, or whose members differ in causality,
+            unit or direct dependencies (one variable carries them for all).
+        """
+        vectors = self.vectors()
+        found = {}
+        for name in self.arrays:
+            members = vectors.get(name)
+            if not members or members[0].type != "Real":
+                raise ValueError(f"{self.model}: array {name} is not a Real vector of the table")
+            if len({(v.causality, v.unit, v.depends, v.variability) for v in members}) > 1:
+                raise ValueError(f"{self.model}: the members of array {name} differ in causality, unit, "
+                                 "dependencies or variability")
+            found[name] = members
+        return found
 
     def vr3(self, name: str) -> int:
         """The FMI 3.0 value reference of variable ``name``.
@@ -349,40 +374,49 @@ class Table:
             '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
             ' description="simulation time" unit="s"/>',
         ]
+        arrays = self.array_members()
+        inner = {v.name for members in arrays.values() for v in members[1:]}  # carried by the first
+        heads = {members[0].name: (name, len(members)) for name, members in arrays.items()}
         for v in self.variables:
-            lines.append(f"    {self._variable_fmi3(v)}")
+            if v.name not in inner:
+                lines.append(f"    {self._variable_fmi3(v, *heads.get(v.name, (None, 0)))}")
         lines.append("  </ModelVariables>")
         lines.append("  <ModelStructure>")
-        for v in self.of("output"):
-            deps = self._depends(v, inputs)
+        outputs = [v for v in self.of("output") if v.name not in inner]
+        for v in outputs:
+            deps = [self.vr3(n) for n in self._depends(v, inputs) if n not in inner]
             lines.append(f'    <Output valueReference="{self.vr3(v.name)}" '
-                         f'dependencies="{" ".join(str(self.vr3(n)) for n in deps)}" '
+                         f'dependencies="{" ".join(map(str, deps))}" '
                          f'dependenciesKind="{" ".join("dependent" for _ in deps)}"/>')
-        for v in self.of("output"):
+        for v in outputs:
             lines.append(f'    <InitialUnknown valueReference="{self.vr3(v.name)}"/>')
         lines.append("  </ModelStructure>")
         lines.append("</fmiModelDescription>")
         return "\n".join(lines) + "\n"
 
-    def _variable_fmi3(self, v: Variable) -> str:
+    def _variable_fmi3(self, v: Variable, array: str | None = None, length: int = 0) -> str:
         attrs = [
-            f'name="{v.name}"',
+            f'name="{array or v.name}"',
             f'valueReference="{self.vr3(v.name)}"',
             f'causality="{v.causality}"',
             f'variability="{v.fmi_variability}"',
         ]
         if v.causality == "parameter":
             attrs.append('initial="exact"')
-        if v.description:
-            attrs.append(f"description={quoteattr(v.description)}")
+        description = self.arrays[array] if array else v.description
+        if description:
+            attrs.append(f"description={quoteattr(description)}")
         if v.start is not None:
-            attrs.append(f'start="{_xml_value(v.type, v.start)}"')
+            members = self.array_members()[array] if array else [v]
+            attrs.append(f'start="{" ".join(_xml_value(m.type, m.start) for m in members)}"')
         if v.unit:
             attrs.append(f'unit="{v.unit}"')
         if v.min is not None:
             attrs.append(f'min="{v.min!r}"')
         if v.max is not None:
             attrs.append(f'max="{v.max!r}"')
+        if array:
+            return f'<{FMI3_TYPES[v.type]} {" ".join(attrs)}><Dimension start="{length}"/></{FMI3_TYPES[v.type]}>'
         return f"<{FMI3_TYPES[v.type]} {' '.join(attrs)}/>"
 
     def build_description(self, source_files: list[str]) -> str:
@@ -498,6 +532,15 @@ class Table:
             if not members:
                 lines.append('    {"", CAUSALITY_LOCAL, 0.0},')
             lines.append("};")
+        if fmi_version == 3:
+            arrays = self.array_members()
+            lines += ["/* FMI 3.0 arrays: a Real vector declared as one variable, by the index of its first member",
+                      " * and its length; the later members have no value reference of their own. */",
+                      f"#define N_ARRAYS {len(arrays)}",
+                      f"static const int ARRAY_FIRST[{max(len(arrays), 1)}] = "
+                      f"{{{', '.join(f'VEC_{n}' for n in arrays) or '0'}}};",
+                      f"static const int ARRAY_LENGTH[{max(len(arrays), 1)}] = "
+                      f"{{{', '.join(f'LEN_{n}' for n in arrays) or '0'}}};"]
         lines.append("")
         lines.append("#endif")
         return "\n".join(lines) + "\n"

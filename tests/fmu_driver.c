@@ -5,11 +5,12 @@
  * Usage: fmu_driver PLAN. The plan is whitespace-separated text, one FMU after another:
  *   FMI_VERSION LIBRARY MODEL_IDENTIFIER TOKEN STEPS STEP_SIZE
  *   N_INPUTS  (VR VALUE) * N_INPUTS
- *   N_OUTPUTS VR * N_OUTPUTS
+ *   N_OUTPUTS N_VALUES VR * N_OUTPUTS
  *   OUTPUT_FILE
  * Each FMU is instantiated (Co-Simulation), initialised at t = 0 with the inputs set, stepped
  * STEPS times with them held; its Real outputs at t = 0 and after every step are written to
- * OUTPUT_FILE as native doubles, one row per instant. Paths hold no spaces. Exit status 1 on
+ * OUTPUT_FILE as native doubles, one row of N_VALUES per instant (an FMI 3.0 array output is one
+ * reference of several values; in FMI 2.0, N_VALUES is N_OUTPUTS). Paths hold no spaces. Exit status 1 on
  * the first refusal, with the FMU's messages on standard error. */
 #include <stdarg.h>
 #include <stdio.h>
@@ -70,7 +71,7 @@ static void *symbol(void *library, const char *name) {
     } while (0)
 
 typedef struct {
-    int version, steps, n_in, n_out;
+    int version, steps, n_in, n_out, n_values;
     char library[MAX_TEXT], identifier[MAX_TEXT], token[MAX_TEXT], output[MAX_TEXT];
     double h, in_value[MAX_VARIABLES];
     unsigned int in_vr[MAX_VARIABLES], out_vr[MAX_VARIABLES];
@@ -84,7 +85,9 @@ static int read_plan(FILE *file, Plan *p) {
     if (fscanf(file, "%d", &p->n_in) != 1 || p->n_in < 0 || p->n_in > MAX_VARIABLES) return -1;
     for (i = 0; i < p->n_in; i++)
         if (fscanf(file, "%u %lf", &p->in_vr[i], &p->in_value[i]) != 2) return -1;
-    if (fscanf(file, "%d", &p->n_out) != 1 || p->n_out < 1 || p->n_out > MAX_VARIABLES) return -1;
+    if (fscanf(file, "%d %d", &p->n_out, &p->n_values) != 2 || p->n_out < 1 || p->n_out > MAX_VARIABLES ||
+        p->n_values < p->n_out || p->n_values > MAX_VARIABLES || (p->version == 2 && p->n_values != p->n_out))
+        return -1;
     for (i = 0; i < p->n_out; i++)
         if (fscanf(file, "%u", &p->out_vr[i]) != 1) return -1;
     return fscanf(file, "%1023s", p->output) == 1 ? 1 : -1;
@@ -134,8 +137,9 @@ static void run3(void *library, const Plan *p, FILE *out) {
         if (k > 0)
             CHECK(((fmi3DoStepTYPE *)symbol(library, "fmi3DoStep"))(c, (k - 1) * p->h, p->h, fmi3True, &event,
                                                                     &terminate, &early, &last));
-        CHECK(((fmi3GetFloat64TYPE *)symbol(library, "fmi3GetFloat64"))(c, p->out_vr, p->n_out, values, p->n_out));
-        fwrite(values, sizeof(double), (size_t)p->n_out, out);
+        CHECK(((fmi3GetFloat64TYPE *)symbol(library, "fmi3GetFloat64"))(c, p->out_vr, p->n_out, values,
+                                                                          p->n_values));
+        fwrite(values, sizeof(double), (size_t)p->n_values, out);
     }
     CHECK(((fmi3TerminateTYPE *)symbol(library, "fmi3Terminate"))(c));
     ((fmi3FreeInstanceTYPE *)symbol(library, "fmi3FreeInstance"))(c);

@@ -37,6 +37,22 @@ def _outputs(description) -> list:
     return [v for v in description.modelVariables if v.causality == "output"]
 
 
+def _values(variables) -> int:
+    """How many values the variables hold (an FMI 3.0 array holds several)."""
+    return sum(int(np.prod(v.shape)) if v.shape else 1 for v in variables)
+
+
+def _column(result, name: str, model: str) -> np.ndarray:
+    """Output ``name`` (an FMI 2.0 scalar) of an fmpy result, from its array in FMI 3.0."""
+    if name in result.dtype.names:
+        return result[name]
+    for array, members in table(model).array_members().items():
+        names = [v.name for v in members]
+        if name in names:
+            return result[array][:, names.index(name)]
+    raise KeyError(name)
+
+
 @pytest.mark.parametrize("version", VERSIONS)
 @pytest.mark.parametrize("model", MODELS)
 def test_validates_with_both_platforms_and_its_sources(model, version):
@@ -52,6 +68,8 @@ def test_validates_with_both_platforms_and_its_sources(model, version):
     assert {f"sources/{name}" for name in SOURCE_FILES[version]} <= names
     if version == 3:
         assert "sources/buildDescription.xml" in names
+        arrays = {v.name: v.shape for v in description.modelVariables if v.shape}
+        assert arrays == ({"acc": (3,), "gyro": (3,), "magneto": (3,)} if model == "IMU" else {})
         assert [s.sourceFiles for c in description.buildConfigurations for s in c.sourceFileSets] == [
             list(SOURCE_FILES[3])]
 
@@ -76,10 +94,9 @@ def test_fmi3_runs_in_fmpy_equal_to_fmi2(model):
     runs = [fmpy.simulate_fmu(str(fmu_path(model, fmi_version=v)), stop_time=0.05, step_size=STEP,
                               start_values=INPUTS[model]) for v in VERSIONS]
     names = [v.name for v in _outputs(fmpy.read_model_description(str(fmu_path(model))))]
-    assert set(names) <= set(runs[1].dtype.names)
     moved = 0
     for name in names:
-        assert np.array_equal(runs[0][name], runs[1][name]), name
+        assert np.array_equal(runs[0][name], _column(runs[1], name, model)), name
         moved += np.ptp(runs[0][name]) > 0
     assert moved >= len(names) // 3  # the inputs drive the model: its outputs change
 
@@ -114,7 +131,7 @@ def test_fmi3_refuses_what_it_must_name():
         assert "unknown value reference 9999" in messages[-1]
         with pytest.raises(FMICallException):
             fmu.getFloat64([vr["m"]], nValues=2)
-        assert "2 values for 1 value references" in messages[-1]
+        assert "2 values for value references that hold 1" in messages[-1]
         with pytest.raises(FMICallException):
             fmu.getInt32([vr["m"]])  # a Float64's reference is no Int32's
         assert f"unknown value reference {vr['m']}" in messages[-1]
@@ -128,6 +145,34 @@ def test_fmi3_refuses_what_it_must_name():
         assert "parameter m can only be set before initialization ends" in messages[-1]
         fmu.doStep(0.0, STEP)
         assert fmu.getFloat64([0]) == [STEP]
+        fmu.terminate()
+    finally:
+        fmu.freeInstance()
+
+
+def test_an_fmi3_array_is_read_whole_by_its_first_reference():
+    from fmpy import extract
+    from fmpy.fmi1 import FMICallException
+    from fmpy.fmi3 import FMU3Slave
+
+    path = fmu_path("IMU", fmi_version=3)
+    description = fmpy.read_model_description(str(path))
+    acc = next(v.valueReference for v in description.modelVariables if v.name == "acc")
+    messages = []
+    fmu = FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)), modelIdentifier="IMU", instanceName="i")
+    fmu.instantiate(logMessage=lambda env, status, category, message: messages.append(message.decode()))
+    try:
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        fmu.doStep(0.0, STEP)
+        x, y, z = fmu.getFloat64([acc], nValues=3)
+        assert z == pytest.approx(-9.81, abs=0.5) and abs(x) < 0.5 and abs(y) < 0.5  # level, at rest: gravity
+        with pytest.raises(FMICallException):
+            fmu.getFloat64([acc + 1])  # acc_y has no reference of its own
+        assert f"unknown value reference {acc + 1}" in messages[-1]
+        with pytest.raises(FMICallException):
+            fmu.getFloat64([acc])
+        assert "1 values for value references that hold 3" in messages[-1]
         fmu.terminate()
     finally:
         fmu.freeInstance()
@@ -163,10 +208,12 @@ def _plan(folder: Path, platform: str, windows_paths: bool) -> tuple[Path, dict]
             library = unzipped / "binaries" / PLATFORMS[version][platform] / f"{model}{suffix}"
             output = folder / f"{platform}-fmi{version}-{model}.bin"
             inputs = " ".join(f"{by_name[n]} {value!r}" for n, value in INPUTS[model].items())
-            refs = " ".join(str(v.valueReference) for v in _outputs(description))
+            variables = _outputs(description)
+            refs = " ".join(str(v.valueReference) for v in variables)
             lines += [f"{version} {native(library)} {model} {description.guid} {STEPS} {STEP!r}",
-                      f"{len(INPUTS[model])} {inputs}", f"{len(_outputs(description))} {refs}", native(output)]
-            outputs[version, model] = (output, len(_outputs(description)))
+                      f"{len(INPUTS[model])} {inputs}", f"{len(variables)} {_values(variables)} {refs}",
+                      native(output)]
+            outputs[version, model] = (output, _values(variables))
     plan = folder / f"{platform}.plan"
     plan.write_text("\n".join(lines) + "\n")
     return plan, outputs
@@ -258,6 +305,7 @@ def test_fmi3_survives_random_calls(model):
     path = fmu_path(model, fmi_version=3)
     description = fmpy.read_model_description(str(path))
     outputs = [v.valueReference for v in _outputs(description)]
+    n_values = _values(_outputs(description))
     top = max(v.valueReference for v in description.modelVariables)
     fmu = FMU3Slave(guid=description.guid, unzipDirectory=extract(str(path)), modelIdentifier=model,
                     instanceName="fuzz")
@@ -293,9 +341,9 @@ def test_fmi3_survives_random_calls(model):
             status = f.fmi3DoStep(instance, t, h, True, *map(ctypes.byref, flags), ctypes.byref(last))
             if status == 0:
                 t += h
-                values = (ctypes.c_double * len(outputs))()
+                values = (ctypes.c_double * n_values)()
                 assert f.fmi3GetFloat64(instance, (fmi3ValueReference * len(outputs))(*outputs), len(outputs),
-                                        values, len(outputs)) == 0
+                                        values, n_values) == 0
                 assert np.isfinite(list(values)).all(), (model, call)
         elif kind == 7:
             status, t = f.fmi3Reset(instance), 0.0

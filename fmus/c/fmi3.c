@@ -3,7 +3,9 @@
  * Boolean here. FMI 3.0 numbers all variables in one sequence: 0 is the independent variable
  * time, then the Real variables in table order, the Integer ones and the Boolean ones, so that
  * value reference vr of a type is index vr - FIRST_<type> of the instance's array of that type
- * (the build writes the same numbers into modelDescription.xml). */
+ * (the build writes the same numbers into modelDescription.xml). A Real vector the variable
+ * table names an array (IMU.acc) is one Float64 variable of several values, at the reference of
+ * its first element. */
 #include "cosimulation.h"
 
 #if FMI_VERSION != 3
@@ -157,26 +159,72 @@ fmi3Status fmi3Reset(fmi3Instance instance) {
 }
 
 /* ---------------------------------------------------------------- get and set */
+/* What Float64 value reference vr stands for: time (INDEX_TIME), a Real scalar, or a whole array
+ * (ARRAY_FIRST, ARRAY_LENGTH of variables.h); its count of values, with the Real index of the first
+ * in *first, or 0 when it is none of them (a later member of an array has no reference of its own). */
+#define INDEX_TIME (-1)
+static int float64_reference(fmi3ValueReference vr, int *first) {
+    int k, a;
+    if (vr == VR_TIME) {
+        *first = INDEX_TIME;
+        return 1;
+    }
+    if (vr - FIRST_REAL >= (unsigned int)N_REAL) return 0;
+    k = (int)(vr - FIRST_REAL);
+    *first = k;
+    for (a = 0; a < N_ARRAYS; a++) {
+        if (k == ARRAY_FIRST[a]) return ARRAY_LENGTH[a];
+        if (k > ARRAY_FIRST[a] && k < ARRAY_FIRST[a] + ARRAY_LENGTH[a]) return 0;
+    }
+    return 1;
+}
+
+/* Refuses unless every reference is a Float64 variable (time only when `time_allowed`) and
+ * together they hold nValues values. */
+static Status check_float64(ModelInstance *m, const char *function, const fmi3ValueReference vr[], size_t nvr,
+                            const void *values, size_t nValues, int time_allowed) {
+    size_t i, total = 0;
+    int first = 0, count;
+    if (nvr > 0 && !vr) return fail(m, function, "null value reference array");
+    if (nvr > 0 && !values) return fail(m, function, "null value array");
+    for (i = 0; i < nvr; i++) {
+        count = float64_reference(vr[i], &first);
+        if (!count)
+            return fail(m, function, "unknown value reference %u: the Float64 variables of %s are time (0) and "
+                        "%u to %d, an array by the reference of its first element", (unsigned)vr[i], MODEL_NAME,
+                        FIRST_REAL, (int)FIRST_REAL + N_REAL - 1);
+        if (first == INDEX_TIME && !time_allowed)
+            return fail(m, function, "time (value reference 0) is the independent variable and cannot be set; "
+                        "give the start time to fmi3EnterInitializationMode");
+        total += (size_t)count;
+    }
+    if (total != nValues)
+        return fail(m, function, "%lu values for value references that hold %lu", (unsigned long)nValues,
+                    (unsigned long)total);
+    return fmi3OK;
+}
+
+/* The Real indices first .. first + count - 1, as the state machine's get and set take them. */
+static const unsigned int *indices(int first, int count, unsigned int room[]) {
+    int j;
+    for (j = 0; j < count; j++) room[j] = (unsigned int)(first + j);
+    return room;
+}
+
 fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, fmi3Float64 values[], size_t nValues) {
     ModelInstance *m = live(instance);
-    size_t i;
+    unsigned int room[N_REAL > 0 ? N_REAL : 1];
+    size_t i, n = 0;
+    int first = 0, count;
     if (!ALLOWED(m, fmi3GetFloat64)) return fmi3Error;
-    if (check_scalars(m, "fmi3GetFloat64", nValueReferences, nValues) != fmi3OK) return fmi3Error;
-    for (i = 0; valueReferences && i < nValueReferences && valueReferences[i] != VR_TIME; i++) {
-    }
-    if (!valueReferences || i == nValueReferences) /* the Real variables alone */
-        return get_reals(m, "fmi3GetFloat64", valueReferences, nValueReferences, FIRST_REAL, values);
-    for (i = 0; i < nValueReferences; i++) { /* time among them: one at a time */
-        if (valueReferences[i] != VR_TIME) {
-            if (get_reals(m, "fmi3GetFloat64", valueReferences + i, 1, FIRST_REAL, values ? values + i : NULL) !=
-                fmi3OK)
-                return fmi3Error;
-        } else if (!values) {
-            return fail(m, "fmi3GetFloat64", "null value array");
-        } else {
-            values[i] = m->time;
-        }
+    if (check_float64(m, "fmi3GetFloat64", valueReferences, nValueReferences, values, nValues, 1) != fmi3OK)
+        return fmi3Error;
+    for (i = 0; i < nValueReferences; i++, n += (size_t)count) {
+        count = float64_reference(valueReferences[i], &first);
+        if (first == INDEX_TIME) values[n] = m->time;
+        else if (get_reals(m, "fmi3GetFloat64", indices(first, count, room), (size_t)count, 0, values + n) != fmi3OK)
+            return fmi3Error;
     }
     return fmi3OK;
 }
@@ -206,14 +254,18 @@ fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference valueR
 fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                           size_t nValueReferences, const fmi3Float64 values[], size_t nValues) {
     ModelInstance *m = live(instance);
-    size_t i;
+    unsigned int room[N_REAL > 0 ? N_REAL : 1];
+    size_t i, n = 0;
+    int first = 0, count;
     if (!ALLOWED(m, fmi3SetFloat64)) return fmi3Error;
-    if (check_scalars(m, "fmi3SetFloat64", nValueReferences, nValues) != fmi3OK) return fmi3Error;
-    for (i = 0; valueReferences && i < nValueReferences; i++)
-        if (valueReferences[i] == VR_TIME)
-            return fail(m, "fmi3SetFloat64", "time (value reference 0) is the independent variable and cannot "
-                                             "be set; give the start time to fmi3EnterInitializationMode");
-    return set_reals(m, "fmi3SetFloat64", valueReferences, nValueReferences, FIRST_REAL, values);
+    if (check_float64(m, "fmi3SetFloat64", valueReferences, nValueReferences, values, nValues, 0) != fmi3OK)
+        return fmi3Error;
+    for (i = 0; i < nValueReferences; i++, n += (size_t)count) {
+        count = float64_reference(valueReferences[i], &first);
+        if (set_reals(m, "fmi3SetFloat64", indices(first, count, room), (size_t)count, 0, values + n) != fmi3OK)
+            return fmi3Error;
+    }
+    return fmi3OK;
 }
 
 fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
