@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed
 # setuptools' BuildBackendWarning on every editable install is information (README), not a fault
 QUIET_EDITABLE := PYTHONWARNINGS="ignore:Editable installation"
 
-.PHONY: setup fmus demo lab test kernels digests references lint bench fuzz docs clean
+.PHONY: setup windows-tools fmus demo lab test kernels digests references lint bench fuzz docs clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 12))' || { echo "quadcosim needs Python 3.12 or newer; $(PYTHON) is $$($(PYTHON) -V 2>&1). Install 3.12 (pyenv install 3.12, uv python install 3.12, or conda create -n quadcosim python=3.12) and run make PYTHON=python3.12" >&2; exit 1; }
@@ -17,6 +17,18 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 setup: $(STAMP)
+
+# The Windows binaries of the FMUs (mingw-w64) and the test that runs them (Wine), on Debian or
+# Ubuntu: installed when missing and the user may (root), else said how; CI calls it before
+# `make test`. Without them the FMUs are built for Linux alone and that test is skipped.
+WINDOWS_PACKAGES := gcc-mingw-w64-x86-64 wine wine64
+windows-tools:
+	@if command -v x86_64-w64-mingw32-gcc >/dev/null && command -v wine >/dev/null; then :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+		echo "installing $(WINDOWS_PACKAGES)"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+			$(WINDOWS_PACKAGES) >/dev/null; \
+	else echo "no mingw-w64 or Wine: the FMUs get no Windows binaries (install: sudo apt-get install $(WINDOWS_PACKAGES))"; fi
 
 fmus: $(STAMP)
 	$(BIN)/quadcosim build

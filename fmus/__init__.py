@@ -1,12 +1,13 @@
-"""The plant as FMI 2.0 Co-Simulation FMUs written in C, with their Modelica twins.
+"""The plant as FMI 2.0 and 3.0 Co-Simulation FMUs written in C, with their Modelica twins.
 
 - :mod:`fmus.vehicle`: the physical constants of the default vehicle, with units;
 - :mod:`fmus.airframe`: motor numbering and spin directions;
 - ``fmus/<Model>/variables.py``: each model's variable table; ``fmus/<Model>/model.c``: its
   equations; ``fmus/c/``: the FMI shell they share;
 - ``fmus/QuadCoSim/``: the Modelica twins;
-- :mod:`fmus.build`: builds ``<build root>/fmus/<Model>.fmu`` (``quadcosim build``, or on first
-  use).
+- :mod:`fmus.build`: builds ``<build root>/fmus/<Model>.fmu`` (FMI 2.0, what a run loads) and
+  ``<build root>/fmus/fmi3/<Model>.fmu`` (FMI 3.0), each for Linux and, with mingw-w64, Windows
+  (``quadcosim build``, or on first use).
 
 The build root (:func:`build_root`) is ``build/`` in a source checkout and a per-user cache
 folder for an installed package, so that an installation never writes into ``site-packages``.
@@ -18,7 +19,7 @@ import functools
 import os
 from pathlib import Path
 
-from fmus.models import MODELS, model_variables  # noqa: F401  (the package's names)
+from fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
 
 
 class FMUNotFoundError(FileNotFoundError):
@@ -79,26 +80,6 @@ def default_fmu_dir() -> Path:
     return Path(env) if env else build_root() / "fmus"
 
 
-def fmu_sources(name: str) -> list[Path]:
-    """The files an FMU is built from: its equations and variable table, the shared shell and
-    headers, and the modules that generate its description and constants.
-
-    Parameters
-    ----------
-    name : str
-        Model name (one of :data:`MODELS`).
-
-    Returns
-    -------
-    list of pathlib.Path
-        Existing files only.
-    """
-    here = Path(__file__).resolve().parent
-    shared = [here / f"{module}.py" for module in ("build", "variables", "airframe", "vehicle")]
-    own = [here / name / "model.c", here / name / "variables.py"]
-    return [path for path in [*sorted((here / "c").glob("*")), *shared, *own] if path.is_file()]
-
-
 _checked: set[Path] = set()  # FMUs found up to date by this process: checked once, not at every look-up
 
 
@@ -109,7 +90,7 @@ def _stale(path: Path, name: str) -> bool:
     return any(source.stat().st_mtime > built for source in fmu_sources(name))
 
 
-def _build_on_first_use(name: str, path: Path) -> None:
+def _build_on_first_use(name: str, path: Path, fmi_version: int) -> None:
     """Build FMU ``name`` into its default folder, one process at a time (a lock file), said on
     standard error: the first run after an installation or an edit of its sources compiles it."""
     import fcntl
@@ -123,21 +104,24 @@ def _build_on_first_use(name: str, path: Path) -> None:
         if _stale(path, name):  # another process may have built it meanwhile
             print(f"quadcosim: building the FMU {name} into {path.parent} (its sources are newer, or it is "
                   "not built yet)", file=sys.stderr, flush=True)
-            build_fmu(name, path.parent)
+            build_fmu(name, default_fmu_dir(), fmi_version=fmi_version)
 
 
-def fmu_path(name: str) -> Path:
+def fmu_path(name: str, fmi_version: int = 2) -> Path:
     """Path of the built FMU called ``name``.
 
     Parameters
     ----------
     name : str
         Model name (one of :data:`MODELS`).
+    fmi_version : int
+        2 (what a run loads) or 3.
 
     Returns
     -------
     pathlib.Path
-        ``<default_fmu_dir()>/<name>.fmu``. In the default folder a plant model is built on
+        ``<default_fmu_dir()>/<name>.fmu``, or ``<default_fmu_dir()>/fmi3/<name>.fmu`` for FMI 3.0.
+        In the default folder a plant model is built on
         first use, and rebuilt when one of its sources (:func:`fmu_sources`) is newer; in a
         folder named by ``$QUADCOSIM_FMU_DIR`` it is used as found.
 
@@ -147,10 +131,12 @@ def fmu_path(name: str) -> Path:
         The FMU is not built (and is not a plant model, or ``$QUADCOSIM_FMU_DIR`` names the
         folder); the message says how to build it.
     """
-    path = default_fmu_dir() / f"{name}.fmu"
+    if fmi_version not in (2, 3):
+        raise ValueError(f"FMI version {fmi_version!r}: the plant's FMUs are built in FMI 2 and 3")
+    path = default_fmu_dir() / ("" if fmi_version == 2 else "fmi3") / f"{name}.fmu"
     if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
         if _stale(path, name):
-            _build_on_first_use(name, path)
+            _build_on_first_use(name, path, fmi_version)
         _checked.add(path)
     if not path.is_file():
         known = ", ".join(MODELS)

@@ -6,7 +6,10 @@ model's equations use, so a variable is declared once, with its unit and descrip
 
 Value references are assigned per type in table order (FMI 2.0 numbers Real, Integer and
 Boolean variables independently), which is also the index of the variable in the instance's
-arrays ``real``, ``integer`` and ``boolean``.
+arrays ``real``, ``integer`` and ``boolean``. FMI 3.0 numbers all variables in one sequence:
+0 is the independent variable ``time``, then the Real (``Float64``), Integer (``Int32``) and
+Boolean variables follow, each type in table order (:meth:`Table.vr3`; ``fmus/c/fmi3.c``
+numbers them the same way).
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ from xml.sax.saxutils import quoteattr
 
 CAUSALITIES = ("parameter", "input", "output")
 TYPES = ("Real", "Integer", "Boolean")
+#: The FMI 3.0 type of each table type.
+FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
 
 
 @dataclass(frozen=True)
@@ -136,6 +141,9 @@ class Table:
         Length of the model's continuous state vector (sizes the shell's RK4 scratch).
     extra_vectors : dict of str to tuple of str
         Vectors beyond those the names imply (see :meth:`vectors`).
+    arrays : dict of str to str
+        Real vectors the FMI 3.0 FMU declares as one array variable (``IMU.acc``), with the
+        array's description; FMI 2.0 keeps their scalar members.
     """
 
     model: str
@@ -145,6 +153,7 @@ class Table:
     # Vectors beyond those the names imply (see :meth:`vectors`): name -> member names in order,
     # e.g. the field of each motor, ``b_d1_x ... b_d4_z``, as one 12-vector.
     extra_vectors: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    arrays: dict[str, str] = field(default_factory=dict)
     vr: dict[str, int] = field(init=False)
 
     def __post_init__(self):
@@ -210,6 +219,47 @@ class Table:
                     f"rows of the variable table, since the C code addresses them as one array; {n} has "
                     f"value reference {present}, not {previous + 1}. Move its rows together.")
 
+    def array_members(self) -> dict[str, list[Variable]]:
+        """The members of each FMI 3.0 array (:attr:`arrays`), in order.
+
+        Raises
+        ------
+        ValueError
+            An array that is not a Real vector of the table, or whose members differ in causality,
+            unit or direct dependencies (one variable carries them for all).
+        """
+        vectors = self.vectors()
+        found = {}
+        for name in self.arrays:
+            members = vectors.get(name)
+            if not members or members[0].type != "Real":
+                raise ValueError(f"{self.model}: array {name} is not a Real vector of the table")
+            if len({(v.causality, v.unit, v.depends, v.variability) for v in members}) > 1:
+                raise ValueError(f"{self.model}: the members of array {name} differ in causality, unit, "
+                                 "dependencies or variability")
+            found[name] = members
+        return found
+
+    def vr3(self, name: str) -> int:
+        """The FMI 3.0 value reference of variable ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A variable of the table, or ``"time"`` (the independent variable, 0).
+
+        Returns
+        -------
+        int
+            1 + its FMI 2.0 value reference, plus the count of the types before its own (Real,
+            then Integer, then Boolean).
+        """
+        if name == "time":
+            return 0
+        type_ = next(v.type for v in self.variables if v.name == name)
+        before = sum(self.counts[t] for t in TYPES[:TYPES.index(type_)])
+        return 1 + before + self.vr[name]
+
     def of(self, causality: str, type_: str | None = None) -> list[Variable]:
         """The variables of one causality (and type).
 
@@ -238,19 +288,26 @@ class Table:
         return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"quadcosim/{self.model}/{text}")) + "}"
 
     # ----------------------------------------------------------------- modelDescription.xml
-    def model_description(self, source_files: list[str]) -> str:
+    def model_description(self, source_files: list[str], fmi_version: int = 2) -> str:
         """The ``modelDescription.xml`` of the model.
 
         Parameters
         ----------
         source_files : list of str
-            C sources listed for a source FMU.
+            C sources listed for a source FMU (FMI 2.0; FMI 3.0 lists them in
+            :meth:`build_description`).
+        fmi_version : int
+            2 or 3.
 
         Returns
         -------
         str
             The XML text, with SI base units declared for each unit definition.
         """
+        if fmi_version == 3:
+            return self._model_description_fmi3()
+        if fmi_version != 2:
+            raise ValueError(f"FMI version {fmi_version!r}: the build writes FMI 2 and 3")
         index = {v.name: i + 1 for i, v in enumerate(self.variables)}
         inputs = [v.name for v in self.variables if v.causality == "input"]
         units = sorted({v.unit for v in self.variables if v.unit})
@@ -295,6 +352,97 @@ class Table:
         lines.append("</fmiModelDescription>")
         return "\n".join(lines) + "\n"
 
+    def _model_description_fmi3(self) -> str:
+        inputs = [v.name for v in self.variables if v.causality == "input"]
+        units = sorted({v.unit for v in self.variables if v.unit} | {"s"})
+        lines = [
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            "<fmiModelDescription",
+            '  fmiVersion="3.0"',
+            f'  modelName="{self.model}"',
+            f'  instantiationToken="{self.guid}"',
+            f"  description={quoteattr(self.description)}",
+            '  generationTool="quadcosim fmus.build"',
+            '  variableNamingConvention="flat">',
+            f'  <CoSimulation modelIdentifier="{self.model}" canHandleVariableCommunicationStepSize="true"'
+            ' hasEventMode="false"/>',
+            "  <UnitDefinitions>",
+            *[f"    {_unit_definition(u)}" for u in units],
+            "  </UnitDefinitions>",
+            '  <DefaultExperiment startTime="0" stopTime="2" stepSize="0.001"/>',
+            "  <ModelVariables>",
+            '    <Float64 name="time" valueReference="0" causality="independent" variability="continuous"'
+            ' description="simulation time" unit="s"/>',
+        ]
+        arrays = self.array_members()
+        inner = {v.name for members in arrays.values() for v in members[1:]}  # carried by the first
+        heads = {members[0].name: (name, len(members)) for name, members in arrays.items()}
+        for v in self.variables:
+            if v.name not in inner:
+                lines.append(f"    {self._variable_fmi3(v, *heads.get(v.name, (None, 0)))}")
+        lines.append("  </ModelVariables>")
+        lines.append("  <ModelStructure>")
+        outputs = [v for v in self.of("output") if v.name not in inner]
+        for v in outputs:
+            deps = [self.vr3(n) for n in self._depends(v, inputs) if n not in inner]
+            lines.append(f'    <Output valueReference="{self.vr3(v.name)}" '
+                         f'dependencies="{" ".join(map(str, deps))}" '
+                         f'dependenciesKind="{" ".join("dependent" for _ in deps)}"/>')
+        for v in outputs:
+            lines.append(f'    <InitialUnknown valueReference="{self.vr3(v.name)}"/>')
+        lines.append("  </ModelStructure>")
+        lines.append("</fmiModelDescription>")
+        return "\n".join(lines) + "\n"
+
+    def _variable_fmi3(self, v: Variable, array: str | None = None, length: int = 0) -> str:
+        attrs = [
+            f'name="{array or v.name}"',
+            f'valueReference="{self.vr3(v.name)}"',
+            f'causality="{v.causality}"',
+            f'variability="{v.fmi_variability}"',
+        ]
+        if v.causality == "parameter":
+            attrs.append('initial="exact"')
+        description = self.arrays[array] if array else v.description
+        if description:
+            attrs.append(f"description={quoteattr(description)}")
+        if v.start is not None:
+            members = self.array_members()[array] if array else [v]
+            attrs.append(f'start="{" ".join(_xml_value(m.type, m.start) for m in members)}"')
+        if v.unit:
+            attrs.append(f'unit="{v.unit}"')
+        if v.min is not None:
+            attrs.append(f'min="{v.min!r}"')
+        if v.max is not None:
+            attrs.append(f'max="{v.max!r}"')
+        if array:
+            return f'<{FMI3_TYPES[v.type]} {" ".join(attrs)}><Dimension start="{length}"/></{FMI3_TYPES[v.type]}>'
+        return f"<{FMI3_TYPES[v.type]} {' '.join(attrs)}/>"
+
+    def build_description(self, source_files: list[str]) -> str:
+        """The FMI 3.0 ``sources/buildDescription.xml``: how to compile the model from its sources.
+
+        Parameters
+        ----------
+        source_files : list of str
+            The C files to compile (C99), in ``sources/`` beside their headers.
+
+        Returns
+        -------
+        str
+            The XML text.
+        """
+        return "\n".join([
+            '<?xml version="1.0" encoding="UTF-8"?>',
+            '<fmiBuildDescription fmiVersion="3.0">',
+            f'  <BuildConfiguration modelIdentifier="{self.model}">',
+            '    <SourceFileSet language="C99">',
+            *[f'      <SourceFile name="{name}"/>' for name in source_files],
+            "    </SourceFileSet>",
+            "  </BuildConfiguration>",
+            "</fmiBuildDescription>",
+        ]) + "\n"
+
     def _scalar_variable(self, v: Variable) -> list[str]:
         attrs = [
             f'name="{v.name}"',
@@ -328,8 +476,13 @@ class Table:
         return list(v.depends)
 
     # ----------------------------------------------------------------- variables.h
-    def c_header(self) -> str:
+    def c_header(self, fmi_version: int = 2) -> str:
         """The ``variables.h`` the shell and the model's equations include.
+
+        Parameters
+        ----------
+        fmi_version : int
+            2, or 3: the header then defines ``FMI_VERSION`` as 3 for ``shell.h``.
 
         Returns
         -------
@@ -342,6 +495,7 @@ class Table:
             "#ifndef VARIABLES_H",
             "#define VARIABLES_H",
             "",
+            *(["#define FMI_VERSION 3"] if fmi_version == 3 else []),
             '#include "shell.h"',
             "",
             f'#define MODEL_NAME "{self.model}"',
@@ -378,6 +532,15 @@ class Table:
             if not members:
                 lines.append('    {"", CAUSALITY_LOCAL, 0.0},')
             lines.append("};")
+        if fmi_version == 3:
+            arrays = self.array_members()
+            lines += ["/* FMI 3.0 arrays: a Real vector declared as one variable, by the index of its first member",
+                      " * and its length; the later members have no value reference of their own. */",
+                      f"#define N_ARRAYS {len(arrays)}",
+                      f"static const int ARRAY_FIRST[{max(len(arrays), 1)}] = "
+                      f"{{{', '.join(f'VEC_{n}' for n in arrays) or '0'}}};",
+                      f"static const int ARRAY_LENGTH[{max(len(arrays), 1)}] = "
+                      f"{{{', '.join(f'LEN_{n}' for n in arrays) or '0'}}};"]
         lines.append("")
         lines.append("#endif")
         return "\n".join(lines) + "\n"

@@ -1,6 +1,6 @@
 """quadcosim: run the quadrotor co-simulation scenarios, build the FMUs, benchmark the master.
 
-  quadcosim build                          build the plant FMUs and the master's call runner
+  quadcosim build [--force]                build the plant FMUs (those not up to date) and the master's call runner
   quadcosim list [--parameters MODEL]      scenarios and their options (or an FMU's parameters)
   quadcosim run SCENARIO [--set k=v k2=v2 ...] [--estimator module:Class] [--out DIR] [--fault ...]
                                            (--set IMU.gyro_noise_density=0.001: an FMU parameter)
@@ -36,7 +36,7 @@ def _build(args) -> int:
     from orchestrator.calls import RunnerBuildError, build_runner
 
     try:
-        build_all(args.out or default_fmu_dir())
+        build_all(args.out or default_fmu_dir(), force=args.force)
         print(f"built {build_runner()}")
         from benchmarks import build_references
 
@@ -316,6 +316,7 @@ def parser() -> argparse.ArgumentParser:
                            "references (into build/ in a source checkout, a per-user cache when installed; a run "
                            "builds what it needs on first use)")
     build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
+    build.add_argument("--force", action="store_true", help="rebuild the FMUs that are up to date too")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL",

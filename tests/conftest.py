@@ -16,10 +16,9 @@ from fmus import MODELS, default_fmu_dir
 
 @pytest.fixture(scope="session", autouse=True)
 def built_fmus():
-    missing = [m for m in MODELS if not (default_fmu_dir() / f"{m}.fmu").is_file()]
-    if missing:
-        from fmus.build import build_all
+    from fmus.build import FMI_VERSIONS, build_all, fmu_file
 
+    if not all(fmu_file(m, default_fmu_dir(), v).is_file() for m in MODELS for v in FMI_VERSIONS):
         build_all(default_fmu_dir(), verbose=False)
     return default_fmu_dir()
 

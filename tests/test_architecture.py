@@ -294,17 +294,21 @@ def test_loads_by_name_are_seen(source, loaded):
 #: Headers the build writes into an FMU's sources (fmus/build.py): generated per model
 #: (``variables.h``, which includes ``shell.h``; ``airframe.h``), or the FMI standard's.
 GENERATED_HEADERS = {"variables.h", "airframe.h"}
-FMI_HEADERS = {"fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"}
+FMI_HEADERS = {"fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h",
+               "fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"}
 #: The C standard library, the only angle-bracket headers an FMU may include (it links nothing else).
 C_STANDARD = {"complex.h", "float.h", "math.h", "stdarg.h", "stdbool.h", "stddef.h", "stdint.h", "stdio.h",
               "stdlib.h", "string.h"}
-#: What each part of an FMU's C sources may include in quotes. The shell (the FMI state machine,
-#: one for every model) knows a model only by its generated variable table; a model
+#: What each part of an FMU's C sources may include in quotes. The shell (the FMI state machine
+#: in ``cosimulation.h``, one for every model, under the FMI 2.0 API ``shell.c`` or the FMI 3.0 API
+#: ``fmi3.c``) knows a model only by its generated variable table; a model
 #: (``fmus/<Model>/model.c``) sees the shell through that table and the shared numerical helpers,
 #: never the FMI API itself nor another model; the helpers include nothing of the project.
 C_INCLUDES = {
-    "shell.c": {"variables.h"},
-    "shell.h": {"fmi2Functions.h"},
+    "shell.c": {"cosimulation.h"},
+    "fmi3.c": {"cosimulation.h"},
+    "cosimulation.h": {"variables.h"},
+    "shell.h": {"fmi2Functions.h", "fmi3Functions.h"},
     "helper": set(),
     "model.c": {"variables.h", "airframe.h", "quaternion.h", "noise.h"},
 }
@@ -312,7 +316,7 @@ C_INCLUDES = {
 
 def _c_part(path: Path) -> str:
     if path.parent.name == "c":
-        return path.name if path.name in ("shell.c", "shell.h") else "helper"
+        return path.name if path.name in ("shell.c", "fmi3.c", "cosimulation.h", "shell.h") else "helper"
     assert path.name == "model.c", f"{path.relative_to(ROOT)}: a model's C source is its model.c alone"
     return "model.c"
 

@@ -20,15 +20,16 @@ def test_validates_and_simulates(model):
     assert all(np.isfinite(result[name]).all() for name in result.dtype.names)
 
 
+@pytest.mark.parametrize(("version", "api", "platform"), [(2, "shell.c", "linux64"), (3, "fmi3.c", "x86_64-linux")])
 @pytest.mark.parametrize("model", MODELS)
-def test_source_fmu_rebuilds_from_its_own_sources(model, tmp_path):
-    with zipfile.ZipFile(fmu_path(model)) as archive:
+def test_source_fmu_rebuilds_from_its_own_sources(model, version, api, platform, tmp_path):
+    with zipfile.ZipFile(fmu_path(model, fmi_version=version)) as archive:
         names = archive.namelist()
-        assert f"binaries/linux64/{model}.so" in names
+        assert f"binaries/{platform}/{model}.so" in names
         archive.extractall(tmp_path)
     sources = tmp_path / "sources"
     command = ["cc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC", "-I", str(sources),
-               str(sources / "shell.c"), str(sources / "model.c"), "-lm", "-o", str(tmp_path / "x.so")]
+               str(sources / api), str(sources / "model.c"), "-lm", "-o", str(tmp_path / "x.so")]
     assert subprocess.run(command, capture_output=True).returncode == 0
 
 

@@ -26,7 +26,7 @@ EXCEPTIONS = {
         "4.0": "ETDRK4 weights; the discriminant trace^2 - 4 det of a 2 x 2 matrix",
         "6.0": "RK4 weights h/6; 1/3! of the phi3 series",
     },
-    "fmus/c/shell.c": {"6.0": "RK4 weights h/6"},
+    "fmus/c/cosimulation.h": {"6.0": "RK4 weights h/6"},
     "fmus/c/noise.h": {
         "0x9E3779B97F4A7C15ull": "splitmix64 (Steele, Lea and Flood, 2014)",
         "0xBF58476D1CE4E5B9ull": "splitmix64", "0x94D049BB133111EBull": "splitmix64",

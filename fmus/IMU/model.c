@@ -120,7 +120,7 @@ static void commit_inertial(ModelInstance *m, Data *d, int64_t k) {
     }
 }
 
-fmi2Status model_initialize(ModelInstance *m) {
+Status model_initialize(ModelInstance *m) {
     Data *d = (Data *)m->data;
     const char *rates[] = {"sample_rate", "mag_sample_rate", "vibration_speed"};
     const double values[] = {R(sample_rate), R(mag_sample_rate), R(vibration_speed)};
@@ -129,18 +129,18 @@ fmi2Status model_initialize(ModelInstance *m) {
     for (i = 0; i < 3; i++) {
         if (!(values[i] > 0.0) || !isfinite(values[i])) {
             log_error(m, "parameter %s = %g %s must be positive and finite", rates[i], values[i], units[i]);
-            return fmi2Error;
+            return STATUS_ERROR;
         }
     }
     if (!(R(gyro_noise_density) >= 0.0) || !(R(acc_noise_density) >= 0.0) ||
         !(R(mag_noise_density) >= 0.0) || !(R(gyro_bias_walk) >= 0.0) || !(R(acc_bias_walk) >= 0.0)) {
         log_error(m, "noise densities and bias walks must be non-negative");
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     if (!(R(vibration_amplitude) >= 0.0) || !isfinite(R(vibration_amplitude))) {
         log_error(m, "parameter vibration_amplitude = %g m/s2 must be non-negative and finite (0: off)",
                   R(vibration_amplitude));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     for (i = 0; i < 3; i++) {
         d->gyro_bias[i] = RV(b_g)[i];
@@ -150,7 +150,7 @@ fmi2Status model_initialize(ModelInstance *m) {
     d->inertial.next = (int64_t)ceil(m->time * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     d->magnetic.next = (int64_t)ceil(m->time * R(mag_sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     d->inertial.current = d->magnetic.current = -1;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
 /* Index one past the last instant of clock `rate` in [t, t + h), or -1 when too many. */
@@ -162,22 +162,22 @@ static int64_t end_of_step(ModelInstance *m, const Clock *c, double rate, const 
     return (int64_t)last;
 }
 
-fmi2Status model_do_step(ModelInstance *m, double t, double h) {
+Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     /* instants in [t, t + h) become final, with the inputs held over the step */
     const double *q = RV(q);
     double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     int64_t inertial_end, magnetic_end;
     if (!(fabs(norm - 1.0) <= QUATERNION_TOLERANCE)) {
-        log_error(m, "fmi2DoStep: the attitude q = (%g, %g, %g, %g) at t = %g has norm %g; the IMU takes a unit "
+        log_error(m, FMI_NAME(DoStep) ": the attitude q = (%g, %g, %g, %g) at t = %g has norm %g; the IMU takes a unit "
                      "quaternion and normalises one only within %g of norm 1",
                   q[0], q[1], q[2], q[3], t, norm, QUATERNION_TOLERANCE);
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     inertial_end = end_of_step(m, &d->inertial, R(sample_rate), "sample_rate", t, h);
     magnetic_end = end_of_step(m, &d->magnetic, R(mag_sample_rate), "mag_sample_rate", t, h);
     int n;
-    if (inertial_end < 0 || magnetic_end < 0) return fmi2Error;
+    if (inertial_end < 0 || magnetic_end < 0) return STATUS_ERROR;
     for (; d->inertial.next < inertial_end; d->inertial.next++) {
         /* the sample at t is already current unless inputs changed since it was read */
         if (!(d->inertial.current == d->inertial.next && !m->outputs_stale)) take_inertial(m, d, d->inertial.next);
@@ -186,7 +186,7 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     for (; d->magnetic.next < magnetic_end; d->magnetic.next++)
         if (!(d->magnetic.current == d->magnetic.next && !m->outputs_stale)) take_magnetic(m, d, d->magnetic.next);
     for (n = 0; n < N_MOTORS; n++) d->phase[n] = fmod(d->phase[n] + (RV(omega_r))[n] * h, 2.0 * PI);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
 /* At an instant of `rate` not yet final, the sample follows the present inputs. */

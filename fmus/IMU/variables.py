@@ -71,6 +71,9 @@ TABLE = Table(
         *[Real(f"acc_bias_{a}", "output", unit="m/s2", description=f"true accelerometer bias, {a}_B")
           for a in _AXES],
     ],
+    # the sensors' outputs as arrays in FMI 3.0 (IMU.acc), as the master connects them
+    arrays={"acc": "accelerometer (x, y, z)_B", "gyro": "gyrometer (x, y, z)_B",
+            "magneto": "magnetometer (x, y, z)_B"},
 )
 
 # Other names a user may give a parameter vector (``--set IMU.gyro_bias=0.01,0,0``): the outputs

@@ -103,60 +103,60 @@ static int bank_ok(ModelInstance *m) {
     return 0;
 }
 
-fmi2Status model_initialize(ModelInstance *m) {
+Status model_initialize(ModelInstance *m) {
     Data *d = (Data *)m->data;
     if (!(R(sample_rate) > 0.0) || !isfinite(R(sample_rate))) {
         log_error(m, "parameter sample_rate = %g Hz must be positive and finite", R(sample_rate));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     if (!(R(airspeed) > 0.0) || !isfinite(R(airspeed))) {
         log_error(m, "parameter airspeed = %g m/s must be positive and finite (r = g tan(phi) / V)", R(airspeed));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     if (!(R(gravity) > 0.0)) {
         log_error(m, "parameter gravity = %g m/s2 must be positive", R(gravity));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     if (!(R(temperature_period) > 0.0) || !(R(cloud_ramp) > 0.0) || !(R(cloud_duration) >= 0.0)) {
         log_error(m, "temperature_period and cloud_ramp must be positive and cloud_duration non-negative");
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     if (!(R(ir_noise) >= 0.0) || !(R(gps_heading_noise) >= 0.0)) {
         log_error(m, "noise levels ir_noise and gps_heading_noise must be non-negative");
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     double delay = samples(m, R(gps_delay)), window = samples(m, R(gps_window));
     if (delay < 0.0 || window < 1.0) {
         log_error(m, "gps_delay = %g s and gps_window = %g s must be whole numbers of sample periods "
                      "(1 / sample_rate = %g s), the window at least one", R(gps_delay), R(gps_window),
                   1.0 / R(sample_rate));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     if (delay + window >= (double)HISTORY) {
         log_error(m, "gps_delay + gps_window = %g s spans %.3g samples, more than the %d kept; shorten them",
                   R(gps_delay) + R(gps_window), delay + window, HISTORY - 1);
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     d->delay = (int)delay;
     d->window = (int)window;
-    if (!bank_ok(m)) return fmi2Error;
+    if (!bank_ok(m)) return STATUS_ERROR;
     d->psi = R(psi0);
     d->next_sample = (int64_t)ceil(m->time * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     d->first = d->next_sample;
     d->current = d->first - 1;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status model_do_step(ModelInstance *m, double t, double h) {
+Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     double r, tk, last = ceil((t + h) * R(sample_rate) - SAMPLE_INSTANT_TOLERANCE);
     int64_t end;
     /* instants in [t, t + h) become final, with phi held over the step */
-    if (!bank_ok(m)) return fmi2Error;
+    if (!bank_ok(m)) return STATUS_ERROR;
     if (!work_allowed(m, last - (double)d->next_sample, h,
                       "take shorter communication steps or a lower sample_rate", "samples at sample_rate = %g Hz",
                       R(sample_rate)))
-        return fmi2Error;
+        return STATUS_ERROR;
     end = (int64_t)last;
     r = turn_rate(m);
     for (; d->next_sample < end; d->next_sample++) {
@@ -166,7 +166,7 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
         }
     }
     d->psi += r * h;
-    return fmi2OK;
+    return STATUS_OK;
 }
 
 void model_outputs(ModelInstance *m) {

@@ -300,7 +300,7 @@ static void substep(ModelInstance *m, Data *d, double h) {
     }
 }
 
-fmi2Status model_initialize(ModelInstance *m) {
+Status model_initialize(ModelInstance *m) {
     Data *d = (Data *)m->data;
     const char *names[] = {"R_m", "L_m", "k_e", "J_r", "n_cells", "capacity", "i_max", "sub_step"};
     const double values[] = {R(R_m), R(L_m), R(k_e), R(J_r), R(n_cells), R(capacity), R(i_max), R(sub_step)};
@@ -309,13 +309,13 @@ fmi2Status model_initialize(ModelInstance *m) {
     for (i = 0; i < sizeof values / sizeof values[0]; i++) {
         if (!(values[i] > 0.0) || !isfinite(values[i])) {
             log_error(m, "parameter %s = %g must be positive and finite", names[i], values[i]);
-            return fmi2Error;
+            return STATUS_ERROR;
         }
     }
     if (!(R(k_m) >= 0.0) || !(R(R_b) >= 0.0) || !(R(soc0) >= 0.0 && R(soc0) <= 1.0)) {
         log_error(m, "k_m = %g and R_b = %g must be non-negative and soc0 = %g within [0, 1]",
                   R(k_m), R(R_b), R(soc0));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     for (n = 0; n < N_MOTORS; n++) {
         const double *v = RV(v) + 3 * n;
@@ -323,7 +323,7 @@ fmi2Status model_initialize(ModelInstance *m) {
         if (!(norm > 0.0) || !isfinite(norm)) {
             log_error(m, "field direction of motor %d is zero or not finite; give v%d_x/y/z", n + 1,
                       n + 1);
-            return fmi2Error;
+            return STATUS_ERROR;
         }
         for (i = 0; i < 3; i++) d->v[n][i] = v[i] / norm;
         d->x[OMEGA + n] = R(omega0);
@@ -331,19 +331,19 @@ fmi2Status model_initialize(ModelInstance *m) {
         if (fabs(d->x[CURRENT + n]) > R(i_max)) {
             log_error(m, "omega0 = %g rad/s needs a motor current of %.3g A, beyond i_max = %g A: lower "
                       "omega0 or raise i_max", R(omega0), d->x[CURRENT + n], R(i_max));
-            return fmi2Error;
+            return STATUS_ERROR;
         }
     }
     d->x[SOC] = R(soc0);
     d->main.h = -1.0;
     select_modes(m, d, d->x);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status model_do_step(ModelInstance *m, double t, double h) {
+Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     int n = substep_count(m, h, R(sub_step), "sub_step"), k;
-    if (n == 0) return fmi2Error;
+    if (n == 0) return STATUS_ERROR;
     for (k = 0; k < N_MOTORS; k++) {
         double c = RV(c)[k];
         int outside = c < 0.0 || c > 1.0;
@@ -354,13 +354,13 @@ fmi2Status model_do_step(ModelInstance *m, double t, double h) {
     for (k = 0; k < n; k++) {
         substep(m, d, h / n);
         if (d->x[SOC] < 0.0) { /* an empty battery is the end of the flight, not a negative charge */
-            log_error(m, "fmi2DoStep: the battery is empty at t = %g s (state of charge %g); raise capacity "
+            log_error(m, FMI_NAME(DoStep) ": the battery is empty at t = %g s (state of charge %g); raise capacity "
                          "(%g A.s) or soc0 (%g), or shorten the run",
                       t + (k + 1) * h / n, d->x[SOC], R(capacity), R(soc0));
-            return fmi2Error;
+            return STATUS_ERROR;
         }
     }
-    return fmi2OK;
+    return STATUS_OK;
 }
 
 void model_outputs(ModelInstance *m) {

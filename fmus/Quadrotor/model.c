@@ -104,7 +104,7 @@ static void derivatives(ModelInstance *m, double t, const double *x, double *dx)
     dw[2] = (tau[2] - (R(Jyy) - R(Jxx)) * w[0] * w[1]) / R(Jzz);
 }
 
-fmi2Status model_initialize(ModelInstance *m) {
+Status model_initialize(ModelInstance *m) {
     Data *d = (Data *)m->data;
     double c1, s1, c2, s2, c3, s3;
     const char *positive[] = {"m", "Jxx", "Jyy", "Jzz", "arm", "k_f", "g", "sub_step"};
@@ -115,19 +115,19 @@ fmi2Status model_initialize(ModelInstance *m) {
     for (i = 0; i < sizeof values / sizeof values[0]; i++) {
         if (!(values[i] > 0.0) || !isfinite(values[i])) {
             log_error(m, "parameter %s = %g must be positive and finite", positive[i], values[i]);
-            return fmi2Error;
+            return STATUS_ERROR;
         }
     }
     for (i = 0; i < sizeof others / sizeof others[0]; i++) {
         if (!(others[i] >= 0.0) || !isfinite(others[i])) {
             log_error(m, "parameter %s = %g must be non-negative and finite", non_negative[i], others[i]);
-            return fmi2Error;
+            return STATUS_ERROR;
         }
     }
     if (R(Jxx) + R(Jyy) < R(Jzz) || R(Jyy) + R(Jzz) < R(Jxx) || R(Jzz) + R(Jxx) < R(Jyy)) {
         log_error(m, "inertia (%g, %g, %g) violates the triangle inequality of a rigid body",
                   R(Jxx), R(Jyy), R(Jzz));
-        return fmi2Error;
+        return STATUS_ERROR;
     }
     d->x[POSITION] = R(p_x0);
     d->x[POSITION + 1] = R(p_y0);
@@ -152,17 +152,17 @@ fmi2Status model_initialize(ModelInstance *m) {
     if (m->boolean[VB_clamped]) {
         for (i = 0; i < 3; i++) d->x[VELOCITY + i] = d->x[RATE + i] = 0.0;
     }
-    return fmi2OK;
+    return STATUS_OK;
 }
 
-fmi2Status model_do_step(ModelInstance *m, double t, double h) {
+Status model_do_step(ModelInstance *m, double t, double h) {
     Data *d = (Data *)m->data;
     int n = substep_count(m, h, R(sub_step), "sub_step"), k;
     double hh;
-    if (n == 0) return fmi2Error;
+    if (n == 0) return STATUS_ERROR;
     hh = h / n;
     for (k = 0; k < n; k++) rk4_step(m, derivatives, t + k * hh, hh, d->x, N_STATES);
-    return fmi2OK;
+    return STATUS_OK;
 }
 
 void model_outputs(ModelInstance *m) {

@@ -1,14 +1,37 @@
-/* The FMI 2.0 Co-Simulation shell shared by every quadcosim model.
+/* The FMI Co-Simulation shell shared by every quadcosim model, for FMI 2.0 and 3.0.
  *
  * The shell owns the FMI state machine, get/set by value reference, logging and error
  * statuses. A model provides its variable table (generated variables.h) and the four
- * functions declared at the bottom of this file, in a short model.c.
+ * functions declared at the bottom of this file, in a short model.c. The same sources build
+ * both versions: the state machine (cosimulation.h) under the FMI 2.0 API (shell.c) or the FMI
+ * 3.0 API (fmi3.c); variables.h of an FMI 3.0 build defines FMI_VERSION as 3.
  */
 #ifndef SHELL_H
 #define SHELL_H
 
 #include <stddef.h>
+
+#ifndef FMI_VERSION
+#define FMI_VERSION 2
+#endif
+
+/* What a model returns (the FMI version's own status values), and the name of an FMI function
+ * in its messages: FMI_NAME(DoStep) is "fmi2DoStep" or "fmi3DoStep". */
+#if FMI_VERSION == 3
+#include "fmi3Functions.h"
+typedef fmi3Status Status;
+#define STATUS_OK fmi3OK
+#define STATUS_WARNING fmi3Warning
+#define STATUS_ERROR fmi3Error
+#define FMI_NAME(function) "fmi3" #function
+#else
 #include "fmi2Functions.h"
+typedef fmi2Status Status;
+#define STATUS_OK fmi2OK
+#define STATUS_WARNING fmi2Warning
+#define STATUS_ERROR fmi2Error
+#define FMI_NAME(function) "fmi2" #function
+#endif
 
 typedef enum {
     CAUSALITY_PARAMETER,
@@ -33,17 +56,22 @@ typedef enum {
 
 typedef struct ModelInstance {
     const char *instance_name;
+#if FMI_VERSION == 3
+    fmi3InstanceEnvironment environment;
+    fmi3LogMessageCallback log_message; /* may be NULL: no logging */
+#else
     const fmi2CallbackFunctions *callbacks;
-    fmi2Boolean logging_on;
+#endif
+    int logging_on;
     Mode mode;
     double time;
     double *real;
     int *integer;
-    fmi2Boolean *boolean;
+    int *boolean; /* 0 or 1 */
     int outputs_stale; /* inputs changed since the outputs were last computed */
     int step_failed;   /* set by a shell helper that refused its work in this doStep */
     void *data;        /* the model's own state, MODEL_DATA_SIZE bytes */
-    unsigned live;     /* LIVE_MARK from fmi2Instantiate to fmi2FreeInstance (shell.c) */
+    unsigned live;     /* LIVE_MARK from instantiation to fmiNFreeInstance (shell.c) */
     struct ModelInstance *next_free; /* the next freed slot waiting for reuse */
 } ModelInstance;
 
@@ -80,10 +108,10 @@ void rk4_step(ModelInstance *m, Derivatives f, double t, double h, double *x, in
 /* What each model implements. */
 extern const size_t MODEL_DATA_SIZE;
 /* Check parameters, set the initial state and outputs. */
-fmi2Status model_initialize(ModelInstance *m);
+Status model_initialize(ModelInstance *m);
 /* Advance the state from t to t + h with the inputs held. A model whose state can become
  * non-finite reports it here; outputs are refreshed lazily, when next read. */
-fmi2Status model_do_step(ModelInstance *m, double t, double h);
+Status model_do_step(ModelInstance *m, double t, double h);
 /* Outputs from the state and the present inputs (direct feedthrough). */
 void model_outputs(ModelInstance *m);
 
