@@ -169,19 +169,31 @@ class Step3(ctypes.Structure):
 _library = None
 
 
+def typed_path(build: bool = False):
+    """The compiled ``orchestrator/c/typed.c``, beside the call runner
+    (:func:`orchestrator.calls.runner_dir`): compiled when missing or older than its source, or
+    when ``build``.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from pathlib import Path
+
+    from orchestrator.calls import compile_shared, runner_dir
+
+    source = Path(__file__).resolve().parent / "c" / "typed.c"
+    library = runner_dir() / "libquadcosim_typed.so"
+    if build or not library.is_file() or library.stat().st_mtime < source.stat().st_mtime:
+        compile_shared(source, library)
+    return library
+
+
 def typed_library() -> ctypes.CDLL:
-    """``orchestrator/c/typed.c``, compiled beside the call runner on first use, loaded once."""
+    """The typed calls' library (:func:`typed_path`), loaded once per process."""
     global _library
     if _library is None:
-        from pathlib import Path
-
-        from orchestrator.calls import compile_shared, runner_dir
-
-        source = Path(__file__).resolve().parent / "c" / "typed.c"
-        library = runner_dir() / "libquadcosim_typed.so"
-        if not library.is_file() or library.stat().st_mtime < source.stat().st_mtime:
-            compile_shared(source, library)
-        _library = ctypes.CDLL(str(library))
+        _library = ctypes.CDLL(str(typed_path()))
     return _library
 
 

@@ -38,6 +38,9 @@ def _build(args) -> int:
     try:
         build_all(args.out or default_fmu_dir())
         print(f"built {build_runner()}")
+        from orchestrator.fmi_types import typed_path
+
+        print(f"built {typed_path(build=True)}")
         from benchmarks import build_references
 
         for library in build_references():

@@ -80,7 +80,8 @@ def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus):
     parameters = {"start_count": 3, "invert": True, "label": "abc"}
     reference = fmpy.simulate_fmu(str(typed_fmus[2]), stop_time=STEPS * DT, output_interval=DT, input=signals,
                                   start_values=parameters, output=OUTPUTS2)
-    block_system = _system(typed_fmus[2], signals, parameters)
+    with pytest.warns(RuntimeWarning, match=r"T: tag is String or Binary, not signals: .* meta\['texts'\]"):
+        block_system = _system(typed_fmus[2], signals, parameters)
     result = block_system.run(STEPS * DT)
     _equal_to_fmpy(result, reference, OUTPUTS2)
     counter = result["T.counter"]
@@ -90,7 +91,7 @@ def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus):
     assert result["T.above"].dtype == bool and np.any(result["T.above"]) and not np.all(result["T.above"])
     assert result["T.k_sum"][-1] == np.sum(signals["k_in"][:-1])  # the inputs of every step but the last
     assert set(result["T.mode_out"]) == {1, 2, 3}
-    assert result.meta["texts"] == {"T.label": "abc"}  # a String parameter, recorded as parameters are
+    assert result.meta["texts"] == {"T.label": "abc", "T.tag": "abc"}  # String variables, recorded once
     assert block_system.blocks["T"].dtypes == {"k_in": "int32", "mode_in": "int32", "b_in": "bool",
                                                "k_sum": "int32", "counter": "int32", "flips": "int32",
                                                "mode_out": "int32", "above": "bool"}
@@ -196,7 +197,7 @@ def test_typed_signals_plot_as_steps(typed_fmus):
     import matplotlib
 
     matplotlib.use("Agg")
-    result = _system(typed_fmus[2], _inputs(TYPES2), {}).run(0.05)
+    result = _system(typed_fmus[3], _inputs(TYPES3), {}, master_vector=0.0).run(0.05)
     ax = result.plot("T.counter", "T.x")
     assert [line.get_drawstyle() for line in ax.lines] == ["steps-post", "default"]
 
@@ -222,3 +223,27 @@ def test_an_fmu_with_clocks_is_refused_by_name(typed_fmus, tmp_path, capsys):
                  "--out", str(tmp_path / "x")]) == 2
     assert "has clocks (tick)" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus):
+    """Set and get by name (an array element alone: the others kept), step, and a reset that
+    gives what a fresh instance gives, bit for bit (the pool of the pytest plugin resets)."""
+    from orchestrator import FMUInstance
+    from orchestrator.fmu import FMU3Instance
+
+    def run(instance):
+        instance.set(["v_2", "u", "i8_in", "enable"], [4.0, 30.0, -3.0, 1.0])
+        for k in range(20):
+            instance.step(k * DT, DT)
+        return instance.get(["w_1", "w_2", "w_3", "x", "counter", "i8_out", "above"])
+
+    fresh = FMUInstance(typed_fmus[3], {"gain": 2.0})
+    assert isinstance(fresh, FMU3Instance)
+    first = run(fresh)
+    assert np.allclose(first[:3], [0.0, 4.0 * 20 * DT, 0.0], rtol=1e-12, atol=0)
+    assert first[4] == 20 and first[5] == -3 + 20  # x gains 0.06 a step: one crossing of 0.05 each step
+    fresh.reset({"gain": 2.0})
+    assert np.array_equal(run(fresh), first)
+    fresh.close()
+    with pytest.raises(KeyError, match=r"T3\.v is an array; name its elements \(v_1, v_2, v_3, \.\.\.\)"):
+        FMUInstance(typed_fmus[3], name="T3").get(["v"])

@@ -1,6 +1,7 @@
 /* An FMI 2.0 Co-Simulation model with a variable of every FMI 2.0 type, for the tests: Real,
- * Integer, Boolean and Enumeration inputs and outputs, String and other parameters, and a state
- * that changes at events (a counter that steps each time an integrator crosses a threshold).
+ * Integer, Boolean and Enumeration inputs and outputs, String and other parameters, a String
+ * output (tag, the label), and a state that changes at events (a counter that steps each time an
+ * integrator crosses a threshold).
  *
  * Per doStep(t, h), from the inputs set before it:
  *   x += gain u h; when x >= threshold: counter += 1 and x -= threshold (the event);
@@ -14,7 +15,7 @@
 enum { R_U, R_X, R_GAIN, R_THRESHOLD, N_REAL };
 enum { I_K_IN, I_K_SUM, I_COUNTER, I_START_COUNT, I_FLIPS, I_MODE_IN, I_MODE_OUT, N_INTEGER };
 enum { B_IN, B_ABOVE, B_INVERT, N_BOOLEAN };
-enum { S_LABEL, N_STRING };
+enum { S_LABEL, S_TAG, N_STRING }; /* tag: an output that reads the label */
 
 typedef struct {
     fmi2Real r[N_REAL];
@@ -98,7 +99,7 @@ ACCESS(Boolean, b, N_BOOLEAN)
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]) {
     Model *m = c;
     for (size_t k = 0; k < n; k++) {
-        if (vr[k] != S_LABEL) return fmi2Error;
+        if (vr[k] >= N_STRING) return fmi2Error;
         v[k] = m->label;
     }
     return fmi2OK;
