@@ -176,8 +176,15 @@ class SetInputs:
 
 @dataclass(frozen=True)
 class GetOutputs:
-    """One call that writes FMU outputs into their bus slots (as :class:`SetInputs`;
-    :meth:`orchestrator.fmu.FMUInstance.getter`)."""
+    """One call that writes FMU outputs into their bus slots (as :class:`SetInputs`).
+
+    Parameters
+    ----------
+    block : orchestrator.FMUBlock
+        The block, with a live instance.
+    entry : orchestrator.fmi_types.CEntry
+        The C call (:meth:`orchestrator.fmu.FMUInstance.getter`).
+    """
 
     block: object
     entry: object

@@ -102,7 +102,20 @@ def signals(description, causality: str) -> list[Signal]:
 
 
 def dtypes(description, names) -> dict[str, str]:
-    """NumPy type names of the signals ``names`` of an FMU that are not float64 (``{"counter": "int32"}``)."""
+    """NumPy type names of the signals of an FMU that are not float64.
+
+    Parameters
+    ----------
+    description : fmpy.model_description.ModelDescription
+        The FMU's model description.
+    names : sequence of str
+        Signal names of its inputs and outputs.
+
+    Returns
+    -------
+    dict of str to str
+        ``{"counter": "int32"}``; a float64 signal is left out.
+    """
     kinds = types_of(is_fmi3(description))
     by_name = {s.name: s for causality in ("input", "output") for s in signals(description, causality)}
     found = {}
@@ -253,7 +266,19 @@ def typed_entry(function_of, component: int, fmi3: bool, pairs: list[tuple[Signa
 
 
 def step3_entry(do_step, component: int) -> CEntry:
-    """The call of ``fmi3DoStep`` through ``step3`` (``typed.c``), its context in ``keep[0]``."""
+    """The call of ``fmi3DoStep`` through ``step3`` (``typed.c``), its context in ``keep[0]``.
+
+    Parameters
+    ----------
+    do_step : ctypes function
+        The FMU's ``fmi3DoStep``.
+    component : int
+        The FMU instance.
+
+    Returns
+    -------
+    CEntry
+    """
     context = Step3(address(do_step), component, 0, 0, 0.0)
     function = typed_library()["step3"]
     return CEntry(address(function), ctypes.addressof(context), 0, 0, 0, "fmi3DoStep", (context, function))

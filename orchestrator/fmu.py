@@ -606,6 +606,17 @@ class FMU3Instance(FMUInstance):
     master's communication steps; an FMU that asks to end the simulation (``terminateSimulation``)
     ends the run with what was recorded. Clocks need event mode, which the master does not run:
     an FMU with clocks is refused, by name (:func:`fmu_file`).
+
+    Parameters
+    ----------
+    model : str
+        Path of an FMI 3.0 ``.fmu`` file.
+    parameters : dict, optional
+        Overrides of parameter start values, by variable name.
+    name : str, optional
+        Instance (block) name used in messages.
+    start_time : float
+        Start time (s).
     """
 
     fmi3 = True
