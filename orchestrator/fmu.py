@@ -556,6 +556,16 @@ class FMUInstance:
             raise FMUError(self.name, "fmi2DoStep", status, t, list(self.log))
         self.time = t + h
 
+    def terminated(self) -> bool:
+        """Whether the FMU asked to end the simulation in its last step (FMI 2.0: a ``fmi2DoStep``
+        that returned Discard with ``fmi2Terminated`` true)."""
+        from fmpy.fmi2 import fmi2Terminated
+
+        try:
+            return self._slave.getBooleanStatus(fmi2Terminated)
+        except Exception:  # an FMU without the status functions: not known, not claimed
+            return False
+
     def close(self):
         """Terminate and free the instance (once; an instance in error is freed all the same)."""
         if not getattr(self, "closed", True):
@@ -653,6 +663,10 @@ class FMU3Instance(FMUInstance):
         if status > 1:
             raise FMUError(self.name, "fmi3DoStep", status, t, list(self.log))
         self.time = t + h
+
+    def terminated(self) -> bool:
+        """Whether the FMU asked to end the simulation in its last ``fmi3DoStep``."""
+        return bool(self._step.keep[0].terminated)
 
     def _free(self):
         self._slave.fmi3FreeInstance(self.component)

@@ -301,6 +301,10 @@ class Plan:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
             message = str(error)
+            instance = getattr(self.system.blocks.get(error.block), "instance", None)
+            if error.status == 2 and instance is not None and instance.terminated():
+                message = f"{error.block}: the FMU asked to end the simulation ({error.function} returned Discard, " \
+                          f"fmi2Terminated) at t = {error.time:.6g} s; the record holds the steps before"
             if "not a finite number" in message:
                 message = self._non_finite(self.t0 + self.n * self.dt) + "\n" + message
             raise SimulationError(message, self.result(error=message)) from None

@@ -247,3 +247,28 @@ def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus):
     fresh.close()
     with pytest.raises(KeyError, match=r"T3\.v is an array; name its elements \(v_1, v_2, v_3, \.\.\.\)"):
         FMUInstance(typed_fmus[3], name="T3").get(["v"])
+
+
+def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typed_fmus):
+    """terminateSimulation from fmi3DoStep (the counter reaching stop_count) ends the run: the
+    error says so, and the record holds every step before, as fmpy's does."""
+    import fmpy
+
+    from orchestrator import SimulationError
+
+    system = System(dt=DT)
+    system.add(FMUBlock("T", model=typed_fmus[3], parameters={"stop_count": 4}))
+    for name in TYPES3:
+        system.set_input(f"T.{name}", {"u": 7.3, "enable": 1.0, "mode": 1.0}.get(name, 0.0))
+    system.set_input("T.v", 0.0)
+    with pytest.raises(SimulationError, match=r"T: fmi3DoStep asked to end the simulation \(terminateSimulation"):
+        system.run(STEPS * DT)
+    try:
+        system.run(STEPS * DT)
+    except SimulationError as error:
+        result = error.result
+    reference = fmpy.simulate_fmu(str(typed_fmus[3]), stop_time=STEPS * DT, output_interval=DT,
+                                  start_values={"stop_count": 4, "u": 7.3}, output=["counter", "x"])
+    assert result["T.counter"][-1] == 3 and reference["counter"][-1] == 4  # fmpy records the last step too
+    assert np.array_equal(result["T.counter"], reference["counter"][:-1])
+    assert np.allclose(result["T.x"], reference["x"][:-1], rtol=0, atol=1e-9)

@@ -6,7 +6,8 @@
  * Per doStep(t, h), from the inputs set before it:
  *   x += gain u h while enable; when x >= threshold: counter += 1 and x -= threshold (the event);
  *   f32_acc += f32_in h (in single precision); each integer output = its input + counter;
- *   above = counter odd; mode_out = mode; w += v h; m = [[x, counter], [w_1, -x]]; steps += 1.
+ *   above = counter odd; mode_out = mode; w += v h; m = [[x, counter], [w_1, -x]]; steps += 1;
+ *   terminateSimulation once the counter reaches stop_count (when above 0).
  * Outputs depend on the state only (no direct feedthrough). */
 #include <stdlib.h>
 #include <string.h>
@@ -25,6 +26,7 @@ typedef struct {
     uint32_t u32_in, u32_out;
     int64_t i64_in, i64_out;
     uint64_t u64_in, u64_out, steps;
+    int32_t stop_count; /* > 0: the FMU asks to end the simulation when the counter reaches it */
     bool enable, above;
     int64_t mode, mode_out;
     double v[3], w[3], m[4];
@@ -121,6 +123,7 @@ static void *where(Model *m, fmi3ValueReference vr, int type, size_t *count) {
     case 29: *count = 3; return type == F64 ? m->w : NULL;
     case 30: *count = 4; return type == F64 ? m->m : NULL;
     case 33: return type == U64 ? &m->steps : NULL;
+    case 34: return type == I32 ? &m->stop_count : NULL;
     default: return NULL;
     }
 }
@@ -229,7 +232,7 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3Boolean 
     m->steps += 1;
     settle(m);
     *event_needed = false;
-    *terminate = false;
+    *terminate = m->stop_count > 0 && m->counter >= m->stop_count;
     *early = false;
     *last = t + h;
     return fmi3OK;
