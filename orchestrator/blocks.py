@@ -281,7 +281,7 @@ class FMUBlock:
     """
 
     def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
-        from orchestrator.fmi_types import dtypes, signals, unit
+        from orchestrator.fmi_types import dtypes, is_parameter, signals, unit
         from orchestrator.fmu import fmu_file, model_description
 
         if int(period) != period or period < 1:
@@ -297,7 +297,7 @@ class FMUBlock:
         self.inputs = tuple(s.name for s in inputs)
         self.outputs = tuple(s.name for s in outputs)
         self.dtypes = dtypes(description, self.inputs + self.outputs)
-        self.parameter_names = tuple(v.name for v in variables if v.causality == "parameter")
+        self.parameter_names = tuple(v.name for v in variables if is_parameter(v))
         self.units = {s.name: unit(s.variable) for s in outputs}  # labels the results
         self.input_units = {s.name: unit(s.variable) for s in inputs}
         unknown = set(self.parameters) - set(self.parameter_names)
@@ -316,8 +316,9 @@ class FMUBlock:
             import warnings
 
             warnings.warn(f"{name}: {', '.join(texts)} {'is' if len(texts) == 1 else 'are'} String or Binary, not "
-                          "signals: an input keeps its start value, and each one's value after initialization is "
-                          "recorded in the result's meta['texts']", RuntimeWarning, stacklevel=2)
+                          "signals: an input keeps its start value unless set as a parameter, and each one's value "
+                          "after initialization is recorded in the result's meta['texts']", RuntimeWarning,
+                          stacklevel=2)
 
     def instantiate(self, t0: float):
         """Instantiate and initialize the FMU, parameters set.

@@ -126,6 +126,12 @@ def dtypes(description, names) -> dict[str, str]:
     return found
 
 
+def is_parameter(variable) -> bool:
+    """Whether a variable is set by name before a run: a parameter, or a String or Binary input
+    (not a signal, so set once, at initialization)."""
+    return variable.causality == "parameter" or (variable.causality == "input" and variable.type in TEXT_TYPES)
+
+
 def unit(variable) -> str:
     """The unit of a variable, its own or its declared type's; ``""`` if none."""
     return variable.unit or getattr(variable.declaredType, "unit", None) or ""

@@ -45,6 +45,7 @@ from orchestrator.fmi_types import (
     TEXT_TYPES,
     CEntry,
     address,
+    is_parameter,
     signals,
     step3_entry,
     typed_entry,
@@ -217,7 +218,7 @@ class FMUInstance:
         description = model_description(path)
         self.description = description
         self.variables = {v.name: v for v in description.modelVariables}
-        self.parameters = [v.name for v in description.modelVariables if v.causality == "parameter"]
+        self.parameters = [v.name for v in description.modelVariables if is_parameter(v)]
         self.signal = {s.name: s for causality in ("input", "output") for s in signals(description, causality)}
         self.inputs = [s.name for s in signals(description, "input")]
         self.outputs = [s.name for s in signals(description, "output")]
@@ -339,7 +340,7 @@ class FMUInstance:
         checked = {}
         for name, value in parameters.items():
             variable = self.variables.get(name)
-            if variable is None or variable.causality != "parameter":
+            if variable is None or not is_parameter(variable):
                 raise ValueError(
                     f"{self.name} has no parameter {name!r}.{nearest(name, self.parameters)} "
                     f"Its parameters are listed by `quadcosim list --parameters {self.name}`."

@@ -21,7 +21,7 @@ import numbers
 import re
 
 from orchestrator.blocks import FMUBlock
-from orchestrator.fmi_types import INTEGER_TYPES
+from orchestrator.fmi_types import INTEGER_TYPES, is_parameter
 from orchestrator.fmu import nearest
 from orchestrator.signals import expand
 
@@ -45,7 +45,7 @@ def fmu_parameters(model: str) -> dict:
     from orchestrator.fmu import fmu_file, model_description
 
     description = model_description(fmu_file(model))
-    return {v.name: v for v in description.modelVariables if v.causality == "parameter"}
+    return {v.name: v for v in description.modelVariables if is_parameter(v)}
 
 
 def model_notes(model: str) -> tuple[dict, dict]:

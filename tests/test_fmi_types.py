@@ -77,10 +77,10 @@ def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus):
     import fmpy
 
     signals = _inputs(TYPES2)
-    parameters = {"start_count": 3, "invert": True, "label": "abc"}
+    parameters = {"start_count": 3, "invert": True, "label": "abc", "note": "set"}
     reference = fmpy.simulate_fmu(str(typed_fmus[2]), stop_time=STEPS * DT, output_interval=DT, input=signals,
                                   start_values=parameters, output=OUTPUTS2)
-    with pytest.warns(RuntimeWarning, match=r"T: tag is String or Binary, not signals: .* meta\['texts'\]"):
+    with pytest.warns(RuntimeWarning, match=r"T: tag, note are String or Binary, not signals: .* meta\['texts'\]"):
         block_system = _system(typed_fmus[2], signals, parameters)
     result = block_system.run(STEPS * DT)
     _equal_to_fmpy(result, reference, OUTPUTS2)
@@ -91,7 +91,7 @@ def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus):
     assert result["T.above"].dtype == bool and np.any(result["T.above"]) and not np.all(result["T.above"])
     assert result["T.k_sum"][-1] == np.sum(signals["k_in"][:-1])  # the inputs of every step but the last
     assert set(result["T.mode_out"]) == {1, 2, 3}
-    assert result.meta["texts"] == {"T.label": "abc", "T.tag": "abc"}  # String variables, recorded once
+    assert result.meta["texts"] == {"T.label": "abc", "T.tag": "abc", "T.note": "set"}  # recorded once
     assert block_system.blocks["T"].dtypes == {"k_in": "int32", "mode_in": "int32", "b_in": "bool",
                                                "k_sum": "int32", "counter": "int32", "flips": "int32",
                                                "mode_out": "int32", "above": "bool"}

@@ -1,7 +1,7 @@
 /* An FMI 2.0 Co-Simulation model with a variable of every FMI 2.0 type, for the tests: Real,
  * Integer, Boolean and Enumeration inputs and outputs, String and other parameters, a String
- * output (tag, the label), and a state that changes at events (a counter that steps each time an
- * integrator crosses a threshold).
+ * output (tag, the label), a String input (note), and a state that changes at events (a counter
+ * that steps each time an integrator crosses a threshold).
  *
  * Per doStep(t, h), from the inputs set before it:
  *   x += gain u h; when x >= threshold: counter += 1 and x -= threshold (the event);
@@ -15,13 +15,14 @@
 enum { R_U, R_X, R_GAIN, R_THRESHOLD, N_REAL };
 enum { I_K_IN, I_K_SUM, I_COUNTER, I_START_COUNT, I_FLIPS, I_MODE_IN, I_MODE_OUT, N_INTEGER };
 enum { B_IN, B_ABOVE, B_INVERT, N_BOOLEAN };
-enum { S_LABEL, S_TAG, N_STRING }; /* tag: an output that reads the label */
+enum { S_LABEL, S_TAG, S_NOTE, N_STRING }; /* tag: an output that reads the label; note: an input */
 
 typedef struct {
     fmi2Real r[N_REAL];
     fmi2Integer i[N_INTEGER];
     fmi2Boolean b[N_BOOLEAN];
     char label[64];
+    char note[64];
     const fmi2CallbackFunctions *callbacks;
     fmi2String name;
 } Model;
@@ -34,6 +35,7 @@ static void defaults(Model *m) {
     m->r[R_THRESHOLD] = 0.05;
     m->i[I_MODE_IN] = m->i[I_MODE_OUT] = 1;
     strcpy(m->label, "plain");
+    strcpy(m->note, "none");
 }
 
 static void settle(Model *m) {
@@ -100,7 +102,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     Model *m = c;
     for (size_t k = 0; k < n; k++) {
         if (vr[k] >= N_STRING) return fmi2Error;
-        v[k] = m->label;
+        v[k] = vr[k] == S_NOTE ? m->note : m->label;
     }
     return fmi2OK;
 }
@@ -108,8 +110,9 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]) {
     Model *m = c;
     for (size_t k = 0; k < n; k++) {
-        if (vr[k] != S_LABEL || strlen(v[k]) >= sizeof m->label) return fmi2Error;
-        strcpy(m->label, v[k]);
+        char *into = vr[k] == S_LABEL ? m->label : vr[k] == S_NOTE ? m->note : NULL;
+        if (into == NULL || strlen(v[k]) >= sizeof m->label) return fmi2Error;
+        strcpy(into, v[k]);
     }
     return fmi2OK;
 }
