@@ -170,8 +170,10 @@ class SetInputs:
 
     @property
     def function(self) -> str:
-        """The FMI functions it calls, for messages."""
-        return self.entry.label
+        """The FMI function it called last, or failed in, for messages."""
+        from orchestrator.fmi_types import failed_function
+
+        return failed_function(self.entry)
 
 
 @dataclass(frozen=True)
@@ -192,8 +194,10 @@ class GetOutputs:
 
     @property
     def function(self) -> str:
-        """The FMI functions it calls, for messages."""
-        return self.entry.label
+        """The FMI function it called last, or failed in, for messages."""
+        from orchestrator.fmi_types import failed_function
+
+        return failed_function(self.entry)
 
 
 @dataclass(frozen=True)

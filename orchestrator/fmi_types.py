@@ -268,7 +268,26 @@ def typed_entry(function_of, component: int, fmi3: bool, pairs: list[tuple[Signa
     context = _Typed(ctypes.addressof(array), len(groups), -1)
     function = typed_library()["typed_set" if direction == "Set" else "typed_get"]
     return CEntry(address(function), ctypes.addressof(context), 0, 0, 0, ", ".join(labels),
-                  (array, context, keep, function))
+                  _TypedKeep(array, context, keep, function, labels))
+
+
+class _TypedKeep(NamedTuple):
+    """What a typed call keeps alive, and the FMI function of each of its groups."""
+
+    array: object
+    context: _Typed
+    buffers: list
+    function: object
+    labels: list
+
+
+def failed_function(entry: CEntry) -> str:
+    """The FMI function a call failed in: of a typed call, the one of the group that failed
+    (``"fmi3SetInt8"``), else the call's label."""
+    keep = entry.keep
+    if isinstance(keep, _TypedKeep) and 0 <= keep.context.failed < len(keep.labels):
+        return keep.labels[keep.context.failed]
+    return entry.label
 
 
 def step3_entry(do_step, component: int) -> CEntry:

@@ -272,3 +272,17 @@ def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typ
     assert result["T.counter"][-1] == 3 and reference["counter"][-1] == 4  # fmpy records the last step too
     assert np.array_equal(result["T.counter"], reference["counter"][:-1])
     assert np.allclose(result["T.x"], reference["x"][:-1], rtol=0, atol=1e-9)
+
+
+def test_a_refused_typed_set_names_its_function(typed_fmus):
+    """The model refuses a UInt16 input of 65535 (the bus's 70000, held in range): the run fails
+    at once, naming the block and fmi3SetUInt16 among the typed calls of the step."""
+    from orchestrator import SimulationError
+
+    system = System(dt=DT)
+    system.add(FMUBlock("T", model=typed_fmus[3]))
+    for name in TYPES3:
+        system.set_input(f"T.{name}", 70000.0 if name == "u16_in" else 0.0)
+    system.set_input("T.v", 0.0)
+    with pytest.raises(SimulationError, match=r"^T: fmi3SetUInt16 returned Error at t = 0 s"):
+        system.run(10 * DT)

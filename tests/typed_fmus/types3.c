@@ -7,7 +7,8 @@
  *   x += gain u h while enable; when x >= threshold: counter += 1 and x -= threshold (the event);
  *   f32_acc += f32_in h (in single precision); each integer output = its input + counter;
  *   above = counter odd; mode_out = mode; w += v h; m = [[x, counter], [w_1, -x]]; steps += 1;
- *   terminateSimulation once the counter reaches stop_count (when above 0).
+ *   terminateSimulation once the counter reaches stop_count (when above 0). A UInt16 input of
+ *   65535 is refused (fmi3Error).
  * Outputs depend on the state only (no direct feedthrough). */
 #include <stdlib.h>
 #include <string.h>
@@ -128,6 +129,9 @@ static void *where(Model *m, fmi3ValueReference vr, int type, size_t *count) {
     }
 }
 
+/* The model refuses a UInt16 input of 65535 (for the tests of a refused set). */
+static int refused(int code, const void *value) { return code == U16 && *(const uint16_t *)value == UINT16_MAX; }
+
 #define ACCESS(Type, type, code)                                                                             \
     fmi3Status fmi3Get##Type(fmi3Instance c, const fmi3ValueReference vr[], size_t n, type v[], size_t nv) {   \
         size_t k, at = 0, count;                                                                             \
@@ -144,7 +148,7 @@ static void *where(Model *m, fmi3ValueReference vr, int type, size_t *count) {
         size_t k, at = 0, count;                                                                             \
         for (k = 0; k < n; k++) {                                                                            \
             type *p = where(c, vr[k], code, &count);                                                         \
-            if (p == NULL || at + count > nv) return fmi3Error;                                              \
+            if (p == NULL || at + count > nv || refused(code, v + at)) return fmi3Error;                     \
             memcpy(p, v + at, count * sizeof(type));                                                         \
             at += count;                                                                                     \
         }                                                                                                    \
