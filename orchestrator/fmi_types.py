@@ -22,7 +22,7 @@ between the bus and the FMU's types in preallocated buffers.
 from __future__ import annotations
 
 import ctypes
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -168,6 +168,51 @@ class CEntry(NamedTuple):
     keep: object = None
 
 
+class Stepping(Protocol):
+    """What the master needs of an FMU instance (:class:`orchestrator.fmu.FMUInstance` for FMI 2.0,
+    :class:`orchestrator.fmu.FMU3Instance` for FMI 3.0, or a stand-in that runs one elsewhere).
+
+    Every value crosses as a float64. The loop makes only the C calls that :meth:`setter`,
+    :meth:`getter` and :meth:`stepper` return, once per run; the rest is set-up.
+    """
+
+    name: str
+    log: object  # orchestrator.fmu_errors.FMULog
+    inputs: list
+    outputs: list
+
+    def get(self, names) -> np.ndarray:
+        """Signals ``names``, as float64."""
+
+    def set(self, names, values) -> None:
+        """Set inputs ``names`` from float64 ``values``."""
+
+    def step(self, t: float, h: float) -> None:
+        """One communication step from ``t`` by ``h`` (s)."""
+
+    def setter(self, names, addresses) -> list[CEntry]:
+        """C calls that set inputs ``names`` from the float64 at each of ``addresses``."""
+
+    def getter(self, names, addresses) -> list[CEntry]:
+        """C calls that write outputs ``names`` to the float64 at each of ``addresses``."""
+
+    def stepper(self) -> CEntry:
+        """The C call of one communication step, ``(component, t, h, 1)``."""
+
+    def texts(self) -> dict[str, str]:
+        """String and Binary values, by name."""
+
+    def terminated(self) -> bool:
+        """Whether the FMU asked to end the simulation in its last step."""
+
+    def reset(self, parameters=None, name=None, start_time: float = 0.0) -> None:
+        """Back to a fresh instance's state: ``parameters`` set, ``name`` for messages,
+        initialized at ``start_time`` (s)."""
+
+    def close(self) -> None:
+        """Terminate and free."""
+
+
 class _Group(ctypes.Structure):
     _fields_ = [("function", ctypes.c_void_p), ("instance", ctypes.c_void_p), ("type", ctypes.c_int),
                 ("fmi3", ctypes.c_int), ("vr", ctypes.c_void_p), ("nvr", ctypes.c_size_t),
@@ -282,8 +327,8 @@ class _TypedKeep(NamedTuple):
 
 
 def failed_function(entry: CEntry) -> str:
-    """The FMI function a call failed in: of a typed call, the one of the group that failed
-    (``"fmi3SetInt8"``), else the call's label."""
+    """The FMI function the call ``entry`` failed in: of a typed call, the one of the group
+    that failed (``"fmi3SetInt8"``), else the call's label."""
     keep = entry.keep
     if isinstance(keep, _TypedKeep) and 0 <= keep.context.failed < len(keep.labels):
         return keep.labels[keep.context.failed]
