@@ -51,7 +51,7 @@ from orchestrator.fmi_types import (
     typed_entry,
     types_of,
 )
-from orchestrator.fmu_errors import STATUS, FMUError, FMULog, ParameterRefused  # noqa: F401 (public here too)
+from orchestrator.fmu_errors import STATUS, FMUError, FMULog, ParameterRefused, keep  # noqa: F401 (public here too)
 
 _extracted: dict[tuple[str, float], str] = {}
 _logs: dict[bytes, FMULog] = {}  # instance name -> its log
@@ -60,8 +60,8 @@ _instances = itertools.count(1)
 
 def _on_log(env, instance, status, category, message):
     log = _logs.get(instance)
-    if log is not None:
-        log.keep(status, message)
+    if log is not None:  # an FMULog, or a plain deque of a test's raw instance
+        keep(log, status, message)
 
 
 # fmpy's native proxy formats the FMU's variadic messages; it keeps one Python logger for the

@@ -30,13 +30,19 @@ class FMULog(deque):
 
     def keep(self, status: int, message: bytes | None):
         """Keep one message the FMU logged with ``status`` (FMI 2.0 and 3.0 alike)."""
-        label = STATUS[status] if 0 <= status < 6 else status
-        text = f"[{label}] {(message or b'').decode(errors='replace')}"
-        self.append(text)
-        if status == 1:
-            self.warnings += 1
-            if len(self.first_warnings) < self.FIRST:
-                self.first_warnings.append(text)
+        keep(self, status, message)
+
+
+def keep(log, status: int, message: bytes | None):
+    """Append one message an FMU logged with ``status`` to ``log`` (a deque), counting a warning
+    into an :class:`FMULog`."""
+    label = STATUS[status] if 0 <= status < 6 else status
+    text = f"[{label}] {(message or b'').decode(errors='replace')}"
+    log.append(text)
+    if status == 1 and isinstance(log, FMULog):
+        log.warnings += 1
+        if len(log.first_warnings) < log.FIRST:
+            log.first_warnings.append(text)
 
 
 class FMUError(RuntimeError):
