@@ -170,10 +170,9 @@ class SetInputs:
 
     @property
     def function(self) -> str:
-        """The FMI function it called last, or failed in, for messages."""
-        from orchestrator.fmi_types import failed_function
-
-        return failed_function(self.entry)
+        """The FMI function it failed in, for messages (of a typed call, the one of the group)."""
+        failed = getattr(self.entry.keep, "failed_function", None)
+        return failed() if failed is not None else self.entry.label
 
 
 @dataclass(frozen=True)
@@ -194,10 +193,9 @@ class GetOutputs:
 
     @property
     def function(self) -> str:
-        """The FMI function it called last, or failed in, for messages."""
-        from orchestrator.fmi_types import failed_function
-
-        return failed_function(self.entry)
+        """The FMI function it failed in, for messages (of a typed call, the one of the group)."""
+        failed = getattr(self.entry.keep, "failed_function", None)
+        return failed() if failed is not None else self.entry.label
 
 
 @dataclass(frozen=True)

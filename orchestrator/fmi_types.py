@@ -325,14 +325,10 @@ class _TypedKeep(NamedTuple):
     function: object
     labels: list
 
-
-def failed_function(entry: CEntry) -> str:
-    """The FMI function the call ``entry`` failed in: of a typed call, the one of the group
-    that failed (``"fmi3SetInt8"``), else the call's label."""
-    keep = entry.keep
-    if isinstance(keep, _TypedKeep) and 0 <= keep.context.failed < len(keep.labels):
-        return keep.labels[keep.context.failed]
-    return entry.label
+    def failed_function(self) -> str:
+        """The FMI function of the group the call failed in (``"fmi3SetInt8"``), or all of them."""
+        failed = self.context.failed
+        return self.labels[failed] if 0 <= failed < len(self.labels) else ", ".join(self.labels)
 
 
 def step3_entry(do_step, component: int) -> CEntry:
