@@ -257,7 +257,7 @@ def is_path(model) -> bool:
 
 
 class FMUBlock:
-    """A block backed by an FMU: a built plant model, or any FMI 2.0 Co-Simulation FMU by path.
+    """A block backed by an FMU: a built plant model, or any FMI 2.0 or 3.0 Co-Simulation FMU by path.
 
     Parameters
     ----------
@@ -266,14 +266,22 @@ class FMUBlock:
     model : str or pathlib.Path, optional
         A built model's name (``"IMU"``), or the path of an FMU file of any exporter
         (``"my_motor.fmu"``: OpenModelica, Dymola, Simulink, pythonfmu, ...); defaults to ``name``.
-        Its real inputs and outputs become the block's, by their variable names.
+        Its numeric inputs and outputs become the block's, by their variable names: every FMI
+        type, an FMI 3.0 array as one signal per element (:mod:`orchestrator.fmi_types`).
     parameters : dict, optional
         Parameter overrides, by FMU variable name.
     period : int
         Runs every ``period`` macro steps, with a communication step of ``period * dt``.
+
+    Attributes
+    ----------
+    dtypes : dict
+        The NumPy type of each signal that is not float64 (``{"counter": "int32"}``): the
+        record keeps it, and its files store the signal with it.
     """
 
     def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
+        from orchestrator.fmi_types import dtypes, is_parameter, signals, unit
         from orchestrator.fmu import fmu_file, model_description
 
         if int(period) != period or period < 1:
@@ -285,13 +293,13 @@ class FMUBlock:
         self.period = int(period)
         description = model_description(self.path)
         variables = description.modelVariables
-        self.inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
-        self.outputs = tuple(v.name for v in variables if v.causality == "output" and v.type == "Real")
-        self.parameter_names = tuple(v.name for v in variables if v.causality == "parameter")
-        self.units = {v.name: v.unit or getattr(v.declaredType, "unit", None) or ""  # labels the results
-                      for v in variables if v.name in self.outputs}
-        self.input_units = {v.name: v.unit or getattr(v.declaredType, "unit", None) or ""
-                            for v in variables if v.name in self.inputs}
+        inputs, outputs = signals(description, "input"), signals(description, "output")
+        self.inputs = tuple(s.name for s in inputs)
+        self.outputs = tuple(s.name for s in outputs)
+        self.dtypes = dtypes(description, self.inputs + self.outputs)
+        self.parameter_names = tuple(v.name for v in variables if is_parameter(v))
+        self.units = {s.name: unit(s.variable) for s in outputs}  # labels the results
+        self.input_units = {s.name: unit(s.variable) for s in inputs}
         unknown = set(self.parameters) - set(self.parameter_names)
         if unknown:
             from orchestrator.fmu import nearest
@@ -301,8 +309,16 @@ class FMUBlock:
         fed = set()
         for output in description.outputs:
             fed |= {d.name for d in (output.dependencies or [])}
-        self.feedthrough_inputs = fed & set(self.inputs)
+        self.feedthrough_inputs = {s.name for s in inputs if s.variable.name in fed}
         self.instance = None
+        texts = [v.name for v in variables if v.causality in ("input", "output") and v.type in ("String", "Binary")]
+        if texts:  # said once, rather than lost silently
+            import warnings
+
+            warnings.warn(f"{name}: {', '.join(texts)} {'is' if len(texts) == 1 else 'are'} String or Binary, not "
+                          "signals: an input keeps its start value unless set as a parameter, and each one's value "
+                          "after initialization is recorded in the result's meta['texts']", RuntimeWarning,
+                          stacklevel=2)
 
     def instantiate(self, t0: float):
         """Instantiate and initialize the FMU, parameters set.

@@ -153,77 +153,83 @@ class _CCall(ctypes.Structure):
 
 @dataclass(frozen=True)
 class SetInputs:
-    """``fmi2SetReal`` of FMU inputs whose sources sit in consecutive bus slots from ``slot``.
-
-    The FMU reads straight from the bus: no copy.
+    """One call that sets FMU inputs from their sources' bus slots (``fmi2SetReal`` straight
+    from the bus for an FMI 2.0 FMU's Real inputs in consecutive slots: no copy).
 
     Parameters
     ----------
     block : orchestrator.FMUBlock
         The block, with a live instance.
-    refs : ndarray of uint32
-        Value references of the inputs, in bus order.
-    slot : int
-        Bus slot of the first input's source.
+    entry : orchestrator.fmi_types.CEntry
+        The C call (:meth:`orchestrator.fmu.FMUInstance.setter`).
     """
 
     block: object  # an FMUBlock with a live instance
-    refs: np.ndarray  # value references, uint32
-    slot: int
+    entry: object
     kind = 0
-    function = "fmi2SetReal"
+
+    @property
+    def function(self) -> str:
+        """The FMI function it failed in, for messages (of a typed call, the one of the group)."""
+        failed = getattr(self.entry.keep, "failed_function", None)
+        return failed() if failed is not None else self.entry.label
 
 
 @dataclass(frozen=True)
 class GetOutputs:
-    """``fmi2GetReal`` of all of an FMU's outputs into its bus slots from ``slot``.
+    """One call that writes FMU outputs into their bus slots (as :class:`SetInputs`).
 
     Parameters
     ----------
     block : orchestrator.FMUBlock
         The block, with a live instance.
-    refs : ndarray of uint32
-        Value references of the outputs, in bus order.
-    slot : int
-        Bus slot of the first output.
+    entry : orchestrator.fmi_types.CEntry
+        The C call (:meth:`orchestrator.fmu.FMUInstance.getter`).
     """
 
     block: object
-    refs: np.ndarray
-    slot: int
+    entry: object
     kind = 1
-    function = "fmi2GetReal"
+
+    @property
+    def function(self) -> str:
+        """The FMI function it failed in, for messages (of a typed call, the one of the group)."""
+        failed = getattr(self.entry.keep, "failed_function", None)
+        return failed() if failed is not None else self.entry.label
 
 
 @dataclass(frozen=True)
 class DoStep:
-    """``fmi2DoStep`` of one communication step from the present time.
+    """One communication step from the present time (:meth:`orchestrator.fmu.FMUInstance.stepper`).
 
     Parameters
     ----------
     block : orchestrator.FMUBlock
         The block, with a live instance.
+    entry : orchestrator.fmi_types.CEntry
+        The C call.
     h : float
         Communication step (s).
     """
 
     block: object
+    entry: object
     h: float
     kind = 2
-    function = "fmi2DoStep"
+
+    @property
+    def function(self) -> str:
+        """The FMI function it calls, for messages."""
+        return self.entry.label
 
 
 FMICall = SetInputs | GetOutputs | DoStep
 
 
 def _pack(call: FMICall, bus: np.ndarray) -> _CCall:
-    instance = call.block.instance
-    function = {0: instance.raw_set_real, 1: instance.raw_get_real, 2: instance.raw_do_step}[call.kind]
-    address = ctypes.cast(function, ctypes.c_void_p).value
-    if isinstance(call, DoStep):
-        return _CCall(call.kind, address, instance.component, None, 0, None, call.h)
-    values = bus.ctypes.data + bus.itemsize * call.slot
-    return _CCall(call.kind, address, instance.component, call.refs.ctypes.data, len(call.refs), values, 0.0)
+    entry = call.entry
+    h = call.h if isinstance(call, DoStep) else 0.0
+    return _CCall(call.kind, entry.function, entry.component, entry.vr or None, entry.n, entry.values or None, h)
 
 
 def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
@@ -246,7 +252,7 @@ def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
         the FMU's log, when a call returns Error or Fatal.
     """
     from orchestrator.faults import apply_faults
-    from orchestrator.fmu import FMUError
+    from orchestrator.fmu_errors import FMUError
 
     run = run_calls()
     array = (_CCall * len(calls))(*[_pack(c, bus) for c in calls])

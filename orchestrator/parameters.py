@@ -21,6 +21,7 @@ import numbers
 import re
 
 from orchestrator.blocks import FMUBlock
+from orchestrator.fmi_types import INTEGER_TYPES, is_parameter
 from orchestrator.fmu import nearest
 from orchestrator.signals import expand
 
@@ -44,7 +45,7 @@ def fmu_parameters(model: str) -> dict:
     from orchestrator.fmu import fmu_file, model_description
 
     description = model_description(fmu_file(model))
-    return {v.name: v for v in description.modelVariables if v.causality == "parameter"}
+    return {v.name: v for v in description.modelVariables if is_parameter(v)}
 
 
 def model_notes(model: str) -> tuple[dict, dict]:
@@ -218,6 +219,8 @@ def _components(target: str, value, count: int) -> list:
 def _parse(label: str, variable, value):
     """The value of one FMU parameter from text or a number, checked against its type and unit."""
     kind = variable.type
+    if kind in ("String", "Binary"):  # text as given (a Binary as hexadecimal text or bytes)
+        return value if isinstance(value, bytes | bytearray) else str(value)
     if kind == "Boolean":
         text = str(value).strip().lower()
         if text in ("1", "true", "on", "yes"):
@@ -241,7 +244,7 @@ def _parse(label: str, variable, value):
         raise ValueError(f"{label} = {value!r} is not a number{_unit_hint(variable)}") from None
     if not math.isfinite(number):
         raise ValueError(f"{label} = {value!r} must be a finite number{_unit_hint(variable)}")
-    if kind == "Integer":
+    if kind in INTEGER_TYPES:
         if number != int(number):
             raise ValueError(f"{label} = {value!r} must be an integer")
         return int(number)

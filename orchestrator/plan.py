@@ -47,10 +47,10 @@ from orchestrator.errors import RunInterrupted, SimulationError
 from orchestrator.faults import FaultTap, apply_faults, describe, suspects
 from orchestrator.fmu import FMUError
 from orchestrator.interrupts import signal_name, signal_number
-from orchestrator.program import RECORD, Entry, Phase, copies, input_runs
+from orchestrator.program import RECORD, Entry, Phase, copies
 from orchestrator.progress import Progress
 from orchestrator.result import Result, check_record_fits
-from orchestrator.signals import signal_units
+from orchestrator.signals import signal_dtypes, signal_units
 
 
 class _BatchPart(NamedTuple):
@@ -102,6 +102,7 @@ class Plan:
         self._plan_recording(record)
         self.fmus: list[FMUBlock] = []
         self.logs = {}  # block name -> its FMU's log, kept after the FMU is freed
+        self.texts = {}  # "Block.variable" -> an FMU's String or Binary value after initialization
         for fault in system.faults:
             fault.reset()
             _warn_if_idle(fault, t0, self.steps, self.dt)
@@ -140,6 +141,7 @@ class Plan:
         by_slot = {v: k for k, v in self.slot.items()}
         self.names = [by_slot[s] for s in slots]
         self.units = signal_units(self.system.blocks, self.names)
+        self.dtypes = signal_dtypes(self.system.blocks, self.names)
         self.record_copies = copies(slots)
         rows = self.steps // self.decimation + 1
         if self.stream is not None:
@@ -215,13 +217,15 @@ class Plan:
         early, late = [], []
         for u in block.inputs:
             slot, is_early = self._source(block.name, u)
-            (early if is_early else late).append((instance.variables[u].valueReference, slot))
+            (early if is_early else late).append((u, self.bus.ctypes.data + 8 * slot))
         first, outputs = self._outputs(block)
         outputs[:] = instance.get(block.outputs)
-        calls_a = [SetInputs(block, refs, slot) for refs, slot in input_runs(early)]
-        calls_a.append(GetOutputs(block, instance.vr(block.outputs), first))
-        calls_b = [SetInputs(block, refs, slot) for refs, slot in input_runs(late)]
-        calls_b.append(DoStep(block, block.period * self.dt))
+        self.texts.update({f"{block.name}.{k}": v for k, v in instance.texts().items()})
+        addresses = [outputs.ctypes.data + 8 * k for k in range(len(block.outputs))]
+        calls_a = [SetInputs(block, e) for e in instance.setter([u for u, _ in early], [a for _, a in early])]
+        calls_a += [GetOutputs(block, e) for e in instance.getter(block.outputs, addresses)]
+        calls_b = [SetInputs(block, e) for e in instance.setter([u for u, _ in late], [a for _, a in late])]
+        calls_b.append(DoStep(block, instance.stepper(), block.period * self.dt))
         return calls_a, calls_b
 
     def _add_batch(self, phases: list[Phase], parts: list[_BatchPart]):
@@ -297,6 +301,10 @@ class Plan:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
             message = str(error)
+            instance = getattr(self.system.blocks.get(error.block), "instance", None)
+            if error.status == 2 and instance is not None and instance.terminated():
+                message = f"{error.block}: the FMU asked to end the simulation ({error.function} returned Discard, " \
+                          f"fmi2Terminated) at t = {error.time:.6g} s; the record holds the steps before"
             if "not a finite number" in message:
                 message = self._non_finite(self.t0 + self.n * self.dt) + "\n" + message
             raise SimulationError(message, self.result(error=message)) from None
@@ -396,7 +404,8 @@ class Plan:
                 "loop_cpu_seconds": getattr(self, "loop_cpu_seconds", None),
                 "order": [b.name for b in self.order],
                 "connections": dict(self.system.connections), "fmu_warnings": warnings, "units": self.units,
-                "constant_inputs": self.constant_inputs}
+                "constant_inputs": self.constant_inputs, **({"dtypes": self.dtypes} if self.dtypes else {}),
+                **({"texts": dict(self.texts)} if self.texts else {})}
 
     def _streamed(self, error: str | None) -> Result:
         from orchestrator.result import StreamedResult

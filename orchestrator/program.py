@@ -10,8 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import NamedTuple
 
-import numpy as np
-
 from orchestrator.blocks import Block
 
 
@@ -58,21 +56,3 @@ def consecutive(slots: list[int]) -> list[tuple[int, int]]:
 def copies(slots: list[int]) -> tuple[Copy, ...]:
     """The slice copies that gather bus ``slots`` into a vector, in order."""
     return tuple(Copy(slice(i, j), slice(slots[i], slots[j - 1] + 1)) for i, j in consecutive(slots))
-
-
-def input_runs(refs: list[tuple[int, int]]) -> list[tuple[np.ndarray, int]]:
-    """Split (value reference, bus slot) pairs into runs of consecutive slots.
-
-    Parameters
-    ----------
-    refs : list of (int, int)
-        Value reference of each input and the bus slot it reads.
-
-    Returns
-    -------
-    list of (ndarray, int)
-        Value references (uint32) of each run and the bus slot of its first member.
-    """
-    refs = sorted(refs, key=lambda r: r[1])
-    slots = [slot for _, slot in refs]
-    return [(np.array([vr for vr, _ in refs[i:j]], dtype=np.uint32), slots[i]) for i, j in consecutive(slots)]

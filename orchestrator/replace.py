@@ -65,7 +65,7 @@ def replace_fmu(system, name: str, model) -> tuple:
     name : str
         An FMU block of ``system`` (``MotorMagnetics``).
     model : str or pathlib.Path
-        An FMI 2.0 Co-Simulation FMU file.
+        An FMI 2.0 or 3.0 Co-Simulation FMU file.
 
     Returns
     -------

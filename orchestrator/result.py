@@ -19,6 +19,7 @@ import numpy as np
 from orchestrator.files import atomic_path, json_text
 from orchestrator.fmu import nearest
 from orchestrator.signals import expand, matrix_shape, vector_groups
+from orchestrator.values import float_text, integer_text, matlab_values
 
 #: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.
 FORMATS = ("npz", "mat", "csv")
@@ -180,12 +181,27 @@ class Result:
             raise KeyError(f"no recorded signal {name!r}.{nearest(name, self.names)}")
         return members
 
+    @property
+    def dtypes(self) -> dict[str, str]:
+        """The NumPy type of each signal that is not float64 (an FMU's integer, Boolean or
+        single-precision signal: ``{"Stair.counter": "int32"}``); it is returned, and saved, with it."""
+        return dict(self.meta.get("dtypes", {}))
+
+    def typed(self, members: list[str], values: np.ndarray) -> np.ndarray:
+        """``values`` of the signals ``members`` (one column each, or one signal) in their own
+        type, when they share one that is not float64; else as they are."""
+        kinds = {self.meta.get("dtypes", {}).get(m) for m in members}
+        if len(kinds) != 1 or None in kinds:
+            return values
+        return values.astype(kinds.pop())
+
     def __getitem__(self, name: str) -> np.ndarray:
         if name == "time":
             return self.time
         members = self.columns(name)
         columns = [self._index[m] for m in members]
-        return self.data[:, columns[0]] if len(columns) == 1 and members[0] == name else self.data[:, columns]
+        values = self.data[:, columns[0]] if len(columns) == 1 and members[0] == name else self.data[:, columns]
+        return self.typed(members, values)
 
     # ------------------------------------------------------------------ windows
     def windows(self):
@@ -233,9 +249,9 @@ class Result:
         grouped = {c for members in groups.values() for c in members}
         for name in names:
             if name not in grouped:
-                yield name, self.data[:, self._index[name]]
+                yield name, self.typed([name], self.data[:, self._index[name]])
         for vector, members in groups.items():
-            yield vector, self._stacked(members).reshape(len(self.time), *matrix_shape(members))
+            yield vector, self.typed(members, self._stacked(members).reshape(len(self.time), *matrix_shape(members)))
 
     def _stacked(self, members) -> np.ndarray:
         """The columns of ``members`` side by side: a view of the record when they are
@@ -254,7 +270,8 @@ class Result:
     def to_npz(self, path, signals=None, compress: bool = False) -> Path:
         """Write a NumPy archive (uncompressed unless ``compress``).
 
-        It holds ``time`` (s), one array per scalar signal, one N x k array per vector signal
+        It holds ``time`` (s), one array per scalar signal (in its own type: an FMU's Int32
+        output is ``int32``, a Boolean ``bool``), one N x k array per vector signal
         (``"IMU.acc"``; ``"IMU.R_reel"`` is N x 3 x 3), and ``_meta``: JSON with ``units``
         (each signal's unit), ``options`` (the scenario's options), ``names`` and ``vectors``
         (the components of each vector). :meth:`from_npz` reads it back. The arrays are
@@ -292,7 +309,8 @@ class Result:
         return path
 
     def to_csv(self, path, signals=None) -> Path:
-        """Write one row per sample: ``time`` (s) then every signal, full precision.
+        """Write one row per sample: ``time`` (s) then every signal, full precision; an integer
+        or Boolean signal as an integer (a Boolean 0 or 1).
 
         Parameters
         ----------
@@ -312,17 +330,20 @@ class Result:
                 temporary.open("w", newline="") as handle:
             writer = csv.writer(handle)
             columns = [self._index[n] for n in names]
+            dtypes = self.meta.get("dtypes", {})
+            text = [integer_text if np.dtype(dtypes.get(n, "float64")).kind in "biu" else float_text for n in names]
             writer.writerow(["time", *names])
             for t, row in zip(self.time, self.data, strict=True):
-                writer.writerow([repr(float(t)), *(repr(float(row[c])) for c in columns)])
+                writer.writerow([repr(float(t)), *(f(row[c]) for f, c in zip(text, columns, strict=True))])
         return path
 
     def to_mat(self, path, signals=None, compress: bool = False) -> Path:
         """Write a MATLAB file (uncompressed unless ``compress``).
 
-        One struct per block, each signal an N x 1 column (``IMU.acc_x`` reads ``IMU.acc_x`` in
-        MATLAB) and each vector also an N x k array (``IMU.acc``; ``IMU.R_reel`` N x 3 x 3);
-        ``time`` (s); ``units``, a struct per block giving each field's unit
+        One struct per block, each signal an N x 1 column in its own type (``IMU.acc_x`` reads
+        ``IMU.acc_x`` in MATLAB; an FMU's Int32 output is an ``int32``, a Boolean a ``logical``)
+        and each vector also an N x k array (``IMU.acc``; ``IMU.R_reel`` N x 3 x 3); ``time`` (s);
+        ``units``, a struct per block giving each field's unit
         (``units.IMU.acc_x`` is ``'m/s2'``); ``options``, the scenario's options; ``meta``,
         the run's step, decimation, scenario and error message.
 
@@ -350,11 +371,12 @@ class Result:
         groups = vector_groups(names)
         for name in names:
             block, _, signal = name.partition(".")
-            blocks.setdefault(block, {})[signal] = self.data[:, self._index[name]]
+            blocks.setdefault(block, {})[signal] = self.typed([name], self.data[:, self._index[name]])
             units.setdefault(block, {})[signal] = every_unit[name]
         for vector, members in groups.items():
             block, _, signal = vector.partition(".")
-            blocks[block][signal] = self._stacked(members).reshape(len(self.time), *matrix_shape(members))
+            blocks[block][signal] = self.typed(members, self._stacked(members).reshape(len(self.time),
+                                                                                       *matrix_shape(members)))
             units[block][signal] = every_unit[members[0]]
         scenario = self.meta.get("scenario", {})
         meta = {"scenario": scenario.get("name", ""), "dt_s": self.meta.get("dt", np.nan),
@@ -363,7 +385,7 @@ class Result:
         size = 8 * len(self) * (1 + len(names) + sum(len(m) for m in groups.values()))
         with atomic_path(path, size=size) as temporary:
             savemat(temporary, {"time": self.time, **blocks, "units": units | {"time": "s"},
-                                "options": _matlab_values(self.options), "meta": _matlab_values(meta)},
+                                "options": matlab_values(self.options), "meta": matlab_values(meta)},
                     long_field_names=True, do_compression=compress, oned_as="column")
         return Path(path)
 
@@ -464,7 +486,8 @@ class Result:
 
     # ------------------------------------------------------------------ plots
     def plot(self, *names, ax=None, scale: float = 1.0, label_prefix: str = "", unit: str | None = None):
-        """Plot signals against time; long series are drawn from their :func:`envelope`.
+        """Plot signals against time; long series are drawn from their :func:`envelope`, integer
+        and Boolean signals as steps (held from one sample to the next).
 
         The y axis is labelled with the names and their unit, from the variable tables (the
         run's ``meta["units"]``), or ``unit`` when given (as it must be with a ``scale``:
@@ -507,7 +530,8 @@ class Result:
             members = self.columns(name)
             for member in members:
                 t, y = envelope(self.time, self[member])
-                ax.plot(t, y * scale, label=label_prefix + member)
+                steps = np.dtype(self.meta.get("dtypes", {}).get(member, "float64")).kind in "biu"
+                ax.plot(t, y * scale, label=label_prefix + member, drawstyle="steps-post" if steps else "default")
             found = {known[m] for m in members if known.get(m)}  # "" is a unit not known
             shown = unit if unit is not None else found.pop() if len(found) == 1 else "unit unknown"
             parts.append((name, shown))
@@ -609,8 +633,8 @@ class StreamedResult(Result):
             return self.time
         members = self.columns(name)
         if len(members) == 1 and members[0] == name:
-            return self._column(self._index[name])
-        return np.stack([self._column(self._index[m]) for m in members], axis=1)
+            return self.typed(members, self._column(self._index[name]))
+        return self.typed(members, np.stack([self._column(self._index[m]) for m in members], axis=1))
 
     def windows(self):
         """One :class:`Result` per chunk, read one at a time (see :meth:`Result.windows`)."""
@@ -671,19 +695,3 @@ def _write_array(archive: zipfile.ZipFile, name: str, values: np.ndarray):
             return
         for first in range(0, len(values), WRITE_ROWS):
             member.write(np.ascontiguousarray(values[first:first + WRITE_ROWS]).data)
-
-
-def _matlab_values(values: dict) -> dict:
-    """``values`` as MATLAB can hold them: None as an empty string, lists of text as cell
-    arrays, ``IMU.gyro_bias`` keys as ``IMU_gyro_bias`` (a field name holds no dot)."""
-    plain = {}
-    for key, value in values.items():
-        key = str(key).replace(".", "_")
-        if value is None:
-            value = ""
-        elif isinstance(value, dict):
-            value = _matlab_values(value)
-        elif isinstance(value, list | tuple) and any(isinstance(v, str) for v in value):
-            value = np.array([str(v) for v in value], dtype=object)
-        plain[key] = value
-    return plain

@@ -75,6 +75,31 @@ def signal_units(blocks, names) -> dict[str, str]:
     return units
 
 
+def signal_dtypes(blocks, names) -> dict[str, str]:
+    """The NumPy type of each recorded signal that is not float64, from its block's ``dtypes``
+    (an FMU's integer, Boolean and single-precision signals: :func:`orchestrator.fmi_types.dtypes`).
+
+    Parameters
+    ----------
+    blocks : dict of str to block
+        The system's blocks by name.
+    names : sequence of str
+        Recorded ``"Block.signal"`` names.
+
+    Returns
+    -------
+    dict of str to str
+        ``{"Stair.counter": "int32"}``; a float64 signal is left out.
+    """
+    found = {}
+    for name in names:
+        block, _, signal = name.partition(".")
+        dtype = getattr(blocks.get(block), "dtypes", {}).get(signal)
+        if dtype:
+            found[name] = dtype
+    return found
+
+
 def expand(name: str, available) -> list[str]:
     """Names a signal name stands for: itself, or its components.
 

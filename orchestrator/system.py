@@ -23,6 +23,8 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
+
 from orchestrator.blocks import Block, Constant, FMUBlock
 from orchestrator.errors import AlgebraicLoopError, SimulationError  # noqa: F401 (public here too)
 from orchestrator.faults import Fault
@@ -114,27 +116,38 @@ class System:
         for s, d in zip(sources, destinations, strict=True):
             self.connections[d] = s
 
-    def set_input(self, destination: str, value: float):
+    def set_input(self, destination: str, value):
         """Tie an input (or each component of a vector input) to a constant.
 
         Parameters
         ----------
         destination : str
-            ``"Block.input"`` or a vector name.
-        value : float
-            The constant, in the input's unit.
+            ``"Block.input"`` or a vector name (``"Quadrotor.wind"``, an FMI 3.0 array).
+        value : float or sequence of float
+            The constant, in the input's unit: one number (every component takes it), or one
+            per component, in order.
 
         Raises
         ------
         ValueError
-            An input is already connected (as :meth:`connect`), or ``value`` is not finite.
+            An input is already connected (as :meth:`connect`), a value is not finite, or the
+            values are not one per component.
         """
         targets = self._resolve(destination, "input")
         self._refuse_connected(targets)
-        if not math.isfinite(float(value)):
-            raise ValueError(f"{destination} = {value!r}: a constant input must be a finite number")
+        values = [value] if isinstance(value, int | float | str) else list(np.ravel(value))
+        if len(values) == 1:
+            values = values * len(targets)
+        if len(values) != len(targets):
+            raise ValueError(f"{destination} has {len(targets)} component{'s' * (len(targets) > 1)} "
+                             f"({', '.join(t.split('.', 1)[1] for t in targets)}): give one value or "
+                             f"{len(targets)}, not {len(values)}")
+        for target, v in zip(targets, values, strict=True):
+            if not math.isfinite(float(v)):
+                raise ValueError(f"{target} = {v!r}: a constant input must be a finite number")
         name = "Const_" + destination.replace(".", "_")
-        block = self.add(Constant(name, {t.split(".", 1)[1]: value for t in targets}, ties=destination))
+        block = self.add(Constant(name, {t.split(".", 1)[1]: v for t, v in zip(targets, values, strict=True)},
+                                  ties=destination))
         for target in targets:
             self.connections[target] = f"{block.name}.{target.split('.', 1)[1]}"
 

@@ -38,6 +38,9 @@ def _build(args) -> int:
     try:
         build_all(args.out or default_fmu_dir(), force=args.force)
         print(f"built {build_runner()}")
+        from orchestrator.fmi_types import typed_path
+
+        print(f"built {typed_path(build=True)}")
         from benchmarks import build_references
 
         for library in build_references():
@@ -385,7 +388,7 @@ def _add_run(sub):
     run.add_argument("--fault", action="append", metavar="TARGET:KIND:START:STOP[:VALUE]",
                      help="fault on the connection into TARGET; KIND is offset, scale, stuck, noise or dropout")
     run.add_argument("--fmu", action="append", metavar="BLOCK=PATH",
-                     help="put an FMU of your own (any FMI 2.0 Co-Simulation exporter) in the place of a plant "
+                     help="put an FMU of your own (FMI 2.0 or 3.0 Co-Simulation, any exporter) in the place of a plant "
                           "block: MotorMagnetics=my_motor.fmu; its inputs and outputs are checked against the "
                           "block's by name and unit, mismatches listed")
     run.add_argument("--overwrite", action="store_true", help="replace the results already in the --out folder")
