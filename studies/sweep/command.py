@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 from pathlib import Path
 
 
@@ -125,8 +126,9 @@ def sweep(args) -> int:
     Returns
     -------
     int
-        Exit code: 0 when every member finished well, 1 when any failed, 2 for bad arguments,
-        128 + the signal when interrupted.
+        Exit code (:data:`studies.sweep.engine.EXIT_CODES`): 0 when every member is ``ok``, 1
+        when any failed or was not run, 2 for bad arguments or a refused folder, 3 when every
+        member ran and some diverged, 128 + the signal when interrupted.
     """
     from studies.sweep import engine, named
 
@@ -213,8 +215,13 @@ def main(argv=None) -> int:
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
+    def one_line(message, category, filename, lineno, file=None, line=None):  # as quadcosim prints warnings
+        print(f"quadcosim sweep: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
     try:
-        with terminate_as_interrupt():
+        with terminate_as_interrupt(), warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = one_line
             p = add_arguments(argparse.ArgumentParser(prog="python -m studies.sweep", description=__doc__,
                                                       formatter_class=argparse.RawDescriptionHelpFormatter))
             return sweep(p.parse_args(argv))

@@ -2,7 +2,9 @@
 
 Members that share the option values (Monte Carlo seeds, or options not shown) are pooled:
 the curve is their mean, the band their spread (minimum to maximum), and each member is a
-faint point. Failed members are left out and counted in the title.
+faint point. A member that diverged is never a value: it is drawn as a red cross on the top edge
+of the axes at its option value, and counted in the legend. Failed members are left out and
+counted in the title. Curves and categories are in numeric order (8, 16, 24, not 16, 24, 8).
 """
 
 from __future__ import annotations
@@ -123,21 +125,31 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     """
     import matplotlib.pyplot as plt
 
-    groups, categories, numeric_x, failed = _groups(columns, metric, x, by)
+    groups, categories, numeric_x, failed, diverged = _groups(columns, metric, x, by)
     if ax is None:
         figure, ax = plt.subplots(figsize=(8, 5))
     else:
         figure = ax.figure
-    for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: str(item[0]))):
-        _curve(ax, series, f"C{n % 10}", f"{by} = {key}" if by else metric)
-    xs = [a for series in groups.values() for a in series]
+    units = units or {}
+    by_unit = f" {units[by]}" if by and units.get(by) else ""
+    for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: natural_key(item[0]))):
+        _curve(ax, series, f"C{n % 10}", f"{by} = {key}{by_unit}" if by else metric)
+    if diverged:
+        from matplotlib.transforms import blended_transform_factory
+
+        ax.plot(diverged, [1.0] * len(diverged), "x", color="red", ms=9, mew=2, clip_on=False, zorder=5,
+                transform=blended_transform_factory(ax.transData, ax.transAxes),
+                label=f"diverged ({len(diverged)}): a crash, no value")
+    xs = [a for series in groups.values() for a in series] + diverged
     if numeric_x and min(xs) > 0 and max(xs) / min(xs) > 10:
+        from matplotlib.ticker import NullFormatter
+
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())  # labels at the decades only: never overlapping
     if logy:
         ax.set_yscale("log")
     if categories:
         ax.set_xticks(range(len(categories)), categories)
-    units = units or {}
     ax.set_xlabel(_labelled(x, units.get(x, "")))
     named = metric_label(metric, components)
     ax.set_ylabel(_labelled(named, units.get(metric) or metric_unit(metric)))
@@ -159,9 +171,16 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     return str(path)
 
 
+def natural_key(value):
+    """A sort key that puts numbers (and numeric text) in numeric order before other text:
+    ``8, 16, 24``, never ``16, 24, 8``."""
+    number = _number(value)
+    return (0, number, "") if number is not None else (1, 0.0, str(value))
+
+
 def _groups(columns, metric, x, by):
     """The finished members' metric by group and x position; the x categories (text options),
-    whether x is numeric, and how many members failed."""
+    whether x is numeric, how many members failed, and the x positions of those that diverged."""
     for name in (metric, x, by):
         if name is not None and name not in columns:
             from orchestrator.fmu import nearest
@@ -170,17 +189,21 @@ def _groups(columns, metric, x, by):
     count = len(columns[x])
     status = columns.get("status", ["ok"] * count)
     kept = [i for i in range(count) if status[i] == "ok" and _number(columns[metric][i]) is not None]
-    failed = sum(s != "ok" for s in status)
-    if not kept:
+    crashed = [i for i in range(count) if status[i] == "diverged"]
+    failed = sum(s not in ("ok", "diverged") for s in status)
+    if not kept and not crashed:
         raise ValueError(f"no finished member has a numeric {metric!r}")
-    xs = [columns[x][i] for i in kept]
+    xs = [columns[x][i] for i in kept + crashed]
     numeric_x = all(_number(v) is not None for v in xs)
-    categories = [] if numeric_x else sorted(set(map(str, xs)))
+    categories = [] if numeric_x else sorted(set(map(str, xs)), key=natural_key)
+
+    def position(i):
+        return float(columns[x][i]) if numeric_x else float(categories.index(str(columns[x][i])))
+
     groups: dict[object, dict[float, list[float]]] = defaultdict(lambda: defaultdict(list))
     for i in kept:
-        at = float(columns[x][i]) if numeric_x else float(categories.index(str(columns[x][i])))
-        groups[columns[by][i] if by else None][at].append(float(columns[metric][i]))
-    return groups, categories, numeric_x, failed
+        groups[columns[by][i] if by else None][position(i)].append(float(columns[metric][i]))
+    return groups, categories, numeric_x, failed, sorted({position(i) for i in crashed})
 
 
 def _curve(ax, series: dict[float, list[float]], colour: str, label: str):
