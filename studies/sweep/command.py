@@ -26,6 +26,8 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
     p.add_argument("--seeds", metavar="N|A:B", help="Monte Carlo: the seed option over 1..N (or A..B)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="use a running Dask scheduler (tcp://host:8786)")
+    p.add_argument("--connect-timeout", type=float, default=10.0, metavar="S",
+                   help="seconds to reach the --scheduler before giving up (default 10)")
     p.add_argument("--out", help="sweep folder (default results/sweep-SCENARIO, or results/sweep-SCENARIO-N when that "
                                  "holds an earlier sweep)")
     p.add_argument("--resume", action="store_true", help="continue the sweep in --out; skip finished members")
@@ -137,6 +139,15 @@ def sweep(args) -> int:
             raise ValueError(f"--workers {args.workers}: give at least 1")
         if args.workers and args.scheduler:
             raise ValueError("--workers and --scheduler: the scheduler's own workers run the sweep; give one")
+        if args.max_members < 1:
+            raise ValueError(f"--max-members {args.max_members}: give at least 1 (the most members a plan may have)")
+        if not args.connect_timeout > 0:
+            raise ValueError(f"--connect-timeout {args.connect_timeout:g}: give a number of seconds above 0")
+        from studies.sweep.folder import check_out, check_scheduler
+
+        check_scheduler(args.scheduler)  # before the plan is made or anything written
+        if args.out:
+            check_out(Path(args.out))
         plan = make_plan(args)
         if not args.quiet:
             print(f"sweep {plan.name or plan.scenario}: {len(plan.members)} members"
@@ -146,7 +157,7 @@ def sweep(args) -> int:
                              retries=args.retries, retry_errors=args.retry_errors,
                              keep_results=args.results or named.keep_results(plan),
                              progress=False if args.quiet else None,
-                             extra_metrics=named.extra_metrics(plan))
+                             extra_metrics=named.extra_metrics(plan), connect_timeout=args.connect_timeout)
     except (KeyError, ValueError) as error:  # SweepError is a ValueError
         print(f"quadcosim sweep {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2

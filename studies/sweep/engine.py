@@ -22,6 +22,7 @@ finished, runs the others (failed ones included) and rewrites the table.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
@@ -315,8 +316,9 @@ def _finished_record(path: Path) -> dict | None:
 
 
 def _prepare_folder(plan: Plan, out: Path, resume: bool) -> table.Rows:
-    """Check the sweep folder against the plan; the table's rows, holding the finished members'
-    when resuming (read one at a time)."""
+    """Check the sweep folder against the plan, writing nothing; the table's rows, holding the
+    finished members' when resuming (read one at a time, each checked against the plan's member:
+    a folder that holds another plan's members is refused)."""
     stored_path = out / "sweep.json"
     if stored_path.exists():
         try:
@@ -327,16 +329,31 @@ def _prepare_folder(plan: Plan, out: Path, resume: bool) -> table.Rows:
     elif resume:
         raise SweepError(f"{out} holds no sweep to resume (no {stored_path.name}): run the sweep without "
                          "--resume to start it, or give the --out of an earlier sweep.")
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "members").mkdir(exist_ok=True)
-    _write_json(stored_path, json.loads(json.dumps(plan.to_json(), default=float)))
+    elif any((out / "members").glob("*/metrics.json")):
+        raise SweepError(f"{out} holds members of a sweep without its plan (no {stored_path.name}); choose "
+                         "another --out.")
     rows = table.Rows(len(plan.members), out)
     if resume:
         for path in sorted((out / "members").glob("*/metrics.json")):
             index = int(path.parent.name) if path.parent.name.isdigit() else -1
             if 0 <= index < len(plan.members) and (record := _finished_record(path)) is not None:
+                planned = json.loads(json.dumps(plan.members[index].options, default=float))
+                if record.get("options") != planned:
+                    rows.close()
+                    changed = sorted(k for k in planned.keys() | (record.get("options") or {}).keys()
+                                     if planned.get(k) != (record.get("options") or {}).get(k))
+                    raise SweepError(f"{path} was run with other options than the plan's member {index} "
+                                     f"(differing: {', '.join(changed)}): the folder mixes two sweeps; "
+                                     "choose another --out.")
                 rows.add(index, table.row(record, plan.varied))
     return rows
+
+
+def _write_plan(plan: Plan, out: Path) -> None:
+    """``sweep.json`` and ``members/``: written once the cluster is up, so that a sweep refused
+    before leaves nothing."""
+    (out / "members").mkdir(exist_ok=True)
+    _write_json(out / "sweep.json", json.loads(json.dumps(plan.to_json(), default=float)))
 
 
 def _save_member(out: Path, member: Member, record: dict, attempts: int, scenario: str) -> dict:
@@ -397,36 +414,66 @@ class _Progress:
             self.bar.close()
 
 
-def _cluster(stack: ExitStack, workers: int | None, scheduler: str | None, retries: int, timeout: float):
+@contextlib.contextmanager
+def cluster(workers: int | None = None, scheduler: str | None = None, connect_timeout: float = 10.0,
+            timeout: float = 60.0):
+    """A Dask client on a local cluster of ``workers`` processes (one thread each), or on the
+    running ``scheduler``; closed when the block ends. Sweeps and tunes run their members here.
+
+    Parameters
+    ----------
+    workers : int, optional
+        Local worker processes (default: the CPUs). Ignored with ``scheduler``.
+    scheduler : str, optional
+        A running scheduler's address (checked by :func:`studies.sweep.folder.check_scheduler`).
+    connect_timeout : float
+        Seconds to reach the scheduler (s).
+    timeout : float
+        Seconds to wait for the first worker (s).
+
+    Raises
+    ------
+    SweepError
+        The scheduler cannot be reached, or no worker joined it in time.
+    """
     from distributed import Client, LocalCluster
 
-    if scheduler:
-        try:
-            client = stack.enter_context(Client(scheduler, timeout=timeout))
-        except OSError as error:
-            raise SweepError(f"cannot reach the Dask scheduler at {scheduler} ({error}). Start one with "
-                             "`dask scheduler`, and workers with `dask worker ADDRESS`.") from None
-    else:
-        import dask
+    with ExitStack() as stack:
+        if scheduler:
+            try:
+                client = stack.enter_context(Client(scheduler, timeout=connect_timeout))
+            except (OSError, TimeoutError) as error:
+                raise SweepError(f"cannot reach the Dask scheduler at {scheduler} within {connect_timeout:g} s "
+                                 f"({' '.join(str(error).split())[:200]}). Start one with `dask scheduler`, and "
+                                 "workers with `dask worker ADDRESS`; --connect-timeout waits longer.") from None
+            except (ValueError, TypeError, RuntimeError) as error:  # a transport refused its configuration
+                raise SweepError(f"cannot use the Dask scheduler at {scheduler}: {type(error).__name__}: "
+                                 f"{' '.join(str(error).split())[:200]}") from None
+        else:
+            import dask
 
-        # Each worker death is reported at once, so that --retries counts every attempt.
-        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                dashboard_address=None, silence_logs=logging.ERROR))
-        client = stack.enter_context(Client(cluster))
-    try:
-        client.wait_for_workers(1, timeout=timeout)
-    except TimeoutError:
-        raise SweepError(f"no Dask worker joined the scheduler {scheduler} within {timeout:g} s: start one with "
-                         f"`dask worker {scheduler}`.") from None
-    return client
+            # Each worker death is reported at once, so that --retries counts every attempt.
+            with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+                local = stack.enter_context(LocalCluster(
+                    n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                    dashboard_address=None, silence_logs=logging.ERROR, worker_dashboard_address=None))
+            client = stack.enter_context(Client(local))
+        try:
+            client.wait_for_workers(1, timeout=timeout)
+        except TimeoutError:
+            raise SweepError(f"no Dask worker joined the scheduler {scheduler} within {timeout:g} s: start one "
+                             f"with `dask worker {scheduler}`.") from None
+        yield client
 
 
 def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = None, resume: bool = False,
         retries: int = 2, retry_errors: bool = False, keep_results: bool = False, progress=None,
-        extra_metrics: str | None = None, timeout: float = 60.0) -> Summary:
+        extra_metrics: str | None = None, timeout: float = 60.0, connect_timeout: float = 10.0) -> Summary:
     """Run every member of ``plan`` on Dask; results stream into ``out`` as members finish.
+
+    The folder is held by this process while the sweep runs (a second sweep into it is
+    refused); nothing is written in it before the cluster is up, so a sweep refused before then
+    leaves nothing.
 
     Parameters
     ----------
@@ -452,9 +499,13 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     progress : None, bool or "lines"
         None: a bar on a terminal, a few lines otherwise; False: silent.
     extra_metrics : str, optional
-        ``"module:function"`` computing more metrics on the worker from ``(result, options)``.
+        ``"module:function"`` computing more metrics on the worker from ``(result, options)``
+        (a dict of metric name to number or list of numbers, merged into the member's metrics:
+        its columns in the table).
     timeout : float
-        Seconds to wait for a scheduler and its first worker (s).
+        Seconds to wait for the first worker (s).
+    connect_timeout : float
+        Seconds to reach ``scheduler`` (s).
 
     Returns
     -------
@@ -463,26 +514,40 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     Raises
     ------
     SweepError
-        The folder does not match the plan, or holds no sweep to resume.
+        The folder does not match the plan, holds no sweep to resume, or the scheduler cannot be
+        reached.
+    studies.sweep.folder.FolderRefused
+        The folder cannot be made or written, or the scheduler's address is not one.
+    orchestrator.files.FolderBusy
+        Another process is writing the folder.
     studies.sweep.checks.MemberRefused
         A member's values would fail (:func:`studies.sweep.checks.check`); nothing was run.
     """
     if retries < 0:
         raise SweepError(f"retries = {retries} must be zero or more")
-    from studies.sweep import checks
+    from studies.sweep import checks, folder
 
+    folder.check_scheduler(scheduler)
+    out = folder.check_out(Path(out))
+    if not resume and (out / "sweep.json").exists():  # said before the members are checked
+        _prepare_folder(plan, out, resume).close()
     checks.check(plan)  # before the folder is written and the cluster started
-    sweep = _Sweep(plan, Path(out), resume)
-    if sweep.left:
-        with ExitStack() as stack:
-            client = _cluster(stack, workers, scheduler, retries, timeout)
-            client.register_plugin(Preload(plan.scenario))
-            sweep.stream(client, retries, retry_errors, keep_results, extra_metrics, progress)
-            sweep.streamed = time.perf_counter()
-        sweep.shutdown = time.perf_counter() - sweep.streamed
-    elif sweep.rows:
-        sweep.flush(force=True)
-    return sweep.summary()
+    with folder.held(out):
+        sweep = _Sweep(plan, out, resume)
+        try:
+            if sweep.left:
+                with cluster(workers, scheduler, connect_timeout, timeout) as client:
+                    _write_plan(plan, out)
+                    client.register_plugin(Preload(plan.scenario))
+                    sweep.stream(client, retries, retry_errors, keep_results, extra_metrics, progress)
+                    sweep.streamed = time.perf_counter()
+                sweep.shutdown = time.perf_counter() - sweep.streamed
+            elif sweep.rows:
+                sweep.flush(force=True)
+        except BaseException:
+            sweep.rows.close()
+            raise
+        return sweep.summary()
 
 
 class _Sweep:
