@@ -163,7 +163,11 @@ def test_a_diverged_member_is_an_outcome_never_a_result(tmp_path, capsys):
     assert "10.0 m below its altitude setpoint" in columns["error"][1]
     record = json.loads((out / "members" / "000001" / "metrics.json").read_text())
     assert record["status"] == "diverged" and 2.0 < record["diverged"]["at_s"] < 3.0
-    figure = sweep.plot(columns, "rms_error_deg[0]", "Controller.kp")
+    assert "signals_not_saved" not in columns  # a member saves no record: no column repeats its list
+    assert table.units(out)["Controller.kp"] == "1/s^2" and table.units(out)["rms_error_deg[0]"] == "deg"
+    units, _, _ = command._plot_context(out)
+    figure = sweep.plot(columns, "rms_error_deg[0]", "Controller.kp", units=units)
+    assert figure.axes[0].get_xlabel() == "Controller.kp (1/s^2)"
     lines = {line.get_label(): line for line in figure.axes[0].get_lines()}
     assert list(lines["diverged (1): a crash, no value"].get_xdata()) == [5000.0]
     assert list(lines["rms_error_deg[0]"].get_xdata()) == [144.0]  # the crash is not on the curve

@@ -169,18 +169,19 @@ def sweep(args) -> int:
 
 
 def _plot_context(folder: Path) -> tuple[dict, str, dict]:
-    """Units of the swept scenario's options (from their help), a line naming the scenario and
+    """Units of the swept scenario's options and block parameters (as declared), a line naming the scenario and
     the options held fixed, and what its metrics' components are (``rms_error_deg[0]``: roll),
     from the sweep's ``sweep.json`` (nothing without one)."""
     import scenarios
-    from studies.sweep.figure import option_unit
+    from studies.sweep import units as units_of
 
     try:
         stored = json.loads((folder / "sweep.json").read_text())
         scenario = scenarios.get(stored["scenario"])
     except (OSError, ValueError, KeyError):
         return {}, "", {}
-    units = {key: option_unit(option.help) for key, option in scenario.options.items()}
+    units = stored.get("units") or units_of.of_options(stored["scenario"], [*scenario.options,
+                                                                             *stored.get("varied", [])])
     fixed = stored.get("description", {}).get("set") or []
     components = {f"{metric}[{i}]": name for metric, names in scenario.extra.get("components", {}).items()
                   for i, name in enumerate(names)}

@@ -44,7 +44,8 @@ from studies.sweep import table
 from studies.sweep.grid import Member, Plan, stored_members
 
 #: Keys of a scenario's metrics that are not metrics of a member.
-NOT_METRICS = ("scenario", "options", "figures", "units", "injected_faults", "status", "diverged")
+NOT_METRICS = ("scenario", "options", "figures", "units", "injected_faults", "status", "diverged",
+               "signals_not_saved")  # a member saves no record unless --results: its own metrics.json says
 _members_run = 0  # members run by this process (reported by worker_state)
 #: Members submitted ahead per worker, and at least: enough to keep every worker busy while
 #: results come back, few enough that neither the client nor the scheduler grows with the plan.
@@ -352,8 +353,12 @@ def _prepare_folder(plan: Plan, out: Path, resume: bool) -> table.Rows:
 def _write_plan(plan: Plan, out: Path) -> None:
     """``sweep.json`` and ``members/``: written once the cluster is up, so that a sweep refused
     before leaves nothing."""
+    from studies.sweep import units
+
     (out / "members").mkdir(exist_ok=True)
-    _write_json(out / "sweep.json", json.loads(json.dumps(plan.to_json(), default=float)))
+    names = list(plan.varied) + (list(plan.members[0].options) if len(plan.members) else [])
+    stored = plan.to_json() | {"units": units.of_options(plan.scenario, names)}
+    _write_json(out / "sweep.json", json.loads(json.dumps(stored, default=float)))
 
 
 def _save_member(out: Path, member: Member, record: dict, attempts: int, scenario: str) -> dict:
@@ -557,6 +562,10 @@ class _Sweep:
     def __init__(self, plan: Plan, out: Path, resume: bool):
         self.plan, self.out = plan, out
         self.rows = _prepare_folder(plan, out, resume)  # on disk, member by member: the client stays flat
+        from studies.sweep import units
+
+        names = list(plan.varied) + (list(plan.members[0].options) if len(plan.members) else [])
+        self.rows.units = units.of_options(plan.scenario, names)  # the Parquet columns' metadata
         self.skipped = self.rows.ok + len(self.rows.divergences)
         self.left = len(plan.members) - self.skipped
         self.started = time.perf_counter()

@@ -10,7 +10,6 @@ counted in the title. Curves and categories are in numeric order (8, 16, 24, not
 from __future__ import annotations
 
 import math
-import re
 from collections import defaultdict
 from pathlib import Path
 
@@ -49,23 +48,6 @@ def metric_unit(name: str) -> str:
     """
     stem = name.split("[", 1)[0]
     return next((unit for suffix, unit in _SUFFIX_UNITS if stem.endswith(suffix)), "")
-
-
-def option_unit(help_text: str) -> str:
-    """The unit an option's help ends with, in parentheses (``"... gain (1/s)"`` -> ``1/s``).
-
-    Parameters
-    ----------
-    help_text : str
-        An option's help.
-
-    Returns
-    -------
-    str
-        The unit, or ``""``.
-    """
-    match = re.search(r"\(([^()]*)\)\s*$", help_text)
-    return match.group(1) if match and len(match.group(1)) <= 12 else ""
 
 
 def _labelled(name: str, unit: str) -> str:

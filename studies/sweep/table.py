@@ -100,6 +100,7 @@ class Rows:
         self._columns: dict[str, tuple[int, int]] = {}  # name -> (first member holding it, position in its row)
         self._kinds: dict[str, dict] = {}  # name -> value type -> a value of it (ints: the least and largest)
         self._replaced = False  # a row was replaced since the columns were counted
+        self.units: dict[str, str] = {}  # option name -> unit (the metrics' come from their names)
         self.ok = 0
         self.failures: dict[int, tuple[str, str | None]] = {}  # failed member -> (label, error)
         self.divergences: dict[int, tuple[str, str | None]] = {}  # diverged member -> (label, what crossed)
@@ -196,7 +197,12 @@ class Rows:
 
         def parquet_file(path):
             types = {n: self._arrow_type(n) for n in names}
-            schema = pa.schema([(n, pa.string() if t is None else t) for n, t in types.items()])
+            from studies.sweep.units import of_columns
+
+            unit = of_columns(names, self.units)
+            schema = pa.schema([pa.field(n, pa.string() if t is None else t,
+                                         metadata={"unit": unit[n]} if n in unit else None)
+                                for n, t in types.items()])
             with pq.ParquetWriter(path, schema) as writer:
                 batch = []
                 for r in self:
@@ -248,6 +254,15 @@ def write(rows: list[dict], out: Path) -> None:
         kept.write(out)
     finally:
         kept.close()
+
+
+def units(path) -> dict[str, str]:
+    """The unit of each column of a sweep table that has one, from ``path``: a sweep folder or its
+    ``sweep.parquet`` (each field's metadata ``unit``)."""
+    path = Path(path)
+    schema = pq.read_schema(path / "sweep.parquet" if path.is_dir() else path)
+    return {field.name: field.metadata[b"unit"].decode() for field in schema
+            if field.metadata and b"unit" in field.metadata}
 
 
 def read(path) -> dict[str, list]:
