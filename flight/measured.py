@@ -3,6 +3,8 @@
 - :func:`tilt_step`: after the pitch step of ``flight=tilt``, the accelerometer's tilt against
   the true tilt at the end, the speed reached, and the time constant of a first-order lag
   fitted to the accelerometer's tilt (against ``m / (k_d sum|omega_n|)``, :func:`trim.drag_time_constant`);
+- :func:`step_response`: an attitude step's rise time, settling time, overshoot and steady
+  error on each axis (python-control's ``step_info``);
 - :func:`wind_hold`: holding a position in a steady wind, the tilt into the wind against
   :func:`trim.wind_hover_tilt`, the final position error and the largest drift on the way.
 """
@@ -73,6 +75,61 @@ def tilt_step(result, tilt: float, rotor_drag: bool) -> dict:
         (_, _, tau), _ = curve_fit(lag, result.time[window], pitch[window], p0=(tilt, tilt, FIT_START_TAU))
         found["tilt_lag_fitted_s"] = float(tau)
         found["tilt_lag_predicted_s"] = trim.drag_time_constant(thrust=float(result["Quadrotor.thrust"][-1]))
+    return found
+
+
+AXES = ("roll", "pitch", "yaw")
+
+
+def step_response(result, steps: list, step_time: float) -> dict:
+    """Step metrics of an attitude step on each axis, by python-control's ``step_info``.
+
+    The response is the true attitude (``Quadrotor.theta1..3``) from ``step_time`` on, less its
+    value just before the step; the reference of rise, settling and overshoot is the step
+    commanded (so a steady error counts against settling).
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A ``tp`` run with a step (``flight=step`` or ``flight=tilt``).
+    steps : list
+        The step on roll, pitch, yaw (rad), None on an axis not stepped
+        (:func:`flight.profiles.step_sizes`).
+    step_time : float
+        When the step is commanded (s).
+
+    Returns
+    -------
+    dict
+        Lists over roll, pitch, yaw (None on an axis not stepped): ``step_rise_time_s`` (10 to 90 %
+        of the step), ``step_settling_time_s`` (s after the step until the response stays within
+        2 % of the step; the whole window when it never does), ``step_overshoot_pct`` (% of the
+        step), ``step_steady_error_deg`` (the step less the mean response over the last 10 % of
+        the window, deg); ``step_settling_worst_s``, the largest settling time of the axes stepped
+        (s), one number to tune on.
+    """
+    import control
+
+    after = result.time >= step_time
+    before = max(int(np.argmax(after)) - 1, 0)
+    time = result.time[after] - step_time
+    found = {"step_rise_time_s": [], "step_settling_time_s": [], "step_overshoot_pct": [],
+             "step_steady_error_deg": []}
+    for i, step in enumerate(steps):
+        if step is None or len(time) < 3:
+            for values in found.values():
+                values.append(None)
+            continue
+        angle = result[f"Quadrotor.theta{i + 1}"]
+        response = angle[after] - angle[before]
+        info = control.step_info(response, timepts=time, final_output=step)
+        found["step_rise_time_s"].append(float(info["RiseTime"]))
+        found["step_settling_time_s"].append(float(info["SettlingTime"]))
+        found["step_overshoot_pct"].append(float(info["Overshoot"]))
+        late = response[time >= 0.9 * time[-1]]
+        found["step_steady_error_deg"].append(math.degrees(step - float(late.mean())))
+    settled = [t for t in found["step_settling_time_s"] if t is not None]
+    found["step_settling_worst_s"] = max(settled) if settled else None
     return found
 
 

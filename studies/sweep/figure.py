@@ -28,11 +28,6 @@ def _number(value) -> float | None:
     return number if math.isfinite(number) else None
 
 
-# unit of a metric, from the end of its name (``rms_error_deg[0]``, ``bias_convergence_s``)
-_SUFFIX_UNITS = (("_deg_s", "deg/s"), ("_rad_s", "rad/s"), ("_rad2", "rad²"), ("_deg", "deg"), ("_rad", "rad"),
-                 ("_uT", "µT"), ("_m", "m"), ("_s", "s"), ("_A", "A"), ("_T", "T"))
-
-
 def metric_unit(name: str) -> str:
     """The unit a metric's name ends with (``rms_error_deg[0]`` -> ``deg``); empty if none.
 
@@ -46,8 +41,9 @@ def metric_unit(name: str) -> str:
     str
         The unit, or ``""``.
     """
-    stem = name.split("[", 1)[0]
-    return next((unit for suffix, unit in _SUFFIX_UNITS if stem.endswith(suffix)), "")
+    from scenarios.metrics import unit_of_name
+
+    return unit_of_name(name.split("[", 1)[0]) or ""
 
 
 def _labelled(name: str, unit: str) -> str:
