@@ -68,7 +68,7 @@ def _stored_plan(out: Path):
                          "run it again into another --out") from None
 
 
-def default_out(base: Path, resume: bool, label: str) -> Path:
+def default_out(base: Path, resume: bool, label: str, marker: str = "sweep.json") -> Path:
     """The folder a sweep writes into when ``--out`` is not given: ``base``, or, when that holds
     an earlier sweep and this is not a ``--resume``, the next free ``base-2``, ``base-3``, ...,
     said on standard error (as ``quadcosim run`` does: a sweep never meets an earlier one unasked).
@@ -81,6 +81,8 @@ def default_out(base: Path, resume: bool, label: str) -> Path:
         A resumed sweep continues in ``base``.
     label : str
         The command, for the message.
+    marker : str
+        The file whose presence means a folder holds an earlier study (``tune.json`` for a tune).
 
     Returns
     -------
@@ -90,11 +92,11 @@ def default_out(base: Path, resume: bool, label: str) -> Path:
         return base
     from orchestrator.files import first_free
 
-    candidate = first_free(base, lambda folder: (folder / "sweep.json").exists()
+    candidate = first_free(base, lambda folder: (folder / marker).exists()
                            or (folder.exists() and not folder.is_dir()))
     if candidate != base:
-        print(f"{label}: {base}/ holds an earlier sweep; writing to {candidate}/ (--out DIR chooses the folder, "
-              f"--resume continues {base}/)", file=sys.stderr)
+        print(f"{label}: {base}/ holds an earlier {marker.split('.')[0]}; writing to {candidate}/ (--out DIR "
+              f"chooses the folder, --resume continues {base}/)", file=sys.stderr)
     return candidate
 
 
