@@ -47,6 +47,7 @@ GROUPS = (
     "excerpt",
     "log_info",
     "example_replay",
+    "tune",
 )
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -80,7 +80,8 @@ def _k_figure(tuned: dict, grid: dict, path: Path) -> None:
     ax.plot([tuned["best"]["k"]], [tuned["value"]], "*", color="C3", ms=15, zorder=4,
             label=f"tuned k = {tuned['best']['k']:.3g} 1/s")
     predicted = tuned["prediction"]
-    ax.axvline(predicted["k"], color="C2", ls="--", label=f"python-control's optimum, noise only: {predicted['k']:.3g} 1/s")
+    ax.axvline(predicted["k"], color="C2", ls="--",
+               label=f"python-control's optimum, noise only: {predicted['k']:.3g} 1/s")
     fig.colorbar(points, ax=ax, label="evaluation")
     ax.set_xscale("log")
     ax.set_yscale("log")

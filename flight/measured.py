@@ -122,10 +122,16 @@ def step_response(result, steps: list, step_time: float) -> dict:
             continue
         angle = result[f"Quadrotor.theta{i + 1}"]
         response = angle[after] - angle[before]
-        info = control.step_info(response, timepts=time, final_output=step)
-        found["step_rise_time_s"].append(float(info["RiseTime"]))
-        found["step_settling_time_s"].append(float(info["SettlingTime"]))
-        found["step_overshoot_pct"].append(float(info["Overshoot"]))
+        try:
+            info = control.step_info(response, timepts=time, final_output=step)
+            rise, settling, overshoot = info["RiseTime"], info["SettlingTime"], info["Overshoot"]
+        except IndexError:  # step_info does not apply: the response never reached 90 % of the step
+            rise, settling = None, float(time[-1])
+            overshoot = max(0.0, 100.0 * (float(np.max(response / step)) - 1.0))
+        found["step_rise_time_s"].append(None if rise is None else float(rise))
+        # never within the band at the end (step_info's NaN): it did not settle in the window
+        found["step_settling_time_s"].append(float(time[-1]) if math.isnan(settling) else float(settling))
+        found["step_overshoot_pct"].append(float(overshoot))
         late = response[time >= 0.9 * time[-1]]
         found["step_steady_error_deg"].append(math.degrees(step - float(late.mean())))
     settled = [t for t in found["step_settling_time_s"] if t is not None]

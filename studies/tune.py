@@ -14,8 +14,9 @@ optimiser is scipy.optimize's, on coordinates scaled to [0, 1] (logarithmic for 
   (:func:`scipy.optimize.minimize_scalar`) between its neighbours for one option, Nelder-Mead with
   bounds (:func:`scipy.optimize.minimize`) for several, until the budget of evaluations is spent.
 
-An evaluation where any member diverged or failed has no value: the optimiser sees a penalty
-(:data:`PENALTY`), and it is never the best. ``tune.json`` (the best point, its value, the
+An evaluation where any member diverged, failed or has no value of the metric (a step that never
+rose to 90 %) has no value: the optimiser sees a penalty (:data:`PENALTY`), and it is never the
+best. ``tune.json`` (the best point, its value, the
 evaluations, the whole history) is rewritten after every batch; ``--resume`` replays the
 optimiser, deterministic, through the evaluations already recorded, and runs only the new ones.
 ``convergence.png`` draws each evaluation and the best so far.
@@ -228,16 +229,18 @@ class _Tuner:
 
         members = []
         for seed, record in zip(self.plan.seeds or [None], records, strict=True):
-            value = flatten(record.get("metrics") or {}).get(self.plan.metric)
-            if record["status"] == "ok" and value is None:
+            flat = flatten(record.get("metrics") or {})
+            if record["status"] == "ok" and self.plan.metric not in flat:
                 from orchestrator.fmu import nearest
 
                 raise TuneError(f"--minimize {self.plan.metric}: the scenario has no such metric."
-                                f"{nearest(self.plan.metric, flatten(record['metrics']))}")
-            members.append({"seed": seed, "status": record["status"], "value": value,
+                                f"{nearest(self.plan.metric, flat)}")
+            value = flat.get(self.plan.metric)
+            status = "no value" if record["status"] == "ok" and value is None else record["status"]
+            members.append({"seed": seed, "status": status, "value": value,
                             "error": next(iter((record.get("error") or "").splitlines()), None)})
         statuses = {m["status"] for m in members}
-        status = "diverged" if "diverged" in statuses else "failed" if "failed" in statuses else "ok"
+        status = next((s for s in ("diverged", "failed", "no value") if s in statuses), "ok")
         value = float(np.mean([m["value"] for m in members])) if status == "ok" else None
         return {"options": point, "value": value, "status": status, "members": members}
 
@@ -285,6 +288,7 @@ def optimise(tuner: _Tuner) -> None:
         return
     from scipy.stats import qmc
 
+    count = 2 ** int(math.log2(count))  # a Sobol sequence is balanced at powers of 2
     scan = qmc.Sobol(dims, scramble=False).random(count)
     values = tuner.evaluate(scan, "scan")
     start = scan[int(np.argmin(values))]
