@@ -105,8 +105,11 @@ def step_response(result, steps: list, step_time: float) -> dict:
         of the step), ``step_settling_time_s`` (s after the step until the response stays within
         2 % of the step; the whole window when it never does), ``step_overshoot_pct`` (% of the
         step), ``step_steady_error_deg`` (the step less the mean response over the last 10 % of
-        the window, deg); ``step_settling_worst_s``, the largest settling time of the axes stepped
-        (s), one number to tune on.
+        the window, deg), ``step_iae_deg_times_s`` (the integral of the absolute error to the step
+        over the window, deg s); ``step_settling_worst_s``, the largest settling time of the axes
+        stepped (s), and ``step_iae_total_deg_times_s``, the sum of their integrals (deg s): one
+        number each to tune on (the integral varies smoothly with the gains, a settling time by
+        jumps).
     """
     import control
 
@@ -114,7 +117,7 @@ def step_response(result, steps: list, step_time: float) -> dict:
     before = max(int(np.argmax(after)) - 1, 0)
     time = result.time[after] - step_time
     found = {"step_rise_time_s": [], "step_settling_time_s": [], "step_overshoot_pct": [],
-             "step_steady_error_deg": []}
+             "step_steady_error_deg": [], "step_iae_deg_times_s": []}
     for i, step in enumerate(steps):
         if step is None or len(time) < 3:
             for values in found.values():
@@ -134,8 +137,10 @@ def step_response(result, steps: list, step_time: float) -> dict:
         found["step_overshoot_pct"].append(float(overshoot))
         late = response[time >= 0.9 * time[-1]]
         found["step_steady_error_deg"].append(math.degrees(step - float(late.mean())))
+        found["step_iae_deg_times_s"].append(math.degrees(float(np.trapezoid(np.abs(step - response), time))))
     settled = [t for t in found["step_settling_time_s"] if t is not None]
     found["step_settling_worst_s"] = max(settled) if settled else None
+    found["step_iae_total_deg_times_s"] = sum(v for v in found["step_iae_deg_times_s"] if v is not None)
     return found
 
 

@@ -17,7 +17,8 @@ A named sweep: its members run on Dask like any sweep (``--workers``, ``--schedu
 - the lab's findings as checks, each with its measured figures: the linear filter accurate in
   quasi-stationary flight (a non-zero error below 1 degree on every axis) and degraded in
   non-stationary flight; the explicit filter below 2 degrees RMS in both; the bias cases as
-  the analyses predict.
+  the analyses predict where they do (the explicit filter's roll and yaw; its pitch is named as
+  missed).
 """
 
 from __future__ import annotations
@@ -69,6 +70,9 @@ LINEAR_ACCURATE_DEG = 1.0  # deg, every axis, quasi-stationary flight
 EXPLICIT_ACCURATE_DEG = 2.0  # deg, every axis, both flights
 PREDICTION_TOLERANCE = {"explicit": 0.1, "passive": 0.2}  # relative, as in tests/test_lab_cases.py
 PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
+# the explicit filter's pitch steady error under the lab's bias, hover, 60 s: -0.53 against -0.29 deg
+# predicted at k1 = k2 = 1, -0.21 against -0.14 at 2 (roll and yaw within 1 %): a gap the analysis leaves
+PITCH_MISSED = 0.3
 
 
 def cases() -> dict[str, dict]:
@@ -144,8 +148,9 @@ def checks(summary: dict) -> list[dict]:
     rms = {name: np.array(m["rms_error_deg"]) for name, m in summary["cases"].items()}
     quasi, fast = rms["linear-quasi-gt"], rms["linear-nonstationary-gt"]
     explicit = np.array([rms[name] for name in EXPLICIT_WITHOUT_BIAS])
-    explicit_gap = max(abs(r["simulated"][0] / r["predicted"][0] - 1)
-                       for r in summary["explicit_steady_bias_error_deg"] if r["k1=k2"] >= 1.0)
+    steady = [r for r in summary["explicit_steady_bias_error_deg"] if r["k1=k2"] >= 1.0]
+    explicit_gap = max(abs(r["simulated"][axis] / r["predicted"][axis] - 1) for r in steady for axis in (0, 2))
+    pitch_gap = min(abs(r["simulated"][1] / r["predicted"][1] - 1) for r in steady)
     passive_gap = max(np.inf if r["simulated"] is None else abs(r["simulated"] / r["predicted"] - 1)
                       for r in summary["passive_bias_convergence_s"])
     rested_on = [name for name in summary.get("diverged", {}) if not name.startswith("compare-")]
@@ -158,9 +163,12 @@ def checks(summary: dict) -> list[dict]:
          "measured": (fast / quasi).tolist(), "ok": bool(np.all(fast > quasi))},
         {"check": f"explicit, without gyro bias, both flights: RMS < {EXPLICIT_ACCURATE_DEG:g} deg (largest)",
          "measured": [float(explicit.max())], "ok": bool(explicit.max() < EXPLICIT_ACCURATE_DEG)},
-        {"check": "explicit without bias estimate, k1 = k2 >= 1: roll steady error as predicted "
+        {"check": "explicit without bias estimate, k1 = k2 >= 1: roll and yaw steady error as predicted "
                   f"(largest relative gap < {PREDICTION_TOLERANCE['explicit']:g})",
          "measured": [float(explicit_gap)], "ok": bool(explicit_gap < PREDICTION_TOLERANCE["explicit"])},
+        {"check": "explicit without bias estimate, k1 = k2 >= 1: pitch steady error NOT as the linearised analysis "
+                  f"predicts (smallest relative gap > {PITCH_MISSED:g})",
+         "measured": [float(pitch_gap)], "ok": bool(pitch_gap > PITCH_MISSED)},
         {"check": "passive, R_reel and TRIAD, hover: bias-convergence time as predicted "
                   f"(largest relative gap < {PREDICTION_TOLERANCE['passive']:g})",
          "measured": [float(passive_gap)], "ok": bool(passive_gap < PREDICTION_TOLERANCE["passive"])},

@@ -401,8 +401,9 @@ def figure(data: dict, path: Path) -> Path:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     best = data["best"] or {}
-    ax.set_title(f"{data['scenario']}: {metric}, {len(history)} evaluations x {max(len(data['seeds']), 1)} seeds; "
-                 f"best {data['value']:.4g} at {_text(best)}" if best else "no evaluation has a value", fontsize=9)
+    seeds = f" x {len(data['seeds'])} seeds" if data["seeds"] else ""
+    ax.set_title(f"{data['scenario']}: {metric}, {len(history)} evaluations{seeds}\n"
+                 + (f"best {data['value']:.4g} at {_text(best)}" if best else "no evaluation has a value"), fontsize=9)
     if one:
         name = data["over"][0]["name"]
         ax2 = axes[0][1]
