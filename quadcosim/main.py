@@ -358,16 +358,7 @@ def parser() -> argparse.ArgumentParser:
     from scenarios import run_plots
 
     run_plots.add_arguments(sub)
-    from studies.sweep import command as sweep
-
-    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
-        .set_defaults(func=sweep.sweep)
-    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
-        .set_defaults(func=sweep.sweep_plot)
-    from studies import tune
-
-    tune.add_arguments(sub.add_parser("tune", help="the options that minimise a metric (scipy.optimize), on Dask"))\
-        .set_defaults(func=tune.command)
+    _add_studies(sub)
     _add_flight_logs(sub)
     return p
 
@@ -411,6 +402,20 @@ def _add_run(sub):
                      help="write the record to OUT/results.stream/ in chunks as the run goes: memory stays flat "
                           "however long the run (read it with Result.load(OUT))")
     run.set_defaults(func=_run)
+
+
+def _add_studies(sub):
+    """The ``sweep``, ``sweep-plot`` and ``tune`` verbs (:mod:`studies.sweep`, :mod:`studies.tune`)."""
+    from studies.sweep import command as sweep
+
+    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
+        .set_defaults(func=sweep.sweep)
+    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
+        .set_defaults(func=sweep.sweep_plot)
+    from studies import tune
+
+    tune.add_arguments(sub.add_parser("tune", help="the options that minimise a metric (scipy.optimize), on Dask"))\
+        .set_defaults(func=tune.command)
 
 
 def _add_flight_logs(sub):
