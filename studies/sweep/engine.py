@@ -461,7 +461,8 @@ def cluster(workers: int | None = None, scheduler: str | None = None, connect_ti
             with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
                 local = stack.enter_context(LocalCluster(
                     n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                    dashboard_address=None, silence_logs=logging.ERROR, worker_dashboard_address=None))
+                    dashboard_address=None, silence_logs=logging.ERROR, worker_dashboard_address=None,
+                    scheduler_kwargs={"dashboard_address": ":0"}))  # its HTTP server on a free port: no 8787 clash
             client = stack.enter_context(Client(local))
         try:
             client.wait_for_workers(1, timeout=timeout)

@@ -119,11 +119,24 @@ SHORT = ["tp", "--grid", "k=0.05,0.1", "--set", "duration=0.2", "noise=on", "--q
 
 
 def test_two_sweeps_into_one_folder_at_once_the_second_is_refused(tmp_path):
+    import socket
+
     out = tmp_path / "shared"
     command_line = [sys.executable, "-m", "studies.sweep", *SHORT, "--workers", "1", "--out", str(out)]
-    both = [subprocess.Popen(command_line, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-            for _ in range(2)]
-    ended = [(process.wait(timeout=300), *process.communicate()) for process in both]
+    dashboard = socket.socket()  # Dask's default dashboard port taken, as by another cluster
+    try:
+        dashboard.bind(("", 8787))
+        dashboard.listen()
+    except OSError:
+        pass  # taken already
+    try:
+        both = [subprocess.Popen(command_line, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                for _ in range(2)]
+        ended = [(process.wait(timeout=300), *process.communicate()) for process in both]
+    finally:
+        dashboard.close()
+    noise = [err for _, _, err in ended if "8787" in err or "unclosed" in err]
+    assert not noise, noise  # neither Dask's port warning nor an unclosed socket
     codes = sorted(code for code, _, _ in ended)
     assert codes == [0, 2], ended
     refused = next(err for code, _, err in ended if code == 2)
