@@ -111,7 +111,7 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     units = units or {}
     by_unit = f" {units[by]}" if by and units.get(by) else ""
     for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: natural_key(item[0]))):
-        _curve(ax, series, f"C{n % 10}", f"{by} = {key}{by_unit}" if by else metric)
+        _curve(ax, series, f"C{n % 10}", f"{by} = {key}{by_unit}" if by else metric, banded=not categories)
     if diverged:
         from matplotlib.transforms import blended_transform_factory
 
@@ -173,10 +173,10 @@ def _groups(columns, metric, x, by):
         raise ValueError(f"no finished member has a numeric {metric!r}")
     xs = [columns[x][i] for i in kept + crashed]
     numeric_x = all(_number(v) is not None for v in xs)
-    categories = [] if numeric_x else sorted(set(map(str, xs)), key=natural_key)
+    categories = [] if numeric_x else sorted(set(map(_shown, xs)), key=natural_key)
 
     def position(i):
-        return float(columns[x][i]) if numeric_x else float(categories.index(str(columns[x][i])))
+        return float(columns[x][i]) if numeric_x else float(categories.index(_shown(columns[x][i])))
 
     groups: dict[object, dict[float, list[float]]] = defaultdict(lambda: defaultdict(list))
     for i in kept:
@@ -184,14 +184,27 @@ def _groups(columns, metric, x, by):
     return groups, categories, numeric_x, failed, sorted({position(i) for i in crashed})
 
 
-def _curve(ax, series: dict[float, list[float]], colour: str, label: str):
-    """One group: the mean through its x positions; with pooled members, their band and points."""
+def _shown(value) -> str:
+    """A category as the command line writes it: on/off for a switch."""
+    return ("on" if value else "off") if isinstance(value, bool) else str(value)
+
+
+def _curve(ax, series: dict[float, list[float]], colour: str, label: str, banded: bool = True):
+    """One group: the mean through its x positions; with pooled members, their spread (a band
+    between numeric positions, a bar at each category) and points."""
     at = np.array(sorted(series))
     values = [np.array(series[a]) for a in at]
     pooled = max(len(v) for v in values)
-    ax.plot(at, [v.mean() for v in values], "o-", color=colour,
-            label=label + (f" (mean of {pooled})" if pooled > 1 else ""))
+    means = np.array([v.mean() for v in values])
+    ax.plot(at, means, "o-" if banded else "o", color=colour,
+            label=label + (f" (mean of {'' if min(map(len, values)) == pooled else 'up to '}{pooled})"
+                           if pooled > 1 else ""))
     if pooled > 1:
-        ax.fill_between(at, [v.min() for v in values], [v.max() for v in values], color=colour, alpha=0.15)
+        lows, highs = np.array([v.min() for v in values]), np.array([v.max() for v in values])
+        if banded:
+            ax.fill_between(at, lows, highs, color=colour, alpha=0.15)
+        else:
+            ax.errorbar(at, means, yerr=[means - lows, highs - means], fmt="none", ecolor=colour, capsize=6,
+                        alpha=0.6)
         for a, v in zip(at, values, strict=True):
             ax.plot(np.full(len(v), a), v, ".", color=colour, alpha=0.3, ms=3)
