@@ -153,6 +153,31 @@ def plan(scenario_name: str, metric: str, over, settings=(), seeds: int | None =
                     {"set": list(settings), "over": list(over)})
 
 
+def loop_margins(tune_plan: TunePlan, best: dict | None) -> dict | None:
+    """python-control's phase margins of the attitude loops at the tuned gains, when a tune of
+    ``tp`` moved ``Controller.kp``, ``kd``, ``kp_yaw`` or ``kd_yaw``: the loop broken at the plant's
+    input, ``L(s) = (kd s + kp) / s^2`` (the law ``tau = J (-kp e - kd omega)`` on the rigid body
+    ``J``), for roll and pitch and for yaw; None otherwise."""
+    names = {d.name for d in tune_plan.over}
+    if tune_plan.scenario != "tp" or best is None or not names & {f"Controller.{g}" for g in
+                                                                   ("kp", "kd", "kp_yaw", "kd_yaw")}:
+        return None
+    import control
+
+    from flight.controller import GAINS
+
+    def gain(name):
+        key = f"Controller.{name}"
+        return float(best.get(key, tune_plan.base.get(key, GAINS[name][0])))
+
+    margins = {}
+    for axis, (kp, kd) in (("roll_pitch", ("kp", "kd")), ("yaw", ("kp_yaw", "kd_yaw"))):
+        _, phase_margin, _, crossover = control.margin(control.tf([gain(kd), gain(kp)], [1.0, 0.0, 0.0]))
+        margins |= {f"{axis}_phase_margin_deg": float(phase_margin), f"{axis}_crossover_rad_s": float(crossover)}
+    return {"what": "phase margins of the attitude loops at the tuned gains, L(s) = (kd s + kp) / s^2 "
+                    "(python-control's margin)"} | margins
+
+
 def prediction(tune_plan: TunePlan) -> dict | None:
     """python-control's predicted optimum where one applies, else None: the linear filter's gain
     ``k`` against the IMU's white noise (:func:`estimators.analysis.linear_optimal_gain`), for
@@ -344,7 +369,9 @@ def run(tune_plan: TunePlan, out, workers: int | None = None, scheduler: str | N
                 tuner.save()
                 raise
         data = tuner.save(finished=True, extra={"seconds": time.perf_counter() - started,
-                                                "prediction": prediction(tune_plan)})
+                                                "prediction": prediction(tune_plan),
+                                                "loop_margins": loop_margins(tune_plan, tuner.best() and
+                                                                             tuner.best()["options"])})
         figure(data, out / "convergence.png")
     return data
 
@@ -485,5 +512,10 @@ def command(args) -> int:
     if data.get("prediction"):
         p = data["prediction"]
         print(f"  python-control predicts k = {p['k']:.4g} 1/s ({p['what']})")
+    if data.get("loop_margins"):
+        m = data["loop_margins"]
+        print(f"  phase margin at the tuned gains: roll and pitch {m['roll_pitch_phase_margin_deg']:.1f} deg at "
+              f"{m['roll_pitch_crossover_rad_s']:.3g} rad/s, yaw {m['yaw_phase_margin_deg']:.1f} deg at "
+              f"{m['yaw_crossover_rad_s']:.3g} rad/s (python-control)")
     print(f"tune.json and convergence.png in {out}/")
     return 0

@@ -57,3 +57,18 @@ def test_the_prediction_applies_to_the_linear_filters_gain_against_noise():
     assert 0.1 < predicted["k"] < 5.0 and predicted["rms_error_deg"] > 0
     assert tune.prediction(tune.plan("tp", "rms_error_deg[0]", ["k=0.005:20:log"])) is None  # no noise
     assert tune.prediction(tune.plan("tp", "rms_error_deg[2]", ["k=0.005:20:log"], ["noise=on"])) is None
+
+
+def test_loop_margins_of_a_tune_of_the_attitude_gains():
+    import math
+
+    plan = tune.plan("tp", "step_iae_total_deg_times_s", ["Controller.kp=30:600:log", "Controller.kd=5:60:log"],
+                     ["flight=step"])
+    margins = tune.loop_margins(plan, {"Controller.kp": 144.0, "Controller.kd": 19.2})
+    w = margins["roll_pitch_crossover_rad_s"]
+    # L(jw) = (kp + j kd w) / (-w^2): unit gain at the crossover, phase margin atan(kd w / kp)
+    assert math.hypot(144.0, 19.2 * w) / w**2 == pytest.approx(1.0, rel=1e-6)
+    assert margins["roll_pitch_phase_margin_deg"] == pytest.approx(math.degrees(math.atan2(19.2 * w, 144.0)), abs=1e-6)
+    # yaw at its defaults 64 and 12.8: the same damping 0.8, the same margin
+    assert margins["yaw_phase_margin_deg"] == pytest.approx(margins["roll_pitch_phase_margin_deg"], abs=1e-6)
+    assert tune.loop_margins(tune.plan("tp", "rms_error_deg[0]", ["k=0.1:1"]), {"k": 0.5}) is None
