@@ -362,3 +362,25 @@ def test_lab_matrix_is_a_named_sweep_of_every_case():
     assert all(m.options["noise"] is True for m in plan.members)
     passive = plan.members[-1].options  # TRIAD, kP = kI = 100: 1.5 times the predicted convergence, at least 10 s
     assert passive["ry"] == "triad" and passive["kP"] == 100.0 and passive["duration"] == 10.0
+
+
+def test_the_lab_matrix_marks_its_diverged_member():
+    """The passive filter on TRIAD, estimate-fed in non-stationary flight, crashes (roll 60 deg off
+    its setpoint at t = 15.7 s): summary.md prints its numbers as a crash, and lists it."""
+    import scenarios
+    from studies import lab_matrix
+    from studies.sweep.engine import run_member
+
+    name = "compare-passive-nonstationary"
+    record = run_member("tp", scenarios.get("tp").parse(lab_matrix.COMPARISON[name]),
+                        extra_metrics="studies.lab_matrix:late_mean_error")
+    assert record["status"] == "diverged" and "roll 60 deg from its setpoint" in record["error"]
+    metrics = record["metrics"]
+    summary = {"diverged": {name: record["error"]}, "cases": {}, "explicit_steady_bias_error_deg": [],
+               "passive_bias_convergence_s": [],
+               "comparison": {name: {k: metrics[k] for k in ("quaternion_rmse_deg", "rms_error_deg",
+                                                             "tracking_rms_deg")} | {"status": "diverged"}}}
+    text = lab_matrix.markdown(summary)
+    row = next(line for line in text.splitlines() if line.startswith("| nonstationary | passive |"))
+    assert row.count("DIVERGED (a crash: ") == 3
+    assert f"- {name}: tp diverged at t = " in text
