@@ -81,6 +81,42 @@ def tilt_step(result, tilt: float, rotor_drag: bool) -> dict:
 AXES = ("roll", "pitch", "yaw")
 
 
+def step_figures(time, response, size: float, band: float = 0.02) -> tuple:
+    """Rise time, settling time and overshoot of a step response, by python-control's ``step_info``
+    where it applies: the one implementation behind :func:`step_response` and the testing
+    assertions' step (:func:`scenarios.testing.assertions.step_response`).
+
+    Parameters
+    ----------
+    time : array_like
+        Time from the step (s).
+    response : array_like
+        The response less its value at the step (the signal's unit).
+    size : float
+        The step commanded, the reference of rise, settling and overshoot (same unit).
+    band : float
+        Settling band, a fraction of the step's size.
+
+    Returns
+    -------
+    tuple
+        ``rise`` (s, 10 to 90 % of the step; None when the response never reaches 90 %, where
+        ``step_info`` does not apply), ``settling`` (s; None when the last sample is outside the
+        band: it did not settle in the window), ``overshoot`` (% of the step, 0 or more).
+    """
+    import control
+
+    time, response = np.asarray(time, float), np.asarray(response, float)
+    outside = np.nonzero(np.abs(response - size) > band * abs(size))[0]
+    unsettled = len(outside) > 0 and outside[-1] == len(response) - 1
+    try:
+        info = control.step_info(response, timepts=time, final_output=size, SettlingTimeThreshold=band)
+    except IndexError:  # the response never reached 90 % of the step
+        return None, None, max(0.0, 100.0 * (float(np.max(response / size)) - 1.0))
+    settling = None if unsettled or math.isnan(info["SettlingTime"]) else float(info["SettlingTime"])
+    return float(info["RiseTime"]), settling, float(info["Overshoot"])
+
+
 def step_response(result, steps: list, step_time: float) -> dict:
     """Step metrics of an attitude step on each axis, by python-control's ``step_info``.
 
@@ -111,8 +147,6 @@ def step_response(result, steps: list, step_time: float) -> dict:
         number each to tune on (the integral varies smoothly with the gains, a settling time by
         jumps).
     """
-    import control
-
     after = result.time >= step_time
     before = max(int(np.argmax(after)) - 1, 0)
     time = result.time[after] - step_time
@@ -125,16 +159,11 @@ def step_response(result, steps: list, step_time: float) -> dict:
             continue
         angle = result[f"Quadrotor.theta{i + 1}"]
         response = angle[after] - angle[before]
-        try:
-            info = control.step_info(response, timepts=time, final_output=step)
-            rise, settling, overshoot = info["RiseTime"], info["SettlingTime"], info["Overshoot"]
-        except IndexError:  # step_info does not apply: the response never reached 90 % of the step
-            rise, settling = None, float(time[-1])
-            overshoot = max(0.0, 100.0 * (float(np.max(response / step)) - 1.0))
-        found["step_rise_time_s"].append(None if rise is None else float(rise))
-        # never within the band at the end (step_info's NaN): it did not settle in the window
-        found["step_settling_time_s"].append(float(time[-1]) if math.isnan(settling) else float(settling))
-        found["step_overshoot_pct"].append(float(overshoot))
+        rise, settling, overshoot = step_figures(time, response, step)
+        found["step_rise_time_s"].append(rise)
+        # not settled by the end: the whole window
+        found["step_settling_time_s"].append(float(time[-1]) if settling is None else settling)
+        found["step_overshoot_pct"].append(overshoot)
         late = response[time >= 0.9 * time[-1]]
         found["step_steady_error_deg"].append(math.degrees(step - float(late.mean())))
         found["step_iae_deg_times_s"].append(math.degrees(float(np.trapezoid(np.abs(step - response), time))))
