@@ -49,6 +49,7 @@ GROUPS = (
     "example_replay",
     "ardupilot_logs",
     "compass_rate",
+    "tune",
 )
 
 ROOT = Path(__file__).resolve().parents[1]

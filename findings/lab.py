@@ -6,6 +6,8 @@ scenarios.ablation`` (it prints it). The quick subset: the default ``tp`` run (a
 
 from __future__ import annotations
 
+import numpy as np
+
 from findings import command, finding
 
 RUN = "quadcosim run tp"
@@ -137,8 +139,49 @@ def madgwick() -> list[dict]:
                2)[0]
 
 
+SEEDS = range(1, 7)  # case 2: the noise's spread over these seeds
+CASE6 = {"estimator": "explicit", "noise": True, "bias": True, "feedback": "estimate"}
+CASE6_STEADY_S = 960.0  # s of hover: the last quarter's mean moves by under 0.1 deg from 480 s on
+
+
+def noise_seeds() -> list[dict]:
+    """Case 2: the linear filter's roll error without noise, and with noise over seeds 1 to 6."""
+    settings = {"estimator": "linear", "noise": True}
+    command_line = "quadcosim sweep tp --grid noise=off,on --seeds 6 --set estimator=linear"
+    roll = [_tp(settings | {"seed": seed})["rms_error_deg"][0] for seed in SEEDS]
+    return [finding("lab.noise_seeds.off_roll", _tp({"estimator": "linear"})["rms_error_deg"][0], "deg",
+                    command_line, 5e-4, 3),
+            finding("lab.noise_seeds.on_roll_min", min(roll), "deg", command_line, 5e-4, 3),
+            finding("lab.noise_seeds.on_roll_max", max(roll), "deg", command_line, 5e-4, 3),
+            finding("lab.noise_seeds.on_roll_mean", float(np.mean(roll)), "deg", command_line, 5e-4, 3),
+            finding("lab.noise_seeds.on_roll_seed1", roll[0], "deg", command_line, 5e-4, 3)]
+
+
+def bias_steady() -> list[dict]:
+    """Case 6: the explicit filter's steady error under a gyro bias without bias estimate, in the
+    case's 20 s non-stationary flight (still growing) and in a hover long enough to be steady,
+    against the linearised prediction; how much the hover's error moved over its last half."""
+    import scenarios
+
+    short = CASE6 | {"flight": "nonstationary"}
+    m = _tp(short)
+    found = _triple("lab.bias_steady.nonstationary_20s", m["steady_error_deg"], "deg", _command(short), 1)
+    found += _triple("lab.bias_steady.predicted", m["steady_error_predicted_deg"], "deg", _command(short), 1)
+    long = CASE6 | {"flight": "hover", "duration": CASE6_STEADY_S, "bench_supply": True}
+    result, m = scenarios.run("tp", long)
+    found += _triple("lab.bias_steady.hover", m["steady_error_deg"], "deg", _command(long), 1)
+    error = np.column_stack([result[f"Quaternion_estim.theta_est{i}"] - result[f"Quadrotor.theta{i}"]
+                             for i in (1, 2, 3)])
+    half, quarter = 0.5 * CASE6_STEADY_S, 0.25 * CASE6_STEADY_S
+    earlier = error[(result.time > half) & (result.time <= half + quarter)].mean(axis=0)
+    later = error[result.time > half + quarter].mean(axis=0)
+    moved = float(np.degrees(np.max(np.abs(later - earlier))))
+    return found + [finding("lab.bias_steady.hover_moved", moved, "deg", _command(long), 0.05, 1)]
+
+
 def compute(quick: bool = False) -> list[dict]:
-    """Every lab finding; ``quick``: the default run's."""
+    """Every lab finding; ``quick``: the default run's and the cases of the lab page checked by
+    measurement (noise over seeds, the bias's steady error: about half a minute)."""
     if quick:
-        return defaults()
-    return defaults() + linear() + explicit() + passive() + triad() + madgwick()
+        return defaults() + noise_seeds() + bias_steady()
+    return defaults() + noise_seeds() + bias_steady() + linear() + explicit() + passive() + triad() + madgwick()

@@ -216,6 +216,8 @@ class Controller(Block):
     inputs = INPUTS
     outputs = OUTPUTS
     units = UNITS
+    #: The unit of each gain (``--set Controller.kp=...``), as :data:`GAINS` declares it.
+    parameter_units = {name: unit for name, (_, unit, _) in GAINS.items()}
 
     def __init__(self, name: str = "Controller", period: int = 1, gains: dict | None = None):
         super().__init__(name, period)

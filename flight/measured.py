@@ -3,6 +3,8 @@
 - :func:`tilt_step`: after the pitch step of ``flight=tilt``, the accelerometer's tilt against
   the true tilt at the end, the speed reached, and the time constant of a first-order lag
   fitted to the accelerometer's tilt (against ``m / (k_d sum|omega_n|)``, :func:`trim.drag_time_constant`);
+- :func:`step_response`: an attitude step's rise time, settling time, overshoot and steady
+  error on each axis (python-control's ``step_info``);
 - :func:`wind_hold`: holding a position in a steady wind, the tilt into the wind against
   :func:`trim.wind_hover_tilt`, the final position error and the largest drift on the way.
 """
@@ -73,6 +75,101 @@ def tilt_step(result, tilt: float, rotor_drag: bool) -> dict:
         (_, _, tau), _ = curve_fit(lag, result.time[window], pitch[window], p0=(tilt, tilt, FIT_START_TAU))
         found["tilt_lag_fitted_s"] = float(tau)
         found["tilt_lag_predicted_s"] = trim.drag_time_constant(thrust=float(result["Quadrotor.thrust"][-1]))
+    return found
+
+
+AXES = ("roll", "pitch", "yaw")
+
+
+def step_figures(time, response, size: float, band: float = 0.02) -> tuple:
+    """Rise time, settling time and overshoot of a step response, by python-control's ``step_info``
+    where it applies: the one implementation behind :func:`step_response` and the testing
+    assertions' step (:func:`scenarios.testing.assertions.step_response`).
+
+    Parameters
+    ----------
+    time : array_like
+        Time from the step (s).
+    response : array_like
+        The response less its value at the step (the signal's unit).
+    size : float
+        The step commanded, the reference of rise, settling and overshoot (same unit).
+    band : float
+        Settling band, a fraction of the step's size.
+
+    Returns
+    -------
+    tuple
+        ``rise`` (s, 10 to 90 % of the step; None when the response never reaches 90 %, where
+        ``step_info`` does not apply), ``settling`` (s; None when the last sample is outside the
+        band: it did not settle in the window), ``overshoot`` (% of the step, 0 or more).
+    """
+    import control
+
+    time, response = np.asarray(time, float), np.asarray(response, float)
+    outside = np.nonzero(np.abs(response - size) > band * abs(size))[0]
+    unsettled = len(outside) > 0 and outside[-1] == len(response) - 1
+    try:
+        info = control.step_info(response, timepts=time, final_output=size, SettlingTimeThreshold=band)
+    except IndexError:  # the response never reached 90 % of the step
+        return None, None, max(0.0, 100.0 * (float(np.max(response / size)) - 1.0))
+    settling = None if unsettled or math.isnan(info["SettlingTime"]) else float(info["SettlingTime"])
+    return float(info["RiseTime"]), settling, float(info["Overshoot"])
+
+
+def step_response(result, steps: list, step_time: float) -> dict:
+    """Step metrics of an attitude step on each axis, by python-control's ``step_info``.
+
+    The response is the true attitude (``Quadrotor.theta1..3``) from ``step_time`` on, less its
+    value just before the step; the reference of rise, settling and overshoot is the step
+    commanded (so a steady error counts against settling).
+
+    Parameters
+    ----------
+    result : orchestrator.Result
+        A ``tp`` run with a step (``flight=step`` or ``flight=tilt``).
+    steps : list
+        The step on roll, pitch, yaw (rad), None on an axis not stepped
+        (:func:`flight.profiles.step_sizes`).
+    step_time : float
+        When the step is commanded (s).
+
+    Returns
+    -------
+    dict
+        Lists over roll, pitch, yaw (None on an axis not stepped): ``step_rise_time_s`` (10 to 90 %
+        of the step), ``step_settling_time_s`` (s after the step until the response stays within
+        2 % of the step; the whole window when it never does), ``step_overshoot_pct`` (% of the
+        step), ``step_steady_error_deg`` (the step less the mean response over the last 10 % of
+        the window, deg), ``step_iae_deg_times_s`` (the integral of the absolute error to the step
+        over the window, deg s); ``step_settling_worst_s``, the largest settling time of the axes
+        stepped (s), and ``step_iae_total_deg_times_s``, the sum of their integrals (deg s): one
+        number each to tune on (the integral varies smoothly with the gains, a settling time by
+        jumps).
+    """
+    after = result.time >= step_time
+    before = max(int(np.argmax(after)) - 1, 0)
+    time = result.time[after] - step_time
+    found = {"step_rise_time_s": [], "step_settling_time_s": [], "step_overshoot_pct": [],
+             "step_steady_error_deg": [], "step_iae_deg_times_s": []}
+    for i, step in enumerate(steps):
+        if step is None or len(time) < 3:
+            for values in found.values():
+                values.append(None)
+            continue
+        angle = result[f"Quadrotor.theta{i + 1}"]
+        response = angle[after] - angle[before]
+        rise, settling, overshoot = step_figures(time, response, step)
+        found["step_rise_time_s"].append(rise)
+        # not settled by the end: the whole window
+        found["step_settling_time_s"].append(float(time[-1]) if settling is None else settling)
+        found["step_overshoot_pct"].append(overshoot)
+        late = response[time >= 0.9 * time[-1]]
+        found["step_steady_error_deg"].append(math.degrees(step - float(late.mean())))
+        found["step_iae_deg_times_s"].append(math.degrees(float(np.trapezoid(np.abs(step - response), time))))
+    settled = [t for t in found["step_settling_time_s"] if t is not None]
+    found["step_settling_worst_s"] = max(settled) if settled else None
+    found["step_iae_total_deg_times_s"] = sum(v for v in found["step_iae_deg_times_s"] if v is not None)
     return found
 
 

@@ -20,6 +20,9 @@ negative), ``hold`` (1: hold the horizontal position and derive roll and pitch f
 - ``tilt``: level hover, then from ``STEP_TIME`` a constant pitch setpoint ``tilt`` (rad)
   held with no position hold, so the vehicle accelerates until the drag balances the
   tilted thrust (a tilt step, for the accelerometer's first-order lag).
+- ``step``: level hover without position hold, then at ``step_time`` an attitude step of
+  ``step`` (rad) on the axes ``step_axis`` (``roll``, ``pitch``, ``yaw`` or ``all``), the
+  altitude held: the response a control engineer tunes on (rise, settling, overshoot).
 """
 
 from __future__ import annotations
@@ -47,7 +50,8 @@ FAST_PITCH, FAST_PITCH_FREQUENCY, FAST_PITCH_PHASE = 20.0 * DEG, 0.3, 0.5  # rad
 FAST_YAW, FAST_YAW_FREQUENCY = 30.0 * DEG, 0.1  # rad, Hz
 FAST_HEAVE, FAST_HEAVE_FREQUENCY = 1.0, 0.2  # m, Hz
 
-FLIGHTS = ("quasi", "nonstationary", "hover", "tilt")
+FLIGHTS = ("quasi", "nonstationary", "hover", "tilt", "step")
+STEP_AXES = {"roll": (0,), "pitch": (1,), "yaw": (2,), "all": (0, 1, 2)}  # attitude columns a step moves
 
 
 @lru_cache
@@ -81,7 +85,19 @@ def profile(flight: str, duration: float, dt: float, tilt: float = 5.0 * DEG) ->
     return profile_at(flight, np.arange(int(round(duration / dt)) + 1) * dt, tilt)
 
 
-def profile_at(flight: str, t: np.ndarray, tilt: float = 5.0 * DEG) -> np.ndarray:
+def step_sizes(flight: str, axis: str = "pitch", size: float = 5.0 * DEG, tilt: float = 5.0 * DEG) -> list:
+    """The attitude step of a profile on roll, pitch and yaw (rad; None on an axis it does not
+    step): ``flight=step`` on ``axis`` by ``size``, ``flight=tilt`` on pitch by ``tilt``; None
+    for a profile without a step."""
+    if flight == "step":
+        return [size if i in STEP_AXES[axis] else None for i in range(3)]
+    if flight == "tilt":
+        return [None, tilt, None]
+    return None
+
+
+def profile_at(flight: str, t: np.ndarray, tilt: float = 5.0 * DEG, step_axis: str = "pitch",
+               step: float = 5.0 * DEG, step_time: float = STEP_TIME) -> np.ndarray:
     """Setpoints of a flight profile at times ``t`` (s). A ``Table`` evaluates it a chunk of
     rows at a time, so that a long run never holds its whole profile.
 
@@ -93,6 +109,8 @@ def profile_at(flight: str, t: np.ndarray, tilt: float = 5.0 * DEG) -> np.ndarra
         Times (s).
     tilt : float
         Pitch of the ``tilt`` profile (rad); ignored by the others.
+    step_axis, step, step_time : str, float, float
+        The ``step`` profile's axes (:data:`STEP_AXES`), size (rad) and time (s).
 
     Returns
     -------
@@ -118,4 +136,8 @@ def profile_at(flight: str, t: np.ndarray, tilt: float = 5.0 * DEG) -> np.ndarra
     if flight == "tilt":
         pitch = np.where(t >= STEP_TIME, tilt, 0.0)
         return np.column_stack([zero, pitch, zero, zero, zero, zero, zero])
+    if flight == "step":
+        stepped = np.where(t >= step_time, step, 0.0)
+        angles = [stepped if i in STEP_AXES[step_axis] else zero for i in range(3)]
+        return np.column_stack([*angles, zero, zero, zero, zero])
     raise ValueError(f"flight {flight!r} must be one of {', '.join(FLIGHTS)}")

@@ -14,6 +14,8 @@
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
+  quadcosim tune SCENARIO --minimize METRIC --over NAME=LOW:HIGH[:log]... [--seeds N] [--budget N]
+                  [--workers N | --scheduler ADDR] [--out DIR] [--resume]   the options that minimise it
   quadcosim replay RECORDING [--estimator KIND] [--figure FILE]   an estimator on a recorded file, scored
   quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
   quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
@@ -360,12 +362,7 @@ def parser() -> argparse.ArgumentParser:
     from scenarios import run_plots
 
     run_plots.add_arguments(sub)
-    from studies.sweep import command as sweep
-
-    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
-        .set_defaults(func=sweep.sweep)
-    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
-        .set_defaults(func=sweep.sweep_plot)
+    _add_studies(sub)
     _add_flight_logs(sub)
     return p
 
@@ -411,6 +408,20 @@ def _add_run(sub):
     run.set_defaults(func=_run)
 
 
+def _add_studies(sub):
+    """The ``sweep``, ``sweep-plot`` and ``tune`` verbs (:mod:`studies.sweep`, :mod:`studies.tune`)."""
+    from studies.sweep import command as sweep
+
+    sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
+        .set_defaults(func=sweep.sweep)
+    sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
+        .set_defaults(func=sweep.sweep_plot)
+    from studies import tune
+
+    tune.add_arguments(sub.add_parser("tune", help="the options that minimise a metric (scipy.optimize), on Dask"))\
+        .set_defaults(func=tune.command)
+
+
 def _add_flight_logs(sub):
     """The ``log`` and ``calibrate`` verbs (:mod:`scenarios.flightlog`) on the sub-parsers ``sub``."""
     from scenarios.flightlog import calibrate
@@ -450,7 +461,7 @@ def main(argv=None) -> int:
                 return replay(argv[1:], prog="quadcosim replay")
             args = parser().parse_args(argv)
             args.final = final
-            if args.command in ("run", "sweep", "bench", "build"):
+            if args.command in ("run", "sweep", "tune", "bench", "build"):
                 from scenarios.compiled import announce_compiles
 
                 announce_compiles()

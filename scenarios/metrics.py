@@ -11,7 +11,8 @@ import functools
 import re
 
 #: Name endings and the unit they stand for, longest first.
-SUFFIX_UNITS = (("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_deg_s", "deg/s"), ("_rad2", "rad^2"),
+SUFFIX_UNITS = (("_deg_times_s", "deg s"), ("_rad_s2", "rad/s^2"), ("_rad_s", "rad/s"), ("_deg_s", "deg/s"),
+                ("_rad2", "rad^2"),
                 ("_m_s", "m/s"), ("_deg", "deg"), ("_rad", "rad"), ("_uT", "uT"), ("_hz", "Hz"), ("_Hz", "Hz"),
                 ("_ms", "ms"), ("_mm", "mm"), ("_s", "s"), ("_m", "m"), ("_A", "A"), ("_v", "V"), ("_V", "V"),
                 ("_bytes", "B"), ("_mb", "MB"), ("_pct", "%"))

@@ -17,6 +17,7 @@ from estimators.core import euler_to_quaternion
 from flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from flight.controller import SETPOINT_UNITS
 from flight.profile_file import FileProfile, is_profile_file
+from flight.profiles import STEP_AXES, STEP_TIME, step_sizes
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
@@ -43,6 +44,9 @@ OPTIONS = {
     "flight": Option("quasi", "flight profile (flight/profiles.py), or a setpoint profile in a CSV file "
                               "(flight/profile_file.py)", choices=FLIGHTS, files=".csv"),
     "tilt_deg": Option(5.0, "pitch setpoint of flight=tilt (deg)", applies="flight=tilt"),
+    "step_axis": Option("pitch", "axes of flight=step", choices=tuple(STEP_AXES), applies="flight=step"),
+    "step_deg": Option(5.0, "attitude step of flight=step (deg)", applies="flight=step"),
+    "step_time": Option(STEP_TIME, "time of the step of flight=step (s)", minimum=0.0, applies="flight=step"),
     "feedback": Option("gt", "controller fed by the ground truth or the estimate", choices=("gt", "estimate")),
     "noise": Option(False, "IMU white noise"),
     "bias": Option(False, "gyro bias (0.02, -0.01, 0.015) rad/s, or IMU.gyro_bias=x,y,z"),
@@ -161,7 +165,8 @@ def build(o: dict, estimator=None) -> System:
     if is_profile_file(o["flight"]):
         setpoint = FileProfile(o["flight"], SETPOINT)
     else:
-        setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]))  # evaluated as the run goes
+        setpoint = partial(profile_at, o["flight"], tilt=np.radians(o["tilt_deg"]), step_axis=o["step_axis"],
+                           step=np.radians(o["step_deg"]), step_time=o["step_time"])  # evaluated as the run goes
     system.add(Table("Setpoint", SETPOINT, setpoint, units=SETPOINT_UNITS))
     if o["accelerometer"] == "gravity":
         system.add(GravityOnly())
@@ -328,12 +333,16 @@ def _predictions(result, o) -> dict:
 
 def _flight_findings(result, o) -> dict:
     """What the flight shows of the drag model: the tilt step's lag and speed (``flight=tilt``),
-    the tilt into a steady wind and the position held (a wind on a position-holding flight)."""
+    the tilt into a steady wind and the position held (a wind on a position-holding flight); an
+    attitude step's metrics (``flight=step`` and ``flight=tilt``, :func:`flight.measured.step_response`)."""
     from flight import measured
 
     found = {}
     if o["flight"] == "tilt":
         found |= measured.tilt_step(result, math.radians(o["tilt_deg"]), o["rotor_drag"])
+    steps = step_sizes(o["flight"], o["step_axis"], math.radians(o["step_deg"]), math.radians(o["tilt_deg"]))
+    if steps is not None:  # rise, settling, overshoot, steady error of the attitude step
+        found |= measured.step_response(result, steps, o["step_time"] if o["flight"] == "step" else STEP_TIME)
     wind = math.hypot(o["wind_n"], o["wind_e"])
     if wind > 0 and o["flight"] == "hover":
         found |= measured.wind_hold(result, wind)

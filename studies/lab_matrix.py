@@ -17,7 +17,8 @@ A named sweep: its members run on Dask like any sweep (``--workers``, ``--schedu
 - the lab's findings as checks, each with its measured figures: the linear filter accurate in
   quasi-stationary flight (a non-zero error below 1 degree on every axis) and degraded in
   non-stationary flight; the explicit filter below 2 degrees RMS in both; the bias cases as
-  the analyses predict.
+  the analyses predict where they do (the explicit filter's roll and yaw; its pitch is named as
+  missed).
 """
 
 from __future__ import annotations
@@ -69,6 +70,9 @@ LINEAR_ACCURATE_DEG = 1.0  # deg, every axis, quasi-stationary flight
 EXPLICIT_ACCURATE_DEG = 2.0  # deg, every axis, both flights
 PREDICTION_TOLERANCE = {"explicit": 0.1, "passive": 0.2}  # relative, as in tests/test_lab_cases.py
 PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
+# the explicit filter's pitch steady error under the lab's bias, hover, 60 s: -0.53 against -0.29 deg
+# predicted at k1 = k2 = 1, -0.21 against -0.14 at 2 (roll and yaw within 1 %): a gap the analysis leaves
+PITCH_MISSED = 0.3
 
 
 def cases() -> dict[str, dict]:
@@ -106,15 +110,17 @@ def late_mean_error(result, options) -> dict:
 def summary_of(records: list[dict]) -> dict:
     """The matrix's numbers and checks, from its members' records (metrics.json)."""
     by_label = {r["label"]: r["metrics"] for r in records}
+    status = {r["label"]: r.get("status", "ok") for r in records}
     summary = {
+        "diverged": {r["label"]: r.get("error") for r in records if status[r["label"]] == "diverged"},
         "cases": {name: {k: by_label[name][k] for k in ("rms_error_deg", "tracking_rms_deg", "bias_error_final")}
-                  for name in CASES},
+                  | {"status": status[name]} for name in CASES},
         "explicit_steady_bias_error_deg": [
             {"k1=k2": k, "simulated": by_label[f"explicit-steady-k{k:g}-hover-bias"]["late_mean_error_deg"],
              "predicted": np.degrees(analysis.explicit_bias_steady_error(k, k, 1.0, LAB_GYRO_BIAS)).tolist()}
             for k in EXPLICIT_GAINS],
         "comparison": {name: {k: by_label[name][k] for k in ("quaternion_rmse_deg", "rms_error_deg",
-                                                               "tracking_rms_deg")}
+                                                               "tracking_rms_deg")} | {"status": status[name]}
                        for name in COMPARISON},
         "passive_bias_convergence_s": [
             {"ry": ry, "kP=kI": g,
@@ -142,20 +148,27 @@ def checks(summary: dict) -> list[dict]:
     rms = {name: np.array(m["rms_error_deg"]) for name, m in summary["cases"].items()}
     quasi, fast = rms["linear-quasi-gt"], rms["linear-nonstationary-gt"]
     explicit = np.array([rms[name] for name in EXPLICIT_WITHOUT_BIAS])
-    explicit_gap = max(abs(r["simulated"][0] / r["predicted"][0] - 1)
-                       for r in summary["explicit_steady_bias_error_deg"] if r["k1=k2"] >= 1.0)
+    steady = [r for r in summary["explicit_steady_bias_error_deg"] if r["k1=k2"] >= 1.0]
+    explicit_gap = max(abs(r["simulated"][axis] / r["predicted"][axis] - 1) for r in steady for axis in (0, 2))
+    pitch_gap = min(abs(r["simulated"][1] / r["predicted"][1] - 1) for r in steady)
     passive_gap = max(np.inf if r["simulated"] is None else abs(r["simulated"] / r["predicted"] - 1)
                       for r in summary["passive_bias_convergence_s"])
+    rested_on = [name for name in summary.get("diverged", {}) if not name.startswith("compare-")]
     return [
+        {"check": "the members the checks rest on: none diverged (count)",
+         "measured": [float(len(rested_on))], "ok": not rested_on},
         {"check": f"linear, quasi-stationary, GT: 0 < RMS < {LINEAR_ACCURATE_DEG:g} deg on every axis",
          "measured": quasi.tolist(), "ok": bool(np.all(quasi > 0) and np.all(quasi < LINEAR_ACCURATE_DEG))},
         {"check": "linear, non-stationary, GT: RMS above the quasi-stationary one on every axis (ratio)",
          "measured": (fast / quasi).tolist(), "ok": bool(np.all(fast > quasi))},
         {"check": f"explicit, without gyro bias, both flights: RMS < {EXPLICIT_ACCURATE_DEG:g} deg (largest)",
          "measured": [float(explicit.max())], "ok": bool(explicit.max() < EXPLICIT_ACCURATE_DEG)},
-        {"check": "explicit without bias estimate, k1 = k2 >= 1: roll steady error as predicted "
+        {"check": "explicit without bias estimate, k1 = k2 >= 1: roll and yaw steady error as predicted "
                   f"(largest relative gap < {PREDICTION_TOLERANCE['explicit']:g})",
          "measured": [float(explicit_gap)], "ok": bool(explicit_gap < PREDICTION_TOLERANCE["explicit"])},
+        {"check": "explicit without bias estimate, k1 = k2 >= 1: pitch steady error NOT as the linearised analysis "
+                  f"predicts (smallest relative gap > {PITCH_MISSED:g})",
+         "measured": [float(pitch_gap)], "ok": bool(pitch_gap > PITCH_MISSED)},
         {"check": "passive, R_reel and TRIAD, hover: bias-convergence time as predicted "
                   f"(largest relative gap < {PREDICTION_TOLERANCE['passive']:g})",
          "measured": [float(passive_gap)], "ok": bool(passive_gap < PREDICTION_TOLERANCE["passive"])},
@@ -180,15 +193,18 @@ def markdown(summary: dict) -> str:
     def deg(values):
         return " / ".join(f"{v:.3f}" for v in values)
 
+    def crashed(m, values):  # a diverged member's numbers describe a crash: marked, never a result
+        return f"DIVERGED (a crash: {deg(values)})" if m.get("status") == "diverged" else deg(values)
+
     lines = ["| case | estimation RMS (deg, roll/pitch/yaw) | tracking RMS (deg) |", "|---|---|---|"]
     for name, m in summary["cases"].items():
-        lines.append(f"| {name} | {deg(m['rms_error_deg'])} | {deg(m['tracking_rms_deg'])} |")
+        lines.append(f"| {name} | {crashed(m, m['rms_error_deg'])} | {crashed(m, m['tracking_rms_deg'])} |")
     lines += ["", "| flight | estimator (estimate-fed, noise, bias) | quaternion RMSE total / inclination / heading "
               "(deg) | estimation RMS (deg, roll/pitch/yaw) | tracking RMS (deg) |", "|---|---|---|---|---|"]
     for name, m in summary["comparison"].items():
         options = COMPARISON[name]
-        lines.append(f"| {options['flight']} | {options['estimator']} | {deg(m['quaternion_rmse_deg'])} | "
-                     f"{deg(m['rms_error_deg'])} | {deg(m['tracking_rms_deg'])} |")
+        lines.append(f"| {options['flight']} | {options['estimator']} | {crashed(m, m['quaternion_rmse_deg'])} | "
+                     f"{crashed(m, m['rms_error_deg'])} | {crashed(m, m['tracking_rms_deg'])} |")
     lines += ["", "| explicit, no bias estimate, k1 = k2 | simulated steady error (deg) | predicted (deg) |",
               "|---|---|---|"]
     for row in summary["explicit_steady_bias_error_deg"]:
@@ -198,6 +214,9 @@ def markdown(summary: dict) -> str:
     for row in summary["passive_bias_convergence_s"]:
         simulated = "not reached" if row["simulated"] is None else f"{row['simulated']:.2f}"
         lines.append(f"| {row['ry']} | {row['kP=kI']:g} | {simulated} | {row['predicted']:.2f} |")
+    if summary.get("diverged"):
+        lines += ["", "Diverged members (their flight crossed the scenario's bounds; their numbers are not results):",
+                  ""] + [f"- {name}: {why}" for name, why in summary["diverged"].items()]
     if "checks" in summary:
         lines += ["", "| check | measured | holds |", "|---|---|---|"]
         for row in summary["checks"]:

@@ -186,3 +186,23 @@ def test_the_trim_root_is_scipys_brentq_to_the_bit():
             trim.brent_root = original
     with pytest.raises(ValueError, match="different signs"):
         trim.brent_root(lambda x: x * x + 1.0, -1.0, 1.0)
+
+
+def test_an_attitude_step_is_measured_on_every_axis_stepped():
+    """flight=step on all three axes: the lab's gains (kp = 144 1/s^2, kd = 19.2 1/s, damping 0.8;
+    yaw 64 and 12.8, slower) settle every axis to the step, with the overshoot of a damping of
+    0.8 or less; yaw rises and settles later than roll and pitch."""
+    import control
+
+    _, metrics = scenarios.run("tp", {"flight": "step", "step_axis": "all", "step_deg": 5.0, "step_time": 0.5,
+                                      "duration": 2.0})
+    rise, settling = np.array(metrics["step_rise_time_s"]), np.array(metrics["step_settling_time_s"])
+    overshoot, steady = np.array(metrics["step_overshoot_pct"]), np.array(metrics["step_steady_error_deg"])
+    # measured: rise 0.16 / 0.16 / 0.40 s, settling 0.31 / 0.28 / 0.60 s, overshoot 0.1 / 1.3 / 1.6 %
+    assert np.all(rise > 0.05) and np.all(settling < 1.0) and np.all(settling > rise)
+    assert rise[2] > 1.5 * max(rise[:2]) and settling[2] > max(settling[:2])
+    bound = control.step_info(control.tf([144.0], [1.0, 19.2, 144.0]))["Overshoot"]  # 1.5 %
+    assert np.all(overshoot < 2 * bound) and np.all(np.abs(steady) < 0.05)  # 1 % of the step; measured 0.023
+    assert metrics["step_settling_worst_s"] == settling.max()
+    _, pitched = scenarios.run("tp", {"flight": "step", "duration": 1.5})  # the default: pitch only
+    assert pitched["step_rise_time_s"][0] is None and pitched["step_rise_time_s"][1] > 0.05

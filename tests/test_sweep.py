@@ -147,6 +147,35 @@ def test_a_dead_worker_is_retried_then_recorded(tmp_path):
     assert summary.failed == 1 and summary.exit_code() == 1
 
 
+@pytest.mark.slow
+def test_a_diverged_member_is_an_outcome_never_a_result(tmp_path, capsys):
+    # kp = 5000 1/s^2 (the default is 144) crashes the lab's quadrotor: 10 m below its setpoint by t = 4 s
+    out = tmp_path / "kp"
+    code = command.main(["tp", "--grid", "Controller.kp=144,5000", "--set", "duration=4", "--workers", "1",
+                         "--out", str(out), "--quiet"])
+    printed = capsys.readouterr()
+    assert code == 3  # every member ran, one diverged (documented: the sweeps guide)
+    assert printed.out.startswith("2 members: 1 ok, 1 diverged, 0 failed")
+    assert "diverged: member 1 (Controller.kp=5000): tp diverged at t = " in printed.out
+    assert "UserWarning" not in printed.err and ".py:" not in printed.err  # one-line warnings, no source line
+    columns = table.read(out)
+    assert columns["status"] == ["ok", "diverged"]
+    assert "10.0 m below its altitude setpoint" in columns["error"][1]
+    record = json.loads((out / "members" / "000001" / "metrics.json").read_text())
+    assert record["status"] == "diverged" and 2.0 < record["diverged"]["at_s"] < 3.0
+    assert "signals_not_saved" not in columns  # a member saves no record: no column repeats its list
+    assert table.units(out)["Controller.kp"] == "1/s^2" and table.units(out)["rms_error_deg[0]"] == "deg"
+    units, _, _ = command._plot_context(out)
+    figure = sweep.plot(columns, "rms_error_deg[0]", "Controller.kp", units=units)
+    assert figure.axes[0].get_xlabel() == "Controller.kp (1/s^2)"
+    lines = {line.get_label(): line for line in figure.axes[0].get_lines()}
+    assert list(lines["diverged (1): a crash, no value"].get_xdata()) == [5000.0]
+    assert list(lines["rms_error_deg[0]"].get_xdata()) == [144.0]  # the crash is not on the curve
+    # --resume keeps a diverged member (its outcome is known) and runs nothing
+    assert command.main(["tp", "--out", str(out), "--resume", "--workers", "1", "--quiet"]) == 3
+    assert "2 already done" in capsys.readouterr().out
+
+
 # ------------------------------------------------------------------ without a cluster
 def test_grid_values_and_members():
     with pytest.warns(UserWarning, match=r"--grid k: k acts only when estimator=linear; with estimator=explicit it "
@@ -282,13 +311,23 @@ def test_figure_pools_seeds_and_groups(tmp_path):
     figure = sweep.plot(columns, "err", "k", by="estimator")
     lines = {line.get_label(): line for line in figure.axes[0].get_lines() if not line.get_label().startswith("_")}
     assert np.allclose(lines["estimator = linear (mean of 2)"].get_ydata(), [2.0, 3.0])
-    assert np.allclose(lines["estimator = explicit (mean of 2)"].get_ydata(), [6.0, 6.0])
+    assert np.allclose(lines["estimator = explicit (mean of up to 2)"].get_ydata(), [6.0, 6.0])
     assert figure.axes[0].get_xscale() == "linear"
     assert "1 failed member not shown" in figure.axes[0].get_title()
     path = sweep.plot(columns, "err", "estimator", out=tmp_path / "by-estimator.png")
     assert Path(path).stat().st_size > 10_000
     with pytest.raises(KeyError, match="no column 'erro'. Did you mean err"):
         sweep.plot(columns, "erro", "k")
+
+
+def test_figure_orders_curves_and_categories_as_numbers():
+    columns = {"status": ["ok"] * 6, "imu_rate": [16, 24, 8, 16, 24, 8], "k": [1, 1, 1, 2, 2, 2],
+               "mode": ["10", "2", "a"] * 2, "err": [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]}
+    figure = sweep.plot(columns, "err", "k", by="imu_rate", units={"imu_rate": "Hz"})
+    labels = [t.get_text() for t in figure.axes[0].get_legend().get_texts()]
+    assert labels == ["imu_rate = 8 Hz", "imu_rate = 16 Hz", "imu_rate = 24 Hz"]
+    figure = sweep.plot(columns, "err", "mode")
+    assert [t.get_text() for t in figure.axes[0].get_xticklabels()] == ["2", "10", "a"]
 
 
 @pytest.mark.parametrize("settings, message", [
@@ -323,3 +362,25 @@ def test_lab_matrix_is_a_named_sweep_of_every_case():
     assert all(m.options["noise"] is True for m in plan.members)
     passive = plan.members[-1].options  # TRIAD, kP = kI = 100: 1.5 times the predicted convergence, at least 10 s
     assert passive["ry"] == "triad" and passive["kP"] == 100.0 and passive["duration"] == 10.0
+
+
+def test_the_lab_matrix_marks_its_diverged_member():
+    """The passive filter on TRIAD, estimate-fed in non-stationary flight, crashes (roll 60 deg off
+    its setpoint at t = 15.7 s): summary.md prints its numbers as a crash, and lists it."""
+    import scenarios
+    from studies import lab_matrix
+    from studies.sweep.engine import run_member
+
+    name = "compare-passive-nonstationary"
+    record = run_member("tp", scenarios.get("tp").parse(lab_matrix.COMPARISON[name]),
+                        extra_metrics="studies.lab_matrix:late_mean_error")
+    assert record["status"] == "diverged" and "roll 60 deg from its setpoint" in record["error"]
+    metrics = record["metrics"]
+    summary = {"diverged": {name: record["error"]}, "cases": {}, "explicit_steady_bias_error_deg": [],
+               "passive_bias_convergence_s": [],
+               "comparison": {name: {k: metrics[k] for k in ("quaternion_rmse_deg", "rms_error_deg",
+                                                             "tracking_rms_deg")} | {"status": "diverged"}}}
+    text = lab_matrix.markdown(summary)
+    row = next(line for line in text.splitlines() if line.startswith("| nonstationary | passive |"))
+    assert row.count("DIVERGED (a crash: ") == 3
+    assert f"- {name}: tp diverged at t = " in text

@@ -239,7 +239,7 @@ def step_response(result, signal, step_s: float, final: float | None = None, ban
     -------
     StepResponse
     """
-    import control
+    from flight.measured import step_figures
 
     name, values = _values(result, signal)
     start = int(np.searchsorted(result.time, step_s))
@@ -251,12 +251,12 @@ def step_response(result, signal, step_s: float, final: float | None = None, ban
     size = target - values[start]
     if size == 0:
         raise ValueError(f"{name}: the step from {values[start]:g} to {target:g} has no size")
-    info = control.step_info(y, t, yfinal=size, SettlingTimeThreshold=band)
+    _, settling, overshoot = step_figures(t, y, size, band)
     outside = np.nonzero(np.abs(y - size) > band * abs(size))[0]
     last = int(outside[-1]) if len(outside) else None
-    settled = np.inf if last == len(y) - 1 else float(info["SettlingTime"])
+    settled = np.inf if settling is None else settling
     peak = start + int(np.argmax(np.sign(size) * y))
-    return StepResponse(settled, float(info["Overshoot"]), float(result.time[peak]), float(values[peak]),
+    return StepResponse(settled, overshoot, float(result.time[peak]), float(values[peak]),
                         None if last is None else float(result.time[start + last]),
                         None if last is None else float(values[start + last]), float(values[start]), target, band)
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 from pathlib import Path
 
 
@@ -25,6 +26,8 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
     p.add_argument("--seeds", metavar="N|A:B", help="Monte Carlo: the seed option over 1..N (or A..B)")
     p.add_argument("--workers", type=int, metavar="N", help="local worker processes (default: the CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="use a running Dask scheduler (tcp://host:8786)")
+    p.add_argument("--connect-timeout", type=float, default=10.0, metavar="S",
+                   help="seconds to reach the --scheduler before giving up (default 10)")
     p.add_argument("--out", help="sweep folder (default results/sweep-SCENARIO, or results/sweep-SCENARIO-N when that "
                                  "holds an earlier sweep)")
     p.add_argument("--resume", action="store_true", help="continue the sweep in --out; skip finished members")
@@ -65,7 +68,7 @@ def _stored_plan(out: Path):
                          "run it again into another --out") from None
 
 
-def default_out(base: Path, resume: bool, label: str) -> Path:
+def default_out(base: Path, resume: bool, label: str, marker: str = "sweep.json") -> Path:
     """The folder a sweep writes into when ``--out`` is not given: ``base``, or, when that holds
     an earlier sweep and this is not a ``--resume``, the next free ``base-2``, ``base-3``, ...,
     said on standard error (as ``quadcosim run`` does: a sweep never meets an earlier one unasked).
@@ -78,6 +81,8 @@ def default_out(base: Path, resume: bool, label: str) -> Path:
         A resumed sweep continues in ``base``.
     label : str
         The command, for the message.
+    marker : str
+        The file whose presence means a folder holds an earlier study (``tune.json`` for a tune).
 
     Returns
     -------
@@ -87,11 +92,11 @@ def default_out(base: Path, resume: bool, label: str) -> Path:
         return base
     from orchestrator.files import first_free
 
-    candidate = first_free(base, lambda folder: (folder / "sweep.json").exists()
+    candidate = first_free(base, lambda folder: (folder / marker).exists()
                            or (folder.exists() and not folder.is_dir()))
     if candidate != base:
-        print(f"{label}: {base}/ holds an earlier sweep; writing to {candidate}/ (--out DIR chooses the folder, "
-              f"--resume continues {base}/)", file=sys.stderr)
+        print(f"{label}: {base}/ holds an earlier {marker.split('.')[0]}; writing to {candidate}/ (--out DIR "
+              f"chooses the folder, --resume continues {base}/)", file=sys.stderr)
     return candidate
 
 
@@ -125,8 +130,9 @@ def sweep(args) -> int:
     Returns
     -------
     int
-        Exit code: 0 when every member finished well, 1 when any failed, 2 for bad arguments,
-        128 + the signal when interrupted.
+        Exit code (:data:`studies.sweep.engine.EXIT_CODES`): 0 when every member is ``ok``, 1
+        when any failed or was not run, 2 for bad arguments or a refused folder, 3 when every
+        member ran and some diverged, 128 + the signal when interrupted.
     """
     from studies.sweep import engine, named
 
@@ -135,6 +141,15 @@ def sweep(args) -> int:
             raise ValueError(f"--workers {args.workers}: give at least 1")
         if args.workers and args.scheduler:
             raise ValueError("--workers and --scheduler: the scheduler's own workers run the sweep; give one")
+        if args.max_members < 1:
+            raise ValueError(f"--max-members {args.max_members}: give at least 1 (the most members a plan may have)")
+        if not args.connect_timeout > 0:
+            raise ValueError(f"--connect-timeout {args.connect_timeout:g}: give a number of seconds above 0")
+        from studies.sweep.folder import check_out, check_scheduler
+
+        check_scheduler(args.scheduler)  # before the plan is made or anything written
+        if args.out:
+            check_out(Path(args.out))
         plan = make_plan(args)
         if not args.quiet:
             print(f"sweep {plan.name or plan.scenario}: {len(plan.members)} members"
@@ -144,7 +159,7 @@ def sweep(args) -> int:
                              retries=args.retries, retry_errors=args.retry_errors,
                              keep_results=args.results or named.keep_results(plan),
                              progress=False if args.quiet else None,
-                             extra_metrics=named.extra_metrics(plan))
+                             extra_metrics=named.extra_metrics(plan), connect_timeout=args.connect_timeout)
     except (KeyError, ValueError) as error:  # SweepError is a ValueError
         print(f"quadcosim sweep {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
         return 2
@@ -156,18 +171,19 @@ def sweep(args) -> int:
 
 
 def _plot_context(folder: Path) -> tuple[dict, str, dict]:
-    """Units of the swept scenario's options (from their help), a line naming the scenario and
+    """Units of the swept scenario's options and block parameters (as declared), a line naming the scenario and
     the options held fixed, and what its metrics' components are (``rms_error_deg[0]``: roll),
     from the sweep's ``sweep.json`` (nothing without one)."""
     import scenarios
-    from studies.sweep.figure import option_unit
+    from studies.sweep import units as units_of
 
     try:
         stored = json.loads((folder / "sweep.json").read_text())
         scenario = scenarios.get(stored["scenario"])
     except (OSError, ValueError, KeyError):
         return {}, "", {}
-    units = {key: option_unit(option.help) for key, option in scenario.options.items()}
+    units = stored.get("units") or units_of.of_options(stored["scenario"], [*scenario.options,
+                                                                             *stored.get("varied", [])])
     fixed = stored.get("description", {}).get("set") or []
     components = {f"{metric}[{i}]": name for metric, names in scenario.extra.get("components", {}).items()
                   for i, name in enumerate(names)}
@@ -213,8 +229,13 @@ def main(argv=None) -> int:
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     from orchestrator.interrupts import exit_code, terminate_as_interrupt
 
+    def one_line(message, category, filename, lineno, file=None, line=None):  # as quadcosim prints warnings
+        print(f"quadcosim sweep: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
     try:
-        with terminate_as_interrupt():
+        with terminate_as_interrupt(), warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = one_line
             p = add_arguments(argparse.ArgumentParser(prog="python -m studies.sweep", description=__doc__,
                                                       formatter_class=argparse.RawDescriptionHelpFormatter))
             return sweep(p.parse_args(argv))

@@ -2,13 +2,14 @@
 
 Members that share the option values (Monte Carlo seeds, or options not shown) are pooled:
 the curve is their mean, the band their spread (minimum to maximum), and each member is a
-faint point. Failed members are left out and counted in the title.
+faint point. A member that diverged is never a value: it is drawn as a red cross on the top edge
+of the axes at its option value, and counted in the legend. Failed members are left out and
+counted in the title. Curves and categories are in numeric order (8, 16, 24, not 16, 24, 8).
 """
 
 from __future__ import annotations
 
 import math
-import re
 from collections import defaultdict
 from pathlib import Path
 
@@ -27,11 +28,6 @@ def _number(value) -> float | None:
     return number if math.isfinite(number) else None
 
 
-# unit of a metric, from the end of its name (``rms_error_deg[0]``, ``bias_convergence_s``)
-_SUFFIX_UNITS = (("_deg_s", "deg/s"), ("_rad_s", "rad/s"), ("_rad2", "rad²"), ("_deg", "deg"), ("_rad", "rad"),
-                 ("_uT", "µT"), ("_m", "m"), ("_s", "s"), ("_A", "A"), ("_T", "T"))
-
-
 def metric_unit(name: str) -> str:
     """The unit a metric's name ends with (``rms_error_deg[0]`` -> ``deg``); empty if none.
 
@@ -45,25 +41,9 @@ def metric_unit(name: str) -> str:
     str
         The unit, or ``""``.
     """
-    stem = name.split("[", 1)[0]
-    return next((unit for suffix, unit in _SUFFIX_UNITS if stem.endswith(suffix)), "")
+    from scenarios.metrics import unit_of_name
 
-
-def option_unit(help_text: str) -> str:
-    """The unit an option's help ends with, in parentheses (``"... gain (1/s)"`` -> ``1/s``).
-
-    Parameters
-    ----------
-    help_text : str
-        An option's help.
-
-    Returns
-    -------
-    str
-        The unit, or ``""``.
-    """
-    match = re.search(r"\(([^()]*)\)\s*$", help_text)
-    return match.group(1) if match and len(match.group(1)) <= 12 else ""
+    return unit_of_name(name.split("[", 1)[0]) or ""
 
 
 def _labelled(name: str, unit: str) -> str:
@@ -123,21 +103,31 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     """
     import matplotlib.pyplot as plt
 
-    groups, categories, numeric_x, failed = _groups(columns, metric, x, by)
+    groups, categories, numeric_x, failed, diverged = _groups(columns, metric, x, by)
     if ax is None:
         figure, ax = plt.subplots(figsize=(8, 5))
     else:
         figure = ax.figure
-    for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: str(item[0]))):
-        _curve(ax, series, f"C{n % 10}", f"{by} = {key}" if by else metric)
-    xs = [a for series in groups.values() for a in series]
+    units = units or {}
+    by_unit = f" {units[by]}" if by and units.get(by) else ""
+    for n, (key, series) in enumerate(sorted(groups.items(), key=lambda item: natural_key(item[0]))):
+        _curve(ax, series, f"C{n % 10}", f"{by} = {key}{by_unit}" if by else metric, banded=not categories)
+    if diverged:
+        from matplotlib.transforms import blended_transform_factory
+
+        ax.plot(diverged, [1.0] * len(diverged), "x", color="red", ms=9, mew=2, clip_on=False, zorder=5,
+                transform=blended_transform_factory(ax.transData, ax.transAxes),
+                label=f"diverged ({len(diverged)}): a crash, no value")
+    xs = [a for series in groups.values() for a in series] + diverged
     if numeric_x and min(xs) > 0 and max(xs) / min(xs) > 10:
+        from matplotlib.ticker import NullFormatter
+
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())  # labels at the decades only: never overlapping
     if logy:
         ax.set_yscale("log")
     if categories:
         ax.set_xticks(range(len(categories)), categories)
-    units = units or {}
     ax.set_xlabel(_labelled(x, units.get(x, "")))
     named = metric_label(metric, components)
     ax.set_ylabel(_labelled(named, units.get(metric) or metric_unit(metric)))
@@ -159,9 +149,16 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     return str(path)
 
 
+def natural_key(value):
+    """A sort key that puts numbers (and numeric text) in numeric order before other text:
+    ``8, 16, 24``, never ``16, 24, 8``."""
+    number = _number(value)
+    return (0, number, "") if number is not None else (1, 0.0, str(value))
+
+
 def _groups(columns, metric, x, by):
     """The finished members' metric by group and x position; the x categories (text options),
-    whether x is numeric, and how many members failed."""
+    whether x is numeric, how many members failed, and the x positions of those that diverged."""
     for name in (metric, x, by):
         if name is not None and name not in columns:
             from orchestrator.fmu import nearest
@@ -170,27 +167,44 @@ def _groups(columns, metric, x, by):
     count = len(columns[x])
     status = columns.get("status", ["ok"] * count)
     kept = [i for i in range(count) if status[i] == "ok" and _number(columns[metric][i]) is not None]
-    failed = sum(s != "ok" for s in status)
-    if not kept:
+    crashed = [i for i in range(count) if status[i] == "diverged"]
+    failed = sum(s not in ("ok", "diverged") for s in status)
+    if not kept and not crashed:
         raise ValueError(f"no finished member has a numeric {metric!r}")
-    xs = [columns[x][i] for i in kept]
+    xs = [columns[x][i] for i in kept + crashed]
     numeric_x = all(_number(v) is not None for v in xs)
-    categories = [] if numeric_x else sorted(set(map(str, xs)))
+    categories = [] if numeric_x else sorted(set(map(_shown, xs)), key=natural_key)
+
+    def position(i):
+        return float(columns[x][i]) if numeric_x else float(categories.index(_shown(columns[x][i])))
+
     groups: dict[object, dict[float, list[float]]] = defaultdict(lambda: defaultdict(list))
     for i in kept:
-        at = float(columns[x][i]) if numeric_x else float(categories.index(str(columns[x][i])))
-        groups[columns[by][i] if by else None][at].append(float(columns[metric][i]))
-    return groups, categories, numeric_x, failed
+        groups[columns[by][i] if by else None][position(i)].append(float(columns[metric][i]))
+    return groups, categories, numeric_x, failed, sorted({position(i) for i in crashed})
 
 
-def _curve(ax, series: dict[float, list[float]], colour: str, label: str):
-    """One group: the mean through its x positions; with pooled members, their band and points."""
+def _shown(value) -> str:
+    """A category as the command line writes it: on/off for a switch."""
+    return ("on" if value else "off") if isinstance(value, bool) else str(value)
+
+
+def _curve(ax, series: dict[float, list[float]], colour: str, label: str, banded: bool = True):
+    """One group: the mean through its x positions; with pooled members, their spread (a band
+    between numeric positions, a bar at each category) and points."""
     at = np.array(sorted(series))
     values = [np.array(series[a]) for a in at]
     pooled = max(len(v) for v in values)
-    ax.plot(at, [v.mean() for v in values], "o-", color=colour,
-            label=label + (f" (mean of {pooled})" if pooled > 1 else ""))
+    means = np.array([v.mean() for v in values])
+    ax.plot(at, means, "o-" if banded else "o", color=colour,
+            label=label + (f" (mean of {'' if min(map(len, values)) == pooled else 'up to '}{pooled})"
+                           if pooled > 1 else ""))
     if pooled > 1:
-        ax.fill_between(at, [v.min() for v in values], [v.max() for v in values], color=colour, alpha=0.15)
+        lows, highs = np.array([v.min() for v in values]), np.array([v.max() for v in values])
+        if banded:
+            ax.fill_between(at, lows, highs, color=colour, alpha=0.15)
+        else:
+            ax.errorbar(at, means, yerr=[means - lows, highs - means], fmt="none", ecolor=colour, capsize=6,
+                        alpha=0.6)
         for a, v in zip(at, values, strict=True):
             ax.plot(np.full(len(v), a), v, ".", color=colour, alpha=0.3, ms=3)

@@ -263,9 +263,9 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None,
     counts = {name: count_of(spec, where) for name, (spec, where) in specs.items()}
     total = math.prod(counts.values())
     if total > max_members:
-        sizes = " x ".join(f"{counts[name]:,} {name}" for name in counts)
-        raise ValueError(f"the plan has {total:,} members ({sizes}), more than the {max_members:,} allowed: "
-                         "narrow the grid, or raise the limit (--max-members)")
+        sizes = f" ({' x '.join(f'{counts[name]:,} {name}' for name in counts)})" if counts else ""
+        raise ValueError(f"the plan has {total:,} member{'s' * (total != 1)}{sizes}, more than the {max_members:,} "
+                         "allowed: narrow the grid, or raise the limit (--max-members)")
     # Type and check every value once, through the scenario's own options.
     base = scenario.parse(fixed)
     typed = {name: _typed(scenario, name, values_of(spec, where)) for name, (spec, where) in specs.items()}

@@ -31,7 +31,8 @@ class NamedSweep:
         One line for ``quadcosim list``.
     summarise : callable, optional
         ``(records, out_dir) -> None``: reports written from the finished members' records
-        (their ``metrics.json``, in member order).
+        (their ``metrics.json``, in member order; a record's ``status`` is ``ok`` or
+        ``diverged``, and a diverged member's numbers must be marked as a crash).
     extra_metrics : str, optional
         ``"module:function"`` computing more metrics from ``(result, options)`` on the worker.
     keep_results : bool
@@ -100,9 +101,10 @@ def records(plan, out) -> list[dict]:
 
 def summarise(plan, out, summary) -> Path | None:
     """Run a named sweep's summary on the members of ``plan`` in ``out``, once every member has
-    finished well (according to the ``summary`` of the run); return the ``summary.md`` it wrote
-    in ``out`` (None when it wrote none)."""
-    if not plan.name or summary.ok != summary.total:
+    an outcome, ``ok`` or ``diverged`` (according to the ``summary`` of the run: the summary
+    marks the diverged ones); return the ``summary.md`` it wrote in ``out`` (None when it wrote
+    none)."""
+    if not plan.name or summary.failed or summary.missing:
         return None
     named = registry()[plan.name]
     if named.summarise is None:

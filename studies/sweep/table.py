@@ -64,7 +64,12 @@ def columns_of(rows: list[dict]) -> list[str]:
 
 #: Rows converted to Arrow at a time when the Parquet file is written.
 BATCH_ROWS = 4096
-_EMPTY, _OK, _FAILED = 0, 1, 2  # a member's state in :class:`Rows`
+_EMPTY, _OK, _FAILED, _DIVERGED = 0, 1, 2, 3  # a member's state in :class:`Rows`
+#: A member's outcome, in its ``status`` column: ``ok`` (its metrics are a result), ``diverged``
+#: (it ran to the end, but its flight crossed the scenario's bounds: its numbers describe a crash,
+#: never a result), ``failed`` (it raised, gave a NaN, or its worker died); ``interrupted`` is the
+#: outcome of a member a signal stopped before it finished (counted, never written as a row).
+OUTCOMES = ("ok", "diverged", "failed", "interrupted")
 
 
 class Rows:
@@ -91,19 +96,22 @@ class Rows:
         self._file = tempfile.TemporaryFile(dir=folder)
         self._offset = array("q", bytes(8 * size))  # where each member's line starts, bytes
         self._length = array("q", bytes(8 * size))  # its length, bytes
-        self._state = bytearray(size)  # _EMPTY, _OK or _FAILED
+        self._state = bytearray(size)  # _EMPTY, _OK, _FAILED or _DIVERGED
         self._columns: dict[str, tuple[int, int]] = {}  # name -> (first member holding it, position in its row)
         self._kinds: dict[str, dict] = {}  # name -> value type -> a value of it (ints: the least and largest)
         self._replaced = False  # a row was replaced since the columns were counted
+        self.units: dict[str, str] = {}  # option name -> unit (the metrics' come from their names)
         self.ok = 0
         self.failures: dict[int, tuple[str, str | None]] = {}  # failed member -> (label, error)
+        self.divergences: dict[int, tuple[str, str | None]] = {}  # diverged member -> (label, what crossed)
 
     def __len__(self) -> int:
-        return self.ok + len(self.failures)
+        return self.ok + len(self.failures) + len(self.divergences)
 
     def finished(self, index: int) -> bool:
-        """Whether member ``index`` finished well."""
-        return self._state[index] == _OK
+        """Whether member ``index`` has a known outcome that running it again would not change:
+        it finished well, or it diverged (members are deterministic)."""
+        return self._state[index] in (_OK, _DIVERGED)
 
     def add(self, index: int, row: dict) -> None:
         """Keep member ``index``'s row (:func:`row`), in the place of one it had."""
@@ -115,9 +123,13 @@ class Rows:
             self.ok -= 1
         self._replaced |= self._state[index] != _EMPTY  # what the row it replaces held may be gone
         self.failures.pop(index, None)
+        self.divergences.pop(index, None)
         if row["status"] == "ok":
             self._state[index] = _OK
             self.ok += 1
+        elif row["status"] == "diverged":
+            self._state[index] = _DIVERGED
+            self.divergences[index] = (row.get("label"), row.get("error"))
         else:
             self._state[index] = _FAILED
             self.failures[index] = (row.get("label"), row.get("error"))
@@ -185,7 +197,12 @@ class Rows:
 
         def parquet_file(path):
             types = {n: self._arrow_type(n) for n in names}
-            schema = pa.schema([(n, pa.string() if t is None else t) for n, t in types.items()])
+            from studies.sweep.units import of_columns
+
+            unit = of_columns(names, self.units)
+            schema = pa.schema([pa.field(n, pa.string() if t is None else t,
+                                         metadata={"unit": unit[n]} if n in unit else None)
+                                for n, t in types.items()])
             with pq.ParquetWriter(path, schema) as writer:
                 batch = []
                 for r in self:
@@ -237,6 +254,15 @@ def write(rows: list[dict], out: Path) -> None:
         kept.write(out)
     finally:
         kept.close()
+
+
+def units(path) -> dict[str, str]:
+    """The unit of each column of a sweep table that has one, from ``path``: a sweep folder or its
+    ``sweep.parquet`` (each field's metadata ``unit``)."""
+    path = Path(path)
+    schema = pq.read_schema(path / "sweep.parquet" if path.is_dir() else path)
+    return {field.name: field.metadata[b"unit"].decode() for field in schema
+            if field.metadata and b"unit" in field.metadata}
 
 
 def read(path) -> dict[str, list]:

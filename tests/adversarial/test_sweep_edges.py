@@ -113,3 +113,78 @@ def test_resume_on_a_folder_without_a_plan_is_refused(capsys, tmp_path):
     (out / "members").mkdir(parents=True)  # a folder, but no plan in it
     assert command.main(["tp", "--grid", "k=0.05,0.1", "--out", str(out), "--resume", "--quiet"]) == 2
     assert "holds no sweep" in capsys.readouterr().err
+
+
+SHORT = ["tp", "--grid", "k=0.05,0.1", "--set", "duration=0.2", "noise=on", "--quiet"]
+
+
+def test_two_sweeps_into_one_folder_at_once_the_second_is_refused(tmp_path):
+    import socket
+
+    out = tmp_path / "shared"
+    command_line = [sys.executable, "-m", "studies.sweep", *SHORT, "--workers", "1", "--out", str(out)]
+    dashboard = socket.socket()  # Dask's default dashboard port taken, as by another cluster
+    try:
+        dashboard.bind(("", 8787))
+        dashboard.listen()
+    except OSError:
+        pass  # taken already
+    try:
+        both = [subprocess.Popen(command_line, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                for _ in range(2)]
+        ended = [(process.wait(timeout=300), *process.communicate()) for process in both]
+    finally:
+        dashboard.close()
+    noise = [err for _, _, err in ended if "8787" in err or "unclosed" in err]
+    assert not noise, noise  # neither Dask's port warning nor an unclosed socket
+    codes = sorted(code for code, _, _ in ended)
+    assert codes == [0, 2], ended
+    refused = next(err for code, _, err in ended if code == 2)
+    # refused while the first holds the folder, or (on a slow start) because it holds its finished sweep
+    assert "is being written by another process: pid" in refused or "already holds a sweep of tp" in refused
+    stored = json.loads((out / "sweep.json").read_text())
+    columns = table.read(out)
+    assert stored["count"] == 2 and columns["status"] == ["ok", "ok"] and columns["k"] == [0.05, 0.1]
+    assert not (out / ".quadcosim.lock").exists()
+
+
+@pytest.mark.parametrize("scheduler, refused", [
+    ("inproc://x", "inproc:// reaches only a scheduler inside this same process"),
+    ("tls://127.0.0.1:1", "tls:// needs this client's TLS certificate"),
+    ("127.0.0.1:8786", "is not a scheduler's address: give tcp://HOST:PORT"),
+    ("tcp://127.0.0.1", "no port in it"),
+    ("tcp://127.0.0.1:1", "cannot reach the Dask scheduler at tcp://127.0.0.1:1 within 1 s"),
+])
+def test_a_scheduler_that_cannot_be_used_is_refused_and_nothing_is_left(scheduler, refused, capsys, tmp_path):
+    out = tmp_path / "a" / "sweep"
+    started = time.perf_counter()
+    assert command.main([*SHORT, "--scheduler", scheduler, "--connect-timeout", "1", "--out", str(out)]) == 2
+    assert refused in capsys.readouterr().err
+    assert not (tmp_path / "a").exists()  # a refused sweep leaves nothing, not even its folder
+    assert time.perf_counter() - started < 30.0  # measured 3 s (1 s of it the connect timeout)
+
+
+def test_folders_that_cannot_take_a_sweep_are_named(capsys, tmp_path):
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    (tmp_path / "dangling").symlink_to(tmp_path / "nowhere")
+    (tmp_path / "file").write_text("")
+    for name, refused in (("loop", "a symbolic link that leads back to itself (a loop)"),
+                          ("loop/sub", "(above it) is a symbolic link that leads back to itself"),
+                          ("dangling", f"a symbolic link to {tmp_path / 'nowhere'}, which does not exist"),
+                          ("file", "a file of that name exists"), ("file/sub", "is a file, so no folder")):
+        assert command.main([*SHORT, "--out", str(tmp_path / name)]) == 2
+        assert refused in capsys.readouterr().err
+    assert not (tmp_path / "nowhere").exists()
+    assert command.main([*SHORT, "--max-members", "0", "--out", str(tmp_path / "x")]) == 2
+    assert "--max-members 0: give at least 1" in capsys.readouterr().err
+
+
+def test_resume_refuses_a_folder_whose_members_are_another_plans(capsys, tmp_path):
+    out = tmp_path / "sweep"
+    assert command.main([*SHORT, "--workers", "1", "--out", str(out)]) == 0
+    record = out / "members" / "000001" / "metrics.json"
+    mixed = json.loads(record.read_text())
+    mixed["options"]["k"] = 7.0  # as a second sweep into the folder would have left it
+    record.write_text(json.dumps(mixed))
+    assert command.main(["tp", "--out", str(out), "--resume", "--workers", "1", "--quiet"]) == 2
+    assert f"{record} was run with other options than the plan's member 1 (differing: k)" in capsys.readouterr().err
