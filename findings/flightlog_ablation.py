@@ -21,7 +21,7 @@ WRONG_RULES = ("other_order", "no_trim", "free_earth", "pwm_throttle")
 def _heading(split, params) -> float:
     from calibration.flight.export import score_parameters
 
-    return score_parameters(split.score, params)["heading_rms_deg"]
+    return score_parameters(split.score, params, offset_from=[*split.fit, *split.choice])["heading_rms_deg"]
 
 
 def costs(log, compass: int) -> dict:

@@ -261,7 +261,7 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
             if code:
                 raise RuntimeError(f"quadcosim calibrate --score {file} failed on {path} (exit {code})")
             metrics = json.loads((out / "metrics.json").read_text())
-            choice = score_parameters(split.choice, params)["heading_rms_deg"]
+            choice = score_parameters(split.choice, params, offset_from=split.fit)["heading_rms_deg"]
             found[setting] = metrics["score"] | {"choice_heading_rms_deg": choice, "params": params,
                                                  "points": points, "samples": count}
             found["as_flown"] = metrics["as_flown"]

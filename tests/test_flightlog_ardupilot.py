@@ -42,28 +42,35 @@ def correct_field(params: dict, slot: int, raw_T, current, throttle, version) ->
     return (raw + mot) @ M.T * MG
 
 
-def heading_rms(field, euler) -> float:
-    """Tilt-compensated heading against the attitude's, its circular mean removed (deg RMS)."""
+def heading_error(field, euler) -> np.ndarray:
+    """Tilt-compensated heading of ``field`` against the attitude's, wrapped, nothing removed (rad)."""
     roll, pitch, yaw = euler.T
     x, y, z = field.T
     north = x * np.cos(pitch) + (y * np.sin(roll) + z * np.cos(roll)) * np.sin(pitch)
     east = y * np.cos(roll) - z * np.sin(roll)
-    error = np.angle(np.exp(1j * (np.arctan2(-east, north) - yaw)))
-    error = np.angle(np.exp(1j * (error - np.angle(np.mean(np.exp(1j * error))))))
-    return float(np.degrees(np.sqrt(np.mean(error**2))))
+    return np.angle(np.exp(1j * (np.arctan2(-east, north) - yaw)))
 
 
 def _check_scores(log, compass: int, folder, version, fraction=0.5):
-    """The file in ``folder`` and the log as flown, applied by :func:`correct_field` on the score part
-    (the held-out part's second half), give metrics.json's figures; returns the export's metrics."""
+    """The file in ``folder`` and the log as flown, applied by :func:`correct_field`, give metrics.json's
+    figures on the score part (the held-out part's second half), each with its heading offset estimated
+    on the fit and choice parts (the first part and the held-out part's first half) and removed frozen;
+    returns the export's metrics."""
     metrics = json.loads((folder / "metrics.json").read_text())["export"]
-    _, score = flight_data(log, compass).split(fraction)[1].split(0.5)
+    fit, held = flight_data(log, compass).split(fraction)
+    choice, score = held.split(0.5)
     slot = log.compasses[compass].slot
     params = read_parameters(folder / "ardupilot.parm")
+
+    def errors(chosen, part):
+        field = correct_field(chosen, slot, part.raw, part.current(), part.autopilot_throttle(), version)
+        return heading_error(field, part.euler)
+
     for label, chosen, reported in (("export", {**log.params, **params}, metrics["heading_rms_deg"]),
                                     ("as flown", log.params, metrics["as_flown"]["heading_rms_deg"])):
-        field = correct_field(chosen, slot, score.raw, score.current(), score.autopilot_throttle(), version)
-        assert heading_rms(field, score.euler) == pytest.approx(reported, abs=1e-6), label
+        offset = np.angle(np.mean(np.exp(1j * np.concatenate([errors(chosen, fit), errors(chosen, choice)]))))
+        error = np.angle(np.exp(1j * (errors(chosen, score) - offset)))
+        assert np.degrees(np.sqrt(np.mean(error**2))) == pytest.approx(reported, abs=1e-6), label
     return metrics, params
 
 
@@ -106,11 +113,14 @@ def test_copter43_compass0_no_worse_than_flown_and_compass1_brought_to_its_bound
         assert main(["calibrate", str(path(COPTER43)), "--test-fraction", "0.5", "--compass", str(compass), "--out",
                      str(out), "--models", "current"]) == 0
         found[compass], params = _check_scores(log, compass, out, (4, 3))
-    # compass 0 (external): measured 0.97 deg exported against 1.28 as flown
+    # each less the heading offset the fit and choice parts show; compass 0 (external): measured 1.17 deg exported
+    # against 1.89 as flown
     assert found[0]["heading_rms_deg"] <= found[0]["as_flown"]["heading_rms_deg"]
-    # compass 1 (internal, unused, zero offsets): measured 6.51 deg; its offsets and current compensation, with
-    # what enabling it needs
-    assert found[1]["heading_rms_deg"] < 7.0
+    # compass 1 (internal, unused, zero offsets): measured 6.93 deg against 12.99 as flown (its hard iron, hidden
+    # when the offset is taken on the landing that scores); its offsets and current compensation, with what
+    # enabling it needs
+    assert found[1]["heading_rms_deg"] < 7.5
+    assert found[1]["heading_rms_deg"] < 0.6 * found[1]["as_flown"]["heading_rms_deg"]
     assert params["COMPASS_USE2"] == 1 and params["COMPASS_DEV_ID2"] == 590114
     assert all(abs(params[f"COMPASS_OFS2_{a}"]) > 0 for a in "XYZ")
 
@@ -150,10 +160,12 @@ def test_every_shared_ardupilot_log_through_every_command_and_no_export_worse_th
         if not read_parameters(out / "ardupilot.parm").get("COMPASS_PMOT_EN"):  # the era's equations, written here
             major, minor = (int(x) for x in re.search(r"Copter V(\d+)\.(\d+)", log.firmware).groups())
             _check_scores(log, compass, out, (major, minor))
-        if np.any(log.compasses[compass].offsets):  # a compass the firmware accepts as calibrated
-            assert export["heading_rms_deg"] <= export["as_flown"]["heading_rms_deg"] + 1e-9, (name, compass)
-        else:  # nothing to fall back to: exported, and the notes say how it compares
-            assert "judge" not in export["notes"] or "offsets are all zero" in export["notes"]["judge"]
+        # no exception, a compass never calibrated included: each score less the heading offset the fit and
+        # choice parts show, so a hard iron that turns the heading by a near-constant angle is not hidden
+        assert export["heading_rms_deg"] <= export["as_flown"]["heading_rms_deg"] + 1e-9, (name, compass)
+        if "judge" in export["notes"]:  # the log's values written back, unchanged
+            assert export["heading_rms_deg"] == export["as_flown"]["heading_rms_deg"], (name, compass)
+            assert set(export["kept"].values()) == {"log"}
 
 
 def test_a_crash_is_the_first_two_seconds_thirty_degrees_off_target_and_a_shorter_upset_is_not():

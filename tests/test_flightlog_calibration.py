@@ -128,7 +128,7 @@ def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, 
     printed = capsys.readouterr().out.replace(log, "logs/quad_2015-10-11_19-59-09.log")
     printed = printed.replace(str(tmp_path / "b"), "results/flight-b-internal")
     assert printed.strip() == shown.strip()
-    parameters = readme.split("ends with the motor compensation (milligauss at full throttle, `COMPASS_MOTCT = 1`):"
+    parameters = readme.split("ends with the motor compensation (milligauss per ampere, `COMPASS_MOTCT = 2`):"
                               "\n\n```text\n", 1)[1]
     written = (tmp_path / "b" / "ardupilot.parm").read_text().strip().splitlines()[-4:]
     assert parameters.split("\n```", 1)[0].splitlines() == written

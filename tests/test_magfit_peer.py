@@ -45,12 +45,13 @@ def test_magfit_fits_the_fit_part_only_and_is_scored_on_the_score_part(logs):
     # it saw the fit part's samples (the first, before any attitude, is dropped by magfit), none held out
     assert fit["samples"] - 1 <= fit["points"] <= fit["samples"]  # 324 of 325 measured
     assert set(fit["params"]) >= {"COMPASS_OFS2_X", "COMPASS_OFS2_Y", "COMPASS_OFS2_Z"}
-    # its file on the last quarter: 3.04 deg RMS (as flown 3.05); the third quarter chose it, alone
-    assert result["chosen"] == "offsets" and abs(fit["heading_rms_deg"] - 3.04) < 0.1
-    assert abs(result["as_flown"]["heading_rms_deg"] - 3.05) < 0.1
+    # its file on the last quarter: 3.05 deg RMS (as flown 14.57, each less the heading offset the fit and choice
+    # parts show); the third quarter chose it, alone
+    assert result["chosen"] == "offsets" and abs(fit["heading_rms_deg"] - 3.05) < 0.1
+    assert abs(result["as_flown"]["heading_rms_deg"] - 14.57) < 0.1
 
 
-EXPORT_WORSE: set[str] = set()  # the docs say so: no compass where magfit runs beats the export
+EXPORT_WORSE = {"b0", "b1", "c0"}  # the docs say so: flight b's two compasses and flight c's external one
 
 
 def test_the_docs_say_where_the_export_is_worse_than_magfit():
@@ -59,4 +60,4 @@ def test_the_docs_say_where_the_export_is_worse_than_magfit():
     assert len(keys) == 6  # the quads' six compasses; the Erle-Brain has no GPS fix
     worse = {k for k in keys if committed[f"flightlogs.export.{k}.export_deg"]["value"]
              > committed[f"magfit.{k}.chosen_deg"]["value"] + committed[f"magfit.{k}.chosen_deg"]["tolerance"]}
-    assert worse == EXPORT_WORSE  # measured on flight a internal: 3.05 against 3.36 deg RMS
+    assert worse == EXPORT_WORSE  # measured on flight b internal: 3.94 against 3.05 deg RMS

@@ -29,11 +29,20 @@ def tilt_compensated_heading(field: np.ndarray, euler: np.ndarray) -> np.ndarray
     return np.arctan2(-east, north)
 
 
-def heading_error(heading: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """``heading - reference`` (rad) wrapped, its circular mean (the declination and any mounting
-    offset) removed."""
+def heading_offset(heading: np.ndarray, reference: np.ndarray) -> float:
+    """Circular mean (rad) of ``heading - reference``: the declination and any mounting offset, as
+    estimated on the samples given (give them the parts a score does not score)."""
+    return float(np.angle(np.mean(np.exp(1j * wrap(np.asarray(heading) - reference)))))
+
+
+def heading_error(heading: np.ndarray, reference: np.ndarray, offset: float | None = None) -> np.ndarray:
+    """``heading - reference`` (rad) wrapped, ``offset`` (rad, :func:`heading_offset` estimated
+    elsewhere and frozen) removed; None removes the samples' own circular mean (an analysis that
+    refits the offset on the part it scores)."""
     error = wrap(heading - reference)
-    return wrap(error - np.angle(np.mean(np.exp(1j * error))))  # the declination and mounting offset removed
+    if offset is None:
+        offset = heading_offset(heading, reference)
+    return wrap(error - offset)
 
 
 def score(fitted, parts) -> dict:

@@ -5,14 +5,17 @@
 parameters and applied to the raw field exactly as the log's firmware applies them
 (:mod:`flightlogs.ardupilot`, :mod:`flightlogs.px4`), on the held-out parts. It
 returns the heading error against the log's attitude and the share of the field residual the
-parameters' motor compensation explains.
+parameters' motor compensation explains. The heading's constant offset (declination, mounting) is
+estimated for each parameter set on parts it does not score and removed frozen: a hard iron that
+turns the heading by a near-constant angle on a scored part that barely turns is then seen.
 
 :func:`choose` builds the export group by group (offsets, motor compensation, soft iron) from
 the fits on the training parts and keeps each group only when it beats what the log already
 holds on the choice parts; the log's values stay for the others, and the notes say which. The
 export is then scored on parts that neither the fit nor the choice has seen.
 A compass whose offsets are all zero (never calibrated) gets offsets from the flight, with the
-Earth field model, or is refused: it is never exported with zeros.
+Earth field model, or is refused: zeros are never fitted; like any other compass, :func:`judge`
+writes the log's values back when the fitted file scores worse on the score part.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from calibration.flight.autopilot import autopilot_of
-from calibration.flight.evaluate import heading_error, tilt_compensated_heading
+from calibration.flight.evaluate import heading_offset, tilt_compensated_heading, wrap
 from calibration.flight.linear import earth_and_offset, fit_linear
 from calibration.static import CalibrationError
 from flightlogs import ardupilot
@@ -44,48 +47,63 @@ def apply_parameters(part, params: dict, rule=None) -> np.ndarray:
     return autopilot_of(part).apply(part, {**part.log.params, **params}, _inputs(part), rule)
 
 
-def score_parameters(parts, params: dict, rule=None) -> dict:
+def _heading_error(part, corrected: np.ndarray) -> np.ndarray:
+    """The tilt-compensated heading of ``corrected`` (T, 3), the field the firmware reports, against
+    ``part``'s heading, wrapped, nothing removed (rad)."""
+    return wrap(tilt_compensated_heading(corrected, part.euler) - part.euler[:, 2])
+
+
+def score_parameters(parts, params: dict, rule=None, *, offset_from) -> dict:
     """Score a parameter set on the held-out ``parts`` (FlightData of one compass), applied as
     each part's firmware applies it (``rule``: an ArduPilot :class:`Rules` overriding the log's).
 
     Parameters
     ----------
     parts : list of FlightData
-        The test parts.
+        The scored parts.
     params : dict
         Parameter name: value, in the autopilot's units; names it lacks keep the log's values.
+    offset_from : list of FlightData
+        Parts of the same compass that are not scored (the fit or choice parts): the heading offset
+        (the declination and any mounting offset) of ``params`` is estimated there and removed,
+        frozen, from the scored parts. Estimated on the scored parts themselves it would hide a
+        constant heading error (a hard iron on a flight that barely turns) from the score.
 
     Returns
     -------
     dict
         ``heading_rms_deg``: RMS of the tilt-compensated heading of the corrected field against the
-        log's heading, its mean (the declination and any mounting offset) removed (deg);
-        ``explained``: the share of the residual left by the Earth field and offset alone (fitted
-        again) on the field the same parameters give with their motor compensation switched off
-        that is gone with it on: what the motor compensation explains (1). The baseline carries the
-        parameters' own offsets and soft iron, so a soft iron that only matches the compass's scale
-        to the field model's magnitude is not counted as explained interference.
+        log's heading, ``heading_offset_deg`` removed (deg); ``explained``: the share of the residual
+        left by the Earth field and offset alone (fitted again) on the field the same parameters give
+        with their motor compensation switched off that is gone with it on: what the motor
+        compensation explains (1). The baseline carries the parameters' own offsets and soft iron,
+        so a soft iron that only matches the compass's scale to the field model's magnitude is not
+        counted as explained interference.
     """
+    offset = heading_offset(np.concatenate([_heading_error(p, apply_parameters(p, params, rule)) for p in offset_from]),
+                            0.0)
     errors, base_cost, cost = [], 0.0, 0.0
     for p in parts:
         corrected = apply_parameters(p, params, rule)
-        errors.append(heading_error(tilt_compensated_heading(corrected, p.euler), p.euler[:, 2]))
+        errors.append(wrap(_heading_error(p, corrected) - offset))
         attitude = p.rotation @ np.asarray(p.log.compasses[p.compass].rotation).T  # body to NED
         uncompensated = apply_parameters(p, {**params, **autopilot_of(p).motor_off}, rule)  # the explained share's base
         base_cost += earth_and_offset(attitude, uncompensated, p.earth).cost
         cost += earth_and_offset(attitude, corrected, p.earth).cost
     return {"heading_rms_deg": float(np.degrees(np.sqrt(np.mean(np.concatenate(errors) ** 2)))),
+            "heading_offset_deg": float(np.degrees(offset)),
             "explained": 1.0 - cost / base_cost if base_cost > 0 else 0.0}
 
 
-def score_file(path, parts, rule=None) -> dict:
+def score_file(path, parts, rule=None, *, offset_from) -> dict:
     """:func:`score_parameters` of the parameter file at ``path`` (ArduPilot ``.parm`` or a PX4
-    ``.params`` of QGroundControl) on ``parts``, applied under ``rule`` (None: the log's), with its
-    name and parameter count."""
+    ``.params`` of QGroundControl) on ``parts``, its heading offset estimated on ``offset_from``,
+    applied under ``rule`` (None: the log's), with its name and parameter count."""
     from calibration.flight.autopilot import read_parameters
 
     params = read_parameters(path)
-    return {"file": str(path), "parameters": len(params)} | score_parameters(parts, params, rule)
+    scored = score_parameters(parts, params, rule, offset_from=offset_from)
+    return {"file": str(path), "parameters": len(params)} | scored
 
 
 @dataclass
@@ -264,7 +282,8 @@ def _setup_notes(part) -> dict:
 def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     """The parameters to export for the compass of ``train``/``choice`` and the notes saying what was
     exported and kept: offsets, then motor compensation, then soft iron, each fitted on ``train``
-    and kept only when it lowers the heading error on the ``choice`` parts (the motor compensation
+    and kept only when it lowers the heading error on the ``choice`` parts (its heading offset
+    estimated on ``train``) (the motor compensation
     also needs a positive explained share there). The export's score belongs on parts neither has
     seen. ``rule`` overrides ArduPilot's version rules; ``models`` (names of the models an
     autopilot can carry, :mod:`calibration.flight.catalogue`) restricts the motor compensations
@@ -286,14 +305,14 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
                                           "rotation sweep")
     names = list(parameters_of(first, Candidate(np.zeros(3), np.eye(3)), rule))
     flown = log_parameters(first, names)
-    best, best_score = dict(flown), score_parameters(choice, flown, rule)
+    best, best_score = dict(flown), score_parameters(choice, flown, rule, offset_from=train)
     kept = {"offsets": "log", "motor": "log", "soft_iron": "log"}
     offsets = np.asarray(compass.offsets, dtype=float)
     log_motor = _motor_keys(first, flown)
 
     def trial(candidate: Candidate, motor: dict | None = None) -> tuple[dict, dict]:
         params = parameters_of(first, candidate, rule) | (motor or {})
-        return params, score_parameters(choice, params, rule)
+        return params, score_parameters(choice, params, rule, offset_from=train)
 
     if identifiable:  # offsets, with the log's soft iron and motor compensation
         fitted_offsets = fit_motor(train, None)[0]
@@ -340,19 +359,15 @@ def judge(part, params: dict, exported: dict, flown_params: dict, flown: dict) -
     when the log's are kept: the export ``params`` (scored ``exported``, :func:`score_parameters`)
     goes out only when it beats ``flown_params``, the log's values of the same names (scored
     ``flown``), on the score part; otherwise the log's values go out, unchanged, and the reason says
-    why (the choice part preferred what the score part does not).
-
-    A compass whose offsets are all zero has nothing to fall back to: the firmware refuses to use it
-    (ArduPilot's ``Compass::configured`` asks for non-zero offsets), so its export goes out, and the
-    reason (or None) says how it compares."""
+    why (the choice part preferred what the score part does not). No compass is exempt: each
+    score removes the heading offset the fit and choice parts show, so a compass never calibrated
+    (offsets all zero) is scored with the heading error its hard iron leaves, not with it hidden."""
     if exported["heading_rms_deg"] <= flown["heading_rms_deg"]:
         return params, exported, None
     compass = part.log.compasses[part.compass]
-    versus = (f"the export scores {exported['heading_rms_deg']:.2f} deg on the score part against "
-              f"{flown['heading_rms_deg']:.2f} deg as flown")
-    if not np.any(compass.offsets):
-        return params, exported, (f"{versus}, but the log's offsets are all zero: a compass the firmware does not "
-                                  "accept as calibrated, whose heading hides its hard iron when the vehicle barely "
-                                  "turns; exported")
-    return dict(flown_params), flown, (f"{versus}: the choice part preferred it, the score part does not; the "
-                                       "log's values are kept (the file holds them unchanged)")
+    uncalibrated = "" if np.any(compass.offsets) else (" (all zero: the firmware still does not accept this compass "
+                                                        "as calibrated)")
+    return dict(flown_params), flown, (f"the export scores {exported['heading_rms_deg']:.2f} deg on the score part "
+                                       f"against {flown['heading_rms_deg']:.2f} deg as flown: the choice part "
+                                       "preferred it, the score part does not; the log's values are kept (the file "
+                                       f"holds them unchanged){uncalibrated}")

@@ -222,8 +222,10 @@ def _export(args, split: Split, metrics: dict) -> tuple:
     autopilot = train[0].log.autopilot
     name = AUTOPILOTS[autopilot].file
     flown_params = log_parameters(score[0], params)
-    flown = score_parameters(score, flown_params, rule)
-    params, exported, kept_why = judge(score[0], params, score_parameters(score, params, rule), flown_params, flown)
+    unscored = [*split.fit, *split.choice]  # where each candidate's heading offset is estimated
+    flown = score_parameters(score, flown_params, rule, offset_from=unscored)
+    exported = score_parameters(score, params, rule, offset_from=unscored)
+    params, exported, kept_why = judge(score[0], params, exported, flown_params, flown)
     if kept_why is not None:
         chosen["notes"]["judge"] = kept_why
         if exported is flown:  # the log's values written back
@@ -232,6 +234,7 @@ def _export(args, split: Split, metrics: dict) -> tuple:
     firmware = AUTOPILOTS[autopilot].firmware(train[0], rule)
     metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
                          "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
+                         "heading_offset_deg": exported["heading_offset_deg"],
                          "as_flown": flown, "kept": chosen["kept"], "notes": chosen["notes"],
                          "split": {"fit": sorted({p.source for p in split.fit}),
                                    "choice": sorted({p.source for p in split.choice}),
@@ -281,7 +284,8 @@ def _export_lines(export: dict) -> list[str]:
             f"{', '.join(logged) or 'nothing'}",
             f"  heading on the score part (seen by neither the fit nor the choice), {export['file']} applied as the "
             "firmware does: "
-            f"{export['heading_rms_deg']:.2f} deg RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg)",
+            f"{export['heading_rms_deg']:.2f} deg RMS (the log as flown: {flown['heading_rms_deg']:.2f} deg), each "
+            "less its heading offset as the fit and choice parts show it",
             f"  share of the score part's residual its motor compensation explains: "
             f"{_percent(export['explained_test'])} % "
             f"(as flown: {_percent(flown['explained'])} %)",
@@ -296,9 +300,10 @@ def _score(args, split: Split) -> int:
     rule = _rule(args, score[0])
 
     def scores():
-        given = score_file(args.score, score, rule)
+        unscored = [*split.fit, *split.choice]  # where each file's heading offset is estimated
+        given = score_file(args.score, score, rule, offset_from=unscored)
         names = list(parameters_of(score[0], Candidate(np.zeros(3), np.eye(3)), rule))
-        return given, score_parameters(score, log_parameters(score[0], names), rule)
+        return given, score_parameters(score, log_parameters(score[0], names), rule, offset_from=unscored)
 
     given, flown = _numeric(scores, [p.source for p in score])
     out = Path(args.out)
