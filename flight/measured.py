@@ -21,6 +21,8 @@ SETTLED_AFTER_STEP = 1.0  # s after the step: the attitude loop has settled (0.3
 FIT_START_TAU = 4.0  # s, first guess of the fitted time constant (the default vehicle's is 4.25 s)
 FIT_PARAMETERS = 3
 MM_PER_M = 1e3  # final tilt, amplitude, time constant
+PERCENT = 100.0
+STEADY_TAIL = 0.9  # the steady error is the mean over the window's last 10 %
 
 
 def accelerometer_tilt(result) -> tuple[np.ndarray, np.ndarray]:
@@ -112,7 +114,7 @@ def step_figures(time, response, size: float, band: float = 0.02) -> tuple:
     try:
         info = control.step_info(response, timepts=time, final_output=size, SettlingTimeThreshold=band)
     except IndexError:  # the response never reached 90 % of the step
-        return None, None, max(0.0, 100.0 * (float(np.max(response / size)) - 1.0))
+        return None, None, max(0.0, PERCENT * (float(np.max(response / size)) - 1.0))
     settling = None if unsettled or math.isnan(info["SettlingTime"]) else float(info["SettlingTime"])
     return float(info["RiseTime"]), settling, float(info["Overshoot"])
 
@@ -164,7 +166,7 @@ def step_response(result, steps: list, step_time: float) -> dict:
         # not settled by the end: the whole window
         found["step_settling_time_s"].append(float(time[-1]) if settling is None else settling)
         found["step_overshoot_pct"].append(overshoot)
-        late = response[time >= 0.9 * time[-1]]
+        late = response[time >= STEADY_TAIL * time[-1]]
         found["step_steady_error_deg"].append(math.degrees(step - float(late.mean())))
         found["step_iae_deg_times_s"].append(math.degrees(float(np.trapezoid(np.abs(step - response), time))))
     settled = [t for t in found["step_settling_time_s"] if t is not None]
