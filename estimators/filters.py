@@ -121,12 +121,14 @@ from orchestrator.blocks import Block
 FILTERS = tuple(core.KINDS)
 RECOMMENDED = "explicit"  # the filter for real recordings: estimate()'s default
 TIME_CONSTANTS = ("tau_inclination", "tau_heading", "tau_bias")
-# The recommended filter's defaults, as time constants (s) and magnetic disturbance thresholds (the field's
-# norm, in uT at the lab's 47 uT field, and its dip, in deg): chosen on four public datasets with optical ground
-# truth (python -m benchmarks.tuning DATA; its record benchmarks/data/tuning_explicit.json), a fifth held out
-# until they were frozen.
-DEFAULT_TIME_CONSTANTS = {"tau_inclination": 0.5, "tau_heading": 10.0, "tau_bias": 400.0}
-DEFAULT_MAG_THRESHOLDS = {"norm_uT": 32.0, "dip_deg": 5.0}
+# The recommended filter's defaults, as time constants (s), magnetic disturbance thresholds (the field's norm,
+# in uT at the lab's 47 uT field, and its dip, in deg) and the magnetic rule's times (s: the tracked reference's,
+# also the time a new field must last to be adopted, and the longest rejection): chosen on four public datasets
+# with optical ground truth, each in turn held out of the search (python -m benchmarks.tuning DATA; its record
+# benchmarks/data/tuning_explicit.json).
+DEFAULT_TIME_CONSTANTS = {"tau_inclination": 1.0, "tau_heading": 5.0, "tau_bias": 100.0}
+DEFAULT_MAG_THRESHOLDS = {"norm_uT": 9.4, "dip_deg": 20.0}
+DEFAULT_MAG_TIMES = {"reference_s": 10.0, "rejection_s": 120.0}
 
 
 def explicit_gains(tau_inclination, tau_heading, tau_bias) -> dict:
@@ -199,14 +201,17 @@ CORRECTIONS = {
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 # The corrections each filter runs with by default (corrections=None or True), at the values of CORRECTIONS.
-# The recommended explicit filter takes the configured Earth field as the magnetic reference for ever (no
-# tracking: on the RING dataset a tracked reference followed slow disturbances, 20.9 deg heading RMSE against
-# 10.1 without, benchmarks/real_recordings.py); the passive filter keeps the corrections it was tuned with.
+# The recommended explicit filter judges a disturbance against a tracked reference that adopts a new field once
+# it has lasted, whether or not the body turns (VQF's rule without its gyro test): the iPhones' calibrated field
+# steps in norm and dip, and a reference frozen at the first second then rejects a clean field for as long as the
+# rejection is allowed (benchmarks/magnetic.py, and the fixed_reference ablation of benchmarks/real_recordings.py);
+# the passive filter keeps the corrections it was tuned with.
 NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time",
                     "correct_at_sample")
 DEFAULT_CORRECTIONS = {
     "explicit": CORRECTIONS | {
-        "mag_reference_time": 0.0, "mag_new_min_gyro": 0.0,
+        "mag_reference_time": DEFAULT_MAG_TIMES["reference_s"], "mag_new_min_gyro": 0.0,
+        "mag_rejection_time": DEFAULT_MAG_TIMES["rejection_s"],
         "mag_norm_tolerance": DEFAULT_MAG_THRESHOLDS["norm_uT"] * 1e-6 / vehicle.EARTH_FIELD_NORM,
         "mag_dip_tolerance": math.radians(DEFAULT_MAG_THRESHOLDS["dip_deg"])},
     "passive": CORRECTIONS | dict.fromkeys(NEW_FOR_EXPLICIT, 0.0),
