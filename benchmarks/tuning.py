@@ -184,7 +184,15 @@ class Fold:
         self.recordings = {name: scorer.recordings[name] for name in names}
 
     def ratios(self, kind: str, gains: dict) -> dict:
-        """As :meth:`Scorer.ratios`, on this fold's datasets only."""
+        """As :meth:`Scorer.ratios`, on this fold's datasets only.
+
+        Parameters
+        ----------
+        kind : str
+            The filter.
+        gains : dict
+            Gain name -> (G,) array of gain sets.
+        """
         found = self.scorer.ratios(kind, gains, list(self.recordings))
         self.last = self.scorer.last
         return found
