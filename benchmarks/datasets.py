@@ -104,6 +104,10 @@ def repoimu(folder: Path):
         time, quat = table[:, 0], table[:, 1:5]
         acc, gyro, mag = table[:, 5:8], table[:, 8:11], table[:, 11:14]
         rate = 1.0 / float(np.median(np.diff(time)))
+        quat = np.where(np.all(quat == 0.0, axis=1)[:, None], np.nan, quat)  # all zero: Vicon lost the body
+        if not np.isfinite(quat).all(axis=1).any():  # no reference at all (the static trials): left out
+            yield path.stem, {"meta": {"frame": "enu", "align": True, "rate_mismatch": math.inf}}
+            continue
         grid = np.arange(int((time[-1] - time[0]) * rate)) / rate + time[0]
         sensors = [np.column_stack([np.interp(grid, time, v[:, k]) for k in range(3)]) for v in (gyro, acc, mag)]
         yield path.stem, _aligned(*sensors, rate, alignment.resample(time, quat, grid))

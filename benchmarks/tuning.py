@@ -1,12 +1,13 @@
-"""Choose the recommended filter's defaults on the development datasets, and tune VQF the same way.
+"""Choose the recommended filter's defaults, each dataset in turn held out, and tune VQF the same way.
 
-    python -m benchmarks.tuning DATA [--filter explicit|vqf] [--out FILE] [--figures DIR]
+    python -m benchmarks.tuning DATA [--filter explicit|vqf] [--limit N] [--out FILE] [--figures DIR]
+    python -m benchmarks.tuning DATA --score-folds [--json FILE]
 
-DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes. Only the datasets
-of :data:`DEVELOPMENT` are read: the held-out one is never touched here.
+DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes; the datasets are
+:data:`benchmarks.real_recordings.DEVELOPMENT`.
 
 The score of a gain set is made of its mean total RMSE over VQF's (at VQF's package defaults) on
-each development dataset, so that each dataset counts alike whatever its number of recordings:
+each dataset it is scored on, so that each dataset counts alike whatever its number of recordings:
 the mean of the worst dataset's ratio and of the mean ratio. The worst alone would choose the set
 that loses least where it loses most but leaves the parameters that dataset does not care about
 to drift; the mean lets every dataset speak.
@@ -15,18 +16,27 @@ The search is a compass search on a logarithmic grid: around the current point, 
 alone at ``1/STEP`` and ``STEP`` times its value (2n + 1 gain sets, in one batch call per
 recording) is scored; the search moves to the best when it gains more than :data:`MIN_GAIN` and
 repeats until the best is the centre, so that no chosen value sits on the edge of the grid it was
-chosen on (the grid is widened, by
-recentring, until none does). Then each parameter is swept alone over ``STEP^-3 .. STEP^3``
-times its chosen value, the others held: the sensitivity curves, drawn per dataset with the
-score (``--figures``).
+chosen on (the grid is widened, by recentring, until none does).
 
-The search starts where an earlier search, scored by the worst dataset alone, stopped moving
-anything but the norm threshold. Parameters, all physical (:data:`SEARCH`): for ``explicit``
-(the recommended filter, corrections on), the time constants of inclination, heading and bias
-(s, :func:`estimators.filters.explicit_gains`) and the magnetic disturbance thresholds, on the
-field's norm (µT at the lab's 47 µT field; the filter applies it relative to the reference norm,
-so any magnetometer unit works) and on its dip
-(deg); for ``vqf``, its two time constants ``tauAcc`` and ``tauMag`` (s).
+Leave one dataset out (:func:`leave_one_out`): the search is run once per dataset with that
+dataset held out (:class:`Fold`: it is not read), then once on all of them: the defaults. The
+search reads at most ``--limit`` recordings of each dataset (:data:`LIMIT`, spread over it,
+:func:`spread`), which keeps a search within minutes on two cores. Then each parameter is swept
+alone over ``STEP^-3 .. STEP^3`` times its chosen value, the others held: the sensitivity curves,
+drawn per dataset with the score (``--figures``). The record (``--out``,
+``benchmarks/data/tuning_KIND.json``) holds the defaults, every fold's values and the sweeps.
+``--score-folds`` reads the committed records only and scores each fold, on every recording of the
+dataset it held out, against VQF at its defaults and VQF tuned by the same fold
+(:func:`score_folds`): the held-out table.
+
+Parameters, all physical (:data:`SEARCH`): for ``explicit`` (the recommended filter, corrections
+on), the time constants of inclination, heading and bias (s, :func:`estimators.filters.explicit_gains`),
+the magnetic disturbance thresholds on the field's norm (µT at the lab's 47 µT field; the filter
+applies it relative to the reference norm, so any magnetometer unit works) and on its dip (deg),
+the magnetic reference's time (s: its tracking time constant, and how long a new field must last
+to be adopted) and the longest rejection (s); the time constants start where the earlier search started,
+the magnetic rule at VQF's published one. For ``vqf``, its two time constants ``tauAcc`` and ``tauMag``
+(s), from its defaults.
 """
 
 from __future__ import annotations
@@ -46,6 +56,7 @@ from orchestrator.files import save_figure, write_text
 
 STEP = 2.0  # ratio between neighbouring grid values
 SWEEP = 3  # the sensitivity sweeps reach STEP**SWEEP either side of the chosen value
+LIMIT = 12  # recordings of a dataset in the search at most (spread); the held-out folds are scored on all
 MIN_GAIN = 1e-3  # a move must lower the score by more than this; the scores of means over tens of recordings
 # differ by less than this in directions no dataset cares about
 LAB_FIELD_UT = vehicle.EARTH_FIELD_NORM * 1e6  # µT, the field the norm threshold is stated at
@@ -55,8 +66,13 @@ SEARCH = {
         "tau_inclination": (0.5, "s", "inclination time constant"),
         "tau_heading": (10.0, "s", "heading time constant"),
         "tau_bias": (200.0, "s", "bias time constant"),
-        "mag_norm_threshold": (32.0, "µT", "magnetic norm threshold"),
+        # the magnetic rule starts at VQF's published values: a field rejected once its norm is 10 % or its dip
+        # 10 deg off the tracked reference (the weight's ramp is half-way there), a new field adopted and the
+        # reference's time constant 20 s, a rejection bounded at 60 s
+        "mag_norm_threshold": (0.2 * LAB_FIELD_UT, "µT", "magnetic norm threshold"),
         "mag_dip_threshold": (20.0, "deg", "magnetic dip threshold"),
+        "mag_reference_time": (20.0, "s", "magnetic reference time"),
+        "mag_rejection_time": (60.0, "s", "longest magnetic rejection"),
     },
     "vqf": {
         "tauAcc": (3.0, "s", "VQF's inclination time constant"),
@@ -89,9 +105,17 @@ def filter_gains(kind: str, values: dict) -> dict:
     return gains
 
 
+def spread(recordings: list, limit: int | None) -> list:
+    """At most ``limit`` of ``recordings``, evenly spaced in their order (all of them when ``limit`` is
+    None): a dataset's recordings are sorted by name, so the pick spans its people, motions and devices."""
+    if limit is None or len(recordings) <= limit:
+        return list(recordings)
+    return [recordings[k] for k in np.linspace(0, len(recordings) - 1, limit).round().astype(int)]
+
+
 class Scorer:
-    """Mean total, heading and inclination RMSE (deg) of gain sets on the development datasets,
-    and their total over VQF's at its defaults.
+    """Mean total, heading and inclination RMSE (deg) of gain sets on datasets, and their total over
+    VQF's at its defaults; every gain set is scored once per dataset (kept in ``memo``).
 
     Parameters
     ----------
@@ -99,16 +123,19 @@ class Scorer:
         Folder of the datasets (see :mod:`benchmarks.datasets`).
     names : sequence of str
         The datasets scored; the development ones by default.
+    limit : int, optional
+        At most this many recordings of each dataset (:func:`spread`); all by default.
     """
 
-    def __init__(self, folder, names=DEVELOPMENT):
+    def __init__(self, folder, names=DEVELOPMENT, limit: int | None = None):
         self.recordings = {}
         for name in names:
-            found = datasets.load(folder, name)
+            found = spread(datasets.load(folder, name), limit)
             if found:
                 self.recordings[name] = found
         if not self.recordings:
             raise FileNotFoundError(f"none of the datasets {', '.join(names)} is under {folder}")
+        self.memo = {}
         self.vqf = {name: self.means("vqf", name, {}) for name in self.recordings}
         self.evaluated = 0
 
@@ -121,7 +148,7 @@ class Scorer:
         rows = [errors(kind, data, filter_gains(kind, gains)) for _, data in self.recordings[name]]
         return {m: np.mean([r[m] for r in rows], axis=0) for m in rows[0]}
 
-    def ratios(self, kind: str, gains: dict) -> dict:
+    def ratios(self, kind: str, gains: dict, names=None) -> dict:
         """Dataset -> (G,) mean total RMSE over VQF's (defaults); also keeps the means in ``self.last``.
 
         Parameters
@@ -129,11 +156,46 @@ class Scorer:
         kind : str
             The filter.
         gains : dict
-            Gain name -> (G,) array: G gain sets scored at once.
+            Gain name -> (G,) array: G gain sets scored at once; those scored before come from ``memo``.
+        names : sequence of str, optional
+            The datasets scored (all of :attr:`recordings` by default); no other is read.
         """
-        self.last = {name: self.means(kind, name, gains) for name in self.recordings}
-        self.evaluated += len(next(iter(gains.values()))) if gains else 1
-        return {name: self.last[name]["total_rmse_deg"] / self.vqf[name]["total_rmse_deg"] for name in self.recordings}
+        names = list(self.recordings) if names is None else list(names)
+        sets = _sets(gains)
+        self.last = {}
+        for name in names:
+            keys = [(kind, name, tuple(sorted(s.items()))) for s in sets]
+            todo = [k for k, key in enumerate(keys) if key not in self.memo]
+            if todo:
+                found = self.means(kind, name, {g: np.array([sets[k][g] for k in todo]) for g in gains})
+                for j, k in enumerate(todo):
+                    self.memo[keys[k]] = {m: float(v[j]) for m, v in found.items()}
+                self.evaluated += len(todo)
+            self.last[name] = {m: np.array([self.memo[key][m] for key in keys]) for m in self.memo[keys[0]]}
+        return {name: self.last[name]["total_rmse_deg"] / self.vqf[name]["total_rmse_deg"] for name in names}
+
+
+class Fold:
+    """The :class:`Scorer` ``scorer`` restricted to the datasets ``names``: what a search sees when
+    the others are held out."""
+
+    def __init__(self, scorer: Scorer, names):
+        self.scorer = scorer
+        self.recordings = {name: scorer.recordings[name] for name in names}
+
+    def ratios(self, kind: str, gains: dict) -> dict:
+        """As :meth:`Scorer.ratios`, on this fold's datasets only.
+
+        Parameters
+        ----------
+        kind : str
+            The filter.
+        gains : dict
+            Gain name -> (G,) array of gain sets.
+        """
+        found = self.scorer.ratios(kind, gains, list(self.recordings))
+        self.last = self.scorer.last
+        return found
 
 
 def _sets(gains: dict) -> list[dict]:
@@ -285,28 +347,126 @@ def figures(kind: str, swept: dict, chosen: dict, folder) -> list[Path]:
     return paths
 
 
+def leave_one_out(scorer: Scorer, kind: str, start: dict | None = None, log=print) -> dict:
+    """Each dataset of ``scorer`` in turn held out of the search: :func:`search` on the others alone
+    (:class:`Fold`; the held-out dataset is not read).
+
+    Parameters
+    ----------
+    scorer : Scorer
+        Scores gain sets on all the datasets.
+    kind : str
+        The filter (a key of :data:`SEARCH`).
+    start : dict, optional
+        The first point of every fold's search; :data:`SEARCH`'s first values by default.
+    log : callable
+        Called with one line per step.
+
+    Returns
+    -------
+    dict
+        Held-out dataset -> ``{"searched_on": [names], "values": chosen, "score": in-sample score,
+        "ratios": in-sample ratios}``.
+    """
+    out = {}
+    for held in scorer.recordings:
+        others = [name for name in scorer.recordings if name != held]
+        found = search(Fold(scorer, others), kind, start, log=lambda text, h=held: log(f"without {h}: {text}"))
+        out[held] = {"searched_on": others, "values": found["values"], "score": found["score"],
+                     "ratios": found["ratios"]}
+    return out
+
+
+def record_path(kind: str) -> Path:
+    """The committed search record of the filter ``kind``: ``benchmarks/data/tuning_KIND.json``."""
+    from benchmarks.real_recordings import TUNING_RECORDS
+
+    return TUNING_RECORDS / f"tuning_{kind}.json"
+
+
+def _mean_errors(kind: str, recordings: list, gains: dict | None) -> dict:
+    rows = [errors(kind, data, gains) for _, data in recordings]
+    return {m: float(np.mean([r[m][0] for r in rows])) for m in rows[0]}
+
+
+def score_folds(folder, log=print) -> dict:
+    """Each fold of the committed records (:func:`record_path`, ``folds``) scored on every recording
+    of the dataset it held out: the explicit filter at the fold's values, VQF at its defaults and
+    VQF at the fold's values (tuned by the same procedure without that dataset).
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder of the datasets.
+    log : callable
+        Called with one line per dataset.
+
+    Returns
+    -------
+    dict
+        Held-out dataset -> ``{"recordings", "explicit", "vqf", "vqf_tuned"`` (each metric -> mean
+        deg), ``"explicit_over_vqf", "explicit_over_vqf_tuned", "vqf_tuned_over_vqf"}``.
+    """
+    records = {kind: json.loads(record_path(kind).read_text()) for kind in ("explicit", "vqf")}
+    out = {}
+    for held, fold in records["explicit"]["folds"].items():
+        recordings = datasets.load(folder, held)
+        if not recordings:
+            continue
+        values = {k: np.array([v]) for k, v in fold["values"].items()}
+        found = {"explicit": _mean_errors("explicit", recordings, filter_gains("explicit", values)),
+                 "vqf": _mean_errors("vqf", recordings, None),
+                 "vqf_tuned": _mean_errors("vqf", recordings, records["vqf"]["folds"][held]["values"])}
+        total = {k: v["total_rmse_deg"] for k, v in found.items()}
+        out[held] = {"recordings": len(recordings), **found,
+                     "explicit_over_vqf": total["explicit"] / total["vqf"],
+                     "explicit_over_vqf_tuned": total["explicit"] / total["vqf_tuned"],
+                     "vqf_tuned_over_vqf": total["vqf_tuned"] / total["vqf"]}
+        log(f"{held} held out: explicit {total['explicit']:.2f}, VQF {total['vqf']:.2f}, VQF tuned "
+            f"{total['vqf_tuned']:.2f} deg; explicit / VQF {out[held]['explicit_over_vqf']:.2f}, / VQF tuned "
+            f"{out[held]['explicit_over_vqf_tuned']:.2f}")
+    return out
+
+
 def main(argv=None) -> int:
     """Command line (see the module docstring); prints the chosen values, returns 0 (2 for a bad
     folder). ``argv``: the arguments (default ``sys.argv[1:]``)."""
     parser = argparse.ArgumentParser(prog="python -m benchmarks.tuning", description=__doc__.splitlines()[0])
     parser.add_argument("folder")
     parser.add_argument("--filter", default="explicit", choices=sorted(SEARCH))
+    parser.add_argument("--limit", type=int, default=LIMIT,
+                        help=f"at most this many recordings of each dataset in the search (default {LIMIT})")
     parser.add_argument("--out", help="write the search record (JSON) here")
     parser.add_argument("--figures", help="write the sensitivity figures (PNG) into this folder")
+    parser.add_argument("--score-folds", action="store_true",
+                        help="score each committed fold on the dataset it held out (all its recordings)")
+    parser.add_argument("--json", help="with --score-folds: write the held-out scores here")
     args = parser.parse_args(argv)
     if not Path(args.folder).is_dir():
         print(f"tuning: {args.folder} is not a folder", file=sys.stderr)
         return 2
     started = time.perf_counter()
-    scorer = Scorer(args.folder)
-    chosen = search(scorer, args.filter, log=lambda text: print(text, file=sys.stderr, flush=True))
+    if args.score_folds:
+        scores = score_folds(args.folder)
+        print(fold_table(scores))
+        if args.json:
+            write_text(args.json, json.dumps(scores, indent=1) + "\n")
+        return 0
+    log = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
+    scorer = Scorer(args.folder, limit=args.limit)
+    folds = leave_one_out(scorer, args.filter, log=log)
+    chosen = search(scorer, args.filter, log=log)
     swept = sweeps(scorer, args.filter, chosen["values"])
-    record = {"filter": args.filter, "development": list(scorer.recordings), "step": STEP, "chosen": chosen["values"],
-              "score": chosen["score"], "ratios": chosen["ratios"], "means": chosen["means"],
+    record = {"filter": args.filter, "development": list(scorer.recordings), "step": STEP, "limit": args.limit,
+              "recordings": {n: [label for label, _ in found] for n, found in scorer.recordings.items()},
+              "chosen": chosen["values"], "score": chosen["score"], "ratios": chosen["ratios"],
+              "means": chosen["means"],
+              "folds": folds,
               "vqf_defaults": {n: {m: float(v[0]) for m, v in found.items()} for n, found in scorer.vqf.items()},
               "sweeps": swept, "history": chosen["history"], "gain_sets": scorer.evaluated,
               "seconds": round(time.perf_counter() - started, 1)}
-    print(json.dumps({k: record[k] for k in ("filter", "chosen", "score", "ratios", "gain_sets", "seconds")}, indent=1))
+    print(json.dumps({k: record[k] for k in ("filter", "chosen", "score", "ratios", "gain_sets", "seconds")}
+                     | {"folds": {h: f["values"] for h, f in folds.items()}}, indent=1))
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         write_text(args.out, json.dumps(record, indent=1) + "\n")
@@ -314,6 +474,18 @@ def main(argv=None) -> int:
         for path in figures(args.filter, swept, chosen["values"], args.figures):
             print(path)
     return 0
+
+
+def fold_table(scores: dict) -> str:
+    """The held-out table of :func:`score_folds`' ``scores`` (markdown): per dataset, the mean total
+    RMSE (deg) of each filter while it was held out, and the ratios."""
+    lines = ["| held out (recordings) | explicit | VQF | VQF tuned | explicit / VQF | explicit / VQF tuned | "
+             "VQF tuned / VQF |", "|---" * 7 + "|"]
+    for held, found in scores.items():
+        lines.append(f"| {held} ({found['recordings']}) | " + " | ".join(
+            f"{found[k]['total_rmse_deg']:.2f}" for k in ("explicit", "vqf", "vqf_tuned")) + " | " + " | ".join(
+            f"{found[k]:.2f}" for k in ("explicit_over_vqf", "explicit_over_vqf_tuned", "vqf_tuned_over_vqf")) + " |")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

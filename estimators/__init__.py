@@ -2,8 +2,9 @@
 
 - :class:`QuaternionEstim`: the streaming block (``linear``, ``explicit``, ``passive``, and the
   published ``vqf`` and ``madgwick`` for comparison);
-- :data:`RECOMMENDED`: the filter for real recordings (``explicit``, at :data:`DEFAULT_GAINS`, set by the
-  time constants :data:`DEFAULT_TIME_CONSTANTS` through :func:`explicit_gains`), :func:`estimate`'s default;
+- :data:`RECORDED`: the filter for recorded data, :func:`estimate`'s default (``vqf``, the published filter);
+- :data:`RECOMMENDED`: the lab's filter recommended for real recordings (``explicit``, at :data:`DEFAULT_GAINS`,
+  set by the time constants :data:`DEFAULT_TIME_CONSTANTS` through :func:`explicit_gains`);
 - :func:`estimate`: the same filters on recorded arrays, many gain sets at once
   (:func:`gain_grid` builds them), with errors against a reference reduced in the loop;
 - :func:`score`: the quaternion-error RMSE (total, inclination, heading);
@@ -23,6 +24,7 @@ from estimators.filters import (
     GAIN_MEANINGS,
     LAB_GAINS,
     RECOMMENDED,
+    RECORDED,
     QuaternionEstim,
     estimate,
     explicit_gains,
@@ -33,4 +35,5 @@ from estimators.filters import (
 )
 
 __all__ = ["CORRECTIONS", "DEFAULT_GAINS", "DEFAULT_TIME_CONSTANTS", "GAIN_MEANINGS", "LAB_GAINS", "RECOMMENDED",
-           "QuaternionEstim", "estimate", "explicit_gains", "gain_grid", "parse_corrections", "references", "score"]
+           "RECORDED", "QuaternionEstim", "estimate", "explicit_gains", "gain_grid", "parse_corrections", "references",
+           "score"]

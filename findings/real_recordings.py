@@ -17,6 +17,7 @@ from estimators import kinds
 
 COMMAND = "python -m benchmarks.real_recordings DATA"
 CHOOSE = "python -m benchmarks.tuning DATA"
+FOLDS = "python -m benchmarks.tuning DATA --score-folds"
 LARGE = "mahony"  # the filter whose failures on single recordings the documentation counts
 FILTERS = {name: kinds.KINDS[name].label for name in ("explicit", "passive", "vqf", "madgwick", "mahony")}
 METRICS = {"total_rmse_deg": "total", "heading_rmse_deg": "heading", "inclination_rmse_deg": "inclination"}
@@ -51,15 +52,60 @@ def findings(results: dict) -> list[dict]:
     return out + notes(results)
 
 
+def _value(name, value, command) -> dict:
+    """A chosen value (a grid point), printed with the decimals it has (at most 3)."""
+    digits = next((d for d in range(3) if round(float(value), d) == float(value)), 3)
+    return _entry(name, value, "1", digits, 0.0, command)
+
+
 def tuning(records: dict) -> list[dict]:
-    """The search records of :mod:`benchmarks.tuning` (filter -> record): the values chosen, the score
-    there (the worst development dataset's ratio to VQF) and the number of gain sets scored."""
+    """The search records of :mod:`benchmarks.tuning` (filter -> record): the values chosen on all the
+    datasets, the score there, and the values each leave-one-dataset-out fold chose without its dataset."""
     out = []
     for kind, record in records.items():
+        command = f"{CHOOSE} --filter {kind}"
         for name, value in record["chosen"].items():
-            digits = 0 if float(value).is_integer() else 3
-            out.append(_entry(f"tuning.{kind}.{name}", value, "1", digits, 0.0, f"{CHOOSE} --filter {kind}"))
-        out.append(_entry(f"tuning.{kind}.score", record["score"], "1", 2, 0.005, f"{CHOOSE} --filter {kind}"))
+            out.append(_value(f"tuning.{kind}.{name}", value, command))
+        out.append(_entry(f"tuning.{kind}.score", record["score"], "1", 2, 0.005, command))
+        for held, fold in record.get("folds", {}).items():
+            out += [_value(f"tuning.{kind}.without_{held}.{name}", value, command)
+                    for name, value in fold["values"].items()]
+    return out
+
+
+def folds(scores: dict) -> list[dict]:
+    """The leave-one-dataset-out table (:func:`benchmarks.tuning.score_folds`' ``scores``): per
+    dataset, while it was held out of the search, the mean total RMSE (deg) of the explicit filter
+    at its fold's values, of VQF at its defaults and of VQF tuned by the same fold, and the ratios."""
+    out = []
+    for held, found in scores.items():
+        for kind in ("explicit", "vqf", "vqf_tuned"):
+            out.append(_entry(f"folds.{held}.{kind}", found[kind]["total_rmse_deg"], "deg", command=FOLDS))
+        for ratio in ("explicit_over_vqf", "explicit_over_vqf_tuned", "vqf_tuned_over_vqf"):
+            out.append(_entry(f"folds.{held}.{ratio}", found[ratio], "1", command=FOLDS))
+    ratios = [found["explicit_over_vqf"] for found in scores.values()]
+    if ratios:
+        out.append(_entry("folds.worst_explicit_over_vqf", max(ratios), "1", command=FOLDS))
+    return out
+
+
+def unreachable() -> list[dict]:
+    """The rows of the datasets that cannot be reached now
+    (:data:`benchmarks.real_recordings.UNREACHABLE`), as measured in an earlier round and kept in
+    their committed records (``benchmarks/data/unreachable_NAME.json``), named
+    ``real_recordings.unreachable.NAME.*``: not re-measured, at the defaults of that round."""
+    import json
+
+    from benchmarks import real_recordings
+
+    out = []
+    for name in real_recordings.UNREACHABLE:
+        record = json.loads((real_recordings.TUNING_RECORDS / f"unreachable_{name}.json").read_text())
+        for key, value in record["values"].items():
+            unit = "1" if key == "recordings" or "_over_" in key else "deg"
+            digits, tolerance = (0, 0.0) if key == "recordings" else (DIGITS, 0.0)
+            out.append(_entry(f"unreachable.{name}.{key}", value, unit, digits, tolerance,
+                              f"{COMMAND} --datasets {name}"))
     return out
 
 
@@ -100,9 +146,13 @@ def compute(quick: bool = False) -> list[dict]:
 
     cache = os.environ.get("QUADCOSIM_REAL_CACHE")
     published = tuple(k for k in os.environ.get("QUADCOSIM_REAL_PUBLISHED", "vqf,madgwick,mahony").split(",") if k)
+    from benchmarks import tuning as search
+
     records = {path.stem.removeprefix("tuning_"): json.loads(path.read_text())
                for path in sorted(real_recordings.TUNING_RECORDS.glob("tuning_*.json"))}
-    return findings(real_recordings.evaluate(folder, cache=cache, published=published)) + tuning(records)
+    results = real_recordings.evaluate(folder, names=real_recordings.DEVELOPMENT, cache=cache, published=published)
+    return (findings(results) + tuning(records) + folds(search.score_folds(folder, log=lambda text: None))
+            + unreachable())
 
 
 def _deg(value) -> str:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from estimators import DEFAULT_GAINS, estimate
-from estimators.filters import DEFAULT_TIME_CONSTANTS, RECOMMENDED, explicit_gains, time_constants
+from estimators.filters import DEFAULT_TIME_CONSTANTS, RECOMMENDED, RECORDED, explicit_gains, time_constants
 
 G = 9.81
 FIELD = 4.7e-5  # T
@@ -54,13 +54,17 @@ def test_time_constants_and_gains_are_one_conversion():
         explicit_gains(0.0, 1.0, 1.0)
 
 
-def test_estimate_runs_the_recommended_filter_by_default_and_takes_time_constants():
+def test_estimate_runs_vqf_by_default_and_the_recommended_filter_takes_time_constants():
     data = _still(2.0)
     default = estimate(**data, outputs=("q",))["q"]
-    named = estimate(RECOMMENDED, **data, gains=DEFAULT_GAINS["explicit"], outputs=("q",))["q"]
-    assert RECOMMENDED == "explicit" and np.array_equal(default, named)
-    by_time = estimate(**data, gains={"tau_heading": 5.0}, outputs=("q",), q0=(math.cos(0.1), 0, 0, math.sin(0.1)))
-    by_gain = estimate(**data, gains=explicit_gains(DEFAULT_TIME_CONSTANTS["tau_inclination"], 5.0,
+    named = estimate(RECORDED, **data, outputs=("q",))["q"]
+    assert RECORDED == "vqf" and np.array_equal(default, named)
+    explicit = estimate(RECOMMENDED, **data, outputs=("q",))["q"]
+    assert RECOMMENDED == "explicit" and np.array_equal(
+        explicit, estimate(RECOMMENDED, **data, gains=DEFAULT_GAINS["explicit"], outputs=("q",))["q"])
+    by_time = estimate(RECOMMENDED, **data, gains={"tau_heading": 5.0}, outputs=("q",),
+                       q0=(math.cos(0.1), 0, 0, math.sin(0.1)))
+    by_gain = estimate(RECOMMENDED, **data, gains=explicit_gains(DEFAULT_TIME_CONSTANTS["tau_inclination"], 5.0,
                                                     DEFAULT_TIME_CONSTANTS["tau_bias"]),
                        outputs=("q",), q0=(math.cos(0.1), 0, 0, math.sin(0.1)))
     assert np.array_equal(by_time["q"], by_gain["q"])
@@ -74,7 +78,7 @@ def test_a_heading_error_decays_with_tau_heading_whatever_the_dip(dip_deg):
     tau, psi0 = 4.0, math.radians(30.0)
     data = _still(8.0, dip_deg)
     q0 = (math.cos(psi0 / 2), 0.0, 0.0, math.sin(psi0 / 2))
-    q = estimate(**data, gains={"tau_inclination": 1.0, "tau_heading": tau, "tau_bias": 1e12}, q0=q0,
+    q = estimate(RECOMMENDED, **data, gains={"tau_inclination": 1.0, "tau_heading": tau, "tau_bias": 1e12}, q0=q0,
                  corrections={"heading_level": True}, outputs=("q",))["q"][0]
     t = np.arange(1, len(q) + 1) / RATE
     predicted = 2 * np.arctan(math.tan(psi0 / 2) * np.exp(-t / tau))
@@ -86,8 +90,8 @@ def test_a_heading_error_decays_with_tau_heading_whatever_the_dip(dip_deg):
 def test_an_inclination_error_decays_with_tau_inclination():
     tau, roll0 = 1.5, math.radians(20.0)
     q0 = (math.cos(roll0 / 2), math.sin(roll0 / 2), 0.0, 0.0)
-    q = estimate(**_still(6.0), gains={"tau_inclination": tau, "tau_heading": 1e6, "tau_bias": 1e12}, q0=q0,
-                 corrections={"heading_level": True}, outputs=("q",))["q"][0]
+    q = estimate(RECOMMENDED, **_still(6.0), gains={"tau_inclination": tau, "tau_heading": 1e6, "tau_bias": 1e12},
+                 q0=q0, corrections={"heading_level": True}, outputs=("q",))["q"][0]
     roll = np.arctan2(2 * (q[:, 2] * q[:, 3] + q[:, 0] * q[:, 1]), 1 - 2 * (q[:, 1] ** 2 + q[:, 2] ** 2))
     t = np.arange(1, len(q) + 1) / RATE
     worst = np.max(np.abs(roll - 2 * np.arctan(math.tan(roll0 / 2) * np.exp(-t / tau))))
@@ -102,7 +106,7 @@ def test_a_gyro_bias_is_learnt_in_motion_with_tau_bias(bias):
     # The tilt and the vertical axes apart: a tilt error turns the horizontal plane the heading is taken in
     tau, tau_b, bias = 1.0, 15.0, np.array(bias)
     data = _still(45.0, gyro=bias)
-    b = estimate(**data, gains={"tau_inclination": tau, "tau_heading": tau, "tau_bias": tau_b},
+    b = estimate(RECOMMENDED, **data, gains={"tau_inclination": tau, "tau_heading": tau, "tau_bias": tau_b},
                  corrections={"heading_level": True}, outputs=("b",))["b"][0]
     s1, s2 = np.roots([1.0, 1.0 / tau, 1.0 / (tau * tau_b)])
     t = np.arange(1, len(b) + 1) / RATE
@@ -121,10 +125,11 @@ def test_rest_is_judged_by_the_deviation_not_the_mean():
     data["gyro"] = np.column_stack([np.radians(5.0) * np.sin(2 * np.pi * 5.0 * t), np.zeros_like(t), np.zeros_like(t)])
     flags = {}
     for deviation in (0.0, 1.0):
-        weights = estimate(**data, corrections={"rest_gyro": True, "rest_deviation": deviation, "bias_clip": True},
+        weights = estimate(RECOMMENDED, **data,
+                           corrections={"rest_gyro": True, "rest_deviation": deviation, "bias_clip": True},
                            outputs=("weights",))["weights"][0]
         flags[deviation] = weights[:, 2]
-    still = estimate(**_still(6.0, gyro=(0.01, 0.0, 0.0)), outputs=("weights",),
+    still = estimate(RECOMMENDED, **_still(6.0, gyro=(0.01, 0.0, 0.0)), outputs=("weights",),
                      corrections={"rest_gyro": True, "rest_deviation": True, "bias_clip": True})["weights"][0][:, 2]
     print(f"vibrating: at rest {flags[0.0].mean():.2f} of the time by the low-pass, {flags[1.0].mean():.2f} by the "
           f"deviation; still with a 0.57 deg/s bias: {still.mean():.2f}")
@@ -139,7 +144,7 @@ def test_a_new_field_is_adopted_only_once_it_has_held_while_turning(turning):
     strong = 1.4 * _field(65.0)
     rate = math.radians(40.0) if turning else 0.0
     data = _turning(8.0, rate, strong)
-    weight = estimate(**data, corrections={"mag_norm_tolerance": True, "mag_dip_tolerance": True,
+    weight = estimate(RECOMMENDED, **data, corrections={"mag_norm_tolerance": True, "mag_dip_tolerance": True,
                                            "mag_reference_time": True, "mag_new_min_gyro": True},
                       outputs=("weights",))["weights"][0][:, 1]
     t = np.arange(len(weight)) / RATE
@@ -153,7 +158,7 @@ def test_a_new_field_is_adopted_only_once_it_has_held_while_turning(turning):
 
 def test_a_rejection_longer_than_mag_rejection_time_corrects_at_half_weight():
     data = _still(8.0, field=1.4 * _field(65.0))
-    weight = estimate(**data, gains={"mag_rejection_time": 5.0},
+    weight = estimate(RECOMMENDED, **data, gains={"mag_rejection_time": 5.0},
                       corrections={"mag_norm_tolerance": True, "mag_dip_tolerance": True, "mag_reference_time": True,
                                    "mag_new_min_gyro": True, "mag_rejection_time": True},
                       outputs=("weights",))["weights"][0][:, 1]

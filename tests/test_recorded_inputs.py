@@ -95,11 +95,11 @@ def test_a_missing_magnetometer_gives_a_tilt_estimate_with_a_warning(kind, optio
         with pytest.warns(checks.NoMagnetometerWarning, match="6-axis estimate"):
             out = estimate(kind, gyro=gyro, acc=acc, mag=absent, dt=1 / RATE, outputs=("q",), reference=quat,
                            scored=late, **options)
-        # from level, the 22 deg tilt is corrected (tilt time constant 2-4 s: after 50 s, measured 3e-4 deg
+        # from level, the 22 deg tilt is corrected (tilt time constant 1-4 s: after 50 s, measured 1.4e-3 deg
         # for explicit, 1.5e-3 deg for passive);
         # nothing corrects the heading: it stays near its start, 17.2 deg off (19.0 measured, the tilt
         # correction turning about a tilted axis)
-        assert out["errors"]["inclination_rmse_deg"][0] < (1e-3 if kind == "explicit" else 3e-3)
+        assert out["errors"]["inclination_rmse_deg"][0] < 3e-3
         assert out["errors"]["heading_rmse_deg"][0] == pytest.approx(math.degrees(0.3), abs=2.5)
         assert np.isfinite(out["q"]).all()
 
@@ -119,7 +119,7 @@ def test_gains_that_make_a_filter_diverge_are_named():
     table = gain_table("explicit", {"kP": [1.0, 2.0]})
     stored = np.zeros((2, 3, 4))
     stored[1, 2, 0] = np.nan
-    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.05, kP = 2"):
+    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.2, kP = 2"):
         checks.check_finite("explicit", table, stored, np.zeros((2, 6)))
 
 
@@ -139,9 +139,10 @@ def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(ca
     exec(compile(code, "README.md", "exec"), namespace)
     errors = namespace["out"]["errors"]["total_rmse_deg"].reshape(4, 3)
     print(errors)
-    # 24 s of slow rotations from a TRIAD start: 0.61 to 0.95 deg measured (the recommended filter's
-    # corrections, the other gains at their defaults), the least at kP = 1
-    assert np.all((errors > 0.55) & (errors < 1.0)) and np.argmin(errors.min(axis=1)) == 2
+    # 24 s of slow rotations from a TRIAD start: 0.56 to 3.30 deg measured (the recommended filter's
+    # corrections, the other gains at their defaults: k2 = 0.2, so kP = 2 turns the heading in 2.5 s), the
+    # least at kP = 0.25
+    assert np.all((errors > 0.5) & (errors < 3.6)) and np.argmin(errors.min(axis=1)) == 0
     assert "[[" in capsys.readouterr().out
 
 
