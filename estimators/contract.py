@@ -155,9 +155,13 @@ def load(spec: str) -> type:
         raise ValueError(f"estimator {spec!r}: write module:Class or file.py:Class")
     try:
         if where.endswith(".py") or "/" in where:
+            from orchestrator.files import regular_file
+
             path = Path(where).resolve()
-            if not path.is_file():
+            if not path.exists():
                 raise ValueError(f"estimator {spec!r}: no file {path}")
+            regular_file(path, "the estimator's module", "give a Python file (file.py:Class)",
+                         label=f"estimator {spec!r}: {path}")
             module_name = f"quadcosim_user_{path.stem}"
             module = sys.modules.get(module_name)
             if module is None or getattr(module, "__file__", None) != str(path):

@@ -182,9 +182,12 @@ def load(path, rate: float | None = None) -> dict:
         shape, an empty CSV, a time column that does not increase, a ``meta`` that is not
         JSON, or no sampling rate: each names the problem and the fix.
     """
+    from orchestrator.files import regular_file
+
     path = Path(path)
-    if not path.exists():
+    if not path.exists() and not path.is_symlink():
         raise FileNotFoundError(f"no recording at {path}")
+    regular_file(path, "the recording", "give a .npz, .mat or .csv recording file")
     raw = _read_raw(path)
     out = {}
     for key in ("gyro", "acc", "mag"):

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.files import atomic_path, json_text
+from orchestrator.files import atomic_path, json_text, read_small_text, regular_file
 from orchestrator.fmu import nearest
 from orchestrator.signals import expand, matrix_shape, vector_groups
 
@@ -407,6 +407,7 @@ class Result:
         Result
             With its meta data (units and options included) and error message.
         """
+        regular_file(path, "a result", "give a run's results.npz (or its folder)")
         # the file opened here and closed here: NumPy leaves its own handle open on a damaged archive
         with open(path, "rb") as file, np.load(file) as archive:
             meta = json.loads(str(archive["_meta"]))
@@ -559,7 +560,8 @@ class StreamedResult(Result):
     def __init__(self, folder):
         folder = Path(folder)
         try:
-            meta = json.loads((folder / "meta.json").read_text())
+            meta = json.loads(read_small_text(folder / "meta.json", "a streamed record's meta.json",
+                                              "run the scenario again with --stream", error=DamagedRecord))
             names = meta.pop("names")
         except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
             raise DamagedRecord(f"{folder}: its meta.json is damaged ({type(error).__name__}: {error})") from None

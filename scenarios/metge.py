@@ -287,6 +287,7 @@ def build(o: dict) -> System:
         raise ValueError(f"settle = {o['settle']} s must be shorter than hold = {o['hold']} s")
     socs(o, 1), socs(o, 2)
     parse_orders(o["orders"])
+    load_static(o)  # read before the simulation: a file refused after it would waste the run
     if abs(round(1.0 / (o["mag_rate"] * o["dt"])) * o["mag_rate"] * o["dt"] - 1.0) > 1e-9:
         raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     clash = sorted(set(regime_settings(o)) & set(block_settings(o)))

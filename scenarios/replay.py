@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from estimators import estimate, kinds, parse_corrections, recording
-from orchestrator.files import write_text
+from orchestrator.files import read_small_text, write_text
 
 FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
 
@@ -223,7 +223,7 @@ def tp_recording(results_dir) -> dict:
     if not (results_dir / "metrics.json").exists() or not (results_dir / "results.npz").exists():
         raise ValueError(f"{results_dir} is not a tp results folder (no metrics.json and results.npz)")
     try:
-        metrics = json.loads((results_dir / "metrics.json").read_text())
+        metrics = json.loads(read_small_text(results_dir / "metrics.json", "the run's metrics.json", "run tp again"))
     except (OSError, ValueError) as error:
         raise ValueError(f"{results_dir}: metrics.json is not readable ({error}); run tp again") from None
     metrics = metrics if isinstance(metrics, dict) else {"scenario": None}

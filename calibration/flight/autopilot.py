@@ -199,16 +199,10 @@ def read_parameters(path) -> dict:
         The file is missing, not a regular file (a FIFO would block), too large, not text, or a
         line holds no ``NAME VALUE``; the message names the file, the line and the fix.
     """
-    import os
-    import stat
+    from orchestrator.files import regular_file
 
     path = Path(path)
-    try:
-        status = os.stat(path)
-    except OSError as error:
-        raise ValueError(f"{path}: cannot read the parameter file ({error.strerror})") from None
-    if not stat.S_ISREG(status.st_mode):
-        raise ValueError(f"{path}: not a regular file; give a parameter file (.parm or .params)")
+    status = regular_file(path, "the parameter file", "give a parameter file (.parm or .params)")
     if status.st_size > MAX_PARAMETER_BYTES:
         raise ValueError(f"{path}: {status.st_size / 1e6:.0f} MB, not a parameter file (.parm or .params)")
     try:
