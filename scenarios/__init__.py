@@ -65,6 +65,11 @@ class Option:
             if str(text).strip().lower() == self.marker:
                 return self.marker
             default = 0.0  # otherwise a number
+        if isinstance(text, (list, tuple, dict, set)) or text is None or \
+                (isinstance(text, bool) and not isinstance(default, bool)):
+            also = f" (or {self.marker})" if self.marker is not None else ""
+            raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}{also}: give one "
+                             f"value, such as {self.default!r}")
         try:
             if isinstance(default, bool):
                 if str(text).lower() in ("1", "true", "on", "yes"):
@@ -336,6 +341,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     from scenarios.outputs import RunFiles, remove_if_empty
 
     status(f"{name}: loading the scenario")
+    if isinstance(record, str):  # one signal named alone, not its characters
+        record = [record]
     files = None
     with first_only(), contextlib.ExitStack() as lock:  # the folder is this run's until it ends
         try:
