@@ -241,7 +241,45 @@ def adopt(estimator, period: int, q0=None, available=INPUTS) -> Block:
             block.q0 = _unit_quaternion(q0)
     check(block, available)
     block.name = "Quaternion_estim"
+    _guard(block)
     return block
+
+
+#: How far from 1 the norm of ``q_est`` may drift before the run is stopped (the contract: unit norm).
+NORM_TOLERANCE = 1e-3
+
+
+class ContractBroken(ValueError):
+    """An estimator's output broke the contract while the run went (a NaN, a quaternion off
+    unit norm); the message names the output, the time and the value."""
+
+    names_its_block = True  # the message says which estimator: no frame to add
+
+
+def _guard(block: Block) -> None:
+    """Check the contract at every step of ``block`` while the run goes: every required output
+    finite, ``q_est`` of unit norm (within :data:`NORM_TOLERANCE`). A filter that lets ``q``
+    grow would otherwise fly on, its run ``completed``, its angles meaningless."""
+    if getattr(block.step, "contract_guard", False):
+        return
+    inner = block.step
+    at = [list(block.outputs).index(name) for name in REQUIRED]
+    quaternion = at[Q]
+
+    def step(t, u, y):
+        inner(t, u, y)
+        values = y[at]
+        if not np.isfinite(values).all():
+            bad = REQUIRED[int(np.flatnonzero(~np.isfinite(values))[0])]
+            raise ContractBroken(f"estimator {label(block)}: {bad} = {y[at[REQUIRED.index(bad)]]} at t = {t:.4f} s; "
+                                 "every output must be a finite number at every step (estimators/contract.py)")
+        norm = float(np.sqrt(np.dot(y[quaternion], y[quaternion])))
+        if abs(norm - 1.0) > NORM_TOLERANCE:
+            raise ContractBroken(f"estimator {label(block)}: |q_est| = {norm:.6g} at t = {t:.4f} s; the contract "
+                                 f"asks for a unit quaternion (within {NORM_TOLERANCE:g}): normalise q in update")
+
+    step.contract_guard = True
+    block.step = step
 
 
 def _arguments(cls, offered: dict) -> dict:
