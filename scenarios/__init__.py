@@ -254,6 +254,9 @@ class Scenario:
             block = key.partition(".")[0]
             for name in values:
                 option = derived.get(f"{block}.{name}")
+                if option is not None and option.startswith("("):  # fixed by the scenario, no option
+                    raise ValueError(f"{block}.{name} is fixed by scenario {self.name} {option}: leave {key} "
+                                     "out of --set")
                 if option is not None:
                     raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
                                      f"use --set {option}=... instead of {key}")
@@ -483,7 +486,7 @@ def _divergence(scenario, result, options) -> dict:
     from scenarios.divergence import first_crossing, unchecked
 
     found = {}
-    missing = unchecked(result)
+    missing = unchecked(result, bounds)
     if missing:
         found["divergence_unchecked"] = missing
     crossing = first_crossing(result, bounds)

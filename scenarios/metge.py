@@ -41,6 +41,7 @@ from orchestrator.files import write_json
 from orchestrator.parameters import apply
 from orchestrator.progress import status
 from scenarios import Option, Scenario
+from scenarios.divergence import CLAMPED
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
@@ -594,7 +595,7 @@ def duration(o: dict) -> float:
 
 
 SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD, "derived": DERIVED})
+                    duration=duration, extra={"record": RECORD, "derived": DERIVED, "divergence": CLAMPED})
 
 
 # --- the rig calibration a closed loop's compensation uses (scenarios.compensation) -----
