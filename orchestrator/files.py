@@ -283,7 +283,11 @@ def atomic_path(path, size: int | None = None):
                 handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}",
                                                 dir=path.parent)
             except OSError as error:
-                raise _no_room(error, path, 0, size) from None
+                problem = _no_room(error, path, 0, size)
+                if problem is error:  # not a full disk: a folder that takes no file (/proc, a read-only mount)
+                    raise OutputRefused(f"{asked}: cannot create a file in {path.parent}/ ({error.strerror}); give "
+                                        "another path") from None
+                raise problem from None
             temporary = Path(name)
             os.close(handle)
         yield temporary
