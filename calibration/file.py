@@ -145,7 +145,7 @@ class Calibration:
         """Read the calibration file at ``path`` (JSON); refuse a malformed one, or one for another
         number of motors or other orders (when ``motors`` or ``orders`` is given), with a message
         naming the defect."""
-        from orchestrator.files import regular_file
+        from orchestrator.inputs import regular_file
 
         path = Path(path)
         fix = "give the JSON file `quadcosim run metge` or Calibration.save writes"

@@ -155,7 +155,7 @@ def load(spec: str) -> type:
         raise ValueError(f"estimator {spec!r}: write module:Class or file.py:Class")
     try:
         if where.endswith(".py") or "/" in where:
-            from orchestrator.files import regular_file
+            from orchestrator.inputs import regular_file
 
             path = Path(where).resolve()
             if not path.exists():

@@ -198,7 +198,7 @@ def load(path, rate: float | None = None) -> dict:
         shape, an empty CSV, a time column that does not increase, a ``meta`` that is not
         JSON, or no sampling rate: each names the problem and the fix.
     """
-    from orchestrator.files import regular_file
+    from orchestrator.inputs import regular_file
 
     path = Path(path)
     if not path.exists() and not path.is_symlink():

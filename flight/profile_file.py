@@ -73,7 +73,7 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
         a finite number, or times not strictly increasing; the message names the file, row and
         column.
     """
-    from orchestrator.files import regular_file
+    from orchestrator.inputs import regular_file
 
     path = Path(path)
     if not path.exists() and not path.is_symlink():

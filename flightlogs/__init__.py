@@ -63,7 +63,7 @@ def check_file(path) -> int:
     LogError
         Naming the file, what it is and the fix.
     """
-    from orchestrator.files import regular_file
+    from orchestrator.inputs import regular_file
 
     path = Path(path)
     status = regular_file(path, "the log", f"give a log file ({FORMATS}); copy a log streamed elsewhere to a file "

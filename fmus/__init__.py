@@ -18,6 +18,7 @@ import functools
 import os
 from pathlib import Path
 
+from fmus.folders import BuildFolderRefused, compiler_command, make_folder  # noqa: F401  (the package's names)
 from fmus.models import MODELS, model_variables  # noqa: F401  (the package's names)
 
 
@@ -102,7 +103,9 @@ def fmu_sources(name: str) -> list[Path]:
 _checked: set[Path] = set()  # FMUs found up to date by this process: checked once, not at every look-up
 
 
-def _stale(path: Path, name: str) -> bool:
+def stale(path: Path, name: str) -> bool:
+    """Whether the FMU file ``path`` of model ``name`` is missing or older than one of its
+    sources (:func:`fmu_sources`): to be built."""
     if not path.is_file():
         return True
     built = path.stat().st_mtime
@@ -117,10 +120,10 @@ def _build_on_first_use(name: str, path: Path) -> None:
 
     from fmus.build import build_fmu
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent, "the FMUs")
     with open(path.parent / ".build.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if _stale(path, name):  # another process may have built it meanwhile
+        if stale(path, name):  # another process may have built it meanwhile
             print(f"quadcosim: building the FMU {name} into {path.parent} (its sources are newer, or it is "
                   "not built yet)", file=sys.stderr, flush=True)
             build_fmu(name, path.parent)
@@ -149,7 +152,7 @@ def fmu_path(name: str) -> Path:
     """
     path = default_fmu_dir() / f"{name}.fmu"
     if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
-        if _stale(path, name):
+        if stale(path, name):
             _build_on_first_use(name, path)
         _checked.add(path)
     if not path.is_file():

@@ -16,6 +16,7 @@ import zipfile
 from pathlib import Path
 
 from fmus.airframe import c_header as airframe_header
+from fmus.folders import compiler_command, make_folder
 from fmus.models import MODELS, model_variables
 
 HERE = Path(__file__).resolve().parent
@@ -77,7 +78,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     BuildError
         The table is inconsistent (a vector's members apart, say) or the compiler refused.
     """
-    compiler = compiler or os.environ.get("CC", "cc")
+    compiler = compiler_command(compiler)
     stage = out_dir / model
     if stage.exists():
         shutil.rmtree(stage)
@@ -103,9 +104,13 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     (stage / "modelDescription.xml").write_text(description)
 
     library = binaries / f"{model}.so"
-    command = [compiler, *CFLAGS, "-shared", "-I", str(sources), "-o", str(library)]
+    command = [*compiler, *CFLAGS, "-shared", "-I", str(sources), "-o", str(library)]
     command += [str(sources / s) for s in SOURCE_FILES] + ["-lm"]
-    done = subprocess.run(command, capture_output=True, text=True)
+    try:
+        done = subprocess.run(command, capture_output=True, text=True)
+    except FileNotFoundError:
+        raise BuildError(f"no C compiler {compiler[0]!r} (from ${'CC' if os.environ.get('CC') else 'CC unset: cc'}); "
+                         "install one (e.g. gcc) or set $CC") from None
     if done.returncode != 0:
         raise BuildError(f"{model}: {' '.join(command)}\n{done.stderr}")
 
@@ -141,8 +146,7 @@ def build_all(out_dir: Path, models=MODELS, verbose: bool = True) -> list[Path]:
     list of pathlib.Path
         The ``.fmu`` files.
     """
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = make_folder(out_dir, "the FMUs")
     built = []
     for model in models:
         built.append(build_fmu(model, out_dir))

@@ -16,8 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.files import atomic_path, json_text, read_small_text, regular_file
+from orchestrator.files import atomic_path, json_text
 from orchestrator.fmu import nearest
+from orchestrator.inputs import read_small_text, regular_file
 from orchestrator.signals import expand, matrix_shape, vector_groups
 
 #: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.

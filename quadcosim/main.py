@@ -31,21 +31,31 @@ from pathlib import Path
 
 
 def _build(args) -> int:
-    from fmus import default_fmu_dir
+    from fmus import MODELS, BuildFolderRefused, default_fmu_dir, stale
     from fmus.build import BuildError, build_all
-    from orchestrator.calls import RunnerBuildError, build_runner
+    from orchestrator.calls import LIBRARY_NAME, SOURCE, RunnerBuildError, build_runner, runner_dir
 
     try:
-        build_all(args.out or default_fmu_dir())
-        print(f"built {build_runner()}")
+        out = Path(args.out or default_fmu_dir())
+        todo = [m for m in MODELS if args.force or stale(out / f"{m}.fmu", m)]
+        build_all(out, todo)
+        if len(todo) < len(MODELS):
+            print(f"up to date (no source newer): {', '.join(m for m in MODELS if m not in todo)} in {out}/ "
+                  "(--force builds them again)")
+        library = runner_dir() / LIBRARY_NAME
+        if args.force or not library.is_file() or library.stat().st_mtime < SOURCE.stat().st_mtime:
+            print(f"built {build_runner()}")
+        else:
+            print(f"up to date {library}")
         from benchmarks import build_references
 
         for library in build_references():
             print(f"built {library}")
-        from scenarios.compiled import compile_all
+        from scenarios import compiled
 
-        print(f"compiled the numba steps in {compile_all():.1f} s")
-    except (BuildError, RunnerBuildError) as error:
+        seconds = compiled.compile_all()
+        print(f"{'compiled' if compiled.compiled_any() else 'loaded'} the numba steps in {seconds:.1f} s")
+    except (BuildError, RunnerBuildError, BuildFolderRefused) as error:
         print(error, file=sys.stderr)
         return 1
     return 0
@@ -316,6 +326,7 @@ def parser() -> argparse.ArgumentParser:
                            "references (into build/ in a source checkout, a per-user cache when installed; a run "
                            "builds what it needs on first use)")
     build.add_argument("--out", default=None, help="output folder of the FMUs (default: fmus/ in the build folder)")
+    build.add_argument("--force", action="store_true", help="build again even what no source change made stale")
     build.set_defaults(func=_build)
     listing = sub.add_parser("list", help="the scenarios and their options")
     listing.add_argument("--parameters", metavar="MODEL",

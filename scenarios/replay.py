@@ -44,7 +44,8 @@ from pathlib import Path
 import numpy as np
 
 from estimators import estimate, kinds, parse_corrections, recording
-from orchestrator.files import read_small_text, write_text
+from orchestrator.files import write_text
+from orchestrator.inputs import read_small_text
 
 FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
 

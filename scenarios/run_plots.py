@@ -12,7 +12,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from orchestrator.files import figure_file, printable, read_small_text, save_figure
+from orchestrator.files import figure_file, printable, save_figure
+from orchestrator.inputs import read_small_text
 from scenarios.output_options import free_file
 
 RESULTS_FILE = "results.npz"

@@ -199,7 +199,7 @@ def read_parameters(path) -> dict:
         The file is missing, not a regular file (a FIFO would block), too large, not text, or a
         line holds no ``NAME VALUE``; the message names the file, the line and the fix.
     """
-    from orchestrator.files import regular_file
+    from orchestrator.inputs import regular_file
 
     path = Path(path)
     status = regular_file(path, "the parameter file", "give a parameter file (.parm or .params)")

@@ -13,7 +13,7 @@ from conftest import ROOT
 
 from calibration import Calibration
 from calibration.static import CalibrationError
-from orchestrator.files import regular_file
+from orchestrator.inputs import regular_file
 
 #: Seconds a refusal may take: the process starts, imports and reads the options; never a hang.
 LIMIT_S = 120
