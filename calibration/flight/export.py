@@ -108,8 +108,8 @@ def _check_scored(path, parts, params: dict, rule) -> None:
     if not size <= MAX_FIELD_RATIO * raw:
         largest = max(params, key=lambda k: abs(params[k]))
         raise ValueError(f"{path}: with its parameters the firmware would report a field of {size * 1e6:.3g} uT, "
-                         f"{MAX_FIELD_RATIO:g}x beyond the log's raw {raw * 1e6:.3g} uT: no calibration gives that "
-                         f"(its largest value: {largest} = {params[largest]:g}); fix the file")
+                         f"more than {MAX_FIELD_RATIO:g} times the log's raw {raw * 1e6:.3g} uT: no calibration gives "
+                         f"that (its largest value: {largest} = {params[largest]:g}); fix the file")
 
 
 @dataclass
