@@ -64,7 +64,7 @@ INPUTS = MEASUREMENTS + R_REEL
 REQUIRED = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "theta_est3",
             "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z")
 # where AttitudeEstimator reads its inputs and writes its outputs (the order of the names above)
-ACC, GYRO, MAG = slice(0, 3), slice(3, 6), slice(6, 9)
+ACC, GYRO, MAG, REEL = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 18)
 Q, THETA, BIAS, OMEGA = slice(0, 4), slice(4, 7), slice(7, 10), slice(10, 13)
 UNITS = {**dict.fromkeys(REQUIRED[Q], "1"), **dict.fromkeys(REQUIRED[THETA], "rad"),
          **dict.fromkeys(REQUIRED[BIAS] + REQUIRED[OMEGA], "rad/s")}
@@ -96,6 +96,10 @@ class AttitudeEstimator(Block):
     def __init__(self, name: str = "Quaternion_estim", period: int = 1, q0=None):
         super().__init__(name, period)
         self.q0 = None if q0 is None else _unit_quaternion(q0)
+        # a filter fed the true rotation (the lab's passive filter) declares it: update(acc, gyro, mag, R_reel)
+        self.reads_reel = "R_reel" in inspect.signature(self.update).parameters
+        if self.reads_reel:
+            self.inputs = MEASUREMENTS + R_REEL
 
     def start(self, t0, dt):
         """Reset: ``self.q`` to ``q0``, ``self.bias`` to zero.
@@ -114,6 +118,11 @@ class AttitudeEstimator(Block):
     def update(self, acc: np.ndarray, gyro: np.ndarray, mag: np.ndarray) -> None:
         """Advance ``self.q`` (and ``self.bias``) by one sample.
 
+        A filter fed the true attitude (as the lab's passive filter was) declares a fourth
+        parameter, ``update(self, acc, gyro, mag, R_reel)``: the block then reads the IMU's
+        ``R_reel_11 .. R_reel_33`` and passes them as a (3, 3) array, the true rotation body to
+        NED.
+
         Parameters
         ----------
         acc : (3,) array
@@ -126,7 +135,10 @@ class AttitudeEstimator(Block):
         raise NotImplementedError(f"{type(self).__name__} must implement update(acc, gyro, mag)")
 
     def step(self, t, u, y):
-        self.update(u[ACC], u[GYRO], u[MAG])
+        if self.reads_reel:
+            self.update(u[ACC], u[GYRO], u[MAG], u[REEL].reshape(3, 3))
+        else:
+            self.update(u[ACC], u[GYRO], u[MAG])
         y[Q] = self.q
         euler_from_quaternion(self.q, y[THETA])
         y[BIAS] = self.bias

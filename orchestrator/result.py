@@ -178,6 +178,11 @@ class Result:
         """
         members = expand(name, self.names)
         if not members:
+            left_out = [n for n in self.meta.get("left_out") or [] if n == name or n.startswith(name + "_")]
+            if left_out:
+                raise KeyError(f"no recorded signal {name!r}: the scenario left it out of its result files (it "
+                               "follows from the signals kept); run it with --record all (record=['all'] from "
+                               "Python) to keep it")
             raise KeyError(f"no recorded signal {name!r}.{nearest(name, self.names)}")
         return members
 

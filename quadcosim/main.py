@@ -217,7 +217,8 @@ def _run_reporting(args) -> int:
     _print_warnings(warnings)
     figures = [name for name in metrics.get("figures") or [] if isinstance(name, str)]
     drawn = [p.name for p in sorted(out.glob("diagram.*"))] + figures
-    print(f"results ({', '.join(formats)}), metrics.json" + (f" and {', '.join(drawn)}" if drawn else "")
+    record = "the record streamed (results.stream/)" if args.stream else f"results ({', '.join(formats)})"
+    print(f"{record}, metrics.json" + (f" and {', '.join(drawn)}" if drawn else "")
           + f" in {out}/" + (" (no report figures: see report above)" if "report" in metrics else ""))
     if metrics.get("status") == "diverged":  # warned above, naming the settings
         print(f"quadcosim run {args.scenario}: the run diverged (metrics.json: status diverged); its record and "
@@ -314,13 +315,23 @@ def _bench(args) -> int:
                       + (["--out", args.out] if args.out else []))
 
 
+def _version() -> str:
+    """The installed package's version (pyproject.toml's), or ``unknown`` outside an installation."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("quadcosim")
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed: pip install -e .)"
+
+
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
     import studies  # noqa: F401  (registers the studies' scenarios in the catalogue the verbs read)
     from scenarios.shown import PlainHelp
 
-    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
-                                formatter_class=PlainHelp)
+    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__, formatter_class=PlainHelp)
+    p.add_argument("--version", action="version", version=f"quadcosim {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
                            "references (into build/ in a source checkout, a per-user cache when installed; a run "

@@ -439,6 +439,8 @@ def _run_phases(scenario: Scenario, options: Options, base: dict, files, request
             files.refused()
         raise
     result.meta |= {"scenario": {"name": name, "options": base["options"]}, "faults": base["injected_faults"]}
+    if base.get("signals_not_saved"):  # named in the files, so that asking for one says how to keep it
+        result.meta["left_out"] = base["signals_not_saved"]
     metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
                       "fmu_warnings": _warning_counts(result)}
     metrics |= _divergence(scenario, result, options)

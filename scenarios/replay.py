@@ -229,8 +229,10 @@ def tp_recording(results_dir) -> dict:
     from scenarios.tp import estimator_gains, initial_state
 
     results_dir = Path(results_dir)
-    if not (results_dir / "metrics.json").exists() or not (results_dir / "results.npz").exists():
-        raise ValueError(f"{results_dir} is not a tp results folder (no metrics.json and results.npz)")
+    stream = results_dir / "results.stream"
+    if not (results_dir / "metrics.json").exists() or not ((results_dir / "results.npz").exists() or stream.is_dir()):
+        raise ValueError(f"{results_dir} is not a tp results folder (no metrics.json beside a results.npz or a "
+                         "results.stream/)")
     try:
         metrics = json.loads(read_small_text(results_dir / "metrics.json", "the run's metrics.json", "run tp again"))
     except (OSError, ValueError) as error:
@@ -240,9 +242,9 @@ def tp_recording(results_dir) -> dict:
     if metrics.get("scenario", "tp") != "tp" or "estimator" not in o:
         raise ValueError(f"{results_dir} holds a {metrics.get('scenario')!r} run, not a tp run")
     try:
-        result = Result.from_npz(results_dir / "results.npz")
+        result = Result.load(results_dir)  # its results.npz, or the record it streamed
     except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
-        raise ValueError(f"{results_dir}: the run's results.npz is not readable ({error}); run tp again") from None
+        raise ValueError(f"{results_dir}: the run's record is not readable ({error}); run tp again") from None
     if round(1.0 / (o["imu_rate"] * o["dt"])) != 1:
         raise ValueError("the estimator of this run ran slower than the macro step: its samples are not the "
                          "recorded ones; run tp with imu_rate = 1/dt")
