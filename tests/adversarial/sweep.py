@@ -36,7 +36,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
-LOGS = ROOT.parent / "shared" / "data" / "flightlogs"
+LOGS = Path(os.environ.get("QUADCOSIM_FLIGHT_LOGS") or ROOT.parent / "shared" / "data" / "flightlogs")
 IN_PROCESS_LIMIT_S = 120
 PROCESS_LIMIT_S = 240
 EXITS = {0, 1, 2, 130, 143}
