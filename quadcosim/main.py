@@ -65,7 +65,7 @@ def _list(args) -> int:
     if args.parameters:
         from fmus import MODELS
         from fmus.build import table
-        from scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines
+        from scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines, scenario_lines
 
         if args.parameters in PYTHON_BLOCKS:
             print("\n".join(parameter_lines(args.parameters)))
@@ -88,6 +88,7 @@ def _list(args) -> int:
             print(f"  {alias} stands for the vector {name}")
         for switch, governed in switched.items():
             print(f"  {', '.join(governed)} act only while {switch} is true")
+        print("\n".join(scenario_lines(args.parameters)))
         return 0
     import scenarios
 

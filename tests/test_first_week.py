@@ -70,3 +70,14 @@ def test_an_attitude_estimator_can_read_the_true_rotation():
     assert metrics["status"] == "completed"
     error = np.asarray(result["Quaternion_estim.theta_est"]) - np.asarray(result["Quadrotor.theta"])
     assert np.abs(error[1:]).max() < 1e-9  # the first sample precedes the first IMU reading
+
+
+def test_list_parameters_shows_what_each_scenario_sets(capsys):
+    """tp runs the IMU with noise off (its option noise), which the FMU's own default (on) hides."""
+    assert main(["list", "--parameters", "IMU"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"noise_enabled +  = True", out)  # the FMU's default, as before
+    assert "IMU parameters the scenarios set from their options" in out
+    assert "  tp: noise_enabled <- option noise (default False); bias_enabled <- option bias (default False)" in out
+    assert main(["list", "--parameters", "Quadrotor"]) == 0
+    assert "  metge: clamped <- (the rig)" in capsys.readouterr().out
