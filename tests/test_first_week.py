@@ -81,3 +81,25 @@ def test_list_parameters_shows_what_each_scenario_sets(capsys):
     assert "  tp: noise_enabled <- option noise (default False); bias_enabled <- option bias (default False)" in out
     assert main(["list", "--parameters", "Quadrotor"]) == 0
     assert "  metge: clamped <- (the rig)" in capsys.readouterr().out
+
+
+def test_the_testing_guide_says_when_parallel_workers_pay():
+    """-n 2 was recommended flat; on two cores the guide's own example ran slower with it."""
+    text = " ".join((ROOT / "docs" / "guides" / "testing.md").read_text().split())
+    assert "When it pays: only when the suite runs much longer in series than a worker takes to start" in text
+    assert "slower with `-n 2` than without on a two-core machine" in text
+
+
+def test_the_docs_pages_keep_no_empty_section_navigation():
+    """Every page is a child of the index alone: the primary sidebar would be an empty column
+    (430 px of a 1280 px window); long commands and table cells wrap."""
+    namespace = {"__file__": str(ROOT / "docs" / "conf.py")}
+    source = (ROOT / "docs" / "conf.py").read_text()
+    exec(compile(source.split("# equations as MathML")[0], "conf.py", "exec"), namespace)
+    sidebars = namespace["html_sidebars"]
+    assert sidebars["**"] == []
+    nested = sorted(p.stem for p in (ROOT / "docs").glob("*.md") if "toctree" in p.read_text() and p.stem != "index")
+    assert nested == ["notebooks"]  # the one section of pages of its own: its pages keep their navigation
+    assert sidebars["notebooks"] == sidebars["_generated/notebooks/*"] == ["sidebar-nav-bs"]
+    css = (ROOT / "docs" / "_static" / "layout.css").read_text()
+    assert "white-space: pre-wrap" in css and "overflow-wrap: anywhere" in css
