@@ -496,7 +496,19 @@ def entry() -> None:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
         code = 128 + signal.SIGPIPE  # as a program that the pipe's signal ended
+    import signal
+
+    for number in (signal.SIGINT, signal.SIGTERM):  # the work is done: a signal now ends the exit at once
+        signal.signal(number, _ended_while_leaving)
     leave(code)
+
+
+def _ended_while_leaving(number, frame):
+    """A signal after the command finished, while the process exits: leave at once with the
+    interrupted code (128 + the signal), rather than die by it (SIGTERM's default) or print a
+    KeyboardInterrupt traceback from an exit handler (SIGINT's)."""
+    sys.stderr.flush()
+    os._exit(128 + number)
 
 
 if __name__ == "__main__":
