@@ -36,17 +36,6 @@ nb_execution_timeout = 300
 nb_execution_in_temp = True
 # the kernel draws inline figures whatever backend the build's environment names (CI's Agg)
 os.environ["MPLBACKEND"] = "module://matplotlib_inline.backend_inline"
-
-
-def _kernels_over_ipc():
-    """Start the notebooks' kernels on local sockets (IPC) rather than TCP: a kernel on TCP without
-    CurveZMQ keys warns on every notebook that its traffic is unencrypted."""
-    from jupyter_client.manager import KernelManager
-
-    KernelManager.transport.default_value = "ipc"
-
-
-_kernels_over_ipc()
 myst_heading_anchors = 3
 # pages include sections of the front page, whose headings start at level 2
 suppress_warnings = ["myst.header", "myst.xref_missing"]
