@@ -19,7 +19,8 @@ html_title = "quadcosim"
 html_theme_options = {"navigation_depth": 2, "show_toc_level": 2}
 # every page but the notebooks is a child of the index alone: its primary sidebar ("Section
 # Navigation") would be empty, and would still take a column of the page (the header lists the pages)
-html_sidebars = {"**": [], "notebooks": ["sidebar-nav-bs"], "_generated/notebooks/*": ["sidebar-nav-bs"]}
+html_sidebars = {"*": [], "guides/*": [], "_generated/*": [], "notebooks": ["sidebar-nav-bs"],
+                 "_generated/notebooks/*": ["sidebar-nav-bs"]}
 myst_enable_extensions = ["colon_fence", "dollarmath"]
 # equations as MathML, made at build time (docs/_ext): they show offline, with no script
 html_math_renderer = "mathml"

@@ -486,20 +486,23 @@ def entry() -> None:
     # spins it at load, CPU a command spends for nothing on its small matrices. A user's setting
     # wins; a program that imports this module is left as it is.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    from orchestrator.interrupts import leave
-
-    try:
-        code = main()
-        sys.stdout.flush()  # here, not at exit: a reader gone (| head) is then seen below
-    except BrokenPipeError:  # the reader of our output left (quadcosim list | head -1): no traceback
-        import signal
-
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
-        code = 128 + signal.SIGPIPE  # as a program that the pipe's signal ended
     import signal
 
-    for number in (signal.SIGINT, signal.SIGTERM):  # the work is done: a signal now ends the exit at once
-        signal.signal(number, _ended_while_leaving)
+    from orchestrator.interrupts import exit_code, leave
+
+    # SIGTERM's handler outside main's own: main restores it when it returns, and a signal then
+    # (the command's work done) ends the process at once with 143, never by SIGTERM's default
+    signal.signal(signal.SIGTERM, _ended_while_leaving)
+    try:
+        code = main()
+        signal.signal(signal.SIGINT, _ended_while_leaving)
+        sys.stdout.flush()  # here, not at exit: a reader gone (| head) is then seen below
+    except BrokenPipeError:  # the reader of our output left (quadcosim list | head -1): no traceback
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
+        code = 128 + signal.SIGPIPE  # as a program that the pipe's signal ended
+    except KeyboardInterrupt as interrupt:  # Ctrl-C as main returned: its work is done or was refused
+        code = exit_code(interrupt)
+    signal.signal(signal.SIGINT, _ended_while_leaving)
     leave(code)
 
 
