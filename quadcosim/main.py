@@ -493,8 +493,9 @@ def entry() -> None:
     # SIGTERM's handler outside main's own: main restores it when it returns, and a signal then
     # (the command's work done) ends the process at once with 143, never by SIGTERM's default
     signal.signal(signal.SIGTERM, _ended_while_leaving)
+    global _leaving_code
     try:
-        code = main()
+        code = _leaving_code = main()
         signal.signal(signal.SIGINT, _ended_while_leaving)
         sys.stdout.flush()  # here, not at exit: a reader gone (| head) is then seen below
     except BrokenPipeError:  # the reader of our output left (quadcosim list | head -1): no traceback
@@ -502,16 +503,22 @@ def entry() -> None:
         code = 128 + signal.SIGPIPE  # as a program that the pipe's signal ended
     except KeyboardInterrupt as interrupt:  # Ctrl-C as main returned: its work is done or was refused
         code = exit_code(interrupt)
+    _leaving_code = code
     signal.signal(signal.SIGINT, _ended_while_leaving)
-    leave(code)
+    leave(code, at_once=True)
+
+
+#: The command's exit code once :func:`main` returned (None before).
+_leaving_code = None
 
 
 def _ended_while_leaving(number, frame):
     """A signal after the command finished, while the process exits: leave at once with the
-    interrupted code (128 + the signal), rather than die by it (SIGTERM's default) or print a
-    KeyboardInterrupt traceback from an exit handler (SIGINT's)."""
+    command's own code (its work is done; 128 + the signal if main had not yet returned), rather
+    than die by it (SIGTERM's default) or print a KeyboardInterrupt traceback from an exit handler
+    (SIGINT's)."""
     sys.stderr.flush()
-    os._exit(128 + number)
+    os._exit(_leaving_code if _leaving_code is not None else 128 + number)
 
 
 if __name__ == "__main__":
