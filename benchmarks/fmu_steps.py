@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks import SOURCES, libraries_dir, reference_library
+from fmus import compiler_command, make_folder
 
 MODELS = ("MotorMagnetics", "Quadrotor", "IMU")
 PARAMETERS = {"IMU": {"noise_enabled": True, "bias_enabled": True}}  # as in the closed-loop benchmark
@@ -55,10 +56,10 @@ def equations_library(model: str) -> ctypes.CDLL:
     library = libraries_dir() / f"libequations_{model}.so"
     newest = max(path.stat().st_mtime for path in [*sources, *staged.glob("*.h")])
     if not library.is_file() or library.stat().st_mtime < newest:
-        library.parent.mkdir(parents=True, exist_ok=True)
+        make_folder(library.parent, "the benchmarks' C references")
         handle, partial = tempfile.mkstemp(prefix=f".equations_{model}-", suffix=".so", dir=library.parent)
         os.close(handle)
-        command = [os.environ.get("CC", "cc"), *CFLAGS, "-shared", "-I", str(staged), "-o", partial,
+        command = [*compiler_command(), *CFLAGS, "-shared", "-I", str(staged), "-o", partial,
                    *map(str, sources), "-lm"]
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode:

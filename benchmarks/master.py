@@ -256,6 +256,14 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=3, help="measurements of each loop")
     parser.add_argument("--out", help="also draw the figures: a PNG, SVG or PDF file, or a folder (bench.png)")
     args = parser.parse_args(argv)
+    if not MIN_SECONDS <= args.seconds <= MAX_SECONDS:  # NaN too
+        print(f"quadcosim bench: --seconds {args.seconds:g}: give the simulated time of each timed run, from "
+              f"{MIN_SECONDS:g} s ({MIN_SECONDS / 1e-3:g} macro steps) to {MAX_SECONDS:g} s (default 5)",
+              file=sys.stderr)
+        return 2
+    if args.repeats < 1:
+        print(f"quadcosim bench: --repeats {args.repeats}: give 1 or more", file=sys.stderr)
+        return 2
     path = None
     if args.out:
         from orchestrator.files import OutputRefused, figure_file
@@ -272,8 +280,16 @@ def main(argv=None) -> int:
         for key, value in figures.items():
             print(f"{key:28s} {value:12.4g}" if isinstance(value, float) else f"{key:28s} {value}")
     if path is not None:
-        print(f"figure: {draw(figures, path)}", file=sys.stderr if args.json else sys.stdout)
+        try:
+            print(f"figure: {draw(figures, path)}", file=sys.stderr if args.json else sys.stdout)
+        except (OSError, ValueError) as error:  # a disk that filled: the figures above are the measurement
+            print(f"quadcosim bench: the figure was not written: {error}", file=sys.stderr)
+            return 1
     return 0
+
+
+#: The range of ``--seconds``: at least enough macro steps for a time per step, at most an hour.
+MIN_SECONDS, MAX_SECONDS = 0.01, 3600.0
 
 
 #: The loops :func:`draw` sets side by side: label, the orchestrator's key, the C reference's key.

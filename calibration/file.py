@@ -34,6 +34,8 @@ from calibration.identify import MotorDynamics
 from calibration.static import CalibrationError, StaticCalibration
 
 FORMAT = "quadcosim-magnetometer-calibration"
+#: The largest calibration file read (bytes): one holds a few kB of coefficients.
+MAX_CALIBRATION_BYTES = 16_000_000
 VERSION = 1
 
 
@@ -143,7 +145,14 @@ class Calibration:
         """Read the calibration file at ``path`` (JSON); refuse a malformed one, or one for another
         number of motors or other orders (when ``motors`` or ``orders`` is given), with a message
         naming the defect."""
+        from orchestrator.inputs import regular_file
+
         path = Path(path)
+        fix = "give the JSON file `quadcosim run metge` or Calibration.save writes"
+        size = regular_file(path, "the calibration file", fix, CalibrationError).st_size
+        if size > MAX_CALIBRATION_BYTES:
+            raise CalibrationError(f"{path}: {size / 1e6:.0f} MB, not a calibration file (at most "
+                                   f"{MAX_CALIBRATION_BYTES / 1e6:.0f} MB); {fix}")
         try:
             text = path.read_text(encoding="utf-8")
         except OSError as error:

@@ -17,11 +17,15 @@ exclude_patterns = ["_build", "_generated/runs"]
 html_theme = "pydata_sphinx_theme"
 html_title = "quadcosim"
 html_theme_options = {"navigation_depth": 2, "show_toc_level": 2}
+# every page but the notebooks is a child of the index alone: its primary sidebar ("Section
+# Navigation") would be empty, and would still take a column of the page (the header lists the pages)
+html_sidebars = {"*": [], "guides/*": [], "_generated/*": [], "notebooks": ["sidebar-nav-bs"],
+                 "_generated/notebooks/*": ["sidebar-nav-bs"]}
 myst_enable_extensions = ["colon_fence", "dollarmath"]
 # equations as MathML, made at build time (docs/_ext): they show offline, with no script
 html_math_renderer = "mathml"
 html_static_path = ["_static"]
-html_css_files = ["mathml.css"]
+html_css_files = ["mathml.css", "layout.css"]
 # The notebooks (notebooks/*.py, made .ipynb in _generated/notebooks/ when the build starts) run
 # once, into a cache under _build/ that tests/test_notebooks.py reads: a notebook is executed
 # again only when its code changes (or the cache is cleared, as on a fresh clone).

@@ -64,7 +64,7 @@ INPUTS = MEASUREMENTS + R_REEL
 REQUIRED = ("q_est0", "q_est1", "q_est2", "q_est3", "theta_est1", "theta_est2", "theta_est3",
             "b_est_x", "b_est_y", "b_est_z", "omega_est_x", "omega_est_y", "omega_est_z")
 # where AttitudeEstimator reads its inputs and writes its outputs (the order of the names above)
-ACC, GYRO, MAG = slice(0, 3), slice(3, 6), slice(6, 9)
+ACC, GYRO, MAG, REEL = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 18)
 Q, THETA, BIAS, OMEGA = slice(0, 4), slice(4, 7), slice(7, 10), slice(10, 13)
 UNITS = {**dict.fromkeys(REQUIRED[Q], "1"), **dict.fromkeys(REQUIRED[THETA], "rad"),
          **dict.fromkeys(REQUIRED[BIAS] + REQUIRED[OMEGA], "rad/s")}
@@ -96,6 +96,10 @@ class AttitudeEstimator(Block):
     def __init__(self, name: str = "Quaternion_estim", period: int = 1, q0=None):
         super().__init__(name, period)
         self.q0 = None if q0 is None else _unit_quaternion(q0)
+        # a filter fed the true rotation (the lab's passive filter) declares it: update(acc, gyro, mag, R_reel)
+        self.reads_reel = "R_reel" in inspect.signature(self.update).parameters
+        if self.reads_reel:
+            self.inputs = MEASUREMENTS + R_REEL
 
     def start(self, t0, dt):
         """Reset: ``self.q`` to ``q0``, ``self.bias`` to zero.
@@ -114,6 +118,11 @@ class AttitudeEstimator(Block):
     def update(self, acc: np.ndarray, gyro: np.ndarray, mag: np.ndarray) -> None:
         """Advance ``self.q`` (and ``self.bias``) by one sample.
 
+        A filter fed the true attitude (as the lab's passive filter was) declares a fourth
+        parameter, ``update(self, acc, gyro, mag, R_reel)``: the block then reads the IMU's
+        ``R_reel_11 .. R_reel_33`` and passes them as a (3, 3) array, the true rotation body to
+        NED.
+
         Parameters
         ----------
         acc : (3,) array
@@ -126,7 +135,10 @@ class AttitudeEstimator(Block):
         raise NotImplementedError(f"{type(self).__name__} must implement update(acc, gyro, mag)")
 
     def step(self, t, u, y):
-        self.update(u[ACC], u[GYRO], u[MAG])
+        if self.reads_reel:
+            self.update(u[ACC], u[GYRO], u[MAG], u[REEL].reshape(3, 3))
+        else:
+            self.update(u[ACC], u[GYRO], u[MAG])
         y[Q] = self.q
         euler_from_quaternion(self.q, y[THETA])
         y[BIAS] = self.bias
@@ -155,9 +167,13 @@ def load(spec: str) -> type:
         raise ValueError(f"estimator {spec!r}: write module:Class or file.py:Class")
     try:
         if where.endswith(".py") or "/" in where:
+            from orchestrator.inputs import regular_file
+
             path = Path(where).resolve()
-            if not path.is_file():
+            if not path.exists():
                 raise ValueError(f"estimator {spec!r}: no file {path}")
+            regular_file(path, "the estimator's module", "give a Python file (file.py:Class)",
+                         label=f"estimator {spec!r}: {path}")
             module_name = f"quadcosim_user_{path.stem}"
             module = sys.modules.get(module_name)
             if module is None or getattr(module, "__file__", None) != str(path):
@@ -237,7 +253,45 @@ def adopt(estimator, period: int, q0=None, available=INPUTS) -> Block:
             block.q0 = _unit_quaternion(q0)
     check(block, available)
     block.name = "Quaternion_estim"
+    _guard(block)
     return block
+
+
+#: How far from 1 the norm of ``q_est`` may drift before the run is stopped (the contract: unit norm).
+NORM_TOLERANCE = 1e-3
+
+
+class ContractBroken(ValueError):
+    """An estimator's output broke the contract while the run went (a NaN, a quaternion off
+    unit norm); the message names the output, the time and the value."""
+
+    names_its_block = True  # the message says which estimator: no frame to add
+
+
+def _guard(block: Block) -> None:
+    """Check the contract at every step of ``block`` while the run goes: every required output
+    finite, ``q_est`` of unit norm (within :data:`NORM_TOLERANCE`). A filter that lets ``q``
+    grow would otherwise fly on, its run ``completed``, its angles meaningless."""
+    if getattr(block.step, "contract_guard", False):
+        return
+    inner = block.step
+    at = [list(block.outputs).index(name) for name in REQUIRED]
+    quaternion = at[Q]
+
+    def step(t, u, y):
+        inner(t, u, y)
+        values = y[at]
+        if not np.isfinite(values).all():
+            bad = REQUIRED[int(np.flatnonzero(~np.isfinite(values))[0])]
+            raise ContractBroken(f"estimator {label(block)}: {bad} = {y[at[REQUIRED.index(bad)]]} at t = {t:.4f} s; "
+                                 "every output must be a finite number at every step (estimators/contract.py)")
+        norm = float(np.sqrt(np.dot(y[quaternion], y[quaternion])))
+        if abs(norm - 1.0) > NORM_TOLERANCE:
+            raise ContractBroken(f"estimator {label(block)}: |q_est| = {norm:.6g} at t = {t:.4f} s; the contract "
+                                 f"asks for a unit quaternion (within {NORM_TOLERANCE:g}): normalise q in update")
+
+    step.contract_guard = True
+    block.step = step
 
 
 def _arguments(cls, offered: dict) -> dict:

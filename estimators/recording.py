@@ -125,8 +125,12 @@ def _read_raw(path: Path) -> dict:
 def _rows(path, key: str, value, width: int) -> np.ndarray:
     """The array ``key`` as (N, width) samples in rows; a transposed (width, N) one is refused, not reshaped."""
     try:
+        if np.iscomplexobj(value):  # numpy would drop the imaginary part with a warning alone
+            raise ValueError(f"{path}: {key} holds complex numbers; a recording holds real samples")
         array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError) as error:
+        if "complex" in str(error):
+            raise
         raise ValueError(f"{path}: {key} is not numeric") from None
     if array.ndim == 2 and array.shape[0] == width and array.shape[1] != width:
         raise ValueError(f"{path}: {key} is stored {array.shape[0]} x {array.shape[1]}, transposed; store it with "
@@ -134,6 +138,18 @@ def _rows(path, key: str, value, width: int) -> np.ndarray:
     if array.ndim != 2 or array.shape[1] != width:
         raise ValueError(f"{path}: {key} must be an (N, {width}) array, one sample per row, not shape {array.shape}")
     return np.ascontiguousarray(array)
+
+
+def _scored(path, value) -> np.ndarray:
+    """The ``scored`` flags: booleans, or numbers 0 and 1 (a CSV's); text is refused (any
+    non-empty string would read as true)."""
+    array = np.asarray(value).reshape(-1)
+    if array.dtype.kind == "b":
+        return array
+    if array.dtype.kind not in "iuf" or not np.isin(array, (0, 1)).all():
+        shown = array[0] if array.dtype.kind not in "iuf" else array[~np.isin(array, (0, 1))][0]
+        raise ValueError(f"{path}: scored holds {shown!r}; it flags each sample with true/false or 1/0")
+    return array.astype(bool)
 
 
 def _meta(path, raw) -> dict:
@@ -182,9 +198,12 @@ def load(path, rate: float | None = None) -> dict:
         shape, an empty CSV, a time column that does not increase, a ``meta`` that is not
         JSON, or no sampling rate: each names the problem and the fix.
     """
+    from orchestrator.inputs import regular_file
+
     path = Path(path)
-    if not path.exists():
+    if not path.exists() and not path.is_symlink():
         raise FileNotFoundError(f"no recording at {path}")
+    regular_file(path, "the recording", "give a .npz, .mat or .csv recording file")
     raw = _read_raw(path)
     out = {}
     for key in ("gyro", "acc", "mag"):
@@ -198,7 +217,7 @@ def load(path, rate: float | None = None) -> dict:
     quat = _first(raw, "quat")
     out["quat"] = None if quat is None else _rows(path, "quat", quat, 4)
     scored = _first(raw, "scored")
-    out["scored"] = None if scored is None else np.asarray(scored).reshape(-1).astype(bool)
+    out["scored"] = None if scored is None else _scored(path, scored)
     out["rate"] = _rate(path, raw, rate)
     out["meta"] = _meta(path, raw)
     return out

@@ -73,14 +73,16 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
         a finite number, or times not strictly increasing; the message names the file, row and
         column.
     """
+    from orchestrator.inputs import regular_file
+
     path = Path(path)
-    if not path.exists():
+    if not path.exists() and not path.is_symlink():
         raise ValueError(f"flight={path}: no such file (a setpoint profile is a CSV file with a header row; "
                          "see flight/profile_file.py)")
-    if not path.is_file():  # a FIFO would block the read, a folder cannot be read
-        raise ValueError(f"flight={path}: not a regular file; a setpoint profile is a CSV file with a header row")
-    if path.stat().st_size > MAX_PROFILE_BYTES:
-        raise ValueError(f"flight={path}: {path.stat().st_size / BYTES_PER_MB:.0f} MB, not a setpoint profile (a CSV "
+    size = regular_file(path, "the setpoint profile", "a setpoint profile is a CSV file with a header row",
+                        label=f"flight={path}").st_size
+    if size > MAX_PROFILE_BYTES:
+        raise ValueError(f"flight={path}: {size / BYTES_PER_MB:.0f} MB, not a setpoint profile (a CSV "
                          f"of at most {MAX_PROFILE_BYTES / BYTES_PER_MB:.0f} MB)")
     try:
         # utf-8-sig: a spreadsheet's "CSV UTF-8" begins with a byte-order mark, not part of the header

@@ -63,22 +63,11 @@ def check_file(path) -> int:
     LogError
         Naming the file, what it is and the fix.
     """
-    import os
-    import stat
+    from orchestrator.inputs import regular_file
 
     path = Path(path)
-    try:
-        status = os.stat(path)
-    except OSError as error:
-        raise LogError(f"{path}: cannot read the log ({error.strerror})") from None
-    mode = status.st_mode
-    if stat.S_ISDIR(mode):
-        raise LogError(f"{path}: a folder, not a log; give a log file ({FORMATS})")
-    if not stat.S_ISREG(mode):
-        kind = ("a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or
-                stat.S_ISBLK(mode) else "a socket" if stat.S_ISSOCK(mode) else "not a regular file")
-        raise LogError(f"{path}: {kind}, not a log file; quadcosim reads logs from files (copy the log to a "
-                       "file first)")
+    status = regular_file(path, "the log", f"give a log file ({FORMATS}); copy a log streamed elsewhere to a file "
+                          "first", LogError)
     size = status.st_size
     if size > MAX_LOG_BYTES:
         raise LogError(f"{path}: {size / 1e9:.1f} GB, more than the {MAX_LOG_BYTES / 1e9:.0f} GB quadcosim reads "

@@ -19,6 +19,7 @@ import functools
 import os
 from pathlib import Path
 
+from fmus.folders import BuildFolderRefused, compiler_command, make_folder  # noqa: F401  (the package's names)
 from fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
 
 
@@ -83,7 +84,9 @@ def default_fmu_dir() -> Path:
 _checked: set[Path] = set()  # FMUs found up to date by this process: checked once, not at every look-up
 
 
-def _stale(path: Path, name: str) -> bool:
+def stale(path: Path, name: str) -> bool:
+    """Whether the FMU file ``path`` of model ``name`` is missing or older than one of its
+    sources (:func:`fmu_sources`): to be built."""
     if not path.is_file():
         return True
     built = path.stat().st_mtime
@@ -98,10 +101,10 @@ def _build_on_first_use(name: str, path: Path, fmi_version: int) -> None:
 
     from fmus.build import build_fmu
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent, "the FMUs")
     with open(path.parent / ".build.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        if _stale(path, name):  # another process may have built it meanwhile
+        if stale(path, name):  # another process may have built it meanwhile
             print(f"quadcosim: building the FMU {name} into {path.parent} (its sources are newer, or it is "
                   "not built yet)", file=sys.stderr, flush=True)
             build_fmu(name, default_fmu_dir(), fmi_version=fmi_version)
@@ -135,7 +138,7 @@ def fmu_path(name: str, fmi_version: int = 2) -> Path:
         raise ValueError(f"FMI version {fmi_version!r}: the plant's FMUs are built in FMI 2 and 3")
     path = default_fmu_dir() / ("" if fmi_version == 2 else "fmi3") / f"{name}.fmu"
     if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
-        if _stale(path, name):
+        if stale(path, name):
             _build_on_first_use(name, path, fmi_version)
         _checked.add(path)
     if not path.is_file():

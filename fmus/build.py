@@ -24,6 +24,7 @@ import zipfile
 from pathlib import Path
 
 from fmus.airframe import c_header as airframe_header
+from fmus.folders import compiler_command, make_folder
 from fmus.models import MODELS, fmu_sources, model_variables
 
 HERE = Path(__file__).resolve().parent
@@ -144,7 +145,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     BuildError
         The table is inconsistent (a vector's members apart, say) or a compiler refused.
     """
-    compiler = compiler or os.environ.get("CC", "cc")
+    compiler = compiler_command(compiler)
     fmu = fmu_file(model, out_dir, fmi_version)
     stage = fmu.parent / model
     if stage.exists():
@@ -173,15 +174,19 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     targets = {"linux": (compiler, ".so")}
     mingw = windows_compiler() if windows else None
     if mingw:
-        targets["windows"] = (mingw, ".dll")
+        targets["windows"] = ([mingw], ".dll")
     jobs = []
     for platform, (cc, suffix) in targets.items():
         binaries = stage / "binaries" / PLATFORMS[fmi_version][platform]
         binaries.mkdir(parents=True)
-        command = [cc, *CFLAGS, *LINK_FLAGS[platform], "-shared", "-I", str(sources),
+        command = [*cc, *CFLAGS, *LINK_FLAGS[platform], "-shared", "-I", str(sources),
                    "-o", str(binaries / f"{model}{suffix}")]
         command += [str(sources / s) for s in source_files] + ["-lm"]
-        jobs.append((command, subprocess.Popen(command, stderr=subprocess.PIPE, text=True)))
+        try:
+            jobs.append((command, subprocess.Popen(command, stderr=subprocess.PIPE, text=True)))
+        except FileNotFoundError:
+            raise BuildError(f"no C compiler {cc[0]!r} (from ${'CC' if os.environ.get('CC') else 'CC unset: cc'}); "
+                             "install one (e.g. gcc) or set $CC") from None
     for command, job in jobs:  # the platforms compile side by side
         _, errors = job.communicate()
         if job.returncode != 0:
@@ -252,7 +257,7 @@ def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=F
     list of pathlib.Path
         The ``.fmu`` files, built or up to date.
     """
-    out_dir = Path(out_dir)
+    out_dir = make_folder(out_dir, "the FMUs")
     built = []
     for fmi_version in fmi_versions:
         fmu_file(models[0], out_dir, fmi_version).parent.mkdir(parents=True, exist_ok=True)

@@ -85,16 +85,18 @@ def compile_shared(source: Path, library: Path, compiler: str | None = None) -> 
     RunnerBuildError
         No compiler, or it refused the source (its messages included).
     """
-    compiler = compiler or os.environ.get("CC", "cc")
-    library.parent.mkdir(parents=True, exist_ok=True)
+    from fmus import compiler_command, make_folder
+
+    compiler = compiler_command(compiler)
+    make_folder(library.parent, "the compiled runner")
     handle, partial = tempfile.mkstemp(prefix=f".{library.stem}-", suffix=".so", dir=library.parent)
     os.close(handle)
-    command = [compiler, *CFLAGS, "-o", partial, str(source), "-lm"]
+    command = [*compiler, *CFLAGS, "-o", partial, str(source), "-lm"]
     try:
         done = subprocess.run(command, capture_output=True, text=True)
     except FileNotFoundError:
         os.unlink(partial)
-        raise RunnerBuildError(f"no C compiler {compiler!r}: install one (e.g. gcc) or set $CC") from None
+        raise RunnerBuildError(f"no C compiler {compiler[0]!r}: install one (e.g. gcc) or set $CC") from None
     if done.returncode != 0:
         os.unlink(partial)
         raise RunnerBuildError(f"{source.name}: {' '.join(command)}\n{done.stderr}")

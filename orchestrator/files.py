@@ -12,6 +12,7 @@ saving leaves the earlier file (or none), never a truncated one.
   (the file it points to is replaced, the link is kept, as ``open(path, "w")`` would do); a
   folder, a FIFO, a device or a socket, a read-only file and a folder that does not exist are
   refused with :class:`OutputRefused`, before anything is written.
+- Every file the project *reads* is checked by :func:`orchestrator.inputs.regular_file` first.
 - :func:`tracking` lists the files written into a folder while it is active, so that a run's
   ``metrics.json`` names exactly the files it wrote (figures included).
 - :func:`prepare_out_dir` checks an output folder before a run and, with ``overwrite``,
@@ -205,7 +206,11 @@ def atomic_path(path, size: int | None = None):
                 handle, name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}",
                                                 dir=path.parent)
             except OSError as error:
-                raise _no_room(error, path, 0, size) from None
+                problem = _no_room(error, path, 0, size)
+                if problem is error:  # not a full disk: a folder that takes no file (/proc, a read-only mount)
+                    raise OutputRefused(f"{asked}: cannot create a file in {path.parent}/ ({error.strerror}); give "
+                                        "another path") from None
+                raise problem from None
             temporary = Path(name)
             os.close(handle)
         yield temporary

@@ -64,7 +64,7 @@ def exit_code(interrupt: BaseException) -> int:
     return 128 + signal_number(interrupt)
 
 
-def leave(code: int):
+def leave(code: int, at_once: bool = False):
     """End the process with exit code ``code``, even after an interrupt.
 
     CPython marks a KeyboardInterrupt raised inside code it runs from a string (``exec``, as
@@ -77,10 +77,15 @@ def leave(code: int):
     ----------
     code : int
         The process's exit code.
+    at_once : bool
+        Leave through ``os._exit`` whatever the code (the exit handlers run and the streams are
+        flushed first): the interpreter's finalisation, which restores SIGINT's and SIGTERM's
+        default actions and takes a while with numba and matplotlib loaded, is skipped, so a
+        signal as the process ends meets the program's handler, never the default (exit -15).
     """
     import os
 
-    if code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
+    if at_once or code in (128 + signal.SIGINT, 128 + signal.SIGTERM):
         import atexit
 
         atexit._run_exitfuncs()

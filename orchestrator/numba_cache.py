@@ -111,7 +111,9 @@ def _folder(package: str, root: Path) -> Path:
         if folder.is_dir():
             os.utime(folder)  # most recently used: kept by the pruning
         else:
-            folder.mkdir(parents=True, exist_ok=True)
+            from fmus import make_folder
+
+            make_folder(folder, "numba's cache")
             _prune(folder, package)
         _used.add(folder)
     _current[package] = folder

@@ -34,9 +34,12 @@ or one step at a time by :meth:`Plan._run_steps`.
 from __future__ import annotations
 
 import math
+import sysconfig
 import time
+import traceback
 import warnings
 from collections.abc import Callable
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -51,6 +54,10 @@ from orchestrator.program import RECORD, Entry, Phase, copies
 from orchestrator.progress import Progress
 from orchestrator.result import Result, check_record_fits
 from orchestrator.signals import signal_dtypes, signal_units
+
+#: This package's folder and the Python's libraries: frames there are not a block's own code.
+_NOT_A_BLOCK = (str(Path(__file__).resolve().parent), sysconfig.get_paths()["stdlib"],
+                sysconfig.get_paths()["purelib"])
 
 
 class _BatchPart(NamedTuple):
@@ -309,8 +316,11 @@ class Plan:
                 message = self._non_finite(self.t0 + self.n * self.dt) + "\n" + message
             raise SimulationError(message, self.result(error=message)) from None
         except Exception as error:  # a Python block failed: keep what was recorded
-            message = f"at t = {self.t0 + self.n * self.dt:.6g} s: {type(error).__name__}: {error}"
-            raise SimulationError(message, self.result(error=message)) from error
+            where = raised_at(error)
+            message = f"at t = {self.t0 + self.n * self.dt:.6g} s: {type(error).__name__}: {error}{where}"
+            failure = SimulationError(message, self.result(error=message))
+            failure.traceback = "".join(traceback.format_exception(error))
+            raise failure from error
         except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM by way of Terminated
             number = signal_number(interrupt)
             message = f"interrupted by {signal_name(number)} at t = {self.t0 + self.n * self.dt:.6g} s"
@@ -449,3 +459,13 @@ def _warn_if_idle(fault, t0: float, steps: int, dt: float):
         warnings.warn(f"the {fault.kind} fault on {fault.target} acts for {fault.start} s <= t < {fault.stop} s, "
                       f"when no step of the run ({t0:g} s to {t0 + steps * dt:g} s, every {dt:g} s) falls: "
                       "it has no effect", RuntimeWarning, stacklevel=4)
+
+
+def raised_at(error: BaseException) -> str:
+    """Where ``error`` was raised, the innermost frame outside this package (a user's block):
+    ``" (raised at my_filter.py, line 12, in update)"``; empty when it was raised here."""
+    frames = [f for f in traceback.extract_tb(error.__traceback__) if not f.filename.startswith(_NOT_A_BLOCK)]
+    if not frames or getattr(error, "names_its_block", False):
+        return ""
+    last = frames[-1]
+    return f" (raised at {last.filename}, line {last.lineno}, in {last.name})"

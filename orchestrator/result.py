@@ -18,6 +18,7 @@ import numpy as np
 
 from orchestrator.files import atomic_path, json_text
 from orchestrator.fmu import nearest
+from orchestrator.inputs import read_small_text, regular_file
 from orchestrator.signals import expand, matrix_shape, vector_groups
 from orchestrator.values import float_text, integer_text, matlab_values
 
@@ -178,6 +179,11 @@ class Result:
         """
         members = expand(name, self.names)
         if not members:
+            left_out = [n for n in self.meta.get("left_out") or [] if n == name or n.startswith(name + "_")]
+            if left_out:
+                raise KeyError(f"no recorded signal {name!r}: the scenario left it out of its result files (it "
+                               "follows from the signals kept); run it with --record all (record=['all'] from "
+                               "Python) to keep it")
             raise KeyError(f"no recorded signal {name!r}.{nearest(name, self.names)}")
         return members
 
@@ -429,6 +435,7 @@ class Result:
         Result
             With its meta data (units and options included) and error message.
         """
+        regular_file(path, "a result", "give a run's results.npz (or its folder)")
         # the file opened here and closed here: NumPy leaves its own handle open on a damaged archive
         with open(path, "rb") as file, np.load(file) as archive:
             meta = json.loads(str(archive["_meta"]))
@@ -583,7 +590,8 @@ class StreamedResult(Result):
     def __init__(self, folder):
         folder = Path(folder)
         try:
-            meta = json.loads((folder / "meta.json").read_text())
+            meta = json.loads(read_small_text(folder / "meta.json", "a streamed record's meta.json",
+                                              "run the scenario again with --stream", error=DamagedRecord))
             names = meta.pop("names")
         except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
             raise DamagedRecord(f"{folder}: its meta.json is damaged ({type(error).__name__}: {error})") from None

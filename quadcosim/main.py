@@ -33,24 +33,29 @@ from pathlib import Path
 
 
 def _build(args) -> int:
-    from fmus import default_fmu_dir
+    from fmus import BuildFolderRefused, default_fmu_dir
     from fmus.build import BuildError, build_all
-    from orchestrator.calls import RunnerBuildError, build_runner
+    from orchestrator.calls import LIBRARY_NAME, SOURCE, RunnerBuildError, build_runner, runner_dir
 
     try:
-        build_all(args.out or default_fmu_dir(), force=args.force)
-        print(f"built {build_runner()}")
+        build_all(Path(args.out or default_fmu_dir()), force=args.force)
+        library = runner_dir() / LIBRARY_NAME
+        if args.force or not library.is_file() or library.stat().st_mtime < SOURCE.stat().st_mtime:
+            print(f"built {build_runner()}")
+        else:
+            print(f"up to date {library}")
         from orchestrator.fmi_types import typed_path
 
-        print(f"built {typed_path(build=True)}")
+        print(f"ready {typed_path(build=args.force)}")
         from benchmarks import build_references
 
         for library in build_references():
             print(f"built {library}")
-        from scenarios.compiled import compile_all
+        from scenarios import compiled
 
-        print(f"compiled the numba steps in {compile_all():.1f} s")
-    except (BuildError, RunnerBuildError) as error:
+        seconds = compiled.compile_all()
+        print(f"{'compiled' if compiled.compiled_any() else 'loaded'} the numba steps in {seconds:.1f} s")
+    except (BuildError, RunnerBuildError, BuildFolderRefused) as error:
         print(error, file=sys.stderr)
         return 1
     return 0
@@ -60,7 +65,7 @@ def _list(args) -> int:
     if args.parameters:
         from fmus import MODELS
         from fmus.build import table
-        from scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines
+        from scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines, scenario_lines
 
         if args.parameters in PYTHON_BLOCKS:
             print("\n".join(parameter_lines(args.parameters)))
@@ -83,6 +88,7 @@ def _list(args) -> int:
             print(f"  {alias} stands for the vector {name}")
         for switch, governed in switched.items():
             print(f"  {', '.join(governed)} act only while {switch} is true")
+        print("\n".join(scenario_lines(args.parameters)))
         return 0
     import scenarios
 
@@ -212,7 +218,8 @@ def _run_reporting(args) -> int:
     _print_warnings(warnings)
     figures = [name for name in metrics.get("figures") or [] if isinstance(name, str)]
     drawn = [p.name for p in sorted(out.glob("diagram.*"))] + figures
-    print(f"results ({', '.join(formats)}), metrics.json" + (f" and {', '.join(drawn)}" if drawn else "")
+    record = "the record streamed (results.stream/)" if args.stream else f"results ({', '.join(formats)})"
+    print(f"{record}, metrics.json" + (f" and {', '.join(drawn)}" if drawn else "")
           + f" in {out}/" + (" (no report figures: see report above)" if "report" in metrics else ""))
     if metrics.get("status") == "diverged":  # warned above, naming the settings
         print(f"quadcosim run {args.scenario}: the run diverged (metrics.json: status diverged); its record and "
@@ -309,13 +316,23 @@ def _bench(args) -> int:
                       + (["--out", args.out] if args.out else []))
 
 
+def _version() -> str:
+    """The installed package's version (pyproject.toml's), or ``unknown`` outside an installation."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("quadcosim")
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed: pip install -e .)"
+
+
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
     import studies  # noqa: F401  (registers the studies' scenarios in the catalogue the verbs read)
     from scenarios.shown import PlainHelp
 
-    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__,
-                                formatter_class=PlainHelp)
+    p = argparse.ArgumentParser(prog="quadcosim", description=__doc__, formatter_class=PlainHelp)
+    p.add_argument("--version", action="version", version=f"quadcosim {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     build = sub.add_parser("build", help="build the plant FMUs, the master's C runner and the benchmark's C "
                            "references (into build/ in a source checkout, a per-user cache when installed; a run "
@@ -478,17 +495,39 @@ def entry() -> None:
     # spins it at load, CPU a command spends for nothing on its small matrices. A user's setting
     # wins; a program that imports this module is left as it is.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    from orchestrator.interrupts import leave
+    import signal
 
+    from orchestrator.interrupts import exit_code, leave
+
+    # SIGTERM's handler outside main's own: main restores it when it returns, and a signal then
+    # (the command's work done) ends the process at once with 143, never by SIGTERM's default
+    signal.signal(signal.SIGTERM, _ended_while_leaving)
+    global _leaving_code
     try:
-        code = main()
+        code = _leaving_code = main()
+        signal.signal(signal.SIGINT, _ended_while_leaving)
         sys.stdout.flush()  # here, not at exit: a reader gone (| head) is then seen below
     except BrokenPipeError:  # the reader of our output left (quadcosim list | head -1): no traceback
-        import signal
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
         code = 128 + signal.SIGPIPE  # as a program that the pipe's signal ended
-    leave(code)
+    except KeyboardInterrupt as interrupt:  # Ctrl-C as main returned: its work is done or was refused
+        code = exit_code(interrupt)
+    _leaving_code = code
+    signal.signal(signal.SIGINT, _ended_while_leaving)
+    leave(code, at_once=True)
+
+
+#: The command's exit code once :func:`main` returned (None before).
+_leaving_code = None
+
+
+def _ended_while_leaving(number, frame):
+    """A signal after the command finished, while the process exits: leave at once with the
+    command's own code (its work is done; 128 + the signal if main had not yet returned), rather
+    than die by it (SIGTERM's default) or print a KeyboardInterrupt traceback from an exit handler
+    (SIGINT's)."""
+    sys.stderr.flush()
+    os._exit(_leaving_code if _leaving_code is not None else 128 + number)
 
 
 if __name__ == "__main__":

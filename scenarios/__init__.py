@@ -65,6 +65,11 @@ class Option:
             if str(text).strip().lower() == self.marker:
                 return self.marker
             default = 0.0  # otherwise a number
+        if isinstance(text, (list, tuple, dict, set)) or text is None or \
+                (isinstance(text, bool) and not isinstance(default, bool)):
+            also = f" (or {self.marker})" if self.marker is not None else ""
+            raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}{also}: give one "
+                             f"value, such as {self.default!r}")
         try:
             if isinstance(default, bool):
                 if str(text).lower() in ("1", "true", "on", "yes"):
@@ -249,6 +254,9 @@ class Scenario:
             block = key.partition(".")[0]
             for name in values:
                 option = derived.get(f"{block}.{name}")
+                if option is not None and option.startswith("("):  # fixed by the scenario, no option
+                    raise ValueError(f"{block}.{name} is fixed by scenario {self.name} {option}: leave {key} "
+                                     "out of --set")
                 if option is not None:
                     raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
                                      f"use --set {option}=... instead of {key}")
@@ -336,6 +344,8 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     from scenarios.outputs import RunFiles, remove_if_empty
 
     status(f"{name}: loading the scenario")
+    if isinstance(record, str):  # one signal named alone, not its characters
+        record = [record]
     files = None
     with first_only(), contextlib.ExitStack() as lock:  # the folder is this run's until it ends
         try:
@@ -429,6 +439,8 @@ def _run_phases(scenario: Scenario, options: Options, base: dict, files, request
             files.refused()
         raise
     result.meta |= {"scenario": {"name": name, "options": base["options"]}, "faults": base["injected_faults"]}
+    if base.get("signals_not_saved"):  # named in the files, so that asking for one says how to keep it
+        result.meta["left_out"] = base["signals_not_saved"]
     metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
                       "fmu_warnings": _warning_counts(result)}
     metrics |= _divergence(scenario, result, options)
@@ -476,7 +488,7 @@ def _divergence(scenario, result, options) -> dict:
     from scenarios.divergence import first_crossing, unchecked
 
     found = {}
-    missing = unchecked(result)
+    missing = unchecked(result, bounds)
     if missing:
         found["divergence_unchecked"] = missing
     crossing = first_crossing(result, bounds)

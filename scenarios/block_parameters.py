@@ -54,3 +54,36 @@ def parameter_lines(model: str) -> list[str]:
                  "gradient step (the ahrs package's default)")
     lines.append("  vqf: the vqf package's own parameters (tauAcc, tauMag, ...; see its documentation)")
     return lines
+
+
+def scenario_lines(model: str) -> list[str]:
+    """The lines ``quadcosim list --parameters MODEL`` adds under an FMU's own defaults: the
+    parameters each scenario sets from one of its options (tp runs with ``IMU.noise_enabled``
+    from its option ``noise``, off by default), which ``--set MODEL.NAME`` cannot change.
+
+    Parameters
+    ----------
+    model : str
+        An FMU's name (``"IMU"``).
+
+    Returns
+    -------
+    list of str
+        A heading, then one line per scenario that sets any: ``parameter <- option (default)``;
+        empty when none does.
+    """
+    import scenarios
+
+    lines = []
+    for name, scenario in scenarios.registry().items():
+        derived = {k.partition(".")[2]: v for k, v in scenario.extra.get("derived", {}).items()
+                   if k.startswith(model + ".")}
+        said = [f"{parameter} <- {option}" if option.startswith("(") else
+                f"{parameter} <- option {option} (default {scenario.options[option].default})"
+                for parameter, option in derived.items() if option.startswith("(") or option in scenario.options]
+        if said:
+            lines.append(f"  {name}: {'; '.join(said)}")
+    if lines:
+        lines.insert(0, f"{model} parameters the scenarios set from their options (change the option, "
+                        "--set OPTION=VALUE; the defaults above apply where no scenario sets them):")
+    return lines

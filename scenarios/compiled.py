@@ -41,6 +41,11 @@ def _on_compile(event):
         "(`quadcosim build` does it ahead)", sys.stderr)
 
 
+def compiled_any() -> bool:
+    """Whether numba compiled anything in this process (rather than loading it all from its cache)."""
+    return _announced
+
+
 def announce_compiles() -> None:
     """Print one line on standard error when numba starts compiling, rather than loading from its
     cache, for the first time in this process."""
@@ -93,9 +98,12 @@ def compile_all(verbose: bool = True) -> float:
     """
     import scenarios
 
+    global _announced
+    _announced = False  # compiled_any() then says whether this call compiled anything
     started = time.perf_counter()
     if verbose:
-        print("compiling the numba steps (estimators, controller, calibration) into numba's cache ...", flush=True)
+        print("the numba steps (estimators, controller, calibration): loading them from numba's cache, compiling "
+              "those it lacks ...", flush=True)
     for name, options in WARM_UP_RUNS:
         scenarios.run(name, options)
     _batch_paths()

@@ -28,18 +28,18 @@ class Bounds:
 
     Attributes
     ----------
-    tilt_error_deg : float
-        Roll or pitch away from the controller's setpoint (deg).
-    altitude_error_m : float
-        Altitude away from its setpoint, above or below (m).
+    tilt_error_deg : float or None
+        Roll or pitch away from the controller's setpoint (deg); None: not bounded (no controller).
+    altitude_error_m : float or None
+        Altitude away from its setpoint, above or below (m); None: not bounded.
     speed_m_s : float
         Speed (m/s).
     held_s : float
         How long a bound must stay crossed (s): a setpoint step is not a divergence.
     """
 
-    tilt_error_deg: float
-    altitude_error_m: float
+    tilt_error_deg: float | None
+    altitude_error_m: float | None
     speed_m_s: float
     held_s: float
 
@@ -74,14 +74,14 @@ def first_crossing(result, bounds: Bounds) -> dict | None:
     time = np.asarray(result.time)
     found = []
     names = set(result.names)
-    if all(a in names and b in names for a, b in ROLL_PITCH):
+    if bounds.tilt_error_deg is not None and all(a in names and b in names for a, b in ROLL_PITCH):
         for k, (true, wanted) in enumerate(ROLL_PITCH):
             error = np.degrees(np.abs((result[wanted] - result[true] + math.pi) % (2 * math.pi) - math.pi))
             at = _held(error > bounds.tilt_error_deg, time, bounds.held_s)
             if at is not None:
                 found.append((at, f"{'roll' if k == 0 else 'pitch'} {error[at]:.0f} deg from its setpoint",
                               bounds.tilt_error_deg, float(error[at]), "deg"))
-    if all(n in names for n in ALTITUDE):
+    if bounds.altitude_error_m is not None and all(n in names for n in ALTITUDE):
         error = result[ALTITUDE[0]] - result[ALTITUDE[1]]  # NED: positive is below the setpoint
         at = _held(np.abs(error) > bounds.altitude_error_m, time, bounds.held_s)
         if at is not None:
@@ -103,9 +103,12 @@ def first_crossing(result, bounds: Bounds) -> dict | None:
     return crossing
 
 
-def unchecked(result) -> list[str]:
-    """The signals a bound reads that ``result`` did not record (its bound is then not checked)."""
-    wanted = [n for pair in ROLL_PITCH for n in pair] + list(ALTITUDE) + list(SPEED)
+def unchecked(result, bounds: Bounds | None = None) -> list[str]:
+    """The signals a bound (of ``bounds``, default all) reads that ``result`` did not record (its
+    bound is then not checked)."""
+    wanted = [n for pair in ROLL_PITCH for n in pair] if bounds is None or bounds.tilt_error_deg is not None else []
+    wanted += list(ALTITUDE) if bounds is None or bounds.altitude_error_m is not None else []
+    wanted += list(SPEED)
     return [n for n in wanted if n not in set(result.names)]
 
 
@@ -128,3 +131,9 @@ def message(scenario: str, crossing: dict, settings: list[str]) -> str:
     return (f"{scenario} diverged at t = {crossing['at_s']:.2f} s: {crossing['what']} (bound {crossing['bound']:g} "
             f"{crossing['unit']}){asked}. The loop is unstable with {given}; its numbers describe a crash, not the "
             "controller or the estimator")
+
+
+#: The bounds of a vehicle clamped to its rig (``rig``, ``metge``): it does not move. A rig whose
+#: clamp is released (``--set Quadrotor.clamped=false``) falls and tumbles; its run once
+#: completed with errors of 64 to 93 deg, the vehicle 284 m below the ground.
+CLAMPED = Bounds(tilt_error_deg=None, altitude_error_m=None, speed_m_s=0.1, held_s=0.05)

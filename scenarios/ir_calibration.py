@@ -210,6 +210,11 @@ def build(o: dict) -> System:
         The scenario's options (see ``OPTIONS``).
     """
     samples = int(round(o["duration"] * RATE))
+    for sensor, start, stop, _ in fault_windows(o["faults"], o["ir_fault"], o["gps_fault"]):
+        if start >= o["duration"]:
+            raise ValueError(f"faults={o['faults']}: the {sensor.upper()} fault starts at {start:g} s (the slides' "
+                             f"onset), after this run's {o['duration']:g} s; run at least duration={stop:g} to see "
+                             "it whole, or choose faults=none")
     system = System(dt=1.0 / RATE)
     # the profile of samples rows (the last is held), the same as simulate_flight flies
     system.add(Table("Bank", ["phi"], bank_profile(samples, o["seed"])[:, None], units={"phi": "rad"}))
@@ -371,7 +376,9 @@ def _innovations_figure(result, o, windows, out, title):
         computed = S > 0.0
         nu = np.where(computed, result[f"Kalman.nu_{key}"] * scale, np.nan)
         ax.plot(t, nu, lw=0.6, label="innovation")
-        if gamma:
+        if not computed.any():  # no sample of this kind was fused (GPS fused for less than a pairing)
+            ax.text(0.5, 0.5, "none computed in this run", transform=ax.transAxes, ha="center", va="center")
+        elif gamma:
             gate = np.where(computed, gamma * np.sqrt(np.where(computed, S, 1.0)) * scale, np.nan)
             ax.plot(t, gate, "r", lw=0.8, label=f"gate ±{gamma:g} sqrt(S)")
             ax.plot(t, -gate, "r", lw=0.8)

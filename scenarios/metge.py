@@ -41,6 +41,7 @@ from orchestrator.files import write_json
 from orchestrator.parameters import apply
 from orchestrator.progress import status
 from scenarios import Option, Scenario
+from scenarios.divergence import CLAMPED
 from scenarios.figures import title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
@@ -287,6 +288,7 @@ def build(o: dict) -> System:
         raise ValueError(f"settle = {o['settle']} s must be shorter than hold = {o['hold']} s")
     socs(o, 1), socs(o, 2)
     parse_orders(o["orders"])
+    load_static(o)  # read before the simulation: a file refused after it would waste the run
     if abs(round(1.0 / (o["mag_rate"] * o["dt"])) * o["mag_rate"] * o["dt"] - 1.0) > 1e-9:
         raise ValueError(f"mag_rate = {o['mag_rate']} Hz must divide the macro step rate {1 / o['dt']:g} Hz")
     clash = sorted(set(regime_settings(o)) & set(block_settings(o)))
@@ -593,7 +595,7 @@ def duration(o: dict) -> float:
 
 
 SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD, "derived": DERIVED})
+                    duration=duration, extra={"record": RECORD, "derived": DERIVED, "divergence": CLAMPED})
 
 
 # --- the rig calibration a closed loop's compensation uses (scenarios.compensation) -----

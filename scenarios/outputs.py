@@ -192,6 +192,8 @@ class RunFiles:
                 "fmu_warnings": dict(record.meta.get("fmu_warnings", {}))}
         if interrupted:
             done["interrupted_by"] = signal_name(error.signal_number)
+        if getattr(error, "traceback", None):  # a block of the user's raised: where, for its author
+            done["traceback"] = error.traceback
         self._write(self.base | done | self._files())
 
     def interrupted(self, interrupt: BaseException) -> RunInterrupted:

@@ -45,6 +45,7 @@ import numpy as np
 
 from estimators import estimate, kinds, parse_corrections, recording
 from orchestrator.files import write_text
+from orchestrator.inputs import read_small_text
 
 FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
 
@@ -102,7 +103,15 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
     ``options``: any other option of :func:`estimators.estimate` (``ry``, ``discretisation``,
     ``q0``, ``b0``, ``dip``, ``declination``; angles in rad).
     """
-    meta = data["meta"].get("estimator", {})
+    meta = data["meta"].get("estimator") or {}
+    if not isinstance(meta, dict):
+        raise ValueError(f"the recording's meta: estimator = {meta!r} must be a JSON object ({{\"kind\": ..., "
+                         "\"gains\": {...}}); fix or remove it")
+    for key, kinds_ in (("gains", dict), ("corrections", (dict, str, bool)), ("kind", str)):
+        if meta.get(key) is not None and not isinstance(meta[key], kinds_):
+            raise ValueError(f"the recording's meta: estimator.{key} = {meta[key]!r} is a "
+                             f"{type(meta[key]).__name__}; it must be a "
+                             f"{'JSON object' if key == 'gains' else 'text' if key == 'kind' else 'setting'}")
     kind = estimator or meta.get("kind", "explicit")
     settings = {
         "gains": gains if gains is not None else (meta.get("gains") if kind == meta.get("kind") else None),
@@ -220,10 +229,12 @@ def tp_recording(results_dir) -> dict:
     from scenarios.tp import estimator_gains, initial_state
 
     results_dir = Path(results_dir)
-    if not (results_dir / "metrics.json").exists() or not (results_dir / "results.npz").exists():
-        raise ValueError(f"{results_dir} is not a tp results folder (no metrics.json and results.npz)")
+    stream = results_dir / "results.stream"
+    if not (results_dir / "metrics.json").exists() or not ((results_dir / "results.npz").exists() or stream.is_dir()):
+        raise ValueError(f"{results_dir} is not a tp results folder (no metrics.json beside a results.npz or a "
+                         "results.stream/)")
     try:
-        metrics = json.loads((results_dir / "metrics.json").read_text())
+        metrics = json.loads(read_small_text(results_dir / "metrics.json", "the run's metrics.json", "run tp again"))
     except (OSError, ValueError) as error:
         raise ValueError(f"{results_dir}: metrics.json is not readable ({error}); run tp again") from None
     metrics = metrics if isinstance(metrics, dict) else {"scenario": None}
@@ -231,9 +242,9 @@ def tp_recording(results_dir) -> dict:
     if metrics.get("scenario", "tp") != "tp" or "estimator" not in o:
         raise ValueError(f"{results_dir} holds a {metrics.get('scenario')!r} run, not a tp run")
     try:
-        result = Result.from_npz(results_dir / "results.npz")
+        result = Result.load(results_dir)  # its results.npz, or the record it streamed
     except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as error:
-        raise ValueError(f"{results_dir}: the run's results.npz is not readable ({error}); run tp again") from None
+        raise ValueError(f"{results_dir}: the run's record is not readable ({error}); run tp again") from None
     if round(1.0 / (o["imu_rate"] * o["dt"])) != 1:
         raise ValueError("the estimator of this run ran slower than the macro step: its samples are not the "
                          "recorded ones; run tp with imu_rate = 1/dt")
@@ -349,24 +360,61 @@ def main(argv=None, prog: str = "python -m scenarios.replay") -> int:
             raise ValueError(f"--set takes GAIN=VALUE, not {args.set}")
         gains = {k.strip(): _value(v) for k, v in pairs} if pairs else None
         corrections = None if args.corrections is None else parse_corrections(args.corrections)
+        _check_numbers(args)
         if args.figure:
             from orchestrator.files import figure_file
 
             figure_file(args.figure, "replay.png", None)  # a path refused before the replay runs
+        if args.out:
+            from orchestrator.files import output_file
+
+            output_file(args.out)  # a folder missing or read-only refused before the replay runs
         data = load_any(args.recording, rate=args.rate)
+        _check_stretch(args, data)
         result = replay(data, args.estimator, gains, corrections, args.initial, args.frame, args.field_from_data,
                         args.align_heading, keep_estimate=bool(args.figure), **_options(args))
+        estimate = {k: result.pop(k) for k in ("q", "gravity") if k in result}
+        text = json.dumps(result, indent=2, default=float)
+        print(text if args.json else summary(result, args.recording))
+        if args.out:  # the JSON first: on a nearly full disk it fits where a figure may not
+            write_text(args.out, text + "\n")
         if args.figure:
-            print(f"figure: {draw_errors(data, result, args.figure, Path(args.recording).name)}", file=sys.stderr)
-            del result["q"], result["gravity"]
+            print(f"figure: {draw_errors(data, result | estimate, args.figure, Path(args.recording).name)}",
+                  file=sys.stderr)
     except (ValueError, FileNotFoundError, OSError) as error:
         print(f"{prog}: {error}", file=sys.stderr)
         return 2
-    text = json.dumps(result, indent=2, default=float)
-    print(text if args.json else summary(result, args.recording))
-    if args.out:
-        write_text(args.out, text + "\n")
     return 0
+
+
+#: The fastest sampling a recording may give (Hz): no IMU samples faster; beyond it, rates such as
+#: 1e308 overflow the sample count of a stretch.
+MAX_RATE_HZ = 1e5
+
+
+def _check_numbers(args) -> None:
+    """Refuse a number of the command line that would mislead the replay or overflow it."""
+    if args.rate is not None and not 0 < args.rate <= MAX_RATE_HZ:
+        raise ValueError(f"--rate {args.rate:g}: a sampling rate is a number of Hz above 0 and at most "
+                         f"{MAX_RATE_HZ:g}")
+    if not 0 <= args.field_from_data < math.inf:
+        raise ValueError(f"--field-from-data {args.field_from_data:g}: give the seconds (0 or more) at the start of "
+                         "the recording to take the field from")
+    if args.dip is not None and not -90 <= args.dip <= 90:
+        raise ValueError(f"--dip {args.dip:g}: the field's dip is an angle from -90 to 90 deg below the horizontal")
+    if not -360 <= args.declination <= 360:
+        raise ValueError(f"--declination {args.declination:g}: give an angle in deg, from -360 to 360")
+
+
+def _check_stretch(args, data: dict) -> None:
+    """Refuse a recording's rate beyond :data:`MAX_RATE_HZ`, and a --field-from-data longer than it."""
+    if not data["rate"] <= MAX_RATE_HZ:
+        raise ValueError(f"{args.recording}: rate = {data['rate']:g} Hz is beyond any IMU's (at most "
+                         f"{MAX_RATE_HZ:g} Hz); fix the recording's rate, or pass --rate")
+    length = len(data["gyro"]) / data["rate"]
+    if args.field_from_data > length:
+        raise ValueError(f"--field-from-data {args.field_from_data:g} s is longer than the recording "
+                         f"({length:.4g} s); give at most that")
 
 
 def summary(result: dict, recording: str) -> str:

@@ -14,6 +14,7 @@ import numpy as np
 
 from orchestrator import System, Table, portable
 from scenarios import Option, Scenario
+from scenarios.divergence import CLAMPED
 from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
 from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
@@ -193,4 +194,4 @@ def report(result, o, out) -> dict:
 
 
 SCENARIO = Scenario("rig", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report, duration=duration,
-                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.seed": "seed"}})
+                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.seed": "seed"}, "divergence": CLAMPED})

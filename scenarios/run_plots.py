@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 from orchestrator.files import figure_file, printable, save_figure
+from orchestrator.inputs import read_small_text
 from scenarios.output_options import free_file
 
 RESULTS_FILE = "results.npz"
@@ -73,8 +74,9 @@ def _check(result, folder: Path, signal: str):
     except KeyError as error:
         hint = ""
         try:
-            left_out = json.loads((folder / "metrics.json").read_text()).get("signals_not_saved", [])
-        except (OSError, ValueError):
+            left_out = json.loads(read_small_text(folder / "metrics.json", "the run's metrics.json",
+                                                  "")).get("signals_not_saved", [])
+        except (OSError, ValueError, AttributeError):
             left_out = []
         if any(name == signal or name.startswith(signal + "_") for name in left_out):
             hint = f" The scenario left {signal} out of its files (it follows from others): run it with --record all."

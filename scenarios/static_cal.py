@@ -50,6 +50,12 @@ def attitude(o: dict) -> tuple[np.ndarray, np.ndarray]:
         assert len(rates) == 3
     except (ValueError, AssertionError):
         raise ValueError(f"option rates = {o['rates']!r} must be three comma-separated turn rates (rev/s)") from None
+    # sampled at min(1/dt, mag_rate): a rate beyond half of it aliases (1e6 rev/s sampled at 100 Hz is no motion)
+    nyquist = 0.5 * min(1.0 / o["dt"], o["mag_rate"])
+    if not all(np.isfinite(rates)) or max(abs(r) for r in rates) >= nyquist or not any(rates):
+        raise ValueError(f"option rates = {o['rates']!r}: each turn rate must be a finite number of rev/s below "
+                         f"{nyquist:g} (half the {2 * nyquist:g} Hz the sweep is sampled at, else it aliases), "
+                         "and not all zero (the sweep must turn); the default is 0.23,0.17,0.41")
     t = np.arange(int(round(o["duration"] / o["dt"])) + 1) * o["dt"]
     R = _rot(2, 2 * np.pi * rates[2] * t) @ _rot(1, 2 * np.pi * rates[1] * t) @ _rot(0, 2 * np.pi * rates[0] * t)
     return t, R

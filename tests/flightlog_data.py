@@ -1,13 +1,19 @@
-"""The shared real flight logs (``../shared/data/flightlogs`` beside the repository), read once
-per test session; tests that need them skip, saying why, when the folder is absent."""
+"""The real flight logs, read once per test session; tests that need them skip, saying why, when
+the folder is absent.
 
+One setting names the folder for the tests and the findings alike: ``$QUADCOSIM_FLIGHT_LOGS``
+(:data:`findings.flightlogs.FOLDER_VARIABLE`), by default ``../shared/data/flightlogs`` beside the
+repository."""
+
+import os
 from functools import cache
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-FOLDER = ROOT.parent / "shared" / "data" / "flightlogs"
+DEFAULT = ROOT.parent / "shared" / "data" / "flightlogs"
+FOLDER = Path(os.environ.get("QUADCOSIM_FLIGHT_LOGS") or DEFAULT)
 QUAD = ("quad_2015-10-11_19-53-46.log", "quad_2015-10-11_19-59-09.log", "quad_2015-10-11_20-17-22.log")
 ERLE = "erlebrain_APM_22.bin"
 PX4 = "px4_sample.ulg"
@@ -21,7 +27,7 @@ def path(name: str) -> Path:
     """The shared log ``name``; skips the test when it is not there."""
     found = FOLDER / name
     if not found.exists():
-        pytest.skip(f"real flight logs not found at {FOLDER} (the shared data folder beside the repository)")
+        pytest.skip(f"real flight logs not found at {FOLDER} (set $QUADCOSIM_FLIGHT_LOGS to their folder)")
     return found
 
 

@@ -38,12 +38,15 @@ ALLOWED = {
     "fmus": (),
     # to find built FMUs only: the package's locating functions, not its build or its models
     "orchestrator": ("fmus",),
-    # the one writer of every file, and Ctrl-C surfaced while a reader holds the process
-    "flightlogs": ("orchestrator.files", "orchestrator.interrupts"),
+    # the one writer of every file, the one check of every file read, and Ctrl-C surfaced while a
+    # reader holds the process
+    "flightlogs": ("orchestrator.files", "orchestrator.inputs", "orchestrator.interrupts"),
     # the block contract, the plant's constants, the flight-log reading layer and the one writer
     # and numba's cache keyed by the sources (installed by the package before its modules decorate)
-    "estimators": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus.", "orchestrator.numba_cache"),
-    "calibration": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "fmus.", "orchestrator.numba_cache"),
+    "estimators": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "orchestrator.inputs", "fmus.",
+                   "orchestrator.numba_cache"),
+    "calibration": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "orchestrator.inputs", "fmus.",
+                    "orchestrator.numba_cache"),
     # the controller: the block contract, the plant, the estimators' quaternion arithmetic
     "flight": ("fmus.", "orchestrator.", "estimators."),
     "scenarios": _below("scenarios"),

@@ -210,20 +210,14 @@ def read_parameters(path) -> dict:
         The file is missing, not a regular file (a FIFO would block), too large, not text, or a
         line holds no ``NAME VALUE``; the message names the file, the line and the fix.
     """
-    import os
-    import stat
+    from orchestrator.inputs import regular_file
 
     path = Path(path)
-    try:
-        status = os.stat(path)
-    except OSError as error:
-        raise ValueError(f"{path}: cannot read the parameter file ({error.strerror})") from None
-    if not stat.S_ISREG(status.st_mode):
-        raise ValueError(f"{path}: not a regular file; give a parameter file (.parm or .params)")
+    status = regular_file(path, "the parameter file", "give a parameter file (.parm or .params)")
     if status.st_size > MAX_PARAMETER_BYTES:
         raise ValueError(f"{path}: {status.st_size / 1e6:.0f} MB, not a parameter file (.parm or .params)")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark is not part of the first name
     except UnicodeDecodeError as error:
         raise ValueError(f"{path}: not a text parameter file (byte {error.start} is not UTF-8); give the .parm or "
                          ".params the ground station saved") from None
@@ -237,10 +231,14 @@ def read_parameters(path) -> dict:
         parts = line.split("\t") if "\t" in line else line.split(",") if "," in line else line.split()
         try:
             name, value = (parts[2], parts[3]) if len(parts) > 3 else parts[:2]
-            params[name.strip()] = int(value) if value.strip().lstrip("-").isdigit() else float(value)
+            given = int(value) if value.strip().lstrip("-").isdigit() else float(value)
         except (ValueError, IndexError):
             raise ValueError(f"{path}, line {number}: {line[:60]!r} is not NAME,VALUE (ArduPilot) nor "
                              "1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE (QGroundControl); fix or remove the line") from None
+        if name.strip() in params:
+            raise ValueError(f"{path}, line {number}: {name.strip()} is given a second time; an autopilot keeps one "
+                             "value per name: remove one of the lines")
+        params[name.strip()] = given
         if not abs(params[name.strip()]) <= FLOAT32_MAX:  # NaN and infinities too
             raise ValueError(f"{path}, line {number}: {name.strip()} = {value.strip()} is not a value an autopilot "
                              "stores (its parameters are finite 32-bit floats); fix or remove the line")

@@ -102,8 +102,32 @@ def score_file(path, parts, rule=None, *, offset_from) -> dict:
     from calibration.flight.autopilot import read_parameters
 
     params = read_parameters(path)
+    _check_scored(path, parts, params, rule)
     scored = score_parameters(parts, params, rule, offset_from=offset_from)
     return {"file": str(path), "parameters": len(params)} | scored
+
+
+#: How many times the log's raw field a calibrated field may be before the parameters are absurd.
+MAX_FIELD_RATIO = 10.0
+
+
+def _check_scored(path, parts, params: dict, rule) -> None:
+    """Refuse a parameter file that would be scored as something it is not: one none of whose
+    parameters acts on the compass scored (it would score as the log), or one whose values make
+    the firmware's field absurd (``COMPASS_MOT2_X,3e38`` once scored a share of -8e78 %)."""
+    fields = [apply_parameters(p, params, rule) for p in parts]
+    if all(np.array_equal(f, apply_parameters(p, {}, rule)) for f, p in zip(fields, parts, strict=True)):
+        raise ValueError(f"{path}: none of its {len(params)} parameters ({', '.join(list(params)[:4])}"
+                         f"{', ...' if len(params) > 4 else ''}) acts on the compass scored (compass "
+                         f"{parts[0].compass}): it would score as the log's own; give the file for this compass "
+                         "(--compass) and this autopilot")
+    size = float(np.median(np.concatenate([np.linalg.norm(f, axis=1) for f in fields])))
+    raw = float(np.median(np.concatenate([np.linalg.norm(p.raw, axis=1) for p in parts])))
+    if not size <= MAX_FIELD_RATIO * raw:
+        largest = max(params, key=lambda k: abs(params[k]))
+        raise ValueError(f"{path}: with its parameters the firmware would report a field of {size * 1e6:.3g} uT, "
+                         f"more than {MAX_FIELD_RATIO:g} times the log's raw {raw * 1e6:.3g} uT: no calibration gives "
+                         f"that (its largest value: {largest} = {params[largest]:g}); fix the file")
 
 
 @dataclass

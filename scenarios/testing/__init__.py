@@ -89,6 +89,27 @@ def pytest_runtest_makereport(item, call):
         report.sections.append(("quadcosim", "\n".join(lines)))
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item):
+    """End the session on an interrupted run, as pytest's own KeyboardInterrupt does (exit 2).
+
+    A run stopped by Ctrl-C or SIGTERM raises :class:`orchestrator.RunInterrupted`, an error
+    of the simulation: left as it is, pytest would count the test as failed and run the next
+    one. It is raised again as a KeyboardInterrupt, naming what the run kept.
+
+    Parameters
+    ----------
+    item : pytest.Item
+        The test.
+    """
+    from orchestrator.errors import RunInterrupted
+
+    try:
+        return (yield)
+    except RunInterrupted as error:
+        raise KeyboardInterrupt(f"{item.nodeid}: {error}") from error
+
+
 @pytest.fixture
 def quadcosim_seed(request) -> int:
     """The test's seed (:func:`seed_of` its node id), printed if the test fails."""
@@ -134,8 +155,17 @@ def run_scenario(request, quadcosim_seed, _quadcosim_pool):
 
     def run(name, duration=None, *, estimator=None, blocks=None, parameters=None, faults=(), record=None, out=None,
             **options):
+        if name not in scenarios.names():
+            from orchestrator.fmu import nearest
+
+            raise ValueError(f"run_scenario: no scenario {name!r}.{nearest(str(name), scenarios.names())} "
+                             f"Scenarios: {', '.join(scenarios.names())}")
         if duration is not None:
+            if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 < duration < float("inf"):
+                raise ValueError(f"run_scenario: duration={duration!r} must be a positive number of seconds")
             options["duration"] = duration
+        if isinstance(record, str):  # one signal named alone, not its characters
+            record = [record]
         if "seed" in scenarios.get(name).options:
             options.setdefault("seed", quadcosim_seed)
         if not isinstance(estimator, (str, type(None))):

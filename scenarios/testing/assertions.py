@@ -19,6 +19,7 @@ same thing.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,40 @@ def seed_text(result) -> str:
         return f"seed {test['seed']} (test {test.get('node', '?')})"
     options = result.meta.get("scenario", {}).get("options", {})
     return f"seed {options['seed']} (option seed)" if "seed" in options else "no seed recorded"
+
+
+def _number(name: str, value, magnitude: bool = True) -> float:
+    """``value`` as a bound: a real number, not NaN (no comparison with NaN fails, so a NaN
+    bound would pass anything), and not negative when it bounds a magnitude."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"{name}={value!r} must be a number (a {type(value).__name__} was given); write "
+                        f"{name}=0.5, in the unit of the quantity bounded")
+    value = float(value)
+    if math.isnan(value):
+        raise ValueError(f"{name}=nan is not a bound: no comparison with NaN fails, so it would pass anything; "
+                         "give a number")
+    if magnitude and value < 0:
+        raise ValueError(f"{name}={value:g} is negative: it bounds a magnitude, which no sample can keep below "
+                         "zero; give a bound >= 0")
+    return value
+
+
+def _axes(axes) -> list[str]:
+    """The Euler axes asked for, checked: a name or names among :data:`AXES`."""
+    axes = [axes] if isinstance(axes, str) else list(axes)
+    unknown = [a for a in axes if a not in AXES]
+    if unknown or not axes:
+        raise ValueError(f"axes={tuple(axes)!r}: {', '.join(map(repr, unknown)) or 'none given'}; give axes among "
+                         f"{', '.join(map(repr, AXES))} (lower case)")
+    return axes
+
+
+def _no_nan(name: str, values: np.ndarray, mask: np.ndarray, result) -> None:
+    """Fail on the first NaN among the samples checked: a NaN compares false with any bound."""
+    bad = np.flatnonzero(mask & np.isnan(values.reshape(len(mask), -1)).any(axis=1))
+    if len(bad):
+        _fail(f"{name} is NaN at t = {result.time[bad[0]]:.4f} s ({len(bad)} of {int(mask.sum())} samples checked): "
+              "a NaN is no value within any bound", result)
 
 
 def _fail(what: str, result) -> None:
@@ -126,9 +161,12 @@ def assert_attitude_error(result, below_deg: float, after_s: float = 0.0, axes=A
     AssertionError
         A sample beyond the bound; the message gives the axis, time, error, bound and seed.
     """
+    below_deg = _number("below_deg", below_deg)
+    axes = _axes(axes)
     columns = [AXES.index(axis) for axis in axes]
     errors = np.abs(attitude_errors_deg(result)[:, columns])
     mask = _after(result, after_s)
+    _no_nan("the attitude error", errors, mask, result)
     worst_per_axis = np.where(mask[:, None], errors, -np.inf).max(axis=0)
     k = int(np.argmax(worst_per_axis))
     i = _worst(errors[:, k], mask)
@@ -167,6 +205,7 @@ def assert_tracking(result, signal, setpoint, within: float, after_s: float = 0.
         A sample off the setpoint by more than ``within``; the message gives its time, the
         signal's value, the setpoint's, the difference, the bound and the seed.
     """
+    within = _number("within", within)
     name, values = _values(result, signal)
     if isinstance(setpoint, (int, float)):
         target_name, target = f"{setpoint:g}", np.full(len(result), float(setpoint))
@@ -178,6 +217,7 @@ def assert_tracking(result, signal, setpoint, within: float, after_s: float = 0.
 
         difference = wrapped(difference)
     mask = _after(result, after_s)
+    _no_nan(f"{name} - {target_name}", difference, mask, result)
     i = _worst(np.abs(difference), mask)
     unit = _unit(result, signal)
     if abs(difference[i]) > within:
@@ -291,9 +331,14 @@ def assert_step(result, signal, step_s: float, final: float | None = None, settl
         Too slow (the message gives the last sample outside the band: its time, value and the
         band) or too much overshoot (the peak's time and value, the bound), and the seed.
     """
+    settles_within_s = None if settles_within_s is None else _number("settles_within_s", settles_within_s)
+    if overshoot_below_percent is not None:
+        overshoot_below_percent = _number("overshoot_below_percent", overshoot_below_percent)
     name = signal if isinstance(signal, str) else signal[0]
     unit = _unit(result, signal)
     step = step_response(result, signal, step_s, final, band)
+    if math.isnan(step.overshoot_percent):
+        _fail(f"step of {name} at {step_s:g} s: the overshoot is NaN (the signal holds NaN)", result)
     half = band * abs(step.final - step.initial)
     low, high = step.final - half, step.final + half
     if settles_within_s is not None and not step.settling_time_s <= settles_within_s:
@@ -301,7 +346,7 @@ def assert_step(result, signal, step_s: float, final: float | None = None, settl
               f"{settles_within_s:g} s; the last sample outside the {100 * band:g} % band "
               f"[{low:.6g}, {high:.6g}]{unit} is {step.last_outside_value:.6g}{unit} at t = "
               f"{step.last_outside_time_s:.4f} s", result)
-    if overshoot_below_percent is not None and step.overshoot_percent > overshoot_below_percent:
+    if overshoot_below_percent is not None and not step.overshoot_percent <= overshoot_below_percent:
         _fail(f"step of {name} at {step_s:g} s from {step.initial:.6g} to {step.final:.6g}{unit}: overshoot "
               f"{step.overshoot_percent:.4g} %, above the bound {overshoot_below_percent:g} %; peak "
               f"{step.peak_value:.6g}{unit} at t = {step.peak_time_s:.4f} s", result)
@@ -336,7 +381,15 @@ def assert_bias_converges(result, within_s: float | None = None, tolerance: floa
     """
     from scenarios.tp import bias_convergence_time
 
-    error = np.asarray(result[estimate]) - np.asarray(result[truth])
+    tolerance = _number("tolerance", tolerance)
+    within_s = None if within_s is None else _number("within_s", within_s)
+    estimated = np.asarray(result[estimate], dtype=float)
+    if len(estimated) and np.isfinite(estimated).all() and (np.ptp(estimated, axis=0) == 0).all():
+        raise ValueError(f"{estimate} holds {estimated[0].tolist()} at every sample: this filter estimates no gyro "
+                         "bias, so its convergence cannot be checked; run a filter that estimates one (tp's "
+                         "estimator=passive or explicit with kI > 0)")
+    error = estimated - np.asarray(result[truth], dtype=float)
+    _no_nan(f"{estimate} - {truth}", error, np.ones(len(error), bool), result)
     converged = bias_convergence_time(result.time, error, tolerance)
     if converged is None or (within_s is not None and converged > within_s):
         outside = np.nonzero((np.abs(error) > tolerance).any(axis=1))[0][-1]
@@ -373,9 +426,14 @@ def assert_bounds(result, signal, lower: float | None = None, upper: float | Non
         A sample out of bounds; the message gives the component, its time, value, the bound and
         the seed.
     """
+    lower = None if lower is None else _number("lower", lower, magnitude=False)
+    upper = None if upper is None else _number("upper", upper, magnitude=False)
+    if lower is not None and upper is not None and lower > upper:
+        raise ValueError(f"lower={lower:g} is above upper={upper:g}: no value lies between them")
     name, values = _values(result, signal)
     table = values.reshape(len(result), -1)
     mask = _after(result, after_s)
+    _no_nan(name, table, mask, result)
     checked = table[mask]
     components = result.columns(name) if isinstance(signal, str) else [name]
     if len(components) != table.shape[1]:
@@ -420,6 +478,7 @@ def assert_runs_close(result, other, signals=None, atol: float = 0.0, rtol: floa
         Different sample times, or a sample beyond the tolerance; the message gives the signal,
         time, both values, the bound and the seeds of both runs.
     """
+    atol, rtol = _number("atol", atol), _number("rtol", rtol)
     if len(result) != len(other) or not np.array_equal(result.time, other.time):
         _fail(f"runs: different time samples ({len(result)} and {len(other)} samples, ending at "
               f"{result.time[-1]:g} and {other.time[-1]:g} s)", result)

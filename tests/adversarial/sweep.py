@@ -4,7 +4,9 @@ Surfaces: flight logs (truncated, bit-flipped, concatenated, shifted or repeated
 and garbage around them, FIFOs, folders, devices, sparse files, empty files, names that are not
 UTF-8) through ``log info``, ``log info --json``, ``log plot``, ``log replay`` and ``calibrate``;
 ``calibrate``'s options and ``--score`` files; ``plot``/``compare`` of damaged runs and into
-refused outputs; CSV setpoint profiles; ``--set`` gains; ``findings``; interrupts (SIGINT and
+refused outputs; CSV setpoint profiles; ``--set`` gains; ``findings``; the edges of one audit
+(FIFOs and devices read as inputs, replay's and bench's numbers, scenario options that misled,
+user estimators breaking the contract, ``--score`` files misread); interrupts (SIGINT and
 SIGTERM at several delays); two processes on one output folder; full disks.
 
 The cheap cases run in this process (``quadcosim.main.main``), each under an alarm: an exception
@@ -34,7 +36,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
-LOGS = ROOT.parent / "shared" / "data" / "flightlogs"
+LOGS = Path(os.environ.get("QUADCOSIM_FLIGHT_LOGS") or ROOT.parent / "shared" / "data" / "flightlogs")
 IN_PROCESS_LIMIT_S = 120
 PROCESS_LIMIT_S = 240
 EXITS = {0, 1, 2, 130, 143}
@@ -489,7 +491,79 @@ def sweep_full_disk(s: Sweep, logs: list[tuple[str, Path]]):
                         found["problem"] = found["problem"] or f"left {path.name}"
 
 
-SURFACES = ("logs", "calibrate", "plot", "profiles", "gains", "findings", "interrupts", "concurrency", "disk")
+ESTIMATORS = """
+from estimators.contract import AttitudeEstimator
+
+
+class Growing(AttitudeEstimator):
+    def update(self, acc, gyro, mag):
+        self.q = self.q * 1.01
+
+
+class Raising(AttitudeEstimator):
+    def update(self, acc, gyro, mag):
+        raise ZeroDivisionError("a bug of the user's")
+"""
+
+
+def sweep_edges(s: Sweep, logs: list[tuple[str, Path]]):
+    """The reads that hung or filled the memory, replay's and bench's numbers, scenario options
+    that misled, user estimators that broke the contract, --score files misread."""
+    folder = s.work / "edges"
+    folder.mkdir()
+    for name in ("fifo.json", "fifo.csv", "fifo.npz"):
+        os.mkfifo(folder / name)
+    (folder / "zero.npz").symlink_to("/dev/zero")
+    tp = ["run", "tp", "--set", "duration=0.5"]
+    for what, argv in (("calibration=/dev/zero", [*tp, "compensation=static", "calibration=/dev/zero"]),
+                       ("calibration= a FIFO", [*tp, "compensation=static", f"calibration={folder / 'fifo.json'}"]),
+                       ("metge static= a FIFO", ["run", "metge", "--set", f"static={folder / 'fifo.json'}"])):
+        s.process("reads", what, [*argv, "--out", s.folder()], limit=150)
+    for name in ("fifo.csv", "fifo.npz", "zero.npz"):
+        s.process("reads", f"replay {name}", ["replay", folder / name], limit=150)
+    run = _finished_run(s)
+    recording = folder / "rec.npz"
+    s.cli("replay", "a recording from tp", ["replay", "--from-tp", run, "--write", recording])
+    import numpy as np
+
+    with np.load(recording) as archive:
+        data = {k: archive[k] for k in archive.files}
+    variants = {"complex.npz": {"gyro": data["gyro"] * (1 + 1e-3j)},
+                "scored_text.npz": {"scored": np.array(["yes"] * len(data["gyro"]))},
+                "rate_1e308.npz": {"rate": np.array(1e308)},
+                "meta_list.npz": {"meta": np.array('{"estimator": ["explicit"]}')},
+                "gains_list.npz": {"meta": np.array('{"estimator": {"kind": "explicit", "gains": [1]}}')}}
+    for name, change in variants.items():
+        np.savez(folder / name, **(data | change))
+        s.cli("replay", name, ["replay", folder / name])
+    for options in (["--rate", "1e308"], ["--field-from-data", "1e308"], ["--field-from-data", "-1"],
+                    ["--dip", "1e308"], ["--out", "/proc/r.json"], ["--out", s.work / "absent" / "r.json"]):
+        s.cli("replay", " ".join(map(str, options)), ["replay", recording, *options])
+    for seconds in ("0", "-1", "nan", "1e-9", "1e308"):
+        s.cli("bench", f"--seconds {seconds}", ["bench", f"--seconds={seconds}"])
+    for what, argv in (("ir-calibration faults=gps in 60 s", ["run", "ir-calibration", "--set", "duration=60",
+                                                              "faults=gps"]),
+                       ("ir-calibration GPS for 0.001 s", ["run", "ir-calibration", "--set", "duration=10",
+                                                           "gps_resetting=false", "calibration_s=0.001"]),
+                       ("static-cal rates=1e6", ["run", "static-cal", "--set", "rates=1e6,0,0"]),
+                       ("static-cal rates=nan", ["run", "static-cal", "--set", "rates=nan,1,1"]),
+                       ("rig unclamped", ["run", "rig", "--set", "sweep=1", "free=1", "Quadrotor.clamped=false"]),
+                       ("metge unclamped", ["run", "metge", "--set", "Quadrotor.clamped=false"])):
+        s.cli("scenario options", what, [*argv, "--out", s.folder()])
+    (folder / "mine.py").write_text(ESTIMATORS)
+    for name in ("Growing", "Raising"):
+        s.cli("user estimator", name, [*tp, "--estimator", f"{folder / 'mine.py'}:{name}", "--out", s.folder()])
+    text = next(p for w, p in logs if w == "a whole synthetic text log")
+    for name, content in (("bom.parm", "\ufeffCOMPASS_MOTCT,2\nCOMPASS_MOT_X,-3\n"),
+                          ("twice.parm", "COMPASS_MOTCT,2\nCOMPASS_MOTCT,1\n"),
+                          ("other_compass.parm", "COMPASS_OFS2_X,100\n"),
+                          ("absurd.parm", "COMPASS_MOTCT,2\nCOMPASS_MOT_X,3e38\n")):
+        (folder / name).write_text(content, encoding="utf-8")
+        s.cli("calibrate --score", name, ["calibrate", text, "--score", folder / name, "--out", s.folder()])
+
+
+SURFACES = ("logs", "calibrate", "plot", "profiles", "gains", "findings", "edges", "interrupts", "concurrency",
+            "disk")
 
 
 def main(argv=None) -> int:
@@ -510,6 +584,7 @@ def main(argv=None) -> int:
         steps = {"logs": lambda: sweep_logs(s, logs), "calibrate": lambda: sweep_calibrate_options(s, logs),
                  "plot": lambda: sweep_plot_compare(s), "profiles": lambda: sweep_profiles(s),
                  "gains": lambda: sweep_gains(s), "findings": lambda: sweep_findings(s),
+                 "edges": lambda: sweep_edges(s, logs),
                  "interrupts": lambda: sweep_interrupts(s, logs), "concurrency": lambda: sweep_concurrency(s, logs),
                  "disk": lambda: sweep_full_disk(s, logs)}
         for name in chosen:

@@ -41,14 +41,14 @@ def test_files_no_reader_can_finish_are_refused_at_once(tmp_path, capsys, deadli
     os.mkfifo(fifo)
     folder = tmp_path / "flight.ulg"
     folder.mkdir()
-    cases = {fifo: "a FIFO (named pipe), not a log file",
+    cases = {fifo: "a FIFO (named pipe), not a regular file",
              _sparse(tmp_path / "sparse.ulg", b"ULog\x01\x12\x35" + bytes(100), 10_000_000_000):
                  "10.0 GB, more than the 1 GB quadcosim reads",
              _sparse(tmp_path / "holes.bin", b"\xa3\x95\x80" + bytes(100), 500_000_000):
                  "a sparse file (500 MB long, 0.0 MB stored)",
-             folder: "a folder, not a log"}
+             folder: "a folder, not a regular file"}
     if os.path.exists("/dev/zero"):
-        cases["/dev/zero"] = "a device, not a log file"
+        cases["/dev/zero"] = "a character device, not a regular file"
     for path, said in cases.items():
         started = time.monotonic()
         argv = [*command[:2], str(path), *command[2:]] if command[0] == "log" else [command[0], str(path),

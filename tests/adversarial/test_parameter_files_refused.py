@@ -29,7 +29,7 @@ def test_a_broken_parameter_file_is_refused_naming_the_line(tmp_path, content, n
 
 def test_a_fifo_or_a_folder_is_refused_without_blocking(tmp_path):
     os.mkfifo(tmp_path / "pipe.parm")  # opened for reading, it would block until a writer came
-    with pytest.raises(ValueError, match="pipe.parm: not a regular file"):
+    with pytest.raises(ValueError, match=r"pipe.parm: a FIFO \(named pipe\), not a regular file"):
         read_parameters(tmp_path / "pipe.parm")
     with pytest.raises(ValueError, match="not a regular file"):
         read_parameters(tmp_path)

@@ -48,4 +48,5 @@ def test_a_fifo_or_a_folder_is_named_as_not_a_file(tmp_path, capsys):
     for name in ("pipe.csv", "folder.csv"):
         assert cli([*RUN, f"flight={tmp_path / name}", "--out", str(tmp_path / "run")]) == 2
         err = capsys.readouterr().err
-        assert f"flight={tmp_path / name}: not a regular file" in err and "no such file" not in err
+        kind = "a FIFO (named pipe)" if name == "pipe.csv" else "a folder"
+        assert f"flight={tmp_path / name}: {kind}, not a regular file" in err and "no such file" not in err
