@@ -76,6 +76,16 @@ _CALLBACKS.freeMemory = fmi2CallbackFreeMemoryTYPE(ctypes.CDLL(None).free)
 addLoggerProxy(ctypes.byref(_CALLBACKS))
 
 
+def status_name(status: int) -> str:
+    """The name of an FMI status, or the number an FMU returned that is no status at all."""
+    return STATUS[status] if 0 <= status < 6 else f"{status} (no FMI status: taken as a failure)"
+
+
+def failed(status: int) -> bool:
+    """Whether an FMI call failed: any status but OK and Warning (-1 is no success)."""
+    return not 0 <= status <= 1
+
+
 class FMUError(RuntimeError):
     """An FMU refused a call: the block, the time, the status and what the FMU logged.
 
@@ -98,7 +108,7 @@ class FMUError(RuntimeError):
         when = "" if time is None else f" at t = {time:.6g} s"
         logged = "\n  ".join(log[-10:]) if log else "(the FMU logged nothing)"
         super().__init__(
-            f"{block}: {function} returned {STATUS[status] if 0 <= status < 6 else status}{when}.\n"
+            f"{block}: {function} returned {status_name(status)}{when}.\n"
             f"  FMU log:\n  {logged}"
         )
 
@@ -126,7 +136,7 @@ class ParameterRefused(FMUError, ValueError):
         logged = "\n  ".join(error.log[-10:]) if error.log else "(the FMU logged nothing)"
         ValueError.__init__(
             self, f"{model} refused its parameters at initialisation ({error.function} returned "
-                  f"{STATUS[error.status] if 0 <= error.status < 6 else error.status}). Values set: {given}.\n"
+                  f"{status_name(error.status)}). Values set: {given}.\n"
                   f"  FMU log:\n  {logged}\n"
                   f"Give a value in the range the log names (`quadcosim list --parameters {model}` lists each "
                   f"parameter's default and unit).")
@@ -166,8 +176,13 @@ def fmu_file(model) -> Path:
     if not path.is_file():
         raise FileNotFoundError(f"FMU file {model} not found (looked at {path}); give the path of an .fmu file, or "
                                 "a built model's name (IMU, Quadrotor, MotorMagnetics)")
+    from orchestrator.fmu_checks import FMURefused, check_archive, check_file
+
     try:
+        check_archive(path)  # before the description is read: no entry of a zip bomb is expanded
         description = model_description(path)
+    except FMURefused:
+        raise
     except Exception as error:  # fmpy raises several kinds on a file that is not an FMU
         raise ValueError(f"{model} is not a readable FMU: {error}") from None
     if not str(description.fmiVersion).startswith("2."):
@@ -176,6 +191,7 @@ def fmu_file(model) -> Path:
     if description.coSimulation is None:
         raise ValueError(f"{model} is an FMI 2.0 Model Exchange FMU only; the master runs Co-Simulation FMUs "
                          "(export for FMI 2.0 Co-Simulation, with its own solver)")
+    check_file(path, description)
     return path
 
 
@@ -403,7 +419,7 @@ class FMUInstance:
         buffer = np.ascontiguousarray(values, dtype=np.float64)
         status = self.raw_set_real(self.component_arg, ctypes.c_void_p(refs.ctypes.data), ctypes.c_size_t(len(refs)),
                                    ctypes.c_void_p(buffer.ctypes.data))
-        if status > 1:
+        if failed(status):
             raise FMUError(self.name, "fmi2SetReal", status, self.time, list(self.log))
 
     def get(self, names) -> np.ndarray:
@@ -423,7 +439,7 @@ class FMUInstance:
         buffer = np.empty(len(refs))
         status = self.raw_get_real(self.component_arg, ctypes.c_void_p(refs.ctypes.data), ctypes.c_size_t(len(refs)),
                                    ctypes.c_void_p(buffer.ctypes.data))
-        if status > 1:
+        if failed(status):
             raise FMUError(self.name, "fmi2GetReal", status, self.time, list(self.log))
         return buffer
 
@@ -438,7 +454,7 @@ class FMUInstance:
             Step size (s), positive.
         """
         status = self.raw_do_step(self.component_arg, ctypes.c_double(t), ctypes.c_double(h), ctypes.c_int(1))
-        if status > 1:
+        if failed(status):
             raise FMUError(self.name, "fmi2DoStep", status, t, list(self.log))
         self.time = t + h
 

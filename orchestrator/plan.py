@@ -296,7 +296,13 @@ class Plan:
         except _Failure as failure:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
-            message = str(error)
+            from orchestrator.isolated import worker_failure
+
+            message, interrupted = worker_failure(self.fmus, error)
+            if interrupted is not None:  # a signal ended a request to a worker: the run was interrupted
+                message = f"interrupted by {signal_name(interrupted)} at t = {self.t0 + self.n * self.dt:.6g} s"
+                raise RunInterrupted(message, self.result(error=message), interrupted) from None
+            message = message or str(error)
             if "not a finite number" in message:
                 message = self._non_finite(self.t0 + self.n * self.dt) + "\n" + message
             raise SimulationError(message, self.result(error=message)) from None

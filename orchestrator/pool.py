@@ -65,17 +65,79 @@ def acquire(model: str, parameters: dict | None = None, name: str | None = None,
     -------
     orchestrator.fmu.FMUInstance
     """
-    from orchestrator.fmu import FMUInstance, fmu_file
+    from orchestrator.fmu import fmu_file
+    from orchestrator.isolated import open_instance
 
     if _enabled:
         path = fmu_file(model)
+        if not _reset_verified(path, parameters, name, start_time):
+            return open_instance(model, parameters, name=name, start_time=start_time)
         with _lock:
             stack = _idle.get(_key(path))
             instance = stack.pop() if stack else None
         if instance is not None:
             instance.reset(parameters, name=name, start_time=start_time)
             return instance
-    return FMUInstance(model, parameters, name=name, start_time=start_time)
+    return open_instance(model, parameters, name=name, start_time=start_time)
+
+
+#: The step of the reset check (s), and the number of steps that move the state before the reset.
+CHECK_STEP, CHECK_STEPS = 1e-3, 10
+_verified: dict[tuple, bool] = {}
+
+
+def _reset_verified(path, parameters, name, start_time) -> bool:
+    """Whether the reset of the FMU at ``path`` makes an instance that steps as a fresh one.
+
+    The project's own FMUs are checked by ``tests/test_fmu_reset.py``. Any other is checked once
+    per process: one instance steps once from its start; another is driven (every Real input
+    at 0.5) for :data:`CHECK_STEPS` steps, reset, and steps once. Its outputs must equal the
+    first's, bit for bit. An FMU that fails is never pooled (a fresh instance for every run),
+    which a warning says once.
+    """
+    import warnings
+
+    import numpy as np
+
+    from orchestrator.isolated import is_own, open_instance
+
+    key = _key(path)
+    if key in _verified:
+        return _verified[key]
+    if is_own(path):
+        _verified[key] = True
+        return True
+    fresh = driven = None
+    reason = None
+    try:
+        fresh = open_instance(path, parameters, name=name, start_time=start_time)
+        outputs = [n for n in fresh.outputs if fresh.variables[n].type == "Real"]
+        inputs = [n for n in fresh.inputs if fresh.variables[n].type == "Real"]
+        fresh.step(start_time, CHECK_STEP)
+        expected = fresh.get(outputs)
+        driven = open_instance(path, parameters, name=name, start_time=start_time)
+        if inputs:
+            driven.set(inputs, np.full(len(inputs), 0.5))
+        for k in range(CHECK_STEPS):
+            driven.step(start_time + k * CHECK_STEP, CHECK_STEP)
+        driven.reset(parameters, name=name, start_time=start_time)
+        driven.step(start_time, CHECK_STEP)
+        got = driven.get(outputs)
+        if not np.array_equal(expected, got, equal_nan=True):
+            worst = int(np.argmax(np.abs(np.nan_to_num(expected - got, nan=np.inf))))
+            reason = (f"after a reset, one step gives {outputs[worst]} = {got[worst]!r} where a fresh instance "
+                      f"gives {expected[worst]!r}")
+    except Exception as error:  # a reset refused, or a call that fails: not poolable
+        reason = f"its reset check failed: {error}".splitlines()[0]
+    finally:
+        for instance in (fresh, driven):
+            if instance is not None:
+                instance.close()
+    _verified[key] = reason is None
+    if reason is not None:
+        warnings.warn(f"{path.name}: fmi2Reset does not reproduce a fresh instance ({reason}); each run instantiates "
+                      "it afresh instead of reusing a pooled one", RuntimeWarning, stacklevel=3)
+    return _verified[key]
 
 
 def release(instance) -> None:

@@ -165,6 +165,20 @@ def _run(args) -> int:
             return exit_code(interrupt)
 
 
+def _isolation(args):
+    """``--watchdog`` and ``--fmu-in-process`` as the settings :mod:`orchestrator.isolated` reads
+    (environment variables: a sweep's worker processes inherit them)."""
+    import os
+
+    if args.watchdog is not None:
+        if not 0 < args.watchdog < float("inf"):
+            raise ValueError(f"--watchdog {args.watchdog}: give the wall seconds an FMU step may take, a positive "
+                             "number (e.g. 5)")
+        os.environ["QUADCOSIM_FMU_WATCHDOG"] = repr(args.watchdog)
+    if args.fmu_in_process:
+        os.environ["QUADCOSIM_FMU_IN_PROCESS"] = "1"
+
+
 def _run_reporting(args) -> int:
     from orchestrator.progress import status
 
@@ -177,6 +191,7 @@ def _run_reporting(args) -> int:
     from scenarios.plant import figure_format
 
     try:
+        _isolation(args)
         faults = [_parse_fault(f) for f in args.fault or []]
         with figure_format(args.figures):
             _, metrics = scenarios.run(args.scenario, _settings(args), out, progress=True, faults=faults,
@@ -387,6 +402,12 @@ def _add_run(sub):
                      help="put an FMU of your own (any FMI 2.0 Co-Simulation exporter) in the place of a plant "
                           "block: MotorMagnetics=my_motor.fmu; its inputs and outputs are checked against the "
                           "block's by name and unit, mismatches listed")
+    run.add_argument("--watchdog", type=float, default=None, metavar="SECONDS",
+                     help="end the run when a step of an FMU of your own (--fmu) takes longer than this, in wall "
+                          "seconds (default: no limit; Ctrl-C always stops it)")
+    run.add_argument("--fmu-in-process", action="store_true",
+                     help="run FMUs of your own in this process, not each in a worker process of its own: faster, "
+                          "for an FMU you trust (a crash in it then ends quadcosim)")
     run.add_argument("--overwrite", action="store_true", help="replace the results already in the --out folder")
     run.add_argument("--decimation", type=_positive_int, default=1, metavar="N",
                      help="record every N-th macro step (default 1)")

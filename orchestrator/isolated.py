@@ -1,0 +1,545 @@
+"""An FMU in a worker process of its own: a crash, an exit or a hang of the FMU ends the run
+with a message, not the master.
+
+An FMU this project did not build (:func:`is_own`) runs isolated by default. The worker hosts
+the same :class:`orchestrator.fmu.FMUInstance` a block uses in process: the same set-up,
+parameters, log and raw FMI functions. The master sees an :class:`IsolatedInstance`, whose raw
+functions (``orchestrator/c/isolated.c``) have the signatures of ``fmi2SetReal``,
+``fmi2GetReal`` and ``fmi2DoStep``, so that the call runner and the chunk runner call them as
+they call an FMU in process. Values travel through a shared memory mapping (``memfd``: nothing
+is left in ``/dev/shm`` whatever ends the process); each request is one byte on a pipe and its
+reply one byte back, so a macro step costs one round trip between the processes, no pickles.
+Set-up, reset and the end go through a pickled message on a socket, once per run.
+
+Settings, read when a block instantiates its FMU:
+
+``QUADCOSIM_FMU_WATCHDOG``
+    Wall seconds one request to the worker (a step, a read, or its set-up) may take; beyond
+    them the worker is stopped and the run fails, naming the block and the FMU. Unset: no limit
+    (Ctrl-C and SIGTERM stop a hanging FMU all the same).
+``QUADCOSIM_FMU_IN_PROCESS``
+    ``1``: run foreign FMUs in process too (a trusted FMU, for speed).
+
+``quadcosim run`` sets both from ``--watchdog`` and ``--fmu-in-process``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+import hashlib
+import mmap
+import os
+import signal
+import socket
+import subprocess
+import sys
+from multiprocessing.connection import Connection
+from pathlib import Path
+
+from orchestrator.fmu import FMUError, FMUInstance, FMULog, fmu_file, model_description
+
+SOURCE = Path(__file__).resolve().parent / "c" / "isolated.c"
+LIBRARY_NAME = "libquadcosim_isolated.so"
+OP_PYTHON = 4
+FAILURE_NONE, FAILURE_ENDED, FAILURE_WATCHDOG, FAILURE_INTERRUPTED = range(4)
+FUNCTIONS = ("fmi2SetReal", "fmi2GetReal", "fmi2DoStep")
+START_SECONDS = 60.0  # the worker's own start (Python, numpy, fmpy), before any FMU code runs
+CLOSE_SECONDS = 5.0  # fmi2Terminate and fmi2FreeInstance at the end: a worker slower than this is killed
+
+
+class _Proxy(ctypes.Structure):
+    """The master's side of one worker, laid out as ``Proxy`` in ``isolated.c``."""
+
+    _fields_ = [("shared", ctypes.c_void_p), ("request_fd", ctypes.c_int), ("reply_fd", ctypes.c_int),
+                ("watchdog_ms", ctypes.c_int), ("failure", ctypes.c_int), ("function", ctypes.c_int)]
+
+
+@functools.cache
+def library() -> ctypes.CDLL:
+    """``orchestrator/c/isolated.c`` compiled (next to the call runner, on first use), loaded once."""
+    from orchestrator.calls import compile_shared, runner_dir
+
+    path = runner_dir() / LIBRARY_NAME
+    if not path.is_file() or path.stat().st_mtime < SOURCE.stat().st_mtime:
+        compile_shared(SOURCE, path)
+    lib = ctypes.CDLL(str(path))
+    lib.shared_size.restype = lib.proxy_size.restype = ctypes.c_long
+    lib.shared_size.argtypes = [ctypes.c_long]
+    lib.shared_init.argtypes = [ctypes.c_void_p, ctypes.c_long]
+    lib.proxy_request.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+    lib.serve.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int] + [ctypes.c_void_p] * 4
+    for name in ("proxy_request", "serve", "proxy_set_real", "proxy_get_real", "proxy_do_step"):
+        getattr(lib, name).restype = ctypes.c_int
+    return lib
+
+
+# ---------------------------------------------------------------------- which FMUs are own
+@functools.lru_cache(maxsize=64)
+def _digest(path: str, mtime_ns: int, size: int) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def digest(path) -> str:
+    """SHA-256 of a file, computed once per version of it (path, modification time, size)."""
+    stat = Path(path).stat()
+    return _digest(str(path), stat.st_mtime_ns, stat.st_size)
+
+
+def is_own(path) -> bool:
+    """Whether the FMU file ``path`` is one this project built: byte for byte one of the plant
+    models in the build folder (:func:`fmus.default_fmu_dir`), whatever its name or place.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An ``.fmu`` file.
+
+    Returns
+    -------
+    bool
+        True for the project's own FMUs, which run in process; False for any other.
+    """
+    from fmus import MODELS, default_fmu_dir
+
+    path = Path(path).absolute()
+    folder = default_fmu_dir()
+    built = [folder / f"{name}.fmu" for name in MODELS if (folder / f"{name}.fmu").is_file()]
+    if path in built:
+        return True
+    size = path.stat().st_size
+    return any(f.stat().st_size == size and digest(f) == digest(path) for f in built)
+
+
+def watchdog_seconds() -> float | None:
+    """The watchdog's wall seconds per request (``$QUADCOSIM_FMU_WATCHDOG``), or None."""
+    text = os.environ.get("QUADCOSIM_FMU_WATCHDOG", "").strip()
+    if not text:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        raise ValueError(f"QUADCOSIM_FMU_WATCHDOG={text!r}: give the wall seconds an FMU step may take, a positive "
+                         "number (e.g. 5)")
+    return value
+
+
+def runs_isolated(path, isolated: bool | None = None) -> bool:
+    """Whether the FMU at ``path`` runs in a worker process: ``isolated`` if given, else a
+    foreign FMU does unless ``$QUADCOSIM_FMU_IN_PROCESS`` is ``1``."""
+    if isolated is not None:
+        return bool(isolated)
+    if os.environ.get("QUADCOSIM_FMU_IN_PROCESS", "").strip() in ("1", "true", "yes"):
+        return False
+    return not is_own(path)
+
+
+# ---------------------------------------------------------------------- the master's side
+class WorkerFailed(FMUError):
+    """The worker of an isolated FMU crashed, exited, or outlasted the watchdog."""
+
+
+class IsolatedInstance(FMUInstance):
+    """An :class:`orchestrator.fmu.FMUInstance` run by a worker process: the same interface
+    (value references, ``set``, ``get``, ``step``, ``reset``, ``close``, the raw functions and
+    ``component`` the runners call).
+
+    Parameters
+    ----------
+    model : str or pathlib.Path
+        Path of an ``.fmu`` file (or a built model's name).
+    parameters : dict, optional
+        Overrides of parameter start values, by variable name.
+    name : str, optional
+        Instance (block) name used in messages.
+    start_time : float
+        Start time (s).
+    watchdog : float, optional
+        Wall seconds one request may take; :func:`watchdog_seconds` by default.
+
+    Raises
+    ------
+    orchestrator.fmu_checks.FMURefused
+        The FMU refused to start (a ``ValueError``: the command line exits 2).
+    WorkerFailed
+        The worker crashed, exited or hung during the set-up.
+    """
+
+    def __init__(self, model, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0,
+                 watchdog: float | None = None):
+        from orchestrator.fmu import _unzip
+
+        self.closed, self.process = True, None
+        path = fmu_file(model)
+        self.path, self.name, self.time = path, name or path.stem, start_time
+        self.log = FMULog()
+        self.description = description = model_description(path)
+        self.variables = {v.name: v for v in description.modelVariables}
+        self.parameters = [v.name for v in description.modelVariables if v.causality == "parameter"]
+        self.inputs = [v.name for v in description.modelVariables if v.causality == "input"]
+        self.outputs = [v.name for v in description.modelVariables if v.causality == "output"]
+        self.overrides = overrides = self._check_parameters(parameters or {})
+        self.watchdog = watchdog_seconds() if watchdog is None else watchdog
+        self.failure_text = None
+        lib = library()
+        capacity = max(16, sum(v.type == "Real" for v in description.modelVariables))
+        self._memfd = os.memfd_create("quadcosim-fmu", os.MFD_CLOEXEC)
+        size = lib.shared_size(capacity)
+        os.ftruncate(self._memfd, size)
+        self._map = mmap.mmap(self._memfd, size)
+        self._view = ctypes.c_char.from_buffer(self._map)
+        lib.shared_init(ctypes.addressof(self._view), capacity)
+        request_r, request_w = os.pipe2(os.O_CLOEXEC)
+        reply_r, reply_w = os.pipe2(os.O_CLOEXEC)
+        ours, theirs = socket.socketpair()
+        self._fds = [request_w, reply_r]
+        self._control = Connection(ours.detach())
+        child = theirs.detach()
+        directory = _unzip(path)  # here: the master's exit removes it, however the worker ends
+        try:
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "orchestrator.isolated", str(child), str(request_r), str(reply_w),
+                 str(self._memfd)],
+                pass_fds=(child, request_r, reply_w, self._memfd), stdin=subprocess.DEVNULL,
+                start_new_session=True)  # the terminal's Ctrl-C reaches the master alone
+        finally:
+            for fd in (child, request_r, reply_w):
+                os.close(fd)
+        self._proxy = _Proxy(ctypes.addressof(self._view), request_w, reply_r,
+                             int(round(self.watchdog * 1000)) if self.watchdog else 0, 0, 0)
+        self.component = ctypes.addressof(self._proxy)
+        self.component_arg = ctypes.c_void_p(self.component)
+        self.raw_set_real, self.raw_get_real, self.raw_do_step = (
+            lib.proxy_set_real, lib.proxy_get_real, lib.proxy_do_step)
+        self.closed = False
+        try:
+            self._ask(("ready",), "its start", limit=START_SECONDS)  # Python and fmpy loaded: no FMU code yet
+            self._ask(("open", str(path), directory, overrides, self.name, start_time), "its set-up")
+        except BaseException:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------------ control messages
+    def _ask(self, message: tuple, doing: str, limit: float | None = None):
+        """Send a control message and return the worker's answer; an error it reports is raised
+        here as the master's own, a worker that ends or hangs as a refusal (:class:`FMURefused`:
+        these requests come before the loop)."""
+        from orchestrator.fmu_checks import FMURefused
+
+        try:
+            return self._control_request(message, doing, limit)
+        except WorkerFailed as error:
+            raise FMURefused(f"{self.name}: {error.log[0]}") from None
+
+    def _control_request(self, message: tuple, doing: str, limit: float | None):
+        if self._proxy.failure:
+            raise self._failed(doing, None)
+        if message[0] != "ready":
+            os.write(self._fds[0], bytes([OP_PYTHON]))
+            self._control.send(message)
+        limit = self.watchdog if limit is None else limit
+        try:
+            if not self._control.poll(None if limit in (None, float("inf")) else limit):
+                self._proxy.failure = FAILURE_WATCHDOG
+                raise self._failed(doing, None)
+            answer = self._control.recv()
+        except (EOFError, OSError):
+            self._proxy.failure = FAILURE_ENDED
+            raise self._failed(doing, None) from None
+        except KeyboardInterrupt:  # the worker is busy with the request: it is killed, not asked again
+            self._proxy.failure = FAILURE_INTERRUPTED
+            raise
+        if answer[0] == "error":
+            raise _rebuild(answer[1], self)
+        return answer[1]
+
+    def _failed(self, doing: str, t: float | None) -> WorkerFailed:
+        """The failure of the worker, its text kept for :meth:`explain`."""
+        return WorkerFailed(self.name, doing, 4, t, [self.what_happened(doing)])
+
+    def what_happened(self, doing: str) -> str:
+        """What became of the worker while it was ``doing`` a call: crashed (by which signal),
+        exited (with which code), outlasted the watchdog, or was interrupted."""
+        if self.failure_text is not None:
+            return self.failure_text
+        failure = self._proxy.failure
+        fmu = self.path.name
+        if failure == FAILURE_WATCHDOG:
+            self._kill()
+            text = (f"{fmu} did not return from {doing} within the watchdog's {self.watchdog:g} s "
+                    "(QUADCOSIM_FMU_WATCHDOG, --watchdog); its process was stopped")
+        elif failure == FAILURE_INTERRUPTED:
+            self._kill()
+            text = f"{fmu} was stopped in {doing} by an interrupt"
+        else:
+            code = self._reap()
+            if code is None:
+                text = f"{fmu}'s process stopped answering in {doing}"
+            elif code < 0:
+                name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else f"signal {-code}"
+                cause = {"SIGSEGV": " (a segmentation fault: the FMU read or wrote memory it does not own)",
+                         "SIGABRT": " (the FMU called abort)", "SIGBUS": " (a bus error)",
+                         "SIGFPE": " (an arithmetic fault)", "SIGKILL": " (killed from outside)"}.get(name, "")
+                text = f"{fmu} crashed in {doing}: its process was killed by {name}{cause}"
+            else:
+                text = f"{fmu} ended its process in {doing} with exit code {code} (the FMU called exit)"
+        kept = " The record is kept up to the last good step;" if doing in FUNCTIONS else ""
+        self.failure_text = text + f".{kept} Run the FMU in fmpy (fmpy simulate) or ask its exporter for a fixed one."
+        return self.failure_text
+
+    def explain(self, error: FMUError) -> str | None:
+        """The message of a run this instance's worker ended: the block, the FMU and what
+        happened; None when the worker did not fail (the FMU returned an error status)."""
+        if not self._proxy.failure:
+            return None
+        doing = FUNCTIONS[self._proxy.function] if 0 <= self._proxy.function < 3 else error.function
+        when = "" if error.time is None else f" at t = {error.time:.6g} s"
+        return f"{self.name} ({self.path}, run in its own process){when}: {self.what_happened(doing)}"
+
+    @property
+    def interrupted(self) -> bool:
+        """Whether a signal ended the last request (the master raises it)."""
+        return self._proxy.failure == FAILURE_INTERRUPTED
+
+    def _reap(self) -> int | None:
+        try:
+            return self.process.wait(timeout=2.0)
+        except subprocess.TimeoutExpired:
+            self._kill()
+            return None
+
+    def _kill(self):
+        if self.process is not None and self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+
+    # ------------------------------------------------------------------ FMUInstance's life cycle
+    def reset(self, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0):
+        """As :meth:`orchestrator.fmu.FMUInstance.reset`, in the worker."""
+        self.overrides = overrides = self._check_parameters(parameters or {})
+        self.name, self.time = name or self.path.stem, start_time
+        self.log.clear()
+        self.log.warnings, self.log.first_warnings = 0, []
+        try:
+            self._ask(("reset", overrides, self.name, start_time), "fmi2Reset")
+        except BaseException:
+            self.close()
+            raise
+
+    def fetch_log(self):
+        """Copy the worker's log (messages, warnings) into :attr:`log`."""
+        if self.closed or self._proxy.failure:
+            return
+        messages, warnings, first = self._ask(("log",), "its log")
+        self.log.clear()
+        self.log.extend(messages)
+        self.log.warnings, self.log.first_warnings = warnings, first
+
+    def close(self):
+        """End the worker: terminate and free the FMU there (a worker that failed is killed),
+        then release the pipes and the shared memory."""
+        if self.closed:
+            return
+        self.closed = True
+        try:
+            if self.process is not None and self.process.poll() is None and not self._proxy.failure:
+                self.watchdog = min(self.watchdog or CLOSE_SECONDS, CLOSE_SECONDS)
+                try:
+                    messages, warnings, first = self._ask(("close",), "fmi2Terminate")
+                    self.log.clear()
+                    self.log.extend(messages)
+                    self.log.warnings, self.log.first_warnings = warnings, first
+                    self.process.wait(timeout=5.0)
+                except (FMUError, ValueError, subprocess.TimeoutExpired, OSError):
+                    pass
+        finally:
+            self._kill()
+            self._control.close()
+            for fd in self._fds:
+                os.close(fd)
+            self._fds = []
+            del self._view
+            self._map.close()
+            os.close(self._memfd)
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+def worker_failure(blocks, error: FMUError) -> tuple[str | None, int | None]:
+    """The message of a run that ``error`` ended, when a worker failed under it.
+
+    Parameters
+    ----------
+    blocks : list of orchestrator.FMUBlock
+        The run's FMU blocks, their instances live.
+    error : orchestrator.fmu.FMUError
+        What the runner raised.
+
+    Returns
+    -------
+    message : str or None
+        The block, the FMU and what happened to its worker; None when no worker failed.
+    interrupted : int or None
+        The signal that ended the request (the run was interrupted, not failed), else None.
+    """
+    from orchestrator.interrupts import stopping
+
+    for block in blocks:
+        instance = getattr(block, "instance", None)
+        if isinstance(instance, IsolatedInstance) and block.name == error.block and instance._proxy.failure:
+            if instance.interrupted:
+                instance.what_happened(error.function)
+                return None, stopping() or int(signal.SIGINT)
+            return instance.explain(error), None
+    return None, None
+
+
+def _rebuild(error: tuple, instance: IsolatedInstance) -> Exception:
+    """The master's exception for an error the worker reported as ``(kind, message, fields)``."""
+    from orchestrator.fmu import ParameterRefused
+    from orchestrator.fmu_checks import FMURefused
+
+    kind, message, fields = error
+    if kind == "FMUError":
+        return FMUError(instance.name, fields["function"], fields["status"], fields["time"], fields["log"])
+    if kind == "ParameterRefused":
+        inner = FMUError(instance.name, fields["function"], fields["status"], fields["time"], fields["log"])
+        return ParameterRefused(inner, instance.overrides, instance.path.stem)
+    if kind == "FMURefused":
+        return FMURefused(message)
+    if kind in ("KeyError", "TypeError", "ValueError"):
+        return {"KeyError": KeyError, "TypeError": TypeError, "ValueError": ValueError}[kind](message)
+    return RuntimeError(f"{instance.name} ({instance.path.name}, in its worker process): {kind}: {message}")
+
+
+def open_instance(model, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0,
+                  isolated: bool | None = None) -> FMUInstance:
+    """An initialized instance of ``model``: in a worker process for a foreign FMU
+    (:func:`runs_isolated`), else in process; its set-up refusals as
+    :class:`orchestrator.fmu_checks.FMURefused`.
+
+    Parameters
+    ----------
+    model : str or pathlib.Path
+        A built model's name or an ``.fmu`` path.
+    parameters, name, start_time
+        As for :class:`orchestrator.fmu.FMUInstance`.
+    isolated : bool, optional
+        Force the choice; by default :func:`runs_isolated` decides.
+
+    Returns
+    -------
+    orchestrator.fmu.FMUInstance
+        Or its :class:`IsolatedInstance`.
+    """
+    from orchestrator.fmu_checks import probe, refused_at_start
+
+    path = fmu_file(model)
+    own = is_own(path)
+    if isolated if isolated is not None else runs_isolated(path) if not own else False:
+        instance = IsolatedInstance(path, parameters, name=name, start_time=start_time)
+    else:
+        try:
+            instance = FMUInstance(model, parameters, name=name, start_time=start_time)
+        except Exception as error:
+            refusal = refused_at_start(error, name or path.stem, path)
+            if refusal is None:
+                raise
+            raise refusal from None
+    if not own:
+        try:
+            probe(instance, [n for n in instance.inputs + instance.outputs if instance.variables[n].type == "Real"])
+        except BaseException:
+            instance.close()
+            raise
+    return instance
+
+
+# ---------------------------------------------------------------------- the worker's side
+def _describe(error: BaseException) -> tuple:
+    fields = {}
+    if isinstance(error, FMUError):
+        fields = {"function": error.function, "status": error.status, "time": error.time, "log": list(error.log)}
+    return type(error).__name__, str(error), fields
+
+
+def _answer(message: tuple, instance):
+    """The worker's instance after a control message, and its answer."""
+    from orchestrator import fmu as module
+    from orchestrator.fmu_checks import refused_at_start
+
+    kind = message[0]
+    if kind == "open":
+        _, path, directory, overrides, name, start_time = message
+        module._extracted[(path, Path(path).stat().st_mtime)] = directory  # the master's copy
+        try:
+            return FMUInstance(path, overrides, name=name, start_time=start_time), None
+        except Exception as error:
+            refusal = refused_at_start(error, name, Path(path))
+            raise refusal if refusal is not None else error from None
+    if kind == "reset":
+        _, overrides, name, start_time = message
+        instance.reset(overrides, name=name, start_time=start_time)
+        return instance, None
+    if kind in ("log", "close"):
+        log = instance.log if instance is not None else FMULog()
+        if kind == "close" and instance is not None:
+            instance.close()
+        return instance, (list(log), log.warnings, list(log.first_warnings))
+    raise ValueError(f"unknown request {kind!r}")
+
+
+def _worker(control_fd: int, request_fd: int, reply_fd: int, memfd: int):
+    """Serve one FMU instance for the master at the other end of the descriptors."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the master decides; it kills this process
+    try:  # and this process ends with the master, whatever ends it
+        ctypes.CDLL(None).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (AttributeError, OSError):
+        pass
+    if os.getppid() == 1:
+        os._exit(0)
+    control = Connection(control_fd)
+    control.send(("ok", None))  # started: the watchdog counts the FMU's time from here
+    shared = mmap.mmap(memfd, 0)
+    view = ctypes.c_char.from_buffer(shared)
+    lib = library()
+    instance = None
+    address = ctypes.addressof(view)
+
+    def pointer(function) -> int:
+        return ctypes.cast(function, ctypes.c_void_p).value
+
+    while True:
+        if instance is None:
+            code = OP_PYTHON if os.read(request_fd, 1) == bytes([OP_PYTHON]) else 0
+        else:
+            code = lib.serve(address, request_fd, reply_fd, pointer(instance.raw_set_real),
+                             pointer(instance.raw_get_real), pointer(instance.raw_do_step), instance.component)
+        if code != OP_PYTHON:
+            break
+        try:
+            message = control.recv()
+        except EOFError:
+            break
+        kind = message[0]
+        try:
+            instance, answer = _answer(message, instance)
+            control.send(("ok", answer))
+        except Exception as error:
+            control.send(("error", _describe(error)))
+            if kind == "open":
+                break
+        if kind == "close":
+            break
+    control.close()
+    os._exit(0)  # no exit handlers: the extracted folder is the master's to remove
+
+
+if __name__ == "__main__":
+    _worker(*(int(a) for a in sys.argv[1:5]))
