@@ -384,7 +384,8 @@ def worker_failure(blocks, error: FMUError) -> tuple[str | None, int | None]:
     Returns
     -------
     message : str or None
-        The block, the FMU and what happened to its worker; None when no worker failed.
+        The block, the FMU and what happened to its worker, or the FMU's error with its file
+        named for an FMU given by path; None otherwise (the error's own message stands).
     interrupted : int or None
         The signal that ended the request (the run was interrupted, not failed), else None.
     """
@@ -397,6 +398,9 @@ def worker_failure(blocks, error: FMUError) -> tuple[str | None, int | None]:
                 instance.what_happened(error.function)
                 return None, stopping() or int(signal.SIGINT)
             return instance.explain(error), None
+        if block.name == error.block and str(block.model).lower().endswith(".fmu"):  # a user's FMU: named
+            text = str(error)
+            return f"{block.name} ({Path(block.model).name}):{text[len(block.name) + 1:]}", None
     return None, None
 
 

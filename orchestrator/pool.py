@@ -4,9 +4,12 @@ A sweep worker runs many members of one scenario: instantiating the same FMUs fo
 more than some members' stepping. With reuse on (:func:`reuse`, which each sweep worker turns
 on), a run's FMU blocks take an idle instance of their model, reset it (``fmi2Reset``, then the
 usual set-up and initialization: :meth:`orchestrator.fmu.FMUInstance.reset`) and give it back
-when the run ends. The FMUs' reset reproduces a fresh instance bit for bit, which
-``tests/test_fmu_reset.py`` checks model by model and on whole runs. With reuse off (the
-default) every run instantiates its FMUs and frees them at its end.
+when the run ends. The project's FMUs' reset reproduces a fresh instance bit for bit, which
+``tests/test_fmu_reset.py`` checks model by model and on whole runs. Any other FMU is pooled
+only once this process has seen its reset do so (:func:`_reset_verified`); one whose reset does
+not (a reset that resets nothing, or fails) is instantiated afresh for every run, and a warning
+says so once. With reuse off (the default) every run instantiates its FMUs and frees them at
+its end.
 """
 
 from __future__ import annotations
@@ -141,14 +144,15 @@ def _reset_verified(path, parameters, name, start_time) -> bool:
 
 
 def release(instance) -> None:
-    """Give back an instance after a run: kept idle when reuse is on, else freed.
+    """Give back an instance after a run: kept idle when reuse is on and its FMU's reset is
+    verified (:func:`_reset_verified`), else freed.
 
     Parameters
     ----------
     instance : orchestrator.fmu.FMUInstance
     """
-    if not _enabled or instance.closed:
-        instance.close()
+    if not _enabled or instance.closed or not _verified.get(_key(instance.path), False):
+        instance.close()  # an FMU whose reset is not verified is never kept
         return
     with _lock:
         _idle.setdefault(_key(instance.path), []).append(instance)
