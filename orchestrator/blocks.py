@@ -271,9 +271,13 @@ class FMUBlock:
         Parameter overrides, by FMU variable name.
     period : int
         Runs every ``period`` macro steps, with a communication step of ``period * dt``.
+    isolated : bool, optional
+        Run the FMU in a worker process of its own (True) or in this one (False); by default an
+        FMU this project did not build runs isolated (:mod:`orchestrator.isolated`).
     """
 
-    def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
+    def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1,
+                 isolated: bool | None = None):
         from orchestrator.fmu import fmu_file, model_description
 
         if int(period) != period or period < 1:
@@ -283,6 +287,7 @@ class FMUBlock:
         self.model = str(self.path) if is_path(model) else (model or name)  # a file: its absolute path
         self.parameters = dict(parameters or {})
         self.period = int(period)
+        self.isolated = isolated
         description = model_description(self.path)
         variables = description.modelVariables
         self.inputs = tuple(v.name for v in variables if v.causality == "input" and v.type == "Real")
@@ -319,7 +324,8 @@ class FMUBlock:
         """
         from orchestrator import pool
 
-        self.instance = pool.acquire(self.model, self.parameters, name=self.name, start_time=t0)
+        self.instance = pool.acquire(self.model, self.parameters, name=self.name, start_time=t0,
+                                     isolated=self.isolated)
         return self.instance
 
     def close(self):

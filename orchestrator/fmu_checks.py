@@ -64,7 +64,13 @@ def check_file(path: Path, description) -> None:
 def check_archive(path: Path) -> None:
     """Refuse an archive with an entry that leaves its folder, or that expands beyond the
     limits :data:`EXTRACT_LIMIT_BYTES` and :data:`RATIO_LIMIT` (read from its directory,
-    before anything is extracted; the extraction reads no more than the sizes listed)."""
+    before anything is extracted; the extraction reads no more than the sizes listed).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.fmu`` file.
+    """
     with zipfile.ZipFile(path) as archive:
         entries = archive.infolist()
     for entry in entries:
@@ -87,7 +93,15 @@ def check_archive(path: Path) -> None:
 
 
 def check_identifier(path: Path, identifier: str) -> None:
-    """Refuse a model identifier that is not a plain file name (the binary's name)."""
+    """Refuse a model identifier that is not a plain file name (the binary's name).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.fmu`` file.
+    identifier : str
+        Its ``modelIdentifier``.
+    """
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", identifier or ""):
         raise FMURefused(f"{path.name}: its modelIdentifier {identifier!r} is not a plain name (a C identifier, "
                          "the binary's file name without a path): the FMU is refused; export it again with a "
@@ -96,7 +110,15 @@ def check_identifier(path: Path, identifier: str) -> None:
 
 def check_binary(path: Path, identifier: str) -> None:
     """Refuse an FMU without a binary this machine can load: none for ``linux64``, or one for
-    another processor. Read from the archive, before anything is extracted or loaded."""
+    another processor. Read from the archive, before anything is extracted or loaded.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.fmu`` file.
+    identifier : str
+        Its ``modelIdentifier``: the binary's name.
+    """
     with zipfile.ZipFile(path) as archive:
         names = archive.namelist()
         platforms = sorted({n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2
@@ -123,7 +145,15 @@ def check_binary(path: Path, identifier: str) -> None:
 def check_references(path: Path, description) -> None:
     """Refuse value references that make the wiring lie: two inputs on one, an output on the
     reference of an input or a parameter (it would read back what the master set, not what
-    the model computes)."""
+    the model computes).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.fmu`` file.
+    description : fmpy.model_description.ModelDescription
+        Its model description.
+    """
     by_ref: dict[tuple[str, int], list] = {}
     for variable in description.modelVariables:
         by_ref.setdefault((variable.type, variable.valueReference), []).append(variable)

@@ -52,7 +52,32 @@ class _Proxy(ctypes.Structure):
     """The master's side of one worker, laid out as ``Proxy`` in ``isolated.c``."""
 
     _fields_ = [("shared", ctypes.c_void_p), ("request_fd", ctypes.c_int), ("reply_fd", ctypes.c_int),
-                ("watchdog_ms", ctypes.c_int), ("failure", ctypes.c_int), ("function", ctypes.c_int)]
+                ("watchdog_ms", ctypes.c_int), ("failure", ctypes.c_int), ("function", ctypes.c_int),
+                ("wake_fd", ctypes.c_int), ("spin_skip", ctypes.c_long), ("spin_backoff", ctypes.c_long)]
+
+
+_wake: list[int] = []  # the read end of the signal wake-up pipe this module set, once per process
+
+
+def wake_fd() -> int:
+    """A pipe Python writes a byte into when a signal arrives (:func:`signal.set_wakeup_fd`), so
+    that a master waiting on a worker wakes at Ctrl-C; -1 outside the main thread, or when
+    another library (an asyncio loop) holds the wake-up descriptor."""
+    import threading
+
+    if _wake:
+        return _wake[0] if signal.set_wakeup_fd(-1) == _wake[1] and signal.set_wakeup_fd(_wake[1]) == -1 else -1
+    if threading.current_thread() is not threading.main_thread():
+        return -1
+    read, write = os.pipe2(os.O_NONBLOCK | os.O_CLOEXEC)
+    previous = signal.set_wakeup_fd(write, warn_on_full_buffer=False)
+    if previous != -1:  # someone else's: theirs stays
+        signal.set_wakeup_fd(previous)
+        os.close(read)
+        os.close(write)
+        return -1
+    _wake.extend((read, write))
+    return read
 
 
 @functools.cache
@@ -68,8 +93,9 @@ def library() -> ctypes.CDLL:
     lib.shared_size.argtypes = [ctypes.c_long]
     lib.shared_init.argtypes = [ctypes.c_void_p, ctypes.c_long]
     lib.proxy_request.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+    lib.proxy_post.argtypes = [ctypes.c_void_p, ctypes.c_int]
     lib.serve.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int] + [ctypes.c_void_p] * 4
-    for name in ("proxy_request", "serve", "proxy_set_real", "proxy_get_real", "proxy_do_step"):
+    for name in ("proxy_request", "proxy_post", "serve", "proxy_set_real", "proxy_get_real", "proxy_do_step"):
         getattr(lib, name).restype = ctypes.c_int
     return lib
 
@@ -138,7 +164,22 @@ def runs_isolated(path, isolated: bool | None = None) -> bool:
 
 # ---------------------------------------------------------------------- the master's side
 class WorkerFailed(FMUError):
-    """The worker of an isolated FMU crashed, exited, or outlasted the watchdog."""
+    """The worker of an isolated FMU crashed, exited, or outlasted the watchdog: an
+    :class:`orchestrator.fmu.FMUError` whose log holds what happened.
+
+    Parameters
+    ----------
+    block : str
+        Block (instance) name.
+    function : str
+        The FMI function, or the set-up request, under way.
+    status : int
+        4 (Fatal).
+    time : float or None
+        Communication time of the call (s).
+    log : list of str
+        What happened to the worker.
+    """
 
 
 class IsolatedInstance(FMUInstance):
@@ -208,7 +249,7 @@ class IsolatedInstance(FMUInstance):
             for fd in (child, request_r, reply_w):
                 os.close(fd)
         self._proxy = _Proxy(ctypes.addressof(self._view), request_w, reply_r,
-                             int(round(self.watchdog * 1000)) if self.watchdog else 0, 0, 0)
+                             int(round(self.watchdog * 1000)) if self.watchdog else 0, 0, 0, wake_fd())
         self.component = ctypes.addressof(self._proxy)
         self.component_arg = ctypes.c_void_p(self.component)
         self.raw_set_real, self.raw_get_real, self.raw_do_step = (
@@ -237,7 +278,9 @@ class IsolatedInstance(FMUInstance):
         if self._proxy.failure:
             raise self._failed(doing, None)
         if message[0] != "ready":
-            os.write(self._fds[0], bytes([OP_PYTHON]))
+            if library().proxy_post(ctypes.byref(self._proxy), OP_PYTHON) < 0:
+                self._proxy.failure = FAILURE_ENDED
+                raise self._failed(doing, None)
             self._control.send(message)
         limit = self.watchdog if limit is None else limit
         try:
@@ -317,7 +360,17 @@ class IsolatedInstance(FMUInstance):
 
     # ------------------------------------------------------------------ FMUInstance's life cycle
     def reset(self, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0):
-        """As :meth:`orchestrator.fmu.FMUInstance.reset`, in the worker."""
+        """As :meth:`orchestrator.fmu.FMUInstance.reset`, in the worker.
+
+        Parameters
+        ----------
+        parameters : dict, optional
+            Overrides of parameter start values, by variable name.
+        name : str, optional
+            Instance (block) name used in messages.
+        start_time : float
+            Start time (s).
+        """
         self.overrides = overrides = self._check_parameters(parameters or {})
         self.name, self.time = name or self.path.stem, start_time
         self.log.clear()
@@ -520,8 +573,8 @@ def _worker(control_fd: int, request_fd: int, reply_fd: int, memfd: int):
         return ctypes.cast(function, ctypes.c_void_p).value
 
     while True:
-        if instance is None:
-            code = OP_PYTHON if os.read(request_fd, 1) == bytes([OP_PYTHON]) else 0
+        if instance is None:  # the first request, Python's
+            code = lib.serve(address, request_fd, reply_fd, None, None, None, None)
         else:
             code = lib.serve(address, request_fd, reply_fd, pointer(instance.raw_set_real),
                              pointer(instance.raw_get_real), pointer(instance.raw_do_step), instance.component)

@@ -49,7 +49,8 @@ def _key(path) -> tuple:
     return str(path), path.stat().st_mtime_ns
 
 
-def acquire(model: str, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0):
+def acquire(model: str, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0,
+            isolated: bool | None = None):
     """An initialized instance of ``model``: an idle one reset, when reuse is on and one is
     idle, else a new one. The arguments are those of :class:`orchestrator.fmu.FMUInstance`.
 
@@ -63,6 +64,8 @@ def acquire(model: str, parameters: dict | None = None, name: str | None = None,
         Instance (block) name used in messages.
     start_time : float
         Start time (s).
+    isolated : bool, optional
+        In a worker process or not; by default :func:`orchestrator.isolated.runs_isolated` decides.
 
     Returns
     -------
@@ -74,14 +77,14 @@ def acquire(model: str, parameters: dict | None = None, name: str | None = None,
     if _enabled:
         path = fmu_file(model)
         if not _reset_verified(path, parameters, name, start_time):
-            return open_instance(model, parameters, name=name, start_time=start_time)
+            return open_instance(model, parameters, name=name, start_time=start_time, isolated=isolated)
         with _lock:
             stack = _idle.get(_key(path))
             instance = stack.pop() if stack else None
         if instance is not None:
             instance.reset(parameters, name=name, start_time=start_time)
             return instance
-    return open_instance(model, parameters, name=name, start_time=start_time)
+    return open_instance(model, parameters, name=name, start_time=start_time, isolated=isolated)
 
 
 #: The step of the reset check (s), and the number of steps that move the state before the reset.

@@ -11,6 +11,7 @@
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
   quadcosim bench pytest [--json]          cost of a short test written with the pytest plugin
+  quadcosim bench isolation [--json]       cost of an FMU run in a worker process of its own
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
@@ -309,6 +310,10 @@ def _bench(args) -> int:
         from benchmarks import sweep
 
         return sweep.main(["--json"] if args.json else [])
+    if args.suite == "isolation":
+        from benchmarks import isolation
+
+        return isolation.main(["--json"] if args.json else [])
     if args.suite == "pytest":
         from benchmarks import pytest_cost
 
@@ -348,11 +353,12 @@ def parser() -> argparse.ArgumentParser:
                          "diagram.png)")
     diagram.set_defaults(func=_diagram)
     bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
-                                         "pytest plugin")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"),
+                                         "pytest plugin, an FMU in a worker process")
+    bench.add_argument("suite", nargs="?", default="master",
+                       choices=("master", "infrared", "sweep", "pytest", "isolation"),
                        help="what to time: master (the co-simulation loop, the default), infrared (the IR "
-                            "calibration's cost per update), sweep (40 closed-loop runs on Dask) or pytest (the "
-                            "pytest plugin's fixtures)")
+                            "calibration's cost per update), sweep (40 closed-loop runs on Dask), pytest (the "
+                            "pytest plugin's fixtures) or isolation (an FMU in a worker process against in process)")
     bench.add_argument("--json", action="store_true",
                        help="print the measurements as one JSON object on standard output instead of a table")
     bench.add_argument("--seconds", type=float, default=5.0, metavar="S",
