@@ -264,7 +264,7 @@ def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
             apply_faults(taps, bus, t)
         now.value = t
         status = run(array, count, now, failed_ref)
-        if status > 1:
+        if not 0 <= status <= 1:  # -1, or any number that is no FMI status, is a failure
             call = calls[failed.value]
             raise FMUError(call.block.name, call.function, status, t, list(call.block.instance.log))
     return phase
