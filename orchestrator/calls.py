@@ -219,8 +219,10 @@ class DoStep:
 
     @property
     def function(self) -> str:
-        """The FMI function it calls, for messages."""
-        return self.entry.label
+        """The FMI function it failed in, for messages (of an isolated FMU, an input set kept
+        for the step may be the one)."""
+        failed = getattr(self.entry.keep, "failed_function", None)
+        return failed() if failed is not None else self.entry.label
 
 
 FMICall = SetInputs | GetOutputs | DoStep
