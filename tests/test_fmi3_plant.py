@@ -33,7 +33,8 @@ def test_an_fmi3_plant_fmu_by_path_gives_the_fmi2_record(model, fmi2_run, tmp_pa
                  "--out", str(out)]) == 0
     result = Result.load(out / "results.npz")
     assert len(result) == len(fmi2_run) == round(float(DURATION) / 1e-3) + 1
-    renamed = {f"IMU.{v}_{c}": f"IMU.{v}_{k}" for v in ("acc", "gyro", "magneto") for k, c in zip("123", "xyz", strict=True)}
+    renamed = {f"IMU.{v}_{c}": f"IMU.{v}_{k}" for v in ("acc", "gyro", "magneto")
+               for k, c in zip("123", "xyz", strict=True)}
     for name in fmi2_run.names:
         ours = renamed.get(name, name) if model == "IMU" else name
         assert np.array_equal(result[ours], fmi2_run[name]), name
