@@ -321,3 +321,61 @@ def test_a_refused_typed_set_names_its_function(typed_fmus, isolated):
     system.set_input("T.v", 0.0)
     with pytest.raises(SimulationError, match=r"^T \(Types3\.fmu\): fmi3SetUInt16 returned Error at t = 0 s"):
         system.run(10 * DT)
+
+
+@pytest.fixture(scope="session")
+def lying_fmus(tmp_path_factory):
+    """The test models whose step returns -1 (no FMI status) from t = 0.1 s."""
+    return {v: build(f"types{v}", tmp_path_factory.mktemp(f"lying{v}"), defines=("LYING_STEP",)) for v in (2, 3)}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("master", ["chunk", "step"])
+def test_a_step_that_returns_minus_one_fails_the_run(lying_fmus, version, master, isolated):
+    """-1 is no FMI status: the run fails at the step that returned it, in both FMI versions,
+    both masters, in process and isolated, and the record keeps every step before it."""
+    from orchestrator import SimulationError
+
+    system = System(dt=DT)
+    block = system.add(FMUBlock("T", model=lying_fmus[version], isolated=isolated))
+    for name in block.inputs:
+        system.set_input(f"T.{name}", 1.0)
+    with pytest.raises(SimulationError) as caught:
+        system.run(0.3, master=master)
+    message = str(caught.value)
+    assert f"fmi{version}DoStep returned -1 (no FMI status: taken as a failure) at t = 0.1 s" in message, message
+    result = caught.value.result
+    assert len(result) == 101 and result.time[-1] == pytest.approx(0.1, abs=1e-12)
+    assert result["T.x"][-1] > 0  # the steps before it ran: the integrator moved
+
+
+def _moved_binary(source: Path, target: Path, rename: dict | None = None, machine: int | None = None):
+    """A copy of an FMU with its binaries renamed (``{old: new}``), or its ELF machine changed."""
+    with zipfile.ZipFile(source) as zin, zipfile.ZipFile(target, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if machine is not None and item.filename.endswith(".so"):
+                data = data[:18] + machine.to_bytes(2, "little") + data[20:]
+            zout.writestr((rename or {}).get(item.filename, item.filename), data)
+
+
+@pytest.mark.parametrize("change, said", [
+    ({"rename": {"binaries/x86_64-linux/Types3.so": "binaries/x86_64-windows/Types3.dll"}},
+     "this FMU has no x86_64-linux binary (it has x86_64-windows): export it for Linux"),
+    ({"rename": {"binaries/x86_64-linux/Types3.so": "binaries/aarch64-linux/Types3.so"}},
+     "this FMU has no x86_64-linux binary (it has aarch64-linux): export it for Linux"),
+    ({"machine": 183}, "its x86_64-linux binary is built for aarch64; this machine runs x86_64"),
+], ids=["windows_only", "aarch64_folder", "aarch64_elf"])
+def test_an_fmi3_fmu_without_a_binary_for_this_machine_is_refused(typed_fmus, tmp_path, capsys, change, said):
+    """FMI 3.0 names its platform folders ``x86_64-linux``, ``x86_64-windows``, ``aarch64-linux``:
+    the refusal (exit 2, nothing written) names the folder it looked for and the ones it found."""
+    import platform
+
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        pytest.skip("the refusals name an x86_64 machine")
+    moved = tmp_path / "moved.fmu"
+    _moved_binary(typed_fmus[3], moved, **change)
+    assert main(["run", "open-loop", "--set", "duration=0.1", "--fmu", f"MotorMagnetics={moved}",
+                 "--out", str(tmp_path / "x")]) == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
