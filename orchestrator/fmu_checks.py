@@ -109,8 +109,18 @@ def check_identifier(path: Path, identifier: str) -> None:
 
 
 def platform_folder(fmi_version: int) -> str:
-    """The ``binaries/`` folder of this machine's Linux binary: ``linux64`` in FMI 2.0,
-    ``x86_64-linux`` (``aarch64-linux`` on an ARM machine) in FMI 3.0."""
+    """The ``binaries/`` folder of this machine's Linux binary.
+
+    Parameters
+    ----------
+    fmi_version : {2, 3}
+        The FMU's FMI version.
+
+    Returns
+    -------
+    str
+        ``linux64`` in FMI 2.0, ``x86_64-linux`` (``aarch64-linux`` on an ARM machine) in FMI 3.0.
+    """
     return PLATFORM if fmi_version == 2 else f"{_MACHINES[_HOST]}-linux"
 
 

@@ -349,13 +349,32 @@ class IsolatedInstance(FMUInstance):
 
     # ------------------------------------------------------------------ set-up and tests, by name
     def set(self, names, values):
-        """Set inputs by signal name (:meth:`orchestrator.fmu.FMUInstance.set`), in the worker."""
+        """Set inputs by signal name (:meth:`orchestrator.fmu.FMUInstance.set`), in the worker.
+
+        Parameters
+        ----------
+        names : sequence of str
+            Signal names.
+        values : array_like
+            Their values (SI), as float64.
+        """
         import numpy as np
 
         self._call("set", list(names), np.asarray(values, dtype=np.float64).reshape(-1))
 
     def get(self, names):
-        """Signals by name, as float64 (:meth:`orchestrator.fmu.FMUInstance.get`), from the worker."""
+        """Signals by name, as float64 (:meth:`orchestrator.fmu.FMUInstance.get`), from the worker.
+
+        Parameters
+        ----------
+        names : sequence of str
+            Signal names.
+
+        Returns
+        -------
+        ndarray
+            Their present values.
+        """
         return self._call("get", list(names))
 
     def step(self, t: float, h: float):
