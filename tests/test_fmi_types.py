@@ -379,3 +379,22 @@ def test_an_fmi3_fmu_without_a_binary_for_this_machine_is_refused(typed_fmus, tm
                  "--out", str(tmp_path / "x")]) == 2
     assert said in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_an_fmi3_fmu_that_crashes_in_its_worker_ends_the_run_with_its_record(tmp_path):
+    """A segmentation fault in ``fmi3DoStep`` of an isolated FMI 3.0 FMU: the run fails naming the
+    block, the FMU, fmi3DoStep and SIGSEGV, and keeps the 101 samples before it."""
+    from orchestrator import SimulationError
+
+    crashing = build("types3", tmp_path, defines=("CRASHING_STEP",))
+    system = System(dt=DT)
+    block = system.add(FMUBlock("T", model=crashing))  # a foreign FMU: isolated by default
+    for name in block.inputs:
+        system.set_input(f"T.{name}", 1.0)
+    with pytest.raises(SimulationError) as caught:
+        system.run(0.3)
+    message = str(caught.value)
+    assert message.startswith(f"T ({crashing}, run in its own process) at t = 0.1 s: Types3.fmu crashed in "
+                              "fmi3DoStep: its process was killed by SIGSEGV"), message
+    result = caught.value.result
+    assert len(result) == 101 and result["T.steps"][-1] == 100
