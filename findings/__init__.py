@@ -36,6 +36,7 @@ GROUPS = (
     "gain_study",
     "gain_ablation",
     "speed",
+    "isolation",
     "sweep_cost",
     "flightlogs",
     "magfit",

@@ -272,6 +272,9 @@ class FMUBlock:
         Parameter overrides, by FMU variable name.
     period : int
         Runs every ``period`` macro steps, with a communication step of ``period * dt``.
+    isolated : bool, optional
+        Run the FMU in a worker process of its own (True) or in this one (False); by default an
+        FMU this project did not build runs isolated (:mod:`orchestrator.isolated`).
 
     Attributes
     ----------
@@ -280,7 +283,8 @@ class FMUBlock:
         record keeps it, and its files store the signal with it.
     """
 
-    def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1):
+    def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1,
+                 isolated: bool | None = None):
         from orchestrator.fmi_types import dtypes, is_parameter, signals, unit
         from orchestrator.fmu import fmu_file, model_description
 
@@ -291,6 +295,7 @@ class FMUBlock:
         self.model = str(self.path) if is_path(model) else (model or name)  # a file: its absolute path
         self.parameters = dict(parameters or {})
         self.period = int(period)
+        self.isolated = isolated
         description = model_description(self.path)
         variables = description.modelVariables
         inputs, outputs = signals(description, "input"), signals(description, "output")
@@ -335,7 +340,8 @@ class FMUBlock:
         """
         from orchestrator import pool
 
-        self.instance = pool.acquire(self.model, self.parameters, name=self.name, start_time=t0)
+        self.instance = pool.acquire(self.model, self.parameters, name=self.name, start_time=t0,
+                                     isolated=self.isolated)
         return self.instance
 
     def close(self):

@@ -221,8 +221,10 @@ class DoStep:
 
     @property
     def function(self) -> str:
-        """The FMI function it calls, for messages."""
-        return self.entry.label
+        """The FMI function it failed in, for messages (of an isolated FMU, an input set kept
+        for the step may be the one)."""
+        failed = getattr(self.entry.keep, "failed_function", None)
+        return failed() if failed is not None else self.entry.label
 
 
 FMICall = SetInputs | GetOutputs | DoStep
@@ -266,7 +268,7 @@ def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
             apply_faults(taps, bus, t)
         now.value = t
         status = run(array, count, now, failed_ref)
-        if status > 1:
+        if not 0 <= status <= 1:  # -1, or any number that is no FMI status, is a failure
             call = calls[failed.value]
             raise FMUError(call.block.name, call.function, status, t, list(call.block.instance.log))
     return phase

@@ -181,8 +181,10 @@ class ChunkRunner:
         dt, t0 = plan.dt, plan.t0
         while True:
             end = self._chunk_end()
-            code = run_chunk(pointer, end)
-            plan.n, plan.recorded = program.n, program.recorded
+            try:
+                code = run_chunk(pointer, end)
+            finally:  # a signal raised as the call returns leaves the record's length known too
+                plan.n, plan.recorded = program.n, program.recorded
             if plan.stream is not None and plan.recorded - plan.record_first == len(plan.record):
                 plan.flush()  # the window is full: to disk, and the next rows start at record[0]
                 program.record_first = plan.record_first

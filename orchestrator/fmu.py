@@ -51,7 +51,15 @@ from orchestrator.fmi_types import (
     typed_entry,
     types_of,
 )
-from orchestrator.fmu_errors import STATUS, FMUError, FMULog, ParameterRefused, keep  # noqa: F401 (public here too)
+from orchestrator.fmu_errors import (  # noqa: F401 (public here too)
+    STATUS,
+    FMUError,
+    FMULog,
+    ParameterRefused,
+    failed,
+    keep,
+    status_name,
+)
 
 _extracted: dict[tuple[str, float], str] = {}
 _logs: dict[bytes, FMULog] = {}  # instance name -> its log
@@ -109,8 +117,13 @@ def fmu_file(model) -> Path:
     if not path.is_file():
         raise FileNotFoundError(f"FMU file {model} not found (looked at {path}); give the path of an .fmu file, or "
                                 "a built model's name (IMU, Quadrotor, MotorMagnetics)")
+    from orchestrator.fmu_checks import FMURefused, check_archive, check_file
+
     try:
+        check_archive(path)  # before the description is read: no entry of a zip bomb is expanded
         description = model_description(path)
+    except FMURefused:
+        raise
     except Exception as error:  # fmpy raises several kinds on a file that is not an FMU
         raise ValueError(f"{model} is not a readable FMU: {error}") from None
     version = str(description.fmiVersion)
@@ -125,6 +138,7 @@ def fmu_file(model) -> Path:
         raise ValueError(f"{model} has clocks ({', '.join(clocks)}): the master runs FMI 3.0 Co-Simulation without "
                          "event mode, which clocks need. Export the FMU without clocks (its clocked partitions "
                          "sampled at a fixed rate of its own)")
+    check_file(path, description)
     return path
 
 
@@ -493,7 +507,7 @@ class FMUInstance:
             refs = self.vr(names)
             status = self.raw_set_real(self.component_arg, ctypes.c_void_p(refs.ctypes.data),
                                        ctypes.c_size_t(len(refs)), ctypes.c_void_p(buffer.ctypes.data))
-            if status > 1:
+            if failed(status):
                 raise FMUError(self.name, "fmi2SetReal", status, self.time, list(self.log))
             return
         self._run(names, buffer, "Set")
@@ -517,7 +531,7 @@ class FMUInstance:
             refs = self.vr(names)
             status = self.raw_get_real(self.component_arg, ctypes.c_void_p(refs.ctypes.data),
                                        ctypes.c_size_t(len(refs)), ctypes.c_void_p(buffer.ctypes.data))
-            if status > 1:
+            if failed(status):
                 raise FMUError(self.name, "fmi2GetReal", status, self.time, list(self.log))
             return buffer
         self._run(names, buffer, "Get")
@@ -537,7 +551,7 @@ class FMUInstance:
         addresses = [buffer_all.ctypes.data + 8 * k for k in range(len(signals_))]
         for entry in self._entries([s.name for s in signals_], addresses, direction):
             status = _SET_OR_GET(entry.function)(entry.component, entry.vr, entry.n, entry.values)
-            if status > 1:
+            if failed(status):
                 raise FMUError(self.name, entry.label, status, self.time, list(self.log))
         if buffer_all is not buffer:
             buffer[:] = buffer_all[:len(buffer)]
@@ -553,7 +567,7 @@ class FMUInstance:
             Step size (s), positive.
         """
         status = self.raw_do_step(self.component_arg, ctypes.c_double(t), ctypes.c_double(h), ctypes.c_int(1))
-        if status > 1:
+        if failed(status):
             raise FMUError(self.name, "fmi2DoStep", status, t, list(self.log))
         self.time = t + h
 
@@ -661,7 +675,7 @@ class FMU3Instance(FMUInstance):
     def step(self, t: float, h: float):
         """Advance one communication step from ``t`` (s) by ``h`` (s)."""
         status = self._step_call(self._step.component, t, h, 1)
-        if status > 1:
+        if failed(status):
             raise FMUError(self.name, "fmi3DoStep", status, t, list(self.log))
         self.time = t + h
 

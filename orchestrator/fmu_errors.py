@@ -10,6 +10,17 @@ STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 TERMINATED = 6
 
 
+def status_name(status: int) -> str:
+    """The name of an FMI status, or the number an FMU returned that is no status at all."""
+    return STATUS[status] if 0 <= status < 6 else f"{status} (no FMI status: taken as a failure)"
+
+
+def failed(status: int) -> bool:
+    """Whether an FMI call failed: any status but OK and Warning (-1 is no success, nor is
+    :data:`TERMINATED`)."""
+    return not 0 <= status <= 1
+
+
 class FMULog(deque):
     """The last messages of one FMU instance, with a count of its warnings and the first few
     of them (a warning, such as a saturated command, is kept even when later messages push it
@@ -66,7 +77,7 @@ class FMUError(RuntimeError):
         self.block, self.function, self.status, self.time, self.log = block, function, status, time, log
         when = "" if time is None else f" at t = {time:.6g} s"
         logged = "\n  ".join(log[-10:]) if log else "(the FMU logged nothing)"
-        what = (f"returned {STATUS[status] if 0 <= status < 6 else status}" if status != TERMINATED else
+        what = (f"returned {status_name(status)}" if status != TERMINATED else
                 "asked to end the simulation (terminateSimulation, or an early return the master did not allow)")
         super().__init__(f"{block}: {function} {what}{when}.\n  FMU log:\n  {logged}")
 
@@ -94,7 +105,7 @@ class ParameterRefused(FMUError, ValueError):
         logged = "\n  ".join(error.log[-10:]) if error.log else "(the FMU logged nothing)"
         ValueError.__init__(
             self, f"{model} refused its parameters at initialisation ({error.function} returned "
-                  f"{STATUS[error.status] if 0 <= error.status < 6 else error.status}). Values set: {given}.\n"
+                  f"{status_name(error.status)}). Values set: {given}.\n"
                   f"  FMU log:\n  {logged}\n"
                   f"Give a value in the range the log names (`quadcosim list --parameters {model}` lists each "
                   f"parameter's default and unit).")

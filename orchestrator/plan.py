@@ -307,7 +307,13 @@ class Plan:
         except _Failure as failure:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
-            message = str(error)
+            from orchestrator.isolated import worker_failure
+
+            message, interrupted = worker_failure(self.fmus, error)
+            if interrupted is not None:  # a signal ended a request to a worker: the run was interrupted
+                message = f"interrupted by {signal_name(interrupted)} at t = {self.t0 + self.n * self.dt:.6g} s"
+                raise RunInterrupted(message, self.result(error=message), interrupted) from None
+            message = message or str(error)
             instance = getattr(self.system.blocks.get(error.block), "instance", None)
             if error.status == 2 and instance is not None and instance.terminated():
                 message = f"{error.block}: the FMU asked to end the simulation ({error.function} returned Discard, " \

@@ -11,6 +11,7 @@
   quadcosim bench infrared [--json]        IR calibration: operations per iteration, us per update
   quadcosim bench sweep [--json]           sweep engine: 40 closed-loop runs on 1 and 2 Dask workers
   quadcosim bench pytest [--json]          cost of a short test written with the pytest plugin
+  quadcosim bench isolation [--json]       cost of an FMU run in a worker process of its own
   quadcosim sweep SCENARIO [--grid k=a:b:logN]... [--set k=v]... [--seeds N] [--workers N | --scheduler ADDR]
                   [--out DIR] [--resume]  the scenario over a grid, on Dask (see `quadcosim sweep -h`)
   quadcosim sweep-plot DIR METRIC --x OPTION [--by OPTION]   a metric of a sweep against an option
@@ -176,6 +177,20 @@ def _run(args) -> int:
             return exit_code(interrupt)
 
 
+def _isolation(args):
+    """``--watchdog`` and ``--fmu-in-process`` as the settings :mod:`orchestrator.isolated` reads
+    (environment variables: a sweep's worker processes inherit them)."""
+    import os
+
+    if args.watchdog is not None:
+        if not 0 < args.watchdog < float("inf"):
+            raise ValueError(f"--watchdog {args.watchdog}: give the wall seconds an FMU step may take, a positive "
+                             "number (e.g. 5)")
+        os.environ["QUADCOSIM_FMU_WATCHDOG"] = repr(args.watchdog)
+    if args.fmu_in_process:
+        os.environ["QUADCOSIM_FMU_IN_PROCESS"] = "1"
+
+
 def _run_reporting(args) -> int:
     from orchestrator.progress import status
 
@@ -188,6 +203,7 @@ def _run_reporting(args) -> int:
     from scenarios.plant import figure_format
 
     try:
+        _isolation(args)
         faults = [_parse_fault(f) for f in args.fault or []]
         with figure_format(args.figures):
             _, metrics = scenarios.run(args.scenario, _settings(args), out, progress=True, faults=faults,
@@ -306,6 +322,10 @@ def _bench(args) -> int:
         from benchmarks import sweep
 
         return sweep.main(["--json"] if args.json else [])
+    if args.suite == "isolation":
+        from benchmarks import isolation
+
+        return isolation.main(["--json"] if args.json else [])
     if args.suite == "pytest":
         from benchmarks import pytest_cost
 
@@ -356,11 +376,12 @@ def parser() -> argparse.ArgumentParser:
                          "diagram.png)")
     diagram.set_defaults(func=_diagram)
     bench = sub.add_parser("bench", help="benchmarks: co-simulation master, IR calibration cost, sweep engine, "
-                                         "pytest plugin")
-    bench.add_argument("suite", nargs="?", default="master", choices=("master", "infrared", "sweep", "pytest"),
+                                         "pytest plugin, an FMU in a worker process")
+    bench.add_argument("suite", nargs="?", default="master",
+                       choices=("master", "infrared", "sweep", "pytest", "isolation"),
                        help="what to time: master (the co-simulation loop, the default), infrared (the IR "
-                            "calibration's cost per update), sweep (40 closed-loop runs on Dask) or pytest (the "
-                            "pytest plugin's fixtures)")
+                            "calibration's cost per update), sweep (40 closed-loop runs on Dask), pytest (the "
+                            "pytest plugin's fixtures) or isolation (an FMU in a worker process against in process)")
     bench.add_argument("--json", action="store_true",
                        help="print the measurements as one JSON object on standard output instead of a table")
     bench.add_argument("--seconds", type=float, default=5.0, metavar="S",
@@ -405,6 +426,12 @@ def _add_run(sub):
                      help="put an FMU of your own (FMI 2.0 or 3.0 Co-Simulation, any exporter) in the place of a plant "
                           "block: MotorMagnetics=my_motor.fmu; its inputs and outputs are checked against the "
                           "block's by name and unit, mismatches listed")
+    run.add_argument("--watchdog", type=float, default=None, metavar="SECONDS",
+                     help="end the run when a step of an FMU of your own (--fmu) takes longer than this, in wall "
+                          "seconds (default: no limit; Ctrl-C always stops it)")
+    run.add_argument("--fmu-in-process", action="store_true",
+                     help="run FMUs of your own in this process, not each in a worker process of its own: faster, "
+                          "for an FMU you trust (a crash in it then ends quadcosim)")
     run.add_argument("--overwrite", action="store_true", help="replace the results already in the --out folder")
     run.add_argument("--decimation", type=_positive_int, default=1, metavar="N",
                      help="record every N-th macro step (default 1)")

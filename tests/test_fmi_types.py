@@ -1,8 +1,9 @@
 """Every FMI type, FMI 2.0 and 3.0 alike: the tests' own FMUs (``tests/typed_fmus``, built from C
 here) have an input and an output of each numeric type, arrays, String and Binary parameters and a
-counter that steps when an integrator crosses a threshold. Run by the master, their outputs equal
-fmpy's (``simulate_fmu``, same inputs, same step) to 1e-9, integers and Booleans exactly, and the
-record keeps each signal's type into its files."""
+counter that steps when an integrator crosses a threshold. Run by the master, in process and in a
+worker process of their own (:mod:`orchestrator.isolated`), their outputs equal fmpy's
+(``simulate_fmu``, same inputs, same step) to 1e-9, integers and Booleans exactly, and the record
+keeps each signal's type into its files."""
 
 import csv
 import json
@@ -29,6 +30,27 @@ def typed_fmus(tmp_path_factory):
     return {2: build("types2", folder), 3: build("types3", folder)}
 
 
+@pytest.fixture(params=[False, True], ids=["in_process", "isolated"])
+def isolated(request) -> bool:
+    """Run the test's FMU in process, then in a worker process of its own."""
+    return request.param
+
+
+@pytest.fixture
+def workers(monkeypatch) -> list:
+    """The FMU files of the worker processes started during the test."""
+    from orchestrator.isolated import IsolatedInstance
+
+    started, init = [], IsolatedInstance.__init__
+
+    def counted(self, model, *args, **kwargs):
+        started.append(Path(model).name)
+        init(self, model, *args, **kwargs)
+
+    monkeypatch.setattr(IsolatedInstance, "__init__", counted)
+    return started
+
+
 def _inputs(types: dict) -> np.ndarray:
     """Input signals at every step, one field per input, in the FMU's own types (fmpy's form)."""
     k = np.arange(STEPS + 1)
@@ -44,11 +66,11 @@ def _inputs(types: dict) -> np.ndarray:
     return signals
 
 
-def _system(path, signals, parameters: dict, master_vector=None) -> System:
+def _system(path, signals, parameters: dict, master_vector=None, isolated=None) -> System:
     names = list(signals.dtype.names[1:])
     system = System(dt=DT)
     system.add(Table("In", names, np.column_stack([signals[n].astype(float) for n in names])))
-    system.add(FMUBlock("T", model=path, parameters=parameters))
+    system.add(FMUBlock("T", model=path, parameters=parameters, isolated=isolated))
     for name in names:
         system.connect(f"In.{name}", f"T.{name}")
     if master_vector is not None:
@@ -71,7 +93,7 @@ TYPES2 = {"u": float, "k_in": np.int32, "b_in": np.bool_, "mode_in": np.int32}
 OUTPUTS2 = ["x", "counter", "k_sum", "flips", "above", "mode_out"]
 
 
-def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus):
+def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus, isolated, workers):
     """Real, Integer, Boolean and Enumeration inputs and outputs, a String parameter, a state that
     changes at events: the counter starts at 3, steps 13 times, and the Boolean it drives toggles."""
     import fmpy
@@ -81,8 +103,9 @@ def test_an_fmi2_fmu_of_every_type_equals_fmpy(typed_fmus):
     reference = fmpy.simulate_fmu(str(typed_fmus[2]), stop_time=STEPS * DT, output_interval=DT, input=signals,
                                   start_values=parameters, output=OUTPUTS2)
     with pytest.warns(RuntimeWarning, match=r"T: tag, note are String or Binary, not signals: .* meta\['texts'\]"):
-        block_system = _system(typed_fmus[2], signals, parameters)
+        block_system = _system(typed_fmus[2], signals, parameters, isolated=isolated)
     result = block_system.run(STEPS * DT)
+    assert workers == (["Types2.fmu"] if isolated else [])
     _equal_to_fmpy(result, reference, OUTPUTS2)
     counter = result["T.counter"]
     crossings = int(np.sum(signals["u"][:-1]) * DT // 0.05)  # u > 0: one per 0.05 of its integral
@@ -104,7 +127,7 @@ OUTPUTS3 = ["x", "counter", "f32_acc", "i8_out", "u8_out", "i16_out", "u16_out",
             "u64_out", "above", "mode_out", "w", "m", "steps"]
 
 
-def test_an_fmi3_fmu_of_every_type_and_arrays_equals_fmpy(typed_fmus, tmp_path):
+def test_an_fmi3_fmu_of_every_type_and_arrays_equals_fmpy(typed_fmus, tmp_path, isolated, workers):
     """Float32/64, Int8 to UInt64, Boolean, Enumeration, a vector input set by ``set_input``, a
     vector and a 2 x 2 output, String and Binary parameters: equal to fmpy, and the master's chunk
     runner equal to its per-step loop, bit for bit."""
@@ -115,18 +138,22 @@ def test_an_fmi3_fmu_of_every_type_and_arrays_equals_fmpy(typed_fmus, tmp_path):
     v = [1.0, -2.0, 0.5]
     reference = fmpy.simulate_fmu(str(typed_fmus[3]), stop_time=STEPS * DT, output_interval=DT, input=signals,
                                   start_values=parameters | {"v": v}, output=OUTPUTS3)
-    system = _system(typed_fmus[3], signals, parameters | {"key": "cdef"}, master_vector=v)
+    system = _system(typed_fmus[3], signals, parameters | {"key": "cdef"}, master_vector=v, isolated=isolated)
     block = system.blocks["T"]
     assert block.inputs[-3:] == ("v_1", "v_2", "v_3") and block.outputs[-5:] == ("m_11", "m_12", "m_21", "m_22",
                                                                                   "steps")
     result = system.run(STEPS * DT)
+    assert workers == (["Types3.fmu"] if isolated else [])
     _equal_to_fmpy(result, reference, OUTPUTS3)
     assert result["T.counter"][-1] >= 10 and result["T.steps"][-1] == STEPS
     assert np.allclose(result["T.w"][-1], np.array(v) * STEPS * DT, rtol=1e-12)
     assert result.meta["texts"] == {"T.label": "abc", "T.key": "cdef"}  # a Binary parameter as hexadecimal
-    step = _system(typed_fmus[3], signals, parameters | {"key": "cdef"}, master_vector=v).run(STEPS * DT,
-                                                                                              master="step")
+    step = _system(typed_fmus[3], signals, parameters | {"key": "cdef"}, master_vector=v,
+                   isolated=isolated).run(STEPS * DT, master="step")
     assert np.array_equal(step.data, result.data)
+    other = _system(typed_fmus[3], signals, parameters | {"key": "cdef"}, master_vector=v,
+                    isolated=not isolated).run(STEPS * DT)
+    assert np.array_equal(other.data, result.data)  # isolated and in process, bit for bit
 
 
 def test_typed_signals_are_saved_with_their_types(typed_fmus, tmp_path):
@@ -225,11 +252,14 @@ def test_an_fmu_with_clocks_is_refused_by_name(typed_fmus, tmp_path, capsys):
     assert not (tmp_path / "x").exists()
 
 
-def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus):
+def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus, isolated):
     """Set and get by name (an array element alone: the others kept), step, and a reset that
     gives what a fresh instance gives, bit for bit (the pool of the pytest plugin resets)."""
-    from orchestrator import FMUInstance
     from orchestrator.fmu import FMU3Instance
+    from orchestrator.isolated import IsolatedInstance, open_instance
+
+    def FMUInstance(path, parameters=None, name=None):  # noqa: N802 (the class it stands for)
+        return open_instance(path, parameters, name=name, isolated=isolated)
 
     def run(instance):
         instance.set(["v_2", "u", "i8_in", "enable"], [4.0, 30.0, -3.0, 1.0])
@@ -238,7 +268,7 @@ def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus):
         return instance.get(["w_1", "w_2", "w_3", "x", "counter", "i8_out", "above"])
 
     fresh = FMUInstance(typed_fmus[3], {"gain": 2.0})
-    assert isinstance(fresh, FMU3Instance)
+    assert isinstance(fresh, IsolatedInstance if isolated else FMU3Instance)
     first = run(fresh)
     assert np.allclose(first[:3], [0.0, 4.0 * 20 * DT, 0.0], rtol=1e-12, atol=0)
     assert first[4] == 20 and first[5] == -3 + 20  # x gains 0.06 a step: one crossing of 0.05 each step
@@ -246,10 +276,14 @@ def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus):
     assert np.array_equal(run(fresh), first)
     fresh.close()
     with pytest.raises(KeyError, match=r"T3\.v is an array; name its elements \(v_1, v_2, v_3, \.\.\.\)"):
-        FMUInstance(typed_fmus[3], name="T3").get(["v"])
+        other = FMUInstance(typed_fmus[3], name="T3")
+        try:
+            other.get(["v"])
+        finally:
+            other.close()
 
 
-def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typed_fmus):
+def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typed_fmus, isolated):
     """terminateSimulation from fmi3DoStep (the counter reaching stop_count) ends the run: the
     error says so, and the record holds every step before, as fmpy's does."""
     import fmpy
@@ -257,11 +291,12 @@ def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typ
     from orchestrator import SimulationError
 
     system = System(dt=DT)
-    system.add(FMUBlock("T", model=typed_fmus[3], parameters={"stop_count": 4}))
+    system.add(FMUBlock("T", model=typed_fmus[3], parameters={"stop_count": 4}, isolated=isolated))
     for name in TYPES3:
         system.set_input(f"T.{name}", {"u": 7.3, "enable": 1.0, "mode": 1.0}.get(name, 0.0))
     system.set_input("T.v", 0.0)
-    with pytest.raises(SimulationError, match=r"T: fmi3DoStep asked to end the simulation \(terminateSimulation"):
+    asked = r"T \(Types3\.fmu\): fmi3DoStep asked to end the simulation \(terminateSimulation"
+    with pytest.raises(SimulationError, match=asked):
         system.run(STEPS * DT)
     try:
         system.run(STEPS * DT)
@@ -274,15 +309,92 @@ def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typ
     assert np.allclose(result["T.x"], reference["x"][:-1], rtol=0, atol=1e-9)
 
 
-def test_a_refused_typed_set_names_its_function(typed_fmus):
+def test_a_refused_typed_set_names_its_function(typed_fmus, isolated):
     """The model refuses a UInt16 input of 65535 (the bus's 70000, held in range): the run fails
     at once, naming the block and fmi3SetUInt16 among the typed calls of the step."""
     from orchestrator import SimulationError
 
     system = System(dt=DT)
-    system.add(FMUBlock("T", model=typed_fmus[3]))
+    system.add(FMUBlock("T", model=typed_fmus[3], isolated=isolated))
     for name in TYPES3:
         system.set_input(f"T.{name}", 70000.0 if name == "u16_in" else 0.0)
     system.set_input("T.v", 0.0)
-    with pytest.raises(SimulationError, match=r"^T: fmi3SetUInt16 returned Error at t = 0 s"):
+    with pytest.raises(SimulationError, match=r"^T \(Types3\.fmu\): fmi3SetUInt16 returned Error at t = 0 s"):
         system.run(10 * DT)
+
+
+@pytest.fixture(scope="session")
+def lying_fmus(tmp_path_factory):
+    """The test models whose step returns -1 (no FMI status) from t = 0.1 s."""
+    return {v: build(f"types{v}", tmp_path_factory.mktemp(f"lying{v}"), defines=("LYING_STEP",)) for v in (2, 3)}
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("master", ["chunk", "step"])
+def test_a_step_that_returns_minus_one_fails_the_run(lying_fmus, version, master, isolated):
+    """-1 is no FMI status: the run fails at the step that returned it, in both FMI versions,
+    both masters, in process and isolated, and the record keeps every step before it."""
+    from orchestrator import SimulationError
+
+    system = System(dt=DT)
+    block = system.add(FMUBlock("T", model=lying_fmus[version], isolated=isolated))
+    for name in block.inputs:
+        system.set_input(f"T.{name}", 1.0)
+    with pytest.raises(SimulationError) as caught:
+        system.run(0.3, master=master)
+    message = str(caught.value)
+    assert f"fmi{version}DoStep returned -1 (no FMI status: taken as a failure) at t = 0.1 s" in message, message
+    result = caught.value.result
+    assert len(result) == 101 and result.time[-1] == pytest.approx(0.1, abs=1e-12)
+    assert result["T.x"][-1] > 0  # the steps before it ran: the integrator moved
+
+
+def _moved_binary(source: Path, target: Path, rename: dict | None = None, machine: int | None = None):
+    """A copy of an FMU with its binaries renamed (``{old: new}``), or its ELF machine changed."""
+    with zipfile.ZipFile(source) as zin, zipfile.ZipFile(target, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if machine is not None and item.filename.endswith(".so"):
+                data = data[:18] + machine.to_bytes(2, "little") + data[20:]
+            zout.writestr((rename or {}).get(item.filename, item.filename), data)
+
+
+@pytest.mark.parametrize("change, said", [
+    ({"rename": {"binaries/x86_64-linux/Types3.so": "binaries/x86_64-windows/Types3.dll"}},
+     "this FMU has no x86_64-linux binary (it has x86_64-windows): export it for Linux"),
+    ({"rename": {"binaries/x86_64-linux/Types3.so": "binaries/aarch64-linux/Types3.so"}},
+     "this FMU has no x86_64-linux binary (it has aarch64-linux): export it for Linux"),
+    ({"machine": 183}, "its x86_64-linux binary is built for aarch64; this machine runs x86_64"),
+], ids=["windows_only", "aarch64_folder", "aarch64_elf"])
+def test_an_fmi3_fmu_without_a_binary_for_this_machine_is_refused(typed_fmus, tmp_path, capsys, change, said):
+    """FMI 3.0 names its platform folders ``x86_64-linux``, ``x86_64-windows``, ``aarch64-linux``:
+    the refusal (exit 2, nothing written) names the folder it looked for and the ones it found."""
+    import platform
+
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        pytest.skip("the refusals name an x86_64 machine")
+    moved = tmp_path / "moved.fmu"
+    _moved_binary(typed_fmus[3], moved, **change)
+    assert main(["run", "open-loop", "--set", "duration=0.1", "--fmu", f"MotorMagnetics={moved}",
+                 "--out", str(tmp_path / "x")]) == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
+def test_an_fmi3_fmu_that_crashes_in_its_worker_ends_the_run_with_its_record(tmp_path):
+    """A segmentation fault in ``fmi3DoStep`` of an isolated FMI 3.0 FMU: the run fails naming the
+    block, the FMU, fmi3DoStep and SIGSEGV, and keeps the 101 samples before it."""
+    from orchestrator import SimulationError
+
+    crashing = build("types3", tmp_path, defines=("CRASHING_STEP",))
+    system = System(dt=DT)
+    block = system.add(FMUBlock("T", model=crashing))  # a foreign FMU: isolated by default
+    for name in block.inputs:
+        system.set_input(f"T.{name}", 1.0)
+    with pytest.raises(SimulationError) as caught:
+        system.run(0.3)
+    message = str(caught.value)
+    assert message.startswith(f"T ({crashing}, run in its own process) at t = 0.1 s: Types3.fmu crashed in "
+                              "fmi3DoStep: its process was killed by SIGSEGV"), message
+    result = caught.value.result
+    assert len(result) == 101 and result["T.steps"][-1] == 100

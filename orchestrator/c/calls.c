@@ -36,7 +36,7 @@ __attribute__((visibility("default"))) int run_calls(const Call *calls, int coun
             status = ((DoStep)c->function)(c->component, t, c->h, 1);
             break;
         }
-        if (status > 1) {
+        if ((unsigned int)status > 1u) { /* -1, or any number that is no FMI status, is a failure */
             *failed = i;
             return status;
         }
@@ -133,13 +133,13 @@ static int run_op(Program *p, const Op *o, long n, double t) {
     switch (o->kind) {
     case OP_SET_REAL:
         p->status = ((SetReal)o->function)(o->component, o->vr, o->n, o->values);
-        return p->status > 1 ? RUN_FMI_FAILED : -1;
+        return (unsigned int)p->status > 1u ? RUN_FMI_FAILED : -1;
     case OP_GET_REAL:
         p->status = ((GetReal)o->function)(o->component, o->vr, o->n, o->values);
-        return p->status > 1 ? RUN_FMI_FAILED : -1;
+        return (unsigned int)p->status > 1u ? RUN_FMI_FAILED : -1;
     case OP_DO_STEP:
         p->status = ((DoStep)o->function)(o->component, t, o->h, 1);
-        return p->status > 1 ? RUN_FMI_FAILED : -1;
+        return (unsigned int)p->status > 1u ? RUN_FMI_FAILED : -1;
     case OP_BLOCK:
         gather(o->u, p->bus, o->gather, o->gathers);
         p->status = o->step(t, o->u, o->y, o->data);

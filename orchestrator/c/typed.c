@@ -114,7 +114,7 @@ __attribute__((visibility("default"))) int typed_set(void *context, const unsign
     for (i = 0; i < c->count; i++) {
         to_fmu(&c->groups[i]);
         status = call(&c->groups[i]);
-        if (status > 1) {
+        if ((unsigned int)status > 1u) { /* -1, or any number that is no FMI status, is a failure */
             c->failed = i;
             return status;
         }
@@ -131,7 +131,7 @@ __attribute__((visibility("default"))) int typed_get(void *context, const unsign
     (void)vr, (void)n, (void)values;
     for (i = 0; i < c->count; i++) {
         status = call(&c->groups[i]);
-        if (status > 1) {
+        if ((unsigned int)status > 1u) { /* -1, or any number that is no FMI status, is a failure */
             c->failed = i;
             return status;
         }
@@ -161,7 +161,7 @@ __attribute__((visibility("default"))) int step3(void *context, double t, double
     int status = ((DoStep3)s->function)(s->instance, t, h, flag != 0, &event, &terminate, &early, &s->last);
     s->terminated = terminate;
     s->early = early;
-    if (status > 1)
+    if ((unsigned int)status > 1u)
         return status;
     return terminate || early ? STEP3_TERMINATED : status;
 }

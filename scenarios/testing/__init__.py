@@ -16,7 +16,10 @@ test without an import:
 
 FMU instances are pooled for the session (one pool per process, so one per pytest-xdist
 worker) and reset between runs (:mod:`orchestrator.pool`): the second test does not pay for
-instantiating the plant. The checks on a result are in :mod:`scenarios.testing.assertions`.
+instantiating the plant. An FMU of one's own is pooled only when its reset is verified (one
+step after a reset equals one step of a fresh instance); otherwise each test takes a fresh
+instance, which a warning says once: results never depend on the order of the tests. The
+checks on a result are in :mod:`scenarios.testing.assertions`.
 """
 
 from __future__ import annotations

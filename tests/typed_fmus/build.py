@@ -28,8 +28,9 @@ def _stubs(version: int, source: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def build(model: str, folder: Path) -> Path:
-    """Compile ``model`` (``"types2"`` or ``"types3"``) into ``folder/<Model>.fmu``.
+def build(model: str, folder: Path, defines: tuple = ()) -> Path:
+    """Compile ``model`` (``"types2"`` or ``"types3"``) into ``folder/<Model>.fmu``, with the C
+    macros ``defines`` (``("LYING_STEP",)``: a step that returns -1 from t = 0.1 s).
 
     Returns
     -------
@@ -44,6 +45,7 @@ def build(model: str, folder: Path) -> Path:
     platform = "x86_64-linux" if version == 3 else "linux64"
     library = folder / f"{identifier}.so"
     subprocess.run(["gcc", "-std=c99", "-O1", "-fPIC", "-shared", "-Wall", "-Werror", f"-I{HEADERS}",
+                    *(f"-D{d}" for d in defines),
                     "-o", str(library), str(HERE / f"{model}.c"), str(stubs)], check=True, capture_output=True,
                    text=True)
     path = folder / f"{identifier}.fmu"

@@ -215,6 +215,16 @@ fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3Boolean 
                       fmi3Boolean *event_needed, fmi3Boolean *terminate, fmi3Boolean *early, fmi3Float64 *last) {
     Model *m = c;
     (void)no_set_prior;
+#ifdef LYING_STEP /* the tests' liar: from t = 0.1 s its step returns -1, which is no FMI status */
+    if (t >= 0.1 - 1e-9)
+        return (fmi3Status)-1;
+#endif
+#ifdef CRASHING_STEP /* the tests' crash: at t = 0.1 s its step writes through a null pointer */
+    if (t >= 0.1 - 1e-9) {
+        volatile int *volatile nowhere = NULL;
+        *nowhere = 1;
+    }
+#endif
     if (m->enable)
         m->x += m->gain * m->u * h;
     if (m->x >= m->threshold) {
