@@ -116,6 +116,32 @@ def windows_compiler() -> str | None:
     return found
 
 
+def _compile(model: str, stage: Path, compiler: list, source_files: list, fmi_version: int, windows: bool) -> None:
+    """Compile the staged sources of ``model`` into its binaries: Linux, and Windows when asked and
+    mingw-w64 is installed, side by side."""
+    sources = stage / "sources"
+    targets = {"linux": (compiler, ".so")}
+    mingw = windows_compiler() if windows else None
+    if mingw:
+        targets["windows"] = ([mingw], ".dll")
+    jobs = []
+    for platform, (cc, suffix) in targets.items():
+        binaries = stage / "binaries" / PLATFORMS[fmi_version][platform]
+        binaries.mkdir(parents=True)
+        command = [*cc, *CFLAGS, *LINK_FLAGS[platform], "-shared", "-I", str(sources),
+                   "-o", str(binaries / f"{model}{suffix}")]
+        command += [str(sources / s) for s in source_files] + ["-lm"]
+        try:
+            jobs.append((command, subprocess.Popen(command, stderr=subprocess.PIPE, text=True)))
+        except FileNotFoundError:
+            raise BuildError(f"no C compiler {cc[0]!r} (from ${'CC' if os.environ.get('CC') else 'CC unset: cc'}); "
+                             "install one (e.g. gcc) or set $CC") from None
+    for command, job in jobs:  # the platforms compile side by side
+        _, errors = job.communicate()
+        if job.returncode != 0:
+            raise BuildError(f"{model}: {' '.join(command)}\n{errors}")
+
+
 def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=None, fmi_version: int = 2,
               windows: bool = True) -> Path:
     """Build ``model``'s FMU of one FMI version from source (:func:`fmu_file` says where).
@@ -171,26 +197,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
         (sources / "buildDescription.xml").write_text(tab.build_description(source_files))
     (stage / "modelDescription.xml").write_text(description)
 
-    targets = {"linux": (compiler, ".so")}
-    mingw = windows_compiler() if windows else None
-    if mingw:
-        targets["windows"] = ([mingw], ".dll")
-    jobs = []
-    for platform, (cc, suffix) in targets.items():
-        binaries = stage / "binaries" / PLATFORMS[fmi_version][platform]
-        binaries.mkdir(parents=True)
-        command = [*cc, *CFLAGS, *LINK_FLAGS[platform], "-shared", "-I", str(sources),
-                   "-o", str(binaries / f"{model}{suffix}")]
-        command += [str(sources / s) for s in source_files] + ["-lm"]
-        try:
-            jobs.append((command, subprocess.Popen(command, stderr=subprocess.PIPE, text=True)))
-        except FileNotFoundError:
-            raise BuildError(f"no C compiler {cc[0]!r} (from ${'CC' if os.environ.get('CC') else 'CC unset: cc'}); "
-                             "install one (e.g. gcc) or set $CC") from None
-    for command, job in jobs:  # the platforms compile side by side
-        _, errors = job.communicate()
-        if job.returncode != 0:
-            raise BuildError(f"{model}: {' '.join(command)}\n{errors}")
+    _compile(model, stage, compiler, source_files, fmi_version, windows)
 
     # written whole, then renamed (fmus sits below the orchestrator and its writer): a build cut
     # short leaves the earlier FMU, never a truncated one a run would load

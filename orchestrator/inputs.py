@@ -70,7 +70,20 @@ def regular_file(path, what: str, fix: str, error: type[Exception] = ValueError,
 
 def read_small_text(path, what: str, fix: str, limit: int = 16_000_000, error: type[Exception] = ValueError) -> str:
     """The UTF-8 text of the small file at ``path`` (a ``metrics.json``, a ``meta.json``), read
-    after :func:`regular_file` and a check of its size (``limit``, bytes).
+    after :func:`regular_file` and a check of its size.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+    what : str
+        What the file is, for the message (``"a run's metrics"``).
+    fix : str
+        What to do instead, for the message.
+    limit : int
+        Largest size read (bytes).
+    error : type
+        The exception raised.
 
     Raises
     ------

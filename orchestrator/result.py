@@ -179,23 +179,19 @@ class Result:
         """
         members = expand(name, self.names)
         if not members:
-            left_out = [n for n in self.meta.get("left_out") or [] if n == name or n.startswith(name + "_")]
-            if left_out:
+            if any(n == name or n.startswith(name + "_") for n in self.meta.get("left_out") or []):
                 raise KeyError(f"no recorded signal {name!r}: the scenario left it out of its result files (it "
-                               "follows from the signals kept); run it with --record all (record=['all'] from "
-                               "Python) to keep it")
+                               "follows from those kept); run it with --record all (record=['all'] from Python)")
             raise KeyError(f"no recorded signal {name!r}.{nearest(name, self.names)}")
         return members
 
     @property
     def dtypes(self) -> dict[str, str]:
-        """The NumPy type of each signal that is not float64 (an FMU's integer, Boolean or
-        single-precision signal: ``{"Stair.counter": "int32"}``); it is returned, and saved, with it."""
+        """The NumPy type of each signal that is not float64 (``{"Stair.counter": "int32"}``)."""
         return dict(self.meta.get("dtypes", {}))
 
     def typed(self, members: list[str], values: np.ndarray) -> np.ndarray:
-        """``values`` of the signals ``members`` (one column each, or one signal) in their own
-        type, when they share one that is not float64; else as they are."""
+        """``values`` of ``members`` in their own type when they share one that is not float64."""
         kinds = {self.meta.get("dtypes", {}).get(m) for m in members}
         if len(kinds) != 1 or None in kinds:
             return values
@@ -315,8 +311,7 @@ class Result:
         return path
 
     def to_csv(self, path, signals=None) -> Path:
-        """Write one row per sample: ``time`` (s) then every signal, full precision; an integer
-        or Boolean signal as an integer (a Boolean 0 or 1).
+        """Write one row per sample: ``time`` (s) then every signal at full precision, integers as integers.
 
         Parameters
         ----------
