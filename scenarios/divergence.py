@@ -32,16 +32,19 @@ class Bounds:
         Roll or pitch away from the controller's setpoint (deg); None: not bounded (no controller).
     altitude_error_m : float or None
         Altitude away from its setpoint, above or below (m); None: not bounded.
-    speed_m_s : float
-        Speed (m/s).
+    speed_m_s : float or None
+        Speed (m/s); None: not bounded (the scenario does not record the velocity).
     held_s : float
         How long a bound must stay crossed (s): a setpoint step is not a divergence.
+    tilt_deg : float or None
+        Roll or pitch away from level (deg), for a vehicle flown without a controller; None: not bounded.
     """
 
     tilt_error_deg: float | None
     altitude_error_m: float | None
-    speed_m_s: float
+    speed_m_s: float | None
     held_s: float
+    tilt_deg: float | None = None
 
 
 def _held(crossed: np.ndarray, time: np.ndarray, held_s: float) -> int | None:
@@ -88,7 +91,14 @@ def first_crossing(result, bounds: Bounds) -> dict | None:
             where = "below" if error[at] > 0 else "above"
             found.append((at, f"{abs(error[at]):.1f} m {where} its altitude setpoint", bounds.altitude_error_m,
                           float(abs(error[at])), "m"))
-    if all(n in names for n in SPEED):
+    if bounds.tilt_deg is not None and all(true in names for true, _ in ROLL_PITCH):
+        for k, (true, _) in enumerate(ROLL_PITCH):
+            tilt = np.degrees(np.abs((result[true] + math.pi) % (2 * math.pi) - math.pi))
+            at = _held(tilt > bounds.tilt_deg, time, bounds.held_s)
+            if at is not None:
+                found.append((at, f"{'roll' if k == 0 else 'pitch'} {tilt[at]:.0f} deg from level", bounds.tilt_deg,
+                              float(tilt[at]), "deg"))
+    if bounds.speed_m_s is not None and all(n in names for n in SPEED):
         speed = np.sqrt(sum(result[n] ** 2 for n in SPEED))
         at = _held(speed > bounds.speed_m_s, time, bounds.held_s)
         if at is not None:
@@ -108,7 +118,9 @@ def unchecked(result, bounds: Bounds | None = None) -> list[str]:
     bound is then not checked)."""
     wanted = [n for pair in ROLL_PITCH for n in pair] if bounds is None or bounds.tilt_error_deg is not None else []
     wanted += list(ALTITUDE) if bounds is None or bounds.altitude_error_m is not None else []
-    wanted += list(SPEED)
+    if bounds is not None and bounds.tilt_deg is not None:
+        wanted += [true for true, _ in ROLL_PITCH if true not in wanted]
+    wanted += list(SPEED) if bounds is None or bounds.speed_m_s is not None else []
     return [n for n in wanted if n not in set(result.names)]
 
 

@@ -14,6 +14,7 @@ import numpy as np
 from fmus import vehicle
 from orchestrator import System, Table
 from scenarios import Option, Scenario
+from scenarios.divergence import Bounds
 from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
 from scenarios.plant import add_plant, imu_parameters, save_figure
 
@@ -155,5 +156,10 @@ def _figures(result, o, out) -> list[str]:
     return [f for f in figures if f]
 
 
+# without a controller the vehicle is free: a tilt of 60 deg (its thrust holds half its weight) or 10 m/s
+# (a second of free fall), held 0.1 s (longer than a 50 ms pulse), is a tumble. The default 2 s run reaches
+# 22 deg of roll and 3.2 m/s; pulse=0.1 rolls it over (175 deg) and duration=4 reaches 73 deg and 16 m/s
+DIVERGENCE = Bounds(tilt_error_deg=None, altitude_error_m=None, speed_m_s=10.0, held_s=0.1, tilt_deg=60.0)
 SCENARIO = Scenario("open-loop", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed"}})
+                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed"},
+                           "divergence": DIVERGENCE})
