@@ -59,3 +59,12 @@ def test_the_scenarios_without_bounds_are_those_without_a_multirotor():
     # neither has a multirotor whose flight could diverge (their bounds are still to be declared)
     unbounded = {name for name in names() if get(name).extra.get("divergence") is None}
     assert unbounded == {"static-cal", "ir-calibration"}
+
+
+def test_the_command_line_guide_states_the_declared_bounds():
+    from pathlib import Path
+
+    guide = (Path(__file__).resolve().parent.parent / "docs" / "guides" / "command-line.md").read_text()
+    free, hover = get("open-loop").extra["divergence"], get("gain-study").extra["divergence"]
+    assert (f"`open-loop` (no controller): `{free.tilt_deg:g}` deg from level or `{free.speed_m_s:g}` m/s held "
+            f"`{free.held_s:g}` s; `gain-study`'s hover: `{hover.tilt_deg:g}` deg held `{hover.held_s:g}` s.") in guide
