@@ -19,6 +19,7 @@ import numpy as np
 ROLL_PITCH = (("Quadrotor.theta1", "Controller.theta_d1"), ("Quadrotor.theta2", "Controller.theta_d2"))
 ALTITUDE = ("Quadrotor.p_z", "Setpoint.z_d")
 SPEED = ("Quadrotor.v_x", "Quadrotor.v_y", "Quadrotor.v_z")
+TURN_RATE = "InfraredSensor.r"  # a fixed-wing's true turn rate (rad/s), from its bank and airspeed
 CONTROLLER = ("Controller.tau_x", "Controller.tau_y", "Controller.tau_z", "Controller.thrust")
 
 
@@ -38,6 +39,8 @@ class Bounds:
         How long a bound must stay crossed (s): a setpoint step is not a divergence.
     tilt_deg : float or None
         Roll or pitch away from level (deg), for a vehicle flown without a controller; None: not bounded.
+    turn_rate_rad_s : float or None
+        A fixed-wing's turn rate, either way (rad/s); None: not bounded.
     """
 
     tilt_error_deg: float | None
@@ -45,6 +48,7 @@ class Bounds:
     speed_m_s: float | None
     held_s: float
     tilt_deg: float | None = None
+    turn_rate_rad_s: float | None = None
 
 
 def _held(crossed: np.ndarray, time: np.ndarray, held_s: float) -> int | None:
@@ -98,6 +102,11 @@ def first_crossing(result, bounds: Bounds) -> dict | None:
             if at is not None:
                 found.append((at, f"{'roll' if k == 0 else 'pitch'} {tilt[at]:.0f} deg from level", bounds.tilt_deg,
                               float(tilt[at]), "deg"))
+    if bounds.turn_rate_rad_s is not None and TURN_RATE in names:
+        rate = np.abs(result[TURN_RATE])
+        at = _held(rate > bounds.turn_rate_rad_s, time, bounds.held_s)
+        if at is not None:
+            found.append((at, f"a turn rate of {rate[at]:.2f} rad/s", bounds.turn_rate_rad_s, float(rate[at]), "rad/s"))
     if bounds.speed_m_s is not None and all(n in names for n in SPEED):
         speed = np.sqrt(sum(result[n] ** 2 for n in SPEED))
         at = _held(speed > bounds.speed_m_s, time, bounds.held_s)
@@ -120,6 +129,7 @@ def unchecked(result, bounds: Bounds | None = None) -> list[str]:
     wanted += list(ALTITUDE) if bounds is None or bounds.altitude_error_m is not None else []
     if bounds is not None and bounds.tilt_deg is not None:
         wanted += [true for true, _ in ROLL_PITCH if true not in wanted]
+    wanted += [TURN_RATE] if bounds is not None and bounds.turn_rate_rad_s is not None else []
     wanted += list(SPEED) if bounds is None or bounds.speed_m_s is not None else []
     return [n for n in wanted if n not in set(result.names)]
 

@@ -1,7 +1,8 @@
 """Silent wrong results: a vehicle flown without a controller (``open-loop``), or the ground-truth hover
-whose stream ``gain-study`` filters, once completed while it tumbled. Each declares the bounds of its
-flight (:mod:`scenarios.divergence`): the tilt from level and, where recorded, the speed. A setting
-that makes it tumble ends ``diverged``, exit 1; its default flight completes."""
+whose stream ``gain-study`` filters, once completed while it tumbled; ``ir-calibration``'s aircraft
+turned at any rate its settings gave. Each declares the bounds of its flight
+(:mod:`scenarios.divergence`): the tilt from level and, where recorded, the speed; the aircraft's turn
+rate. A setting that breaks that flight ends ``diverged``, exit 1; its default flight completes."""
 
 import json
 
@@ -54,17 +55,32 @@ def test_gain_study_hover_completes_within_its_bounds(tmp_path):
     assert metrics["status"] == "completed" and "divergence_unchecked" not in metrics
 
 
-def test_the_scenarios_without_bounds_are_those_without_a_multirotor():
-    # static-cal turns the IMU by a scripted attitude and ir-calibration flies a scripted bank profile:
-    # neither has a multirotor whose flight could diverge (their bounds are still to be declared)
+def test_ir_calibration_flown_too_slow_for_its_banks_ends_diverged(tmp_path, capsys):
+    # the bank profile at 1 m/s instead of the sensor's 12: turn rates up to 5.9 rad/s
+    assert cli(["run", "ir-calibration", "--set", "duration=60", "InfraredSensor.airspeed=1",
+                "--out", str(tmp_path / "i")]) == 1
+    crossing = _metrics(tmp_path / "i")["diverged"]
+    assert crossing["what"].startswith("a turn rate of") and crossing["bound"] == 2.5
+    assert "ir-calibration diverged at t = " in capsys.readouterr().err
+
+
+def test_ir_calibration_flight_completes_within_its_bounds(tmp_path):
+    assert cli(["run", "ir-calibration", "--set", "duration=60", "--out", str(tmp_path / "i")]) == 0
+    metrics = _metrics(tmp_path / "i")
+    assert metrics["status"] == "completed" and "divergence_unchecked" not in metrics
+
+
+def test_the_scenario_without_bounds_is_the_one_without_a_vehicle():
+    # static-cal turns the IMU by a scripted attitude, motors off: no vehicle whose flight could diverge
     unbounded = {name for name in names() if get(name).extra.get("divergence") is None}
-    assert unbounded == {"static-cal", "ir-calibration"}
+    assert unbounded == {"static-cal"}
 
 
 def test_the_command_line_guide_states_the_declared_bounds():
     from pathlib import Path
 
     guide = (Path(__file__).resolve().parent.parent / "docs" / "guides" / "command-line.md").read_text()
-    free, hover = get("open-loop").extra["divergence"], get("gain-study").extra["divergence"]
+    free, hover, turn = (get(name).extra["divergence"] for name in ("open-loop", "gain-study", "ir-calibration"))
     assert (f"`open-loop` (no controller): `{free.tilt_deg:g}` deg from level or `{free.speed_m_s:g}` m/s held "
-            f"`{free.held_s:g}` s; `gain-study`'s hover: `{hover.tilt_deg:g}` deg held `{hover.held_s:g}` s.") in guide
+            f"`{free.held_s:g}` s; `gain-study`'s hover: `{hover.tilt_deg:g}` deg held `{hover.held_s:g}` s; "
+            f"`ir-calibration`: a turn rate of `{turn.turn_rate_rad_s:g}` rad/s held `{turn.held_s:g}` s.") in guide
