@@ -658,9 +658,19 @@ def _remove(path: Path):
 
 
 def holds_results(out) -> list[str]:
-    """The result files of an earlier run in folder ``out`` (empty if none, or no folder)."""
+    """The result files of an earlier run in folder ``out`` (empty if none, or no folder; a
+    ``metrics.json`` alone that says ``status: refused`` holds no result: a run replaces it)."""
     out = Path(out)
-    return [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
+    names = [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
+    return [] if names == ["metrics.json"] and _refused(out / "metrics.json") else names
+
+
+def _refused(metrics: Path) -> bool:
+    """``metrics.json`` of a run refused before its loop."""
+    try:
+        return json.loads(metrics.read_text()).get("status") == "refused"
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def first_free(path, taken, file: bool = False) -> Path:
