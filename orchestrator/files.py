@@ -658,19 +658,10 @@ def _remove(path: Path):
 
 
 def holds_results(out) -> list[str]:
-    """The result files of an earlier run in folder ``out`` (empty if none, or no folder; a
-    ``metrics.json`` alone that says ``status: refused`` holds no result: a run replaces it)."""
+    """The result files of an earlier run in ``out`` (none if no folder, or a refused run's metrics.json alone)."""
     out = Path(out)
     names = [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
-    return [] if names == ["metrics.json"] and _refused(out / "metrics.json") else names
-
-
-def _refused(metrics: Path) -> bool:
-    """``metrics.json`` of a run refused before its loop."""
-    try:
-        return json.loads(metrics.read_text()).get("status") == "refused"
-    except (OSError, ValueError, AttributeError):
-        return False
+    return [] if names == ["metrics.json"] and _earlier_metrics(out).get("status") == "refused" else names
 
 
 def first_free(path, taken, file: bool = False) -> Path:
@@ -693,11 +684,16 @@ def free_folder(base) -> Path:
                       or (candidate.exists() and not candidate.is_dir()))
 
 
+def _earlier_metrics(out: Path) -> dict:
+    """The metrics.json an earlier run left in ``out`` (empty if none, or unreadable)."""
+    try:
+        metrics = json.loads((out / "metrics.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return metrics if isinstance(metrics, dict) else {}
+
+
 def _listed_files(out: Path) -> list[str]:
     """The files an earlier run listed in its metrics.json (its figures among them)."""
-    try:
-        listed = json.loads((out / "metrics.json").read_text()).get("files", [])
-    except (OSError, ValueError, AttributeError):
-        return []
-    return [name for name in listed
+    return [name for name in _earlier_metrics(out).get("files", [])
             if isinstance(name, str) and Path(name).name == name and name not in ("", ".", "..")]
