@@ -658,9 +658,10 @@ def _remove(path: Path):
 
 
 def holds_results(out) -> list[str]:
-    """The result files of an earlier run in folder ``out`` (empty if none, or no folder)."""
+    """The result files of an earlier run in ``out`` (none if no folder, or a refused run's metrics.json alone)."""
     out = Path(out)
-    return [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
+    names = [name for name in RESULT_FILES if (out / name).exists()] if out.is_dir() else []
+    return [] if names == ["metrics.json"] and _earlier_metrics(out).get("status") == "refused" else names
 
 
 def first_free(path, taken, file: bool = False) -> Path:
@@ -683,11 +684,16 @@ def free_folder(base) -> Path:
                       or (candidate.exists() and not candidate.is_dir()))
 
 
+def _earlier_metrics(out: Path) -> dict:
+    """The metrics.json an earlier run left in ``out`` (empty if none, or unreadable)."""
+    try:
+        metrics = json.loads((out / "metrics.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return metrics if isinstance(metrics, dict) else {}
+
+
 def _listed_files(out: Path) -> list[str]:
     """The files an earlier run listed in its metrics.json (its figures among them)."""
-    try:
-        listed = json.loads((out / "metrics.json").read_text()).get("files", [])
-    except (OSError, ValueError, AttributeError):
-        return []
-    return [name for name in listed
+    return [name for name in _earlier_metrics(out).get("files", [])
             if isinstance(name, str) and Path(name).name == name and name not in ("", ".", "..")]

@@ -83,6 +83,7 @@ def replace_fmu(system, name: str, model) -> tuple:
         every mismatch (a missing variable, another unit).
     """
     from orchestrator.blocks import FMUBlock
+    from orchestrator.fmu_checks import FMURefused
 
     if name not in system.blocks:
         raise KeyError(f"--fmu {name}: unknown block {name!r}.{nearest(name, system.blocks)} "
@@ -92,7 +93,10 @@ def replace_fmu(system, name: str, model) -> tuple:
         fmus = [n for n, b in system.blocks.items() if isinstance(b, FMUBlock)]
         raise ValueError(f"--fmu {name}: {name} is a Python block ({type(old).__name__}); an FMU replaces an FMU "
                          f"block: {', '.join(fmus)}")
-    new = FMUBlock(name, model=model, period=old.period)
+    try:
+        new = FMUBlock(name, model=model, period=old.period)
+    except FMURefused as error:  # refused from the file alone: named with the block it was to replace
+        raise FMURefused(f"{name}: {error}") from None
     fed = sorted({d.split(".", 1)[1] for d in system.connections if d.split(".", 1)[0] == name},
                  key=old.inputs.index)
     read = sorted({s.split(".", 1)[1] for s in system.connections.values() if s.split(".", 1)[0] == name},

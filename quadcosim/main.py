@@ -221,6 +221,10 @@ def _run_reporting(args) -> int:
         return 1
     except (KeyError, ValueError) as error:
         print(f"quadcosim run {args.scenario}: {_said(error)}", file=sys.stderr)
+        from orchestrator.fmu_checks import FMURefused
+
+        if isinstance(error, FMURefused) and (out / "metrics.json").is_file():
+            print(f"metrics.json (status refused, no sample) is in {out}/", file=sys.stderr)
         return 2
     except OSError as error:  # the output folder failed under the run (removed, read-only, a disk error)
         print(f"quadcosim run {args.scenario}: failed: {error}", file=sys.stderr)

@@ -332,7 +332,9 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     ------
     ValueError, KeyError
         A refused option, parameter or output folder, before the run starts; nothing is left
-        in ``out_dir``.
+        in ``out_dir``, but for an FMU refused before the loop
+        (:class:`orchestrator.fmu_checks.FMURefused`): then ``out_dir`` holds a ``metrics.json``
+        with ``status: refused``, the message, the options and ``samples: 0``.
     orchestrator.SimulationError
         The run failed (:class:`orchestrator.RunInterrupted`: it was interrupted, in any
         phase); what was recorded is saved all the same, with a ``metrics.json`` saying where
@@ -390,9 +392,11 @@ def _run_tracked(name: str, settings, files, base: dict, made: bool, request: Ru
         if files is None:
             raise
         raise files.interrupted(interrupt) from None
-    except (KeyError, ValueError):  # refused before the run: the folder is left as it was
-        if files is not None and files.result is None:
-            files.refused(remove_folder=made)
+    except (KeyError, ValueError) as error:  # refused before the run: the folder is left as it was
+        if files is not None and files.result is None:  # but for metrics.json naming an FMU refused
+            from orchestrator.fmu_checks import FMURefused
+
+            files.refused(remove_folder=made, fmu_refusal=error if isinstance(error, FMURefused) else None)
         raise
     except OSError as error:  # the disk filled, or the folder failed, outside the loop and the save
         if files is None:

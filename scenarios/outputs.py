@@ -254,14 +254,20 @@ class RunFiles:
         self.stopped(failure, complete=self.result is not None)
         return failure
 
-    def refused(self, remove_folder: bool = False):
+    def refused(self, remove_folder: bool = False, fmu_refusal: Exception | None = None):
         """Remove what this run wrote: it was refused before it started (a value an FMU
-        refused, a record too large), and the folder is left as it was.
+        refused, a record too large), and the folder is left as it was; for an FMU of the
+        user's refused (``fmu_refusal``), a ``metrics.json`` then says so.
 
         Parameters
         ----------
         remove_folder : bool
-            The run made the folder: remove it too, if nothing else is in it.
+            The run made the folder: remove it too, if nothing else is in it (not with
+            ``fmu_refusal``).
+        fmu_refusal : orchestrator.fmu_checks.FMURefused, optional
+            The refusal of an FMU before the loop: ``metrics.json`` gets ``status: refused``,
+            its message (the block, the FMU, what is wrong and the fix), the options and an
+            empty record (``samples: 0``, no result file).
         """
         import shutil
 
@@ -269,6 +275,12 @@ class RunFiles:
             (self.out / name).unlink(missing_ok=True)
         if self.stream is not None and self.stream.path.is_dir():
             shutil.rmtree(self.stream.path)
+        if fmu_refusal is not None:
+            self.names.clear()
+            self._write(self.base | {"status": "refused", "error": str(fmu_refusal), "stopped_during": self.phase,
+                                     "recorded_until_s": None, "samples": 0, "record_complete": False,
+                                     "files": []})
+            return
         self.reserve.release()
         if remove_folder:
             remove_if_empty(self.out)

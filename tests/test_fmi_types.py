@@ -368,7 +368,8 @@ def _moved_binary(source: Path, target: Path, rename: dict | None = None, machin
 ], ids=["windows_only", "aarch64_folder", "aarch64_elf"])
 def test_an_fmi3_fmu_without_a_binary_for_this_machine_is_refused(typed_fmus, tmp_path, capsys, change, said):
     """FMI 3.0 names its platform folders ``x86_64-linux``, ``x86_64-windows``, ``aarch64-linux``:
-    the refusal (exit 2, nothing written) names the folder it looked for and the ones it found."""
+    the refusal (exit 2, metrics.json alone, ``refused``) names the folder it looked for and the
+    ones it found."""
     import platform
 
     if platform.machine().lower() not in ("x86_64", "amd64"):
@@ -378,7 +379,9 @@ def test_an_fmi3_fmu_without_a_binary_for_this_machine_is_refused(typed_fmus, tm
     assert main(["run", "open-loop", "--set", "duration=0.1", "--fmu", f"MotorMagnetics={moved}",
                  "--out", str(tmp_path / "x")]) == 2
     assert said in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+    assert sorted(p.name for p in (tmp_path / "x").iterdir()) == ["metrics.json"]
+    metrics = json.loads((tmp_path / "x" / "metrics.json").read_text())
+    assert metrics["status"] == "refused" and said in metrics["error"] and metrics["samples"] == 0
 
 
 def test_an_fmi3_fmu_that_crashes_in_its_worker_ends_the_run_with_its_record(tmp_path):

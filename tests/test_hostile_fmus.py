@@ -1,7 +1,8 @@
 """FMUs that crash, exit, hang, lie or do not load, built from C at test time
 (:mod:`tests.hostile_fmu`): each ends the run with a message naming the block, the FMU and
 what happened, exit 1 in the loop (the record up to the last good step kept) or 2 before it
-(nothing written), and leaves no lock, temporary folder or worker process behind."""
+(metrics.json alone, ``refused`` with the message and no sample), and leaves no lock, temporary
+folder or worker process behind."""
 
 import json
 import os
@@ -122,7 +123,8 @@ REFUSALS = {
 
 @pytest.mark.parametrize("case", list(REFUSALS))
 def test_an_fmu_that_cannot_run_is_refused_before_the_loop(hostile, case, tmp_path, capsys, monkeypatch):
-    """Exit 2 with the problem and the fix, nothing written, nothing extracted."""
+    """Exit 2 with the problem and the fix, nothing extracted, and metrics.json alone in the
+    folder: ``refused``, the message naming the block and the FMU, the options, no sample."""
     make, words = REFUSALS[case]
     fmu = hostile(case) if make is None else make(hostile("good"), tmp_path / f"{case.replace(' ', '_')}.fmu")
     extracted = []
@@ -134,7 +136,29 @@ def test_an_fmu_that_cannot_run_is_refused_before_the_loop(hostile, case, tmp_pa
     assert main([*RUN, "--fmu", f"MotorMagnetics={fmu}", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert words in err, err
-    assert "Traceback" not in err and not out.exists() and not extracted
+    assert "Traceback" not in err and not extracted
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json"]  # no lock, record, .part or reserve
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "refused" and words in metrics["error"]
+    assert metrics["error"].startswith("MotorMagnetics: ") and fmu.name in metrics["error"]
+    assert metrics["samples"] == 0 and metrics["files"] == [] and metrics["recorded_until_s"] is None
+    assert metrics["options"]["duration"] == pytest.approx(0.3)
+
+
+def test_a_refused_fmu_leaves_the_files_already_in_the_folder(hostile, tmp_path, capsys):
+    """A folder that held files before keeps them; its refused metrics.json holds no result,
+    so the next run into the folder needs no --overwrite and replaces it."""
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    assert main([*RUN, "--fmu", f"MotorMagnetics={hostile('null_instance')}", "--out", str(out)]) == 2
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "notes.txt"]
+    assert json.loads((out / "metrics.json").read_text())["status"] == "refused"
+    assert (out / "notes.txt").read_text() == "mine"
+    assert main([*RUN, "--fmu", f"MotorMagnetics={hostile('good')}", "--out", str(out)]) == 0
+    assert json.loads((out / "metrics.json").read_text())["status"] == "completed"
+    assert {"metrics.json", "notes.txt", "results.npz"} <= {p.name for p in out.iterdir()}
+    assert (out / "notes.txt").read_text() == "mine"
 
 
 def _cli(args, env_extra, tmp):
