@@ -83,7 +83,7 @@ bench: fmus
 	$(BIN)/quadcosim bench
 
 fuzz: fmus
-	$(BIN)/python -m benchmarks.fuzz
+	$(BIN)/python -m quadcosim.benchmarks.fuzz
 
 clean:
 	rm -rf build results docs/_build docs/_generated

@@ -1,15 +1,15 @@
 """Benchmark scripts that print figures (``quadcosim bench``); they are not timed tests.
 
-- :mod:`benchmarks.master`: the co-simulation master, open and closed loop, against reference
+- :mod:`quadcosim.benchmarks.master`: the co-simulation master, open and closed loop, against reference
   loops written in C (``benchmarks/c/loops.c``) that make the same FMI calls;
-- :mod:`benchmarks.estimators`: the closed loop's real-time factor and the estimators'
+- :mod:`quadcosim.benchmarks.estimators`: the closed loop's real-time factor and the estimators'
   batch path against the ``ahrs`` package;
-- :mod:`benchmarks.infrared`: operations per iteration and time per update of the IR
+- :mod:`quadcosim.benchmarks.infrared`: operations per iteration and time per update of the IR
   calibration estimators against the slides' 300 operations at 20 Hz.
 
 The C references in ``benchmarks/c/`` ship with the package as sources; ``quadcosim build``
 (:func:`build_references`), or their first use, compiles them with the system C compiler into
-``benchmarks/`` under :func:`fmus.build_root`.
+``benchmarks/`` under :func:`quadcosim.fmus.build_root`.
 """
 
 from __future__ import annotations
@@ -20,14 +20,14 @@ SOURCES = Path(__file__).resolve().parent / "c"
 
 
 def libraries_dir() -> Path:
-    """Folder of the compiled C references: ``benchmarks/`` under :func:`fmus.build_root`.
+    """Folder of the compiled C references: ``benchmarks/`` under :func:`quadcosim.fmus.build_root`.
 
     Returns
     -------
     pathlib.Path
         The folder (it may not exist yet).
     """
-    from fmus import build_root
+    from quadcosim.fmus import build_root
 
     return build_root() / "benchmarks"
 
@@ -40,7 +40,7 @@ def build_references() -> list[Path]:
     list of pathlib.Path
         The libraries written.
     """
-    from orchestrator.calls import compile_shared
+    from quadcosim.orchestrator.calls import compile_shared
 
     return [compile_shared(source, libraries_dir() / f"lib{source.stem}.so") for source in sorted(SOURCES.glob("*.c"))]
 
@@ -61,7 +61,7 @@ def reference_library(name: str):
     """
     import ctypes
 
-    from orchestrator.calls import compile_shared
+    from quadcosim.orchestrator.calls import compile_shared
 
     source, library = SOURCES / f"{name}.c", libraries_dir() / f"lib{name}.so"
     newest = max(path.stat().st_mtime for path in [source, *SOURCES.glob("*.h")])

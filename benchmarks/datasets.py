@@ -13,7 +13,7 @@ Each dataset sits in its own sub-folder of the data folder, as its authors publi
     people (texting, phoning, swinging, in pockets, augmented reality, running in the hand or in
     a pocket), with and without magnetic disturbances; a Qualisys system at 60 Hz. The phone's
     calibrated gyro, accelerometer and magnetometer are resampled to 100 Hz; the reference is
-    aligned (:mod:`estimators.alignment`: body and vertical rotations, then the heading).
+    aligned (:mod:`quadcosim.estimators.alignment`: body and vertical rotations, then the heading).
 ``diodem/``
     The dataset recorded for RING (Bachhuber, Weygers, Lehmann, Dammann, Seel, "RING: a
     recurrent inertial graph-based estimator", supplementary material; folders ``trial1`` and
@@ -33,7 +33,7 @@ Each dataset sits in its own sub-folder of the data folder, as its authors publi
 
 A recording whose reference does not turn as its gyro does (:func:`usable`), or cannot be aligned
 at all, is left out.
-Every loader gives recordings as :func:`estimators.recording.load` does (``gyro``, ``acc``,
+Every loader gives recordings as :func:`quadcosim.estimators.recording.load` does (``gyro``, ``acc``,
 ``mag``, ``rate``, ``quat``, ``scored``, ``meta``), with ``meta["align"]`` saying whether the
 heading offset is removed when scoring.
 """
@@ -44,8 +44,7 @@ import math
 from pathlib import Path
 
 import numpy as np
-
-from estimators import alignment, recording
+from quadcosim.estimators import alignment, recording
 
 PHONE_RATE = 100.0  # Hz, the grid the phones' unevenly timed sensors are resampled to
 TIME_SEARCH_S = 4.0  # s, span searched for the phones' clock offset
@@ -205,7 +204,7 @@ def iphones(folder: Path):
 
 def usable(data: dict) -> bool:
     """Whether the recording ``data`` can score a filter: its reference turns as its gyro does
-    (:func:`estimators.alignment.rate_mismatch` under :data:`MISMATCH_LIMIT`). A recording whose
+    (:func:`quadcosim.estimators.alignment.rate_mismatch` under :data:`MISMATCH_LIMIT`). A recording whose
     reference lost track of its body, or whose clocks could not be matched, is left out."""
     return data["meta"].get("rate_mismatch", 0.0) < MISMATCH_LIMIT
 

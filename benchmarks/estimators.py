@@ -1,6 +1,6 @@
-"""Benchmark figures of the estimators' batch path, for ``quadcosim bench`` (``benchmarks.master``).
+"""Benchmark figures of the estimators' batch path, for ``quadcosim bench`` (``quadcosim.benchmarks.master``).
 
-- the batch path of the explicit filter (``estimators.estimate``, 256 gain sets in one call,
+- the batch path of the explicit filter (``quadcosim.estimators.estimate``, 256 gain sets in one call,
   attitude kept) against its C reference (``benchmarks/c/batch_explicit.c``, the same update
   operation for operation, compiled by ``quadcosim build``), both single-threaded, for the
   exponential map and the Euler step: ``batch_updates_per_s``, ``batch_c_updates_per_s``,
@@ -41,8 +41,8 @@ def _batch_case(gain_sets: int, samples: int, discretisation: str) -> dict:
     """The arrays of one batch run: the explicit filter's defaults with the corrections the C reference
     transcribes on (the low-passes and the magnetic reference tracking off), kI = 0.1 (1/s^2) and k1
     from 0.01 to 10 over the gain sets."""
-    from estimators import core
-    from estimators.filters import CORRECTIONS, check_measurements, config_vector, gain_table
+    from quadcosim.estimators import core
+    from quadcosim.estimators.filters import CORRECTIONS, check_measurements, config_vector, gain_table
 
     acc, gyro, mag = _data(samples)
     config = config_vector(discretisation)
@@ -57,7 +57,7 @@ def _batch_case(gain_sets: int, samples: int, discretisation: str) -> dict:
 
 def _numba_batch(case: dict) -> np.ndarray:
     """The attitude (G, N, 4) of the batch path, through the public ``estimate``."""
-    from estimators import estimate
+    from quadcosim.estimators import estimate
 
     return estimate("explicit", acc=case["acc"], gyro=case["gyro"], mag=case["mag"], dt=1e-3, gains=case["gains"],
                     corrections=case["corrections"], discretisation=case["discretisation"], outputs=("q",))["q"]
@@ -65,18 +65,19 @@ def _numba_batch(case: dict) -> np.ndarray:
 
 def _c_batch(case: dict) -> np.ndarray:
     """The attitude (G, N, 4) of the C reference, after checking its slot numbers against
-    :mod:`estimators.core`'s layouts."""
+    :mod:`quadcosim.estimators.core`'s layouts."""
     import ctypes
 
-    from benchmarks import reference_library
-    from estimators import core
+    from quadcosim.benchmarks import reference_library
+    from quadcosim.estimators import core
 
     library = reference_library("batch_explicit")
     slots = np.zeros(len(_C_SLOTS), dtype=np.int64)
     library.batch_explicit_slots(slots.ctypes.data_as(ctypes.c_void_p))
     expected = [getattr(core, name) for name in _C_SLOTS]
     if slots.tolist() != expected:
-        raise RuntimeError(f"benchmarks/c/batch_explicit.c numbers its slots {slots.tolist()}, estimators.core "
+        raise RuntimeError(f"benchmarks/c/batch_explicit.c numbers its slots {slots.tolist()}, "
+                           "quadcosim.estimators.core "
                            f"{expected} ({', '.join(_C_SLOTS)}): update the C reference")
     table, inputs = case["table"], case["inputs"]
     q = np.empty((len(table), len(inputs), 4))
@@ -171,7 +172,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
     Parameters
     ----------
     seconds : float
-        Unused (the batch runs are 4 s of samples at 1 kHz); kept for ``benchmarks.master``'s call.
+        Unused (the batch runs are 4 s of samples at 1 kHz); kept for ``quadcosim.benchmarks.master``'s call.
     repeats : int
         Timed calls of each, the best kept.
 
@@ -190,12 +191,13 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
 
 
 def main(argv=None) -> int:
-    """Print the batch path's figures (``python -m benchmarks.estimators``); returns 0.
+    """Print the batch path's figures (``python -m quadcosim.benchmarks.estimators``); returns 0.
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
     import json
 
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.estimators", description="the batch path against C")
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.estimators",
+                                     description="the batch path against C")
     parser.add_argument("--gain-sets", type=int, default=256, help="filters per call")
     parser.add_argument("--samples", type=int, default=4000, help="samples per filter")
     parser.add_argument("--repeats", type=int, default=3, help="timed calls, best kept")

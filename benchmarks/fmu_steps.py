@@ -17,9 +17,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-from benchmarks import SOURCES, libraries_dir, reference_library
-from fmus import compiler_command, make_folder
+from quadcosim.benchmarks import SOURCES, libraries_dir, reference_library
+from quadcosim.fmus import compiler_command, make_folder
 
 MODELS = ("MotorMagnetics", "Quadrotor", "IMU")
 PARAMETERS = {"IMU": {"noise_enabled": True, "bias_enabled": True}}  # as in the closed-loop benchmark
@@ -45,8 +44,8 @@ def equations_library(model: str) -> ctypes.CDLL:
     import subprocess
     import tempfile
 
-    from fmus import default_fmu_dir
-    from fmus.build import CFLAGS
+    from quadcosim.fmus import default_fmu_dir
+    from quadcosim.fmus.build import CFLAGS
 
     staged = Path(default_fmu_dir()) / model / "sources"
     harness = SOURCES / "equations" / "equations_step.c"
@@ -71,7 +70,7 @@ def equations_library(model: str) -> ctypes.CDLL:
 
 def _instances():
     """The three FMUs with the benchmark's parameters and inputs (outputs wired once, held)."""
-    from orchestrator.fmu import FMUInstance
+    from quadcosim.orchestrator.fmu import FMUInstance
 
     fmus = {name: FMUInstance(name, PARAMETERS.get(name), name=name) for name in MODELS}
     motors, body, imu = fmus.values()

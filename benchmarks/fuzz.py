@@ -1,4 +1,4 @@
-"""The long fuzz of the FMUs (``python -m benchmarks.fuzz``), beside the short one of the tests.
+"""The long fuzz of the FMUs (``python -m quadcosim.benchmarks.fuzz``), beside the short one of the tests.
 
 Each FMU is driven through its bare FMI functions by ``tests/fuzz_fmu.py`` (hypothesis draws
 sessions of calls in random order: value references anywhere in the unsigned range, NaN, Inf
@@ -31,7 +31,7 @@ def fuzz(model: str, calls: int) -> dict:
     Parameters
     ----------
     model : str
-        A built FMU (``fmus.MODELS``).
+        A built FMU (``quadcosim.fmus.MODELS``).
     calls : int
         Calls to make, at least.
 
@@ -56,9 +56,9 @@ def main(argv=None) -> int:
     1 when any model failed. ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
-    from fmus import MODELS
+    from quadcosim.fmus import MODELS
 
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.fuzz", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.fuzz", description=__doc__.splitlines()[0])
     parser.add_argument("--calls", type=int, default=CALLS, help=f"calls per model (default {CALLS:,})")
     parser.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
     parser.add_argument("--json", action="store_true", help="print one JSON object")

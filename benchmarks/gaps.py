@@ -1,6 +1,6 @@
 """Silences of a command: the longest wait between two lines of its output, read from pipes.
 
-``python -m benchmarks.gaps [--show] -- quadcosim run tp --set duration=20 --out /tmp/tp --overwrite``
+``python -m quadcosim.benchmarks.gaps [--show] -- quadcosim run tp --set duration=20 --out /tmp/tp --overwrite``
 
 The command runs in a child process with its standard output and error piped; every line (or
 carriage-return redraw) is stamped with the wall time since the start. Printed: the number of

@@ -1,7 +1,7 @@
 """Cost per iteration of the IR calibration estimators (``quadcosim bench infrared``).
 
 Counts the operations of each estimator's step (flops, comparisons, functions; what counts is
-stated in :mod:`calibration.infrared.cost`), by running its Python source on counting numbers,
+stated in :mod:`quadcosim.calibration.infrared.cost`), by running its Python source on counting numbers,
 over a fault-free flight of the ``ir-calibration`` scenario (``--faults both``: with the
 slides' faults, during which part of the samples skip fusion and cost less); times one update
 in the compiled batch loop and one streaming call from Python, best of ``repeats``. Sets them
@@ -16,11 +16,11 @@ import sys
 
 
 def measure(samples: int = 8000, start_s: float = 0.0, repeats: int = 3, faults: str = "none") -> dict:
-    """:func:`calibration.infrared.cost` on ``samples`` samples (20 Hz) of the ``ir-calibration``
+    """:func:`quadcosim.calibration.infrared.cost` on ``samples`` samples (20 Hz) of the ``ir-calibration``
     flight with ``faults`` (``"none"`` or ``"both"``), from ``start_s`` (s); timings best of
     ``repeats``."""
-    from calibration.infrared import cost
-    from scenarios.ir_calibration import RATE, simulate_flight
+    from quadcosim.calibration.infrared import cost
+    from quadcosim.scenarios.ir_calibration import RATE, simulate_flight
 
     first = int(start_s * RATE)
     flight = simulate_flight(first + samples, seed=1, faults=faults)

@@ -1,7 +1,7 @@
 """What running an FMU in a worker process of its own costs (``quadcosim bench``).
 
 The closed loop ``tp`` is run with its ``MotorMagnetics`` FMU in process and in a worker process
-(:mod:`orchestrator.isolated`), alternately, in wall time (the worker's time and the crossings
+(:mod:`quadcosim.orchestrator.isolated`), alternately, in wall time (the worker's time and the crossings
 between the processes are not the master's CPU time). Both give the same trajectory, bit for bit.
 """
 
@@ -40,7 +40,7 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
         macro step, the lowest over the repeats), ``isolated_step_cost_us`` (their difference:
         what one isolated FMU adds to a step) and ``isolated_identical`` (every signal equal).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     definition = scenarios.get("tp")
     options = definition.parse({"duration": seconds} | CLOSED_LOOP)

@@ -1,11 +1,11 @@
 """What the magnetometer does on a recording, and what the recommended filter's magnetic rule makes of it.
 
-    python -m benchmarks.magnetic DATA [--recordings DATASET/NAME,...] [--figure FILE]
+    python -m quadcosim.benchmarks.magnetic DATA [--recordings DATASET/NAME,...] [--figure FILE]
 
-Per recording (DATA as :mod:`benchmarks.datasets` describes): the field's norm over the first
+Per recording (DATA as :mod:`quadcosim.benchmarks.datasets` describes): the field's norm over the first
 second's, its dip against the optical reference's vertical (the true one, not the estimate's),
 the magnetometer's weight in the recommended filter at its defaults and with the earlier rule
-(the first second's field the reference for ever, :data:`benchmarks.real_recordings.ABLATIONS`'
+(the first second's field the reference for ever, :data:`quadcosim.benchmarks.real_recordings.ABLATIONS`'
 ``fixed_reference``), and the heading error of both against the reference. Printed per
 recording: the share of the time the field was rejected (weight under 0.5), the longest
 rejection (s) and the heading RMSE (deg) of both rules and of VQF.
@@ -18,12 +18,11 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from benchmarks import datasets
-from benchmarks.real_recordings import ABLATIONS, _options, errors
-from estimators import estimate
-from estimators.filters import DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
-from scenarios.replay import field_from_data
+from quadcosim.benchmarks import datasets
+from quadcosim.benchmarks.real_recordings import ABLATIONS, _options, errors
+from quadcosim.estimators import estimate
+from quadcosim.estimators.filters import DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
+from quadcosim.scenarios.replay import field_from_data
 
 # an iPhone whose magnetometer the phone re-calibrates at the start, and a BROAD trial with a magnet
 EXAMPLES = ("iphones/Jakob_iPhone5_NoDist_Phoning", "iphones/Guillaume_iPhone5_NoDist_AR",
@@ -44,7 +43,7 @@ def _longest(flags: np.ndarray) -> int:
 
 
 def analyse(data: dict) -> dict:
-    """Series (per sample) and summaries of one recording (as :mod:`benchmarks.datasets` loads it).
+    """Series (per sample) and summaries of one recording (as :mod:`quadcosim.benchmarks.datasets` loads it).
 
     Returns
     -------
@@ -102,7 +101,7 @@ def figure(found: dict, path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import save_figure
+    from quadcosim.infra.files import save_figure
 
     fig, axes = plt.subplots(4, len(found), figsize=(4.4 * len(found), 8.0), sharex="col", squeeze=False)
     try:
@@ -132,7 +131,8 @@ def figure(found: dict, path) -> Path:
 def main(argv=None) -> int:
     """Command line (see the module docstring); returns 0 (2 for a bad folder or recording name).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.magnetic", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.magnetic",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("folder")
     parser.add_argument("--recordings", default=",".join(EXAMPLES), help="comma-separated DATASET/NAME")
     parser.add_argument("--figure", help="draw the series into this PNG file")

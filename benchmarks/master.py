@@ -15,8 +15,8 @@ Measures, in one run, per macro step at 1 kHz, CPU time of the stepping loop onl
   trajectories are compared bit for bit: every recorded signal of the C loop must equal the
   orchestrator's (``*_identical``).
 
-The keys of :func:`benchmarks.estimators.measure` (the batch path) and of
-:func:`benchmarks.save.figures` (``save_fraction``) join the same JSON object.
+The keys of :func:`quadcosim.benchmarks.estimators.measure` (the batch path) and of
+:func:`quadcosim.benchmarks.save.figures` (``save_fraction``) join the same JSON object.
 """
 
 from __future__ import annotations
@@ -29,9 +29,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-from benchmarks import estimators, fmu_steps, reference_library
-from benchmarks.save import figures as save_figures
+from quadcosim.benchmarks import estimators, fmu_steps, reference_library
+from quadcosim.benchmarks.save import figures as save_figures
 
 CLOSED_LOOP = {"estimator": "explicit", "noise": True, "bias": True}  # tp options of the closed loop
 
@@ -81,7 +80,7 @@ class ReferenceLoop:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
         The ``open-loop`` or ``tp`` system, whose blocks give the FMU parameters, the setpoint
         table, the constant inputs, and the filter's and controller's settings.
     seconds : float
@@ -89,7 +88,7 @@ class ReferenceLoop:
     """
 
     def __init__(self, system, seconds: float):
-        from orchestrator.fmu import FMUInstance
+        from quadcosim.orchestrator.fmu import FMUInstance
 
         blocks = system.blocks
         self.closed = "Controller" in blocks
@@ -165,14 +164,14 @@ class ReferenceLoop:
 
 
 def _control(block) -> _Control:
-    from flight.controller import PARAMETERS
+    from quadcosim.flight.controller import PARAMETERS
 
     values = dict(zip(PARAMETERS, block.parameters, strict=True))
     return _Control(*[values[name] for name in _CONTROL_NAMES], (_double * 16)(*block.mixer_inverse.ravel()))
 
 
 def _explicit(block) -> _Explicit:
-    from estimators import core
+    from quadcosim.estimators import core
 
     gains, config, vector = block.gains, block.config, _double * 3
     if block.kind != "explicit" or any(gains[name] for name in gains if name not in ("k1", "k2", "kP", "kI")):
@@ -202,7 +201,7 @@ def compare(scenario: str, settings: dict, seconds: float, repeats: int) -> dict
         ``c_us_per_step`` (the lowest over the repeats, µs), ``identical`` (every recorded signal
         of the C loop equal, bit for bit, to the orchestrator's, in every repeat).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     definition = scenarios.get(scenario)
     options = definition.parse({"duration": seconds} | settings)
@@ -232,8 +231,8 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
         ``open_loop_over_c`` and ``closed_loop_over_c`` (median ratio of CPU times), their
         ``*_spread`` (lowest, highest), the µs per step of each loop, ``rtf_open_loop``,
         ``rtf_closed_loop`` and ``rtf_closed_loop_c`` (simulated over CPU seconds, best run),
-        ``*_identical``, then the batch-path figures of :func:`benchmarks.estimators.measure` and
-        the FMI shell's cost, :func:`benchmarks.fmu_steps.measure` (``fmu_step_over_equations``).
+        ``*_identical``, then the batch-path figures of :func:`quadcosim.benchmarks.estimators.measure` and
+        the FMI shell's cost, :func:`quadcosim.benchmarks.fmu_steps.measure` (``fmu_step_over_equations``).
     """
     figures = {}
     for key, scenario, settings in (("open_loop", "open-loop", {}), ("closed_loop", "tp", CLOSED_LOOP)):
@@ -266,7 +265,7 @@ def main(argv=None) -> int:
         return 2
     path = None
     if args.out:
-        from orchestrator.files import OutputRefused, figure_file
+        from quadcosim.infra.files import OutputRefused, figure_file
 
         try:
             path = figure_file(args.out, "bench.png", None)  # refused before minutes of timing
@@ -317,7 +316,7 @@ def draw(figures: dict, path) -> Path:
     """
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import headless_backend, save_figure
+    from quadcosim.infra.files import headless_backend, save_figure
 
     headless_backend()
     fig, (steps, batch) = plt.subplots(1, 2, figsize=(10.0, 3.8), layout="constrained",

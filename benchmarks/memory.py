@@ -1,6 +1,6 @@
 """Peak memory of ``quadcosim run tp`` against duration, with and without decimation.
 
-``python -m benchmarks.memory [--durations 20 200 600] [--decimations 1 10] [--json]``
+``python -m quadcosim.benchmarks.memory [--durations 20 200 600] [--decimations 1 10] [--json]``
 
 Each case runs the command line in a child process and reads the child's peak resident set
 (``wait4``). The bytes recorded are ``samples x (signals + 1) x 8`` (the signals and the time

@@ -85,7 +85,7 @@ def measure(tests: int = TESTS, duration: float = DURATION) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
         test_file = folder / "test_short_horizons.py"
-        test_file.write_text("from scenarios.testing.assertions import assert_attitude_error\n"
+        test_file.write_text("from quadcosim.scenarios.testing.assertions import assert_attitude_error\n"
                              + TEST_FILE.format(tests=tests, duration=duration))
         (folder / "conftest.py").write_text(CONFTEST)
         out = folder / "loops.json"

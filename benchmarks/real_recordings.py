@@ -1,22 +1,23 @@
 """The estimators on public real recordings with optical ground truth, against VQF, Madgwick and Mahony.
 
-    python -m benchmarks.real_recordings DATA [--datasets broad,smartphones,...] [--cache DIR]
+    python -m quadcosim.benchmarks.real_recordings DATA [--datasets broad,smartphones,...] [--cache DIR]
         [--json OUT]
 
-DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes (where each comes
+DATA holds one sub-folder per dataset, as :mod:`quadcosim.benchmarks.datasets` describes (where each comes
 from, by title, and how it is read and aligned); the data stay outside the repository. Every
 recording is scored by the quaternion-error RMSE (total, heading, inclination; the BROAD
-benchmark's decomposition, :func:`estimators.score`) over its scored samples, after the
+benchmark's decomposition, :func:`quadcosim.estimators.score`) over its scored samples, after the
 alignment its dataset needs, and the mean over a dataset's recordings is reported for the
 recommended ``explicit`` filter and the ``passive`` (TRIAD) filter at their defaults
-(``estimators.DEFAULT_GAINS``, corrections on), for the explicit filter with each of its parts
+(``quadcosim.estimators.DEFAULT_GAINS``, corrections on), for the explicit filter with each of its parts
 for real recordings taken away in turn (:data:`ABLATIONS`), and for VQF, Madgwick and Mahony at
 their packages' defaults and VQF at the time constants chosen for it by the same procedure as
-ours (:data:`TUNED`, ``python -m benchmarks.tuning DATA --filter vqf``). Every filter starts from
+ours (:data:`TUNED`, ``python -m quadcosim.benchmarks.tuning DATA --filter vqf``). Every filter starts from
 the TRIAD attitude of the first sample (VQF from its own first samples); the field's dip and norm
 are taken from the first second.
 
-The defaults were chosen on :data:`DEVELOPMENT`, each in turn held out of the search (``python -m benchmarks.tuning
+The defaults were chosen on :data:`DEVELOPMENT`, each in turn held out of the search (``python -m
+quadcosim.benchmarks.tuning
 DATA``, ``--score-folds``).
 
 The published filters' results do not depend on our gains: ``--cache DIR`` keeps them.
@@ -31,14 +32,14 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from quadcosim.benchmarks import datasets
+from quadcosim.estimators import DEFAULT_GAINS, estimate
+from quadcosim.estimators.filters import DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
+from quadcosim.scenarios.replay import field_from_data, references
 
-from benchmarks import datasets
-from estimators import DEFAULT_GAINS, estimate
-from estimators.filters import DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
-from orchestrator.files import write_text
-from scenarios.replay import field_from_data, references
+from quadcosim.infra.files import write_text
 
-# the datasets the defaults are chosen on, each in turn held out of the search (benchmarks.tuning)
+# the datasets the defaults are chosen on, each in turn held out of the search (quadcosim.benchmarks.tuning)
 DEVELOPMENT = ("broad", "smartphones", "repoimu", "iphones")
 # datasets measured in an earlier round whose recordings cannot be reached now: their committed rows are kept, marked
 UNREACHABLE = ("diodem",)
@@ -58,11 +59,11 @@ ABLATIONS = {
     "no_separation": {"heading_level": 0.0, "heading_only": 0.0},  # the magnetometer's correction tilts too
     "previous_attitude": {"correct_at_sample": 0.0},  # corrections against the previous sample's attitude
 }
-TUNING_RECORDS = Path(__file__).parent / "data"  # the search records of benchmarks.tuning
+TUNING_RECORDS = Path(__file__).parent / "data"  # the search records of quadcosim.benchmarks.tuning
 
 
 def tuned(kind: str) -> dict | None:
-    """The gains chosen for the published filter ``kind`` by :mod:`benchmarks.tuning` (its committed
+    """The gains chosen for the published filter ``kind`` by :mod:`quadcosim.benchmarks.tuning` (its committed
     record ``benchmarks/data/tuning_KIND.json``), or None when it was not tuned."""
     path = TUNING_RECORDS / f"tuning_{kind}.json"
     return json.loads(path.read_text())["chosen"] if path.exists() else None
@@ -80,7 +81,7 @@ def _options(kind: str, data: dict) -> dict:
 
 def errors(kind: str, data: dict, gains: dict | None = None) -> dict:
     """Total, heading and inclination RMSE (deg; (G,) arrays over the gain sets ``gains``) of the
-    filter ``kind`` on the recording ``data`` (as :mod:`benchmarks.datasets` loads it)."""
+    filter ``kind`` on the recording ``data`` (as :mod:`quadcosim.benchmarks.datasets` loads it)."""
     found = estimate(kind, gains=gains, **_options(kind, data))["errors"]
     return {metric: np.asarray(found[metric]) for metric in METRICS}
 
@@ -130,12 +131,12 @@ def _tuned_published(recordings: list, kinds=PUBLISHED) -> dict:
 def evaluate(folder, names=DEVELOPMENT + UNREACHABLE, cache=None, published=PUBLISHED) -> dict:
     """Per dataset, the mean total, heading and inclination RMSE (deg) of every filter at its
     defaults, of the explicit filter's ablations (:data:`ABLATIONS`) and of the published filters
-    tuned by :mod:`benchmarks.tuning` (``vqf_tuned``, ...).
+    tuned by :mod:`quadcosim.benchmarks.tuning` (``vqf_tuned``, ...).
 
     Parameters
     ----------
     folder : str or pathlib.Path
-        The data folder (one sub-folder per dataset, see :mod:`benchmarks.datasets`).
+        The data folder (one sub-folder per dataset, see :mod:`quadcosim.benchmarks.datasets`).
     names : sequence of str
         Datasets to score; those absent from ``folder`` are skipped.
     cache : str or pathlib.Path, optional
@@ -235,7 +236,8 @@ def table(results: dict) -> str:
 def main(argv=None) -> int:
     """Command line (see the module docstring); prints the tables, returns 0 (2 for a bad folder).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.real_recordings", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.real_recordings",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("folder")
     parser.add_argument("--datasets", default=",".join(DEVELOPMENT + UNREACHABLE), help="comma-separated dataset names")
     parser.add_argument("--cache", help="folder keeping the published filters' results")

@@ -1,6 +1,6 @@
 """What a short run costs against a long one: the CPU of ``quadcosim run tp`` for 2 s and 320 s of flight.
 
-``python -m benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--in-process] [--parts] [--json]``
+``python -m quadcosim.benchmarks.run_cost [--short 2] [--long 320] [--repeats 3] [--in-process] [--parts] [--json]``
 
 Each run is the command a user types, ``quadcosim run tp --set duration=D --out DIR
 --overwrite``, in a fresh interpreter: its CPU (user and system, ``resource.getrusage`` of the
@@ -10,7 +10,7 @@ fills numba's cache and the diagram cache, as any earlier run on the machine has
 and the long run alternate, so that a load on the machine weighs on both alike; the ratio of
 each pair is printed, then the median of the ratios.
 
-With ``--in-process`` the runs are :func:`scenarios.run` calls in this one process, after a
+With ``--in-process`` the runs are :func:`quadcosim.scenarios.run` calls in this one process, after a
 first run that paid the imports: what a run costs in a notebook, a test session or a sweep's
 worker, where the interpreter, numba and matplotlib are loaded once. Each run still builds its
 system, draws (or copies) its wiring, writes its record and draws its report.
@@ -32,7 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchmarks.startup import child_times
+from quadcosim.benchmarks.startup import child_times
 
 SHORT_S, LONG_S = 2.0, 320.0  # simulated seconds of the two runs compared
 
@@ -58,7 +58,7 @@ def run_cpu(duration: float, out: Path) -> float:
 
 
 def run_cpu_in_process(duration: float, out: Path) -> float:
-    """CPU seconds of :func:`scenarios.run` of ``tp`` for ``duration`` s of flight in this process,
+    """CPU seconds of :func:`quadcosim.scenarios.run` of ``tp`` for ``duration`` s of flight in this process,
     writing into ``out`` (replaced), as ``quadcosim run`` writes.
 
     Parameters
@@ -73,7 +73,7 @@ def run_cpu_in_process(duration: float, out: Path) -> float:
     float
         CPU of this process during the run (s, every thread).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     started = time.process_time()
     scenarios.run("tp", {"duration": duration}, out_dir=out, overwrite=True)
@@ -116,7 +116,8 @@ PARTS = {
     "interpreter": ("the interpreter", "pass"),
     "numpy": ("numpy and fmpy", "import numpy, fmpy"),
     "numba": ("the estimators and the controller, with numba and their two compiled steps from its cache",
-              "import estimators.filters as e, flight.controller as c; e._compiled_step(); c._compiled_step()"),
+              "import quadcosim.estimators.filters as e, quadcosim.flight.controller as c; "
+               "e._compiled_step(); c._compiled_step()"),
     "matplotlib": ("matplotlib's pyplot", "import matplotlib; matplotlib.use('agg'); import matplotlib.pyplot"),
 }
 #: The loads :func:`without_loading` takes off both runs, alone and together: what only the
@@ -199,12 +200,13 @@ def without_loading(figures: dict) -> dict:
 def main(argv=None) -> int:
     """Print the CPU of each run and the ratios; returns 0. ``argv``: the arguments (default
     ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.run_cost", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.run_cost",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("--short", type=float, default=SHORT_S, help="simulated time of the short run (s, default 2)")
     parser.add_argument("--long", type=float, default=LONG_S, help="simulated time of the long run (s, default 320)")
     parser.add_argument("--repeats", type=int, default=3, help="pairs of runs measured (default 3)")
     parser.add_argument("--in-process", action="store_true",
-                        help="runs as scenarios.run calls in this process, after one that paid the imports")
+                        help="runs as quadcosim.scenarios.run calls in this process, after one that paid the imports")
     parser.add_argument("--parts", action="store_true",
                         help="also the CPU of what a fresh run loads before it simulates (the interpreter, numpy "
                              "and fmpy, the estimators and the controller with numba and their compiled steps, "

@@ -1,17 +1,17 @@
 """What saving costs in a long run: ``save_fraction``, the CPU of writing a 320 s ``tp``
 run's record over the CPU of the whole run (``quadcosim bench`` reports it).
 
-``python -m benchmarks.save [--duration 320] [--compressed] [--stream-peak] [--json]``
+``python -m quadcosim.benchmarks.save [--duration 320] [--compressed] [--stream-peak] [--json]``
 
-The run is ``scenarios.run("tp", duration=320)`` into a temporary folder, in this process,
+The run is ``quadcosim.scenarios.run("tp", duration=320)`` into a temporary folder, in this process,
 after a short run that loads the compiled steps. Its CPU time (``time.process_time``: the
 build, the loop, the save, the report and its figures) is measured around the call; the save's
-CPU is the time :class:`scenarios.outputs.RunFiles` spends writing the record
+CPU is the time :class:`quadcosim.scenarios.outputs.RunFiles` spends writing the record
 (``metrics.json``'s ``save_cpu_s``). ``--compressed`` measures the compressed archive too.
 
 ``--stream-peak`` measures, instead of the save's share, how flat ``--stream`` keeps memory: the
 peak resident set of ``quadcosim run tp --stream`` (bench supply on) for 60 s and 3600 s of
-flight, each in a child process (:func:`benchmarks.memory.peak_rss`), and their ratio (with
+flight, each in a child process (:func:`quadcosim.benchmarks.memory.peak_rss`), and their ratio (with
 ``--compressed`` the save's share is measured as well).
 """
 
@@ -44,7 +44,7 @@ def save_fraction(duration: float = DURATION_S, compress: bool = False) -> dict:
         ``fraction``, ``save_cpu_s`` and ``run_cpu_s`` (s of CPU), ``record_mb`` (the
         ``results.npz`` written, MB).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     with tempfile.TemporaryDirectory() as folder:
         scenarios.run("tp", {"duration": 1.0}, Path(folder) / "warm-up")  # compiled steps loaded
@@ -78,7 +78,7 @@ def stream_peak(durations=(60.0, 3600.0)) -> dict:
     dict
         ``peak_mb`` (duration to MB) and ``ratio`` (longest over shortest).
     """
-    from benchmarks.memory import peak_rss
+    from quadcosim.benchmarks.memory import peak_rss
 
     peaks = {}
     for duration in durations:
@@ -98,7 +98,7 @@ def main(argv=None) -> int:
     argv : list of str, optional
         The arguments (the process's by default).
     """
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.save", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.save", description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=DURATION_S, help="simulated seconds (default 320)")
     parser.add_argument("--compressed", action="store_true", help="measure the compressed archive too")
     parser.add_argument("--stream-peak", action="store_true", help="peak memory of 60 s and 3600 s streamed runs")

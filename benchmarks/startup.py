@@ -4,8 +4,8 @@ Each command runs in a fresh interpreter (``python -m quadcosim.main ...``) ``re
 the median and the spread (min, max) of the wall times are printed, and the modules among
 :data:`HEAVY` that the command imported::
 
-    python -m benchmarks.startup                      # list and --help, 5 runs each
-    python -m benchmarks.startup --repeats 3 -- run tp --out /tmp/tp --overwrite
+    python -m quadcosim.benchmarks.startup                      # list and --help, 5 runs each
+    python -m quadcosim.benchmarks.startup --repeats 3 -- run tp --out /tmp/tp --overwrite
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import time
 
 # packages a command should import only when it uses them
 HEAVY = ("control", "dask", "distributed", "matplotlib", "pyarrow", "scipy", "scipy.optimize", "scipy.io",
-         "numba", "fmpy", "vqf", "ahrs", "calibration", "estimators.analysis")
+         "numba", "fmpy", "vqf", "ahrs", "calibration", "quadcosim.estimators.analysis")
 
 _REPORT = ("import atexit, os, sys, json\n"
            "def _report():\n"
@@ -136,7 +136,7 @@ def measure(commands=DEFAULT_COMMANDS, repeats: int = 5) -> dict:
 def main(argv=None) -> int:
     """Print the median wall time and the heavy imports of each command; returns 0.
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.startup", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.startup", description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5, help="runs per command")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("command", nargs="*", help="one quadcosim command (default: list, then --help)")

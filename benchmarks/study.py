@@ -1,4 +1,4 @@
-"""A large study on the local cluster (``python -m benchmarks.study``): what a member costs at scale.
+"""A large study on the local cluster (``python -m quadcosim.benchmarks.study``): what a member costs at scale.
 
 Runs ``members`` closed-loop members (the sweep benchmark's: the lab's loop, linear filter fed
 back, IMU noise on, 5 s simulated, one seed each) on a local Dask cluster of ``workers``
@@ -55,7 +55,7 @@ def measure(members: int = 10_000, workers: int = 2, duration: float = 5.0) -> d
         ``client_rss_growth_per_member_kb`` (last sample less the first, over the members, kB),
         counts and times.
     """
-    from studies.sweep import engine, grid, table
+    from quadcosim.studies.sweep import engine, grid, table
 
     settings = [s for s in SETTINGS if not s.startswith("duration=")] + [f"duration={duration:g}"]
     plan = grid.plan("tp", settings=settings, seeds=str(members))
@@ -87,11 +87,11 @@ def measure(members: int = 10_000, workers: int = 2, duration: float = 5.0) -> d
 
 
 def main(argv=None) -> int:
-    """``python -m benchmarks.study [--members N] [--workers W] [--json]``; returns 0, or 1 when a
+    """``python -m quadcosim.benchmarks.study [--members N] [--workers W] [--json]``; returns 0, or 1 when a
     member failed. ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.study", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.study", description=__doc__.splitlines()[0])
     parser.add_argument("--members", type=int, default=10_000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--duration", type=float, default=5.0, help="simulated seconds per member")

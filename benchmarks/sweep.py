@@ -55,7 +55,7 @@ def measure(members: int = MEMBERS, duration: float = 5.0) -> dict:
         their stepping loop's CPU), disk per member (bytes), the 10 000-member extrapolation (min,
         MB), load averages.
     """
-    from studies.sweep import engine, grid, table
+    from quadcosim.studies.sweep import engine, grid, table
 
     settings = [s for s in SETTINGS if not s.startswith("duration=")] + [f"duration={duration:g}"]
     plan = grid.plan("tp", settings=settings, seeds=str(members))

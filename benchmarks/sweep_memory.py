@@ -1,10 +1,10 @@
 """How a sweep's client grows with its members: bytes of client memory per finished member.
 
-``python -m benchmarks.sweep_memory [--members 20000] [--workers 2] [--json]``
+``python -m quadcosim.benchmarks.sweep_memory [--members 20000] [--workers 2] [--json]``
 
 A ``tp`` sweep over seeds 1..N runs on a real :class:`distributed.LocalCluster` (whose
 scheduler lives in the client's process, as in every local sweep), through
-:func:`studies.sweep.engine.run`. Each member returns, at once, the record of one real ``tp``
+:func:`quadcosim.studies.sweep.engine.run`. Each member returns, at once, the record of one real ``tp``
 member (run once beforehand), so that the table rows have their real width and the cost is
 the sweep engine's and Dask's alone, not the simulation's. The client's memory is sampled
 each time another ``N / 40`` members have finished: its resident set, and with ``--traced``
@@ -36,7 +36,7 @@ def resident_bytes() -> int:
 
 def canned_record() -> dict:
     """A real ``tp`` member's record (a 0.05 s run, seed 1), as a worker returns it."""
-    from studies.sweep import engine
+    from quadcosim.studies.sweep import engine
 
     return engine.run_member("tp", {"duration": 0.05})
 
@@ -74,8 +74,7 @@ def measure(members: int = MEMBERS, workers: int = 2, traced: bool = False) -> d
     import tracemalloc
 
     import numpy as np
-
-    from studies.sweep import engine, grid
+    from quadcosim.studies.sweep import engine, grid
 
     record = canned_record()
     samples = []
@@ -117,7 +116,8 @@ def measure(members: int = MEMBERS, workers: int = 2, traced: bool = False) -> d
 def main(argv=None) -> int:
     """Print the client's growth per member; returns 0. ``argv``: the arguments (default
     ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.sweep_memory", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.sweep_memory",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("--members", type=int, default=MEMBERS, help=f"members of the sweep (default {MEMBERS})")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
     parser.add_argument("--traced", action="store_true", help="also the bytes Python's allocations hold (slower)")

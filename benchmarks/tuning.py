@@ -1,10 +1,10 @@
 """Choose the recommended filter's defaults, each dataset in turn held out, and tune VQF the same way.
 
-    python -m benchmarks.tuning DATA [--filter explicit|vqf] [--limit N] [--out FILE] [--figures DIR]
-    python -m benchmarks.tuning DATA --score-folds [--json FILE]
+    python -m quadcosim.benchmarks.tuning DATA [--filter explicit|vqf] [--limit N] [--out FILE] [--figures DIR]
+    python -m quadcosim.benchmarks.tuning DATA --score-folds [--json FILE]
 
-DATA holds one sub-folder per dataset, as :mod:`benchmarks.datasets` describes; the datasets are
-:data:`benchmarks.real_recordings.DEVELOPMENT`.
+DATA holds one sub-folder per dataset, as :mod:`quadcosim.benchmarks.datasets` describes; the datasets are
+:data:`quadcosim.benchmarks.real_recordings.DEVELOPMENT`.
 
 The score of a gain set is made of its mean total RMSE over VQF's (at VQF's package defaults) on
 each dataset it is scored on, so that each dataset counts alike whatever its number of recordings:
@@ -30,7 +30,7 @@ dataset it held out, against VQF at its defaults and VQF tuned by the same fold
 (:func:`score_folds`): the held-out table.
 
 Parameters, all physical (:data:`SEARCH`): for ``explicit`` (the recommended filter, corrections
-on), the time constants of inclination, heading and bias (s, :func:`estimators.filters.explicit_gains`),
+on), the time constants of inclination, heading and bias (s, :func:`quadcosim.estimators.filters.explicit_gains`),
 the magnetic disturbance thresholds on the field's norm (µT at the lab's 47 µT field; the filter
 applies it relative to the reference norm, so any magnetometer unit works) and on its dip (deg),
 the magnetic reference's time (s: its tracking time constant, and how long a new field must last
@@ -48,11 +48,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from quadcosim.benchmarks import datasets
+from quadcosim.benchmarks.real_recordings import DEVELOPMENT, errors
+from quadcosim.fmus import vehicle
 
-from benchmarks import datasets
-from benchmarks.real_recordings import DEVELOPMENT, errors
-from fmus import vehicle
-from orchestrator.files import save_figure, write_text
+from quadcosim.infra.files import save_figure, write_text
 
 STEP = 2.0  # ratio between neighbouring grid values
 SWEEP = 3  # the sensitivity sweeps reach STEP**SWEEP either side of the chosen value
@@ -120,7 +120,7 @@ class Scorer:
     Parameters
     ----------
     folder : str or pathlib.Path
-        Folder of the datasets (see :mod:`benchmarks.datasets`).
+        Folder of the datasets (see :mod:`quadcosim.benchmarks.datasets`).
     names : sequence of str
         The datasets scored; the development ones by default.
     limit : int, optional
@@ -379,7 +379,7 @@ def leave_one_out(scorer: Scorer, kind: str, start: dict | None = None, log=prin
 
 def record_path(kind: str) -> Path:
     """The committed search record of the filter ``kind``: ``benchmarks/data/tuning_KIND.json``."""
-    from benchmarks.real_recordings import TUNING_RECORDS
+    from quadcosim.benchmarks.real_recordings import TUNING_RECORDS
 
     return TUNING_RECORDS / f"tuning_{kind}.json"
 
@@ -431,7 +431,7 @@ def score_folds(folder, log=print) -> dict:
 def main(argv=None) -> int:
     """Command line (see the module docstring); prints the chosen values, returns 0 (2 for a bad
     folder). ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.tuning", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.benchmarks.tuning", description=__doc__.splitlines()[0])
     parser.add_argument("folder")
     parser.add_argument("--filter", default="explicit", choices=sorted(SEARCH))
     parser.add_argument("--limit", type=int, default=LIMIT,

@@ -14,7 +14,7 @@ Modes:
 - ``STATIC`` (0): ``b_d = 0``, the classical calibration alone;
 - ``METGE`` (1): eq. 9 with the bi-polynomial of the command and the voltage;
 - ``DYNAMIC`` (2): the commands pass through the identified motor dynamics
-  (:class:`calibration.identify.MotorDynamics`): per motor a back-EMF state ``e`` (V) with
+  (:class:`quadcosim.calibration.identify.MotorDynamics`): per motor a back-EMF state ``e`` (V) with
   ``de/dt = rate w - drag e |e|`` (DC motor, quasi-static current), the winding voltage
   ``w = clip(c u - e, low, limit)`` with ``low = 0`` when the ESC free-wheels (else
   ``-limit``), and the amplitude
@@ -33,8 +33,7 @@ import math
 
 import numpy as np
 from numba import njit
-
-from orchestrator.blocks import Block
+from quadcosim.orchestrator.blocks import Block
 
 STATIC, METGE, DYNAMIC = 0, 1, 2
 MODES = {"static": STATIC, "metge": METGE, "dynamic": DYNAMIC}
@@ -176,7 +175,7 @@ def compensate(calibration, time, magneto, commands, voltage, mode: str = "metge
 
     Parameters
     ----------
-    calibration : calibration.Calibration
+    calibration : quadcosim.calibration.Calibration
     time : (T,) array
         Times (s) of the rows, increasing.
     magneto : (T, 3) array
@@ -218,7 +217,7 @@ class MagCompensator(Block):
 
     Parameters
     ----------
-    calibration : calibration.Calibration
+    calibration : quadcosim.calibration.Calibration
     mode : {"static", "metge", "dynamic"}
     sample_rate : float
         Magnetometer rate (Hz); 0 refreshes ``b_d`` at every step.

@@ -24,8 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from calibration.static import CalibrationError
+from quadcosim.calibration.static import CalibrationError
 
 
 def basis(c, u, orders: tuple[int, int]) -> np.ndarray:

@@ -28,10 +28,9 @@ from dataclasses import field as _default
 from pathlib import Path
 
 import numpy as np
-
-from calibration.dynamic import MotorFieldModel
-from calibration.identify import MotorDynamics
-from calibration.static import CalibrationError, StaticCalibration
+from quadcosim.calibration.dynamic import MotorFieldModel
+from quadcosim.calibration.identify import MotorDynamics
+from quadcosim.calibration.static import CalibrationError, StaticCalibration
 
 FORMAT = "quadcosim-magnetometer-calibration"
 #: The largest calibration file read (bytes): one holds a few kB of coefficients.
@@ -89,9 +88,9 @@ class Calibration:
         }
 
     def save(self, path) -> Path:
-        """Write the calibration to ``path`` (JSON, atomically: :func:`orchestrator.files.atomic_path`)
+        """Write the calibration to ``path`` (JSON, atomically: :func:`quadcosim.infra.files.atomic_path`)
         and return the path."""
-        from orchestrator.files import write_text
+        from quadcosim.infra.files import write_text
 
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -145,7 +144,7 @@ class Calibration:
         """Read the calibration file at ``path`` (JSON); refuse a malformed one, or one for another
         number of motors or other orders (when ``motors`` or ``orders`` is given), with a message
         naming the defect."""
-        from orchestrator.inputs import regular_file
+        from quadcosim.infra.inputs import regular_file
 
         path = Path(path)
         fix = "give the JSON file `quadcosim run metge` or Calibration.save writes"

@@ -22,9 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from calibration.compensator import _compensate
-from calibration.static import CalibrationError
+from quadcosim.calibration.compensator import _compensate
+from quadcosim.calibration.static import CalibrationError
 
 
 @dataclass(frozen=True)

@@ -8,16 +8,16 @@
 - :func:`estimate`: the same filters on recorded arrays, many gain sets at once
   (:func:`gain_grid` builds them), with errors against a reference reduced in the loop;
 - :func:`score`: the quaternion-error RMSE (total, inclination, heading);
-- :mod:`estimators.recording`: recorded files (``.npz``, ``.mat``, ``.csv``) in and out;
-- :mod:`estimators.analysis`: python-control analyses of the gains.
+- :mod:`quadcosim.estimators.recording`: recorded files (``.npz``, ``.mat``, ``.csv``) in and out;
+- :mod:`quadcosim.estimators.analysis`: python-control analyses of the gains.
 """
 
-from orchestrator import numba_cache
+from quadcosim.infra import numba_cache
 
 # before the modules below decorate their functions: numba picks a function's cache folder then
 numba_cache.install()
 
-from estimators.filters import (
+from quadcosim.estimators.filters import (
     CORRECTIONS,
     DEFAULT_GAINS,
     DEFAULT_TIME_CONSTANTS,

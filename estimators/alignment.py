@@ -10,7 +10,7 @@ Earth frame):
 - on the inertial side, the capture frame against the Earth's: its vertical is found from the
   accelerometer, whose specific force averages to "up" over a recording
   (:func:`vertical_rotation`), and the remaining constant heading offset is removed when
-  scoring (``align_heading`` of :func:`estimators.estimate`).
+  scoring (``align_heading`` of :func:`quadcosim.estimators.estimate`).
 
 Both are fitted on the recording being scored, once and the same for every filter, from the
 raw sensors and the reference (never from an estimate), so that no filter is favoured. A

@@ -26,9 +26,8 @@ import math
 
 import control
 import numpy as np
+from quadcosim.fmus import vehicle
 from scipy.optimize import minimize_scalar
-
-from fmus import vehicle
 
 HORIZON_TIME_CONSTANTS = 12.0  # simulated span of a bias transient, in time constants of its slowest pole
 RESPONSE_SAMPLES = 20001  # samples of that transient (the convergence time is read to span / 20000)
@@ -88,7 +87,7 @@ def imu_noise_per_sample(sample_rate: float, gyro_density: float | None = None, 
     roll/pitch angle (rad, accelerometer noise over g) at ``sample_rate`` (Hz), from the noise
     densities ``gyro_density`` (rad/s/sqrt(Hz)) and ``acc_density`` (m/s^2/sqrt(Hz)), by default
     the IMU model's."""
-    from fmus.IMU.variables import ACC_NOISE_DENSITY, GYRO_NOISE_DENSITY
+    from quadcosim.fmus.IMU.variables import ACC_NOISE_DENSITY, GYRO_NOISE_DENSITY
 
     root = math.sqrt(sample_rate)
     gyro = (GYRO_NOISE_DENSITY if gyro_density is None else gyro_density) * root
@@ -131,7 +130,7 @@ def explicit_bias_steady_error(k1: float, k2: float, kP: float, bias, attitude=(
     estimation, for a constant gyro ``bias`` (rad/s, body axes), at a fixed ``attitude`` (rad;
     roll, pitch, yaw), with the weights ``k1`` (gravity), ``k2`` (field), the gain ``kP`` (1/s)
     and the reference field ``earth_field`` (T, NED; only its direction counts)."""
-    from estimators.core import quaternion_from_euler, rotation
+    from quadcosim.estimators.core import quaternion_from_euler, rotation
 
     q, r = np.empty(4), np.empty((3, 3))
     quaternion_from_euler(np.asarray(attitude, dtype=float), q)

@@ -14,8 +14,7 @@ import math
 import warnings
 
 import numpy as np
-
-from estimators import core
+from quadcosim.estimators import core
 
 UNIT_WINDOW_S = 2.0  # s, windows over which the specific force is averaged for the unit check (several steps)
 QUIET_FRACTION = 0.2  # the windows with the least gyro activity that judge the unit
@@ -123,7 +122,7 @@ def loop_coefficients(kind: str, table: np.ndarray, dt: float) -> dict:
 def check_stability(kind: str, table: np.ndarray, dt: float, names=None):
     """Refuse gain sets of the filter ``kind`` whose discrete correction loop diverges at the period ``dt`` (s).
 
-    ``table`` (G, GAIN_SIZE) as :func:`estimators.filters.gain_table` builds it. Linear filter:
+    ``table`` (G, GAIN_SIZE) as :func:`quadcosim.estimators.filters.gain_table` builds it. Linear filter:
     ``k_i dt < 2`` (explicit Euler). Explicit and passive: the loop ``e <- e - a e - b sum e``
     with ``a = kP max(k1, k2) dt`` and ``b = kI max(k1, k2) dt^2`` is stable for ``a < 2`` and
     ``b < 4 - 2 a``; the rest gain ``rest_gain dt < 2``. ``names`` labels the gain sets.

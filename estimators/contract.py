@@ -2,9 +2,9 @@
 
 A closed-loop scenario (``tp``) takes an attitude estimator of the user's in the place of its
 ``Quaternion_estim`` block, from Python (``tp.build(options, estimator=MyBlock())``,
-``scenarios.run("tp", ..., estimator=MyBlock)`` or ``system.replace("Quaternion_estim", block)``)
+``quadcosim.scenarios.run("tp", ..., estimator=MyBlock)`` or ``system.replace("Quaternion_estim", block)``)
 or from the command line (``quadcosim run tp --estimator my_filter.py:MyBlock``). The block is
-an :class:`orchestrator.Block`; its Python ``step(t, u, y)`` is the whole contract, and a
+an :class:`quadcosim.orchestrator.Block`; its Python ``step(t, u, y)`` is the whole contract, and a
 compiled form, where the master offers one, is an optional speed-up that must compute the same
 outputs.
 
@@ -30,12 +30,12 @@ Outputs (:data:`REQUIRED`, in any order, each written at every step)
 Rate and timing
     The scenario runs the block at the IMU's rate: its ``period`` is the IMU's, in macro steps,
     and ``start(t0, dt)`` receives its own step ``dt`` (s) before the run. The block has direct
-    feedthrough (the default of :class:`orchestrator.Block`): it reads the present IMU sample.
+    feedthrough (the default of :class:`quadcosim.orchestrator.Block`): it reads the present IMU sample.
 
 Construction and parameters
     Given as a class (``--estimator module:Class``), the block is built as
     ``Class(period=..., q0=...)``: the IMU's period and the vehicle's initial attitude (body to
-    NED, scalar first), each if the constructor takes it (a plain :class:`orchestrator.Block`
+    NED, scalar first), each if the constructor takes it (a plain :class:`quadcosim.orchestrator.Block`
     subclass is built as ``Class(name, period=...)``). Given as an instance, the scenario sets
     its ``period`` to the IMU's. A Python block's parameters are its public numeric attributes:
     ``--set Quaternion_estim.beta=0.1`` sets ``beta`` before the run.
@@ -54,9 +54,8 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from estimators.core import euler_from_quaternion
-from orchestrator.blocks import Block
+from quadcosim.estimators.core import euler_from_quaternion
+from quadcosim.orchestrator.blocks import Block
 
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")
 R_REEL = tuple(f"R_reel_{i}{j}" for i in range(1, 4) for j in range(1, 4))
@@ -167,7 +166,7 @@ def load(spec: str) -> type:
         raise ValueError(f"estimator {spec!r}: write module:Class or file.py:Class")
     try:
         if where.endswith(".py") or "/" in where:
-            from orchestrator.inputs import regular_file
+            from quadcosim.infra.inputs import regular_file
 
             path = Path(where).resolve()
             if not path.exists():
@@ -222,7 +221,7 @@ def adopt(estimator, period: int, q0=None, available=INPUTS) -> Block:
 
     Returns
     -------
-    orchestrator.Block
+    quadcosim.orchestrator.Block
         Named ``Quaternion_estim``.
 
     Raises
@@ -235,8 +234,8 @@ def adopt(estimator, period: int, q0=None, available=INPUTS) -> Block:
         estimator = load(estimator)
     if isinstance(estimator, type):
         if not issubclass(estimator, Block):
-            raise ValueError(f"estimator {label(estimator)} is not an orchestrator.Block; subclass "
-                             "estimators.contract.AttitudeEstimator (see its docstring)")
+            raise ValueError(f"estimator {label(estimator)} is not an quadcosim.orchestrator.Block; subclass "
+                             "quadcosim.estimators.contract.AttitudeEstimator (see its docstring)")
         arguments = _arguments(estimator, {"name": "Quaternion_estim", "period": int(period),
                                            "q0": None if q0 is None else np.asarray(q0, dtype=float)})
         try:
@@ -247,7 +246,7 @@ def adopt(estimator, period: int, q0=None, available=INPUTS) -> Block:
     else:
         block = estimator
         if not isinstance(block, Block):
-            raise ValueError(f"estimator {block!r} is not an orchestrator.Block")
+            raise ValueError(f"estimator {block!r} is not an quadcosim.orchestrator.Block")
         block.period = int(period)
         if isinstance(block, AttitudeEstimator) and block.q0 is None and q0 is not None:
             block.q0 = _unit_quaternion(q0)
@@ -296,7 +295,7 @@ def _guard(block: Block) -> None:
 
 def _arguments(cls, offered: dict) -> dict:
     """The keywords of ``offered`` that ``cls``'s constructor takes (all, with ``**kwargs``);
-    ``name`` only where it has no default (a plain :class:`orchestrator.Block`)."""
+    ``name`` only where it has no default (a plain :class:`quadcosim.orchestrator.Block`)."""
     try:
         parameters = inspect.signature(cls).parameters
     except (TypeError, ValueError):
@@ -314,7 +313,7 @@ def check(block, available=INPUTS) -> None:
 
     Parameters
     ----------
-    block : orchestrator.Block
+    block : quadcosim.orchestrator.Block
         The estimator.
     available : sequence of str
         The inputs the scenario can wire.

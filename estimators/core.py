@@ -78,7 +78,7 @@ OUTPUT_LAYOUT = (("q", 4), ("theta", 3), ("b", 3), ("omega", 3), ("weights", 3))
 OUTPUT_SLOTS, OUTPUT_SIZE = _offsets(OUTPUT_LAYOUT)
 OUT_Q, OUT_THETA, OUT_B, OUT_OMEGA, OUT_WEIGHTS = (OUTPUT_SLOTS[n][0] for n in ("q", "theta", "b", "omega", "weights"))
 
-# Gains and correction settings, one vector per gain set; see estimators.filters for meanings.
+# Gains and correction settings, one vector per gain set; see quadcosim.estimators.filters for meanings.
 GAIN_NAMES = ("k1", "k2", "k3", "kP", "kI", "heading_only", "acc_tolerance", "mag_norm_tolerance",
               "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain",
               "acc_lowpass", "mag_lowpass", "mag_reference_time", "bias_clip", "heading_level", "rest_deviation",

@@ -1,8 +1,8 @@
 """Attitude estimators as a streaming block and as a function on recorded arrays.
 
-Both call the compiled update of :mod:`estimators.core`, so the block and the batch path
+Both call the compiled update of :mod:`quadcosim.estimators.core`, so the block and the batch path
 compute the same numbers. Three filters of the lab, and two published ones for comparison
-(:mod:`estimators.reference`: ``vqf``, ``madgwick``).
+(:mod:`quadcosim.estimators.reference`: ``vqf``, ``madgwick``).
 
 ``linear`` (lab report, section II)
     Per axis, ``dtheta_i = omega_m,i - k_i (theta_i - theta_i,meas)`` with
@@ -112,19 +112,19 @@ import itertools
 import math
 
 import numpy as np
-
-from estimators import core
-from estimators.checks import check_finite, check_measurements, check_stability
-from fmus import vehicle
-from orchestrator.blocks import Block
+from quadcosim.estimators import core
+from quadcosim.estimators.checks import check_finite, check_measurements, check_stability
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator.blocks import Block
 
 FILTERS = tuple(core.KINDS)
 RECOMMENDED = "explicit"  # the lab's filter recommended for real recordings, at DEFAULT_GAINS
-RECORDED = "vqf"  # estimate()'s default: RECOMMENDED loses to it out of sample (benchmarks.tuning --score-folds)
+RECORDED = "vqf"  # estimate()'s default: RECOMMENDED loses to it out of sample
+# (quadcosim.benchmarks.tuning --score-folds)
 TIME_CONSTANTS = ("tau_inclination", "tau_heading", "tau_bias")
 # The recommended filter's defaults: time constants (s), magnetic thresholds (norm in uT at the lab's 47 uT, dip
 # in deg) and times (s: the tracked reference's, and the longest rejection), chosen on four public datasets, each
-# held out of the search in turn (python -m benchmarks.tuning DATA; benchmarks/data/tuning_explicit.json).
+# held out of the search in turn (python -m quadcosim.benchmarks.tuning DATA; benchmarks/data/tuning_explicit.json).
 DEFAULT_TIME_CONSTANTS = {"tau_inclination": 1.0, "tau_heading": 5.0, "tau_bias": 100.0}
 DEFAULT_MAG = {"norm_uT": 9.4, "dip_deg": 20.0, "reference_s": 10.0, "rejection_s": 120.0}
 
@@ -200,7 +200,8 @@ CORRECTIONS = {
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 # The corrections each filter runs with by default (corrections=None or True), at the values of CORRECTIONS.
 # The explicit filter tracks its magnetic reference and adopts a lasting new field, turning or not (VQF's rule
-# less its gyro test): a reference fixed at the first second rejected the iPhones' clean field (benchmarks.magnetic,
+# less its gyro test): a reference fixed at the first second rejected the iPhones' clean field
+# (quadcosim.benchmarks.magnetic,
 # the fixed_reference ablation); the passive filter keeps the corrections it was tuned with.
 NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time",
                     "correct_at_sample")
@@ -224,7 +225,7 @@ WARM_UP_STEP = 1e-3  # s, step of the throw-away update that compiles the kernel
 
 
 def _reference_kinds():
-    from estimators import reference
+    from quadcosim.estimators import reference
 
     return reference.KINDS
 
@@ -452,7 +453,7 @@ class QuaternionEstim(Block):
         self.b0 = np.asarray(b0, dtype=float)
         self.config = config_vector(discretisation, ry, earth_field, gravity, dip, declination)
         if kind in _reference_kinds():
-            from estimators import reference
+            from quadcosim.estimators import reference
 
             self.gains = reference.check_gains(kind, gains)
             self.inputs = MEASUREMENTS
@@ -466,7 +467,7 @@ class QuaternionEstim(Block):
     def start(self, t0, dt):
         self.dt = dt
         if self.kind in _reference_kinds():
-            from estimators import reference
+            from quadcosim.estimators import reference
 
             self.step = reference.streaming_step(self.kind, self.gains, self.config, dt, self.q0, self.b0,
                                                  self.from_triad)
@@ -493,7 +494,7 @@ class QuaternionEstim(Block):
         ``None`` for the published filters, which run in Python."""
         if self.kind in _reference_kinds():
             return None
-        from orchestrator.blocks import CompiledStep
+        from quadcosim.orchestrator.blocks import CompiledStep
 
         function = _compiled_step()
         return CompiledStep(function.address, self.sample, self.data, function)
@@ -512,8 +513,7 @@ def _compiled_step():
     global _COMPILED
     if _COMPILED is None:
         from numba import carray, cfunc
-
-        from orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
+        from quadcosim.orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
 
         (s0, s1), (g0, g1), (c0, c1), (w0, w1) = _D_PARTS
         sources = source_fingerprint(core)  # the update's file: in numba's cache key with the layout above
@@ -555,7 +555,7 @@ def estimate(kind: str = RECORDED, *, gyro, acc, mag, dt: float, gains: dict | N
     ----------
     kind : {"explicit", "linear", "passive", "vqf", "madgwick", "mahony"}
         The filter (see the module docstring; ``vqf``, ``madgwick`` and ``mahony`` are the
-        published filters of :mod:`estimators.reference`). Default: :data:`RECORDED`, ``"vqf"``,
+        published filters of :mod:`quadcosim.estimators.reference`). Default: :data:`RECORDED`, ``"vqf"``,
         the filter for recorded data (:data:`RECOMMENDED` loses to it out of sample).
     gyro, acc, mag : (N, 3) arrays, keyword-only
         Body-frame measurements: rad/s, m/s^2 (specific force: ``-g`` rotated into the body at
@@ -581,7 +581,7 @@ def estimate(kind: str = RECORDED, *, gyro, acc, mag, dt: float, gains: dict | N
         ``(gyro, acc, mag) -> q0`` computes ``q0`` from the recording.
     discretisation : {"exp", "euler"}
         Quaternion update: exponential map, or Euler step plus renormalisation (see
-        :mod:`estimators.core`).
+        :mod:`quadcosim.estimators.core`).
     ry : {"reel", "triad"}
         Passive filter's measured rotation: the true one (``R_reel``) or TRIAD.
     gravity, earth_field, dip, declination
@@ -599,7 +599,7 @@ def estimate(kind: str = RECORDED, *, gyro, acc, mag, dt: float, gains: dict | N
         inertial frame differs from the filter's by a constant heading); costs a second pass.
     check_units : bool
         Refuse an ``acc`` whose specific force at rest is far from g, a unit error (see
-        :func:`estimators.checks.check_measurements`); running or vibrating recordings pass.
+        :func:`quadcosim.estimators.checks.check_measurements`); running or vibrating recordings pass.
 
     Returns
     -------
@@ -624,7 +624,7 @@ def estimate(kind: str = RECORDED, *, gyro, acc, mag, dt: float, gains: dict | N
                                       inputs[:, core.MAG:core.MAG + 3]), None)
     reference, scored = _scoring(reference, scored, len(inputs))
     if kind in _reference_kinds():
-        from estimators import reference as published
+        from quadcosim.estimators import reference as published
 
         series = published.estimate(kind, inputs, dt, gains, config, q_start, np.asarray(b0, float), from_triad,
                                     outputs)
@@ -713,7 +713,7 @@ def score(q, reference, scored=None, gravity=vehicle.GRAVITY, align_heading: boo
     """Quaternion-error RMSE of estimates ``q`` (N, 4) or (G, N, 4) against ``reference`` (N, 4).
 
     The same reduction as :func:`estimate`'s ``reference`` (total, inclination and heading
-    RMSE in degrees, over the ``scored`` samples; see :func:`estimators.core.error_angles`),
+    RMSE in degrees, over the ``scored`` samples; see :func:`quadcosim.estimators.core.error_angles`),
     taken a block of samples at a time so that it adds little memory to a long record.
     ``gravity`` (m/s^2, or a 3-vector, inertial frame) gives the vertical; with
     ``align_heading`` the constant heading offset between the two frames is removed first.

@@ -2,9 +2,9 @@
 ``estimator`` option offers, what the comparisons run, and how tables label them.
 
 Adding an estimator is one file and one line here. A filter of this package's compiled core
-(:mod:`estimators.core`) or of the published packages (:mod:`estimators.reference`) is built as
-:class:`estimators.QuaternionEstim` of its name; an estimator written as a block of its own
-(the contract of :mod:`estimators.contract`) names that block, ``"module:Class"``, in
+(:mod:`quadcosim.estimators.core`) or of the published packages (:mod:`quadcosim.estimators.reference`) is built as
+:class:`quadcosim.estimators.QuaternionEstim` of its name; an estimator written as a block of its own
+(the contract of :mod:`quadcosim.estimators.contract`) names that block, ``"module:Class"``, in
 :attr:`Kind.block`, and is placed as a user's block would be.
 """
 
@@ -25,19 +25,19 @@ class Kind:
         As tables and figures name it (``"VQF"``).
     lab : bool
         One of the lab's filters: its gains are the options ``k1``, ``k2``, ``kP``, ``kI``
-        (1, 1, 1/s, 1/s^2), defaulting to :data:`estimators.LAB_GAINS`.
+        (1, 1, 1/s, 1/s^2), defaulting to :data:`quadcosim.estimators.LAB_GAINS`.
     bias : bool
         Estimates a gyro bias, with the gain ``kI`` (1/s^2).
     streaming : bool
         Runs as a block in a closed loop (a scenario's ``estimator`` choice).
     batch : bool
-        Runs on recorded arrays (:func:`estimators.estimate`): replays of flight logs.
+        Runs on recorded arrays (:func:`quadcosim.estimators.estimate`): replays of flight logs.
     compared : dict or None
         The settings the comparisons of estimators (the lab matrix, Metge's yaw study, flight-log
         replays) run it with; None leaves it out of them.
     block : str or None
         ``"module:Class"`` of the block that implements it (an estimator of its own file); None
-        for the filters :class:`estimators.QuaternionEstim` builds by name.
+        for the filters :class:`quadcosim.estimators.QuaternionEstim` builds by name.
     """
 
     name: str

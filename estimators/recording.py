@@ -32,7 +32,7 @@ import numpy as np
 # A small real recording shipped with the package: 24 s of BROAD's trial "01_undisturbed_slow_rotation_A"
 # (Laidig, Caruso, Cereatti, Seel, "BROAD - A Benchmark for Robust Inertial Orientation Estimation",
 # Data, 2021; CC BY 4.0, cut and stored in single precision, otherwise unchanged): 286 Hz, ENU, mag in uT,
-# at rest, then slow rotations (`python -m estimators.recording` says how long each), with its optical
+# at rest, then slow rotations (`python -m quadcosim.estimators.recording` says how long each), with its optical
 # reference and movement phases.
 EXAMPLE = Path(__file__).parent / "data" / "broad_excerpt.npz"
 
@@ -66,7 +66,7 @@ def _read_csv(path: Path) -> dict:
                              "a Latin-1 or Windows character?); save the file as UTF-8") from None
         except ValueError as error:
             raise ValueError(f"{path} is not a readable CSV recording ({error}); write it with "
-                             "estimators.recording.save") from None
+                             "quadcosim.estimators.recording.save") from None
     names = table.dtype.names or ()
     if not names or len(table) == 0:
         raise ValueError(f"{path} holds no samples: a header row (gyro_x, ..., mag_z) and one row per sample are "
@@ -108,7 +108,7 @@ def _read_raw(path: Path) -> dict:
                 return {k: f[k] for k in f.files}
         except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
             raise ValueError(f"{path} is not a readable .npz archive ({error}); write it with numpy.savez or "
-                             "estimators.recording.save") from None
+                             "quadcosim.estimators.recording.save") from None
     if suffix == ".mat":
         from scipy.io import loadmat
 
@@ -198,7 +198,7 @@ def load(path, rate: float | None = None) -> dict:
         shape, an empty CSV, a time column that does not increase, a ``meta`` that is not
         JSON, or no sampling rate: each names the problem and the fix.
     """
-    from orchestrator.inputs import regular_file
+    from quadcosim.infra.inputs import regular_file
 
     path = Path(path)
     if not path.exists() and not path.is_symlink():
@@ -249,7 +249,7 @@ def save(path, *, gyro, acc, mag, rate: float, quat=None, scored=None, meta: dic
     suffix = path.suffix.lower()
     if suffix not in (".npz", ".mat", ".csv"):
         raise ValueError(f"{path}: unknown recording format {suffix!r}; use .npz, .mat or .csv")
-    from orchestrator.files import atomic_path
+    from quadcosim.infra.files import atomic_path
 
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as temporary:
@@ -302,7 +302,7 @@ def describe(data: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    """``python -m estimators.recording [FILE]``: print :func:`describe` of ``FILE`` (default
+    """``python -m quadcosim.estimators.recording [FILE]``: print :func:`describe` of ``FILE`` (default
     :data:`EXAMPLE`, the shipped excerpt).
 
     Parameters
@@ -317,7 +317,8 @@ def main(argv=None) -> int:
     """
     import argparse
 
-    parser = argparse.ArgumentParser(prog="python -m estimators.recording", description=describe.__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.estimators.recording",
+                                     description=describe.__doc__.split("\n")[0])
     parser.add_argument("file", nargs="?", default=str(EXAMPLE), help="a recording (default: the shipped excerpt)")
     path = Path(parser.parse_args(argv).file)
     d = describe(load(path))

@@ -27,8 +27,7 @@ rotation between the two frames built from those references.
 from __future__ import annotations
 
 import numpy as np
-
-from estimators import core
+from quadcosim.estimators import core
 
 KINDS = ("vqf", "madgwick", "mahony")
 DEFAULT_GAINS = {"vqf": {}, "madgwick": {"beta": 0.041}, "mahony": {"k_P": 1.0, "k_I": 0.3}}
@@ -180,7 +179,7 @@ def estimate(kind, inputs, dt, gains, config, q0, b0, from_triad, outputs) -> di
     ``from_triad``); ``b0`` is taken for the common signature and not used; ``outputs`` names
     the outputs to keep.
 
-    Returns the requested outputs (G, N, size) as :func:`estimators.estimate` does, and
+    Returns the requested outputs (G, N, size) as :func:`quadcosim.estimators.estimate` does, and
     ``q_all`` (G, N, 4) for scoring.
     """
     sets = _gain_sets(kind, gains)

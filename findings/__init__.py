@@ -213,7 +213,7 @@ def load(path=FINDINGS_FILE) -> dict[str, dict]:
 
 def save(findings: dict[str, dict], path=FINDINGS_FILE) -> Path:
     """Write ``findings`` (name -> finding) to ``path`` atomically, sorted by group order then name."""
-    from orchestrator.files import write_json
+    from quadcosim.infra.files import write_json
 
     order = {g: i for i, g in enumerate(GROUPS)}
     rows = sorted(findings.values(), key=lambda f: (order.get(f["group"], len(order)), f["name"]))

@@ -1,4 +1,4 @@
-"""``python -m findings`` (or ``quadcosim findings``): run the README's findings.
+"""``python -m findings``: run the README's findings.
 
 Runs every group of :data:`findings.GROUPS` (or those named), prints each finding
 with its command, writes ``findings.json`` and rewrites the README's numbers from it. A
@@ -20,9 +20,9 @@ from findings import readme
 
 def parser() -> argparse.ArgumentParser:
     """The command's argument parser."""
-    from scenarios.shown import PlainHelp
+    from quadcosim.scenarios.shown import PlainHelp
 
-    p = argparse.ArgumentParser(prog="quadcosim findings", description=__doc__,
+    p = argparse.ArgumentParser(prog="python -m findings", description=__doc__,
                                 formatter_class=PlainHelp)
     p.add_argument("groups", nargs="*", metavar="GROUP",
                    help=f"groups to run (default all: {', '.join(findings.GROUPS)})")
@@ -97,8 +97,8 @@ def checkout(root: Path) -> bool:
 
 def _check_out(path: Path, write: bool):
     """Refuse ``--out`` before any group runs: a folder, or (when it is to be written) what the one
-    writer refuses (:func:`orchestrator.files.output_file`: a FIFO, a device, a missing folder)."""
-    from orchestrator.files import OutputRefused, output_file
+    writer refuses (:func:`quadcosim.infra.files.output_file`: a FIFO, a device, a missing folder)."""
+    from quadcosim.infra.files import OutputRefused, output_file
 
     if path.is_dir():
         raise OutputRefused(f"--out {path}: a folder, not a file; give a findings file such as findings.json")
@@ -120,11 +120,11 @@ def main(argv=None) -> int:
     args = parser().parse_args(argv)
     unknown = [g for g in args.groups if g not in findings.GROUPS]
     if unknown:
-        print(f"quadcosim findings: unknown group {', '.join(unknown)}; groups: {', '.join(findings.GROUPS)}",
+        print(f"python -m findings: unknown group {', '.join(unknown)}; groups: {', '.join(findings.GROUPS)}",
               file=sys.stderr)
         return 2
     if not checkout(findings.ROOT):
-        print(f"quadcosim findings: a maintainer's tool, run from a source checkout: it measures the README's "
+        print(f"python -m findings: a maintainer's tool, run from a source checkout: it measures the README's "
               f"numbers into findings.json and rewrites the README and docs/ beside it. This copy of quadcosim is "
               f"installed in {findings.ROOT} (no pyproject.toml, README.md and docs/ there) and is not written "
               "into; clone the repository and run it there", file=sys.stderr)
@@ -133,7 +133,7 @@ def main(argv=None) -> int:
         _check_out(args.out, write=not (args.check or args.verify_commands))
         committed = findings.load(args.out)
     except (ValueError, OSError) as error:  # OutputRefused and FindingError among them
-        print(f"quadcosim findings: {error}", file=sys.stderr)
+        print(f"python -m findings: {error}", file=sys.stderr)
         return 2
     if args.verify_commands:
         return verify_commands(committed, args.groups or None, args.timeout, args.matching)
@@ -143,7 +143,7 @@ def main(argv=None) -> int:
         print(f"{group}: skipped ({reason}); its {len(kept)} committed values are kept", file=sys.stderr)
     if args.check:
         if not computed:
-            print(f"quadcosim findings --check: nothing was checked: every group asked for was skipped "
+            print(f"python -m findings --check: nothing was checked: every group asked for was skipped "
                   f"({', '.join(skipped)}); give their data (see each reason above) to check them", file=sys.stderr)
             return 1
         lines = findings.differences(computed, committed)
@@ -156,7 +156,7 @@ def main(argv=None) -> int:
     try:
         findings.save(new, args.out)
     except OSError as error:  # a full disk (named, the earlier file kept whole) or a folder gone meanwhile
-        print(f"quadcosim findings: {error}", file=sys.stderr)
+        print(f"python -m findings: {error}", file=sys.stderr)
         return 1
     print(f"{len(computed)} findings written to {args.out}")
     if args.no_readme:

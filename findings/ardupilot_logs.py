@@ -44,7 +44,7 @@ def _arguments(name: str, compass: int, fraction) -> list[str]:
 
 def export(key: str, name: str, compass: int, fraction) -> list[dict]:
     """The export of compass ``compass`` of the log ``name`` and the log as flown, on the score part."""
-    from scenarios.flightlog.calibrate import main as calibrate
+    from quadcosim.scenarios.flightlog.calibrate import main as calibrate
 
     with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stdout(io.StringIO()), \
             contextlib.redirect_stderr(io.StringIO()):

@@ -150,7 +150,7 @@ def _data(words: list[str]) -> tuple[list[str], str]:
 
 def _rewrites(words: list[str]) -> str:
     """Why the command ``words`` may not be run here ('' if it may): ``python -m findings``
-    (``quadcosim findings``) without ``--check`` rewrites the repository's findings.json and pages."""
+    (``python -m findings``) without ``--check`` rewrites the repository's findings.json and pages."""
     runs_findings = words[:3] == ["python", "-m", "findings"] or words[:2] == ["quadcosim", "findings"]
     if runs_findings and "--check" not in words:
         return "it would rewrite findings.json and the pages: a finding's command must only print (add --check)"

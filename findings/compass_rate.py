@@ -1,12 +1,12 @@
 """Findings of the compass rate a flight calibration needs: the example flights (``quadcosim log
-example``, their internal compass moved by :data:`scenarios.flightlog.example.INTERNAL_T_PER_A`
-lagging :data:`scenarios.flightlog.example.DELAY_S`) calibrated with the default Earth field
+example``, their internal compass moved by :data:`quadcosim.scenarios.flightlog.example.INTERNAL_T_PER_A`
+lagging :data:`quadcosim.scenarios.flightlog.example.DELAY_S`) calibrated with the default Earth field
 model as ``quadcosim calibrate`` fits them, their compass decimated from its logged 10 Hz to
 each of :data:`RATES_HZ`: the ``current`` model's coefficient error (% of the true vector's norm)
 and its delay error (ms), flight by flight.
 
 The slowest rate at which every flight still gives its delay exactly is the floor
-:data:`calibration.flight.data.MIN_COMPASS_RATE_HZ` the command enforces; PX4's default logging
+:data:`quadcosim.calibration.flight.data.MIN_COMPASS_RATE_HZ` the command enforces; PX4's default logging
 profile logs ``sensor_mag`` at 1 Hz, under it.
 """
 
@@ -39,9 +39,9 @@ def recovered(log, step: int) -> tuple[float, float]:
     """The ``current`` model fitted on the first half of ``log`` (one sample in ``step`` of its compass
     :data:`COMPASS`), as ``quadcosim calibrate`` splits and aligns it: its coefficient error (% of the
     true vector's norm) and delay error (ms)."""
-    from calibration.flight import calibrate
-    from scenarios.flightlog.calibrate import split_parts
-    from scenarios.flightlog.example import DELAY_S, INTERNAL_T_PER_A
+    from quadcosim.calibration.flight import calibrate
+    from quadcosim.scenarios.flightlog.calibrate import split_parts
+    from quadcosim.scenarios.flightlog.example import DELAY_S, INTERNAL_T_PER_A
 
     split = split_parts([decimated(log, COMPASS, step)], [], COMPASS)
     metrics, _, _ = calibrate(split.train, split.test, ("current",))
@@ -52,8 +52,8 @@ def recovered(log, step: int) -> tuple[float, float]:
 
 def compute(quick: bool = False) -> list[dict]:
     """The group's findings (``quick``: the logged rate alone, seconds; all of them: about a minute)."""
-    from flightlogs import read_log
-    from scenarios.flightlog.example import write_examples
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog.example import write_examples
 
     found = []
     with tempfile.TemporaryDirectory() as folder:

@@ -2,10 +2,10 @@
 estimator's heading difference from the log's attitude without and with the compensation, and
 an ablation of the linear filter's heading on flight a's internal compass.
 
-The example logs are written by the package (:mod:`scenarios.flightlog.example`), so the group
+The example logs are written by the package (:mod:`quadcosim.scenarios.flightlog.example`), so the group
 always runs; their attitude is the simulated truth, and their Earth field the World Magnetic
 Model's, whose declination the replay's Earth field carries. The ablation takes flight a as
-:func:`scenarios.flightlog.replay.replay_log` replays it and changes one thing at a time: the
+:func:`quadcosim.scenarios.flightlog.replay.replay_log` replays it and changes one thing at a time: the
 compensation paired with the log's offsets (which already hold the motors' mean field) instead of
 those fitted with its model; for the linear filter, the reference turned to magnetic north by the
 replay's Earth field's declination, the gyro's body rates turned into Euler-angle rates (at the
@@ -46,12 +46,11 @@ def linear_ablation(path) -> dict:
     with the log's offsets; ``declination``: of the replay's Earth field (deg, east of north) and
     of the World Magnetic Model's (``wmm``); ``bias``: the norm of the mean difference (µT) between
     the field replayed and the one the example was made with."""
+    from quadcosim.estimators import estimate
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog import replay
+    from quadcosim.scenarios.flightlog.example import earth_field
     from scipy.spatial.transform import Rotation
-
-    from estimators import estimate
-    from flightlogs import read_log
-    from scenarios.flightlog import replay
-    from scenarios.flightlog.example import earth_field
 
     log = read_log(path)
     time, dt, gyro, acc, reference = replay._uniform(log, COMPASS)
@@ -88,8 +87,8 @@ def linear_ablation(path) -> dict:
 
 def compute(quick: bool = False) -> list[dict]:
     """The group's findings (see the module docstring; the same with ``quick``: about a minute)."""
-    from scenarios.flightlog.example import write_examples
-    from scenarios.flightlog.replay import replay_log
+    from quadcosim.scenarios.flightlog.example import write_examples
+    from quadcosim.scenarios.flightlog.replay import replay_log
 
     found = []
     with tempfile.TemporaryDirectory() as folder:

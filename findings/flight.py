@@ -1,10 +1,10 @@
 """Findings of the flight side: what rotor drag lets the accelerometer see, the wind hold, and
 how fast the yaw loop may be at a 100 Hz loop rate.
 
-Each is a ``tp`` run whose ``metrics.json`` records the number (:mod:`flight.measured`),
+Each is a ``tp`` run whose ``metrics.json`` records the number (:mod:`quadcosim.flight.measured`),
 except the PD hold without integral, an ablation of the controller's gain that no option
 reaches: it is computed here, as ``tests/test_flight.py`` does, and printed by this group; and
-the yaw loop's cases (:mod:`studies.yaw_loop`), printed by their module.
+the yaw loop's cases (:mod:`quadcosim.studies.yaw_loop`), printed by their module.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ def _command(options: dict) -> str:
 
 
 def _run(options: dict) -> dict:
-    import scenarios
+    from quadcosim import scenarios
 
     return scenarios.run("tp", options)[1]
 
@@ -66,8 +66,8 @@ ABLATION = "python -m findings flight --check"  # prints the group, writes nothi
 
 def predicted_offset() -> float:
     """Downwind offset (m) of a PD position hold: the drag to cancel over ``kp_xy``, ``g tan(tilt) / kp_xy``."""
-    from flight import GAINS, trim
-    from fmus import vehicle
+    from quadcosim.flight import GAINS, trim
+    from quadcosim.fmus import vehicle
 
     tilt, _ = trim.wind_hover_tilt(math.hypot(WIND["wind_n"], WIND.get("wind_e", 0.0)))
     return math.tan(tilt) * vehicle.GRAVITY / GAINS["kp_xy"][0]
@@ -75,8 +75,9 @@ def predicted_offset() -> float:
 
 def offset_without_integral() -> float:
     """Final downwind offset (m) of the position hold in :data:`WIND` with ``ki_xy = 0``."""
-    import scenarios
-    from flight import controller as law
+    from quadcosim.flight import controller as law
+
+    from quadcosim import scenarios
 
     tp = scenarios.get("tp")
     system = tp.build(tp.parse(WIND))
@@ -85,7 +86,7 @@ def offset_without_integral() -> float:
     return math.hypot(result["Quadrotor.p"][-1, 0], result["Quadrotor.p"][-1, 1])
 
 
-YAW = "python -m studies.yaw_loop"
+YAW = "python -m quadcosim.studies.yaw_loop"
 #: Tolerances of the yaw loop's figures: a ringing loop's limit cycle grows from rounding error,
 #: so another CPU may sample it at other phases.
 YAW_TOLERANCE = {"ringing_nm": 0.002, "ring_hz": 0.3, "command_min": 0.005, "command_max": 0.005,
@@ -100,7 +101,7 @@ def yaw(quick: bool = False) -> list[dict]:
     """The yaw loop's cases (a ringing one's ringing and its frequency; every one's command and
     current ranges), the largest quiet loop at 100 Hz and the first whose commands reach a
     bound; ``quick``: the 100 Hz cases alone (a second each)."""
-    from studies import yaw_loop
+    from quadcosim.studies import yaw_loop
 
     found = []
     for name, rate, w, flight, settings in yaw_loop.CASES:

@@ -1,6 +1,6 @@
 """What a wrong firmware rule costs the exported calibration: the export made under each wrong
 rule, applied as the log's firmware really applies it, on the same score part as the export
-made under the right rules (:func:`scenarios.flightlog.calibrate.split_parts`: fitted on the
+made under the right rules (:func:`quadcosim.scenarios.flightlog.calibrate.split_parts`: fitted on the
 first half, chosen on the third quarter, scored on the last).
 
 The wrong rules: the motor offset's order of the other era (after the soft iron, Copter 3.6 and
@@ -19,7 +19,7 @@ WRONG_RULES = ("other_order", "no_trim", "free_earth", "pwm_throttle")
 
 
 def _heading(split, params) -> float:
-    from calibration.flight.export import score_parameters
+    from quadcosim.calibration.flight.export import score_parameters
 
     return score_parameters(split.score, params, offset_from=[*split.fit, *split.choice])["heading_rms_deg"]
 
@@ -29,9 +29,9 @@ def costs(log, compass: int) -> dict:
     ``compass`` made under the right rules (``right``; ``right_throttle`` with the throttle
     compensation alone) and under each of :data:`WRONG_RULES`, every one applied with the log's
     own firmware rules."""
-    from calibration.flight.export import choose
-    from flightlogs import ardupilot
-    from scenarios.flightlog.calibrate import split_parts
+    from quadcosim.calibration.flight.export import choose
+    from quadcosim.flightlogs import ardupilot
+    from quadcosim.scenarios.flightlog.calibrate import split_parts
 
     right = split_parts([log], [], compass)
     found = {"right": _heading(right, choose(right.fit, right.choice)[0]),

@@ -69,9 +69,9 @@ def _calibrate_command(files, compass: int, cross: bool) -> str:
 def _calibrations(flights, compasses, models, cross: bool) -> list[dict]:
     """Each flight's last half scored on a fit to its first half (and, with ``cross``, each
     flight scored on a fit to the two others)."""
-    from calibration.flight import calibrate
-    from flightlogs import read_log
-    from scenarios.flightlog.calibrate import split_parts
+    from quadcosim.calibration.flight import calibrate
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog.calibrate import split_parts
 
     logs = {k: read_log(_path(k)) for k in flights}
     found = []
@@ -120,7 +120,7 @@ def _exports(keys) -> list[dict]:
     import json
     import tempfile
 
-    from scenarios.flightlog.calibrate import main as calibrate
+    from quadcosim.scenarios.flightlog.calibrate import main as calibrate
 
     found = []
     for key, compass in keys:
@@ -139,8 +139,9 @@ def _exports(keys) -> list[dict]:
 def _ablations() -> list[dict]:
     """The heading error (deg RMS, score part) of the export under the right rules and under each
     wrong one, applied as the log's firmware applies it (:mod:`findings.flightlog_ablation`)."""
+    from quadcosim.flightlogs import read_log
+
     from findings.flightlog_ablation import costs
-    from flightlogs import read_log
 
     found = []
     for key, compass in ABLATIONS:
@@ -150,7 +151,7 @@ def _ablations() -> list[dict]:
 
 
 def _replays() -> list[dict]:
-    from scenarios.flightlog.replay import replay_log
+    from quadcosim.scenarios.flightlog.replay import replay_log
 
     found = []
     for key, compass in REPLAYS:

@@ -20,8 +20,10 @@ def compute(quick: bool = False) -> list[dict]:
     at the largest with gravity alone; at the largest without drag (a ratio). ``quick``: none."""
     if quick:
         return []
-    import scenarios
-    import studies  # noqa: F401  (registers gain-study)
+    from quadcosim import (
+        scenarios,
+        studies,  # noqa: F401  (registers gain-study)
+    )
 
     gravity = scenarios.run("gain-study", GRAVITY)[1]["closed_loop_relative_difference"]
     no_drag = scenarios.run("gain-study", NO_DRAG)[1]["closed_loop_relative_difference"]

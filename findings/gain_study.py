@@ -22,8 +22,10 @@ def compute(quick: bool = False) -> list[dict]:
     ``quick``: none (the run takes minutes)."""
     if quick:
         return []
-    import scenarios
-    import studies  # noqa: F401  (registers gain-study)
+    from quadcosim import (
+        scenarios,
+        studies,  # noqa: F401  (registers gain-study)
+    )
 
     m = scenarios.run("gain-study", {})[1]
     gains, difference = m["gains"], m["closed_loop_relative_difference"]

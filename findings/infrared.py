@@ -1,11 +1,11 @@
 """Findings of the in-flight infrared calibration: the estimators' errors, the fault detection, the cost.
 
-``quadcosim run ir-calibration`` in five cases, ``python -m studies.ir_detection --quick``
+``quadcosim run ir-calibration`` in five cases, ``python -m quadcosim.studies.ir_detection --quick``
 (IR +100 counts and GPS +0.1 rad/s over 40 fresh flights each, 200 fresh fault-free flights:
-the quick subset CI re-checks), ``python -m studies.ir_detectability --explain`` and
+the quick subset CI re-checks), ``python -m quadcosim.studies.ir_detectability --explain`` and
 ``--ramps`` (the small faults in the filter's innovations, ramped faults), ``python -m
-studies.ir_detection --plateau`` (the return test's ablation, tuning seeds), ``python -m
-studies.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
+quadcosim.studies.ir_detection --plateau`` (the return test's ablation, tuning seeds), ``python -m
+quadcosim.studies.ir_slides`` (the slides' comparison over fresh flights) and ``quadcosim bench
 infrared`` (the operation count; its timings are not findings).
 """
 
@@ -18,10 +18,10 @@ import numpy as np
 from findings import command, finding
 
 RUN = "quadcosim run ir-calibration"
-DETECTION = "python -m studies.ir_detection"
-DETECTABILITY = "python -m studies.ir_detectability"
+DETECTION = "python -m quadcosim.studies.ir_detection"
+DETECTABILITY = "python -m quadcosim.studies.ir_detectability"
 BENCH = "quadcosim bench infrared"
-SLIDES = "python -m studies.ir_slides"
+SLIDES = "python -m quadcosim.studies.ir_slides"
 UNIT = {"ir": "count", "gps": "rad/s"}
 CASES = {"drift": {}, "no_drift": {"drift": False}, "no_gps_resetting": {"gps_resetting": False},
          "faults": {"faults": "both"}, "faults_ungated": {"faults": "both", "gating": False}}
@@ -35,7 +35,7 @@ def _command(settings: dict) -> str:
 def errors() -> list[dict]:
     """The flight's statistics, the turn-rate error of each estimator in each case, the slides'
     faults declared and ended."""
-    import scenarios
+    from quadcosim import scenarios
 
     found = []
     for case, settings in CASES.items():
@@ -65,7 +65,7 @@ def errors() -> list[dict]:
 
 
 def _case(label: str, s: dict, command: str) -> list[dict]:
-    """The findings of one fault case of :func:`studies.ir_detection.summary`."""
+    """The findings of one fault case of :func:`quadcosim.studies.ir_detection.summary`."""
     found = [finding(f"{label}.flights", s["flights"], "1", command, 0.0, 0)]
     for key in ("right", "ended_early", "standing"):
         p = s[key]
@@ -81,7 +81,7 @@ def _case(label: str, s: dict, command: str) -> list[dict]:
 
 
 def _clean(label: str, c: dict, command: str) -> list[dict]:
-    """The findings of the fault-free fleet of :func:`studies.ir_detection.summary`."""
+    """The findings of the fault-free fleet of :func:`quadcosim.studies.ir_detection.summary`."""
     fa = c["false_alarms"]
     return [finding(f"{label}.flights", c["flights"], "1", command, 0.0, 0),
             finding(f"{label}.hours", c["hours"], "h", command, 0.05, 1),
@@ -92,8 +92,8 @@ def _clean(label: str, c: dict, command: str) -> list[dict]:
 
 def detection_quick() -> list[dict]:
     """CI's re-check: IR +100 counts and GPS +0.1 rad/s over the 40 fresh flights each of
-    :data:`studies.ir_detection.QUICK`, and its 200 fault-free flights."""
-    from studies import ir_detection
+    :data:`quadcosim.studies.ir_detection.QUICK`, and its 200 fault-free flights."""
+    from quadcosim.studies import ir_detection
 
     result, command = ir_detection.quick(), f"{DETECTION} --quick"
     found = []
@@ -104,9 +104,9 @@ def detection_quick() -> list[dict]:
 
 def detection_fresh() -> list[dict]:
     """The judgement of the frozen design: IR +100 counts and GPS +0.1 rad/s over the 1000 fresh
-    flights each of :data:`studies.ir_detection.FRESH`, and the 4500 fault-free flights (500
-    flight-hours) of :data:`studies.ir_detection.FRESH_CLEAN` (about two minutes on one core)."""
-    from studies import ir_detection
+    flights each of :data:`quadcosim.studies.ir_detection.FRESH`, and the 4500 fault-free flights (500
+    flight-hours) of :data:`quadcosim.studies.ir_detection.FRESH_CLEAN` (about two minutes on one core)."""
+    from quadcosim.studies import ir_detection
 
     result, command = ir_detection.study(echo=False), DETECTION
     found = []
@@ -117,8 +117,8 @@ def detection_fresh() -> list[dict]:
 
 def plateau() -> list[dict]:
     """The test that takes the end of an offset missed from its start for a return, each part
-    undone alone, on the tuning fleets of :data:`studies.ir_detection.PLATEAU_SEEDS` pooled."""
-    from studies import ir_detection
+    undone alone, on the tuning fleets of :data:`quadcosim.studies.ir_detection.PLATEAU_SEEDS` pooled."""
+    from quadcosim.studies import ir_detection
 
     command, found = f"{DETECTION} --plateau", []
     for label, cases in ir_detection.plateau_ablation().items():
@@ -133,7 +133,7 @@ def plateau() -> list[dict]:
 def detectability() -> list[dict]:
     """Why the small faults escape the CUSUMs on the filter's own innovations (seed 1), and how
     slow a fault may come before it passes for drift (seed 1)."""
-    from studies import ir_detectability
+    from quadcosim.studies import ir_detectability
 
     e = ir_detectability.explain()
     free = e["fault_free"]
@@ -159,8 +159,8 @@ def detectability() -> list[dict]:
 def limits() -> list[dict]:
     """The detectability limit: the residual's noise, the predicted smallest offset found in
     99 % of flights, and per size the measured share declared on the right sensor and the delay
-    within which 99 % were (fresh seeds of :data:`studies.ir_detectability.MEASURED`)."""
-    from studies import ir_detectability
+    within which 99 % were (fresh seeds of :data:`quadcosim.studies.ir_detectability.MEASURED`)."""
+    from quadcosim.studies import ir_detectability
 
     result, command = ir_detectability.limits(jobs=2), f"{DETECTABILITY} --jobs 2"
     f = result["figures"]
@@ -181,8 +181,8 @@ def limits() -> list[dict]:
 
 def comparison() -> list[dict]:
     """The slides' Kalman/regression comparison in their terms (bank angle, degrees) and in turn
-    rate, with its ablation, as the mean over the fresh flights of :data:`studies.ir_slides.SEEDS`."""
-    from studies import ir_slides
+    rate, with its ablation, as the mean over the fresh flights of :data:`quadcosim.studies.ir_slides.SEEDS`."""
+    from quadcosim.studies import ir_slides
 
     found = []
     for label, entry in ir_slides.table().items():
@@ -196,7 +196,7 @@ def comparison() -> list[dict]:
 
 def cost() -> list[dict]:
     """Operations per iteration on the fault-free flight (the convention of calibration/infrared/cost.py)."""
-    from benchmarks.infrared import measure
+    from quadcosim.benchmarks.infrared import measure
 
     figures = measure(repeats=1)
     return [finding("infrared.cost.gated_mean", figures["kalman"]["operations_mean"], "1", BENCH, 0.05, 1),

@@ -1,5 +1,5 @@
 """Findings of what an FMU in a worker process of its own costs: ``quadcosim bench isolation``
-(:func:`benchmarks.isolation.measure`: the closed loop ``tp`` with its ``MotorMagnetics`` FMU
+(:func:`quadcosim.benchmarks.isolation.measure`: the closed loop ``tp`` with its ``MotorMagnetics`` FMU
 in process and in a worker, alternately, in wall time), a few minutes on a loaded machine.
 
 The crossing between the processes is wall time on shared cores: it moves with the machine's
@@ -27,7 +27,7 @@ def compute(quick: bool = False) -> list[dict]:
     """
     if quick:
         return []
-    from benchmarks.isolation import measure
+    from quadcosim.benchmarks.isolation import measure
 
     figures = measure()
     if not figures["isolated_identical"]:

@@ -1,7 +1,7 @@
 """Findings of the lab's matrix: the estimators in the closed loop, their ablations, the analyses' predictions.
 
 Each is a ``quadcosim run tp`` (its metrics.json records the number) or ``python -m
-scenarios.ablation`` (it prints it). The quick subset: the default ``tp`` run (a few seconds).
+quadcosim.scenarios.ablation`` (it prints it). The quick subset: the default ``tp`` run (a few seconds).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import numpy as np
 from findings import command, finding
 
 RUN = "quadcosim run tp"
-ABLATION = "python -m scenarios.ablation"
+ABLATION = "python -m quadcosim.scenarios.ablation"
 AXES = ("roll", "pitch", "yaw")
 PASSIVE_GAINS = (0.1, 1.0, 10.0, 100.0)
 
@@ -21,7 +21,7 @@ def _command(settings: dict) -> str:
 
 
 def _tp(settings: dict) -> dict:
-    import scenarios
+    from quadcosim import scenarios
 
     return scenarios.run("tp", settings)[1]
 
@@ -58,7 +58,7 @@ def defaults() -> list[dict]:
 
 def linear() -> list[dict]:
     """The linear filter in non-stationary flight, and the ablations that say where its error comes from."""
-    from scenarios.ablation import linear_ablation
+    from quadcosim.scenarios.ablation import linear_ablation
 
     found, m = rms("lab.linear_nonstationary_gt", {"flight": "nonstationary"}, 2)
     quasi = _tp({})["rms_error_deg"]
@@ -93,9 +93,9 @@ def explicit() -> list[dict]:
 def passive() -> list[dict]:
     """The passive filter's bias-convergence time at kP = kI, with R_reel and with TRIAD, against
     the prediction: each run long enough to show it (1.5 times the prediction, 10 s at least)."""
-    from estimators import analysis
-    from fmus.IMU.variables import LAB_GYRO_BIAS
-    from scenarios.tp import BIAS_TOLERANCE
+    from quadcosim.estimators import analysis
+    from quadcosim.fmus.IMU.variables import LAB_GYRO_BIAS
+    from quadcosim.scenarios.tp import BIAS_TOLERANCE
 
     found = []
     for gain in PASSIVE_GAINS:
@@ -117,7 +117,7 @@ def passive() -> list[dict]:
 def triad() -> list[dict]:
     """The passive filter on TRIAD: the bias estimate in non-stationary flight (ablation), and
     estimate-fed in the cruise."""
-    from scenarios.ablation import triad_ablation
+    from quadcosim.scenarios.ablation import triad_ablation
 
     rows = triad_ablation({"flight": "nonstationary"})
     command = f"{ABLATION} --triad --set flight=nonstationary"
@@ -161,7 +161,7 @@ def bias_steady() -> list[dict]:
     """Case 6: the explicit filter's steady error under a gyro bias without bias estimate, in the
     case's 20 s non-stationary flight (still growing) and in a hover long enough to be steady,
     against the linearised prediction; how much the hover's error moved over its last half."""
-    import scenarios
+    from quadcosim import scenarios
 
     short = CASE6 | {"flight": "nonstationary"}
     m = _tp(short)

@@ -1,6 +1,6 @@
 """Findings of what the quad's three flight logs hold: battery current range and logging rates.
 
-``quadcosim log info logs/FLIGHT`` prints them (:mod:`flightlogs.info`): the battery
+``quadcosim log info logs/FLIGHT`` prints them (:mod:`quadcosim.flightlogs.info`): the battery
 current's range (A) and the rates (Hz) of the internal compass (``MAG2``, the one the
 documentation calibrates) and of the motor outputs. The logs are read from
 ``$QUADCOSIM_FLIGHT_LOGS`` (see :mod:`findings.flightlogs`); without it the group is
@@ -25,8 +25,8 @@ def flight(key: str) -> list[dict]:
     key : str
         A flight of :data:`findings.flightlogs.FLIGHTS`.
     """
-    from flightlogs import read_log
-    from flightlogs.info import summary
+    from quadcosim.flightlogs import read_log
+    from quadcosim.flightlogs.info import summary
 
     info = summary(read_log(_path(key)))
     command = f"quadcosim log info {_shown(key)}"

@@ -113,7 +113,7 @@ def training_span(mlog, compass_name: str, start: float, end: float):
     compass_name : str
         The compass as the log names it (``MAG``, ``MAG2``, ``MAG[1]``).
     start, end : float
-        The range (s, the log's clock, as :class:`calibration.flight.FlightData` holds it).
+        The range (s, the log's clock, as :class:`quadcosim.calibration.flight.FlightData` holds it).
 
     Returns
     -------
@@ -213,8 +213,8 @@ def _orientation(params: dict, slot: int) -> int:
 
 def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
     """magfit on the export's fit part of compass ``compass`` of log ``key`` (the same split as
-    ``quadcosim calibrate``: :func:`scenarios.flightlog.calibrate.split_parts`), each of
-    ``settings`` scored on the choice part (:func:`calibration.flight.export.score_parameters`, as
+    ``quadcosim calibrate``: :func:`quadcosim.scenarios.flightlog.calibrate.split_parts`), each of
+    ``settings`` scored on the choice part (:func:`quadcosim.calibration.flight.export.score_parameters`, as
     the export's groups are chosen) and on the score part by ``quadcosim calibrate --score``.
 
     Returns
@@ -227,12 +227,11 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
     """
     require_mavproxy()  # skips before any work when MAVProxy is absent
     from pymavlink import mavutil
-
-    from calibration.flight.autopilot import write_ardupilot
-    from calibration.flight.export import score_parameters
-    from flightlogs import read_log
-    from scenarios.flightlog.calibrate import main as calibrate
-    from scenarios.flightlog.calibrate import split_parts
+    from quadcosim.calibration.flight.autopilot import write_ardupilot
+    from quadcosim.calibration.flight.export import score_parameters
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog.calibrate import main as calibrate
+    from quadcosim.scenarios.flightlog.calibrate import split_parts
 
     path = _path(key)
     mlog = mavutil.mavlink_connection(str(path))

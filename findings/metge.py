@@ -1,8 +1,8 @@
 """Findings of the magnetometer calibration on the clamped rig (Metge et al.) and of its robustness.
 
 Four ``metge`` runs (default options; ``noise=off``; one battery state per set; the paper's
-free-set regime), the robustness study (:mod:`studies.metge_robustness`) and the free set's
-ablation (:mod:`studies.metge_free`). About 20 minutes; the quick subset is the free set's
+free-set regime), the robustness study (:mod:`quadcosim.studies.metge_robustness`) and the free set's
+ablation (:mod:`quadcosim.studies.metge_free`). About 20 minutes; the quick subset is the free set's
 uncompensated error of the default and the paper's regime over the ablation's seeds (no
 calibration needed) and the bounds (seconds).
 """
@@ -14,16 +14,16 @@ from findings import finding
 RUN = "quadcosim run metge"
 NOISELESS = f"{RUN} --set noise=off"
 ONE_STATE = f"{RUN} --set soc1=0.95 soc2=0.8"
-ROBUSTNESS = "python -m studies.metge --robustness --out results/robustness"
+ROBUSTNESS = "python -m quadcosim.studies.metge --robustness --out results/robustness"
 PAPER_REGIME = f"{RUN} --set regime=paper"
-FREE_SET = "python -m studies.metge --free-set --out results/free-set"
+FREE_SET = "python -m quadcosim.studies.metge --free-set --out results/free-set"
 #: The ablation's cases whose uncompensated free set the quick subset re-measures.
 QUICK_CASES = ("default", "paper")
 DEG = 0.005  # deg, tolerance of a re-run (the runs are seeded: a re-run differs by round-off)
 
 
 def _run(settings: dict) -> dict:
-    import scenarios
+    from quadcosim import scenarios
 
     return scenarios.run("metge", settings)[1]
 
@@ -70,7 +70,7 @@ def noiseless_and_one_state() -> list[dict]:
 
 def robustness() -> list[dict]:
     """The compensation on plants the identified family does not contain."""
-    from studies.metge_robustness import study
+    from quadcosim.studies.metge_robustness import study
 
     found = []
     for case, row in study().items():
@@ -108,7 +108,7 @@ def _case(name: str, row: dict, fields=CASE_FIELDS) -> list[dict]:
 
 
 def _bounds() -> list[dict]:
-    from studies import metge_free
+    from quadcosim.studies import metge_free
 
     return [finding("metge.free.bound_steady_deg", metge_free.largest_turn_deg(), "deg", FREE_SET, DEG, 1),
             finding("metge.free.bound_current_limit_deg", metge_free.largest_turn_deg(limit_current=True), "deg",
@@ -119,7 +119,7 @@ def _bounds() -> list[dict]:
 def free_set(quick: bool = False) -> list[dict]:
     """The free set's ablation: every case, the heading and the flight, the bounds; ``quick``:
     the uncompensated free set of :data:`QUICK_CASES` and the bounds."""
-    from studies import metge_free
+    from quadcosim.studies import metge_free
 
     if quick:
         found = []

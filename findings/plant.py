@@ -1,6 +1,6 @@
 """Findings of the default vehicle at hover: its trim, its motors' time constant and what follows.
 
-All come from ``python -m studies.hover`` (:func:`studies.hover.figures`), a second of the
+All come from ``python -m quadcosim.studies.hover`` (:func:`quadcosim.studies.hover.figures`), a second of the
 MotorMagnetics FMU at the hover command and a small step from there, and the drag model's
 predictions; deterministic, a few seconds in all.
 """
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from findings import finding
 
-COMMAND = "python -m studies.hover"
-# name, key of studies.hover.figures, unit, tolerance, digits (tolerances: the printed rounding,
+COMMAND = "python -m quadcosim.studies.hover"
+# name, key of quadcosim.studies.hover.figures, unit, tolerance, digits (tolerances: the printed rounding,
 # the figures being deterministic; the time constant is read on a 0.1 ms grid)
 FIGURES = (
     ("command", "command", "1", 5e-4, 2),
@@ -25,7 +25,7 @@ FIGURES = (
 
 def compute(quick: bool = False) -> list[dict]:
     """The hover findings (the same, and fast, with ``quick``)."""
-    from studies.hover import figures
+    from quadcosim.studies.hover import figures
 
     measured = figures()
     return [finding(f"plant.hover.{name}", measured[key], unit, COMMAND, tolerance, digits)

@@ -258,7 +258,7 @@ def rewrite(path, old: dict[str, dict], new: dict[str, dict]) -> list[str]:
         The numbers that could not be rewritten (printed from no old finding, or from several
         old findings whose new values differ); empty when the page is up to date.
     """
-    from orchestrator.files import write_text
+    from quadcosim.infra.files import write_text
 
     path = Path(path)
     page = path.read_text()

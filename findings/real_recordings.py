@@ -1,6 +1,6 @@
 """Findings on public real recordings: our filters at their defaults against VQF, Madgwick and Mahony.
 
-The numbers need the datasets, which are not shipped (:mod:`benchmarks.datasets` says where each
+The numbers need the datasets, which are not shipped (:mod:`quadcosim.benchmarks.datasets` says where each
 comes from): set ``QUADCOSIM_REAL_DATA`` to the data folder (and optionally
 ``QUADCOSIM_REAL_CACHE`` to a folder keeping the published filters' results, which take tens of
 minutes). Without the data, :func:`compute` raises ``FileNotFoundError``: the group is skipped and
@@ -13,11 +13,11 @@ import math
 import os
 from pathlib import Path
 
-from estimators import kinds
+from quadcosim.estimators import kinds
 
-COMMAND = "python -m benchmarks.real_recordings DATA"
-CHOOSE = "python -m benchmarks.tuning DATA"
-FOLDS = "python -m benchmarks.tuning DATA --score-folds"
+COMMAND = "python -m quadcosim.benchmarks.real_recordings DATA"
+CHOOSE = "python -m quadcosim.benchmarks.tuning DATA"
+FOLDS = "python -m quadcosim.benchmarks.tuning DATA --score-folds"
 LARGE = "mahony"  # the filter whose failures on single recordings the documentation counts
 FILTERS = {name: kinds.KINDS[name].label for name in ("explicit", "passive", "vqf", "madgwick", "mahony")}
 METRICS = {"total_rmse_deg": "total", "heading_rmse_deg": "heading", "inclination_rmse_deg": "inclination"}
@@ -31,7 +31,7 @@ def _entry(name, value, unit, digits=DIGITS, tolerance=TOLERANCE_DEG, command=CO
 
 
 def findings(results: dict) -> list[dict]:
-    """The findings of :func:`benchmarks.real_recordings.evaluate`'s ``results``: per dataset, its
+    """The findings of :func:`quadcosim.benchmarks.real_recordings.evaluate`'s ``results``: per dataset, its
     number of recordings, the mean total, heading and inclination RMSE (deg) of every filter, of
     the published filters tuned the same way as ours and of the recommended filter's ablations,
     and the recommended filter's mean total RMSE over VQF's (at VQF's defaults, and tuned)."""
@@ -59,7 +59,7 @@ def _value(name, value, command) -> dict:
 
 
 def tuning(records: dict) -> list[dict]:
-    """The search records of :mod:`benchmarks.tuning` (filter -> record): the values chosen on all the
+    """The search records of :mod:`quadcosim.benchmarks.tuning` (filter -> record): the values chosen on all the
     datasets, the score there, and the values each leave-one-dataset-out fold chose without its dataset."""
     out = []
     for kind, record in records.items():
@@ -74,7 +74,7 @@ def tuning(records: dict) -> list[dict]:
 
 
 def folds(scores: dict) -> list[dict]:
-    """The leave-one-dataset-out table (:func:`benchmarks.tuning.score_folds`' ``scores``): per
+    """The leave-one-dataset-out table (:func:`quadcosim.benchmarks.tuning.score_folds`' ``scores``): per
     dataset, while it was held out of the search, the mean total RMSE (deg) of the explicit filter
     at its fold's values, of VQF at its defaults and of VQF tuned by the same fold, and the ratios."""
     out = []
@@ -91,12 +91,12 @@ def folds(scores: dict) -> list[dict]:
 
 def unreachable() -> list[dict]:
     """The rows of the datasets that cannot be reached now
-    (:data:`benchmarks.real_recordings.UNREACHABLE`), as measured in an earlier round and kept in
+    (:data:`quadcosim.benchmarks.real_recordings.UNREACHABLE`), as measured in an earlier round and kept in
     their committed records (``benchmarks/data/unreachable_NAME.json``), named
     ``real_recordings.unreachable.NAME.*``: not re-measured, at the defaults of that round."""
     import json
 
-    from benchmarks import real_recordings
+    from quadcosim.benchmarks import real_recordings
 
     out = []
     for name in real_recordings.UNREACHABLE:
@@ -110,11 +110,11 @@ def unreachable() -> list[dict]:
 
 
 def notes(results: dict) -> list[dict]:
-    """What the means of ``results`` (:func:`benchmarks.real_recordings.evaluate`'s) hide
-    (:func:`benchmarks.real_recordings.notes`): per dataset that left
+    """What the means of ``results`` (:func:`quadcosim.benchmarks.real_recordings.evaluate`'s) hide
+    (:func:`quadcosim.benchmarks.real_recordings.notes`): per dataset that left
     recordings out, how many of how many; on ``broad``, the recordings where Mahony's total RMSE
-    exceeds :data:`benchmarks.real_recordings.LARGE_ERROR_DEG`, how many and the largest (deg)."""
-    from benchmarks.real_recordings import large_errors
+    exceeds :data:`quadcosim.benchmarks.real_recordings.LARGE_ERROR_DEG`, how many and the largest (deg)."""
+    from quadcosim.benchmarks.real_recordings import large_errors
 
     out = []
     for dataset, found in results.items():
@@ -133,7 +133,7 @@ def compute(quick: bool = False) -> list[dict]:
     """The group's findings, from the data folder named by ``QUADCOSIM_REAL_DATA`` (the published
     filters' results at their defaults come from ``QUADCOSIM_REAL_CACHE`` when kept there), and the
     tuning's committed records (``benchmarks/data/tuning_*.json``; ``quick`` or not, the search itself
-    is not re-run here: ``python -m benchmarks.tuning DATA`` re-runs it). ``QUADCOSIM_REAL_PUBLISHED``
+    is not re-run here: ``python -m quadcosim.benchmarks.tuning DATA`` re-runs it). ``QUADCOSIM_REAL_PUBLISHED``
     names the published filters to run (comma-separated; default all).
     Raises ``FileNotFoundError`` when the data are absent."""
     folder = os.environ.get("QUADCOSIM_REAL_DATA")
@@ -142,11 +142,11 @@ def compute(quick: bool = False) -> list[dict]:
                                 "folder (see benchmarks/datasets.py); the recorded values are kept")
     import json
 
-    from benchmarks import real_recordings
+    from quadcosim.benchmarks import real_recordings
 
     cache = os.environ.get("QUADCOSIM_REAL_CACHE")
     published = tuple(k for k in os.environ.get("QUADCOSIM_REAL_PUBLISHED", "vqf,madgwick,mahony").split(",") if k)
-    from benchmarks import tuning as search
+    from quadcosim.benchmarks import tuning as search
 
     records = {path.stem.removeprefix("tuning_"): json.loads(path.read_text())
                for path in sorted(real_recordings.TUNING_RECORDS.glob("tuning_*.json"))}

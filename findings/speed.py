@@ -2,8 +2,8 @@
 shell's cost, the command line's start-up, a ``tp`` run's wall time and what a short run costs
 against a long one.
 
-One run of each benchmark (``quadcosim bench --json``: :func:`benchmarks.master.measure`;
-``python -m benchmarks.startup``: :func:`benchmarks.startup.measure`, for ``list``, ``--help``
+One run of each benchmark (``quadcosim bench --json``: :func:`quadcosim.benchmarks.master.measure`;
+``python -m quadcosim.benchmarks.startup``: :func:`quadcosim.benchmarks.startup.measure`, for ``list``, ``--help``
 and ``run tp``), a few minutes on a loaded machine. Absolute times (µs per step, updates per
 second) of one thread move about twofold with the machine's load: their tolerance is their
 value; wall times on the shared cores (start-up, the batch path on every core) up to fivefold:
@@ -20,12 +20,12 @@ from pathlib import Path
 from findings import finding
 
 BENCH = "quadcosim bench --json"
-STARTUP = "python -m benchmarks.startup"
+STARTUP = "python -m quadcosim.benchmarks.startup"
 TP_OUT = "/tmp/quadcosim-tp"
 TP_RUNS = 3
-TP = f"python -m benchmarks.startup --repeats {TP_RUNS} -- run tp --out {TP_OUT} --overwrite"
-RUN_COST = "python -m benchmarks.run_cost --parts"
-RUN_COST_IN_PROCESS = "python -m benchmarks.run_cost --in-process"
+TP = f"python -m quadcosim.benchmarks.startup --repeats {TP_RUNS} -- run tp --out {TP_OUT} --overwrite"
+RUN_COST = "python -m quadcosim.benchmarks.run_cost --parts"
+RUN_COST_IN_PROCESS = "python -m quadcosim.benchmarks.run_cost --in-process"
 # The ratio of a 2 s run's CPU to a 320 s run's moved from 0.43 to 0.51 between pairs of one run.
 RUN_COST_TOLERANCE = 0.1
 MILLION = 1e6
@@ -57,7 +57,7 @@ def _identical(bench: dict):
 
 
 def bench_findings(bench: dict) -> list[dict]:
-    """The findings of one ``quadcosim bench --json`` object (:func:`benchmarks.master.measure`).
+    """The findings of one ``quadcosim bench --json`` object (:func:`quadcosim.benchmarks.master.measure`).
 
     Parameters
     ----------
@@ -90,7 +90,7 @@ def bench_findings(bench: dict) -> list[dict]:
 
 def startup_findings(startup: dict, tp: dict) -> list[dict]:
     """The start-up findings: median wall time of ``quadcosim list`` and ``--help``
-    (:func:`benchmarks.startup.measure`), and of ``quadcosim run tp``.
+    (:func:`quadcosim.benchmarks.startup.measure`), and of ``quadcosim run tp``.
 
     Parameters
     ----------
@@ -105,7 +105,7 @@ def startup_findings(startup: dict, tp: dict) -> list[dict]:
 
 
 def run_cost_findings(fresh: dict, in_process: dict) -> list[dict]:
-    """What a short run costs against a long one (:func:`benchmarks.run_cost.measure`): the
+    """What a short run costs against a long one (:func:`quadcosim.benchmarks.run_cost.measure`): the
     median ratio of fresh commands and of runs in one process, what the estimators and the
     controller with numba, and matplotlib, cost a fresh interpreter to load, and the fresh ratio
     with that loading taken off both runs.
@@ -132,7 +132,7 @@ def compute(quick: bool = False) -> list[dict]:
     are not re-checked)."""
     if quick:
         return []
-    from benchmarks import master, run_cost, startup
+    from quadcosim.benchmarks import master, run_cost, startup
 
     bench = master.measure()
     with tempfile.TemporaryDirectory() as folder:

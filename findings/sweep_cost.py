@@ -1,6 +1,6 @@
-"""Findings of what a sweep costs: ``quadcosim bench sweep`` (:func:`benchmarks.sweep.measure`:
+"""Findings of what a sweep costs: ``quadcosim bench sweep`` (:func:`quadcosim.benchmarks.sweep.measure`:
 40 closed-loop members on 1 then 2 local workers, and the 10 000-member study it extrapolates)
-and a study of :data:`STUDY_MEMBERS` members on 2 workers (``python -m benchmarks.study``:
+and a study of :data:`STUDY_MEMBERS` members on 2 workers (``python -m quadcosim.benchmarks.study``:
 run as written in a fresh interpreter, :func:`study`), a few minutes in all on a loaded machine.
 
 CPU times per member, on the member's thread, moved by under a tenth between runs at load
@@ -20,7 +20,7 @@ from findings import finding
 BENCH = "quadcosim bench sweep"
 STUDY_MEMBERS = 1000
 STUDY_WORKERS = 2
-STUDY = f"python -m benchmarks.study --members {STUDY_MEMBERS} --workers {STUDY_WORKERS}"
+STUDY = f"python -m quadcosim.benchmarks.study --members {STUDY_MEMBERS} --workers {STUDY_WORKERS}"
 MS = 1e3
 CPU_SWING = 0.5  # CPU time of a member on its worker's thread
 WALL_SWING = 4.0  # wall time and rates on shared cores: a re-run may take five times as long
@@ -44,7 +44,7 @@ def _disk(key: str, value: float) -> dict:
 
 
 def bench_findings(figures: dict) -> list[dict]:
-    """The findings of one ``quadcosim bench sweep`` (:func:`benchmarks.sweep.measure`'s dict ``figures``)."""
+    """The findings of one ``quadcosim bench sweep`` (:func:`quadcosim.benchmarks.sweep.measure`'s dict ``figures``)."""
     one, two = figures["workers_1"], figures["workers_2"]
     found = [_timing("bench.members_per_s_1", one["members_per_s"], "1/s", BENCH, 2),
              _timing("bench.members_per_s_2", two["members_per_s"], "1/s", BENCH, 2),
@@ -71,7 +71,7 @@ def bench_findings(figures: dict) -> list[dict]:
 
 
 def study_findings(figures: dict) -> list[dict]:
-    """The findings of one ``python -m benchmarks.study`` (:func:`study`'s dict ``figures``)."""
+    """The findings of one ``python -m quadcosim.benchmarks.study`` (:func:`study`'s dict ``figures``)."""
     if figures["failed"]:
         raise RuntimeError(f"{STUDY}: {figures['failed']} members failed")
     rss = figures["client_rss_mb"]
@@ -91,7 +91,7 @@ def study_findings(figures: dict) -> list[dict]:
 
 
 def study(members: int = STUDY_MEMBERS, workers: int = STUDY_WORKERS) -> dict:
-    """The figures of ``python -m benchmarks.study --members MEMBERS --workers WORKERS --json``,
+    """The figures of ``python -m quadcosim.benchmarks.study --members MEMBERS --workers WORKERS --json``,
     run as written in a fresh interpreter: the client's memory is that of the command, not of
     a process that ran other benchmarks first.
 
@@ -105,7 +105,7 @@ def study(members: int = STUDY_MEMBERS, workers: int = STUDY_WORKERS) -> dict:
     Returns
     -------
     dict
-        :func:`benchmarks.study.measure`'s figures.
+        :func:`quadcosim.benchmarks.study.measure`'s figures.
 
     Raises
     ------
@@ -118,7 +118,8 @@ def study(members: int = STUDY_MEMBERS, workers: int = STUDY_WORKERS) -> dict:
 
     from findings import ROOT
 
-    command = [sys.executable, "-m", "benchmarks.study", "--members", str(members), "--workers", str(workers), "--json"]
+    command = [sys.executable, "-m", "quadcosim.benchmarks.study", "--members", str(members),
+               "--workers", str(workers), "--json"]
     done = subprocess.run(command, capture_output=True, text=True, cwd=ROOT)
     if done.returncode not in (0, 1):  # 1: a member failed, reported in the figures
         raise RuntimeError(f"{' '.join(command[1:])} exited with {done.returncode}: {done.stderr[-2000:]}")
@@ -130,6 +131,6 @@ def compute(quick: bool = False) -> list[dict]:
     none (timings are not re-checked; the disk figures come from the timed sweep)."""
     if quick:
         return []
-    from benchmarks import sweep
+    from quadcosim.benchmarks import sweep
 
     return bench_findings(sweep.measure()) + study_findings(study())

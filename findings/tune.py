@@ -38,7 +38,7 @@ FIGURES = ROOT / "docs" / "tuning"
 
 
 def _tune(args: list[str], out: Path) -> dict:
-    from studies import tune
+    from quadcosim.studies import tune
 
     parsed = tune.add_arguments(__import__("argparse").ArgumentParser()).parse_args(args)
     tune_plan = tune.plan(parsed.scenario, parsed.minimize, parsed.over, parsed.set, parsed.seeds, parsed.budget)
@@ -46,7 +46,7 @@ def _tune(args: list[str], out: Path) -> dict:
 
 
 def _grid(args: list[str], out: Path) -> dict:
-    from studies.sweep import command, engine, table
+    from quadcosim.studies.sweep import command, engine, table
 
     parsed = command.add_arguments(__import__("argparse").ArgumentParser()).parse_args([*args, "--out", str(out)])
     plan = command.make_plan(parsed)
@@ -68,7 +68,7 @@ def _pooled(columns: dict, metric: str, names: list[str]) -> dict:
 def _k_figure(tuned: dict, grid: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import save_figure
+    from quadcosim.infra.files import save_figure
 
     ks = sorted(grid)
     fig, ax = plt.subplots(figsize=(8, 5))
@@ -103,7 +103,7 @@ def _step_figure(tuned: dict, grid: dict, names: list[str], path: Path) -> None:
     value along the search."""
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import save_figure
+    from quadcosim.infra.files import save_figure
 
     history = tuned["history"]
     n = np.arange(1, len(history) + 1)

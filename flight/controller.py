@@ -25,9 +25,9 @@ Law, per sample of period ``dt``:
   whole loop at 100 Hz, a yaw loop above 11 rad/s is unstable: at 12 rad/s an 18 Hz
   oscillation grows until the motor currents reach zero, where free-wheeling ESCs hold them
   (the ESC commands stay inside [0, 1]: 0.35 to 0.58 in non-stationary flight); 8 rad/s is
-  quiet, and so is 12 rad/s at 1 kHz (:mod:`studies.yaw_loop` measures it);
+  quiet, and so is 12 rad/s at 1 kHz (:mod:`quadcosim.studies.yaw_loop` measures it);
 - altitude: ``a_z = kp_z (z_d - p_z) - kd_z v_z``, ``T = m (g - a_z) / R33``;
-- mixer: ``[T_1..T_4] = M^-1 [T, tau]`` (:func:`flight.mixer.allocation_matrix`),
+- mixer: ``[T_1..T_4] = M^-1 [T, tau]`` (:func:`quadcosim.flight.mixer.allocation_matrix`),
   each rotor thrust saturated to ``[0, T_max]``, ``omega_n = sqrt(T_n / k_f)``, and the ESC
   command from the motors' steady-state map at the present battery voltage, saturated to
   ``[0, 1]``.
@@ -42,13 +42,12 @@ import math
 
 import numpy as np
 from numba import njit
-
-from estimators.core import euler_to_quaternion
-from flight.mixer import allocation_matrix, esc_command
-from fmus import vehicle
-from orchestrator import portable
-from orchestrator.blocks import Block
-from orchestrator.fmu import nearest
+from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.flight.mixer import allocation_matrix, esc_command
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator import portable
+from quadcosim.orchestrator.blocks import Block
+from quadcosim.orchestrator.fmu import nearest
 
 SETPOINT = ("theta_d1", "theta_d2", "theta_d3", "x_d", "y_d", "z_d", "hold")
 INPUTS = SETPOINT + ("q0", "q1", "q2", "q3", "omega_x", "omega_y", "omega_z", "p_x", "p_y", "p_z",
@@ -124,7 +123,7 @@ DATA_SIZE = D_DT + 1
 
 def parameters(gains: dict | None = None) -> np.ndarray:
     """Parameter vector of the law, in :data:`PARAMETERS` order, from the default vehicle
-    (:mod:`fmus.vehicle`) and ``gains`` (names of :data:`GAINS`, their units).
+    (:mod:`quadcosim.fmus.vehicle`) and ``gains`` (names of :data:`GAINS`, their units).
 
     Raises
     ------
@@ -267,7 +266,7 @@ class Controller(Block):
 
     def compiled(self):
         """The law as a C-callable step on the block's memory (see :meth:`Block.compiled`)."""
-        from orchestrator.blocks import CompiledStep
+        from quadcosim.orchestrator.blocks import CompiledStep
 
         function = _compiled_step()
         return CompiledStep(function.address, np.zeros(len(INPUTS)), self.data, function)
@@ -278,10 +277,9 @@ def _compiled_step():
     global _COMPILED
     if _COMPILED is None:
         from numba import carray, cfunc
-
-        from estimators import core
-        from flight import mixer
-        from orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
+        from quadcosim.estimators import core
+        from quadcosim.flight import mixer
+        from quadcosim.orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
 
         sources = source_fingerprint(core, mixer, vehicle)  # the files the law calls into: in the cache key
 

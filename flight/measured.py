@@ -14,8 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from flight import profiles, trim
+from quadcosim.flight import profiles, trim
 
 SETTLED_AFTER_STEP = 1.0  # s after the step: the attitude loop has settled (0.3 s), the lag alone remains
 FIT_START_TAU = 4.0  # s, first guess of the fitted time constant (the default vehicle's is 4.25 s)
@@ -30,7 +29,7 @@ def accelerometer_tilt(result) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A run recording ``IMU.acc`` (m/s^2, body frame).
 
     Returns
@@ -47,7 +46,7 @@ def tilt_step(result, tilt: float, rotor_drag: bool) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A ``tp`` run with ``flight=tilt``.
     tilt : float
         The commanded pitch (rad).
@@ -86,7 +85,7 @@ AXES = ("roll", "pitch", "yaw")
 def step_figures(time, response, size: float, band: float = 0.02) -> tuple:
     """Rise time, settling time and overshoot of a step response, by python-control's ``step_info``
     where it applies: the one implementation behind :func:`step_response` and the testing
-    assertions' step (:func:`scenarios.testing.assertions.step_response`).
+    assertions' step (:func:`quadcosim.scenarios.testing.assertions.step_response`).
 
     Parameters
     ----------
@@ -128,11 +127,11 @@ def step_response(result, steps: list, step_time: float) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A ``tp`` run with a step (``flight=step`` or ``flight=tilt``).
     steps : list
         The step on roll, pitch, yaw (rad), None on an axis not stepped
-        (:func:`flight.profiles.step_sizes`).
+        (:func:`quadcosim.flight.profiles.step_sizes`).
     step_time : float
         When the step is commanded (s).
 
@@ -180,7 +179,7 @@ def wind_hold(result, wind_speed: float) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A ``tp`` run holding its position in the wind.
     wind_speed : float
         Horizontal wind speed (m/s).

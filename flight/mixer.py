@@ -1,7 +1,7 @@
 """Mixer of the quad-X: body thrust and torques to rotor speeds, rotor speeds to ESC commands.
 
-Motor numbering, arm directions and spins come from :mod:`fmus.airframe`; the ESC command
-that holds a rotor speed is the motors' steady-state map :func:`fmus.vehicle.steady_command`,
+Motor numbering, arm directions and spins come from :mod:`quadcosim.fmus.airframe`; the ESC command
+that holds a rotor speed is the motors' steady-state map :func:`quadcosim.fmus.vehicle.steady_command`,
 compiled here for the control law (one formula for the plant's defaults and the controller).
 """
 
@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-
-from fmus import vehicle
-from fmus.airframe import MOTORS
+from quadcosim.fmus import vehicle
+from quadcosim.fmus.airframe import MOTORS
 
 #: ESC command (1) holding rotor speed ``omega`` (rad/s) at battery voltage ``u_batt`` (V),
 #: for winding resistance (ohm), back-EMF constant (V s/rad) and rotor drag-torque
-#: coefficient (N m s^2): :func:`fmus.vehicle.steady_command`, compiled.
+#: coefficient (N m s^2): :func:`quadcosim.fmus.vehicle.steady_command`, compiled.
 esc_command = njit(cache=True)(vehicle.steady_command)
 
 
@@ -36,7 +35,7 @@ def allocation_matrix(arm: float = vehicle.ARM, thrust_coeff: float = vehicle.TH
     -------
     (4, 4) ndarray
         Rows: total thrust (N, along -z_B), torques about x_B, y_B, z_B (N m) per unit rotor
-        thrust (N), body frame FRD; columns: motors in :data:`fmus.airframe.MOTORS` order.
+        thrust (N), body frame FRD; columns: motors in :data:`quadcosim.fmus.airframe.MOTORS` order.
     """
     rows = [[1.0] * len(MOTORS),
             [-arm * m.direction[1] for m in MOTORS],

@@ -9,7 +9,7 @@ The file has a header row and one row per time, for example::
 
 - ``t`` (s): strictly increasing times; before the first row the first row holds, after the
   last the last.
-- any of :data:`flight.SETPOINT`: ``theta_d1, theta_d2, theta_d3`` (roll, pitch, yaw,
+- any of :data:`quadcosim.flight.SETPOINT`: ``theta_d1, theta_d2, theta_d3`` (roll, pitch, yaw,
   rad; or in degrees with the suffix ``_deg``), ``x_d, y_d, z_d`` (m, NED: up is negative),
   ``hold`` (1: hold the horizontal position ``x_d, y_d``; 0: fly the roll and pitch
   setpoints). A column left out is 0.
@@ -25,8 +25,7 @@ import math
 from pathlib import Path
 
 import numpy as np
-
-from orchestrator.fmu import nearest
+from quadcosim.orchestrator.fmu import nearest
 
 TIME_COLUMN = "t"
 MAX_PROFILE_BYTES = 100_000_000  # a profile is a table of setpoints, not a recording
@@ -73,7 +72,7 @@ def read_profile(path: str | Path, setpoint: tuple) -> tuple[np.ndarray, np.ndar
         a finite number, or times not strictly increasing; the message names the file, row and
         column.
     """
-    from orchestrator.inputs import regular_file
+    from quadcosim.infra.inputs import regular_file
 
     path = Path(path)
     if not path.exists() and not path.is_symlink():

@@ -8,7 +8,7 @@ negative), ``hold`` (1: hold the horizontal position and derive roll and pitch f
 - ``quasi`` (quasi-stationary, the lab's definition): small, slow attitude and position
   changes about a steady flight. The vehicle starts in trimmed cruise, 2 m/s north, pitched
   nose-down by the angle at which rotor drag balances the tilted thrust (2.75 degrees,
-  :func:`flight.trim.wind_hover_tilt`), and flies slow variations about it: pitch
+  :func:`quadcosim.flight.trim.wind_hover_tilt`), and flies slow variations about it: pitch
   1 degree at 0.02 Hz, roll 1 degree at 0.015 Hz, yaw 10 degrees at 0.01 Hz, altitude 0.5 m at
   0.05 Hz, without position hold. Its velocity stays near the steady one (the variations are
   slow against the drag's 4.2 s time constant), so the accelerometer, which reads gravity
@@ -31,8 +31,7 @@ import math
 from functools import lru_cache
 
 import numpy as np
-
-from flight import trim
+from quadcosim.flight import trim
 
 EASE_IN = 2.0  # s, ramp of the periodic profiles
 STEP_TIME = 1.0  # s, start of the tilt step

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 
-from fmus import vehicle
+from quadcosim.fmus import vehicle
 
 THRUST_ITERATIONS = 50  # fixed-point iterations of the vertical balance (they converge: drag << weight)
 LARGEST_TRIM_TILT = math.radians(60.0)  # rad, upper end of the search for the tilt into the wind

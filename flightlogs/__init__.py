@@ -6,7 +6,7 @@ instance with its own time stamps, motor outputs normalised to 0..1 from the log
 limits, the battery, the autopilot's attitude, the parameters, firmware, vehicle type and
 whether it is a simulator log. Each compass carries the field as logged and the raw field
 before the autopilot's offsets and motor compensation, which is what a calibration starts
-from (:mod:`flightlogs.dataflash` and :mod:`flightlogs.ulog` say how each
+from (:mod:`quadcosim.flightlogs.dataflash` and :mod:`quadcosim.flightlogs.ulog` say how each
 autopilot logs it). This is the one reading layer: the command line, the estimators' replay and
 the calibration all read logs through it.
 """
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flightlogs.model import (
+from quadcosim.flightlogs.model import (
     Attitude,
     Battery,
     Compass,
@@ -63,7 +63,7 @@ def check_file(path) -> int:
     LogError
         Naming the file, what it is and the fix.
     """
-    from orchestrator.inputs import regular_file
+    from quadcosim.infra.inputs import regular_file
 
     path = Path(path)
     status = regular_file(path, "the log", f"give a log file ({FORMATS}); copy a log streamed elsewhere to a file "
@@ -106,9 +106,9 @@ def read_log(path) -> FlightLog:
     """Read the flight log at ``path`` (format detected from its content).
 
     The file is checked before a reader opens it (:func:`check_file`); what the readers print
-    while they read is summarised in one warning (:mod:`flightlogs.noise`); every
+    while they read is summarised in one warning (:mod:`quadcosim.flightlogs.noise`); every
     sensor's time stamps are checked, and the span the sensors share reported
-    (:func:`flightlogs.checks.validated`).
+    (:func:`quadcosim.flightlogs.checks.validated`).
 
     Raises
     ------
@@ -120,15 +120,15 @@ def read_log(path) -> FlightLog:
     KeyboardInterrupt
         A signal stopped the reading (never reported as a corrupt log).
     """
-    from flightlogs.checks import validated
+    from quadcosim.flightlogs.checks import validated
 
     path = Path(path)
     kind = detect_format(path)
     if kind == "ulog":
-        from flightlogs.ulog import read_ulog
+        from quadcosim.flightlogs.ulog import read_ulog
 
         return validated(read_ulog(path))
-    from flightlogs.dataflash import read_dataflash
+    from quadcosim.flightlogs.dataflash import read_dataflash
 
     return validated(read_dataflash(path, text=kind == "dataflash-text"))
 

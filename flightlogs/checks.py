@@ -14,7 +14,7 @@ PX4 and ArduPilot:
 - a gap in a series (no sample for :data:`GAP_PERIODS` of its periods, and at least
   :data:`GAP_MIN_S`) is said in a warning: two flights joined, or a logging stall;
 - the span of time all the series share is what a replay or a calibration can use
-  (:meth:`flightlogs.FlightLog.overlap`); a series that shares no time with the
+  (:meth:`quadcosim.flightlogs.FlightLog.overlap`); a series that shares no time with the
   others, and a shared span shorter than :data:`SHARED_SHARE` of the log, are said in a warning.
 """
 
@@ -24,8 +24,7 @@ import bisect
 from dataclasses import replace
 
 import numpy as np
-
-from flightlogs.model import FlightLog, LogError
+from quadcosim.flightlogs.model import FlightLog, LogError
 
 #: Share of a series' samples that may be out of order and dropped as damaged stamps; more is
 #: a clock that goes back for good (two logs joined), refused.

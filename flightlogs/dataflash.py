@@ -7,15 +7,16 @@ What ArduPilot logs, and how it is turned into the project's conventions:
   (4.0 and later): the field in the body frame, in milligauss, *after* the compass's corrections,
   with the offsets ``Ofs`` (``COMPASS_OFS*``) and the motor compensation ``MOfs`` (``MOX..MOZ`` from
   4.0) logged beside it. The raw field is recovered sample by sample in the order of the log's
-  firmware version (:func:`flightlogs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter
+  firmware version (:func:`quadcosim.flightlogs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter
   3.5, ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later). A 4.x instance ``I`` is the compass's
   priority; its parameters are those of the slot whose ``COMPASS_DEV_IDn`` is
-  ``COMPASS_PRIO{I+1}_ID`` (:func:`flightlogs.ardupilot.slot_of`).
+  ``COMPASS_PRIO{I+1}_ID`` (:func:`quadcosim.flightlogs.ardupilot.slot_of`).
 - ``PARM``: the parameters (pymavlink's), and from 4.x the firmware's default of each (``Default``).
 - ``GPS`` (the first receiver, ``I = 0`` in 4.x logs): the position and date the Earth field model is
   evaluated at (3D fixes only).
 - ``ATT``'s ``DesRoll``/``DesPitch`` against ``Roll``/``Pitch``: a crash at the end of a flight
-  (:func:`flightlogs.trim.crash_time`), which is cut off with the logging stalls (:mod:`flightlogs.trim`).
+  (:func:`quadcosim.flightlogs.trim.crash_time`), which is cut off with the logging stalls
+  (:mod:`quadcosim.flightlogs.trim`).
 - ``CTUN.ThO`` (``ThrOut`` in 0..1000 in older firmware): ``motors->get_throttle()``, the throttle
   ``COMPASS_MOTCT = 1`` multiplies.
 - ``IMU``, ``IMU2``, ``IMU3`` (or ``IMU`` with ``I``): rad/s and m/s^2, body frame.
@@ -34,9 +35,8 @@ import re
 from pathlib import Path
 
 import numpy as np
-
-from flightlogs import ardupilot, trim
-from flightlogs.model import (
+from quadcosim.flightlogs import ardupilot, trim
+from quadcosim.flightlogs.model import (
     Attitude,
     Battery,
     Compass,
@@ -79,10 +79,11 @@ def _reader(path: Path, text: bool):
 
 def _collect(path: Path, text: bool):
     """Rows of the wanted messages (type -> list of dicts), the formats, the parameters, what
-    pymavlink printed while it read (:class:`flightlogs.noise.Noise`) and the bytes the
+    pymavlink printed while it read (:class:`quadcosim.flightlogs.noise.Noise`) and the bytes the
     last message lacks."""
-    from flightlogs.noise import captured
-    from orchestrator.interrupts import surfaced
+    from quadcosim.flightlogs.noise import captured
+
+    from quadcosim.infra.interrupts import surfaced
 
     rows: dict[str, list] = {}
     with surfaced(), captured() as noise:

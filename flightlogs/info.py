@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-
-from flightlogs.model import FlightLog, rate
+from quadcosim.flightlogs.model import FlightLog, rate
 
 
 def summary(log: FlightLog) -> dict:
@@ -12,7 +11,7 @@ def summary(log: FlightLog) -> dict:
     in m/s^2), duration (s), the span every sensor covers (``common_span_s``, s on the log's
     clock, None when they share none), vehicle, firmware, simulator flag, the log's own statement
     that it is synthetic (empty for a recording) and current sensor of ``log``."""
-    from flightlogs.checks import common_span
+    from quadcosim.flightlogs.checks import common_span
 
     span = common_span(log)
     compasses = [{"index": k, "name": c.name, "samples": len(c.time), "rate_hz": rate(c.time),

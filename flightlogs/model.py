@@ -171,7 +171,7 @@ class FlightLog:
         The autopilot's own throttle signal, the one its compass compensation multiplies.
     warnings : list of str
         What was found wrong but could be read past (corruption skipped, a truncated end), and what
-        was cut off (a crash, a logging stall: :mod:`flightlogs.trim`).
+        was cut off (a crash, a logging stall: :mod:`quadcosim.flightlogs.trim`).
     defaults : dict
         The firmware's default of each parameter where the log states it (ArduPilot 4.x's
         ``PARM.Default``), name: value; empty otherwise.

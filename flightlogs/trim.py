@@ -22,8 +22,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-
-from flightlogs.model import FlightLog
+from quadcosim.flightlogs.model import FlightLog
 
 STALL_S = 1.0  # s without an IMU sample: logging stalled (an IMU logs at 10 Hz or more)
 MIN_STRETCH = 10  # samples on each side of a gap for it to be a stall

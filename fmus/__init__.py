@@ -1,11 +1,11 @@
 """The plant as FMI 2.0 and 3.0 Co-Simulation FMUs written in C, with their Modelica twins.
 
-- :mod:`fmus.vehicle`: the physical constants of the default vehicle, with units;
-- :mod:`fmus.airframe`: motor numbering and spin directions;
+- :mod:`quadcosim.fmus.vehicle`: the physical constants of the default vehicle, with units;
+- :mod:`quadcosim.fmus.airframe`: motor numbering and spin directions;
 - ``fmus/<Model>/variables.py``: each model's variable table; ``fmus/<Model>/model.c``: its
   equations; ``fmus/c/``: the FMI shell they share;
 - ``fmus/QuadCoSim/``: the Modelica twins;
-- :mod:`fmus.build`: builds ``<build root>/fmus/<Model>.fmu`` (FMI 2.0, what a run loads) and
+- :mod:`quadcosim.fmus.build`: builds ``<build root>/fmus/<Model>.fmu`` (FMI 2.0, what a run loads) and
   ``<build root>/fmus/fmi3/<Model>.fmu`` (FMI 3.0), each for Linux and, with mingw-w64, Windows
   (``quadcosim build``, or on first use).
 
@@ -15,58 +15,21 @@ folder for an installed package, so that an installation never writes into ``sit
 
 from __future__ import annotations
 
-import functools
 import os
 from pathlib import Path
 
-from fmus.folders import BuildFolderRefused, compiler_command, make_folder  # noqa: F401  (the package's names)
-from fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
+from quadcosim.fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
+
+from quadcosim.infra.folders import (  # noqa: F401  (the package's names)
+    BuildFolderRefused,
+    build_root,
+    compiler_command,
+    make_folder,
+)
 
 
 class FMUNotFoundError(FileNotFoundError):
     """A built FMU is missing."""
-
-
-def _checkout() -> Path | None:
-    """The source checkout this package is imported from (the folder holding quadcosim's
-    ``pyproject.toml`` beside the packages), or None for an installed package."""
-    root = Path(__file__).resolve().parent.parent
-    project = root / "pyproject.toml"
-    if project.is_file() and 'name = "quadcosim"' in project.read_text():
-        return root
-    return None
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("quadcosim")
-    except PackageNotFoundError:
-        return "unversioned"
-
-
-def build_root() -> Path:
-    """Where compiled artefacts (FMUs, the master's C runner, benchmark references) live.
-
-    Returns
-    -------
-    pathlib.Path
-        ``$QUADCOSIM_BUILD_DIR`` if set; else ``build/`` in the source checkout the package is
-        imported from; else, for an installed package, the per-user cache
-        ``$XDG_CACHE_HOME/quadcosim/<version>`` (``~/.cache/quadcosim/<version>``).
-    """
-    return _build_root(os.environ.get("QUADCOSIM_BUILD_DIR"), os.environ.get("XDG_CACHE_HOME"))
-
-
-@functools.lru_cache(maxsize=8)  # resolved once per setting: runs look FMUs up often
-def _build_root(env: str | None, cache: str | None) -> Path:
-    if env:
-        return Path(env)
-    checkout = _checkout()
-    if checkout is not None:
-        return checkout / "build"
-    return Path(cache or Path.home() / ".cache") / "quadcosim" / _version()
 
 
 def default_fmu_dir() -> Path:
@@ -99,7 +62,7 @@ def _build_on_first_use(name: str, path: Path, fmi_version: int) -> None:
     import fcntl
     import sys
 
-    from fmus.build import build_fmu
+    from quadcosim.fmus.build import build_fmu
 
     make_folder(path.parent, "the FMUs")
     with open(path.parent / ".build.lock", "w") as lock:

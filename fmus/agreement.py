@@ -1,6 +1,6 @@
 """How closely the FMUs agree with their Modelica twins, and with themselves at half the sub-step.
 
-``python -m fmus.agreement`` prints, for each case, the largest difference of an output over
+``python -m quadcosim.fmus.agreement`` prints, for each case, the largest difference of an output over
 its peak, in parts per million (ppm):
 
 - each Modelica twin (``fmus/QuadCoSim/``) simulated by the pure-Python ``modelica`` toolchain
@@ -18,9 +18,8 @@ import argparse
 import sys
 
 import numpy as np
-
-from fmus.build import table
-from fmus.twins import simulate_fmu, simulate_twin
+from quadcosim.fmus.build import table
+from quadcosim.fmus.twins import simulate_fmu, simulate_twin
 
 STOP_S = 2.0  # s simulated by every case
 SUBSTEP_COMMUNICATION_S = 0.02  # s, communication step of the sub-step manoeuvres
@@ -132,7 +131,7 @@ def main(argv=None) -> int:
     int
         Exit status, 0.
     """
-    parser = argparse.ArgumentParser(prog="python -m fmus.agreement", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.fmus.agreement", description=__doc__.splitlines()[0])
     parser.add_argument("--twins", action="store_true", help="the twin checks only")
     parser.add_argument("--substeps", action="store_true", help="the sub-step checks only")
     args = parser.parse_args(argv)

@@ -15,7 +15,7 @@ angular velocity along -z_B; the drag reaction on the body is then along +z_B, a
 (nose-right) yaw torque. Hence ``spin = +1`` for CCW rotors and the yaw torque is
 ``tau_z = k_m * sum(spin_n * omega_n^2)``.
 
-The C models include ``airframe.h``, generated from this table by :mod:`fmus.build`; the
+The C models include ``airframe.h``, generated from this table by :mod:`quadcosim.fmus.build`; the
 mixer reads :data:`MOTORS`.
 """
 
@@ -53,7 +53,7 @@ def c_header() -> str:
     sin = ", ".join(repr(m.direction[1]) for m in MOTORS)
     spin = ", ".join(f"{m.spin:.1f}" for m in MOTORS)
     return (
-        "/* Generated from fmus/airframe.py by fmus.build: do not edit. */\n"
+        "/* Generated from fmus/airframe.py by quadcosim.fmus.build: do not edit. */\n"
         "#ifndef AIRFRAME_H\n#define AIRFRAME_H\n\n"
         f"#define N_MOTORS {len(MOTORS)}\n"
         "/* Unit arm direction in the body frame and spin (+1 CCW seen from above). */\n"

@@ -2,7 +2,7 @@
 
 For each model and FMI version the build stages a source FMU: ``modelDescription.xml`` and
 ``variables.h`` generated from the model's variable table, ``airframe.h`` from
-:mod:`fmus.airframe`, the shared shell, the model's equations and the FMI headers of that
+:mod:`quadcosim.fmus.airframe`, the shared shell, the model's equations and the FMI headers of that
 version (taken from the installed fmpy); FMI 3.0 adds ``sources/buildDescription.xml``. The
 binaries are then compiled from those staged sources alone, warnings as errors, so that the
 sources shipped in the FMU are known to build: for Linux with the system compiler, and for
@@ -23,9 +23,10 @@ import sys
 import zipfile
 from pathlib import Path
 
-from fmus.airframe import c_header as airframe_header
-from fmus.folders import compiler_command, make_folder
-from fmus.models import MODELS, fmu_sources, model_variables
+from quadcosim.fmus.airframe import c_header as airframe_header
+from quadcosim.fmus.models import MODELS, fmu_sources, model_variables
+
+from quadcosim.infra.folders import compiler_command, make_folder
 
 HERE = Path(__file__).resolve().parent
 CFLAGS = ["-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-fvisibility=hidden"]
@@ -61,7 +62,7 @@ def table(model: str):
 
     Returns
     -------
-    fmus.variables.Table
+    quadcosim.fmus.variables.Table
         ``fmus.<model>.variables.TABLE``.
     """
     return model_variables(model).TABLE
@@ -154,7 +155,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
         Output folder; the staged sources stay beside the FMU, in ``<model>/``.
     compiler : str, optional
         C compiler command; ``$CC`` or ``cc`` by default.
-    variables : fmus.variables.Table, optional
+    variables : quadcosim.fmus.variables.Table, optional
         A variable table to build with instead of the model's own (tests build variants).
     fmi_version : int
         2 or 3.
@@ -228,7 +229,7 @@ def up_to_date(model: str, out_dir: Path, fmi_version: int = 2) -> bool:
     Returns
     -------
     bool
-        The FMU is newer than each of its sources (:func:`fmus.fmu_sources`) and holds the binary of
+        The FMU is newer than each of its sources (:func:`quadcosim.fmus.fmu_sources`) and holds the binary of
         each platform this machine builds for (Windows only with mingw-w64).
     """
     fmu = fmu_file(model, out_dir, fmi_version)
@@ -248,9 +249,9 @@ def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=F
     Parameters
     ----------
     out_dir : pathlib.Path
-        Output folder (:func:`fmus.default_fmu_dir`, where a run looks for the FMUs).
+        Output folder (:func:`quadcosim.fmus.default_fmu_dir`, where a run looks for the FMUs).
     models : sequence of str
-        Model names (folders under ``fmus/``); all of :data:`fmus.MODELS` by default.
+        Model names (folders under ``fmus/``); all of :data:`quadcosim.fmus.MODELS` by default.
     verbose : bool
         Print each FMU's path as it is built (or found up to date).
     fmi_versions : sequence of int

@@ -18,7 +18,7 @@ def model_variables(model: str):
     """
     if model not in MODELS:
         raise KeyError(f"unknown model {model!r}; models: {', '.join(MODELS)}")
-    return importlib.import_module(f"fmus.{model}.variables")
+    return importlib.import_module(f"quadcosim.fmus.{model}.variables")
 
 
 def fmu_sources(name: str) -> list[Path]:

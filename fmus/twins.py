@@ -18,8 +18,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-
-from fmus import fmu_path
+from quadcosim.fmus import fmu_path
 
 PACKAGE_DIR = Path(__file__).resolve().parent / "QuadCoSim"
 _FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "pi": math.pi}
@@ -127,7 +126,7 @@ def simulate_fmu(model: str, inputs: dict[str, str], parameters: dict, stop: flo
     Parameters
     ----------
     model : str
-        Name of a built FMU (found by :func:`fmus.fmu_path`).
+        Name of a built FMU (found by :func:`quadcosim.fmus.fmu_path`).
     inputs : dict of str to str
         Input name to expression of ``time`` (s), as for :func:`simulate_twin`.
     parameters : dict

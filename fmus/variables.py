@@ -318,7 +318,7 @@ class Table:
             f'  modelName="{self.model}"',
             f'  guid="{self.guid}"',
             f"  description={quoteattr(self.description)}",
-            '  generationTool="quadcosim fmus.build"',
+            '  generationTool="quadcosim quadcosim.fmus.build"',
             '  variableNamingConvention="flat"',
             '  numberOfEventIndicators="0">',
             f'  <CoSimulation modelIdentifier="{self.model}" canHandleVariableCommunicationStepSize="true"'
@@ -362,7 +362,7 @@ class Table:
             f'  modelName="{self.model}"',
             f'  instantiationToken="{self.guid}"',
             f"  description={quoteattr(self.description)}",
-            '  generationTool="quadcosim fmus.build"',
+            '  generationTool="quadcosim quadcosim.fmus.build"',
             '  variableNamingConvention="flat">',
             f'  <CoSimulation modelIdentifier="{self.model}" canHandleVariableCommunicationStepSize="true"'
             ' hasEventMode="false"/>',
@@ -491,7 +491,7 @@ class Table:
             ``LEN_name``) and the variable information arrays.
         """
         lines = [
-            f"/* Generated from fmus/{self.model}/variables.py by fmus.build: do not edit. */",
+            f"/* Generated from fmus/{self.model}/variables.py by quadcosim.fmus.build: do not edit. */",
             "#ifndef VARIABLES_H",
             "#define VARIABLES_H",
             "",

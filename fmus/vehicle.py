@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 
-from fmus.airframe import MOTORS
+from quadcosim.fmus.airframe import MOTORS
 
 GRAVITY = 9.81  # m/s^2, along +z of the NED frame {I}
 

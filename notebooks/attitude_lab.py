@@ -17,7 +17,7 @@
 # The lab's closed loop, `Setpoint -> Controller -> MotorMagnetics -> Quadrotor -> IMU ->
 # Quaternion_estim`, run from Python: one run and its figures, then the three filters in the two
 # flights of the lab, then the linear filter's gain against the analysis of
-# `estimators.analysis`. Short horizons (a few seconds of flight each), so that the notebook runs
+# `quadcosim.estimators.analysis`. Short horizons (a few seconds of flight each), so that the notebook runs
 # in well under a minute.
 #
 # ## Does the vehicle follow its attitude setpoint?
@@ -33,9 +33,9 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 from IPython.display import Image, display
+from quadcosim.scenarios.run_plots import plot
 
-import scenarios
-from scenarios.run_plots import plot
+from quadcosim import scenarios
 
 folder = Path(tempfile.mkdtemp())
 result, metrics = scenarios.run("tp", {"flight": "nonstationary", "duration": 6.0, "noise": True}, folder / "run")
@@ -98,7 +98,7 @@ plt.show()
 #
 # ## The linear filter's gain, predicted
 #
-# `estimators.analysis` predicts the linear filter's error variance against its gain $k$ from
+# `quadcosim.estimators.analysis` predicts the linear filter's error variance against its gain $k$ from
 # the sensor noise per sample (python-control): the sum of the gyro's and the
 # accelerometer-derived angle's noise variances, each through the filter's discrete transfer
 # function from that noise to the error, by its $H_2$ norm:
@@ -110,7 +110,7 @@ plt.show()
 # accelerometer's noise; `quadcosim run gain-study` sets the prediction against simulation.
 
 # %%
-from estimators import analysis
+from quadcosim.estimators import analysis
 
 dt = 1e-3  # s, the IMU's sample time
 sigma_gyro, sigma_angle = analysis.imu_noise_per_sample(1.0 / dt)

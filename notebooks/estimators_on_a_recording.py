@@ -15,7 +15,7 @@
 # # Estimators on a recording
 #
 # A recording is a file of gyro, accelerometer and magnetometer samples at a rate, with, when
-# known, a reference attitude and the samples to score (`estimators.recording`: `.npz`,
+# known, a reference attitude and the samples to score (`quadcosim.estimators.recording`: `.npz`,
 # `.mat` or `.csv`). Set `QUADCOSIM_RECORDING` to a file of your own (a real flight log, say);
 # without one, the notebook records 10 s of a simulated non-stationary flight, with noise and a
 # gyro bias, and uses it as the recording.
@@ -27,10 +27,10 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from quadcosim.estimators import recording
+from quadcosim.scenarios import replay
 
-import scenarios
-from estimators import recording
-from scenarios import replay
+from quadcosim import scenarios
 
 RECORDING = os.environ.get("QUADCOSIM_RECORDING", "")
 if not RECORDING:
@@ -71,7 +71,7 @@ plt.show()
 # Each estimator on the same samples, scored by the quaternion-error RMSE (total, inclination,
 # heading; degrees): Mahony's explicit filter with the package's default gains (its
 # disturbance-aware corrections on), and the published VQF and Madgwick filters run as the
-# same block. `python -m scenarios.replay FILE --estimator NAME` does the same from a shell.
+# same block. `python -m quadcosim.scenarios.replay FILE --estimator NAME` does the same from a shell.
 
 # %%
 scores = {name: replay.replay(data, estimator=name)["errors"] for name in ("explicit", "vqf", "madgwick")}

@@ -29,7 +29,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from IPython.display import Image, display
 
-import scenarios
+from quadcosim import scenarios
 
 FLIGHT_S = 200.0  # s of simulated flight per run
 ESTIMATORS = ("kalman", "regression", "rls")

@@ -15,13 +15,13 @@
 # # Magnetometer calibration: static, Metge et al.'s, dynamics-aware
 #
 # 1. Static: soft and hard iron from a hand-held rotation sweep, motors off
-#    (`calibration.fit_static`): the magnetometer reads $m = A\,h + b_s$, and the fit
+#    (`quadcosim.calibration.fit_static`): the magnetometer reads $m = A\,h + b_s$, and the fit
 #    recovers $A$ and $b_s$ from the sweep's ellipsoid.
 # 2. Dynamic (Metge et al.): the field the motor currents make, from the clamped rig's sweeps
-#    of each motor at two battery states (`calibration.fit_dynamic`, eqs. 5 to 8), compensated
+#    of each motor at two battery states (`quadcosim.calibration.fit_dynamic`, eqs. 5 to 8), compensated
 #    by eq. 9.
 # 3. Dynamics-aware: the same compensation with the commands passed through the motors'
-#    identified dynamics (`calibration.fit_motor_dynamics`).
+#    identified dynamics (`quadcosim.calibration.fit_motor_dynamics`).
 #
 # The runs are shortened (a 20 s sweep; the rig at 6 command levels with a 6 s free set) so
 # that the notebook runs in under a minute; `quadcosim run metge` is the full rig.
@@ -33,7 +33,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 from IPython.display import Image, display
 
-import scenarios
+from quadcosim import scenarios
 
 folder = Path(tempfile.mkdtemp())
 

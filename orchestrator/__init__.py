@@ -14,5 +14,5 @@ __all__ = sorted(_EXPORTS)
 
 def __getattr__(name):
     if name not in _EXPORTS:
-        raise AttributeError(f"module 'orchestrator' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"orchestrator.{_EXPORTS[name]}"), name)
+        raise AttributeError(f"module 'quadcosim.orchestrator' has no attribute {name!r}")
+    return getattr(importlib.import_module(f"quadcosim.orchestrator.{_EXPORTS[name]}"), name)

@@ -251,7 +251,7 @@ class Constant(Block):
 
 def is_path(model) -> bool:
     """Whether ``model`` is an FMU file's path rather than a built model's name."""
-    from orchestrator.fmu import is_fmu_file
+    from quadcosim.orchestrator.fmu import is_fmu_file
 
     return model is not None and is_fmu_file(model)
 
@@ -267,14 +267,14 @@ class FMUBlock:
         A built model's name (``"IMU"``), or the path of an FMU file of any exporter
         (``"my_motor.fmu"``: OpenModelica, Dymola, Simulink, pythonfmu, ...); defaults to ``name``.
         Its numeric inputs and outputs become the block's, by their variable names: every FMI
-        type, an FMI 3.0 array as one signal per element (:mod:`orchestrator.fmi_types`).
+        type, an FMI 3.0 array as one signal per element (:mod:`quadcosim.orchestrator.fmi_types`).
     parameters : dict, optional
         Parameter overrides, by FMU variable name.
     period : int
         Runs every ``period`` macro steps, with a communication step of ``period * dt``.
     isolated : bool, optional
         Run the FMU in a worker process of its own (True) or in this one (False); by default an
-        FMU this project did not build runs isolated (:mod:`orchestrator.isolated`).
+        FMU this project did not build runs isolated (:mod:`quadcosim.orchestrator.isolated`).
 
     Attributes
     ----------
@@ -285,8 +285,8 @@ class FMUBlock:
 
     def __init__(self, name: str, model: str | None = None, parameters: dict | None = None, period: int = 1,
                  isolated: bool | None = None):
-        from orchestrator.fmi_types import dtypes, is_parameter, signals, unit
-        from orchestrator.fmu import fmu_file, model_description
+        from quadcosim.orchestrator.fmi_types import dtypes, is_parameter, signals, unit
+        from quadcosim.orchestrator.fmu import fmu_file, model_description
 
         if int(period) != period or period < 1:
             raise ValueError(f"{name}: period must be a positive integer number of macro steps, not {period}")
@@ -307,7 +307,7 @@ class FMUBlock:
         self.input_units = {s.name: unit(s.variable) for s in inputs}
         unknown = set(self.parameters) - set(self.parameter_names)
         if unknown:
-            from orchestrator.fmu import nearest
+            from quadcosim.orchestrator.fmu import nearest
 
             name0 = sorted(unknown)[0]
             raise ValueError(f"{name} ({self.model}) has no parameter {name0!r}.{nearest(name0, self.parameter_names)}")
@@ -335,10 +335,10 @@ class FMUBlock:
 
         Returns
         -------
-        orchestrator.fmu.FMUInstance
+        quadcosim.orchestrator.fmu.FMUInstance
             The live instance, also kept as ``self.instance``.
         """
-        from orchestrator import pool
+        from quadcosim.orchestrator import pool
 
         self.instance = pool.acquire(self.model, self.parameters, name=self.name, start_time=t0,
                                      isolated=self.isolated)
@@ -346,9 +346,9 @@ class FMUBlock:
 
     def close(self):
         """Free the FMU instance after a run (or keep it for the next run, when this process
-        reuses instances: :mod:`orchestrator.pool`)."""
+        reuses instances: :mod:`quadcosim.orchestrator.pool`)."""
         if self.instance is not None:
-            from orchestrator import pool
+            from quadcosim.orchestrator import pool
 
             pool.release(self.instance)
             self.instance = None

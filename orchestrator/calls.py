@@ -3,7 +3,7 @@
 A co-simulation step then costs one crossing from Python into C per group of FMU calls
 instead of one per call. The runner's source is ``orchestrator/c/calls.c``; it is compiled
 with the system C compiler into the runner folder, a setting: ``$QUADCOSIM_RUNNER_DIR`` or
-``orchestrator/`` under :func:`fmus.build_root`. :func:`runner_path` compiles it on first use when it
+``orchestrator/`` under :func:`quadcosim.fmus.build_root`. :func:`runner_path` compiles it on first use when it
 is missing or older than its source; ``quadcosim build`` compiles it with the FMUs.
 """
 
@@ -33,10 +33,10 @@ def runner_dir() -> Path:
     Returns
     -------
     pathlib.Path
-        ``$QUADCOSIM_RUNNER_DIR`` if set, else ``orchestrator/`` under :func:`fmus.build_root`
+        ``$QUADCOSIM_RUNNER_DIR`` if set, else ``orchestrator/`` under :func:`quadcosim.fmus.build_root`
         (``build/`` in a source checkout, a per-user cache for an installed package).
     """
-    from fmus import build_root
+    from quadcosim.fmus import build_root
 
     env = os.environ.get("QUADCOSIM_RUNNER_DIR")
     return Path(env) if env else build_root() / "orchestrator"
@@ -85,7 +85,7 @@ def compile_shared(source: Path, library: Path, compiler: str | None = None) -> 
     RunnerBuildError
         No compiler, or it refused the source (its messages included).
     """
-    from fmus import compiler_command, make_folder
+    from quadcosim.fmus import compiler_command, make_folder
 
     compiler = compiler_command(compiler)
     make_folder(library.parent, "the compiled runner")
@@ -128,7 +128,7 @@ def runner_library() -> ctypes.CDLL:
     -------
     ctypes.CDLL
         ``run_calls(calls, count, t, failed)`` (a list of FMI calls) and
-        ``run_chunk(program, end)`` (the chunk runner of :mod:`orchestrator.chunks`).
+        ``run_chunk(program, end)`` (the chunk runner of :mod:`quadcosim.orchestrator.chunks`).
     """
     global _library
     if _library is None:
@@ -160,10 +160,10 @@ class SetInputs:
 
     Parameters
     ----------
-    block : orchestrator.FMUBlock
+    block : quadcosim.orchestrator.FMUBlock
         The block, with a live instance.
-    entry : orchestrator.fmi_types.CEntry
-        The C call (:meth:`orchestrator.fmu.FMUInstance.setter`).
+    entry : quadcosim.orchestrator.fmi_types.CEntry
+        The C call (:meth:`quadcosim.orchestrator.fmu.FMUInstance.setter`).
     """
 
     block: object  # an FMUBlock with a live instance
@@ -183,10 +183,10 @@ class GetOutputs:
 
     Parameters
     ----------
-    block : orchestrator.FMUBlock
+    block : quadcosim.orchestrator.FMUBlock
         The block, with a live instance.
-    entry : orchestrator.fmi_types.CEntry
-        The C call (:meth:`orchestrator.fmu.FMUInstance.getter`).
+    entry : quadcosim.orchestrator.fmi_types.CEntry
+        The C call (:meth:`quadcosim.orchestrator.fmu.FMUInstance.getter`).
     """
 
     block: object
@@ -202,13 +202,13 @@ class GetOutputs:
 
 @dataclass(frozen=True)
 class DoStep:
-    """One communication step from the present time (:meth:`orchestrator.fmu.FMUInstance.stepper`).
+    """One communication step from the present time (:meth:`quadcosim.orchestrator.fmu.FMUInstance.stepper`).
 
     Parameters
     ----------
-    block : orchestrator.FMUBlock
+    block : quadcosim.orchestrator.FMUBlock
         The block, with a live instance.
-    entry : orchestrator.fmi_types.CEntry
+    entry : quadcosim.orchestrator.fmi_types.CEntry
         The C call.
     h : float
         Communication step (s).
@@ -243,7 +243,7 @@ def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
     ----------
     calls : list of SetInputs, GetOutputs or DoStep
         In the order they run.
-    taps : list of orchestrator.faults.FaultTap
+    taps : list of quadcosim.orchestrator.faults.FaultTap
         Faults to apply first.
     bus : ndarray
         The bus the calls read and write (float64; its address is resolved now).
@@ -252,11 +252,11 @@ def batch(calls: list[FMICall], taps: list, bus: np.ndarray):
     -------
     callable
         ``phase(t)`` with ``t`` the present time (s); it raises
-        :class:`orchestrator.fmu.FMUError`, naming the block, the FMI function, the time and
+        :class:`quadcosim.orchestrator.fmu.FMUError`, naming the block, the FMI function, the time and
         the FMU's log, when a call returns Error or Fatal.
     """
-    from orchestrator.faults import apply_faults
-    from orchestrator.fmu_errors import FMUError
+    from quadcosim.orchestrator.faults import apply_faults
+    from quadcosim.orchestrator.fmu_errors import FMUError
 
     run = run_calls()
     array = (_CCall * len(calls))(*[_pack(c, bus) for c in calls])

@@ -1,13 +1,13 @@
 """The chunk runner: the master's loop in compiled code, for whole chunks of macro steps.
 
-A :class:`~orchestrator.plan.Plan` is turned into a program of operations per step, run by
+A :class:`~quadcosim.orchestrator.plan.Plan` is turned into a program of operations per step, run by
 ``run_chunk`` of ``orchestrator/c/calls.c``:
 
 - each FMI call of a batch (``fmi2SetReal`` straight from the bus, ``fmi2GetReal`` into it,
   ``fmi2DoStep``);
-- each block with a compiled step (:meth:`orchestrator.blocks.Block.compiled`): its inputs
+- each block with a compiled step (:meth:`quadcosim.orchestrator.blocks.Block.compiled`): its inputs
   gathered from the bus, its C-callable step called with its outputs' slots of the bus;
-- each :class:`~orchestrator.blocks.Table` and :class:`~orchestrator.blocks.Constant`: a row
+- each :class:`~quadcosim.orchestrator.blocks.Table` and :class:`~quadcosim.orchestrator.blocks.Constant`: a row
   copied onto the bus (a callable table is evaluated by Python a chunk of rows at a time, the
   same chunks as the per-step master evaluates);
 - the recording (every ``decimation`` steps) and the non-finite check of the whole bus.
@@ -26,13 +26,13 @@ from __future__ import annotations
 import ctypes
 
 import numpy as np
+from quadcosim.orchestrator.blocks import Block, Constant, Table
+from quadcosim.orchestrator.calls import _pack, runner_library
+from quadcosim.orchestrator.faults import apply_faults
+from quadcosim.orchestrator.fmu import FMUError
+from quadcosim.orchestrator.program import RECORD
 
-from orchestrator.blocks import Block, Constant, Table
-from orchestrator.calls import _pack, runner_library
-from orchestrator.faults import apply_faults
-from orchestrator.fmu import FMUError
-from orchestrator.program import RECORD
-from orchestrator.progress import status
+from quadcosim.infra.progress import status
 
 OP_BLOCK, OP_TABLE, OP_RECORD, OP_PYTHON = 3, 4, 5, 6
 CHUNK_DONE, PYTHON, FINISHED, NON_FINITE, FMI_FAILED, BLOCK_FAILED = range(6)
@@ -72,7 +72,7 @@ def _gathers(pairs: list[tuple[int, int, int]]):
 
 def _runs(slots: list[int]) -> list[tuple[int, int, int]]:
     """Copies gathering bus ``slots`` into a vector, one per run of consecutive slots."""
-    from orchestrator.program import consecutive
+    from quadcosim.orchestrator.program import consecutive
 
     return [(i, slots[i], j - i) for i, j in consecutive(slots)]
 
@@ -89,7 +89,7 @@ class ChunkRunner:
 
     Parameters
     ----------
-    plan : orchestrator.plan.Plan
+    plan : quadcosim.orchestrator.plan.Plan
         A plan, wired (FMUs instantiated, Python blocks started).
     """
 
@@ -165,15 +165,15 @@ class ChunkRunner:
 
         Parameters
         ----------
-        bar : orchestrator.progress.Progress, optional
+        bar : quadcosim.infra.progress.Progress, optional
             Updated at the end of each chunk.
 
         Raises
         ------
-        orchestrator.fmu.FMUError
+        quadcosim.orchestrator.fmu.FMUError
             An FMI call failed.
         Exception
-            What :meth:`orchestrator.plan.Plan.non_finite` returns, or what a Python block raised.
+            What :meth:`quadcosim.orchestrator.plan.Plan.non_finite` returns, or what a Python block raised.
         """
         plan, program, items = self.plan, self.program, self.items
         run_chunk = runner_library().run_chunk

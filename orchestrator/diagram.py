@@ -18,8 +18,9 @@ from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
-from orchestrator.blocks import Constant, FMUBlock
-from orchestrator.files import atomic_path, save_figure
+from quadcosim.orchestrator.blocks import Constant, FMUBlock
+
+from quadcosim.infra.files import atomic_path, save_figure
 
 # Layout, in axis units (one unit is INCH inches on the page): a block's box, the spacing of the
 # columns, the spacing of the lanes above and below the row.
@@ -112,7 +113,7 @@ def draw(system, path, title: str | None = None, cache: Path | None = None) -> P
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
         The system; it need not be fully connected.
     path : str or pathlib.Path
         Output file; its folder is created.
@@ -140,7 +141,7 @@ def draw(system, path, title: str | None = None, cache: Path | None = None) -> P
         return path
     import matplotlib
 
-    from orchestrator.files import headless_backend
+    from quadcosim.infra.files import headless_backend
 
     headless_backend()
     import matplotlib.pyplot as plt
@@ -163,7 +164,7 @@ def wiring_key(system, title: str | None = None) -> str:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     title : str, optional
         The title's first line, as given to :func:`draw`.
 
@@ -217,7 +218,7 @@ def figure(system, title: str | None = None):
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     title : str, optional
         First line of the title.
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from orchestrator.result import Result
+from quadcosim.orchestrator.result import Result
 
 
 class SimulationError(RuntimeError):
@@ -12,7 +12,7 @@ class SimulationError(RuntimeError):
     ----------
     message : str
         What failed, where and when.
-    result : orchestrator.Result, optional
+    result : quadcosim.orchestrator.Result, optional
         What was recorded up to the failure.
     """
 
@@ -23,13 +23,13 @@ class SimulationError(RuntimeError):
 
 class RunInterrupted(SimulationError):
     """The run was interrupted (Ctrl-C, or SIGTERM turned into
-    :class:`orchestrator.interrupts.Terminated`).
+    :class:`quadcosim.infra.interrupts.Terminated`).
 
     Parameters
     ----------
     message : str
         When it stopped.
-    result : orchestrator.Result or None
+    result : quadcosim.orchestrator.Result or None
         What was recorded.
     signal_number : int
         The signal that stopped it.

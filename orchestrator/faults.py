@@ -136,7 +136,7 @@ def suspects(faults: list[Fault], connections: dict[str, str], block: str,
     faults : list of Fault
         The injected faults (targets resolved, ``"Block.input"``).
     connections : dict
-        Destination ``"B.u"`` to source ``"A.y"``, as :class:`orchestrator.System` holds them.
+        Destination ``"B.u"`` to source ``"A.y"``, as :class:`quadcosim.orchestrator.System` holds them.
     block : str
         The block whose output failed.
     t : float

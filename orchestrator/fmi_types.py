@@ -10,7 +10,7 @@ signal ``NAME`` with the components ``NAME_1`` to ``NAME_n``, one of shape ``(n,
 
 A value set into an integer input is rounded to the nearest integer and held in the type's
 range; a Boolean input is true when its value is not zero. String and Binary variables are not
-signals: their values are recorded once, as parameters are (:meth:`orchestrator.fmu.FMUInstance.texts`).
+signals: their values are recorded once, as parameters are (:meth:`quadcosim.orchestrator.fmu.FMUInstance.texts`).
 
 Every FMI call of the loop is a :class:`CEntry`: a C function of one of three signatures, that of
 ``fmi2SetReal`` (set), ``fmi2GetReal`` (get) or ``fmi2DoStep`` (step), and its first argument.
@@ -169,15 +169,15 @@ class CEntry(NamedTuple):
 
 
 class Stepping(Protocol):
-    """What the master needs of an FMU instance (:class:`orchestrator.fmu.FMUInstance` for FMI 2.0,
-    :class:`orchestrator.fmu.FMU3Instance` for FMI 3.0, or a stand-in that runs one elsewhere).
+    """What the master needs of an FMU instance (:class:`quadcosim.orchestrator.fmu.FMUInstance` for FMI 2.0,
+    :class:`quadcosim.orchestrator.fmu.FMU3Instance` for FMI 3.0, or a stand-in that runs one elsewhere).
 
     Every value crosses as a float64. The loop makes only the C calls that :meth:`setter`,
     :meth:`getter` and :meth:`stepper` return, once per run; the rest is set-up.
     """
 
     name: str
-    log: object  # orchestrator.fmu_errors.FMULog
+    log: object  # quadcosim.orchestrator.fmu_errors.FMULog
     inputs: list
     outputs: list
 
@@ -235,7 +235,7 @@ _library = None
 
 def typed_path(build: bool = False):
     """The compiled ``orchestrator/c/typed.c``, beside the call runner
-    (:func:`orchestrator.calls.runner_dir`): compiled when missing or older than its source, or
+    (:func:`quadcosim.orchestrator.calls.runner_dir`): compiled when missing or older than its source, or
     when ``build``.
 
     Returns
@@ -244,7 +244,7 @@ def typed_path(build: bool = False):
     """
     from pathlib import Path
 
-    from orchestrator.calls import compile_shared, runner_dir
+    from quadcosim.orchestrator.calls import compile_shared, runner_dir
 
     source = Path(__file__).resolve().parent / "c" / "typed.c"
     library = runner_dir() / "libquadcosim_typed.so"

@@ -8,13 +8,13 @@ master (or a worker process hosting the instance) step it:
 - by signal name, for set-up and tests: :meth:`FMUInstance.set`, :meth:`FMUInstance.get`,
   :meth:`FMUInstance.step`, all with float64 values;
 - in the loop: :meth:`FMUInstance.setter`, :meth:`FMUInstance.getter` and
-  :meth:`FMUInstance.stepper` give, once, C calls (:class:`orchestrator.fmi_types.CEntry`) that
+  :meth:`FMUInstance.stepper` give, once, C calls (:class:`quadcosim.orchestrator.fmi_types.CEntry`) that
   read and write float64 values at fixed addresses (the bus, or a shared buffer) with no name
   look-up and no allocation per step;
 - :meth:`FMUInstance.reset`, :meth:`FMUInstance.close`, and :attr:`FMUInstance.log`.
 
 The signals (:attr:`FMUInstance.inputs`, :attr:`FMUInstance.outputs`) are the numeric variables
-of every FMI type, an FMI 3.0 array as one signal per element (:mod:`orchestrator.fmi_types`).
+of every FMI type, an FMI 3.0 array as one signal per element (:mod:`quadcosim.orchestrator.fmi_types`).
 """
 
 from __future__ import annotations
@@ -38,9 +38,8 @@ from fmpy.fmi2 import (
 )
 from fmpy.fmi3 import FMU3Slave
 from fmpy.logging import addLoggerProxy
-
-from fmus import fmu_path
-from orchestrator.fmi_types import (
+from quadcosim.fmus import fmu_path
+from quadcosim.orchestrator.fmi_types import (
     INTEGER_TYPES,
     TEXT_TYPES,
     CEntry,
@@ -51,7 +50,7 @@ from orchestrator.fmi_types import (
     typed_entry,
     types_of,
 )
-from orchestrator.fmu_errors import (  # noqa: F401 (public here too)
+from quadcosim.orchestrator.fmu_errors import (  # noqa: F401 (public here too)
     STATUS,
     FMUError,
     FMULog,
@@ -91,7 +90,7 @@ def is_fmu_file(model) -> bool:
 
 
 def fmu_file(model) -> Path:
-    """The FMU file of ``model``: a built model by name (:func:`fmus.fmu_path`), or a path to any
+    """The FMU file of ``model``: a built model by name (:func:`quadcosim.fmus.fmu_path`), or a path to any
     FMI 2.0 or 3.0 Co-Simulation FMU, made absolute.
 
     Parameters
@@ -117,7 +116,7 @@ def fmu_file(model) -> Path:
     if not path.is_file():
         raise FileNotFoundError(f"FMU file {model} not found (looked at {path}); give the path of an .fmu file, or "
                                 "a built model's name (IMU, Quadrotor, MotorMagnetics)")
-    from orchestrator.fmu_checks import FMURefused, check_archive, check_file
+    from quadcosim.orchestrator.fmu_checks import FMURefused, check_archive, check_file
 
     try:
         check_archive(path)  # before the description is read: no entry of a zip bomb is expanded
@@ -199,7 +198,7 @@ class FMUInstance:
     ----------
     model : str
         Name of a built FMU (``"Quadrotor"``, ``"MotorMagnetics"``, ``"IMU"``), found by
-        :func:`fmus.fmu_path`, or a path to an ``.fmu`` file.
+        :func:`quadcosim.fmus.fmu_path`, or a path to an ``.fmu`` file.
     parameters : dict, optional
         Overrides of parameter start values, by variable name.
     name : str, optional
@@ -212,7 +211,7 @@ class FMUInstance:
     inputs, outputs : list of str
         The signals: numeric variables of every FMI type, an FMI 3.0 array one signal per element.
     signal : dict
-        Signal name to its :class:`orchestrator.fmi_types.Signal`.
+        Signal name to its :class:`quadcosim.orchestrator.fmi_types.Signal`.
     """
 
     fmi3 = False
@@ -456,7 +455,7 @@ class FMUInstance:
 
         Returns
         -------
-        list of orchestrator.fmi_types.CEntry
+        list of quadcosim.orchestrator.fmi_types.CEntry
             Calls of the signature of ``fmi2SetReal``; an FMI 2.0 FMU's Real variables from
             consecutive addresses take the FMU's own ``fmi2SetReal``, one call per run.
         """
@@ -603,8 +602,8 @@ class FMUInstance:
 
 
 def signals_of(variable) -> list:
-    """The signals of one variable (:func:`orchestrator.fmi_types.element_names`)."""
-    from orchestrator.fmi_types import Signal, element_names
+    """The signals of one variable (:func:`quadcosim.orchestrator.fmi_types.element_names`)."""
+    from quadcosim.orchestrator.fmi_types import Signal, element_names
 
     return [Signal(n, variable, k) for k, n in enumerate(element_names(variable.name, tuple(variable.shape or ())))]
 

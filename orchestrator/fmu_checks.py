@@ -197,14 +197,14 @@ def refused_at_start(error: Exception, name: str, path: Path) -> FMURefused | No
     Parameters
     ----------
     error : Exception
-        What :class:`orchestrator.fmu.FMUInstance` raised.
+        What :class:`quadcosim.orchestrator.fmu.FMUInstance` raised.
     name : str
         The block.
     path : pathlib.Path
         The FMU file.
     """
     text = str(error)
-    function = getattr(error, "function", None)  # an orchestrator.fmu.FMUError
+    function = getattr(error, "function", None)  # an quadcosim.orchestrator.fmu.FMUError
     if function in ("fmi2Instantiate", "fmi3InstantiateCoSimulation"):
         logged = "; ".join(error.log[-5:]) or "it logged nothing"
         return FMURefused(f"{name}: {path.name} refused to make an instance ({function} returned NULL; "
@@ -225,7 +225,7 @@ def probe(instance, names) -> None:
 
     Parameters
     ----------
-    instance : orchestrator.fmu.FMUInstance
+    instance : quadcosim.orchestrator.fmu.FMUInstance
         Initialized.
     names : sequence of str
         The inputs and outputs the master wires (signal names, of any numeric type).
@@ -238,7 +238,7 @@ def probe(instance, names) -> None:
     for name in names:
         try:
             instance.get([name])
-        except RuntimeError as error:  # orchestrator.fmu.FMUError (imported by fmu, which imports this)
+        except RuntimeError as error:  # quadcosim.orchestrator.fmu.FMUError (imported by fmu, which imports this)
             if not hasattr(error, "status"):
                 raise
             if getattr(instance, "_proxy", None) is not None and instance._proxy.failure:

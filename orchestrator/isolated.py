@@ -2,10 +2,10 @@
 with a message, not the master.
 
 An FMU this project did not build (:func:`is_own`) runs isolated by default. The worker hosts
-the same instance a block uses in process (:class:`orchestrator.fmu.FMUInstance`, or
-:class:`orchestrator.fmu.FMU3Instance` for FMI 3.0: every variable type): the same set-up,
+the same instance a block uses in process (:class:`quadcosim.orchestrator.fmu.FMUInstance`, or
+:class:`quadcosim.orchestrator.fmu.FMU3Instance` for FMI 3.0: every variable type): the same set-up,
 parameters and log. It asks the instance for the C calls of the loop
-(:class:`orchestrator.fmi_types.Stepping`: ``setter``, ``getter``, ``stepper``) with addresses
+(:class:`quadcosim.orchestrator.fmi_types.Stepping`: ``setter``, ``getter``, ``stepper``) with addresses
 in a shared memory mapping (``memfd``: nothing is left in ``/dev/shm`` whatever ends the
 process), and runs them on request. The master sees an :class:`IsolatedInstance`, whose
 ``setter``, ``getter`` and ``stepper`` return C calls of its own (``orchestrator/c/isolated.c``)
@@ -41,8 +41,8 @@ import sys
 from multiprocessing.connection import Connection
 from pathlib import Path
 
-from orchestrator.fmi_types import CEntry, address, signals
-from orchestrator.fmu import FMUError, FMUInstance, FMULog, fmu_file, model_description
+from quadcosim.orchestrator.fmi_types import CEntry, address, signals
+from quadcosim.orchestrator.fmu import FMUError, FMUInstance, FMULog, fmu_file, model_description
 
 SOURCE = Path(__file__).resolve().parent / "c" / "isolated.c"
 LIBRARY_NAME = "libquadcosim_isolated.so"
@@ -97,7 +97,7 @@ def wake_fd() -> int:
 @functools.cache
 def library() -> ctypes.CDLL:
     """``orchestrator/c/isolated.c`` compiled (next to the call runner, on first use), loaded once."""
-    from orchestrator.calls import compile_shared, runner_dir
+    from quadcosim.orchestrator.calls import compile_shared, runner_dir
 
     path = runner_dir() / LIBRARY_NAME
     if not path.is_file() or path.stat().st_mtime < SOURCE.stat().st_mtime:
@@ -130,7 +130,7 @@ def digest(path) -> str:
 
 def is_own(path) -> bool:
     """Whether the FMU file ``path`` is one this project built: byte for byte one of the plant
-    models in the build folder (:func:`fmus.default_fmu_dir`), whatever its name or place.
+    models in the build folder (:func:`quadcosim.fmus.default_fmu_dir`), whatever its name or place.
 
     Parameters
     ----------
@@ -142,7 +142,7 @@ def is_own(path) -> bool:
     bool
         True for the project's own FMUs, which run in process; False for any other.
     """
-    from fmus import MODELS, default_fmu_dir
+    from quadcosim.fmus import MODELS, default_fmu_dir
 
     path = Path(path).absolute()
     folder = default_fmu_dir()
@@ -192,7 +192,7 @@ class _Program:
 
 class WorkerFailed(FMUError):
     """The worker of an isolated FMU crashed, exited, or outlasted the watchdog: an
-    :class:`orchestrator.fmu.FMUError` whose log holds what happened.
+    :class:`quadcosim.orchestrator.fmu.FMUError` whose log holds what happened.
 
     Parameters
     ----------
@@ -211,7 +211,7 @@ class WorkerFailed(FMUError):
 
 class IsolatedInstance(FMUInstance):
     """An FMU instance run by a worker process: the instance protocol of the master
-    (:class:`orchestrator.fmi_types.Stepping`), for an FMI 2.0 or 3.0 FMU of any variable type.
+    (:class:`quadcosim.orchestrator.fmi_types.Stepping`), for an FMI 2.0 or 3.0 FMU of any variable type.
 
     Parameters
     ----------
@@ -228,7 +228,7 @@ class IsolatedInstance(FMUInstance):
 
     Raises
     ------
-    orchestrator.fmu_checks.FMURefused
+    quadcosim.orchestrator.fmu_checks.FMURefused
         The FMU refused to start (a ``ValueError``: the command line exits 2).
     WorkerFailed
         The worker crashed, exited or hung during the set-up.
@@ -236,8 +236,8 @@ class IsolatedInstance(FMUInstance):
 
     def __init__(self, model, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0,
                  watchdog: float | None = None):
-        from orchestrator.fmi_types import is_fmi3, is_parameter
-        from orchestrator.fmu import _unzip
+        from quadcosim.orchestrator.fmi_types import is_fmi3, is_parameter
+        from quadcosim.orchestrator.fmu import _unzip
 
         self.closed, self.process = True, None
         path = fmu_file(model)
@@ -273,7 +273,8 @@ class IsolatedInstance(FMUInstance):
         directory = _unzip(path)  # here: the master's exit removes it, however the worker ends
         try:
             self.process = subprocess.Popen(
-                [sys.executable, "-m", "orchestrator.isolated_worker", str(child), str(request_r), str(reply_w),
+                [sys.executable, "-m", "quadcosim.orchestrator.isolated_worker", str(child), str(request_r),
+                 str(reply_w),
                  str(self._memfd)],
                 pass_fds=(child, request_r, reply_w, self._memfd), stdin=subprocess.DEVNULL,
                 start_new_session=True)  # the terminal's Ctrl-C reaches the master alone
@@ -304,7 +305,7 @@ class IsolatedInstance(FMUInstance):
 
         Returns
         -------
-        list of orchestrator.fmi_types.CEntry
+        list of quadcosim.orchestrator.fmi_types.CEntry
             One call, of the signature of ``fmi2SetReal``, or none for no names.
         """
         return self._program("Set", names, addresses)
@@ -349,7 +350,7 @@ class IsolatedInstance(FMUInstance):
 
     # ------------------------------------------------------------------ set-up and tests, by name
     def set(self, names, values):
-        """Set inputs by signal name (:meth:`orchestrator.fmu.FMUInstance.set`), in the worker.
+        """Set inputs by signal name (:meth:`quadcosim.orchestrator.fmu.FMUInstance.set`), in the worker.
 
         Parameters
         ----------
@@ -363,7 +364,7 @@ class IsolatedInstance(FMUInstance):
         self._call("set", list(names), np.asarray(values, dtype=np.float64).reshape(-1))
 
     def get(self, names):
-        """Signals by name, as float64 (:meth:`orchestrator.fmu.FMUInstance.get`), from the worker.
+        """Signals by name, as float64 (:meth:`quadcosim.orchestrator.fmu.FMUInstance.get`), from the worker.
 
         Parameters
         ----------
@@ -383,7 +384,7 @@ class IsolatedInstance(FMUInstance):
         self.time = t + h
 
     def texts(self) -> dict[str, str]:
-        """The FMU's String and Binary values (:meth:`orchestrator.fmu.FMUInstance.texts`)."""
+        """The FMU's String and Binary values (:meth:`quadcosim.orchestrator.fmu.FMUInstance.texts`)."""
         return self._call("texts")
 
     def terminated(self) -> bool:
@@ -410,7 +411,7 @@ class IsolatedInstance(FMUInstance):
         """Send a control message and return the worker's answer; an error it reports is raised
         here as the master's own, a worker that ends or hangs as a refusal (:class:`FMURefused`:
         these requests come before the loop)."""
-        from orchestrator.fmu_checks import FMURefused
+        from quadcosim.orchestrator.fmu_checks import FMURefused
 
         try:
             return self._control_request(message, doing, limit)
@@ -503,7 +504,7 @@ class IsolatedInstance(FMUInstance):
 
     # ------------------------------------------------------------------ FMUInstance's life cycle
     def reset(self, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0):
-        """As :meth:`orchestrator.fmu.FMUInstance.reset`, in the worker.
+        """As :meth:`quadcosim.orchestrator.fmu.FMUInstance.reset`, in the worker.
 
         Parameters
         ----------
@@ -572,9 +573,9 @@ def worker_failure(blocks, error: FMUError) -> tuple[str | None, int | None]:
 
     Parameters
     ----------
-    blocks : list of orchestrator.FMUBlock
+    blocks : list of quadcosim.orchestrator.FMUBlock
         The run's FMU blocks, their instances live.
-    error : orchestrator.fmu.FMUError
+    error : quadcosim.orchestrator.fmu.FMUError
         What the runner raised.
 
     Returns
@@ -585,7 +586,7 @@ def worker_failure(blocks, error: FMUError) -> tuple[str | None, int | None]:
     interrupted : int or None
         The signal that ended the request (the run was interrupted, not failed), else None.
     """
-    from orchestrator.interrupts import stopping
+    from quadcosim.infra.interrupts import stopping
 
     for block in blocks:
         instance = getattr(block, "instance", None)
@@ -602,8 +603,8 @@ def worker_failure(blocks, error: FMUError) -> tuple[str | None, int | None]:
 
 def _rebuild(error: tuple, instance: IsolatedInstance) -> Exception:
     """The master's exception for an error the worker reported as ``(kind, message, fields)``."""
-    from orchestrator.fmu import ParameterRefused
-    from orchestrator.fmu_checks import FMURefused
+    from quadcosim.orchestrator.fmu import ParameterRefused
+    from quadcosim.orchestrator.fmu_checks import FMURefused
 
     kind, message, fields = error
     if kind == "FMUError":
@@ -622,23 +623,23 @@ def open_instance(model, parameters: dict | None = None, name: str | None = None
                   isolated: bool | None = None) -> FMUInstance:
     """An initialized instance of ``model``: in a worker process for a foreign FMU
     (:func:`runs_isolated`), else in process; its set-up refusals as
-    :class:`orchestrator.fmu_checks.FMURefused`.
+    :class:`quadcosim.orchestrator.fmu_checks.FMURefused`.
 
     Parameters
     ----------
     model : str or pathlib.Path
         A built model's name or an ``.fmu`` path.
     parameters, name, start_time
-        As for :class:`orchestrator.fmu.FMUInstance`.
+        As for :class:`quadcosim.orchestrator.fmu.FMUInstance`.
     isolated : bool, optional
         Force the choice; by default :func:`runs_isolated` decides.
 
     Returns
     -------
-    orchestrator.fmu.FMUInstance
+    quadcosim.orchestrator.fmu.FMUInstance
         Or its :class:`IsolatedInstance`.
     """
-    from orchestrator.fmu_checks import probe, refused_at_start
+    from quadcosim.orchestrator.fmu_checks import probe, refused_at_start
 
     path = fmu_file(model)
     own = is_own(path)

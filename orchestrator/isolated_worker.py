@@ -1,8 +1,8 @@
-"""The worker process of an isolated FMU (:mod:`orchestrator.isolated`): it hosts the FMU's
+"""The worker process of an isolated FMU (:mod:`quadcosim.orchestrator.isolated`): it hosts the FMU's
 instance and runs the C calls of its programs on the master's requests.
 
-Run as ``python -m orchestrator.isolated_worker CONTROL REQUEST REPLY MEMFD`` by
-:class:`orchestrator.isolated.IsolatedInstance`, with the descriptors it passes.
+Run as ``python -m quadcosim.orchestrator.isolated_worker CONTROL REQUEST REPLY MEMFD`` by
+:class:`quadcosim.orchestrator.isolated.IsolatedInstance`, with the descriptors it passes.
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ import sys
 from multiprocessing.connection import Connection
 from pathlib import Path
 
-from orchestrator.fmi_types import CEntry
-from orchestrator.fmu import FMUError, FMUInstance, FMULog
-from orchestrator.isolated import KINDS, MAX_PROGRAMS, OP_PYTHON, library
+from quadcosim.orchestrator.fmi_types import CEntry
+from quadcosim.orchestrator.fmu import FMUError, FMUInstance, FMULog
+from quadcosim.orchestrator.isolated import KINDS, MAX_PROGRAMS, OP_PYTHON, library
 
 
 class _Call(ctypes.Structure):
@@ -73,8 +73,8 @@ class _Hosted:
 
 def _answer(message: tuple, hosted: _Hosted | None, slots: int, shared):
     """The worker's hosted instance after a control message, and its answer."""
-    from orchestrator import fmu as module
-    from orchestrator.fmu_checks import refused_at_start
+    from quadcosim.orchestrator import fmu as module
+    from quadcosim.orchestrator.fmu_checks import refused_at_start
 
     kind = message[0]
     instance = hosted.instance if hosted is not None else None

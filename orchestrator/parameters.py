@@ -20,10 +20,10 @@ import math
 import numbers
 import re
 
-from orchestrator.blocks import FMUBlock
-from orchestrator.fmi_types import INTEGER_TYPES, is_parameter
-from orchestrator.fmu import nearest
-from orchestrator.signals import expand
+from quadcosim.orchestrator.blocks import FMUBlock
+from quadcosim.orchestrator.fmi_types import INTEGER_TYPES, is_parameter
+from quadcosim.orchestrator.fmu import nearest
+from quadcosim.orchestrator.signals import expand
 
 _NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(.*)", re.IGNORECASE)
 _NOT_PARAMETERS = ("name", "period", "feedthrough", "inputs", "outputs")
@@ -42,7 +42,7 @@ def fmu_parameters(model: str) -> dict:
     dict
         Name to fmpy's variable (``type``, ``start``, ``unit``, ``description``).
     """
-    from orchestrator.fmu import fmu_file, model_description
+    from quadcosim.orchestrator.fmu import fmu_file, model_description
 
     description = model_description(fmu_file(model))
     return {v.name: v for v in description.modelVariables if is_parameter(v)}
@@ -51,7 +51,7 @@ def fmu_parameters(model: str) -> dict:
 def model_notes(model: str) -> tuple[dict, dict]:
     """``ALIASES`` and ``SWITCHED`` of ``fmus/<model>/variables.py`` (empty if none, as for an
     FMU file of the user's)."""
-    from fmus import MODELS, model_variables
+    from quadcosim.fmus import MODELS, model_variables
 
     if model not in MODELS:
         return {}, {}
@@ -64,7 +64,7 @@ def resolve(system, target: str, value) -> dict:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
         The system holding the block.
     target : str
         ``"Block.parameter"``: an FMU parameter or parameter vector (or an alias of one), or a
@@ -109,7 +109,7 @@ def apply(system, settings: dict, options: dict | None = None) -> dict:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     settings : dict
         ``{"Block.parameter": value}``, each as :func:`resolve` takes it.
     options : dict, optional
@@ -134,7 +134,7 @@ def resolve_all(system, settings: dict) -> dict[str, dict]:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     settings : dict
         ``{"Block.parameter": value}``.
 
@@ -151,7 +151,7 @@ def set_all(system, resolved: dict[str, dict], options: dict | None = None) -> d
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     resolved : dict
         ``{"Block.parameter": {name: value}}``.
     options : dict, optional
@@ -260,7 +260,7 @@ def python_parameters(block) -> dict:
 
     Parameters
     ----------
-    block : orchestrator.Block
+    block : quadcosim.orchestrator.Block
         A Python block.
 
     Returns

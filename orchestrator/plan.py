@@ -9,26 +9,28 @@ Building a plan (:class:`Plan`), in order:
 1. :meth:`Plan._lay_out_bus`: a slot per block output, then a slot per fault (several faults
    on one input form a chain, each reading the slot of the one before: they compose in the
    order they were injected);
-2. :meth:`Plan._plan_recording`: the recorded signals, as :class:`~orchestrator.program.Copy` slices from the bus
-   into a row of a preallocated array;
+2. :meth:`Plan._plan_recording`: the recorded signals, as
+   :class:`~quadcosim.orchestrator.program.Copy` slices from the bus into a row of a preallocated array;
 3. :meth:`Plan._wire_blocks`, block by block in dependency order:
 
    - an FMU block (:meth:`Plan._wire_fmu`) is instantiated and its first outputs read. Its
      calls are split in two phases: phase A sets the inputs whose sources ran earlier in this
      macro step and gets the outputs; phase B sets the inputs whose sources run later (non
      feedthrough: a unit delay, not an algebraic loop) and steps. Inputs fed from
-     consecutive slots share one :class:`~orchestrator.calls.SetInputs` call that reads straight
+     consecutive slots share one :class:`~quadcosim.orchestrator.calls.SetInputs` call that reads straight
      from the bus;
    - a Python block (:meth:`Plan._wire_python`) gets a view of its output slots, and its
-     inputs as a view of the bus when their slots are consecutive, or as :class:`~orchestrator.program.Copy` slices;
+     inputs as a view of the bus when their slots are consecutive, or as
+     :class:`~quadcosim.orchestrator.program.Copy` slices;
    - consecutive FMU blocks with one period and no fault share one batch: one call into the C
-     runner (:func:`orchestrator.calls.batch`) per group per step.
+     runner (:func:`quadcosim.orchestrator.calls.batch`) per group per step.
 
-Running (:meth:`Plan.run`), per macro step ``n`` at ``t_n``: the :class:`~orchestrator.program.Phase` entries of
-phase A, due at ``n``, in order; the bus is recorded (every ``decimation`` steps) and checked for
-NaN and Inf; the phase B entries due at ``n``. The same plan, read from :attr:`Plan.program`, is
-run either by the chunk runner (:class:`orchestrator.chunks.ChunkRunner`, compiled, the default)
-or one step at a time by :meth:`Plan._run_steps`.
+Running (:meth:`Plan.run`), per macro step ``n`` at ``t_n``: the
+:class:`~quadcosim.orchestrator.program.Phase` entries of phase A, due at ``n``, in order; the bus
+is recorded (every ``decimation`` steps) and checked for NaN and Inf; the phase B entries due at
+``n``. The same plan, read from :attr:`Plan.program`, is run either by the chunk runner
+(:class:`quadcosim.orchestrator.chunks.ChunkRunner`, compiled, the default) or one step at a time
+by :meth:`Plan._run_steps`.
 """
 
 from __future__ import annotations
@@ -43,17 +45,17 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
+from quadcosim.orchestrator.blocks import Block, FMUBlock
+from quadcosim.orchestrator.calls import DoStep, FMICall, GetOutputs, SetInputs, batch
+from quadcosim.orchestrator.errors import RunInterrupted, SimulationError
+from quadcosim.orchestrator.faults import FaultTap, apply_faults, describe, suspects
+from quadcosim.orchestrator.fmu import FMUError
+from quadcosim.orchestrator.program import RECORD, Entry, Phase, copies
+from quadcosim.orchestrator.result import Result, check_record_fits
+from quadcosim.orchestrator.signals import signal_dtypes, signal_units
 
-from orchestrator.blocks import Block, FMUBlock
-from orchestrator.calls import DoStep, FMICall, GetOutputs, SetInputs, batch
-from orchestrator.errors import RunInterrupted, SimulationError
-from orchestrator.faults import FaultTap, apply_faults, describe, suspects
-from orchestrator.fmu import FMUError
-from orchestrator.interrupts import signal_name, signal_number
-from orchestrator.program import RECORD, Entry, Phase, copies
-from orchestrator.progress import Progress
-from orchestrator.result import Result, check_record_fits
-from orchestrator.signals import signal_dtypes, signal_units
+from quadcosim.infra.interrupts import signal_name, signal_number
+from quadcosim.infra.progress import Progress
 
 #: This package's folder and the Python's libraries: frames there are not a block's own code.
 _NOT_A_BLOCK = (str(Path(__file__).resolve().parent), sysconfig.get_paths()["stdlib"],
@@ -82,7 +84,7 @@ class Plan:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
         The system, fully connected.
     duration : float
         Simulated time (s).
@@ -92,9 +94,9 @@ class Plan:
         Start time (s).
     record : list of str, optional
         Signals to record (vector names allowed); every output by default.
-    stream : orchestrator.stream.StreamWriter, optional
+    stream : quadcosim.orchestrator.stream.StreamWriter, optional
         Write the record to disk in chunks as the run goes: memory then holds a window of
-        rows (:func:`orchestrator.stream.window_rows`), not the whole record.
+        rows (:func:`quadcosim.orchestrator.stream.window_rows`), not the whole record.
     """
 
     def __init__(self, system, duration: float, decimation: int, t0: float, record=None, stream=None):
@@ -152,7 +154,7 @@ class Plan:
         self.record_copies = copies(slots)
         rows = self.steps // self.decimation + 1
         if self.stream is not None:
-            from orchestrator.stream import window_rows
+            from quadcosim.orchestrator.stream import window_rows
 
             rows = window_rows(len(slots), rows)
         check_record_fits(rows, len(slots), self.decimation)
@@ -273,19 +275,19 @@ class Plan:
         Parameters
         ----------
         progress : bool
-            Show the run's progress on standard error (:class:`orchestrator.progress.Progress`:
+            Show the run's progress on standard error (:class:`quadcosim.infra.progress.Progress`:
             a bar on a terminal, a few plain lines otherwise).
         master : {"chunk", "step"}
-            ``"chunk"``: the compiled chunk runner (:mod:`orchestrator.chunks`) runs whole chunks
+            ``"chunk"``: the compiled chunk runner (:mod:`quadcosim.orchestrator.chunks`) runs whole chunks
             of steps in C; ``"step"``: this loop, in Python, one step at a time. Both give
             bit-identical results.
 
         Raises
         ------
-        orchestrator.SimulationError
+        quadcosim.orchestrator.SimulationError
             On any failure; its ``result`` holds what was recorded up to it.
         """
-        from orchestrator.chunks import ChunkRunner
+        from quadcosim.orchestrator.chunks import ChunkRunner
 
         # the bar first: on a terminal it shows while the compiled steps load (compiled at the first run after a change)
         bar = Progress(self.steps * self.dt, "run") if progress else None
@@ -307,7 +309,7 @@ class Plan:
         except _Failure as failure:
             raise SimulationError(str(failure), self.result(error=str(failure))) from None
         except FMUError as error:
-            from orchestrator.isolated import worker_failure
+            from quadcosim.orchestrator.isolated import worker_failure
 
             message, interrupted = worker_failure(self.fmus, error)
             if interrupted is not None:  # a signal ended a request to a worker: the run was interrupted
@@ -399,9 +401,9 @@ class Plan:
 
         Returns
         -------
-        orchestrator.Result
+        quadcosim.orchestrator.Result
             Time in s from ``t0``, one column per recorded signal; for a streamed record, read
-            back from its folder (:class:`orchestrator.result.StreamedResult`).
+            back from its folder (:class:`quadcosim.orchestrator.result.StreamedResult`).
         """
         if self.stream is not None:
             return self._streamed(error)
@@ -424,7 +426,7 @@ class Plan:
                 **({"texts": dict(self.texts)} if self.texts else {})}
 
     def _streamed(self, error: str | None) -> Result:
-        from orchestrator.result import StreamedResult
+        from quadcosim.orchestrator.result import StreamedResult
 
         if self.recorded > self.record_first:
             self.flush()

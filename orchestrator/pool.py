@@ -3,7 +3,7 @@
 A sweep worker runs many members of one scenario: instantiating the same FMUs for each costs
 more than some members' stepping. With reuse on (:func:`reuse`, which each sweep worker turns
 on), a run's FMU blocks take an idle instance of their model, reset it (``fmi2Reset``, then the
-usual set-up and initialization: :meth:`orchestrator.fmu.FMUInstance.reset`) and give it back
+usual set-up and initialization: :meth:`quadcosim.orchestrator.fmu.FMUInstance.reset`) and give it back
 when the run ends. The project's FMUs' reset reproduces a fresh instance bit for bit, which
 ``tests/test_fmu_reset.py`` checks model by model and on whole runs. Any other FMU is pooled
 only once this process has seen its reset do so (:func:`_reset_verified`); one whose reset does
@@ -52,7 +52,7 @@ def _key(path) -> tuple:
 def acquire(model: str, parameters: dict | None = None, name: str | None = None, start_time: float = 0.0,
             isolated: bool | None = None):
     """An initialized instance of ``model``: an idle one reset, when reuse is on and one is
-    idle, else a new one. The arguments are those of :class:`orchestrator.fmu.FMUInstance`.
+    idle, else a new one. The arguments are those of :class:`quadcosim.orchestrator.fmu.FMUInstance`.
 
     Parameters
     ----------
@@ -65,14 +65,14 @@ def acquire(model: str, parameters: dict | None = None, name: str | None = None,
     start_time : float
         Start time (s).
     isolated : bool, optional
-        In a worker process or not; by default :func:`orchestrator.isolated.runs_isolated` decides.
+        In a worker process or not; by default :func:`quadcosim.orchestrator.isolated.runs_isolated` decides.
 
     Returns
     -------
-    orchestrator.fmu.FMUInstance
+    quadcosim.orchestrator.fmu.FMUInstance
     """
-    from orchestrator.fmu import fmu_file
-    from orchestrator.isolated import open_instance
+    from quadcosim.orchestrator.fmu import fmu_file
+    from quadcosim.orchestrator.isolated import open_instance
 
     if _enabled:
         path = fmu_file(model)
@@ -104,8 +104,7 @@ def _reset_verified(path, parameters, name, start_time) -> bool:
     import warnings
 
     import numpy as np
-
-    from orchestrator.isolated import is_own, open_instance
+    from quadcosim.orchestrator.isolated import is_own, open_instance
 
     key = _key(path)
     if key in _verified:
@@ -140,7 +139,7 @@ def _reset_verified(path, parameters, name, start_time) -> bool:
                 instance.close()
     _verified[key] = reason is None
     if reason is not None:
-        from orchestrator.fmu import fmi_version
+        from quadcosim.orchestrator.fmu import fmi_version
 
         reset = f"fmi{fmi_version(path)}Reset"
         warnings.warn(f"{path.name}: {reset} does not reproduce a fresh instance ({reason}); each run instantiates "
@@ -154,7 +153,7 @@ def release(instance) -> None:
 
     Parameters
     ----------
-    instance : orchestrator.fmu.FMUInstance
+    instance : quadcosim.orchestrator.fmu.FMUInstance
     """
     if not _enabled or instance.closed or not _verified.get(_key(instance.path), False):
         instance.close()  # an FMU whose reset is not verified is never kept

@@ -1,7 +1,7 @@
 """The program a run plan is compiled into, as both runners read it: the slice copies between
 the bus and the blocks, the phases run per macro step, and the entries of the chunk runner.
 
-:class:`orchestrator.plan.Plan` builds it; :class:`orchestrator.chunks.ChunkRunner` and the
+:class:`quadcosim.orchestrator.plan.Plan` builds it; :class:`quadcosim.orchestrator.chunks.ChunkRunner` and the
 plan's own step loop run it.
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import NamedTuple
 
-from orchestrator.blocks import Block
+from quadcosim.orchestrator.blocks import Block
 
 
 class Copy(NamedTuple):

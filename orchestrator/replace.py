@@ -2,23 +2,23 @@
 
 from __future__ import annotations
 
-from orchestrator.fmu import nearest
+from quadcosim.orchestrator.fmu import nearest
 
 
 def replace(system, name: str, block):
     """Put ``block`` in the place of the block called ``name``, keeping its connections.
 
     ``block`` takes the name ``name``. Connections into inputs the new block does not have are
-    dropped; inputs it adds are left for :meth:`orchestrator.System.connect` (a run refuses
+    dropped; inputs it adds are left for :meth:`quadcosim.orchestrator.System.connect` (a run refuses
     unconnected inputs). Every output of the old block that feeds another block must exist on
     the new one.
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     name : str
         The block replaced.
-    block : orchestrator.Block or orchestrator.FMUBlock
+    block : quadcosim.orchestrator.Block or quadcosim.orchestrator.FMUBlock
         The new block.
 
     Returns
@@ -61,7 +61,7 @@ def replace_fmu(system, name: str, model) -> tuple:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     name : str
         An FMU block of ``system`` (``MotorMagnetics``).
     model : str or pathlib.Path
@@ -69,7 +69,7 @@ def replace_fmu(system, name: str, model) -> tuple:
 
     Returns
     -------
-    block : orchestrator.FMUBlock
+    block : quadcosim.orchestrator.FMUBlock
         The new block, in the system.
     notes : list of str
         What the new block does not take over: parameters it lacks, units it does not declare.
@@ -82,8 +82,8 @@ def replace_fmu(system, name: str, model) -> tuple:
         ``name`` is not an FMU block, or the new FMU's interface differs; the message lists
         every mismatch (a missing variable, another unit).
     """
-    from orchestrator.blocks import FMUBlock
-    from orchestrator.fmu_checks import FMURefused
+    from quadcosim.orchestrator.blocks import FMUBlock
+    from quadcosim.orchestrator.fmu_checks import FMURefused
 
     if name not in system.blocks:
         raise KeyError(f"--fmu {name}: unknown block {name!r}.{nearest(name, system.blocks)} "

@@ -3,7 +3,7 @@
 The ``.npz`` and ``.mat`` files are compressed and carry the signals' units and the run's
 options; vector signals (``IMU.acc``, ``Quadrotor.q``) are stored as N x k arrays and the
 rotation matrix ``IMU.R_reel`` as N x 3 x 3. A record streamed to disk as the run went
-(:mod:`orchestrator.stream` writes it) is read back by :class:`StreamedResult`, one signal at a
+(:mod:`quadcosim.orchestrator.stream` writes it) is read back by :class:`StreamedResult`, one signal at a
 time; :meth:`Result.load` reads either.
 """
 
@@ -15,12 +15,12 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+from quadcosim.orchestrator.fmu import nearest
+from quadcosim.orchestrator.signals import expand, matrix_shape, vector_groups
+from quadcosim.orchestrator.values import float_text, integer_text, matlab_values
 
-from orchestrator.files import atomic_path, json_text
-from orchestrator.fmu import nearest
-from orchestrator.inputs import read_small_text, regular_file
-from orchestrator.signals import expand, matrix_shape, vector_groups
-from orchestrator.values import float_text, integer_text, matlab_values
+from quadcosim.infra.files import atomic_path, json_text
+from quadcosim.infra.inputs import read_small_text, regular_file
 
 #: Export formats of :meth:`Result.save`, as the command line's ``--format`` names them.
 FORMATS = ("npz", "mat", "csv")
@@ -48,7 +48,7 @@ def check_record_fits(rows: int, signals: int, decimation: int = 1, writers: int
         The run's decimation, named in the message as a way out.
     writers : int
         Bytes the writers of the result files add at their peak
-        (:func:`orchestrator.memory.writers_peak`).
+        (:func:`quadcosim.infra.memory.writers_peak`).
 
     Returns
     -------
@@ -62,7 +62,7 @@ def check_record_fits(rows: int, signals: int, decimation: int = 1, writers: int
         (the machine's, ``ulimit -v`` or the control group's, whichever is smallest); the
         message gives the figures, the limit that binds and the way out.
     """
-    from orchestrator.memory import available, in_gigabytes
+    from quadcosim.infra.memory import available, in_gigabytes
 
     record = rows * signals * 8
     need = record + writers
@@ -294,7 +294,7 @@ class Result:
         pathlib.Path
             ``path``.
         """
-        from orchestrator.progress import Every
+        from quadcosim.infra.progress import Every
 
         path = Path(path)
         every = Every(1.5)  # a status line now and then while a long record is written
@@ -646,7 +646,7 @@ class StreamedResult(Result):
             yield Result(block[0], self.names, block[1:].T, self.meta, self.error)
 
     def envelope(self, of, points: int = 2000) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`orchestrator.result.envelope` of ``of(window)``, chunk by chunk: the runs
+        """:func:`quadcosim.orchestrator.result.envelope` of ``of(window)``, chunk by chunk: the runs
         are those of the whole record, and a run that spans two chunks is carried over, so the
         samples kept are those of the envelope of the whole curve.
 

@@ -77,7 +77,7 @@ def signal_units(blocks, names) -> dict[str, str]:
 
 def signal_dtypes(blocks, names) -> dict[str, str]:
     """The NumPy type of each recorded signal that is not float64, from its block's ``dtypes``
-    (an FMU's integer, Boolean and single-precision signals: :func:`orchestrator.fmi_types.dtypes`).
+    (an FMU's integer, Boolean and single-precision signals: :func:`quadcosim.orchestrator.fmi_types.dtypes`).
 
     Parameters
     ----------

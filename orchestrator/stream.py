@@ -11,9 +11,9 @@ folder ``results.stream/``; memory then stays flat however long the run. The fol
   error), ``samples`` and ``chunks`` once the run has ended (written at the start too, so that
   a run killed outright leaves a readable folder: its complete chunks).
 
-Every chunk and ``meta.json`` go through :func:`orchestrator.files.atomic_path`: a chunk on
-disk is whole. :class:`orchestrator.result.StreamedResult` reads the folder back (whose name is
-:data:`orchestrator.result.FOLDER`): a signal is gathered from the chunks when asked for, so that
+Every chunk and ``meta.json`` go through :func:`quadcosim.infra.files.atomic_path`: a chunk on
+disk is whole. :class:`quadcosim.orchestrator.result.StreamedResult` reads the folder back (whose name is
+:data:`quadcosim.orchestrator.result.FOLDER`): a signal is gathered from the chunks when asked for, so that
 a report reads one signal at a time.
 """
 
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.files import atomic_path, write_json
+from quadcosim.infra.files import atomic_path, write_json
 
 #: Bytes of the window of rows held in memory before they go to disk.
 WINDOW_BYTES = 8 * 2 ** 20

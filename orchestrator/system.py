@@ -5,7 +5,7 @@ slice of it. Before a run everything is resolved once: value references, the sli
 FMU reads its inputs from (one ``fmi2SetReal`` per contiguous run, straight from the bus,
 no copy), the views each Python block reads and writes, faults, recording. The loop then
 makes only the FMI calls and the block steps, with no name look-up and no allocation per
-step. It runs in C for whole chunks of steps (:mod:`orchestrator.chunks`: FMI calls, compiled
+step. It runs in C for whole chunks of steps (:mod:`quadcosim.orchestrator.chunks`: FMI calls, compiled
 block steps, tables, recording, checks), returning to Python per chunk, for blocks without a
 compiled form and for faults; ``run(..., master="step")`` runs it from Python one step at a
 time, with bit-identical results.
@@ -24,14 +24,13 @@ import math
 import os
 
 import numpy as np
-
-from orchestrator.blocks import Block, Constant, FMUBlock
-from orchestrator.errors import AlgebraicLoopError, SimulationError  # noqa: F401 (public here too)
-from orchestrator.faults import Fault
-from orchestrator.fmu import nearest
-from orchestrator.plan import Plan
-from orchestrator.result import Result
-from orchestrator.signals import expand
+from quadcosim.orchestrator.blocks import Block, Constant, FMUBlock
+from quadcosim.orchestrator.errors import AlgebraicLoopError, SimulationError  # noqa: F401 (public here too)
+from quadcosim.orchestrator.faults import Fault
+from quadcosim.orchestrator.fmu import nearest
+from quadcosim.orchestrator.plan import Plan
+from quadcosim.orchestrator.result import Result
+from quadcosim.orchestrator.signals import expand
 
 
 class System:
@@ -165,16 +164,16 @@ class System:
             ``"Block.parameter"``: an FMU parameter, vector or alias, checked against the FMU's
             variable table, or a Python block's numeric attribute.
         value : number, bool, str or sequence
-            In the parameter's unit (see :func:`orchestrator.parameters.resolve`).
+            In the parameter's unit (see :func:`quadcosim.orchestrator.parameters.resolve`).
         """
-        from orchestrator.parameters import apply
+        from quadcosim.orchestrator.parameters import apply
 
         return apply(self, {target: value})[target]
 
     def replace(self, name: str, block):
         """Put ``block`` in the place of block ``name`` (it takes that name), keeping the wiring;
-        see :func:`orchestrator.replace.replace`. Returns ``block``."""
-        from orchestrator.replace import replace
+        see :func:`quadcosim.orchestrator.replace.replace`. Returns ``block``."""
+        from quadcosim.orchestrator.replace import replace
 
         return replace(self, name, block)
 
@@ -240,22 +239,22 @@ class System:
             block by default.
         master : {"chunk", "step"}, optional
             ``"chunk"`` (the default, or ``$QUADCOSIM_MASTER``): compiled code runs whole chunks
-            of steps (:mod:`orchestrator.chunks`); ``"step"``: one step at a time from Python.
+            of steps (:mod:`quadcosim.orchestrator.chunks`); ``"step"``: one step at a time from Python.
             Both give bit-identical results.
-        stream : orchestrator.stream.StreamWriter, optional
+        stream : quadcosim.orchestrator.stream.StreamWriter, optional
             Write the record to its folder in chunks as the run goes (memory stays flat);
             the result is then read back from that folder.
 
         Returns
         -------
-        orchestrator.Result
+        quadcosim.orchestrator.Result
             The recorded signals, indexed by name.
 
         Raises
         ------
         ValueError
             Invalid duration or decimation, or an input left unconnected.
-        orchestrator.SimulationError
+        quadcosim.orchestrator.SimulationError
             A failure during the run; its ``result`` holds what was recorded up to it.
         """
         if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):

@@ -20,7 +20,6 @@
   quadcosim replay RECORDING [--estimator KIND] [--figure FILE]   an estimator on a recorded file, scored
   quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
   quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
-  quadcosim findings [GROUP...] [--quick] [--check]   the README's numbers, measured into findings.json
 """
 
 from __future__ import annotations
@@ -34,9 +33,9 @@ from pathlib import Path
 
 
 def _build(args) -> int:
-    from fmus import BuildFolderRefused, default_fmu_dir
-    from fmus.build import BuildError, build_all
-    from orchestrator.calls import LIBRARY_NAME, SOURCE, RunnerBuildError, build_runner, runner_dir
+    from quadcosim.fmus import BuildFolderRefused, default_fmu_dir
+    from quadcosim.fmus.build import BuildError, build_all
+    from quadcosim.orchestrator.calls import LIBRARY_NAME, SOURCE, RunnerBuildError, build_runner, runner_dir
 
     try:
         build_all(Path(args.out or default_fmu_dir()), force=args.force)
@@ -45,14 +44,14 @@ def _build(args) -> int:
             print(f"built {build_runner()}")
         else:
             print(f"up to date {library}")
-        from orchestrator.fmi_types import typed_path
+        from quadcosim.orchestrator.fmi_types import typed_path
 
         print(f"ready {typed_path(build=args.force)}")
-        from benchmarks import build_references
+        from quadcosim.benchmarks import build_references
 
         for library in build_references():
             print(f"built {library}")
-        from scenarios import compiled
+        from quadcosim.scenarios import compiled
 
         seconds = compiled.compile_all()
         print(f"{'compiled' if compiled.compiled_any() else 'loaded'} the numba steps in {seconds:.1f} s")
@@ -64,9 +63,9 @@ def _build(args) -> int:
 
 def _list(args) -> int:
     if args.parameters:
-        from fmus import MODELS
-        from fmus.build import table
-        from scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines, scenario_lines
+        from quadcosim.fmus import MODELS
+        from quadcosim.fmus.build import table
+        from quadcosim.scenarios.block_parameters import PYTHON_BLOCKS, parameter_lines, scenario_lines
 
         if args.parameters in PYTHON_BLOCKS:
             print("\n".join(parameter_lines(args.parameters)))
@@ -75,11 +74,11 @@ def _list(args) -> int:
             print(f"unknown model {args.parameters!r}; FMUs: {', '.join(MODELS)}; Python blocks: "
                   f"{', '.join(PYTHON_BLOCKS)}", file=sys.stderr)
             return 2
-        from orchestrator.parameters import model_notes
+        from quadcosim.orchestrator.parameters import model_notes
 
         print(f"{args.parameters} parameters (set one in any scenario with --set {args.parameters}.NAME=VALUE; "
               "a vector as x,y,z):")
-        from scenarios.shown import PARAMETER_DIGITS, shown
+        from quadcosim.scenarios.shown import PARAMETER_DIGITS, shown
 
         for v in table(args.parameters).of("parameter"):
             unit = f" [{v.unit}]" if v.unit else ""
@@ -91,7 +90,7 @@ def _list(args) -> int:
             print(f"  {', '.join(governed)} act only while {switch} is true")
         print("\n".join(scenario_lines(args.parameters)))
         return 0
-    import scenarios
+    from quadcosim import scenarios
 
     for name, scenario in scenarios.registry().items():
         print(f"{name}: {scenario.description}")
@@ -105,7 +104,7 @@ def _settings(args) -> list[str]:
     """The ``--set`` pairs, with ``--estimator`` as the option it stands for."""
     settings = list(args.set)
     if getattr(args, "estimator", None):
-        import scenarios
+        from quadcosim import scenarios
 
         if "estimator" not in scenarios.get(args.scenario).options:
             raise ValueError(f"--estimator: scenario {args.scenario} has no estimator; "
@@ -121,7 +120,7 @@ _FAULT_FORM = ("write TARGET:KIND:START:STOP[:VALUE], e.g. IMU.omega_x:offset:0.
 
 
 def _parse_fault(text: str):
-    from orchestrator import Fault
+    from quadcosim.orchestrator import Fault
 
     parts = text.split(":")
     if len(parts) not in (4, 5):
@@ -164,8 +163,8 @@ def _positive_int(text: str) -> int:
 
 
 def _run(args) -> int:
-    from orchestrator.interrupts import exit_code, first_only
-    from orchestrator.progress import reporting
+    from quadcosim.infra.interrupts import exit_code, first_only
+    from quadcosim.infra.progress import reporting
 
     # the first signal stops the run; later ones wait until its record is safe, then (when this
     # is the process's command line) are ignored while the process ends with the first one's code
@@ -178,7 +177,7 @@ def _run(args) -> int:
 
 
 def _isolation(args):
-    """``--watchdog`` and ``--fmu-in-process`` as the settings :mod:`orchestrator.isolated` reads
+    """``--watchdog`` and ``--fmu-in-process`` as the settings :mod:`quadcosim.orchestrator.isolated` reads
     (environment variables: a sweep's worker processes inherit them)."""
     import os
 
@@ -192,15 +191,15 @@ def _isolation(args):
 
 
 def _run_reporting(args) -> int:
-    from orchestrator.progress import status
+    from quadcosim.infra.progress import status
 
     status(f"quadcosim run {args.scenario}: loading the packages")
-    import scenarios
-    from orchestrator import RunInterrupted, SimulationError
+    from quadcosim import scenarios
+    from quadcosim.orchestrator import RunInterrupted, SimulationError
 
     out = Path(args.out) if args.out else _default_out(args.scenario, args.overwrite)
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
-    from scenarios.plant import figure_format
+    from quadcosim.scenarios.plant import figure_format
 
     try:
         _isolation(args)
@@ -221,7 +220,7 @@ def _run_reporting(args) -> int:
         return 1
     except (KeyError, ValueError) as error:
         print(f"quadcosim run {args.scenario}: {_said(error)}", file=sys.stderr)
-        from orchestrator.fmu_checks import FMURefused
+        from quadcosim.orchestrator.fmu_checks import FMURefused
 
         if isinstance(error, FMURefused) and (out / "metrics.json").is_file():
             print(f"metrics.json (status refused, no sample) is in {out}/", file=sys.stderr)
@@ -231,7 +230,7 @@ def _run_reporting(args) -> int:
         return 1
     warnings = metrics.pop("fmu_warnings", {})
     shown = {k: v for k, v in metrics.items() if k not in ("options", "scenario", "units", "signals_not_saved")}
-    from scenarios.shown import shown as text
+    from quadcosim.scenarios.shown import shown as text
 
     for key, value in shown.items():
         print(f"  {key}: {text(value)}")
@@ -258,7 +257,7 @@ def _said(error: Exception) -> str:
 def _default_out(scenario: str, overwrite: bool) -> Path:
     """``results/SCENARIO``, or with earlier results there (and no --overwrite) the next free
     ``results/SCENARIO-N``, said on standard error: a run never replaces results unasked."""
-    from orchestrator.files import free_folder, holds_results
+    from quadcosim.infra.files import free_folder, holds_results
 
     base = Path("results") / scenario
     if overwrite:
@@ -281,12 +280,12 @@ def _print_warnings(warnings: dict, shown: int = 3):
 
 
 def _diagram(args) -> int:
-    from orchestrator.progress import reporting, status
+    from quadcosim.infra.progress import reporting, status
 
     with reporting(True):
         status(f"quadcosim diagram {args.scenario}: loading the packages")
-        import scenarios
-        from orchestrator.diagram import draw
+        from quadcosim import scenarios
+        from quadcosim.orchestrator.diagram import draw
 
         try:
             scenario = scenarios.get(args.scenario)
@@ -296,8 +295,8 @@ def _diagram(args) -> int:
         except (KeyError, ValueError) as error:
             print(error.args[0] if error.args else error, file=sys.stderr)
             return 2
-        from orchestrator.diagram import blocks_text
-        from orchestrator.files import figure_file
+        from quadcosim.infra.files import figure_file
+        from quadcosim.orchestrator.diagram import blocks_text
 
         status(f"{args.scenario}: drawing the wiring ({blocks_text(system)})")
         try:
@@ -319,22 +318,22 @@ def _bench(args) -> int:
               "quadcosim bench --out FILE", file=sys.stderr)
         return 2
     if args.suite == "infrared":
-        from benchmarks import infrared
+        from quadcosim.benchmarks import infrared
 
         return infrared.main(["--json"] if args.json else [])
     if args.suite == "sweep":
-        from benchmarks import sweep
+        from quadcosim.benchmarks import sweep
 
         return sweep.main(["--json"] if args.json else [])
     if args.suite == "isolation":
-        from benchmarks import isolation
+        from quadcosim.benchmarks import isolation
 
         return isolation.main(["--json"] if args.json else [])
     if args.suite == "pytest":
-        from benchmarks import pytest_cost
+        from quadcosim.benchmarks import pytest_cost
 
         return pytest_cost.main(["--json"] if args.json else [])
-    from benchmarks import master as bench
+    from quadcosim.benchmarks import master as bench
 
     return bench.main((["--json"] if args.json else []) + ["--seconds", str(args.seconds)]
                       + (["--out", args.out] if args.out else []))
@@ -352,8 +351,7 @@ def _version() -> str:
 
 def parser() -> argparse.ArgumentParser:
     """The ``quadcosim`` argument parser, one sub-command per action."""
-    import studies  # noqa: F401  (registers the studies' scenarios in the catalogue the verbs read)
-    from scenarios.shown import PlainHelp
+    from quadcosim.scenarios.shown import PlainHelp
 
     p = argparse.ArgumentParser(prog="quadcosim", description=__doc__, formatter_class=PlainHelp)
     p.add_argument("--version", action="version", version=f"quadcosim {_version()}")
@@ -396,12 +394,8 @@ def parser() -> argparse.ArgumentParser:
     replay = sub.add_parser("replay", add_help=False,
                             help="any estimator on a recorded IMU file or a tp run's folder, scored against its "
                                  "reference attitude (quadcosim replay --help)")
-    replay.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to scenarios.replay
-    findings = sub.add_parser("findings", add_help=False,
-                              help="run the README's findings, write findings.json, rewrite the README's numbers "
-                                   "(quadcosim findings --help)")
-    findings.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to findings
-    from scenarios import run_plots
+    replay.add_argument("rest", nargs=argparse.REMAINDER)  # main() hands them to quadcosim.scenarios.replay
+    from quadcosim.scenarios import run_plots
 
     run_plots.add_arguments(sub)
     _add_studies(sub)
@@ -457,23 +451,24 @@ def _add_run(sub):
 
 
 def _add_studies(sub):
-    """The ``sweep``, ``sweep-plot`` and ``tune`` verbs (:mod:`studies.sweep`, :mod:`studies.tune`)."""
-    from studies.sweep import command as sweep
+    """The ``sweep``, ``sweep-plot`` and ``tune`` verbs (:mod:`quadcosim.studies.sweep`,
+    :mod:`quadcosim.studies.tune`)."""
+    from quadcosim.studies.sweep import command as sweep
 
     sweep.add_arguments(sub.add_parser("sweep", help="run a scenario over a grid of options and seeds, on Dask"))\
         .set_defaults(func=sweep.sweep)
     sweep.add_plot_arguments(sub.add_parser("sweep-plot", help="a metric of a sweep table against an option"))\
         .set_defaults(func=sweep.sweep_plot)
-    from studies import tune
+    from quadcosim.studies import tune
 
     tune.add_arguments(sub.add_parser("tune", help="the options that minimise a metric (scipy.optimize), on Dask"))\
         .set_defaults(func=tune.command)
 
 
 def _add_flight_logs(sub):
-    """The ``log`` and ``calibrate`` verbs (:mod:`scenarios.flightlog`) on the sub-parsers ``sub``."""
-    from scenarios.flightlog import calibrate
-    from scenarios.flightlog import command as flightlog
+    """The ``log`` and ``calibrate`` verbs (:mod:`quadcosim.scenarios.flightlog`) on the sub-parsers ``sub``."""
+    from quadcosim.scenarios.flightlog import calibrate
+    from quadcosim.scenarios.flightlog import command as flightlog
 
     flightlog.add_arguments(sub.add_parser("log", help="read a PX4 ULog or ArduPilot DataFlash flight log"))
     calibrate.add_arguments(sub.add_parser("calibrate", help="calibrate a magnetometer and its motor interference "
@@ -481,14 +476,14 @@ def _add_flight_logs(sub):
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    from orchestrator.progress import say
+    from quadcosim.infra.progress import say
 
     say(f"quadcosim: warning: {message}", sys.stderr)  # above a progress bar, never inside it
 
 
 def main(argv=None) -> int:
     """Run ``quadcosim`` with ``argv`` (the process arguments if None); returns the exit code."""
-    from orchestrator.interrupts import exit_code, terminate_as_interrupt
+    from quadcosim.infra.interrupts import exit_code, terminate_as_interrupt
 
     for stream in (sys.stdout, sys.stderr):  # a file name that is not UTF-8 is printed escaped, never a traceback
         if hasattr(stream, "reconfigure"):
@@ -499,18 +494,14 @@ def main(argv=None) -> int:
             warnings.showwarning = _show_warning
             final = argv is None  # the process's own command line, not a call from Python
             argv = sys.argv[1:] if argv is None else list(argv)
-            if argv[:1] == ["findings"]:  # its own parser: its options, --help included, are its own
-                from findings.__main__ import main as findings
-
-                return findings(argv[1:])
-            if argv[:1] == ["replay"]:  # the replay's parser, shared with python -m scenarios.replay
-                from scenarios.replay import main as replay
+            if argv[:1] == ["replay"]:  # the replay's parser, shared with python -m quadcosim.scenarios.replay
+                from quadcosim.scenarios.replay import main as replay
 
                 return replay(argv[1:], prog="quadcosim replay")
             args = parser().parse_args(argv)
             args.final = final
             if args.command in ("run", "sweep", "tune", "bench", "build"):
-                from scenarios.compiled import announce_compiles
+                from quadcosim.scenarios.compiled import announce_compiles
 
                 announce_compiles()
             return args.func(args)
@@ -521,14 +512,14 @@ def main(argv=None) -> int:
 
 def entry() -> None:
     """The ``quadcosim`` program: :func:`main`, then exit with its code
-    (:func:`orchestrator.interrupts.leave`)."""
+    (:func:`quadcosim.infra.interrupts.leave`)."""
     # Before numpy loads: numpy and scipy each bring an OpenBLAS that starts a thread per core and
     # spins it at load, CPU a command spends for nothing on its small matrices. A user's setting
     # wins; a program that imports this module is left as it is.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     import signal
 
-    from orchestrator.interrupts import exit_code, leave
+    from quadcosim.infra.interrupts import exit_code, leave
 
     # SIGTERM's handler outside main's own: main restores it when it returns, and a signal then
     # (the command's work done) ends the process at once with 143, never by SIGTERM's default

@@ -1,7 +1,7 @@
 """Named scenarios: one command runs one and leaves results, figures and metrics behind.
 
 A scenario declares its options (each with a default, a unit or choices, and a help text),
-builds a :class:`orchestrator.System` from them, and reports on the result: it writes its
+builds a :class:`quadcosim.orchestrator.System` from them, and reports on the result: it writes its
 figures and returns its metrics. :func:`run` does the rest: results (``results.npz``,
 ``results.mat``), ``metrics.json``, and on a failure what was recorded up to it.
 """
@@ -14,8 +14,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from scenarios.catalogue import get, names, registry
-from scenarios.state import Build, Duration, Extra, Options, Prepared, Report, Resolve, RunRequest
+from quadcosim.scenarios.catalogue import get, names, registry
+from quadcosim.scenarios.state import Build, Duration, Extra, Options, Prepared, Report, Resolve, RunRequest
 
 
 @dataclass
@@ -36,7 +36,7 @@ class Option:
     @property
     def unit(self) -> str | None:
         """The option's unit, the first parenthesised unit of its help (``"(s)"``), or None."""
-        from scenarios.metrics import option_unit
+        from quadcosim.scenarios.metrics import option_unit
 
         return option_unit(self.help)
 
@@ -171,7 +171,7 @@ class Scenario:
                 values[key] = text
                 continue
             if key not in self.options:
-                from orchestrator.fmu import nearest
+                from quadcosim.orchestrator.fmu import nearest
 
                 raise ValueError(f"unknown option {key!r} for scenario {self.name}.{nearest(key, self.options)} "
                                  f"Options: {', '.join(self.options)} (see `quadcosim list`).")
@@ -193,7 +193,7 @@ class Scenario:
 
         Returns
         -------
-        orchestrator.System
+        quadcosim.orchestrator.System
         """
         return self.prepare(options, estimator, fmus).system
 
@@ -208,11 +208,11 @@ class Scenario:
             against the built system (the FMU's variable table, or the Python block) and set.
         estimator : Block or class, optional
             A block of the user's in the place of ``Quaternion_estim`` (see
-            :mod:`estimators.contract`), for a scenario with an ``estimator`` option; the
+            :mod:`quadcosim.estimators.contract`), for a scenario with an ``estimator`` option; the
             options name it (``module:Class``).
         fmus : dict, optional
             Block name to an FMU file of the user's with the same interface, put in that
-            block's place (:func:`orchestrator.replace.replace_fmu` checks it); the system's
+            block's place (:func:`quadcosim.orchestrator.replace.replace_fmu` checks it); the system's
             ``replaced`` says which, with what the new FMU did not take over (also warned).
 
         Returns
@@ -227,12 +227,12 @@ class Scenario:
             An unknown block or parameter, a bad value, or a parameter the scenario sets from
             one of its options (the message names that option).
         """
-        from orchestrator.parameters import resolve_all, set_all
+        from quadcosim.orchestrator.parameters import resolve_all, set_all
 
         if estimator is not None:
             if "estimator" not in self.options:
                 raise ValueError(f"scenario {self.name} has no estimator to replace; {_with_estimator()}")
-            from estimators import contract
+            from quadcosim.estimators import contract
 
             options = Options(options | {"estimator": contract.label(estimator)})
             system = self.build(options, estimator=estimator)
@@ -242,7 +242,7 @@ class Scenario:
         for block, path in (fmus or {}).items():
             import warnings
 
-            from orchestrator.replace import replace_fmu
+            from quadcosim.orchestrator.replace import replace_fmu
 
             new, notes = replace_fmu(system, block, path)
             system.replaced[block] = {"fmu": str(new.path), "notes": notes}
@@ -293,7 +293,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         holding earlier results is refused unless ``overwrite``.
     progress : bool
         Progress and status lines on standard error.
-    faults : sequence of orchestrator.Fault
+    faults : sequence of quadcosim.orchestrator.Fault
         Faults injected; recorded in ``metrics.json``.
     decimation : int
         Keep every N-th macro step; at most the run's number of steps.
@@ -304,18 +304,18 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
         Result files written (``npz``, ``mat``, ``csv``); the ``.npz`` alone by default.
     overwrite : bool
         Replace the results already in ``out_dir``: every file of the earlier run is removed.
-    estimator : orchestrator.Block or class, optional
-        A block of the user's (an instance or a class, see :mod:`estimators.contract`) in the
+    estimator : quadcosim.orchestrator.Block or class, optional
+        A block of the user's (an instance or a class, see :mod:`quadcosim.estimators.contract`) in the
         place of ``Quaternion_estim``.
     compress : bool
         Compress the ``.npz`` and ``.mat`` files (smaller, several times slower to write).
     stream : bool
         Write the record to ``results.stream/`` in chunks as the run goes, so that its memory
-        stays flat however long the run (:mod:`orchestrator.stream`); needs ``out_dir`` and
+        stays flat however long the run (:mod:`quadcosim.orchestrator.stream`); needs ``out_dir`` and
         the ``npz`` format alone.
     blocks : dict, optional
         Blocks of the user's in the place of the scenario's, by name (``{"Controller":
-        MyController()}``), each wired as the block it replaces (:meth:`orchestrator.System.replace`).
+        MyController()}``), each wired as the block it replaces (:meth:`quadcosim.orchestrator.System.replace`).
     fmus : dict, optional
         Block name to the path of an FMU of the user's with the same interface, in that block's
         place (``{"MotorMagnetics": "my_motor.fmu"}``; :meth:`Scenario.system`); recorded in
@@ -323,7 +323,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
 
     Returns
     -------
-    (orchestrator.Result, dict)
+    (quadcosim.orchestrator.Result, dict)
         The result and the metrics. ``metrics["options"]`` holds every option's value as
         used (no default markers), ``metrics["units"]`` the units of the metrics and options,
         ``metrics["injected_faults"]`` the faults (:func:`fault_record`).
@@ -333,17 +333,18 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
     ValueError, KeyError
         A refused option, parameter or output folder, before the run starts; nothing is left
         in ``out_dir``, but for an FMU refused before the loop
-        (:class:`orchestrator.fmu_checks.FMURefused`): then ``out_dir`` holds a ``metrics.json``
+        (:class:`quadcosim.orchestrator.fmu_checks.FMURefused`): then ``out_dir`` holds a ``metrics.json``
         with ``status: refused``, the message, the options and ``samples: 0``.
-    orchestrator.SimulationError
-        The run failed (:class:`orchestrator.RunInterrupted`: it was interrupted, in any
+    quadcosim.orchestrator.SimulationError
+        The run failed (:class:`quadcosim.orchestrator.RunInterrupted`: it was interrupted, in any
         phase); what was recorded is saved all the same, with a ``metrics.json`` saying where
         the run stopped and which files were kept.
     """
-    from orchestrator.files import prepare_out_dir
-    from orchestrator.interrupts import first_only, held
-    from orchestrator.progress import status
-    from scenarios.outputs import RunFiles, remove_if_empty
+    from quadcosim.scenarios.outputs import RunFiles, remove_if_empty
+
+    from quadcosim.infra.files import prepare_out_dir
+    from quadcosim.infra.interrupts import first_only, held
+    from quadcosim.infra.progress import status
 
     status(f"{name}: loading the scenario")
     if isinstance(record, str):  # one signal named alone, not its characters
@@ -379,7 +380,7 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
 
 def _run_tracked(name: str, settings, files, base: dict, made: bool, request: RunRequest, progress: bool):
     """The run of :func:`run` once its folder is made: load, then :func:`_run_phases`; an
-    interrupt in any phase becomes :class:`orchestrator.RunInterrupted`, a refusal leaves the
+    interrupt in any phase becomes :class:`quadcosim.orchestrator.RunInterrupted`, a refusal leaves the
     folder as it was."""
     try:
         scenario = get(name)
@@ -394,7 +395,7 @@ def _run_tracked(name: str, settings, files, base: dict, made: bool, request: Ru
         raise files.interrupted(interrupt) from None
     except (KeyError, ValueError) as error:  # refused before the run: the folder is left as it was
         if files is not None and files.result is None:  # but for metrics.json naming an FMU refused
-            from orchestrator.fmu_checks import FMURefused
+            from quadcosim.orchestrator.fmu_checks import FMURefused
 
             files.refused(remove_folder=made, fmu_refusal=error if isinstance(error, FMURefused) else None)
         raise
@@ -405,7 +406,7 @@ def _run_tracked(name: str, settings, files, base: dict, made: bool, request: Ru
 
 
 def _check_formats(formats, stream: bool, out_dir):
-    from orchestrator.result import FORMATS
+    from quadcosim.orchestrator.result import FORMATS
 
     unknown = [f for f in formats if f not in FORMATS]
     if unknown or not formats:
@@ -419,16 +420,17 @@ def _run_phases(scenario: Scenario, options: Options, base: dict, files, request
     """Build, draw, run, save and report, each phase named in ``files`` for ``metrics.json``;
     ``request`` holds the faults, the user's estimator, blocks and FMUs, the signals to record
     and ``stream``."""
-    from orchestrator import SimulationError
-    from orchestrator.progress import status
-    from scenarios.metrics import FAULT_UNITS, metric_units
+    from quadcosim.orchestrator import SimulationError
+    from quadcosim.scenarios.metrics import FAULT_UNITS, metric_units
+
+    from quadcosim.infra.progress import status
 
     name = scenario.name
     prepared, duration, kept, saved = _build(scenario, options, base, files, request)
     system, options = prepared.system, prepared.options
     if files:
         files.phase, files.stream = "running", _open_stream(files, request.stream)
-    from orchestrator.diagram import blocks_text
+    from quadcosim.orchestrator.diagram import blocks_text
 
     status(f"{name}: starting {duration:g} s of simulated time ({blocks_text(system)})")
     try:
@@ -468,7 +470,7 @@ def _run_phases(scenario: Scenario, options: Options, base: dict, files, request
     if metrics["status"] == "diverged":
         import warnings
 
-        from scenarios.divergence import message
+        from quadcosim.scenarios.divergence import message
 
         warnings.warn(message(name, metrics["diverged"], _settings_given(scenario, options)), stacklevel=2)
     return result, metrics
@@ -489,7 +491,7 @@ def _divergence(scenario, result, options) -> dict:
     bounds = scenario.extra.get("divergence")
     if bounds is None or not len(result):
         return {}
-    from scenarios.divergence import first_crossing, unchecked
+    from quadcosim.scenarios.divergence import first_crossing, unchecked
 
     found = {}
     missing = unchecked(result, bounds)
@@ -509,7 +511,7 @@ def _settings_given(scenario, options) -> list[str]:
 
 def _recorded_names(system, kept) -> list[str]:
     """The signals a run records: ``kept`` resolved (vector names expanded), or every output."""
-    from scenarios.metrics import recorded_outputs
+    from quadcosim.scenarios.metrics import recorded_outputs
 
     if kept is None:
         return recorded_outputs(system)
@@ -520,8 +522,8 @@ def _open_stream(files, stream: bool):
     """The writer of ``results.stream/`` when the record is streamed, else None."""
     if not stream:
         return None
-    from orchestrator.result import FOLDER
-    from orchestrator.stream import StreamWriter
+    from quadcosim.orchestrator.result import FOLDER
+    from quadcosim.orchestrator.stream import StreamWriter
 
     return StreamWriter(files.out / FOLDER)
 
@@ -530,7 +532,7 @@ def _build(scenario: Scenario, options: Options, base: dict, files, request: Run
     """The prepared system (:meth:`Scenario.prepare`), its duration (s), the signals recorded and
     those written (``base`` takes the options as used, the duration and the FMUs replaced). A
     refusal removes what this run wrote."""
-    from orchestrator.progress import status
+    from quadcosim.infra.progress import status
 
     if files:
         files.phase = "building the system"
@@ -570,10 +572,10 @@ def _check_decimation(decimation: int, duration: float, dt: float):
 
 
 def _draw(scenario, system, options, files):
-    from orchestrator.progress import status
+    from quadcosim.infra.progress import status
 
     if scenario.extra.get("diagram"):  # the wiring of this run, drawn before it runs
-        from orchestrator.diagram import draw
+        from quadcosim.orchestrator.diagram import draw
 
         files.phase = "drawing the wiring diagram"
         status(f"{scenario.name}: wiring diagram")
@@ -582,18 +584,18 @@ def _draw(scenario, system, options, files):
 
 def diagram_cache() -> Path:
     """Where runs keep the wiring diagrams they drew, by a digest of the wiring
-    (:func:`orchestrator.diagram.wiring_key`): ``$QUADCOSIM_DIAGRAM_CACHE`` if set, else
+    (:func:`quadcosim.orchestrator.diagram.wiring_key`): ``$QUADCOSIM_DIAGRAM_CACHE`` if set, else
     ``diagrams/`` beside the built FMUs."""
     import os
 
-    from fmus import build_root
+    from quadcosim.fmus import build_root
 
     return Path(os.environ.get("QUADCOSIM_DIAGRAM_CACHE") or build_root() / "diagrams")
 
 
 def _report(scenario, result, options, files, record) -> dict:
     """The scenario's metrics (and figures); a report that fails keeps the saved record."""
-    from scenarios.figures import closed_on_failure
+    from quadcosim.scenarios.figures import closed_on_failure
 
     try:
         with closed_on_failure():
@@ -606,13 +608,13 @@ def _report(scenario, result, options, files, record) -> dict:
         # the report needs a signal the user chose not to record: the results stand alone
         return {"report": f"report skipped: {error.args[0]} (add it to --record for the report)"}
     except Exception as error:
-        from orchestrator.interrupts import interrupt_for, stopping
+        from quadcosim.infra.interrupts import interrupt_for, stopping
 
         if stopping() is not None:  # a signal surfaced as another error inside a C extension (a figure's)
             raise interrupt_for(stopping()) from error
         if files is None:
             raise
-        from orchestrator.files import DiskFull
+        from quadcosim.infra.files import DiskFull
 
         what = str(error) if isinstance(error, DiskFull) else f"{type(error).__name__}: {error}"
         raise files.failed(f"the report failed: {what}") from error
@@ -623,7 +625,7 @@ def fault_record(fault) -> dict:
 
     Parameters
     ----------
-    fault : orchestrator.Fault
+    fault : quadcosim.orchestrator.Fault
 
     Returns
     -------
@@ -643,7 +645,7 @@ def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | Non
     (recorded all the same, for the report and for Python callers), listed in
     ``base["signals_not_saved"]``.
     """
-    from scenarios.metrics import recorded_outputs
+    from quadcosim.scenarios.metrics import recorded_outputs
 
     if record == ["all"]:
         return None, None

@@ -1,6 +1,6 @@
 """Ablation of the linear filter's error: which signal makes it, measured by swapping in the ideal one.
 
-    python -m scenarios.ablation --set flight=nonstationary --set duration=20
+    python -m quadcosim.scenarios.ablation --set flight=nonstationary --set duration=20
 
 Runs one ``tp`` case (GT feedback, the options given with ``--set``), then re-runs the
 linear filter on the recorded stream through the batch path (the same compiled update as
@@ -25,11 +25,10 @@ import argparse
 import sys
 
 import numpy as np
-
-from estimators import estimate, parse_corrections
-from estimators.core import euler_to_quaternion
-from fmus import vehicle
-from orchestrator.blocks import Block
+from quadcosim.estimators import estimate, parse_corrections
+from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator.blocks import Block
 
 VARIANTS = ("recorded", "ideal accelerometer", "true Euler rates", "both")
 
@@ -85,7 +84,7 @@ def linear_ablation(settings: dict | None = None) -> dict:
         ``{variant: [roll, pitch, yaw]}`` in degrees, plus ``"streaming"``: the closed loop's own
         RMS error (the ``recorded`` variant reproduces it).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     options = dict(settings or {}) | {"estimator": "linear", "feedback": "gt"}
     result, metrics = scenarios.run("tp", options)
@@ -114,7 +113,7 @@ def triad_ablation(settings: dict | None = None) -> dict:
     final bias-estimate error (rad/s, x/y/z) with the recorded accelerometer and with gravity
     alone in its place, and the true bias. ``settings``: ``tp`` options (``estimator``,
     ``ry``, ``bias`` and ``feedback`` forced)."""
-    import scenarios
+    from quadcosim import scenarios
 
     options = dict(settings or {}) | {"estimator": "passive", "ry": "triad", "bias": True, "feedback": "gt"}
     result, _ = scenarios.run("tp", options)
@@ -155,7 +154,7 @@ def markdown(rms: dict) -> str:
 
 
 def main(argv=None) -> int:
-    """Command line ``python -m scenarios.ablation``: print the ablation table.
+    """Command line ``python -m quadcosim.scenarios.ablation``: print the ablation table.
 
     Parameters
     ----------
@@ -169,7 +168,7 @@ def main(argv=None) -> int:
     int
         Exit status, 0.
     """
-    parser = argparse.ArgumentParser(prog="python -m scenarios.ablation", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.scenarios.ablation", description=__doc__.splitlines()[0])
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="a tp option")
     parser.add_argument("--triad", action="store_true", help="the passive filter on TRIAD: bias error instead")
     args = parser.parse_args(argv)

@@ -1,9 +1,9 @@
 """The parameters of the Python blocks, as ``quadcosim list --parameters MODEL`` shows them.
 
 An FMU's parameters come from its variable table; a Python block's from the tables its module
-declares: the controller's gains (:data:`flight.GAINS`) and each attitude filter's
-gains (:data:`estimators.GAIN_MEANINGS`, defaults :data:`estimators.LAB_GAINS` as ``tp`` runs
-them and :data:`estimators.DEFAULT_GAINS` as :func:`estimators.estimate` runs them).
+declares: the controller's gains (:data:`quadcosim.flight.GAINS`) and each attitude filter's
+gains (:data:`quadcosim.estimators.GAIN_MEANINGS`, defaults :data:`quadcosim.estimators.LAB_GAINS` as ``tp`` runs
+them and :data:`quadcosim.estimators.DEFAULT_GAINS` as :func:`quadcosim.estimators.estimate` runs them).
 """
 
 from __future__ import annotations
@@ -26,21 +26,21 @@ def parameter_lines(model: str) -> list[str]:
         A heading that says how to set them, then one line per parameter: name, default, unit
         in brackets, meaning.
     """
-    from scenarios.shown import PARAMETER_DIGITS, shown
+    from quadcosim.scenarios.shown import PARAMETER_DIGITS, shown
 
     if model == "Controller":
-        from flight import GAINS
+        from quadcosim.flight import GAINS
 
         lines = ["Controller gains (set one in tp with --set Controller.NAME=VALUE; in Python, "
                  "Controller(gains={NAME: VALUE})):"]
         for name, (default, unit, meaning) in GAINS.items():
             lines.append(f"  {name:10s} = {shown(default, PARAMETER_DIGITS):10}{'[' + unit + ']':10s} {meaning}")
         return lines
-    from estimators import DEFAULT_GAINS, GAIN_MEANINGS, LAB_GAINS
-    from estimators.reference import DEFAULT_GAINS as REFERENCE_GAINS
+    from quadcosim.estimators import DEFAULT_GAINS, GAIN_MEANINGS, LAB_GAINS
+    from quadcosim.estimators.reference import DEFAULT_GAINS as REFERENCE_GAINS
 
     lines = ["Quaternion_estim gains, by estimator: tp's default (the lab's values; tp sets them with its options "
-             "k, k1, k2, kP, kI) and the default of estimators.estimate (recordings); in Python, "
+             "k, k1, k2, kP, kI) and the default of quadcosim.estimators.estimate (recordings); in Python, "
              "QuaternionEstim(KIND, gains={NAME: VALUE}):"]
     for kind, meanings in GAIN_MEANINGS.items():
         lines.append(f"  {kind}:")
@@ -72,7 +72,7 @@ def scenario_lines(model: str) -> list[str]:
         A heading, then one line per scenario that sets any: ``parameter <- option (default)``;
         empty when none does.
     """
-    import scenarios
+    from quadcosim import scenarios
 
     lines = []
     for name, scenario in scenarios.registry().items():

@@ -1,13 +1,13 @@
 """The motor field compensated in a closed loop (``tp --set compensation=...``): a
-:class:`calibration.MagCompensator` between the IMU's magnetometer and the estimator, with a
+:class:`quadcosim.calibration.MagCompensator` between the IMU's magnetometer and the estimator, with a
 calibration file or one made on the clamped rig of the same vehicle
-(:func:`scenarios.metge.rig_calibration`)."""
+(:func:`quadcosim.scenarios.metge.rig_calibration`)."""
 
 from __future__ import annotations
 
-from calibration import Calibration
-from orchestrator import System
-from scenarios.metge import rig_calibration, vehicle_settings
+from quadcosim.calibration import Calibration
+from quadcosim.orchestrator import System
+from quadcosim.scenarios.metge import rig_calibration, vehicle_settings
 
 #: The compensations a flight may run, ``none`` first (the option's choices).
 COMPENSATIONS = ("none", "static", "metge", "dynamic")
@@ -16,8 +16,7 @@ COMPENSATIONS = ("none", "static", "metge", "dynamic")
 def magnetometer_rate(system: System) -> float:
     """Rate (Hz) at which the system's IMU samples and holds its magnetometer."""
     from fmpy import read_model_description
-
-    from fmus import fmu_path
+    from quadcosim.fmus import fmu_path
 
     imu = system.blocks["IMU"]
     starts = {v.name: v.start for v in read_model_description(str(fmu_path(imu.model))).modelVariables}
@@ -31,9 +30,9 @@ def add_compensator(system: System, mode: str, path: str, options: dict, estimat
     """Put a MagCompensator between the IMU's magnetometer and the estimator (nothing for
     ``mode = "none"``): commands from the controller, voltage from the battery, ``b_d``
     refreshed at the magnetometer's sample instants. ``path``: a calibration file, or empty for
-    :func:`scenarios.metge.rig_calibration` of the vehicle of the flight's ``options``.
+    :func:`quadcosim.scenarios.metge.rig_calibration` of the vehicle of the flight's ``options``.
     ``system``: the flight's system; ``estimator``: the name of its block."""
-    from calibration import MagCompensator
+    from quadcosim.calibration import MagCompensator
 
     if mode == "none":
         if path:

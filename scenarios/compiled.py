@@ -2,7 +2,7 @@
 
 numba compiles a function the first time it is called with new argument types and keeps the
 machine code in its on-disk cache (``cache=True``; placed and keyed by its sources by
-:mod:`orchestrator.numba_cache`), where later processes load it. Without
+:mod:`quadcosim.infra.numba_cache`), where later processes load it. Without
 this module the first run after installing would sit silent for tens of seconds while that
 happens. :func:`compile_all` (run by ``quadcosim build``, so by ``make demo``) calls every
 compiled step once, the way the scenarios call them, so that runs load them from the cache;
@@ -35,7 +35,7 @@ def _on_compile(event):
         return
     _announced = True
     name = getattr(getattr(event.data.get("dispatcher"), "py_func", None), "__qualname__", "a step")
-    from orchestrator.progress import say
+    from quadcosim.infra.progress import say
 
     say(f"quadcosim: compiling numba code ({name} first), once, into numba's cache; this takes a while "
         "(`quadcosim build` does it ahead)", sys.stderr)
@@ -67,7 +67,7 @@ def announce_compiles() -> None:
 
 def _batch_paths() -> None:
     """The estimators' batch path, each filter, and its scoring."""
-    from estimators import filters
+    from quadcosim.estimators import filters
 
     samples, dt = 20, 0.01
     acc = np.tile([0.0, 0.0, -9.81], (samples, 1))
@@ -96,7 +96,7 @@ def compile_all(verbose: bool = True) -> float:
     float
         Seconds it took (s).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     global _announced
     _announced = False  # compiled_any() then says whether this call compiled anything

@@ -67,7 +67,7 @@ def first_crossing(result, bounds: Bounds) -> dict | None:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A closed-loop run's record.
     bounds : Bounds
 

@@ -4,7 +4,7 @@ floor under the span of an axis, and units on every axis.
 A figure of a quasi-stationary run must not stretch a 1e-14 deg wobble over the whole axis:
 :func:`floor_span` widens any axis whose data span less than a stated minimum, about the
 middle of the data. Faults come from ``result.meta["faults"]`` (target, kind, start, stop,
-value), as :func:`scenarios.run` records them.
+value), as :func:`quadcosim.scenarios.run` records them.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def faults_of(result) -> list[dict]:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A run's record.
 
     Returns
@@ -183,14 +183,14 @@ def angle_curve(t, degrees, points: int = 2000):
     degrees : ndarray
         The angle (deg), wrapped or not.
     points : int
-        Runs of the envelope (:func:`orchestrator.result.envelope`).
+        Runs of the envelope (:func:`quadcosim.orchestrator.result.envelope`).
 
     Returns
     -------
     times, values : ndarray
         Ready for ``ax.plot``.
     """
-    from orchestrator.result import envelope
+    from quadcosim.orchestrator.result import envelope
 
     unwrapped = np.degrees(np.unwrap(np.radians(degrees)))
     return wrapped_curve(*envelope(t, unwrapped, points))

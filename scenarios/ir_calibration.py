@@ -18,15 +18,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from calibration.infrared import METHODS, EKFSettings, Estimator, InfraredCalibration
-from fmus.build import table
-from orchestrator import Block, FMUBlock, System, Table, portable
-from orchestrator.fmu import FMUInstance
-from scenarios import Option, Scenario
-from scenarios.divergence import Bounds
-from scenarios.figures import fault_text, faults_of, title_lines
-from scenarios.plant import save_figure
+from quadcosim.calibration.infrared import METHODS, EKFSettings, Estimator, InfraredCalibration
+from quadcosim.fmus.build import table
+from quadcosim.orchestrator import Block, FMUBlock, System, Table, portable
+from quadcosim.orchestrator.fmu import FMUInstance
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.divergence import Bounds
+from quadcosim.scenarios.figures import fault_text, faults_of, title_lines
+from quadcosim.scenarios.plant import save_figure
 
 RATE = 20.0  # Hz, the sensor's
 IR_FAULT = (60.0, 1200.0)  # onset (s), offset (count): 2000 samples
@@ -277,7 +276,7 @@ def report(result, o, out) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The run.
     o : dict
         The scenario's options.
@@ -307,7 +306,7 @@ def run_title(result, o: dict) -> str:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The run (its injected faults, if any, are named too).
     o : dict
         The scenario's options.

@@ -23,7 +23,7 @@ clamped, so the Earth field is constant in the sensor frame.
   regime of the paper's free set: one common lead (every motor's field along one direction,
   up, as the current loops of a power board below the sensor make it), its gains scaled so
   that a one-motor sweep deflects the field as much as on the default vehicle (the sets keep
-  their error), and a free set swinging 0.25. :mod:`studies.metge_free` measures what each
+  their error), and a free set swinging 0.25. :mod:`quadcosim.studies.metge_free` measures what each
   ingredient does.
 """
 
@@ -33,17 +33,17 @@ import functools
 from pathlib import Path
 
 import numpy as np
+from quadcosim.calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator import System, Table, portable
+from quadcosim.orchestrator.parameters import apply
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.divergence import CLAMPED
+from quadcosim.scenarios.figures import title_lines
+from quadcosim.scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
-from calibration import Calibration, Sweep, compensate, fit_dynamic, fit_motor_dynamics, order_study
-from fmus import vehicle
-from orchestrator import System, Table, portable
-from orchestrator.files import write_json
-from orchestrator.parameters import apply
-from orchestrator.progress import status
-from scenarios import Option, Scenario
-from scenarios.divergence import CLAMPED
-from scenarios.figures import title_lines
-from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
+from quadcosim.infra.files import write_json
+from quadcosim.infra.progress import status
 
 PAPER_TABLE1 = {"none": {"set1": 11.142, "set2": 10.623, "free": 55.853},
                 "calibration1": {"set1": 0.248, "set2": 0.635, "free": 7.970},
@@ -174,7 +174,7 @@ def free_commands(o: dict, t: np.ndarray) -> np.ndarray:
 def steady_supply_current(c, u) -> np.ndarray:
     """Steady supply current ``c i`` (A) of one default motor at commands ``c`` (1) and battery
     voltage ``u`` (V): ``c u = R i + k_e omega`` with ``k_e i = k_m omega^2`` (the plant's
-    steady state, :func:`fmus.vehicle.steady_command` solved for ``omega``)."""
+    steady state, :func:`quadcosim.fmus.vehicle.steady_command` solved for ``omega``)."""
     c, u = np.asarray(c, dtype=float), np.asarray(u, dtype=float)
     a = vehicle.MOTOR_RESISTANCE * vehicle.DRAG_TORQUE_COEFF / vehicle.MOTOR_KE  # V s^2
     omega = (-vehicle.MOTOR_KE + np.sqrt(vehicle.MOTOR_KE**2 + 4 * a * c * u)) / (2 * a)
@@ -485,7 +485,7 @@ def table1_text(numbers: dict, orders, o: dict, out):
     file name written, or None."""
     if out is None:
         return None
-    from orchestrator.files import atomic_path
+    from quadcosim.infra.files import atomic_path
 
     table, dynamic = numbers["table"], numbers["dynamic_free"]
     names = {"none": "no dynamic calibration", "calibration1": "calibration 1", "calibration2": "calibration 2"}
@@ -598,7 +598,7 @@ SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS,
                     duration=duration, extra={"record": RECORD, "derived": DERIVED, "divergence": CLAMPED})
 
 
-# --- the rig calibration a closed loop's compensation uses (scenarios.compensation) -----
+# --- the rig calibration a closed loop's compensation uses (quadcosim.scenarios.compensation) -----
 
 
 @functools.lru_cache(maxsize=4)

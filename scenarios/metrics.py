@@ -17,7 +17,7 @@ SUFFIX_UNITS = (("_deg_times_s", "deg s"), ("_rad_s2", "rad/s^2"), ("_rad_s", "r
                 ("_ms", "ms"), ("_mm", "mm"), ("_s", "s"), ("_m", "m"), ("_A", "A"), ("_v", "V"), ("_V", "V"),
                 ("_bytes", "B"), ("_mb", "MB"), ("_pct", "%"))
 
-#: The units of an injected fault's fields (:func:`scenarios.fault_record`), as ``metrics.json`` states them.
+#: The units of an injected fault's fields (:func:`quadcosim.scenarios.fault_record`), as ``metrics.json`` states them.
 FAULT_UNITS = "start, stop: s (stop null: no end); value: the target's unit (scale: a factor)"
 
 _PARENTHESES = re.compile(r"\(([^()]*)\)")
@@ -90,7 +90,7 @@ def recorded_outputs(system, left_out=()) -> list[str]:
 @functools.lru_cache(maxsize=64)
 def _kept(names: tuple[str, ...], left_out: tuple[str, ...]) -> tuple[str, ...]:
     """``names`` but the members of ``left_out``; the same systems come back run after run."""
-    from orchestrator.signals import expand
+    from quadcosim.orchestrator.signals import expand
 
     dropped = {member for name in left_out for member in expand(name, names)}
     return tuple(n for n in names if n not in dropped)

@@ -10,13 +10,12 @@ from __future__ import annotations
 from functools import partial
 
 import numpy as np
-
-from fmus import vehicle
-from orchestrator import System, Table
-from scenarios import Option, Scenario
-from scenarios.divergence import Bounds
-from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
-from scenarios.plant import add_plant, imu_parameters, save_figure
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator import System, Table
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.divergence import Bounds
+from quadcosim.scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
+from quadcosim.scenarios.plant import add_plant, imu_parameters, save_figure
 
 OPTIONS = {
     "duration": Option(2.0, "simulated time (s)", minimum=1e-3),
@@ -63,7 +62,7 @@ def build(o: dict) -> System:
 
     Returns
     -------
-    orchestrator.System
+    quadcosim.orchestrator.System
         Blocks ``Setpoint``, ``MotorMagnetics``, ``Quadrotor`` and ``IMU``.
     """
     system = System(dt=o["dt"])
@@ -80,7 +79,7 @@ def report(result, o, out) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The recorded run.
     o : dict
         Parsed options.

@@ -9,7 +9,7 @@
   never replaced unasked: a default file taken takes the next free ``-N`` name
   (:func:`free_file`), a default folder the next free ``-N`` folder (:func:`default_folder`).
 
-The old spelling ``--json FILE`` (``log replay``, ``python -m scenarios.replay``) still works: it
+The old spelling ``--json FILE`` (``log replay``, ``python -m quadcosim.scenarios.replay``) still works: it
 means ``--out FILE`` and says so on standard error.
 """
 
@@ -70,7 +70,7 @@ def default_folder(command: str, name: str, overwrite: bool):
     """
     from pathlib import Path
 
-    from orchestrator.files import free_folder, holds_results
+    from quadcosim.infra.files import free_folder, holds_results
 
     base = Path("results") / name
     if overwrite:
@@ -99,7 +99,7 @@ def free_file(path, command: str):
     """
     from pathlib import Path
 
-    from orchestrator.files import first_free
+    from quadcosim.infra.files import first_free
 
     path = Path(path)
     candidate = first_free(path, Path.exists, file=True)

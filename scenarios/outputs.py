@@ -1,9 +1,9 @@
 """What a run leaves in its output folder, whatever ends it.
 
 :class:`RunFiles` is the one place where a scenario's run writes its record and its
-``metrics.json``. Every file goes through :func:`orchestrator.files.atomic_path` (a temporary
+``metrics.json``. Every file goes through :func:`quadcosim.infra.files.atomic_path` (a temporary
 name, ``fsync``, a rename), and the record and ``metrics.json`` are written with SIGINT and
-SIGTERM held back (:func:`orchestrator.interrupts.held`): a signal during the save lets it
+SIGTERM held back (:func:`quadcosim.infra.interrupts.held`): a signal during the save lets it
 finish, then stops the run. Whatever stops a run (a signal in any phase, a failure, a full
 disk), ``metrics.json`` says what happened, in which phase, and which files were kept.
 """
@@ -15,10 +15,19 @@ import time
 from pathlib import Path
 
 import numpy as np
+from quadcosim.orchestrator import Result, RunInterrupted, SimulationError
 
-from orchestrator import Result, RunInterrupted, SimulationError
-from orchestrator.files import LOCK_NAME, DiskFull, Reserve, free_bytes, megabytes, note_written, tracking, write_json
-from orchestrator.interrupts import held, signal_name, signal_number, stopping
+from quadcosim.infra.files import (
+    LOCK_NAME,
+    DiskFull,
+    Reserve,
+    free_bytes,
+    megabytes,
+    note_written,
+    tracking,
+    write_json,
+)
+from quadcosim.infra.interrupts import held, signal_name, signal_number, stopping
 
 #: The file that keeps room for ``metrics.json`` on a disk that fills during the run (named as
 #: a temporary file: ``--overwrite`` removes one a killed run left).
@@ -46,7 +55,7 @@ class RunFiles:
     Parameters
     ----------
     out : pathlib.Path
-        The output folder, checked (:func:`orchestrator.files.prepare_out_dir`).
+        The output folder, checked (:func:`quadcosim.infra.files.prepare_out_dir`).
     formats : sequence of str
         Record formats (``npz``, ``mat``, ``csv``).
     base : dict
@@ -90,7 +99,7 @@ class RunFiles:
 
         Parameters
         ----------
-        result : orchestrator.Result
+        result : quadcosim.orchestrator.Result
         """
         self._keep(result, self.saved, self.stream)
 
@@ -150,7 +159,7 @@ class RunFiles:
         return kept
 
     def _write(self, metrics: dict):
-        from scenarios.metrics import FAULT_UNITS, metric_units
+        from quadcosim.scenarios.metrics import FAULT_UNITS, metric_units
 
         declared = metrics.get("units") or {}
         metrics = metrics | {"units": metric_units(metrics, declared) | self.units | {"injected_faults": FAULT_UNITS}}
@@ -172,7 +181,7 @@ class RunFiles:
 
         Parameters
         ----------
-        error : orchestrator.SimulationError
+        error : quadcosim.orchestrator.SimulationError
             What stopped the run; its ``result`` is what was recorded (None: nothing).
         complete : bool
             The loop had ended: the record is whole.
@@ -203,11 +212,11 @@ class RunFiles:
         Parameters
         ----------
         interrupt : KeyboardInterrupt
-            The interrupt raised (:class:`orchestrator.interrupts.Terminated` for SIGTERM).
+            The interrupt raised (:class:`quadcosim.infra.interrupts.Terminated` for SIGTERM).
 
         Returns
         -------
-        orchestrator.RunInterrupted
+        quadcosim.orchestrator.RunInterrupted
             The error to raise.
         """
         number = stopping() or signal_number(interrupt)
@@ -227,7 +236,7 @@ class RunFiles:
 
         Returns
         -------
-        orchestrator.SimulationError
+        quadcosim.orchestrator.SimulationError
             The error to raise, with the record.
         """
         error = SimulationError(message, self.result)
@@ -242,11 +251,11 @@ class RunFiles:
         Parameters
         ----------
         error : OSError
-            What failed (:class:`orchestrator.files.DiskFull` for a full disk).
+            What failed (:class:`quadcosim.infra.files.DiskFull` for a full disk).
 
         Returns
         -------
-        orchestrator.SimulationError
+        quadcosim.orchestrator.SimulationError
             The error to raise.
         """
         what = str(error) if isinstance(error, DiskFull) else f"{type(error).__name__}: {error}"
@@ -264,7 +273,7 @@ class RunFiles:
         remove_folder : bool
             The run made the folder: remove it too, if nothing else is in it (not with
             ``fmu_refusal``).
-        fmu_refusal : orchestrator.fmu_checks.FMURefused, optional
+        fmu_refusal : quadcosim.orchestrator.fmu_checks.FMURefused, optional
             The refusal of an FMU before the loop: ``metrics.json`` gets ``status: refused``,
             its message (the block, the FMU, what is wrong and the fix), the options and an
             empty record (``samples: 0``, no result file).
@@ -303,14 +312,15 @@ class RunFiles:
 
         Raises
         ------
-        orchestrator.result.RecordTooLarge, NoRoom
+        quadcosim.orchestrator.result.RecordTooLarge, NoRoom
             The figures, the limit that binds and the way out.
         """
         from collections import Counter
 
-        from orchestrator.memory import writers_peak
-        from orchestrator.result import check_record_fits
-        from orchestrator.signals import vector_groups
+        from quadcosim.orchestrator.result import check_record_fits
+        from quadcosim.orchestrator.signals import vector_groups
+
+        from quadcosim.infra.memory import writers_peak
 
         groups = vector_groups(saved)
         if not stream:
@@ -340,7 +350,7 @@ class RunFiles:
         vector_members : int
             Signals that a ``.mat`` file also holds as members of a vector array.
         """
-        from orchestrator.result import CSV_BYTES_PER_VALUE
+        from quadcosim.orchestrator.result import CSV_BYTES_PER_VALUE
 
         values = rows * (signals + 1)
         sizes = {"npz": 0 if self.compress else 8 * values, "csv": CSV_BYTES_PER_VALUE * values,

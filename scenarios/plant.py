@@ -12,8 +12,7 @@ import contextlib
 import contextvars
 
 import numpy as np
-
-from orchestrator import FMUBlock, System
+from quadcosim.orchestrator import FMUBlock, System
 
 
 def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: bool = True,
@@ -134,8 +133,8 @@ def save_figure(figure, out_dir, name: str):
         return None
     import matplotlib.pyplot as plt
 
-    from orchestrator.files import save_figure as save_atomically
-    from orchestrator.progress import status
+    from quadcosim.infra.files import save_figure as save_atomically
+    from quadcosim.infra.progress import status
 
     path = (out_dir / name).with_suffix("." + FIGURE_FORMAT.get())
     status(f"figure {path.name}")

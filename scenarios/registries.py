@@ -1,9 +1,9 @@
 """The package's closed sets of names as Markdown tables, read from their registries.
 
-- the estimators, :data:`estimators.kinds.KINDS`;
-- the interference models a flight calibration fits, :data:`calibration.flight.catalogue.MODELS`;
-- the autopilots the export writes parameters for, :data:`calibration.flight.autopilot.AUTOPILOTS`;
-- the scenarios, :mod:`scenarios.catalogue` (those a higher floor registers too, once imported).
+- the estimators, :data:`quadcosim.estimators.kinds.KINDS`;
+- the interference models a flight calibration fits, :data:`quadcosim.calibration.flight.catalogue.MODELS`;
+- the autopilots the export writes parameters for, :data:`quadcosim.calibration.flight.autopilot.AUTOPILOTS`;
+- the scenarios, :mod:`quadcosim.scenarios.catalogue` (those a higher floor registers too, once imported).
 
 The documentation's page of these sets is :func:`tables`, written when the site is built: a
 member added by its registry line is listed there as in ``quadcosim list`` and the command
@@ -27,8 +27,8 @@ def _table(header, rows) -> list[str]:
 
 def estimator_rows() -> list[tuple]:
     """One row per estimator: name, label, lab filter, gyro bias, closed loop, recorded arrays,
-    compared, its own block (none: :class:`estimators.QuaternionEstim` builds it by name)."""
-    from estimators.kinds import KINDS
+    compared, its own block (none: :class:`quadcosim.estimators.QuaternionEstim` builds it by name)."""
+    from quadcosim.estimators.kinds import KINDS
 
     return [(f"`{kind.name}`", kind.label, _yes(kind.lab), _yes(kind.bias), _yes(kind.streaming), _yes(kind.batch),
              "" if kind.compared is None else ", ".join(f"{k}={v}" for k, v in kind.compared.items()) or "yes",
@@ -38,7 +38,7 @@ def estimator_rows() -> list[tuple]:
 
 def model_rows() -> list[tuple]:
     """One row per interference model, richest first: name, rank, calibration file, an autopilot."""
-    from calibration.flight.catalogue import MODELS
+    from quadcosim.calibration.flight.catalogue import MODELS
 
     ordered = sorted(MODELS.values(), key=lambda model: model.preference)
     return [(f"`{model.name}`", model.preference, _yes(model.in_file), _yes(model.autopilot)) for model in ordered]
@@ -46,14 +46,14 @@ def model_rows() -> list[tuple]:
 
 def autopilot_rows() -> list[tuple]:
     """One row per autopilot: name, the parameter file written."""
-    from calibration.flight.autopilot import AUTOPILOTS
+    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
 
     return [(autopilot.name, f"`{autopilot.file}`") for autopilot in AUTOPILOTS.values()]
 
 
 def scenario_rows() -> list[tuple]:
     """One row per registered scenario: name, description, module (imports every scenario)."""
-    from scenarios.catalogue import registrations, registry
+    from quadcosim.scenarios.catalogue import registrations, registry
 
     modules = registrations()
     return [(f"`{name}`", scenario.description, f"`{modules[name][0]}`") for name, scenario in registry().items()]
@@ -67,7 +67,8 @@ def tables() -> str:
              "## Estimators", "", "`estimators/kinds.py`, read by a scenario's `estimator` choices, the comparisons "
              "and the replays. Columns: one of the lab's filters (gains `k1`, `k2`, `kP`, `kI`); a gyro bias "
              "estimated; runs in a closed loop; runs on recorded arrays (the batch path); in the comparisons (with "
-             "these settings); its own block (without one, `estimators.QuaternionEstim` builds the filter by its "
+             "these settings); its own block (without one, `quadcosim.estimators.QuaternionEstim` builds the "
+             "filter by its "
              "name).", ""]
     lines += _table(("name", "label", "lab", "bias", "loop", "batch", "compared", "block"),
                     estimator_rows())

@@ -1,22 +1,22 @@
 """Replay: any estimator on a recorded IMU file, scored against its reference attitude.
 
-    quadcosim replay RECORDING [--estimator explicit]     (or python -m scenarios.replay) [--set kP=0.5 ...]
+    quadcosim replay RECORDING [--estimator explicit]     (or python -m quadcosim.scenarios.replay) [--set kP=0.5 ...]
         [--corrections on|off|NAMES] [--ry reel|triad] [--discretisation exp|euler]
         [--initial triad] [--q0 Q0,Q1,Q2,Q3] [--b0 BX,BY,BZ] [--frame ned|enu]
         [--field-from-data SECONDS] [--dip DEG] [--declination DEG] [--align-heading]
         [--rate HZ] [--json] [--out FILE] [--figure FILE]
-    python -m scenarios.replay results/tp            # a tp run's results folder, as it is
-    python -m scenarios.replay --from-tp RESULTS_DIR --write RECORDING
-    python -m scenarios.replay FLIGHT.ulg|.bin|.log [--compass N] [--json OUT]
+    python -m quadcosim.scenarios.replay results/tp            # a tp run's results folder, as it is
+    python -m quadcosim.scenarios.replay --from-tp RESULTS_DIR --write RECORDING
+    python -m quadcosim.scenarios.replay FLIGHT.ulg|.bin|.log [--compass N] [--json OUT]
 
-A flight log (PX4 ULog, ArduPilot DataFlash) is replayed by :mod:`scenarios.flightlog.replay`:
+A flight log (PX4 ULog, ArduPilot DataFlash) is replayed by :mod:`quadcosim.scenarios.flightlog.replay`:
 every estimator, without and with the magnetometer compensation, against the autopilot's own
 attitude (a reference, not the truth).
 
-The recording is read by :mod:`estimators.recording` (``.npz``, ``.mat``, ``.csv``: gyro, acc,
+The recording is read by :mod:`quadcosim.estimators.recording` (``.npz``, ``.mat``, ``.csv``: gyro, acc,
 mag, rate, optional reference quaternion and scored samples). With a reference, the
 quaternion-error RMSE (total, inclination, heading; degrees) over the scored samples is
-printed, the metric of :func:`estimators.score`, with the gains and correction settings in force
+printed, the metric of :func:`quadcosim.estimators.score`, with the gains and correction settings in force
 (defaults filled in; :func:`summary`); ``--json`` prints every setting and the errors as JSON
 instead, ``--out FILE`` writes that JSON (``gains_in_force`` among it). ``--figure FILE`` draws
 the errors sample by sample against time (PNG, SVG or PDF).
@@ -42,12 +42,12 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+from quadcosim.estimators import estimate, kinds, parse_corrections, recording
 
-from estimators import estimate, kinds, parse_corrections, recording
-from orchestrator.files import write_text
-from orchestrator.inputs import read_small_text
+from quadcosim.infra.files import write_text
+from quadcosim.infra.inputs import read_small_text
 
-FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by scenarios.flightlog.replay
+FLIGHT_LOGS = (".ulg", ".bin", ".log")  # replayed by quadcosim.scenarios.flightlog.replay
 
 
 def field_from_data(acc, mag, samples: int) -> dict:
@@ -64,7 +64,7 @@ def references(frame: str, dip: float | None, norm: float | None, declination: f
     """Gravity and Earth field for ``frame`` ("ned": x north; "enu": y north), heading to magnetic
     north (or to geographic north with the field's ``declination``, rad, east of north), the
     field of ``dip`` (rad, below the horizontal) and ``norm`` (None: the lab's)."""
-    from fmus import vehicle
+    from quadcosim.fmus import vehicle
 
     dip = vehicle.EARTH_FIELD_INCLINATION if dip is None else dip
     norm = vehicle.EARTH_FIELD_NORM if norm is None else norm
@@ -87,7 +87,7 @@ def _value(text: str):
 def replay(data: dict, estimator: str | None = None, gains: dict | None = None, corrections=None,
            initial: str | None = None, frame: str | None = None, field_from_data_s: float = 0.0,
            align_heading: bool = False, keep_estimate: bool = False, **options) -> dict:
-    """Run an estimator on a loaded recording (see :func:`estimators.recording.load`).
+    """Run an estimator on a loaded recording (see :func:`quadcosim.estimators.recording.load`).
 
     Settings not given come from the recording's ``meta`` (a ``tp`` run's), then from the
     package's defaults. Returns the errors (degrees) when the recording has a reference, the
@@ -95,12 +95,12 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
     setting with its value).
 
     ``data``: the recording; ``estimator``, ``gains``, ``corrections`` and ``initial``
-    (``"triad"`` or None): as :func:`estimators.estimate` takes them; ``frame``: ``"ned"`` or
+    (``"triad"`` or None): as :func:`quadcosim.estimators.estimate` takes them; ``frame``: ``"ned"`` or
     ``"enu"``; ``field_from_data_s`` (s): take the field's dip and norm from that first stretch
     of the data (0: the lab's field); ``align_heading``: remove the constant heading offset
     before scoring; ``keep_estimate``: also return the estimate (``q``, (N, 4), body to inertial)
     and the gravity vector of the scoring (``gravity``, m/s^2), for :func:`draw_errors`;
-    ``options``: any other option of :func:`estimators.estimate` (``ry``, ``discretisation``,
+    ``options``: any other option of :func:`quadcosim.estimators.estimate` (``ry``, ``discretisation``,
     ``q0``, ``b0``, ``dip``, ``declination``; angles in rad).
     """
     meta = data["meta"].get("estimator") or {}
@@ -173,9 +173,9 @@ def draw_errors(data: dict, result: dict, path, title: str = "") -> Path:
         A recording without a reference attitude: there is no error to draw.
     """
     import matplotlib.pyplot as plt
+    from quadcosim.estimators.core import error_angles
 
-    from estimators.core import error_angles
-    from orchestrator.files import figure_file, headless_backend, save_figure
+    from quadcosim.infra.files import figure_file, headless_backend, save_figure
 
     reference = data.get("quat")
     if reference is None or not len(reference):
@@ -210,9 +210,9 @@ def draw_errors(data: dict, result: dict, path, title: str = "") -> Path:
 
 def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
     """Every gain and correction setting the filter ``kind`` runs with, defaults filled in
-    (``gains`` and ``corrections`` as :func:`estimators.estimate` takes them)."""
-    from estimators import reference
-    from estimators.filters import check_gains
+    (``gains`` and ``corrections`` as :func:`quadcosim.estimators.estimate` takes them)."""
+    from quadcosim.estimators import reference
+    from quadcosim.estimators.filters import check_gains
 
     if kind in reference.KINDS:
         merged = reference.check_gains(kind, gains)
@@ -223,10 +223,10 @@ def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
 
 def tp_recording(results_dir) -> dict:
     """The recording of the ``tp`` run in the results folder ``results_dir``, as
-    :func:`estimators.recording.load` returns one (see the module docstring)."""
-    from estimators.core import euler_to_quaternion
-    from orchestrator.result import Result
-    from scenarios.tp import estimator_gains, initial_state
+    :func:`quadcosim.estimators.recording.load` returns one (see the module docstring)."""
+    from quadcosim.estimators.core import euler_to_quaternion
+    from quadcosim.orchestrator.result import Result
+    from quadcosim.scenarios.tp import estimator_gains, initial_state
 
     results_dir = Path(results_dir)
     stream = results_dir / "results.stream"
@@ -292,7 +292,7 @@ def _vector(text: str, size: int, label: str) -> list:
     return values
 
 
-def _parser(prog: str = "python -m scenarios.replay") -> argparse.ArgumentParser:
+def _parser(prog: str = "python -m quadcosim.scenarios.replay") -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording, or a tp run's results folder")
     parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")
@@ -312,7 +312,7 @@ def _parser(prog: str = "python -m scenarios.replay") -> argparse.ArgumentParser
     parser.add_argument("--declination", type=float, default=0.0, metavar="DEG", help="the field's declination")
     parser.add_argument("--align-heading", action="store_true", help="remove a constant heading offset")
     parser.add_argument("--rate", type=float, help="sampling rate (Hz), if the file has none")
-    from scenarios.output_options import add_json_flag
+    from quadcosim.scenarios.output_options import add_json_flag
 
     add_json_flag(parser, "the result as JSON on standard output, in place of the summary (of a recording) or the "
                           "table (of a flight log)")
@@ -337,14 +337,14 @@ def _options(args) -> dict:
     return options
 
 
-def main(argv=None, prog: str = "python -m scenarios.replay") -> int:
+def main(argv=None, prog: str = "python -m quadcosim.scenarios.replay") -> int:
     """Command line (see the module docstring); returns the exit status (2 on bad input).
     ``argv``: the arguments (default ``sys.argv[1:]``); ``prog``: the command as its messages
     name it (``quadcosim replay``)."""
     parser = _parser(prog)
     args = parser.parse_args(argv)
     if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
-        from scenarios.flightlog import replay as flight
+        from quadcosim.scenarios.flightlog import replay as flight
 
         return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json, out=args.out))
     try:
@@ -362,11 +362,11 @@ def main(argv=None, prog: str = "python -m scenarios.replay") -> int:
         corrections = None if args.corrections is None else parse_corrections(args.corrections)
         _check_numbers(args)
         if args.figure:
-            from orchestrator.files import figure_file
+            from quadcosim.infra.files import figure_file
 
             figure_file(args.figure, "replay.png", None)  # a path refused before the replay runs
         if args.out:
-            from orchestrator.files import output_file
+            from quadcosim.infra.files import output_file
 
             output_file(args.out)  # a folder missing or read-only refused before the replay runs
         data = load_any(args.recording, rate=args.rate)
@@ -428,7 +428,7 @@ def summary(result: dict, recording: str) -> str:
     recording : str
         The recording replayed, as the user named it.
     """
-    from estimators import CORRECTIONS
+    from quadcosim.estimators import CORRECTIONS
 
     def shown(values: dict) -> str:
         return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v}" for k, v in values.items())

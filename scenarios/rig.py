@@ -11,12 +11,11 @@ The metrics are the uncompensated mean angular errors between the measured field
 from __future__ import annotations
 
 import numpy as np
-
-from orchestrator import System, Table, portable
-from scenarios import Option, Scenario
-from scenarios.divergence import CLAMPED
-from scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
-from scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
+from quadcosim.orchestrator import System, Table, portable
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.divergence import CLAMPED
+from quadcosim.scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
+from quadcosim.scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
 
 OPTIONS = {
     "reference": Option(1.0, "motors-off time at the start (s)", minimum=0.1),
@@ -104,7 +103,7 @@ def build(o: dict) -> System:
 
     Returns
     -------
-    orchestrator.System
+    quadcosim.orchestrator.System
         Blocks ``Setpoint``, ``MotorMagnetics``, ``Quadrotor`` (clamped) and ``IMU``.
     """
     system = System(dt=o["dt"])
@@ -137,7 +136,7 @@ def report(result, o, out) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The recorded run.
     o : dict
         Parsed options.

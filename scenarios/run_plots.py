@@ -12,9 +12,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from orchestrator.files import figure_file, printable, save_figure
-from orchestrator.inputs import read_small_text
-from scenarios.output_options import free_file
+from quadcosim.scenarios.output_options import free_file
+
+from quadcosim.infra.files import figure_file, printable, save_figure
+from quadcosim.infra.inputs import read_small_text
 
 RESULTS_FILE = "results.npz"
 #: Width and height (inches) of one signal's axes.
@@ -31,7 +32,7 @@ def load(run) -> tuple:
 
     Returns
     -------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
     folder : pathlib.Path
 
     Raises
@@ -42,7 +43,7 @@ def load(run) -> tuple:
     """
     import zipfile
 
-    from orchestrator import Result
+    from quadcosim.orchestrator import Result
 
     path = Path(run)
     folder = path if path.is_dir() else path.parent
@@ -61,7 +62,7 @@ def load(run) -> tuple:
 
 
 def _holds_record(folder: Path) -> bool:
-    from orchestrator.result import FOLDER
+    from quadcosim.orchestrator.result import FOLDER
 
     return (folder / RESULTS_FILE).exists() or (folder / FOLDER).is_dir() or (folder / "meta.json").exists()
 
@@ -116,7 +117,7 @@ def signal_lines(run) -> list[str]:
     list of str
         A heading, then one line per vector or signal: ``IMU.acc [x, y, z] (m/s2)``.
     """
-    from orchestrator.signals import vector_groups
+    from quadcosim.orchestrator.signals import vector_groups
 
     result, folder = load(run)
     units = result.meta.get("units", {})

@@ -1,9 +1,9 @@
 """A run's state, typed: the options as parsed (read-only), what the caller asks beside them, and
 the system as built with the options as it uses them.
 
-``--set Controller.kp_yaw=50`` is read once (:meth:`scenarios.Scenario.parse`, into
+``--set Controller.kp_yaw=50`` is read once (:meth:`quadcosim.scenarios.Scenario.parse`, into
 :class:`Options`), resolved once against the built system and set on its block
-(:meth:`scenarios.Scenario.prepare`, into :class:`Prepared`), and written to ``metrics.json``
+(:meth:`quadcosim.scenarios.Scenario.prepare`, into :class:`Prepared`), and written to ``metrics.json``
 from :attr:`Prepared.used`; nothing on the way changes the options in place.
 """
 
@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any, TypedDict
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from orchestrator import Result, System
+    from quadcosim.orchestrator import Result, System
 
 
 class Options(dict):
@@ -40,11 +40,11 @@ class Options(dict):
 
 @dataclass(frozen=True)
 class RunRequest:
-    """What a caller of :func:`scenarios.run` asks beside the options.
+    """What a caller of :func:`quadcosim.scenarios.run` asks beside the options.
 
     Parameters
     ----------
-    faults : tuple of orchestrator.Fault
+    faults : tuple of quadcosim.orchestrator.Fault
         Injected on their connections.
     estimator : Block or class, optional
         A block of the user's in the place of ``Quaternion_estim``.
@@ -75,13 +75,13 @@ class Prepared:
 
     Parameters
     ----------
-    system : orchestrator.System
+    system : quadcosim.orchestrator.System
     options : Options
         The options as the run reads them: as parsed, with the user's estimator named
         (``module:Class``) and each ``Block.parameter`` as set (a number, or a list for a vector).
     used : dict
         ``options`` with every default marker replaced by the value it stands for
-        (:meth:`scenarios.Scenario.used`): what ``metrics.json`` states.
+        (:meth:`quadcosim.scenarios.Scenario.used`): what ``metrics.json`` states.
     """
 
     system: System
@@ -100,7 +100,7 @@ Resolve = Callable[[Mapping], dict]
 
 
 class Extra(TypedDict, total=False):
-    """What a scenario declares beside its options and hooks (:attr:`scenarios.Scenario.extra`), each
+    """What a scenario declares beside its options and hooks (:attr:`quadcosim.scenarios.Scenario.extra`), each
     key optional."""
 
     diagram: bool  # its wiring diagram drawn with each run's results
@@ -109,5 +109,5 @@ class Extra(TypedDict, total=False):
     record: list[str]  # the signals recorded (default: every output)
     unrecorded: list[str]  # recorded for the report, left out of the result files
     components: dict[str, tuple[str, ...]]  # a list metric's components, named (roll, pitch, yaw)
-    divergence: Any  # scenarios.divergence.Bounds: the flight's bounds, a run beyond them diverged
+    divergence: Any  # quadcosim.scenarios.divergence.Bounds: the flight's bounds, a run beyond them diverged
     units: dict[str, str]  # units of metrics whose names carry none

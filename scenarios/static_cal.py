@@ -3,7 +3,7 @@
 The IMU is driven by a scripted attitude, as a hand-held calibration turns the vehicle: three
 rotations at incommensurate rates, ``R = Rz(w3 t) Ry(w2 t) Rx(w1 t)``, which carry the sensor
 through every orientation. The magnetometer has a known soft iron ``A`` and hard iron ``b_s``
-(the option values); :func:`calibration.fit_static` recovers them from the readings alone,
+(the option values); :func:`quadcosim.calibration.fit_static` recovers them from the readings alone,
 and the metrics compare them with the truth, give the quality figures, and the heading error
 of the corrected field over a level yaw turn.
 """
@@ -11,14 +11,14 @@ of the corrected field over a level yaw turn.
 from __future__ import annotations
 
 import numpy as np
+from quadcosim.calibration import Calibration, fit_static
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator import FMUBlock, System, Table
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.figures import title_lines
+from quadcosim.scenarios.plant import angle_between, imu_parameters, save_figure
 
-from calibration import Calibration, fit_static
-from fmus import vehicle
-from orchestrator import FMUBlock, System, Table
-from orchestrator.files import write_json
-from scenarios import Option, Scenario
-from scenarios.figures import title_lines
-from scenarios.plant import angle_between, imu_parameters, save_figure
+from quadcosim.infra.files import write_json
 
 SOFT_IRON = ((1.06, 0.04, -0.03), (0.04, 0.95, 0.05), (-0.03, 0.05, 1.02))  # 1, symmetric
 HARD_IRON = (12e-6, -8e-6, 20e-6)  # T

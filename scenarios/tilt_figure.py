@@ -6,8 +6,7 @@ balances the tilted thrust; without rotor drag it reads level and the speed neve
 from __future__ import annotations
 
 import numpy as np
-
-from flight import profiles, trim
+from quadcosim.flight import profiles, trim
 
 
 def accelerometer_tilt_deg(acc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -34,7 +33,7 @@ def tilt_figure(result, o: dict, title: str):
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A tp run with ``flight=tilt``.
     o : dict
         tp's options (``tilt_deg``, ``rotor_drag``).
@@ -42,8 +41,7 @@ def tilt_figure(result, o: dict, title: str):
         The figure's title (the run in words).
     """
     import matplotlib.pyplot as plt
-
-    from orchestrator.result import envelope
+    from quadcosim.orchestrator.result import envelope
 
     t = result.time
     _, acc_pitch = accelerometer_tilt_deg(result["IMU.acc"])

@@ -11,20 +11,19 @@ import math
 from functools import partial
 
 import numpy as np
-
-from estimators import LAB_GAINS, QuaternionEstim, kinds, parse_corrections
-from estimators.core import euler_to_quaternion
-from flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
-from flight.controller import SETPOINT_UNITS
-from flight.profile_file import FileProfile, is_profile_file
-from flight.profiles import STEP_AXES, STEP_TIME, step_sizes
-from fmus import vehicle
-from orchestrator import System, Table
-from scenarios import Option, Scenario
-from scenarios.ablation import GravityOnly
-from scenarios.compensation import COMPENSATIONS, add_compensator
-from scenarios.divergence import Bounds
-from scenarios.figures import (
+from quadcosim.estimators import LAB_GAINS, QuaternionEstim, kinds, parse_corrections
+from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
+from quadcosim.flight.controller import SETPOINT_UNITS
+from quadcosim.flight.profile_file import FileProfile, is_profile_file
+from quadcosim.flight.profiles import STEP_AXES, STEP_TIME, step_sizes
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator import System, Table
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.ablation import GravityOnly
+from quadcosim.scenarios.compensation import COMPENSATIONS, add_compensator
+from quadcosim.scenarios.divergence import Bounds
+from quadcosim.scenarios.figures import (
     angle_curve,
     fault_text,
     faults_of,
@@ -34,7 +33,7 @@ from scenarios.figures import (
     title_lines,
     wrapped_curve,
 )
-from scenarios.plant import add_plant, imu_parameters, save_figure
+from quadcosim.scenarios.plant import add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
 
@@ -96,7 +95,7 @@ def estimator_gains(o: dict) -> dict:
     Returns
     -------
     dict
-        Gain name -> value, as :class:`estimators.QuaternionEstim` takes them.
+        Gain name -> value, as :class:`quadcosim.estimators.QuaternionEstim` takes them.
     """
     kind = o["estimator"]
     if kind == "linear":
@@ -142,14 +141,14 @@ def build(o: dict, estimator=None) -> System:
     ----------
     o : dict
         Parsed options (``quadcosim list`` shows them with their units).
-    estimator : orchestrator.Block or class, optional
+    estimator : quadcosim.orchestrator.Block or class, optional
         An estimator of the user's in the place of ``Quaternion_estim`` (see
-        :mod:`estimators.contract`; :meth:`scenarios.Scenario.prepare` names it in the options,
+        :mod:`quadcosim.estimators.contract`; :meth:`quadcosim.scenarios.Scenario.prepare` names it in the options,
         ``module:Class``). ``o["estimator"] = "module:Class"`` does the same from the options.
 
     Returns
     -------
-    orchestrator.System
+    quadcosim.orchestrator.System
         The system, ready to run for ``duration`` seconds.
 
     Raises
@@ -182,7 +181,7 @@ def build(o: dict, estimator=None) -> System:
     q0 = euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)
     registered = kinds.KINDS.get(o["estimator"])
     if estimator is not None or registered is None or registered.block:  # a block of its own
-        from estimators import contract
+        from quadcosim.estimators import contract
 
         spec = estimator if estimator is not None else registered.block if registered else o["estimator"]
         estimator = system.add(contract.adopt(spec, period,
@@ -234,7 +233,7 @@ def euler_error(result, signal: str, k: int) -> np.ndarray:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A tp run (or a window of one).
     signal : str
         ``"Quaternion_estim.theta_est"`` (the component ``k + 1`` is taken) or a setpoint
@@ -261,7 +260,7 @@ def report(result, o, out) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The recorded run.
     o : dict
         Parsed options.
@@ -297,7 +296,7 @@ def _bias_error(window, axis: str) -> np.ndarray:
 
 def _bias_statistics(result) -> dict:
     """The final gyro bias error (rad/s) and its convergence time (s, :func:`bias_convergence_time`),
-    window by window (:meth:`orchestrator.Result.windows`)."""
+    window by window (:meth:`quadcosim.orchestrator.Result.windows`)."""
     last, offset, window = -1, 0, None  # index of the last sample outside the tolerance, over every axis
     for window in result.windows():
         found = bias_convergence_time(np.arange(len(window)), (_bias_error(window, a) for a in "xyz"),
@@ -314,12 +313,12 @@ def _bias_statistics(result) -> dict:
 
 
 def _predictions(result, o) -> dict:
-    """What the linearised analyses (:mod:`estimators.analysis`) predict for this run's gyro bias:
+    """What the linearised analyses (:mod:`quadcosim.estimators.analysis`) predict for this run's gyro bias:
     the passive filter's bias-convergence time (s), the explicit filter's steady error without
     bias estimate (deg, roll, pitch, yaw); nothing without a bias or for the other filters."""
     if not o["bias"] or o["estimator"] not in kinds.with_bias():
         return {}
-    from estimators import analysis
+    from quadcosim.estimators import analysis
 
     gains, bias = estimator_gains(o), next(result.windows())["IMU.gyro_bias"][0]  # the first sample
     if o["estimator"] == "passive" and gains["kI"] > 0:
@@ -334,8 +333,8 @@ def _predictions(result, o) -> dict:
 def _flight_findings(result, o) -> dict:
     """What the flight shows of the drag model: the tilt step's lag and speed (``flight=tilt``),
     the tilt into a steady wind and the position held (a wind on a position-holding flight); an
-    attitude step's metrics (``flight=step`` and ``flight=tilt``, :func:`flight.measured.step_response`)."""
-    from flight import measured
+    attitude step's metrics (``flight=step`` and ``flight=tilt``, :func:`quadcosim.flight.measured.step_response`)."""
+    from quadcosim.flight import measured
 
     found = {}
     if o["flight"] == "tilt":
@@ -364,7 +363,7 @@ def steady_errors(result) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A tp run's record.
 
     Returns
@@ -493,7 +492,7 @@ def figure_title(result, o: dict) -> str:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The run (its ``meta`` may name a user's estimator, and names the faults).
     o : dict
         tp's options.
@@ -574,7 +573,7 @@ def _figures(result, o, out) -> list[str]:
 
 
 def _angle_curve(result, name: str):
-    """:func:`scenarios.figures.angle_curve` of signal ``name`` (rad); a streamed record is
+    """:func:`quadcosim.scenarios.figures.angle_curve` of signal ``name`` (rad); a streamed record is
     unwrapped window by window, each window continuing from the last sample of the one before."""
     windows = result.windows()
     first = next(windows)
@@ -612,7 +611,7 @@ def _tilt_figures(result, o, out) -> list[str]:
     """The tilt finding's figure for ``flight=tilt`` (what the accelerometer reads, the speed)."""
     if o["flight"] != "tilt":
         return []
-    from scenarios.tilt_figure import tilt_figure
+    from quadcosim.scenarios.tilt_figure import tilt_figure
 
     written = save_figure(tilt_figure(result, o, figure_title(result, o)), out, "tilt.png")
     return [written] if written else []

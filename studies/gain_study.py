@@ -26,12 +26,12 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from quadcosim.scenarios import Option, Scenario
+from quadcosim.scenarios.divergence import Bounds
+from quadcosim.scenarios.figures import fault_text, faults_of, title_lines
+from quadcosim.scenarios.plant import save_figure
 
-from orchestrator.progress import active, status
-from scenarios import Option, Scenario
-from scenarios.divergence import Bounds
-from scenarios.figures import fault_text, faults_of, title_lines
-from scenarios.plant import save_figure
+from quadcosim.infra.progress import active, status
 
 OPTIONS = {
     "k_min": Option(0.05, "smallest gain (1/s)", minimum=1e-4),
@@ -105,10 +105,10 @@ def build(o: dict):
 
     Returns
     -------
-    orchestrator.System
+    quadcosim.orchestrator.System
         The system to run for ``duration`` seconds.
     """
-    import scenarios
+    from quadcosim import scenarios
 
     validate(o)
     tp = scenarios.get("tp")
@@ -124,7 +124,7 @@ def simulated_variances(result, gains, o) -> tuple[np.ndarray, np.ndarray]:
     """Roll and pitch error variances (rad^2, pooled) and their relative standard errors, of the
     linear filter run by the batch path at each of ``gains`` (1/s) on the stream of ``result``
     (the recorded hover), after ``o["burn_in"]``."""
-    from estimators import estimate
+    from quadcosim.estimators import estimate
 
     dt = 1.0 / o["imu_rate"]
     truth = np.column_stack([result["Quadrotor.theta1"], result["Quadrotor.theta2"]])
@@ -164,7 +164,7 @@ def closed_loop_variances(gains, o, out=None) -> tuple[np.ndarray, list, list]:
     ``out``/closed-loop if given); and the failures, as (gain, error)."""
     import shutil
 
-    from studies.sweep import engine, grid, named
+    from quadcosim.studies.sweep import engine, grid, named
 
     plan = grid.plan_of_cases("tp", {f"k={k:.6g}": closed_loop_options(float(k), o) for k in gains})
     with tempfile.TemporaryDirectory() as scratch:
@@ -218,7 +218,7 @@ def report(result, o, out) -> dict:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         The recorded hover (IMU signals and true Euler angles).
     o : dict
         Parsed options of the study.
@@ -233,8 +233,7 @@ def report(result, o, out) -> dict:
         variances, failures and tracking RMS (deg), and the figures written.
     """
     import matplotlib.pyplot as plt
-
-    from estimators import analysis  # python-control: imported by the report only
+    from quadcosim.estimators import analysis  # python-control: imported by the report only
     gains = grid(o)
     dt = 1.0 / o["imu_rate"]
     sigma_gyro, sigma_angle = analysis.imu_noise_per_sample(o["imu_rate"])

@@ -1,16 +1,16 @@
 """The default vehicle at hover, simulated: trim, motor time constant, and what follows from them.
 
-``python -m studies.hover`` prints the figures the documentation states about the default
+``python -m quadcosim.studies.hover`` prints the figures the documentation states about the default
 vehicle (``fmus/vehicle.py``):
 
-- the MotorMagnetics FMU driven at the hover command (:func:`fmus.vehicle.hover_command`) for
+- the MotorMagnetics FMU driven at the hover command (:func:`quadcosim.fmus.vehicle.hover_command`) for
   :data:`SETTLE_S`: the rotor speed and the motor current it settles at;
 - the command-to-speed time constant: the time the rotor speed takes to cover 63.2 % of its
   response to a small command step (:data:`STEP`) from that hover, stepped at :data:`FINE_STEP_S`;
 - the yaw actuator's spin-up reaction over the rate drag torque, ``J_r / (2 k_m omega tau)``: the
   rotors' reaction to their own acceleration ``J_r dω/dt`` against the change of ``k_m ω²``
   during the first time constant;
-- the drag model's predictions (:mod:`flight.trim`): the velocity time constant of
+- the drag model's predictions (:mod:`quadcosim.flight.trim`): the velocity time constant of
   rotor drag at hover and the pitch of the ``quasi`` cruise.
 """
 
@@ -20,8 +20,7 @@ import argparse
 import math
 
 import numpy as np
-
-from fmus import vehicle
+from quadcosim.fmus import vehicle
 
 SETTLE_S = 1.0  # s at the hover command before the rotor speed and current are read
 STEP = 0.02  # 1, height of the command step whose response gives the time constant
@@ -52,8 +51,8 @@ def figures() -> dict:
         and the ``quasi`` cruise's ``cruise_speed_m_s`` (m/s) and ``cruise_pitch_deg`` (deg, nose
         down positive).
     """
-    from flight import profiles, trim
-    from orchestrator.fmu import FMUInstance
+    from quadcosim.flight import profiles, trim
+    from quadcosim.orchestrator.fmu import FMUInstance
 
     command = vehicle.hover_command()
     fmu = FMUInstance("MotorMagnetics")
@@ -86,7 +85,8 @@ def main(argv=None) -> int:
     int
         Exit status, 0.
     """
-    argparse.ArgumentParser(prog="python -m studies.hover", description=__doc__.splitlines()[0]).parse_args(argv)
+    argparse.ArgumentParser(prog="python -m quadcosim.studies.hover",
+                            description=__doc__.splitlines()[0]).parse_args(argv)
     f = figures()
     print(f"hover: ESC command {f['command']:.3f}, rotor speed {f['omega_rad_s']:.2f} rad/s, "
           f"current {f['current_a']:.3f} A per motor")

@@ -1,6 +1,6 @@
 """How small an offset the infrared calibration's fault detector can find, and how fast: computed, and measured.
 
-The detector (:mod:`calibration.infrared.detection`) declares a fault when a generalised
+The detector (:mod:`quadcosim.calibration.infrared.detection`) declares a fault when a generalised
 likelihood ratio on the GPS-IR consistency residual of the last ``RING_SIZE`` samples, against
 the calibration from before them, reaches ``significance``, beside a constant error of that
 calibration and a drift of it (its rate with the prior ``sd_drift``); it looks only when a
@@ -21,7 +21,7 @@ sqrt(E) / sigma`` exceeds ``sqrt(2 significance)`` by the normal's 99 % quantile
 a floor: its increments ``d / s - k`` (``s`` the filter's model deviation of the residual,
 ``k`` the allowance) must reach its threshold. :func:`measured` flies fleets of fresh seeds
 with offsets from below to above that limit and gives the delay within which 99 % of them were
-declared on the right sensor. ``python -m studies.ir_detectability`` prints both and draws
+declared on the right sensor. ``python -m quadcosim.studies.ir_detectability`` prints both and draws
 ``detectability.png``.
 
 ``--explain`` shows, on one flight, why the filter's own innovations miss small offsets (it
@@ -37,11 +37,10 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from calibration.infrared import EKFSettings
-from calibration.infrared.layout import RING_SIZE
-from scenarios.ir_calibration import FAULT_SAMPLES, GPS_FAULT, IR_FAULT, RATE, episodes
-from studies.ir_detection import TUNING, fleet, fly, kalman
+from quadcosim.calibration.infrared import EKFSettings
+from quadcosim.calibration.infrared.layout import RING_SIZE
+from quadcosim.scenarios.ir_calibration import FAULT_SAMPLES, GPS_FAULT, IR_FAULT, RATE, episodes
+from quadcosim.studies.ir_detection import TUNING, fleet, fly, kalman
 
 SAMPLES = 8000
 SETTLED_S = 30.0  # s: the spreads are taken after the filter has converged
@@ -180,8 +179,7 @@ def figure(out, prediction: dict, measurement: dict, figures: dict):
     and ``measurement`` the per-sensor tables of :func:`limits` (``predicted``, ``measured``),
     ``figures`` the residual's figures of :func:`spread`."""
     import matplotlib.pyplot as plt
-
-    from scenarios.plant import save_figure
+    from quadcosim.scenarios.plant import save_figure
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
     for ax, sensor, unit in ((axes[0], "ir", "count"), (axes[1], "gps", "rad/s")):
@@ -312,7 +310,7 @@ def calibrate(clean=(1, 9000), faults=(1, 300)) -> dict:
 
 
 def main(argv=None) -> int:
-    """``python -m studies.ir_detectability [--explain | --ramps | --calibrate] [--out DIR] [--jobs N]``.
+    """``python -m quadcosim.studies.ir_detectability [--explain | --ramps | --calibrate] [--out DIR] [--jobs N]``.
 
     Parameters
     ----------

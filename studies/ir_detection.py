@@ -2,8 +2,8 @@
 
 Judged on fleets of flights it was never tuned on.
 
-``python -m studies.ir_detection`` flies the ``ir-calibration`` flight (8000 samples at
-20 Hz, drift on) in batch (:mod:`studies.ir_fleet`, the InfraredSensor's arithmetic on
+``python -m quadcosim.studies.ir_detection`` flies the ``ir-calibration`` flight (8000 samples at
+20 Hz, drift on) in batch (:mod:`quadcosim.studies.ir_fleet`, the InfraredSensor's arithmetic on
 arrays), one fault at a time at the slides' onsets and length (IR from 60 s, GPS from 280 s,
 2000 samples), over a fleet of seeds per fault kind and size, and fault-free flights over
 another; it prints for each case the rates with their 95 % intervals (Clopper-Pearson for a
@@ -23,7 +23,7 @@ The seeds: :data:`TUNING` are those the detector's settings were chosen on (and 
 was looked at on); :data:`FRESH` (per fault case) and :data:`FRESH_CLEAN` (fault-free) are
 disjoint from them and were flown only to score the design once frozen.
 
-``--ablation`` scores each design choice of :mod:`calibration.infrared.detection` by flying
+``--ablation`` scores each design choice of :mod:`quadcosim.calibration.infrared.detection` by flying
 fleets of tuning seeds (:data:`ABLATION_FAULTS`, :data:`ABLATION_CLEAN`: an ablation is looked
 at) with it undone (:data:`ABLATIONS`), and the earlier design as a whole.
 ``--quick`` is the small fresh set CI re-checks (:data:`QUICK`). ``--figure DIR`` draws a GPS
@@ -40,9 +40,8 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
-
-from calibration.infrared import EKFSettings, Estimator
-from scenarios.ir_calibration import RATE, episodes, fault_windows
+from quadcosim.calibration.infrared import EKFSettings, Estimator
+from quadcosim.scenarios.ir_calibration import RATE, episodes, fault_windows
 
 SAMPLES = 8000
 #: seeds the settings were chosen on or a design looked at: the first fault-free 9999 and fault seeds 1-300, then
@@ -105,7 +104,7 @@ def kalman(flight: dict, settings: EKFSettings | None = None) -> dict:
 def fly(seed: int, sensor: str = "none", size: float = 0.0) -> dict:
     """The ``ir-calibration`` flight of ``seed`` with one fault of ``size`` on ``sensor``
     (``"ir"``, count; ``"gps"``, rad/s; ``"none"``), in batch."""
-    from studies.ir_fleet import fly as batch
+    from quadcosim.studies.ir_fleet import fly as batch
 
     return batch(seed, SAMPLES, faults=sensor, ir_fault=size, gps_fault=size)
 
@@ -262,7 +261,8 @@ def ablation(variants=ABLATIONS, cases=ABLATION_CASES, fresh=ABLATION_FAULTS, cl
 
 
 def main(argv=None) -> int:
-    """``python -m studies.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--plateau] [--figure DIR]
+    """``python -m quadcosim.studies.ir_detection [--fresh A:B] [--clean A:B] [--ablation] [--quick] [--plateau]
+    [--figure DIR]
     [--jobs N] [--out FILE]``.
 
     Parameters
@@ -313,7 +313,7 @@ def main(argv=None) -> int:
               f"{clean[0]} to {clean[1]} fault-free", flush=True)
         result = study(CASES + (LARGER + BELOW if args.larger else ()), fresh=fresh, clean=clean, jobs=args.jobs)
     if args.out:
-        from orchestrator.files import write_json
+        from quadcosim.infra.files import write_json
 
         write_json(args.out, result)
     return 0
@@ -358,8 +358,7 @@ def missed_figure(out, seed: int = 60_000_178, size: float = 0.1):
     against the true one (count), and the GPS fault it declares; returns its path. ``out`` is
     the folder."""
     import matplotlib.pyplot as plt
-
-    from scenarios.plant import save_figure
+    from quadcosim.scenarios.plant import save_figure
 
     flight = fly(seed, "gps", size)
     time = flight["time"]

@@ -5,7 +5,7 @@ flight of 8000 samples takes about a second through it). :func:`fly` computes th
 from the same equations as ``fmus/InfraredSensor/model.c``, on arrays:
 
 - the turn rate ``r = g tan(phi) / V`` of the bank profile
-  (:func:`scenarios.ir_calibration.bank_profile`, the same function the FMU is fed from);
+  (:func:`quadcosim.scenarios.ir_calibration.bank_profile`, the same function the FMU is fed from);
 - the drift of ``a`` and ``b`` (time of day, temperature, cloud) at ``t_k = k / rate``;
 - ``IR_k = a r + b + n_IR``, the noise drawn by the FMU's counter-based generator
   (``fmus/c/noise.h``: splitmix64 of the seed, the sample and the channel, then Box-Muller),
@@ -14,7 +14,7 @@ from the same equations as ``fmus/InfraredSensor/model.c``, on arrays:
   window and delivered the GPS delay late.
 
 ``tests/test_infrared_fleet.py`` holds it to the FMU's output to rounding. Faults are added as
-:func:`scenarios.ir_calibration.simulate_flight` adds them.
+:func:`quadcosim.scenarios.ir_calibration.simulate_flight` adds them.
 """
 
 from __future__ import annotations
@@ -23,10 +23,10 @@ import math
 
 import numpy as np
 from numba import njit
+from quadcosim.fmus.build import table
+from quadcosim.scenarios.ir_calibration import RATE, bank_profile, fault_windows
 
-from fmus.build import table
-from orchestrator import numba_cache
-from scenarios.ir_calibration import RATE, bank_profile, fault_windows
+from quadcosim.infra import numba_cache
 
 numba_cache.install()  # before any decorator: numba picks a function's cache folder then
 
@@ -100,7 +100,7 @@ def calibration(p: dict, t: np.ndarray, drift: bool = True) -> tuple[np.ndarray,
 def sensor(phi: np.ndarray, seed: int, drift: bool = True, noise: bool = True,
            overrides: dict | None = None) -> dict[str, np.ndarray]:
     """The InfraredSensor's outputs for the bank angles ``phi`` (rad, one per sample from
-    ``t = 0``), as :func:`scenarios.ir_calibration.simulate_flight` reads them from the FMU.
+    ``t = 0``), as :func:`quadcosim.scenarios.ir_calibration.simulate_flight` reads them from the FMU.
 
     Parameters
     ----------
@@ -146,7 +146,7 @@ def sensor(phi: np.ndarray, seed: int, drift: bool = True, noise: bool = True,
 
 def fly(seed: int, samples: int = 8000, faults: str = "none", ir_fault: float = 1200.0, gps_fault: float = 1.5,
         drift: bool = True, noise: bool = True, overrides: dict | None = None) -> dict[str, np.ndarray]:
-    """One ``ir-calibration`` flight in batch: :func:`scenarios.ir_calibration.simulate_flight`'s
+    """One ``ir-calibration`` flight in batch: :func:`quadcosim.scenarios.ir_calibration.simulate_flight`'s
     flight (the same bank profile, sensor and faults) without the FMU.
 
     Parameters

@@ -16,7 +16,7 @@ simulation allows:
   reading of the slides' real case); the regression fits all the pairs since take-off either
   way.
 
-``python -m studies.ir_slides`` prints the table as the mean over the flights of :data:`SEEDS`
+``python -m quadcosim.studies.ir_slides`` prints the table as the mean over the flights of :data:`SEEDS`
 (fresh seeds: no setting of the estimators was chosen on them), and the ablation of what moves
 the ratio from the slides' 4.2 to the project's: which reference, whether the GPS calibrates
 after 60 s, the regression's start without the slides' line, and a drift of ``a`` and ``b`` three times the default.
@@ -28,8 +28,7 @@ import argparse
 import sys
 
 import numpy as np
-
-from calibration.infrared import EKFSettings, Estimator, RegressionSettings
+from quadcosim.calibration.infrared import EKFSettings, Estimator, RegressionSettings
 
 SLIDES = {"kalman_resetting_deg": 6.87, "kalman_real_deg": 7.44, "regression_deg": 31.51}
 SEEDS = (50_000_000, 50_000_019)  # the mean over these flights, fresh seeds
@@ -47,7 +46,7 @@ VARIANTS = {
 
 
 def _flight(seed: int, drift_scale: float = 1.0) -> dict:
-    from studies.ir_fleet import fly, parameters
+    from quadcosim.studies.ir_fleet import fly, parameters
 
     defaults = parameters()
     overrides = {name: defaults[name] * drift_scale for name in DRIFT} if drift_scale != 1.0 else None
@@ -60,7 +59,7 @@ def errors(flight: dict, estimate: dict, reference: str = "truth") -> dict:
     degrees per second), against the ``reference``: ``"truth"``, or ``"gps"`` (the GPS turn rate
     against the estimate at its window's middle, 1.5 s earlier). ``flight`` is the simulated
     flight, ``estimate`` an estimator's output on it."""
-    from studies.ir_fleet import parameters
+    from quadcosim.studies.ir_fleet import parameters
 
     p = parameters()
     gain = p["airspeed"] / p["gravity"]
@@ -112,7 +111,7 @@ def table(seeds=range(SEEDS[0], SEEDS[1] + 1)) -> dict:
 
 
 def main(argv=None) -> int:
-    """``python -m studies.ir_slides``: the table and its ablation.
+    """``python -m quadcosim.studies.ir_slides``: the table and its ablation.
 
     Parameters
     ----------

@@ -1,13 +1,13 @@
 """The lab's matrix in one go: every ``tp`` case of the report, and the checks against analysis.
 
-    quadcosim sweep lab-matrix --out results/lab-matrix      (or python -m studies.lab_matrix)
+    quadcosim sweep lab-matrix --out results/lab-matrix      (or python -m quadcosim.studies.lab_matrix)
 
 A named sweep: its members run on Dask like any sweep (``--workers``, ``--scheduler``,
 ``--resume``); each case leaves its own folder (figures, metrics.json, results) under
 ``members/`` with ``sweep.csv`` beside, and ``summary.md`` gathers the numbers:
 - estimation RMS error (roll, pitch, yaw) and tracking RMS for each case;
 - the explicit filter without bias estimate: simulated steady error against the linearised
-  prediction (estimators.analysis.explicit_bias_steady_error);
+  prediction (quadcosim.estimators.analysis.explicit_bias_steady_error);
 - the passive filter: bias-convergence time against the linearised prediction for
   kP = kI in {0.1, 1, 10, 100}, with R_reel and with TRIAD;
 - the published filters beside the lab's: VQF (``vqf``) and Madgwick (``ahrs``) with the
@@ -28,10 +28,10 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from quadcosim.estimators import analysis, kinds, score
+from quadcosim.fmus.IMU.variables import LAB_GYRO_BIAS
 
-from estimators import analysis, kinds, score
-from fmus.IMU.variables import LAB_GYRO_BIAS
-from orchestrator.files import write_json, write_text
+from quadcosim.infra.files import write_json, write_text
 
 CASES = {
     "linear-quasi-gt": {"estimator": "linear"},
@@ -225,7 +225,7 @@ def markdown(summary: dict) -> str:
 
 
 def main(argv=None) -> int:
-    """Command line ``python -m studies.lab_matrix``: run the matrix as the named sweep
+    """Command line ``python -m quadcosim.studies.lab_matrix``: run the matrix as the named sweep
     ``lab-matrix`` and print its summary.
 
     Parameters
@@ -239,9 +239,9 @@ def main(argv=None) -> int:
     int
         The sweep's exit status (0: every member completed).
     """
-    from studies.sweep import command
+    from quadcosim.studies.sweep import command
 
-    parser = argparse.ArgumentParser(prog="python -m studies.lab_matrix", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m quadcosim.studies.lab_matrix", description=__doc__.splitlines()[0])
     parser.add_argument("--out", help="output folder (default results/lab-matrix, or results/lab-matrix-N when that "
                                       "holds an earlier matrix)")
     parser.add_argument("--workers", help="local Dask worker processes (default: the CPUs)")
@@ -257,10 +257,11 @@ def main(argv=None) -> int:
 
 
 def _sweep():
-    from studies.sweep.named import NamedSweep
+    from quadcosim.studies.sweep.named import NamedSweep
 
     return NamedSweep("lab-matrix", "tp", cases, "every tp case of the lab report, and the checks against analysis",
-                      summarise=summarise, extra_metrics="studies.lab_matrix:late_mean_error", keep_results=True)
+                      summarise=summarise, extra_metrics="quadcosim.studies.lab_matrix:late_mean_error",
+                      keep_results=True)
 
 
 SWEEP = _sweep()

@@ -7,8 +7,8 @@ errors (deg, roll/pitch/yaw, after the settling time) and their difference. It t
 the estimators need anything beyond the zero-order-held sample (a flag for a fresh sample,
 a rate-aware gain)::
 
-    python -m studies.mag_rate                       # noise off and on, 20 s per run
-    python -m studies.mag_rate --duration 40 --noise on
+    python -m quadcosim.studies.mag_rate                       # noise off and on, 20 s per run
+    python -m quadcosim.studies.mag_rate --duration 40 --noise on
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
+from quadcosim.scenarios import tp
 
-import scenarios
-from scenarios import tp
+from quadcosim import scenarios
 
 DURATION_S = 20.0  # s, simulated time per run by default
 

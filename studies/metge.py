@@ -1,19 +1,20 @@
 """Metge's studies on the closed loop: the yaw error of each estimator with the motor currents'
-field compensated, the compensation on perturbed plants (:mod:`studies.metge_robustness`) and the
-free set's ablation (:mod:`studies.metge_free`).
+field compensated, the compensation on perturbed plants (:mod:`quadcosim.studies.metge_robustness`) and the
+free set's ablation (:mod:`quadcosim.studies.metge_free`).
 
-    python -m studies.metge --calibration FILE --out DIR
-    python -m studies.metge --robustness [CASE ...] --out DIR
-    python -m studies.metge --free-set [CASE ...] --out DIR
+    python -m quadcosim.studies.metge --calibration FILE --out DIR
+    python -m quadcosim.studies.metge --robustness [CASE ...] --out DIR
+    python -m quadcosim.studies.metge --free-set [CASE ...] --out DIR
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from estimators import kinds
-from orchestrator.files import write_json, write_text
-from scenarios.compensation import COMPENSATIONS
+from quadcosim.estimators import kinds
+from quadcosim.scenarios.compensation import COMPENSATIONS
+
+from quadcosim.infra.files import write_json, write_text
 
 # --- the closed loop: yaw error per estimator and compensation --------------------------
 
@@ -26,7 +27,7 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
     estimators' yaw RMS error (deg) for each, written to ``out/yaw_study.json`` and ``.md``.
     ``calibration_path``: the calibration file; ``flights``, ``estimators``: those compared;
     ``duration`` (s) and ``noise``: of every run."""
-    import scenarios
+    from quadcosim import scenarios
 
     out = Path(out)
     table = {}
@@ -55,9 +56,9 @@ def yaw_study(out, calibration_path: str, flights=("quasi", "nonstationary"), es
 
 
 def main(argv=None):
-    """Command line of the studies: ``python -m studies.metge --calibration FILE --out DIR``
-    (the yaw study), ``--robustness --out DIR`` (:mod:`studies.metge_robustness`) or
-    ``--free-set --out DIR`` (:mod:`studies.metge_free`).
+    """Command line of the studies: ``python -m quadcosim.studies.metge --calibration FILE --out DIR``
+    (the yaw study), ``--robustness --out DIR`` (:mod:`quadcosim.studies.metge_robustness`) or
+    ``--free-set --out DIR`` (:mod:`quadcosim.studies.metge_free`).
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
     import argparse
 
@@ -73,7 +74,7 @@ def main(argv=None):
     parser.add_argument("--duration", type=float, default=20.0, help="simulated time of each run (s)")
     parser.add_argument("--estimators", default=",".join(STUDY_ESTIMATORS), help="comma-separated estimators")
     args = parser.parse_args(argv)
-    from studies import metge_free, metge_robustness
+    from quadcosim.studies import metge_free, metge_robustness
 
     for chosen, study in ((args.free_set, metge_free), (args.robustness, metge_robustness)):
         if chosen is not None:  # a study of its own module, with its cases

@@ -12,7 +12,7 @@ seed draws other frequencies and phases for the commands, and other noise):
   ``free_speed``);
 - the cables' geometry: one common lead (every motor's field along one direction, gains
   scaled so that a one-motor sweep deflects the field as on the default vehicle:
-  :func:`scenarios.metge.common_lead_settings`), pointing up or east;
+  :func:`quadcosim.scenarios.metge.common_lead_settings`), pointing up or east;
 - the motors' transients: the rotor inertia; and the error the steady-state map gives for
   the same commands (``quasi_static_deg``), against the simulated one;
 - the reference: the heading error in place of the angle between vectors, on the sets and
@@ -21,7 +21,7 @@ seed draws other frequencies and phases for the commands, and other noise):
 - the bound: the largest angle by which the default vehicle's cables can turn the Earth
   field at steady state, and with every supply current anywhere up to the ESC's limit.
 
-``python -m studies.metge --free-set --out DIR`` prints the table and writes
+``python -m quadcosim.studies.metge --free-set --out DIR`` prints the table and writes
 ``free_set.json``; :func:`study` does it from Python.
 """
 
@@ -30,10 +30,9 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-
-from calibration import Calibration, compensate
-from fmus import vehicle
-from scenarios.metge import (
+from quadcosim.calibration import Calibration, compensate
+from quadcosim.fmus import vehicle
+from quadcosim.scenarios.metge import (
     PAPER_TABLE1,
     RECORD,
     SCENARIO,
@@ -51,7 +50,7 @@ from scenarios.metge import (
     steady_supply_current,
     system_for,
 )
-from scenarios.plant import angle_between
+from quadcosim.scenarios.plant import angle_between
 
 #: Free-set seeds (``seed1``) every case is scored on.
 SEEDS = (1, 2, 3, 4, 5)
@@ -160,7 +159,7 @@ def largest_turn_deg(limit_current: bool = False) -> float:
     level rig: over every combination of the four commands (steady state, on a grid of
     :data:`GRID` levels per motor, full battery), or of the four supply currents anywhere in
     ``[0, i_max]`` (``limit_current``: what transients could at most reach)."""
-    from scenarios.metge import MATCHED_SOCS
+    from quadcosim.scenarios.metge import MATCHED_SOCS
 
     m0 = np.array(vehicle.EARTH_FIELD)
     v = cable_directions(SCENARIO.parse({}))
@@ -181,8 +180,9 @@ def flying(cal: Calibration) -> dict:
     compensated field (calibration ``cal``) against the true Earth field in {B} (``R^T m_I``)
     and against the field at the start (a motors-off reference taken as a clamped rig takes
     it); and the attitude's own share (the true field against its start)."""
-    import scenarios
-    from scenarios.compensation import magnetometer_rate
+    from quadcosim.scenarios.compensation import magnetometer_rate
+
+    from quadcosim import scenarios
 
     tp = scenarios.get("tp")
     rate = magnetometer_rate(tp.build(tp.parse(FLIGHT)))
@@ -230,7 +230,7 @@ def study(out=None, names=None) -> dict:
     """
     from pathlib import Path
 
-    from orchestrator.files import write_json
+    from quadcosim.infra.files import write_json
 
     table, calibrations = {}, {}
     for name, (description, settings) in cases().items():

@@ -1,7 +1,7 @@
 """How far the motor-field compensation holds on plants its model family does not contain.
 
 ``quadcosim run metge`` calibrates on a rig whose motors, ESCs and cables are exactly those the
-identified family can describe (:mod:`calibration.identify`: a first-order motor with back-EMF,
+identified family can describe (:mod:`quadcosim.calibration.identify`: a first-order motor with back-EMF,
 free-wheeling or not, a current limit, one field gain per cable), so its free-set error is a best
 case. Here each case calibrates on one plant (set 1: a full and a half-used battery, rising
 sweeps) and scores the compensation on the free set of another:
@@ -13,14 +13,14 @@ sweeps) and scores the compensation on the free set of another:
   weaker magnets (back-EMF constant -5 %), a cable moved (every field gain +10 %), an older
   battery (internal resistance x3).
 
-``python -m studies.metge --robustness --out DIR`` writes ``robustness.json`` and prints the
+``python -m quadcosim.studies.metge --robustness --out DIR`` writes ``robustness.json`` and prints the
 table; :func:`study` does it from Python.
 """
 
 from __future__ import annotations
 
-from fmus import vehicle
-from scenarios.metge import (
+from quadcosim.fmus import vehicle
+from quadcosim.scenarios.metge import (
     RECORD,
     SCENARIO,
     RigRun,
@@ -119,7 +119,7 @@ def study(out=None, names=None) -> dict:
     """
     from pathlib import Path
 
-    from orchestrator.files import write_json
+    from quadcosim.infra.files import write_json
 
     table = {}
     for name, (description, calibration_plant, flight_plant) in cases().items():

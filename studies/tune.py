@@ -5,7 +5,7 @@
 
 Each evaluation runs the scenario once per seed (``--seeds N``: seeds 1 to N, the same seeds at
 every point, so that two points differ by their options alone) on the cluster a sweep uses
-(:func:`studies.sweep.engine.cluster`), and its value is the metric's mean over the seeds. The
+(:func:`quadcosim.studies.sweep.engine.cluster`), and its value is the metric's mean over the seeds. The
 optimiser is scipy.optimize's, on coordinates scaled to [0, 1] (logarithmic for ``:log``):
 
 - first a scan: a batch of points spread over the box (evenly for one option, a Sobol sequence
@@ -98,8 +98,9 @@ class TunePlan:
 
     def members(self, point: dict) -> list[dict]:
         """The options of each member of one evaluation at ``point`` (option name to value)."""
-        import scenarios
-        from studies.sweep.grid import _typed
+        from quadcosim.studies.sweep.grid import _typed
+
+        from quadcosim import scenarios
 
         scenario = scenarios.get(self.scenario)
         typed = {name: _typed(scenario, name, [value])[0] for name, value in point.items()}
@@ -122,8 +123,9 @@ def plan(scenario_name: str, metric: str, over, settings=(), seeds: int | None =
     TuneError, ValueError, KeyError
         A bad metric, bound, option, seed count or budget (the message names it).
     """
-    import scenarios
-    from studies.sweep.grid import _typed, split_assignment
+    from quadcosim.studies.sweep.grid import _typed, split_assignment
+
+    from quadcosim import scenarios
 
     scenario = scenarios.get(scenario_name)
     if not _METRIC.match(metric):
@@ -163,8 +165,7 @@ def loop_margins(tune_plan: TunePlan, best: dict | None) -> dict | None:
                                                                    ("kp", "kd", "kp_yaw", "kd_yaw")}:
         return None
     import control
-
-    from flight.controller import GAINS
+    from quadcosim.flight.controller import GAINS
 
     def gain(name):
         key = f"Controller.{name}"
@@ -180,7 +181,7 @@ def loop_margins(tune_plan: TunePlan, best: dict | None) -> dict | None:
 
 def prediction(tune_plan: TunePlan) -> dict | None:
     """python-control's predicted optimum where one applies, else None: the linear filter's gain
-    ``k`` against the IMU's white noise (:func:`estimators.analysis.linear_optimal_gain`), for
+    ``k`` against the IMU's white noise (:func:`quadcosim.estimators.analysis.linear_optimal_gain`), for
     ``tp`` with ``estimator=linear``, ``noise=on`` and roll or pitch error tuned over ``k`` alone.
     The prediction counts the sensor noise only: a flight's accelerations, which the
     accelerometer reads as tilt, move the simulated optimum towards smaller gains."""
@@ -188,14 +189,14 @@ def prediction(tune_plan: TunePlan) -> dict | None:
     if (tune_plan.scenario != "tp" or [d.name for d in tune_plan.over] != ["k"] or o.get("estimator") != "linear"
             or not o.get("noise") or tune_plan.metric not in ("rms_error_deg[0]", "rms_error_deg[1]")):
         return None
-    from estimators import analysis
+    from quadcosim.estimators import analysis
 
     sigma_gyro, sigma_angle = analysis.imu_noise_per_sample(o["imu_rate"])
     dt = 1.0 / o["imu_rate"]
     k = analysis.linear_optimal_gain(dt, sigma_gyro, sigma_angle)
     rms = math.degrees(math.sqrt(float(analysis.linear_error_variance(k, dt, sigma_gyro, sigma_angle)[0])))
     return {"what": "linear filter's gain against the IMU's white noise (python-control, "
-                    "estimators.analysis.linear_optimal_gain)", "k": k, "rms_error_deg": rms}
+                    "quadcosim.estimators.analysis.linear_optimal_gain)", "k": k, "rms_error_deg": rms}
 
 
 class _BudgetSpent(Exception):
@@ -220,7 +221,7 @@ class _Tuner:
     def evaluate(self, us, phase: str) -> list[float]:
         """What the optimiser sees at the scaled points ``us``: each point's mean metric over the
         seeds, or :data:`PENALTY`. New points run at once, every member of the batch together."""
-        from studies.sweep.engine import run_member
+        from quadcosim.studies.sweep.engine import run_member
 
         points = self.points(us)
         room = self.plan.budget - len(self.history)
@@ -250,13 +251,13 @@ class _Tuner:
         return values
 
     def _entry(self, point: dict, records: list) -> dict:
-        from studies.sweep.table import flatten
+        from quadcosim.studies.sweep.table import flatten
 
         members = []
         for seed, record in zip(self.plan.seeds or [None], records, strict=True):
             flat = flatten(record.get("metrics") or {})
             if record["status"] == "ok" and self.plan.metric not in flat:
-                from orchestrator.fmu import nearest
+                from quadcosim.orchestrator.fmu import nearest
 
                 raise TuneError(f"--minimize {self.plan.metric}: the scenario has no such metric."
                                 f"{nearest(self.plan.metric, flat)}")
@@ -274,7 +275,7 @@ class _Tuner:
         return min(kept, key=lambda e: e["value"]) if kept else None
 
     def save(self, finished: bool = False, extra: dict | None = None):
-        from orchestrator.files import write_json
+        from quadcosim.infra.files import write_json
 
         best = self.best()
         data = self.plan.to_json() | {
@@ -335,7 +336,7 @@ def run(tune_plan: TunePlan, out, workers: int | None = None, scheduler: str | N
     out : path
         The tune's folder (``tune.json``, ``convergence.png``); held while the tune runs.
     workers, scheduler, connect_timeout
-        The cluster, as for a sweep (:func:`studies.sweep.engine.cluster`).
+        The cluster, as for a sweep (:func:`quadcosim.studies.sweep.engine.cluster`).
     resume : bool
         Continue the tune in ``out`` (the same plan): the evaluations recorded are not run again.
     progress : bool
@@ -346,9 +347,9 @@ def run(tune_plan: TunePlan, out, workers: int | None = None, scheduler: str | N
     TuneError
         The folder holds another tune, or no tune to resume; the metric is not the scenario's.
     """
-    from studies.sweep import checks, folder
-    from studies.sweep.engine import Preload, cluster
-    from studies.sweep.grid import Member, Plan
+    from quadcosim.studies.sweep import checks, folder
+    from quadcosim.studies.sweep.engine import Preload, cluster
+    from quadcosim.studies.sweep.grid import Member, Plan
 
     folder.check_scheduler(scheduler)
     out = folder.check_out(Path(out))
@@ -402,9 +403,9 @@ def figure(data: dict, path: Path) -> Path:
     values against it, the best and python-control's prediction where there is one."""
     import matplotlib.pyplot as plt
     from matplotlib.transforms import blended_transform_factory
+    from quadcosim.studies.sweep.figure import metric_unit
 
-    from orchestrator.files import save_figure
-    from studies.sweep.figure import metric_unit
+    from quadcosim.infra.files import save_figure
 
     history, metric = data["history"], data["minimize"]
     unit = metric_unit(metric)
@@ -445,7 +446,7 @@ def figure(data: dict, path: Path) -> Path:
         if data["over"][0]["log"]:
             ax2.set_xscale("log")
         ax2.set_yscale(ax.get_yscale())
-        from studies.sweep.units import of_options
+        from quadcosim.studies.sweep.units import of_options
 
         unit_x = of_options(data["scenario"], [name]).get(name)
         ax2.set_xlabel(f"{name} ({unit_x})" if unit_x else name)
@@ -488,7 +489,7 @@ def command(args) -> int:
         0: a best point found; 1: no evaluation had a value; 2: refused (bad arguments, a folder
         held or holding another tune, an unreachable scheduler); 128 + the signal if interrupted.
     """
-    from studies.sweep.command import default_out
+    from quadcosim.studies.sweep.command import default_out
 
     label = f"quadcosim tune {args.scenario}"
     try:

@@ -17,7 +17,7 @@ The ablation case ``100hz_24_hover_no_reaction`` removes the rotors' reaction to
 acceleration (``J_r domega/dt``) from the rigid body: what makes the yaw actuator's first
 tens of milliseconds stronger than ``k_m omega^2`` says, and the 100 Hz loop unstable.
 
-``python -m studies.yaw_loop`` prints the cases of :func:`study`.
+``python -m quadcosim.studies.yaw_loop`` prints the cases of :func:`study`.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def yaw_loop(rate: float, natural_frequency: float, flight: str = "hover", setti
         ``ringing_nm``, ``ring_hz``, ``command_min``, ``command_max`` (1), ``current_min_a``,
         ``current_max_a`` (A), ``oscillating`` (ringing above :data:`QUIET_NM`).
     """
-    import scenarios
+    from quadcosim import scenarios
 
     w = float(natural_frequency)
     options = {"flight": flight, "duration": DURATION_S, "dt": 1.0 / rate, "imu_rate": rate,

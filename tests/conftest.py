@@ -11,12 +11,12 @@ import pytest
 os.environ.setdefault("QUADCOSIM_FLIGHT_LOGS",
                       str(Path(__file__).resolve().parents[1].parent / "shared" / "data" / "flightlogs"))
 
-from fmus import MODELS, default_fmu_dir
+from quadcosim.fmus import MODELS, default_fmu_dir
 
 
 @pytest.fixture(scope="session", autouse=True)
 def built_fmus():
-    from fmus.build import FMI_VERSIONS, build_all, fmu_file
+    from quadcosim.fmus.build import FMI_VERSIONS, build_all, fmu_file
 
     if not all(fmu_file(m, default_fmu_dir(), v).is_file() for m in MODELS for v in FMI_VERSIONS):
         build_all(default_fmu_dir(), verbose=False)

@@ -33,12 +33,12 @@ def path(name: str) -> Path:
 
 @cache
 def _read(name: str):
-    from flightlogs import read_log
+    from quadcosim.flightlogs import read_log
 
     return read_log(FOLDER / name)
 
 
 def log(name: str):
-    """The :class:`flightlogs.FlightLog` of the shared log ``name``, read once."""
+    """The :class:`quadcosim.flightlogs.FlightLog` of the shared log ``name``, read once."""
     path(name)
     return _read(name)

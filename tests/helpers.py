@@ -1,8 +1,7 @@
 """Small helpers shared by the tests."""
 
 import numpy as np
-
-from orchestrator.fmu import FMUInstance
+from quadcosim.orchestrator.fmu import FMUInstance
 
 
 def run_fmu(model, parameters, inputs, steps, h=1e-3, outputs=()):

@@ -204,7 +204,7 @@ def build(behaviour: str, folder: Path, fault_step: int = FAULT_STEP) -> Path:
     -------
     pathlib.Path
     """
-    from fmus.build import _fmi_header_dir
+    from quadcosim.fmus.build import _fmi_header_dir
 
     code = list(BEHAVIOURS).index(behaviour)  # 0 good, then the enum's order
     stage = folder / f"{behaviour}.stage"

@@ -12,9 +12,8 @@ from pathlib import Path
 
 from fmpy import read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2CoSimulation
-
-from fmus import fmu_path
-from orchestrator.fmu import _CALLBACKS, _logs, _unzip
+from quadcosim.fmus import fmu_path
+from quadcosim.orchestrator.fmu import _CALLBACKS, _logs, _unzip
 
 _names = itertools.count(1)
 LAST_SUCCESSFUL_TIME = 2  # fmi2StatusKind

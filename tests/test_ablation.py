@@ -2,8 +2,7 @@
 closed loop's own figure, so that the rows beside it differ by the swapped input alone."""
 
 import numpy as np
-
-from scenarios.ablation import linear_ablation, triad_ablation
+from quadcosim.scenarios.ablation import linear_ablation, triad_ablation
 
 
 def test_linear_ablation_recorded_row_is_the_streaming_row():

@@ -18,12 +18,26 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-#: The floors, from the ground up: the plant, the master, reading flight logs, estimation and
-#: calibration, flight control, the scenarios, the studies over many runs, the benchmarks, the
-#: maintainer's findings (not shipped), and the command line over all of them.
-FLOORS = ("fmus", "orchestrator", "flightlogs", "estimators", "calibration", "flight", "scenarios", "studies",
-          "benchmarks", "findings", "quadcosim")
-PACKAGES = FLOORS
+#: The floors, from the ground up, by import name and folder: the infrastructure every floor
+#: may use (files, interrupts, progress, caches), the plant, the master, reading flight logs,
+#: estimation and calibration, flight control, the scenarios, the studies over many runs, the
+#: benchmarks, the package's own face (its Python API and command line), and the maintainer's
+#: findings (not shipped).
+FLOORS = ("quadcosim.infra", "quadcosim.fmus", "quadcosim.orchestrator", "quadcosim.flightlogs",
+          "quadcosim.estimators", "quadcosim.calibration", "quadcosim.flight", "quadcosim.scenarios",
+          "quadcosim.studies", "quadcosim.benchmarks", "quadcosim", "findings")
+#: Where each floor's sources are: the repository's folders are installed as ``quadcosim.<folder>``.
+FOLDERS = {"quadcosim.infra": "quadcosim/infra", "quadcosim": "quadcosim", "findings": "findings",
+           **{floor: floor.split(".")[1] for floor in FLOORS[1:-2]}}
+#: The import names of the project: anything else is a library, or the user's own.
+PACKAGES = ("quadcosim", "findings")
+#: The folders' own names, which a user's project may hold too: never imported bare.
+FOLDER_NAMES = tuple(name for name in FOLDERS.values() if "/" not in name and name not in PACKAGES)
+
+
+def _floor(module: str) -> str:
+    """The floor a module name is on: the longest floor name it is or starts with."""
+    return max((f for f in FLOORS if module == f or module.startswith(f + ".")), key=len, default="")
 
 
 def _below(package: str) -> tuple[str, ...]:
@@ -31,38 +45,36 @@ def _below(package: str) -> tuple[str, ...]:
     return tuple(f"{p}." for p in FLOORS[:FLOORS.index(package)])
 
 
+GROUND = "quadcosim.infra."
 # What each package may import from the project, besides itself. A name ending in "." allows
 # the whole package; a bare module name allows that module and nothing below it. No package is
 # allowed a floor above its own.
 ALLOWED = {
-    "fmus": (),
+    "quadcosim.infra": (),
+    "quadcosim.fmus": (GROUND,),
     # to find built FMUs only: the package's locating functions, not its build or its models
-    "orchestrator": ("fmus",),
-    # the one writer of every file, the one check of every file read, and Ctrl-C surfaced while a
-    # reader holds the process
-    "flightlogs": ("orchestrator.files", "orchestrator.inputs", "orchestrator.interrupts"),
-    # the block contract, the plant's constants, the flight-log reading layer and the one writer
-    # and numba's cache keyed by the sources (installed by the package before its modules decorate)
-    "estimators": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "orchestrator.inputs", "fmus.",
-                   "orchestrator.numba_cache"),
-    "calibration": ("orchestrator.blocks", "flightlogs.", "orchestrator.files", "orchestrator.inputs", "fmus.",
-                    "orchestrator.numba_cache"),
+    "quadcosim.orchestrator": (GROUND, "quadcosim.fmus"),
+    "quadcosim.flightlogs": (GROUND,),
+    # the block contract, the plant's constants and the flight-log reading layer
+    "quadcosim.estimators": (GROUND, "quadcosim.orchestrator.blocks", "quadcosim.flightlogs.", "quadcosim.fmus."),
+    "quadcosim.calibration": (GROUND, "quadcosim.orchestrator.blocks", "quadcosim.flightlogs.", "quadcosim.fmus."),
     # the controller: the block contract, the plant, the estimators' quaternion arithmetic
-    "flight": ("fmus.", "orchestrator.", "estimators."),
-    "scenarios": _below("scenarios"),
-    "studies": _below("studies"),
-    "benchmarks": _below("benchmarks"),
-    "findings": _below("findings"),
+    "quadcosim.flight": (GROUND, "quadcosim.fmus.", "quadcosim.orchestrator.", "quadcosim.estimators."),
+    "quadcosim.scenarios": _below("quadcosim.scenarios"),
+    "quadcosim.studies": _below("quadcosim.studies"),
+    "quadcosim.benchmarks": _below("quadcosim.benchmarks"),
     "quadcosim": _below("quadcosim"),
+    "findings": _below("findings"),
 }
 
 #: The places that load a module whose name is computed whole, and what that name is: the
 #: floors are checked where the name is written (a user's file, or a registration of a package
-#: that may import the module, :func:`test_registered_scenarios_keep_to_the_floors`).
+#: that may import the module, :func:`test_every_registered_member_is_a_module_of_the_project`).
 LOADS_BY_NAME = {
     "estimators/contract.py": "a block class of the user's, named module:Class on the command line",
     "studies/sweep/engine.py": "a metric function of the user's, named module:function in a sweep file",
-    "scenarios/catalogue.py": "a scenario's module, as the catalogue lists it or a package above registers it",
+    "quadcosim/infra/members.py": "a member of a closed set, as its entry point (pyproject.toml) names it",
+    "quadcosim/__init__.py": "the subpackage holding a name of the Python API, as its _EXPORTS table says",
 }
 
 _LOADERS = {"import_module", "__import__"}
@@ -100,17 +112,17 @@ def _imports(path: Path) -> list[tuple[int, str]]:
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 raise AssertionError(f"{path.relative_to(ROOT)}:{node.lineno}: relative import; write it absolute")
-            # `from fmus import vehicle` imports the module fmus.vehicle; `from fmus import fmu_path`
+            # `from fmus import vehicle` imports the module quadcosim.fmus.vehicle; `from fmus import fmu_path`
             # an attribute of fmus, told apart where the name is checked
             found += [(node.lineno, f"{node.module}.{alias.name}") for alias in node.names]
         elif isinstance(node, ast.Call) and (loaded := _load_name(node)) is not None:
             found.append((node.lineno, loaded))
     return [(line, name) for line, name in found
-            if name == COMPUTED or name.split(".")[0].rstrip(COMPUTED) in PACKAGES]
+            if name == COMPUTED or name.split(".")[0].rstrip(COMPUTED) in PACKAGES + FOLDER_NAMES]
 
 
 def _allowed(layer: str, module: str, package_names: set[str]) -> bool:
-    if module.split(".")[0] == layer:
+    if _floor(module.rstrip(COMPUTED).rstrip(".")) == layer:
         return True
     computed = module.endswith(COMPUTED)  # any module below its literal head: a whole-package rule only
     head = module.rstrip(COMPUTED).rstrip(".")
@@ -125,14 +137,23 @@ def _allowed(layer: str, module: str, package_names: set[str]) -> bool:
     return False
 
 
+def _floor_of(path: Path) -> str:
+    """The floor whose folder holds ``path`` (the most specific folder)."""
+    where = path.relative_to(ROOT).as_posix()
+    return max((f for f, folder in FOLDERS.items() if where.startswith(folder + "/")),
+               key=lambda f: len(FOLDERS[f]))
+
+
 def _sources(suffix: str = ".py"):
-    for package in PACKAGES:
-        yield from sorted((ROOT / package).rglob(f"*{suffix}"))
+    for floor in FLOORS:
+        yield from sorted(p for p in (ROOT / FOLDERS[floor]).rglob(f"*{suffix}") if _floor_of(p) == floor)
 
 
 def _module_of(path: Path) -> str:
-    parts = path.relative_to(ROOT).with_suffix("").parts
-    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+    floor = _floor_of(path)
+    parts = path.relative_to(ROOT / FOLDERS[floor]).with_suffix("").parts
+    parts = floor.split(".") + list(parts[:-1] if parts[-1] == "__init__" else parts)
+    return ".".join(parts)
 
 
 def _modules() -> set[str]:
@@ -144,9 +165,12 @@ def _violations() -> list[str]:
     bad = []
     for path in _sources():
         where = path.relative_to(ROOT)
-        package = where.parts[0]
+        package = _floor_of(path)
         for line, module in _imports(path):
-            if module == COMPUTED:
+            if module.split(".")[0] in FOLDER_NAMES:
+                bad.append(f"{where}:{line} imports {module.split('.')[0]} bare: a user's package of that name "
+                           f"would be imported; write quadcosim.{module}")
+            elif module == COMPUTED:
                 if where.as_posix() not in LOADS_BY_NAME:
                     bad.append(f"{where}:{line} loads a module by a name computed whole; name it, or declare "
                                "the place in LOADS_BY_NAME with what it loads")
@@ -167,18 +191,28 @@ def test_the_places_that_load_by_name_exist():
     assert [p for p in LOADS_BY_NAME if not (ROOT / p).is_file()] == []
 
 
-def test_registered_scenarios_keep_to_the_floors():
-    """A scenario's module is loaded by name: the package that lists or registers it must be
-    allowed to import it."""
-    import scenarios
-    import studies  # noqa: F401  (registers the studies' scenarios)
-    from scenarios import catalogue
+def test_every_registered_member_is_a_module_of_the_project():
+    """A member is loaded by the name its entry point gives (pyproject.toml): that module exists,
+    and a member of a set sits on or above the floor of the package reading that set."""
+    import tomllib
 
+    from quadcosim.infra.members import GROUPS
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]
     modules = _modules()
-    for name, (module, registrant) in catalogue.registrations().items():
-        package = registrant.split(".")[0]
-        assert _allowed(package, module, modules), f"scenario {name!r}: {registrant} registers {module}"
-    assert set(catalogue.registrations()) == set(scenarios.names())
+    readers = {"scenarios": "quadcosim.scenarios", "estimators": "quadcosim.estimators",
+               "sensors": "quadcosim.fmus", "autopilots": "quadcosim.flightlogs",
+               "interference": "quadcosim.calibration"}
+    bad = []
+    for kind, group in GROUPS.items():
+        for name, value in project.get(group, {}).items():
+            module = value.split(":")[0]
+            if module not in modules:
+                bad.append(f"{group} {name}: {module} is not a module of the project")
+            elif FLOORS.index(_floor(module)) < FLOORS.index(readers[kind]):
+                bad.append(f"{group} {name}: {module} is below {readers[kind]}, which reads the set")
+    assert project.get(GROUPS["scenarios"]), "no scenario registered"
+    assert not bad, "\n".join(bad)
 
 
 def _edges() -> dict[str, set[str]]:
@@ -190,7 +224,7 @@ def _edges() -> dict[str, set[str]]:
         source = _module_of(path)
         targets = set()
         for _, name in _imports(path):
-            if name.endswith(COMPUTED) or name.split(".")[0] != source.split(".")[0]:
+            if name.endswith(COMPUTED) or _floor(name) != _floor(source):
                 continue
             while name not in modules:  # an attribute of a module: that module
                 name = name.rsplit(".", 1)[0]
@@ -247,7 +281,7 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
 
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())
     assert project["project"]["scripts"]["quadcosim"] == "quadcosim.main:entry"
-    assert "benchmarks*" in project["tool"]["setuptools"]["packages"]["find"]["include"]
+    assert "quadcosim.benchmarks" in project["tool"]["setuptools"]["packages"]
     assert not (ROOT / "orchestrator" / "cli.py").exists()
     assert not list((ROOT / "orchestrator").glob("bench*.py"))
     assert not list((ROOT / "estimators").glob("bench*.py"))
@@ -259,7 +293,9 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     ("orchestrator", "fmus.build", False),
     ("orchestrator", "scenarios", False),
     ("orchestrator", "fmus.*", False),  # fmus.<Model>.variables by a computed name
+    ("orchestrator", "infra.files", True),
     ("fmus", "orchestrator.fmu", False),
+    ("infra", "fmus", False),
     ("estimators", "orchestrator.blocks", True),
     ("estimators", "orchestrator.system", False),
     ("calibration", "flightlogs.model", True),
@@ -270,21 +306,24 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     ("scenarios", "studies.sweep", False),
     ("scenarios", "studies.*", False),
     ("studies", "studies.*", True),
-    ("quadcosim", "studies.*", True),
-    ("flightlogs", "orchestrator.files", True),
+    ("", "studies.*", True),  # the package's face over the studies
+    ("flightlogs", "infra.files", True),
     ("flightlogs", "calibration.static", False),
     ("estimators", "calibration.static", False),
     ("flight", "scenarios.tp", False),
-    ("quadcosim", "findings.__main__", True),
-    ("findings", "quadcosim.main", False),
+    ("", "main", True),
+    ("benchmarks", "main", False),
 ])
 def test_the_rule_itself(layer, module, expected):
-    assert _allowed(layer, module, _modules() | {"fmus.build", "orchestrator.system"}) is expected
+    """Floors and modules named without their ``quadcosim.`` (``""``: the package's face)."""
+    layer = f"quadcosim.{layer}".rstrip(".")
+    assert _allowed(layer, f"quadcosim.{module}", _modules() | {"quadcosim.fmus.build",
+                                                                "quadcosim.orchestrator.system"}) is expected
 
 
 @pytest.mark.parametrize(("source", "loaded"), [
-    ("importlib.import_module('benchmarks.master')", "benchmarks.master"),
-    ("import_module(f'studies.{name}')", "studies.*"),
+    ("importlib.import_module('quadcosim.benchmarks.master')", "quadcosim.benchmarks.master"),
+    ("import_module(f'quadcosim.studies.{name}')", "quadcosim.studies.*"),
     ("__import__(name)", COMPUTED),
     ("importlib.util.find_spec(name)", None),
 ])
@@ -382,11 +421,11 @@ def _package_installs_first(init: Path) -> bool:
 
 def test_cached_numba_code_is_keyed_by_its_sources():
     """numba picks a function's cache folder when it decorates it: a module holding cached numba
-    code installs :mod:`orchestrator.numba_cache`'s locator before its first decorator, or a
+    code installs :mod:`quadcosim.infra.numba_cache`'s locator before its first decorator, or a
     package it is in does before importing its modules; and it is on a floor the key covers."""
-    from orchestrator import numba_cache
+    from quadcosim.infra import numba_cache
 
-    assert numba_cache.FLOORS == FLOORS[:len(numba_cache.FLOORS)]
+    assert numba_cache.FLOORS == tuple(FOLDERS[f] for f in FLOORS[1:1 + len(numba_cache.FLOORS)])
     bad = []
     for path in _sources():
         tree = ast.parse(path.read_text())
@@ -394,7 +433,7 @@ def test_cached_numba_code_is_keyed_by_its_sources():
         if first is None:
             continue
         where = path.relative_to(ROOT)
-        if where.parts[0] not in numba_cache.FLOORS:
+        if where.parts[0] not in numba_cache.FLOORS:  # the floors' folders
             bad.append(f"{where}: above the floors numba_cache.FLOORS keys")
         own = _install_line(tree)
         packages = [ROOT.joinpath(*where.parts[:k], "__init__.py") for k in range(1, len(where.parts))]

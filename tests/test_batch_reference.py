@@ -3,8 +3,7 @@ the compiled batch path computes, to the last bit: the benchmark's ratio compare
 
 import numpy as np
 import pytest
-
-from benchmarks.estimators import _batch_case, _c_batch, _numba_batch
+from quadcosim.benchmarks.estimators import _batch_case, _c_batch, _numba_batch
 
 
 @pytest.mark.parametrize("discretisation", ["exp", "euler"])

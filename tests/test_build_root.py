@@ -4,8 +4,10 @@ per-user cache; a plant FMU missing from its default folder is built on first us
 import os
 from pathlib import Path
 
-import fmus
-from fmus import build_root, fmu_path
+from quadcosim.fmus import build_root, fmu_path
+
+from quadcosim import fmus
+from quadcosim.infra import folders
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -17,9 +19,11 @@ def test_a_checkout_builds_into_its_own_build_folder(monkeypatch):
 
 def test_an_installed_package_builds_into_the_user_cache(monkeypatch, tmp_path):
     monkeypatch.delenv("QUADCOSIM_BUILD_DIR", raising=False)
-    monkeypatch.setattr(fmus, "_checkout", lambda: None)
+    monkeypatch.setattr(folders, "_checkout", lambda: None)
+    folders._build_root.cache_clear()
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    assert build_root() == tmp_path / "quadcosim" / fmus._version()
+    assert build_root() == tmp_path / "quadcosim" / folders._version()
+    folders._build_root.cache_clear()
 
 
 def test_a_missing_fmu_is_built_on_first_use_then_reused(monkeypatch, tmp_path, capsys):

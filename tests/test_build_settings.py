@@ -9,9 +9,9 @@ import subprocess
 import sys
 
 import pytest
+from quadcosim.fmus import MODELS, BuildFolderRefused, compiler_command
+from quadcosim.orchestrator.calls import build_runner
 
-from fmus import MODELS, BuildFolderRefused, compiler_command
-from orchestrator.calls import build_runner
 from quadcosim.main import main
 
 
@@ -27,7 +27,7 @@ def test_a_runner_folder_that_cannot_be_made_names_its_setting(monkeypatch):
     with pytest.raises(BuildFolderRefused, match=r"/proc/runner/: cannot write the compiled runner there \(.*\); it "
                                                  r"comes from \$QUADCOSIM_RUNNER_DIR=/proc/runner: set "
                                                  r"\$QUADCOSIM_RUNNER_DIR to a writable folder, or unset it"):
-        from orchestrator.calls import runner_dir
+        from quadcosim.orchestrator.calls import runner_dir
 
         build_runner(runner_dir())
 

@@ -5,8 +5,7 @@ import json
 
 import numpy as np
 import pytest
-
-from calibration import (
+from quadcosim.calibration import (
     Calibration,
     CalibrationError,
     MagCompensator,
@@ -18,7 +17,7 @@ from calibration import (
     fit_static,
     order_study,
 )
-from fmus import vehicle
+from quadcosim.fmus import vehicle
 
 EARTH = np.array(vehicle.EARTH_FIELD)
 NORM = vehicle.EARTH_FIELD_NORM
@@ -272,7 +271,7 @@ def test_eq9_removes_the_modelled_field():
 
 @pytest.mark.parametrize("mode", ["static", "metge", "dynamic"])
 def test_streaming_block_equals_arrays(mode):
-    from orchestrator import System, Table
+    from quadcosim.orchestrator import System, Table
 
     cal = calibration()
     rng = np.random.default_rng(2)

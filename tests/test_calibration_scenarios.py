@@ -5,7 +5,7 @@ paper regime the paper's free set."""
 import numpy as np
 import pytest
 
-import scenarios
+from quadcosim import scenarios
 
 
 def test_static_cal_recovers_the_iron_of_the_imu(tmp_path):
@@ -28,9 +28,9 @@ def test_metge_table1_and_the_motor_dynamics(tmp_path):
     free set eq. 9 gains 1.88-2.67 times (the paper: 7 times, in its regime: regime=paper), the
     motor dynamics another 6.6-8.7 times; eq. 9's error 2.7 times larger where the commands vary
     fast; the directions within 0.28 deg (calibration 1)."""
-    from calibration import Calibration
-    from scenarios.metge import SCENARIO, errors_deg
-    from studies.metge_free import free_run
+    from quadcosim.calibration import Calibration
+    from quadcosim.scenarios.metge import SCENARIO, errors_deg
+    from quadcosim.studies.metge_free import free_run
 
     settings = {"levels": 6, "free": 6.0}
     _, m = scenarios.run("metge", settings, out_dir=tmp_path)
@@ -61,7 +61,7 @@ def test_the_paper_regime_reproduces_the_papers_free_set_and_the_default_does_no
     """regime=paper (one common lead, swing 0.25): the uncompensated free set within a fifth
     of the paper's 55.9 deg on every seed of the ablation (58.9-63.1 measured, mean 61.5); the
     default regime's is 12.0-13.6 (mean 12.9), 4.8 times smaller."""
-    from studies.metge_free import SEEDS, uncompensated_free_deg
+    from quadcosim.studies.metge_free import SEEDS, uncompensated_free_deg
 
     paper, default = np.array(uncompensated_free_deg({"regime": "paper"})), np.array(uncompensated_free_deg({}))
     print(f"uncompensated free set (deg): regime=paper {paper.round(2)}, default {default.round(2)}")
@@ -74,8 +74,8 @@ def test_the_paper_regime_reproduces_the_papers_free_set_and_the_default_does_no
 def test_the_common_lead_keeps_the_sets_deflection_and_refuses_other_cables():
     """The common lead's gains hold the default vehicle's one-motor deflection (static
     prediction, 10.9 deg) to rounding; regime=paper with a cable set by hand is refused."""
-    from fmus import vehicle
-    from scenarios.metge import SCENARIO, common_lead_settings, one_motor_deflection_deg
+    from quadcosim.fmus import vehicle
+    from quadcosim.scenarios.metge import SCENARIO, common_lead_settings, one_motor_deflection_deg
 
     lead = common_lead_settings()
     directions = [[lead[f"MotorMagnetics.v{n}_{a}"] for a in "xyz"] for n in range(1, 5)]
@@ -112,7 +112,7 @@ def test_a_block_parameter_reaches_every_rig_run_and_both_calibrations():
     """`--set MotorMagnetics.kappa1=...` changes the field of motor 1 in both calibration sets
     (each set's runs identify its calibration's gains): motor 1's identified gain scales with
     kappa1 in calibration 1 and calibration 2, the other motors' do not move."""
-    from fmus import vehicle
+    from quadcosim.fmus import vehicle
 
     gains = {}
     for kappa in (None, KAPPA1):
@@ -130,8 +130,8 @@ def test_a_block_parameter_reaches_every_rig_run_and_both_calibrations():
 @pytest.mark.slow
 def test_tp_calibrates_on_the_rig_of_its_own_vehicle():
     """tp's automatic rig calibration takes tp's vehicle settings (not the gyro bias of its flight)."""
-    from fmus import vehicle
-    from scenarios.metge import rig_calibration
+    from quadcosim.fmus import vehicle
+    from quadcosim.scenarios.metge import rig_calibration
 
     tp = scenarios.get("tp")
     options = tp.parse({"magnetic": True, "compensation": "dynamic", "MotorMagnetics.kappa1": KAPPA1,

@@ -5,14 +5,16 @@ is reported at the same step, time and block, with the same record kept."""
 import numpy as np
 import pytest
 from numba import carray, cfunc
+from quadcosim.orchestrator import Block, FMUBlock, SimulationError, System, Table
+from quadcosim.orchestrator.blocks import COMPILED_SIGNATURE, CompiledStep
+from quadcosim.orchestrator.chunks import CHUNK_STEPS
+from quadcosim.orchestrator.faults import Fault
+from quadcosim.scenarios.testing.assertions import assert_runs_close
 
-import scenarios
-import studies  # noqa: F401  (registers gain-study in the scenarios' catalogue)
-from orchestrator import Block, FMUBlock, SimulationError, System, Table
-from orchestrator.blocks import COMPILED_SIGNATURE, CompiledStep
-from orchestrator.chunks import CHUNK_STEPS
-from orchestrator.faults import Fault
-from scenarios.testing.assertions import assert_runs_close
+from quadcosim import (
+    scenarios,
+    studies,  # noqa: F401  (registers gain-study in the scenarios' catalogue)
+)
 
 
 def both(build, duration, **run):
@@ -42,14 +44,14 @@ def test_every_scenario_is_identical_by_chunks(name):
     ({"estimator": "linear", "magnetic": True, "compensation": "static"}, {"record": ["Quadrotor.q", "IMU.acc"]}),
 ])
 def test_closed_loop_variants_are_identical_by_chunks(settings, run):
-    from scenarios import tp
+    from quadcosim.scenarios import tp
 
     options = tp.SCENARIO.parse({"duration": 0.6} | settings)
     assert_identical(*both(lambda: tp.build(options), 0.6, **run))
 
 
 def test_faults_are_exact_by_chunks():
-    from scenarios import tp
+    from quadcosim.scenarios import tp
 
     def build():
         system = tp.build(tp.SCENARIO.parse({"estimator": "explicit", "feedback": "estimate"}))
@@ -150,10 +152,10 @@ def test_an_unknown_master_is_refused():
 def test_the_cached_compiled_steps_follow_the_files_they_call_into():
     """numba reuses a cached function while its own file is unchanged; the compiled steps hold a
     fingerprint of the files they call into (estimators/core.py, ...) in their cache key."""
-    from estimators import core, filters
-    from flight import controller, mixer
-    from fmus import vehicle
-    from orchestrator.blocks import source_fingerprint
+    from quadcosim.estimators import core, filters
+    from quadcosim.flight import controller, mixer
+    from quadcosim.fmus import vehicle
+    from quadcosim.orchestrator.blocks import source_fingerprint
 
     for function, modules in ((filters._compiled_step(), (core,)),
                               (controller._compiled_step(), (core, mixer, vehicle))):

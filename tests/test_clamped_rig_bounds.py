@@ -1,15 +1,15 @@
 """Silent wrong results: a rig whose clamp is released (``Quadrotor.clamped=false``) once
 completed with the vehicle 284 m below the ground. The clamped scenarios declare the bounds of
-a vehicle that does not move (:data:`scenarios.divergence.CLAMPED`): such a run ends
+a vehicle that does not move (:data:`quadcosim.scenarios.divergence.CLAMPED`): such a run ends
 ``diverged``, exit 1; metge, which fixes the clamp, says so in words."""
 
 import json
 
 import pytest
+from quadcosim.scenarios import get
+from quadcosim.scenarios.divergence import CLAMPED
 
 from quadcosim.main import main as cli
-from scenarios import get
-from scenarios.divergence import CLAMPED
 
 RIG = ["run", "rig", "--set", "sweep=1", "free=1"]
 

@@ -8,14 +8,14 @@ import math
 import numpy as np
 import pytest
 from matplotlib.image import imread
+from quadcosim.flight import SETPOINT
+from quadcosim.flight.profile_file import FileProfile
+from quadcosim.scenarios import run as run_scenario
+from quadcosim.scenarios.figures import angle_curve
+from quadcosim.scenarios.shown import PARAMETER_DIGITS, shown
+from quadcosim.studies.sweep.command import default_out
 
-from flight import SETPOINT
-from flight.profile_file import FileProfile
 from quadcosim.main import main
-from scenarios import run as run_scenario
-from scenarios.figures import angle_curve
-from scenarios.shown import PARAMETER_DIGITS, shown
-from studies.sweep.command import default_out
 
 
 def test_set_reaches_a_named_controller_gain_and_records_it(tmp_path, capsys):
@@ -117,7 +117,7 @@ def test_a_wrapping_yaw_is_drawn_with_a_gap_not_a_vertical_line():
 
 
 def test_a_tilt_run_draws_the_accelerometer_s_tilt_and_the_speed(tmp_path):
-    from scenarios.tilt_figure import accelerometer_tilt_deg
+    from quadcosim.scenarios.tilt_figure import accelerometer_tilt_deg
 
     _, metrics = run_scenario("tp", {"flight": "tilt", "duration": 3.0}, tmp_path)
     assert "tilt.png" in metrics["figures"] and imread(tmp_path / "tilt.png").shape[1] > 900

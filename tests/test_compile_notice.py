@@ -4,7 +4,7 @@ for a run of the lab's scenario."""
 import subprocess
 import sys
 
-from scenarios import compiled
+from quadcosim.scenarios import compiled
 
 
 def test_a_compilation_prints_one_line_once(capsys):

@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers import documentation
+from quadcosim.estimators.contract import REQUIRED, AttitudeEstimator
+from quadcosim.orchestrator import Block, Result, System
 
-import scenarios
-from estimators.contract import REQUIRED, AttitudeEstimator
-from orchestrator import Block, Result, System
+from quadcosim import scenarios
 from quadcosim.main import main as cli
 
 README = Path(__file__).resolve().parent.parent / "README.md"
@@ -92,7 +92,7 @@ def test_system_replace_keeps_the_wiring_and_refuses_a_block_missing_an_output()
 
 
 def test_a_block_breaking_the_contract_is_refused_before_the_run(tmp_path, monkeypatch, capsys):
-    (tmp_path / "broken.py").write_text("from orchestrator import Block\n\nclass NoOutputs(Block):\n"
+    (tmp_path / "broken.py").write_text("from quadcosim.orchestrator import Block\n\nclass NoOutputs(Block):\n"
                                         "    inputs = ('gyro_x',)\n    outputs = ('q_est0',)\n")
     monkeypatch.chdir(tmp_path)
     assert run_cli(["run", "tp", "--estimator", "broken:NoOutputs", "--out", "x"]) == 2
@@ -151,7 +151,7 @@ def test_bad_parameters_are_refused_with_the_fix(setting, message, tmp_path, cap
 
 def test_set_parameter_in_python_with_units_and_the_list_shows_them(capsys):
     system = System()
-    from orchestrator import FMUBlock
+    from quadcosim.orchestrator import FMUBlock
 
     imu = system.add(FMUBlock("IMU"))
     assert system.set_parameter("IMU.gyro_noise_density", "0.003 rad/s/Hz0.5") == 0.003

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
+from quadcosim.estimators import CORRECTIONS, score
+from quadcosim.estimators.filters import NEW_FOR_EXPLICIT
+from quadcosim.fmus.IMU.variables import LAB_GYRO_BIAS
+from quadcosim.orchestrator import Fault
 
-import scenarios
-from estimators import CORRECTIONS, score
-from estimators.filters import NEW_FOR_EXPLICIT
-from fmus.IMU.variables import LAB_GYRO_BIAS
-from orchestrator import Fault
+from quadcosim import scenarios
 
 FAULT = (8.0, 13.0, 2e-5)  # s, s, T: 20 uT on the magnetometer's x axis
 
@@ -80,8 +80,8 @@ def test_bias_is_estimated_at_rest():
 def _spinning_and_shaken(n=20000, dt=1e-3, shake=3.0):
     """A body turning at 1 rad/s about a tilted axis while shaken along the inertial x axis at
     2 Hz (``shake`` m/s^2): true attitude and perfect gyro, accelerometer and magnetometer."""
-    from estimators import core
-    from fmus import vehicle
+    from quadcosim.estimators import core
+    from quadcosim.fmus import vehicle
 
     t = np.arange(n) * dt
     rate = np.array([0.6, 0.0, 0.8])
@@ -99,7 +99,7 @@ def _spinning_and_shaken(n=20000, dt=1e-3, shake=3.0):
 
 @pytest.mark.parametrize("estimator", ["explicit", "passive"])
 def test_the_lowpass_in_the_gyro_frame_filters_linear_acceleration_without_lagging_the_rotation(estimator):
-    from estimators import estimate
+    from quadcosim.estimators import estimate
 
     inclination = {}
     for shake in (0.0, 3.0):

@@ -10,12 +10,12 @@ import sys
 import matplotlib
 import numpy as np
 import pytest
+from quadcosim.estimators import DEFAULT_GAINS, LAB_GAINS
+from quadcosim.flight import GAINS
+from quadcosim.scenarios import get
 from scipy.io import loadmat
 
-from estimators import DEFAULT_GAINS, LAB_GAINS
-from flight import GAINS
 from quadcosim.main import main, parser
-from scenarios import get
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +60,7 @@ def test_the_default_bias_gain_is_one_word_everywhere(finished_run, tmp_path, ca
     assert main(["run", "tp", "--set", "duration=0.2", "--format", "npz,mat", "--out", str(linear)]) == 0
     metrics = json.loads((linear / "metrics.json").read_text())
     assert metrics["options"]["kI"] == "lab" == loadmat(linear / "results.mat")["options"]["kI"][0, 0][0]
-    from studies.sweep import table
+    from quadcosim.studies.sweep import table
 
     table.write([table.row({"member": 0, "options": get("tp").parse(None)})], tmp_path)
     csv = (tmp_path / "sweep.csv").read_text().splitlines()
@@ -82,16 +82,15 @@ def test_plot_without_a_signal_lists_the_run_s_signals_with_units(finished_run, 
 
 
 def test_deg_draws_angles_in_degrees_and_format_writes_vector_figures(finished_run, tmp_path, capsys):
-    from orchestrator import Result
-    from scenarios.run_plots import plot
+    from quadcosim.orchestrator import Result
+    from quadcosim.scenarios.run_plots import plot
 
     result = Result.load(finished_run)
     path = plot(finished_run, ["Quadrotor.theta2", "MotorMagnetics.u_batt"], out=tmp_path / "deg.svg", deg=True)
     matplotlib.use("Agg")
     # the figure's numbers: read back from the SVG's axis labels would be fragile; redraw instead
     import matplotlib.pyplot as plt
-
-    from scenarios.run_plots import _draw
+    from quadcosim.scenarios.run_plots import _draw
 
     fig, (angle, volts) = plt.subplots(2)
     _draw(angle, result, "Quadrotor.theta2", deg=True)
@@ -139,10 +138,12 @@ def test_every_argument_has_help():
 
 
 def test_help_is_plain_text(capsys):
+    from findings.__main__ import main as findings
+
     with pytest.raises(SystemExit):
-        main(["findings", "--help"])
+        findings(["--help"])
     text = capsys.readouterr().out
-    assert "quadcosim findings" in text and "findings.GROUPS" in text
+    assert "python -m findings" in text and "findings.GROUPS" in text
     assert "``" not in text and ":data:" not in text and ":mod:" not in text
     with pytest.raises(SystemExit):
         main(["--help"])
@@ -162,9 +163,8 @@ def test_labels_fit_their_axes(finished_run, tmp_path):
     """compare's y labels are the unit alone (the name is the axes' title): the label, drawn,
     is shorter than its axes (it overlapped its neighbours when it carried the long name)."""
     import matplotlib.pyplot as plt
-
-    from orchestrator import Result
-    from scenarios.run_plots import AXES_SIZE, _draw
+    from quadcosim.orchestrator import Result
+    from quadcosim.scenarios.run_plots import AXES_SIZE, _draw
 
     result = Result.load(finished_run)
     fig, axes = plt.subplots(3, 1, figsize=(AXES_SIZE[0], 3 * AXES_SIZE[1]), layout="constrained")
@@ -196,7 +196,7 @@ class _Terminal:
 
 
 def test_a_status_line_during_a_progress_bar_is_written_on_a_line_of_its_own(monkeypatch):
-    from orchestrator import progress
+    from quadcosim.infra import progress
 
     terminal = _Terminal()
     monkeypatch.setattr(sys, "stderr", terminal)
@@ -241,8 +241,8 @@ def test_the_run_names_the_figures_it_wrote_and_counts_as_metrics_json_counts(tm
 def test_tracking_draws_setpoint_and_response_on_one_axes_in_degrees(finished_run, tmp_path, capsys, monkeypatch):
     """``plot RUN Setpoint.theta_d Quadrotor.theta --tracking --deg``: roll, pitch and yaw each on
     one axes, the setpoint (dashed) and the response, in degrees, the unit on the y axis."""
-    from orchestrator import Result
-    from scenarios import run_plots
+    from quadcosim.orchestrator import Result
+    from quadcosim.scenarios import run_plots
 
     drawn = {}
     real_save = run_plots.save_figure
@@ -278,7 +278,7 @@ def test_compare_writes_under_results_never_replacing_and_names_the_runs_alone(f
     """``compare`` without ``--out``: ``results/compare-SIGNAL.png``, then the next free name
     (said), ``--overwrite`` replaces; each legend entry names a run, not the component again
     (the component is the axes' title)."""
-    import scenarios.run_plots as run_plots
+    import quadcosim.scenarios.run_plots as run_plots
 
     legends = []
 

@@ -6,10 +6,10 @@ import json
 
 import numpy as np
 import pytest
+from quadcosim.estimators.contract import NORM_TOLERANCE, AttitudeEstimator
+from quadcosim.orchestrator import SimulationError
 
-import scenarios
-from estimators.contract import NORM_TOLERANCE, AttitudeEstimator
-from orchestrator import SimulationError
+from quadcosim import scenarios
 
 
 class Growing(AttitudeEstimator):

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
+from quadcosim.estimators import analysis, core, estimate, filters, gain_grid, parse_corrections, score
+from quadcosim.fmus import vehicle
 
-import scenarios
-from estimators import analysis, core, estimate, filters, gain_grid, parse_corrections, score
-from fmus import vehicle
+from quadcosim import scenarios
 
 
 def synthetic(n=3000, dt=1e-3, seed=0):
@@ -39,7 +39,7 @@ def test_batch_path_equals_streaming_block(kind, options):
     result, _ = scenarios.run("tp", {"estimator": kind, "noise": True, "bias": True, "duration": 1.0,
                                      "flight": "nonstationary", "feedback": "estimate", **options})
     tp = scenarios.get("tp")
-    gains = __import__("scenarios.tp", fromlist=["estimator_gains"]).estimator_gains(tp.parse(
+    gains = __import__("quadcosim.scenarios.tp", fromlist=["estimator_gains"]).estimator_gains(tp.parse(
         {"estimator": kind, **options}))
     batch = estimate(kind, acc=result["IMU.acc"], gyro=result["IMU.gyro"], mag=result["IMU.magneto"], dt=1e-3,
                      gains=gains, R_reel=result["IMU.R_reel"], ry=options.get("ry", "reel"), q0=(1, 0, 0, 0),

@@ -5,10 +5,10 @@ import json
 
 import numpy as np
 import pytest
+from quadcosim.fmus import FMUNotFoundError
+from quadcosim.orchestrator import Block, FMUBlock, SimulationError, System, Table
 
-import scenarios
-from fmus import FMUNotFoundError
-from orchestrator import Block, FMUBlock, SimulationError, System, Table
+from quadcosim import scenarios
 from quadcosim.main import main as cli
 
 

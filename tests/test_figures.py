@@ -6,9 +6,9 @@ import re
 import matplotlib
 import numpy as np
 import pytest
+from quadcosim.orchestrator import Fault, Result
 
-import scenarios
-from orchestrator import Fault, Result
+from quadcosim import scenarios
 
 matplotlib.use("Agg")
 
@@ -17,11 +17,10 @@ def drawn(monkeypatch, module_name: str) -> dict:
     """Keep the figures a scenario module saves, by file name, instead of closing them."""
     import importlib
 
-    import studies  # noqa: F401  (registers gain-study)
-    from scenarios import catalogue
+    from quadcosim.scenarios import catalogue
 
     registered = catalogue.registrations().get(module_name.replace("_", "-"))
-    module = importlib.import_module(registered[0] if registered else f"scenarios.{module_name}")
+    module = importlib.import_module(registered[0] if registered else f"quadcosim.scenarios.{module_name}")
     figures = {}
 
     def keep(figure, out_dir, name):
@@ -50,7 +49,7 @@ def spans(ax) -> list[tuple[float, float]]:
 def title_of(options, faults=()):
     tp = scenarios.get("tp")
     meta = {"faults": [scenarios.fault_record(f) for f in faults]}
-    from scenarios.tp import figure_title
+    from quadcosim.scenarios.tp import figure_title
 
     return figure_title(Result(np.zeros(1), [], np.zeros((1, 0)), meta), tp.parse(options))
 
@@ -146,7 +145,7 @@ def test_tp_diagram_reads_as_the_labs_loop(feedback):
     """Blocks in the order of the lab's diagram; feedbacks below the row; every box, arrow and
     label inside the canvas; no two labels overlap; the title clear of the drawing; each
     label just above its arrow's run."""
-    from orchestrator import diagram
+    from quadcosim.orchestrator import diagram
 
     tp = scenarios.get("tp")
     options = tp.parse({"feedback": feedback})
@@ -188,7 +187,7 @@ def test_tp_diagram_reads_as_the_labs_loop(feedback):
 
 
 def test_fold_names_vectors_and_renamed_components():
-    from orchestrator.diagram import fold
+    from quadcosim.orchestrator.diagram import fold
 
     assert fold(["acc_x", "acc_y", "acc_z", "hold"]) == "acc[xyz], hold"
     assert fold([f"omega_r{n}" for n in range(1, 5)]) == "omega_r[1-4]"
@@ -201,8 +200,8 @@ def test_sweep_plot_axes_carry_units(tmp_path):
     the sweep and what it held fixed (from sweep.json)."""
     import json
 
-    from studies.sweep import figure
-    from studies.sweep.command import _plot_context
+    from quadcosim.studies.sweep import figure
+    from quadcosim.studies.sweep.command import _plot_context
 
     assert figure.metric_unit("rms_error_deg[0]") == "deg" and figure.metric_unit("bias_convergence_s") == "s"
     assert figure.metric_unit("real_time_factor") == ""
@@ -222,7 +221,7 @@ def test_every_python_block_states_the_unit_of_each_output(name, options):
     """The Python blocks of the scenarios (setpoint tables, controller, estimator, ablations)
     give a unit to every output, as the FMUs' variable tables do: plots and result files
     label them."""
-    from orchestrator import Constant, FMUBlock
+    from quadcosim.orchestrator import Constant, FMUBlock
 
     scenario = scenarios.get(name)
     system = scenario.build(scenario.parse(options))

@@ -237,7 +237,7 @@ def test_verifier_refuses_a_command_that_rewrites_the_findings_and_skips_absent_
     refused = commands.verify("python -m findings flight", [_finding("g.a", 1.0, 0.1, 1)])
     assert refused.status == "failed" and "--check" in refused.detail and refused.missing == ["g.a"]
     monkeypatch.delenv("QUADCOSIM_REAL_DATA", raising=False)
-    absent = commands.verify("python -m benchmarks.real_recordings DATA", [_finding("g.b", 1.0, 0.1, 1)])
+    absent = commands.verify("python -m quadcosim.benchmarks.real_recordings DATA", [_finding("g.b", 1.0, 0.1, 1)])
     assert absent.status == "skipped" and "QUADCOSIM_REAL_DATA" in absent.detail
     monkeypatch.delenv("QUADCOSIM_FLIGHT_LOGS", raising=False)
     assert commands.verify("quadcosim log replay logs/x.ulg", [_finding("g.c", 1.0, 0.1, 1)]).status == "skipped"

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from quadcosim.estimators.contract import AttitudeEstimator
+from quadcosim.orchestrator import Result
 from scipy.spatial.transform import Rotation
 
-import scenarios
-from estimators.contract import AttitudeEstimator
-from orchestrator import Result
+from quadcosim import scenarios
 from quadcosim.main import main
 
 ROOT = Path(__file__).resolve().parents[1]

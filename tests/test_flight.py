@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
+from quadcosim.flight import GAINS, Controller, allocation_matrix, esc_command, initial_state, profile, profiles, trim
+from quadcosim.flight import controller as law
+from quadcosim.fmus import vehicle
+from quadcosim.scenarios.testing.assertions import assert_bounds
 
-import scenarios
-from flight import GAINS, Controller, allocation_matrix, esc_command, initial_state, profile, profiles, trim
-from flight import controller as law
-from fmus import vehicle
-from scenarios.testing.assertions import assert_bounds
+from quadcosim import scenarios
 
 
 def test_unknown_or_bad_gains_are_refused_with_the_nearest_name():
@@ -31,7 +31,7 @@ def test_the_law_reads_its_slots_by_name():
 
 def test_level_hover_commands_the_motors_steady_state_map():
     """At the hover point the law asks every motor for the hover speed; the command is the
-    motors' steady-state map (the one in fmus.vehicle) at the battery voltage."""
+    motors' steady-state map (the one in quadcosim.fmus.vehicle) at the battery voltage."""
     block = Controller()
     block.start(0.0, 1e-3)
     u = np.zeros(len(law.INPUTS))
@@ -144,7 +144,7 @@ def test_a_12_rad_s_yaw_loop_at_100_hz_rings_until_the_free_wheeling_currents_re
     and so does 24 rad/s at 100 Hz without the rotors' reaction torque (Quadrotor.J_r = 0): the
     cause. Measured: ringing 2.2e-2 N m at 18.5 Hz; commands 0.403-0.508 in hover, 0.347-0.582
     in non-stationary flight; the hover current 3.78 A when quiet."""
-    from studies.yaw_loop import QUIET_NM, yaw_loop
+    from quadcosim.studies.yaw_loop import QUIET_NM, yaw_loop
 
     ringing, flying = yaw_loop(100.0, 12.0), yaw_loop(100.0, 12.0, "nonstationary")
     quiet, fast = yaw_loop(100.0, 8.0), yaw_loop(1000.0, 12.0)

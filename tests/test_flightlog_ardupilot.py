@@ -8,10 +8,10 @@ import re
 
 import numpy as np
 import pytest
+from quadcosim.calibration.flight import flight_data
+from quadcosim.calibration.flight.autopilot import read_parameters
+from quadcosim.flightlogs import read_log
 
-from calibration.flight import flight_data
-from calibration.flight.autopilot import read_parameters
-from flightlogs import read_log
 from quadcosim.main import main
 from tests.flightlog_data import ARDUPILOT, COPTER36, COPTER43, path
 from tests.flightlog_synthetic import DEVICES, write_log
@@ -169,7 +169,7 @@ def test_every_shared_ardupilot_log_through_every_command_and_no_export_worse_th
 
 
 def test_a_crash_is_the_first_two_seconds_thirty_degrees_off_target_and_a_shorter_upset_is_not():
-    from flightlogs.trim import crash_time
+    from quadcosim.flightlogs.trim import crash_time
 
     def rows(upset_from, upset_s):
         found = []

@@ -6,11 +6,11 @@ import json
 import numpy as np
 import pytest
 from helpers import documentation
+from quadcosim.calibration import Calibration, StaticCalibration, compensate
+from quadcosim.calibration.flight import autopilot, calibrate, flight_data
+from quadcosim.calibration.flight.calibrate import _field_model
+from quadcosim.flightlogs import ardupilot, px4
 
-from calibration import Calibration, StaticCalibration, compensate
-from calibration.flight import autopilot, calibrate, flight_data
-from calibration.flight.calibrate import _field_model
-from flightlogs import ardupilot, px4
 from quadcosim.main import main
 from tests.flightlog_data import ERLE, PX4, QUAD, log, path
 from tests.flightlog_synthetic import write_log
@@ -135,9 +135,10 @@ def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, 
 
 
 def test_the_command_lines_defaults_are_the_calibrations_names():
-    from calibration.flight import MODELS
+    from quadcosim.calibration.flight import MODELS
+    from quadcosim.scenarios.flightlog.calibrate import _check_choices
+
     from quadcosim.main import parser
-    from scenarios.flightlog.calibrate import _check_choices
 
     args = parser().parse_args(["calibrate", "flight.log", "--out", "out"])
     assert args.models is None and args.attitude == "auto"

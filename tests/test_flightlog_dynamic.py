@@ -5,12 +5,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from quadcosim.calibration import Calibration, MotorDynamics, MotorFieldModel, compensate
+from quadcosim.calibration.flight.data import FlightData
+from quadcosim.calibration.flight.dynamic import DynamicModel
+from quadcosim.calibration.flight.models import Fitted
 from scipy.spatial.transform import Rotation
-
-from calibration import Calibration, MotorDynamics, MotorFieldModel, compensate
-from calibration.flight.data import FlightData
-from calibration.flight.dynamic import DynamicModel
-from calibration.flight.models import Fitted
 
 
 @pytest.mark.slow

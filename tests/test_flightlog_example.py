@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from quadcosim.scenarios.flightlog import example
 
 from quadcosim.main import main
-from scenarios.flightlog import example
 
 GUIDE = Path(__file__).resolve().parent.parent / "docs" / "guides" / "flight-logs.md"
 
@@ -86,10 +86,9 @@ def test_an_example_folder_that_cannot_be_written_is_refused(tmp_path, capsys):
 
 
 def test_the_replay_s_compensation_leaves_no_constant_field_and_helps_the_filters(ran):
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog import replay
     from scipy.spatial.transform import Rotation
-
-    from flightlogs import read_log
-    from scenarios.flightlog import replay
 
     folder, _ = ran
     log = read_log(folder / "logs" / "example-a.log")
@@ -108,12 +107,11 @@ def test_the_replay_s_compensation_leaves_no_constant_field_and_helps_the_filter
 
 
 def test_the_calibration_file_pairs_its_model_with_the_offsets_fitted_with_it(ran):
+    from quadcosim.calibration import Calibration, compensate
+    from quadcosim.calibration.flight import flight_data
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog import replay
     from scipy.spatial.transform import Rotation
-
-    from calibration import Calibration, compensate
-    from calibration.flight import flight_data
-    from flightlogs import read_log
-    from scenarios.flightlog import replay
 
     folder, _ = ran
     metrics = json.loads((folder / "results" / "cal" / "metrics.json").read_text())
@@ -136,9 +134,9 @@ def test_the_calibration_file_pairs_its_model_with_the_offsets_fitted_with_it(ra
 
 
 def test_the_figures_draw_the_quartiles_wherever_the_current_is_and_yaw_wrapped_on_its_own_axis(ran):
-    from flightlogs import read_log
-    from scenarios.flightlog.calibration_figures import RESIDUAL_BIN_SAMPLES, _binned
-    from scenarios.flightlog.overview import _broken_at_wraps, _euler_deg
+    from quadcosim.flightlogs import read_log
+    from quadcosim.scenarios.flightlog.calibration_figures import RESIDUAL_BIN_SAMPLES, _binned
+    from quadcosim.scenarios.flightlog.overview import _broken_at_wraps, _euler_deg
 
     folder, _ = ran
     log = read_log(folder / "logs" / "example-a.log")

@@ -6,10 +6,10 @@ import json
 
 import numpy as np
 import pytest
+from quadcosim.calibration.flight import flight_data
+from quadcosim.calibration.flight.autopilot import read_parameters
+from quadcosim.flightlogs import read_log
 
-from calibration.flight import flight_data
-from calibration.flight.autopilot import read_parameters
-from flightlogs import read_log
 from quadcosim.main import main
 from tests.flightlog_synthetic import write_log
 from tests.flightlog_ulog_synthetic import write_ulog
@@ -187,7 +187,7 @@ def test_score_judges_any_parameter_file_with_the_exports_own_scorer(tmp_path, c
 
 
 def test_the_log_motor_compensation_carried_into_a_trial_leaves_its_offsets_and_soft_iron_alone():
-    from calibration.flight.autopilot import AUTOPILOTS
+    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
 
     def _motor_keys(params, autopilot):  # what the export carries of the log's motor compensation
         return {k for k in params if AUTOPILOTS[autopilot].is_motor_key(k)}

@@ -7,10 +7,10 @@ import json
 
 import numpy as np
 import pytest
+from quadcosim.calibration.flight.data import MIN_COMPASS_RATE_HZ
+from quadcosim.flightlogs import px4, read_log
+from quadcosim.flightlogs.info import summary
 
-from calibration.flight.data import MIN_COMPASS_RATE_HZ
-from flightlogs import px4, read_log
-from flightlogs.info import summary
 from quadcosim.main import main
 from tests.flightlog_data import PX4, path
 from tests.flightlog_synthetic import _commands

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from quadcosim.flightlogs import LogError, read_log
+from quadcosim.flightlogs.info import summary
 
-from flightlogs import LogError, read_log
-from flightlogs.info import summary
 from tests.flightlog_data import COPTER36, COPTER43, ERLE, PX4, QUAD, log, path
 
 # WMM 2015 at the quad's GPS position (42.356 N, 71.299 W), October 2015: 51.9 uT total
@@ -126,7 +126,8 @@ def test_log_info_and_plot_commands(tmp_path, capsys):
 
 
 def test_a_ulog_with_current_px4_topics(tmp_path):
-    from calibration.flight import calibrate, flight_data
+    from quadcosim.calibration.flight import calibrate, flight_data
+
     from tests.flightlog_ulog_synthetic import write_ulog
 
     truth = write_ulog(tmp_path / "sitl.ulg")

@@ -2,8 +2,8 @@
 flight calibration flown in simulation."""
 
 import pytest
+from quadcosim.scenarios.flightlog.replay import ESTIMATORS, replay_log
 
-from scenarios.flightlog.replay import ESTIMATORS, replay_log
 from tests.flightlog_data import ERLE, PX4, QUAD, log, path
 
 
@@ -43,8 +43,8 @@ def test_the_explicit_filters_inclination_on_a_flight_is_set_by_its_correction_t
     because its inclination correction is fast (1 s): with 5 s, the difference shrinks and the
     heading pays (flight b, internal compass: 3.61 -> 2.44 deg inclination, 9.46 -> 9.81 deg
     heading, measured)."""
-    import scenarios.flightlog.replay as replay
-    from estimators.filters import DEFAULT_TIME_CONSTANTS, explicit_gains
+    import quadcosim.scenarios.flightlog.replay as replay
+    from quadcosim.estimators.filters import DEFAULT_TIME_CONSTANTS, explicit_gains
 
     found = {}
     for tau in (DEFAULT_TIME_CONSTANTS["tau_inclination"], 5.0):

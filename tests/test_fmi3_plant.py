@@ -1,14 +1,14 @@
-"""The plant's own FMUs in FMI 3.0 (``fmus.fmu_path(name, fmi_version=3)``) run in the master as
+"""The plant's own FMUs in FMI 3.0 (``quadcosim.fmus.fmu_path(name, fmi_version=3)``) run in the master as
 their FMI 2.0 builds do: given by path to ``quadcosim run open-loop --fmu``, each gives the FMI 2.0
 run's record bit for bit (the IMU's FMI 3.0 arrays as ``acc_1`` ... where FMI 2.0 has ``acc_x``
 ...), in process, since they are this project's builds; and in a worker process of its own
-(:mod:`orchestrator.isolated`) an FMI 3.0 motor gives its FMI 2.0 build's outputs bit for bit."""
+(:mod:`quadcosim.orchestrator.isolated`) an FMI 3.0 motor gives its FMI 2.0 build's outputs bit for bit."""
 
 import numpy as np
 import pytest
+from quadcosim.orchestrator import FMUBlock, Result, System
 
-import fmus
-from orchestrator import FMUBlock, Result, System
+from quadcosim import fmus
 from quadcosim.main import main
 
 DURATION = "0.3"
@@ -24,7 +24,7 @@ def fmi2_run(tmp_path_factory) -> Result:
 
 @pytest.mark.parametrize("model", ["MotorMagnetics", "Quadrotor", "IMU"])
 def test_an_fmi3_plant_fmu_by_path_gives_the_fmi2_record(model, fmi2_run, tmp_path):
-    from orchestrator.isolated import runs_isolated
+    from quadcosim.orchestrator.isolated import runs_isolated
 
     path = fmus.fmu_path(model, fmi_version=3)
     assert not runs_isolated(path)  # the project's own build: in process

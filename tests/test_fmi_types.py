@@ -1,7 +1,7 @@
 """Every FMI type, FMI 2.0 and 3.0 alike: the tests' own FMUs (``tests/typed_fmus``, built from C
 here) have an input and an output of each numeric type, arrays, String and Binary parameters and a
 counter that steps when an integrator crosses a threshold. Run by the master, in process and in a
-worker process of their own (:mod:`orchestrator.isolated`), their outputs equal fmpy's
+worker process of their own (:mod:`quadcosim.orchestrator.isolated`), their outputs equal fmpy's
 (``simulate_fmu``, same inputs, same step) to 1e-9, integers and Booleans exactly, and the record
 keeps each signal's type into its files."""
 
@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from quadcosim.orchestrator import FMUBlock, Result, System, Table
 
-from orchestrator import FMUBlock, Result, System, Table
 from quadcosim.main import main
 
 sys.path.insert(0, str(Path(__file__).parent / "typed_fmus"))
@@ -39,7 +39,7 @@ def isolated(request) -> bool:
 @pytest.fixture
 def workers(monkeypatch) -> list:
     """The FMU files of the worker processes started during the test."""
-    from orchestrator.isolated import IsolatedInstance
+    from quadcosim.orchestrator.isolated import IsolatedInstance
 
     started, init = [], IsolatedInstance.__init__
 
@@ -159,9 +159,8 @@ def test_an_fmi3_fmu_of_every_type_and_arrays_equals_fmpy(typed_fmus, tmp_path, 
 def test_typed_signals_are_saved_with_their_types(typed_fmus, tmp_path):
     """The .npz keeps int32, bool, float32, uint64; the .mat int32 and logical; the .csv writes
     integers as integers; a streamed record and the reread .npz give the same types back."""
+    from quadcosim.orchestrator.stream import StreamWriter
     from scipy.io import loadmat
-
-    from orchestrator.stream import StreamWriter
 
     signals = _inputs(TYPES3)
     result = _system(typed_fmus[3], signals, {}, master_vector=[1, 2, 3]).run(0.1)
@@ -255,8 +254,8 @@ def test_an_fmu_with_clocks_is_refused_by_name(typed_fmus, tmp_path, capsys):
 def test_an_fmi3_instance_by_name_and_after_a_reset(typed_fmus, isolated):
     """Set and get by name (an array element alone: the others kept), step, and a reset that
     gives what a fresh instance gives, bit for bit (the pool of the pytest plugin resets)."""
-    from orchestrator.fmu import FMU3Instance
-    from orchestrator.isolated import IsolatedInstance, open_instance
+    from quadcosim.orchestrator.fmu import FMU3Instance
+    from quadcosim.orchestrator.isolated import IsolatedInstance, open_instance
 
     def FMUInstance(path, parameters=None, name=None):  # noqa: N802 (the class it stands for)
         return open_instance(path, parameters, name=name, isolated=isolated)
@@ -287,8 +286,7 @@ def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typ
     """terminateSimulation from fmi3DoStep (the counter reaching stop_count) ends the run: the
     error says so, and the record holds every step before, as fmpy's does."""
     import fmpy
-
-    from orchestrator import SimulationError
+    from quadcosim.orchestrator import SimulationError
 
     system = System(dt=DT)
     system.add(FMUBlock("T", model=typed_fmus[3], parameters={"stop_count": 4}, isolated=isolated))
@@ -312,7 +310,7 @@ def test_an_fmu_that_asks_to_end_the_simulation_ends_the_run_with_its_record(typ
 def test_a_refused_typed_set_names_its_function(typed_fmus, isolated):
     """The model refuses a UInt16 input of 65535 (the bus's 70000, held in range): the run fails
     at once, naming the block and fmi3SetUInt16 among the typed calls of the step."""
-    from orchestrator import SimulationError
+    from quadcosim.orchestrator import SimulationError
 
     system = System(dt=DT)
     system.add(FMUBlock("T", model=typed_fmus[3], isolated=isolated))
@@ -334,7 +332,7 @@ def lying_fmus(tmp_path_factory):
 def test_a_step_that_returns_minus_one_fails_the_run(lying_fmus, version, master, isolated):
     """-1 is no FMI status: the run fails at the step that returned it, in both FMI versions,
     both masters, in process and isolated, and the record keeps every step before it."""
-    from orchestrator import SimulationError
+    from quadcosim.orchestrator import SimulationError
 
     system = System(dt=DT)
     block = system.add(FMUBlock("T", model=lying_fmus[version], isolated=isolated))
@@ -387,7 +385,7 @@ def test_an_fmi3_fmu_without_a_binary_for_this_machine_is_refused(typed_fmus, tm
 def test_an_fmi3_fmu_that_crashes_in_its_worker_ends_the_run_with_its_record(tmp_path):
     """A segmentation fault in ``fmi3DoStep`` of an isolated FMI 3.0 FMU: the run fails naming the
     block, the FMU, fmi3DoStep and SIGSEGV, and keeps the 101 samples before it."""
-    from orchestrator import SimulationError
+    from quadcosim.orchestrator import SimulationError
 
     crashing = build("types3", tmp_path, defines=("CRASHING_STEP",))
     system = System(dt=DT)

@@ -7,9 +7,8 @@ import fmpy
 import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
-
-from fmus import MODELS, fmu_path
-from orchestrator.fmu import FMUError, FMUInstance
+from quadcosim.fmus import MODELS, fmu_path
+from quadcosim.orchestrator.fmu import FMUError, FMUInstance
 
 
 @pytest.mark.parametrize("model", MODELS)

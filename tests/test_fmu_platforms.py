@@ -12,9 +12,8 @@ import fmpy
 import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
-
-from fmus import MODELS, fmu_path
-from fmus.build import PLATFORMS, SOURCE_FILES, table, windows_compiler
+from quadcosim.fmus import MODELS, fmu_path
+from quadcosim.fmus.build import PLATFORMS, SOURCE_FILES, table, windows_compiler
 
 HERE = Path(__file__).resolve().parent
 VERSIONS = (2, 3)
@@ -267,7 +266,7 @@ def test_the_windows_binaries_under_wine_equal_the_linux_ones(linux_outputs, tmp
 
 
 def test_without_mingw_the_build_ships_linux_alone_and_says_so_once(tmp_path, monkeypatch, capsys):
-    from fmus import build
+    from quadcosim.fmus import build
 
     monkeypatch.setenv("CC_WIN64", "no-such-mingw-gcc")
     build.windows_compiler.cache_clear()
@@ -283,7 +282,7 @@ def test_without_mingw_the_build_ships_linux_alone_and_says_so_once(tmp_path, mo
 
 
 def test_an_up_to_date_fmu_is_not_rebuilt(tmp_path):
-    from fmus.build import build_all
+    from quadcosim.fmus.build import build_all
 
     first = build_all(tmp_path, models=("InfraredSensor",), fmi_versions=(3,), verbose=False)
     stamp = first[0].stat().st_mtime_ns

@@ -1,16 +1,16 @@
 """fmi2Reset gives back a fresh instance, bit for bit: what lets a sweep worker reuse its FMU
-instances from member to member (orchestrator.pool) without changing any trajectory."""
+instances from member to member (quadcosim.orchestrator.pool) without changing any trajectory."""
 
 import math
 
 import numpy as np
 import pytest
+from quadcosim.fmus import MODELS
+from quadcosim.orchestrator import pool
+from quadcosim.orchestrator.fmu import FMUError, FMUInstance
+from quadcosim.scenarios.testing.assertions import assert_runs_close
 
-import scenarios
-from fmus import MODELS
-from orchestrator import pool
-from orchestrator.fmu import FMUError, FMUInstance
-from scenarios.testing.assertions import assert_runs_close
+from quadcosim import scenarios
 
 DT = 1e-3
 PARAMETERS = {  # off their defaults, so that a reset that kept the earlier run's values would show

@@ -1,13 +1,14 @@
 """Silent wrong results: a vehicle flown without a controller (``open-loop``), or the ground-truth hover
 whose stream ``gain-study`` filters, once completed while it tumbled; ``ir-calibration``'s aircraft
 turned at any rate its settings gave. Each declares the bounds of its flight
-(:mod:`scenarios.divergence`): the tilt from level and, where recorded, the speed; the aircraft's turn
+(:mod:`quadcosim.scenarios.divergence`): the tilt from level and, where recorded, the speed; the aircraft's turn
 rate. A setting that breaks that flight ends ``diverged``, exit 1; its default flight completes."""
 
 import json
 
+from quadcosim.scenarios import get, names
+
 from quadcosim.main import main as cli
-from scenarios import get, names
 
 # gain-study shortened to seconds: the batch-means check wants 20 blocks longer than 1/k_min
 GAIN_STUDY = ["run", "gain-study", "--set", "duration=4", "burn_in=1", "closed_loop=false", "count=3", "k_min=10",

@@ -17,8 +17,8 @@ import hostile_fmu
 import numpy as np
 import pytest
 from hostile_fmu import FAULT_STEP
+from quadcosim.orchestrator import Result
 
-from orchestrator import Result
 from quadcosim.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -129,7 +129,7 @@ def test_an_fmu_that_cannot_run_is_refused_before_the_loop(hostile, case, tmp_pa
     fmu = hostile(case) if make is None else make(hostile("good"), tmp_path / f"{case.replace(' ', '_')}.fmu")
     extracted = []
     if make is not None:  # refused from the archive alone: nothing of it is extracted
-        import orchestrator.fmu as module
+        import quadcosim.orchestrator.fmu as module
 
         monkeypatch.setattr(module, "extract", lambda *args: extracted.append(args))
     out = tmp_path / "run"
@@ -219,7 +219,7 @@ def test_a_crash_leaves_no_temporary_folder_and_the_watchdog_option_works(hostil
 
 
 def _motor_system(fmu: Path):
-    from orchestrator import Constant, FMUBlock, System
+    from quadcosim.orchestrator import Constant, FMUBlock, System
 
     system = System(dt=1e-3)
     system.add(Constant("Command", {f"c{n}": 0.2 * n for n in (1, 2, 3, 4)}))
@@ -250,7 +250,7 @@ def test_the_pool_keeps_an_fmu_only_when_its_reset_resets(hostile, behaviour, po
     run, and a warning says so once."""
     import warnings
 
-    from orchestrator import pool
+    from quadcosim.orchestrator import pool
 
     system = _motor_system(hostile(behaviour))
     previous = pool.reuse(True)

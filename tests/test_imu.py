@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
+from quadcosim.fmus import vehicle
+from quadcosim.fmus.IMU.variables import ACC_NOISE_DENSITY, GYRO_NOISE_DENSITY, MAG_NOISE_DENSITY
+from quadcosim.orchestrator.fmu import FMUInstance
 
-from fmus import vehicle
-from fmus.IMU.variables import ACC_NOISE_DENSITY, GYRO_NOISE_DENSITY, MAG_NOISE_DENSITY
-from orchestrator.fmu import FMUInstance
 from tests.helpers import rotation
 
 ACC = [f"acc_{a}" for a in "xyz"]

@@ -4,10 +4,10 @@ batch equals streaming, and refusals of bad data."""
 
 import numpy as np
 import pytest
+from quadcosim.calibration.infrared import SLIDES_OPERATIONS, CalibrationError, EKFSettings, Estimator, cost
+from quadcosim.scenarios.ir_calibration import estimate, fault_windows, simulate_flight
 
-import scenarios
-from calibration.infrared import SLIDES_OPERATIONS, CalibrationError, EKFSettings, Estimator, cost
-from scenarios.ir_calibration import estimate, fault_windows, simulate_flight
+from quadcosim import scenarios
 
 
 @pytest.fixture(scope="module")
@@ -70,8 +70,8 @@ def test_gated_filter_declares_attributes_and_survives_both_faults(both_faults):
 
 def test_no_false_alarm_on_100_fresh_fault_free_flights():
     """Seeds no setting was chosen on, flown in batch (the FMU's arithmetic): 0 declared in 11.1
-    flight-hours (``python -m studies.ir_detection`` judges 500)."""
-    from studies.ir_detection import fleet
+    flight-hours (``python -m quadcosim.studies.ir_detection`` judges 500)."""
+    from quadcosim.studies.ir_detection import fleet
 
     rows = fleet("none", 0.0, range(50_100_000, 50_100_100))
     declared = sum(r["declarations"] for r in rows)

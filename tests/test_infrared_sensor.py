@@ -5,10 +5,9 @@ import math
 
 import numpy as np
 import pytest
-
-from fmus.build import table
-from fmus.InfraredSensor.variables import GPS_HEADING_NOISE, IR_NOISE
-from orchestrator.fmu import FMUError, FMUInstance
+from quadcosim.fmus.build import table
+from quadcosim.fmus.InfraredSensor.variables import GPS_HEADING_NOISE, IR_NOISE
+from quadcosim.orchestrator.fmu import FMUError, FMUInstance
 
 OUTPUTS = ["r", "psi", "a", "b", "ir", "gps_turn_rate", "gps_valid"]
 RATE = 20.0
@@ -126,7 +125,7 @@ def test_bank_at_or_beyond_90_degrees_is_an_error(bank):
 
 def test_twin_agrees_with_the_fmu():
     pytest.importorskip("modelica")
-    from fmus.twins import simulate_fmu, simulate_twin
+    from quadcosim.fmus.twins import simulate_fmu, simulate_twin
 
     inputs = {"phi": "0.1 + 0.5*sin(1.3*time)"}
     params = {"noise_enabled": False, "cloud_start": 0.4, "cloud_ramp": 0.5, "cloud_duration": 0.6,
@@ -151,7 +150,7 @@ def test_twin_agrees_with_the_fmu():
 
 def test_twin_parameters_equal_fmu_start_values():
     pytest.importorskip("modelica")
-    from fmus.twins import simulate_twin
+    from quadcosim.fmus.twins import simulate_twin
 
     tab = table("InfraredSensor")
     twin = simulate_twin("InfraredSensor", {"phi": "0.0"}, {}, 0.01, np.array([0.0, 0.01]))

@@ -1,13 +1,12 @@
 """The slides' Kalman/regression comparison in degrees of bank angle, on fresh flights.
 
-Measured on seeds 50000000-50000002 (``python -m studies.ir_slides`` averages 20 from the
+Measured on seeds 50000000-50000002 (``python -m quadcosim.studies.ir_slides`` averages 20 from the
 first): Kalman with GPS resetting 0.91-0.94 deg, without 5.16-5.44 deg, regression
 5.05-5.47 deg; regression over Kalman 5.39-5.87 with resetting, 0.95-1.00 without.
 """
 
 import pytest
-
-from studies import ir_slides
+from quadcosim.studies import ir_slides
 
 SEEDS = (50_000_000, 50_000_001, 50_000_002)
 

@@ -6,10 +6,9 @@ as the batch path."""
 
 import numpy as np
 import pytest
-
-from calibration.infrared import EKFSettings, Estimator
-from scenarios.ir_calibration import episodes, fault_report, simulate_flight
-from studies.ir_detection import fleet, fly
+from quadcosim.calibration.infrared import EKFSettings, Estimator
+from quadcosim.scenarios.ir_calibration import episodes, fault_report, simulate_flight
+from quadcosim.studies.ir_detection import fleet, fly
 
 SEEDS = range(50_000_000, 50_000_020)  # fresh: flown in batch (the FMU's arithmetic), 20 per case
 
@@ -95,7 +94,7 @@ def test_consistency_settings_are_checked():
 
 #: Flights of the tuning seeds where, before the return test, an offset whose declaration ended
 #: early was absorbed into the calibration, and its end was then declared as a fault that never
-#: cleared (``python -m studies.ir_detection`` with ``alt_ended`` and ``alt_innovation`` off).
+#: cleared (``python -m quadcosim.studies.ir_detection`` with ``alt_ended`` and ``alt_innovation`` off).
 ABSORBED = (("gps", 0.1, (1_000_367, 10_000_284, 10_000_971)), ("ir", 100.0, (1_000_771, 10_000_509)))
 
 
@@ -111,7 +110,7 @@ def test_the_end_of_an_absorbed_offset_leaves_no_fault_standing(sensor, size, se
 
 #: Flights of the tuning seeds where a GPS +0.1 rad/s offset was missed from its start, absorbed
 #: into the calibration, and its end declared as a fault that never cleared (before the plateau
-#: test: ``python -m studies.ir_detection`` with ``plateau=0``).
+#: test: ``python -m quadcosim.studies.ir_detection`` with ``plateau=0``).
 MISSED = (1_000_182, 1_000_549, 1_000_648, 10_000_438, 10_000_667, 10_000_742, 60_000_178, 60_000_228, 60_000_787)
 
 

@@ -18,8 +18,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-TOP_LEVEL = {"fmus", "flightlogs", "orchestrator", "estimators", "calibration", "flight", "scenarios", "studies",
-             "benchmarks", "quadcosim"}  # findings/ is a maintainer tool of the checkout, not shipped
+#: One import name: the repository's folders are its subpackages (findings/, a maintainer tool of
+#: the checkout, is not shipped).
+TOP_LEVEL = {"quadcosim"}
+FOLDERS = ("fmus", "flightlogs", "orchestrator", "estimators", "calibration", "flight", "scenarios", "studies",
+           "benchmarks")
 
 pytestmark = pytest.mark.slow
 
@@ -74,13 +77,37 @@ def test_the_wheel_holds_the_project_packages_and_their_c_sources(installed):
     assert top == TOP_LEVEL, top  # no `build`, no `tests`, nothing else at the top level
     for source in ("benchmarks/c/loops.c", "benchmarks/c/rotation.h", "orchestrator/c/calls.c",
                    "fmus/c/shell.c", "fmus/Quadrotor/model.c", "fmus/QuadCoSim/package.order"):
-        assert (site / source).is_file(), source
+        assert (site / "quadcosim" / source).is_file(), source
+    # every package of the checkout is shipped (pyproject.toml lists them one by one)
+    inits = [init.parent.relative_to(ROOT).as_posix() for folder in (*FOLDERS, "quadcosim")
+             for init in (ROOT / folder).rglob("__init__.py")]
+    checkout = {name if name.startswith("quadcosim") else f"quadcosim/{name}" for name in inits}
+    shipped = {str(Path(name).parent) for name in files if name.endswith("/__init__.py")}
+    assert shipped == checkout, sorted(shipped ^ checkout)
+
+
+def test_no_shipped_command_traces_back(installed, tmp_path):
+    """Every verb's help from the installed copy, and the maintainer's `findings` (not shipped) refused
+    as an unknown verb, not a ModuleNotFoundError."""
+    python, _, _, env = installed
+    quadcosim = python.parent / "quadcosim"
+    verbs = _call([str(python), "-c", "from quadcosim.main import parser; "
+                   "print(*parser()._subparsers._group_actions[0].choices)"], tmp_path, env).stdout.split()
+    assert "run" in verbs and "findings" not in verbs
+    for verb in verbs:
+        done = subprocess.run([str(quadcosim), verb, "--help"], cwd=tmp_path, env=env, capture_output=True,
+                              text=True, timeout=120)
+        assert done.returncode == 0 and "Traceback" not in done.stderr, (verb, done.stderr[-2000:])
+    done = subprocess.run([str(quadcosim), "findings", "--help"], cwd=tmp_path, env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 2 and "invalid choice: 'findings'" in done.stderr and "Traceback" not in done.stderr
 
 
 def test_quadcosim_run_tp_from_an_unrelated_folder(installed, tmp_path):
     python, site, cache, env = installed
     quadcosim = python.parent / "quadcosim"
-    located = _call([str(python), "-c", "import fmus, scenarios; print(fmus.__file__); print(fmus.build_root())"],
+    located = _call([str(python), "-c", "import quadcosim.fmus as fmus, quadcosim.scenarios; print(fmus.__file__); "
+                     "print(fmus.build_root())"],
                     tmp_path, env).stdout.split()
     assert Path(located[0]).is_relative_to(site)
     assert Path(located[1]) == cache / "quadcosim" / "0.1.0"
@@ -100,6 +127,6 @@ def test_quadcosim_run_tp_from_an_unrelated_folder(installed, tmp_path):
 
 def test_the_benchmark_references_compile_from_the_installed_sources(installed, tmp_path):
     python, _, cache, env = installed
-    script = "from benchmarks import reference_library; print(reference_library('loops')._name)"
+    script = "from quadcosim.benchmarks import reference_library; print(reference_library('loops')._name)"
     library = Path(_call([str(python), "-c", script], tmp_path, env).stdout.strip())
     assert library == cache / "quadcosim" / "0.1.0" / "benchmarks" / "libloops.so" and library.is_file()

@@ -2,12 +2,14 @@
 
 import numpy as np
 import pytest
+from quadcosim.estimators import analysis
+from quadcosim.fmus.IMU.variables import LAB_GYRO_BIAS as LAB_BIAS
+from quadcosim.scenarios.testing.assertions import assert_bias_converges, assert_bounds
 
-import scenarios
-import studies  # noqa: F401  (registers gain-study in the scenarios' catalogue)
-from estimators import analysis
-from fmus.IMU.variables import LAB_GYRO_BIAS as LAB_BIAS
-from scenarios.testing.assertions import assert_bias_converges, assert_bounds
+from quadcosim import (
+    scenarios,
+    studies,  # noqa: F401  (registers gain-study in the scenarios' catalogue)
+)
 
 
 def run(**options):
@@ -99,9 +101,9 @@ def test_linear_gain_prediction_matches_simulation():
 
 
 def test_linear_non_stationary_error_comes_from_integrating_body_rates_as_euler_rates():
-    """Ablation (python -m scenarios.ablation): the ideal accelerometer leaves the error as it
+    """Ablation (python -m quadcosim.scenarios.ablation): the ideal accelerometer leaves the error as it
     is (within 13 % measured); true Euler rates in place of the gyro cut it 7 to 400 times."""
-    from scenarios.ablation import linear_ablation
+    from quadcosim.scenarios.ablation import linear_ablation
 
     rms = {k: np.array(v) for k, v in linear_ablation({"flight": "nonstationary", "duration": 10.0}).items()}
     assert rms["recorded"] == pytest.approx(rms["streaming"], rel=1e-9)  # batch path = closed loop

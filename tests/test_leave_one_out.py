@@ -2,15 +2,14 @@
 their scores alone choose; the recordings a search uses are spread over a dataset."""
 
 import numpy as np
-
-from benchmarks import tuning
+from quadcosim.benchmarks import tuning
 
 # three 'datasets' whose ratio to VQF is a bowl in log2 of the inclination time constant, least at 2, 8 and 32 s
 MINIMA = {"one": 1.0, "two": 3.0, "three": 5.0}
 
 
 class _Bowls:
-    """A stand-in for benchmarks.tuning.Scorer that records which datasets each call reads."""
+    """A stand-in for quadcosim.benchmarks.tuning.Scorer that records which datasets each call reads."""
 
     def __init__(self):
         self.recordings = dict.fromkeys(MINIMA)

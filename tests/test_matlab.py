@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 from scipy.io import loadmat
 
-import orchestrator
-import scenarios
+from quadcosim import orchestrator, scenarios
 
 SCRIPTS = Path(orchestrator.__file__).resolve().parent / "matlab"
 

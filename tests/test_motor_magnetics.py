@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
-
-from fmus import vehicle
-from orchestrator.fmu import FMUInstance
-from studies.hover import figures
+from quadcosim.fmus import vehicle
+from quadcosim.orchestrator.fmu import FMUInstance
+from quadcosim.studies.hover import figures
 
 OUT = ["omega_r1", "i1", "i2", "i3", "i4", "u_batt", "i_batt", "soc", "b_d_x", "b_d_y", "b_d_z",
        *[f"b_d{n}_{a}" for n in range(1, 5) for a in "xyz"], *[f"i_s{n}" for n in range(1, 5)],
@@ -149,8 +148,8 @@ def test_current_limit_holds_the_motor_current_on_a_start_from_rest(capsys):
 @pytest.mark.parametrize("case", [0, 1])
 def test_substep_manoeuvres_reach_both_current_bounds(case):
     """The sub-step convergence manoeuvres (fmus/agreement.py, tests/test_substep.py) exercise the mode switches."""
-    from fmus.agreement import SUBSTEP_CASES as CASES
-    from fmus.twins import simulate_fmu
+    from quadcosim.fmus.agreement import SUBSTEP_CASES as CASES
+    from quadcosim.fmus.twins import simulate_fmu
 
     inputs, params, _ = CASES["MotorMagnetics"][case]
     _, out = simulate_fmu("MotorMagnetics", inputs, params, 2.0, 0.02, MOTOR_CURRENTS)
@@ -162,7 +161,7 @@ def test_rig_one_motor_error_is_of_the_order_of_table_1(capsys):
     """Acceptance: the `rig` scenario at its defaults (`quadcosim run rig`): drone clamped, each
     motor swept alone, then the free set. Metge et al. report 10.6 to 11.1 degrees without dynamic
     calibration (Table 1); the supply currents stay non-negative throughout, the free set included."""
-    import scenarios
+    from quadcosim import scenarios
 
     result, metrics = scenarios.run("rig")
     single, errors = metrics["mean_angular_error_single_motor_deg"], metrics["mean_angular_error_deg"]

@@ -1,5 +1,5 @@
 """numba's cache of the project's code follows every source it was compiled from
-(:mod:`orchestrator.numba_cache`): an edit of a callee in another module reaches the caller's
+(:mod:`quadcosim.infra.numba_cache`): an edit of a callee in another module reaches the caller's
 next run, and earlier sources find their folder again.
 
 numba's own cache is invalidated by the edit of the cached function's own file only. A tiny
@@ -13,14 +13,14 @@ import sys
 import textwrap
 from pathlib import Path
 
-from orchestrator import numba_cache
+from quadcosim.infra import numba_cache
 
 # a fresh process: the package in argv[1] keyed as the project's floors are, its result and
 # whether the caller came from the cache
 PROBE = textwrap.dedent("""
     import sys
     from pathlib import Path
-    from orchestrator import numba_cache
+    from quadcosim.infra import numba_cache
     numba_cache.ROOT, numba_cache.FLOORS = Path(sys.argv[1]), ("mini",)
     numba_cache.install()
     sys.path.insert(0, sys.argv[1])

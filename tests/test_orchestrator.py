@@ -6,9 +6,9 @@ import tracemalloc
 import numpy as np
 import pytest
 import scipy.io
+from quadcosim.orchestrator import AlgebraicLoopError, Block, Fault, FMUBlock, Result, System, Table
 
-import scenarios
-from orchestrator import AlgebraicLoopError, Block, Fault, FMUBlock, Result, System, Table
+from quadcosim import scenarios
 
 
 class Ramp(Block):
@@ -198,7 +198,7 @@ def test_set_input_refuses_a_connected_input_as_connect_does():
 
 
 def test_a_wiring_drawn_before_is_copied_from_the_diagram_cache(tmp_path, monkeypatch):
-    from orchestrator import diagram
+    from quadcosim.orchestrator import diagram
 
     def system(gain):
         s = System()
@@ -226,7 +226,7 @@ def test_a_wiring_drawn_before_is_copied_from_the_diagram_cache(tmp_path, monkey
 
 
 def test_diagram_draws_a_tied_input_with_its_value_and_no_block(tmp_path):
-    from orchestrator.diagram import _wiring
+    from quadcosim.orchestrator.diagram import _wiring
 
     system = System()
     system.add(Probe("Probe"))

@@ -5,9 +5,9 @@ deprecated."""
 import json
 
 import pytest
+from quadcosim.scenarios.flightlog.example import write_flight
 
 from quadcosim.main import main
-from scenarios.flightlog.example import write_flight
 
 
 @pytest.fixture(scope="module")

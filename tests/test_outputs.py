@@ -6,11 +6,11 @@ import json
 
 import numpy as np
 import pytest
+from quadcosim.estimators import LAB_GAINS
+from quadcosim.orchestrator import Result
+from quadcosim.orchestrator.signals import matrix_shape, vector_groups
 from scipy.io import loadmat
 
-from estimators import LAB_GAINS
-from orchestrator import Result
-from orchestrator.signals import matrix_shape, vector_groups
 from quadcosim.main import main as cli
 
 
@@ -116,6 +116,6 @@ def test_the_default_out_never_replaces_earlier_results(tmp_path, monkeypatch, c
                                         ("gravity alone (an ablation)", None), ("bias (0.02, -0.01) rad/s", None),
                                         ("profile (flight/profiles.py)", None)])
 def test_option_units_come_from_their_help(text, unit):
-    from scenarios.metrics import option_unit
+    from quadcosim.scenarios.metrics import option_unit
 
     assert option_unit(text) == unit

@@ -7,8 +7,7 @@ import sys
 
 import numpy as np
 import pytest
-
-from orchestrator import portable
+from quadcosim.orchestrator import portable
 
 ANGLES = np.random.default_rng(7).uniform(-60.0, 60.0, 200_000)
 RATIOS = np.random.default_rng(8).uniform(-1, 1, 200_000) * 10.0 ** np.random.default_rng(9).uniform(-8, 8, 200_000)
@@ -43,7 +42,7 @@ DIGESTS = """
 import hashlib, sys
 import numpy as np
 sys.path.insert(0, {root!r})
-from orchestrator import portable
+from quadcosim.orchestrator import portable
 rng = np.random.default_rng(7)
 x = rng.uniform(-60.0, 60.0, 200_000)
 for f in (portable.sin, portable.arctan, np.sin, np.arctan):
@@ -65,7 +64,7 @@ def test_the_bits_do_not_depend_on_the_machines_kernels():
 
 
 def test_the_inverse_inverts_and_refuses_a_singular_matrix():
-    from flight.mixer import allocation_matrix
+    from quadcosim.flight.mixer import allocation_matrix
 
     mixer = allocation_matrix()
     inverse = portable.inverse(mixer)

@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from orchestrator.progress import PIPE_LINES, Progress, reporting, status
+from quadcosim.infra.progress import PIPE_LINES, Progress, reporting, status
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -1,4 +1,4 @@
-"""The pytest plugin (scenarios.testing): its helpers' checks and failure messages, the guide's
+"""The pytest plugin (quadcosim.scenarios.testing): its helpers' checks and failure messages, the guide's
 example run as written, and a test file outside the checkout run by the installed package."""
 
 import subprocess
@@ -7,10 +7,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from orchestrator import Result
-from scenarios.testing import SEED_LIMIT, seed_of
-from scenarios.testing.assertions import (
+from quadcosim.orchestrator import Result
+from quadcosim.scenarios.testing import SEED_LIMIT, seed_of
+from quadcosim.scenarios.testing.assertions import (
     assert_attitude_error,
     assert_bias_converges,
     assert_bounds,
@@ -150,7 +149,8 @@ def test_deliberately_failing(run_scenario, quadcosim_seed):
 def test_a_test_file_outside_the_checkout_runs_with_the_installed_package(tmp_path):
     """Only the plugin's fixtures and helpers, in a folder of its own, run by pytest in a fresh
     process: one passes, the other fails and prints the worst sample's time, value, bound and seed."""
-    (tmp_path / "test_outside.py").write_text("from scenarios.testing import assert_attitude_error\n" + OUTSIDE)
+    (tmp_path / "test_outside.py").write_text("from quadcosim.scenarios.testing import assert_attitude_error\n" +
+    OUTSIDE)
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:xdist",
                            "test_outside.py"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
     print(done.stdout[-3000:], done.stderr[-2000:])

@@ -8,9 +8,7 @@ import sys
 
 import numpy as np
 import pytest
-from test_pytest_plugin import attitude, record, second_order
-
-from scenarios.testing.assertions import (
+from quadcosim.scenarios.testing.assertions import (
     assert_attitude_error,
     assert_bias_converges,
     assert_bounds,
@@ -18,12 +16,13 @@ from scenarios.testing.assertions import (
     assert_step,
     assert_tracking,
 )
+from test_pytest_plugin import attitude, record, second_order
 
 LONG_TESTS = '''
 import os
 import signal
 
-from estimators.contract import AttitudeEstimator
+from quadcosim.estimators.contract import AttitudeEstimator
 
 
 class CtrlC(AttitudeEstimator):
@@ -134,6 +133,6 @@ def test_run_scenario_takes_one_signal_by_name_and_knows_gain_study(run_scenario
     result = run_scenario("tp", duration=0.2, record="Quadrotor.q")
     assert result.names == ["Quadrotor.q0", "Quadrotor.q1", "Quadrotor.q2", "Quadrotor.q3"]
     assert np.allclose(np.linalg.norm(result["Quadrotor.q"], axis=1), 1.0, atol=1e-9)
-    import scenarios
+    from quadcosim import scenarios
 
     assert "gain-study" in scenarios.names()  # registered by the plugin's studies entry point

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
+from quadcosim.fmus import vehicle
+from quadcosim.fmus.airframe import MOTORS
+from quadcosim.orchestrator.fmu import FMUInstance
 
-from fmus import vehicle
-from fmus.airframe import MOTORS
-from orchestrator.fmu import FMUInstance
 from tests.helpers import rotation, run_fmu
 
 W_HOVER = vehicle.hover_rotor_speed()
@@ -125,7 +125,7 @@ def test_gyroscopic_moment_of_the_rotors_precesses_the_body_rates():
 def rotor_pair_step(k_m, pair_step=0.1, h=1e-4, seconds=0.15):
     """Hover, then the counter-clockwise pair (motors 1 and 2, on a diagonal) gets a command step;
     motors and body co-simulated at step h. Returns the recorded signals."""
-    from orchestrator import FMUBlock, System, Table
+    from quadcosim.orchestrator import FMUBlock, System, Table
 
     w0 = vehicle.hover_rotor_speed()
     c0 = vehicle.hover_command()

@@ -6,9 +6,8 @@ import math
 
 import numpy as np
 import pytest
-
-from estimators import DEFAULT_GAINS, estimate
-from estimators.filters import DEFAULT_TIME_CONSTANTS, RECOMMENDED, RECORDED, explicit_gains, time_constants
+from quadcosim.estimators import DEFAULT_GAINS, estimate
+from quadcosim.estimators.filters import DEFAULT_TIME_CONSTANTS, RECOMMENDED, RECORDED, explicit_gains, time_constants
 
 G = 9.81
 FIELD = 4.7e-5  # T
@@ -168,7 +167,7 @@ def test_a_rejection_longer_than_mag_rejection_time_corrects_at_half_weight():
 
 
 class _Bowl:
-    """A stand-in for benchmarks.tuning.Scorer: two 'datasets' whose ratio to VQF is a bowl in the log
+    """A stand-in for quadcosim.benchmarks.tuning.Scorer: two 'datasets' whose ratio to VQF is a bowl in the log
     of each parameter, minimal at known values (a: 4 and 16 s, b: 8 s)."""
 
     recordings = {"one": None, "two": None}
@@ -180,7 +179,7 @@ class _Bowl:
 
 
 def test_the_compass_search_stops_inside_its_grid_at_the_least_worst_ratio():
-    from benchmarks import tuning
+    from quadcosim.benchmarks import tuning
 
     chosen = tuning.search(_Bowl(), "explicit", {"tau_inclination": 1.0, "tau_heading": 64.0},
                            log=lambda text: None)

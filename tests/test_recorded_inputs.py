@@ -7,10 +7,9 @@ import math
 import numpy as np
 import pytest
 from helpers import documentation
-
-from estimators import checks, estimate, gain_grid, recording
-from estimators.filters import gain_table
-from scenarios import replay
+from quadcosim.estimators import checks, estimate, gain_grid, recording
+from quadcosim.estimators.filters import gain_table
+from quadcosim.scenarios import replay
 
 RATE = 100.0  # Hz
 G = 9.81  # m/s^2
@@ -18,12 +17,12 @@ G = 9.81  # m/s^2
 
 def _static(seconds=20.0, tilt_deg=(20.0, -10.0)):
     """A sensor at rest, tilted (roll, pitch), in NED with the lab's field: gyro, acc, mag, reference."""
-    from estimators.core import euler_to_quaternion
-    from estimators.filters import references
+    from quadcosim.estimators.core import euler_to_quaternion
+    from quadcosim.estimators.filters import references
 
     q = np.array(euler_to_quaternion(math.radians(tilt_deg[0]), math.radians(tilt_deg[1]), 0.3))
     r = np.empty((3, 3))
-    from estimators.core import rotation
+    from quadcosim.estimators.core import rotation
 
     rotation(q, r)
     g, m = references()
@@ -133,7 +132,7 @@ def test_replay_refuses_a_folder_that_is_not_a_tp_run(tmp_path, capsys):
 def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(capsys):
 
     readme = documentation()
-    start = readme.index("```python\nfrom estimators import estimate, gain_grid, recording")
+    start = readme.index("```python\nfrom quadcosim.estimators import estimate, gain_grid, recording")
     code = readme[start + len("```python\n"):readme.index("```", start + 10)]
     namespace = {}
     exec(compile(code, "README.md", "exec"), namespace)

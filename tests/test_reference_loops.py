@@ -3,8 +3,7 @@ same explicit filter and controller as the orchestrator: their trajectories are 
 last bit, which is what lets ``quadcosim bench`` compare their speeds."""
 
 import pytest
-
-from benchmarks import master
+from quadcosim.benchmarks import master
 
 
 @pytest.mark.parametrize("scenario, settings", [("open-loop", {}), ("tp", master.CLOSED_LOOP),
@@ -16,7 +15,7 @@ def test_the_c_reference_loops_give_the_orchestrators_trajectories(scenario, set
 
 
 def test_the_c_reference_refuses_a_filter_it_does_not_implement():
-    import scenarios
+    from quadcosim import scenarios
 
     definition = scenarios.get("tp")
     system = definition.build(definition.parse({"estimator": "explicit", "corrections": "on"}))
@@ -35,7 +34,7 @@ def test_bench_draws_its_figures_and_refuses_a_figure_it_cannot_write(tmp_path, 
                "closed_loop_c_us_per_step": 2.0, "fmu_steps_us": 1.04, "equations_steps_us": 0.97,
                "batch_updates_per_s": 7.0e6, "batch_c_updates_per_s": 7.4e6, "parallel_batch_updates_per_s": 6.6e6}
     kept = []
-    monkeypatch.setattr("orchestrator.files.save_figure", lambda fig, path, **o: kept.append(fig) or path)
+    monkeypatch.setattr("quadcosim.infra.files.save_figure", lambda fig, path, **o: kept.append(fig) or path)
     master.draw(figures, tmp_path / "bench.png")
     steps, batch = kept[0].axes
     heights = [bar.get_height() for bar in steps.patches]

@@ -15,6 +15,24 @@ ROOT = Path(__file__).resolve().parent.parent
 DUMMIES = Path(__file__).resolve().parent / "registry_dummies"
 
 
+def installed_member(site: Path, group: str, line: str) -> Path:
+    """A third-party package's registration, as pip leaves it: a ``dummy-members`` distribution in
+    ``site`` whose ``entry_points.txt`` holds ``line`` in ``group`` (the one registry line a
+    member takes, in its package's ``pyproject.toml``); ``site`` goes on ``sys.path``."""
+    record = site / "dummy_members-0.1.dist-info"
+    record.mkdir(parents=True, exist_ok=True)
+    (record / "METADATA").write_text("Metadata-Version: 2.1\nName: dummy-members\nVersion: 0.1\n")
+    points = record / "entry_points.txt"
+    points.write_text((points.read_text() if points.is_file() else "") + f"[{group}]\n{line}\n\n")
+    return site
+
+
+def _with_member(group: str, line: str, body: str, tmp_path: Path) -> dict:
+    """Run ``body`` with a dummy member registered by ``line`` in the entry-point ``group``."""
+    site = installed_member(tmp_path / "site", group, line)
+    return _with_line(f"sys.path.insert(0, {str(site)!r})", body, tmp_path)
+
+
 def _with_line(registry_line: str, body: str, tmp_path: Path) -> dict:
     """Run ``body`` after ``registry_line`` in a fresh interpreter (the dummies importable, the
     working folder ``tmp_path``); what ``body`` leaves in ``found`` (a dict)."""
@@ -39,7 +57,7 @@ def _with_line(registry_line: str, body: str, tmp_path: Path) -> dict:
 
 def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
     found = _with_line('''
-        from estimators import kinds
+        from quadcosim.estimators import kinds
         kinds.KINDS["gyro-only"] = kinds.Kind("gyro-only", "gyro only", batch=False, block="dummy_estimator:GyroOnly")
     ''', '''
         code, listing = cli("list")
@@ -47,12 +65,13 @@ def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
         code, _ = cli("run", "tp", "--set", "estimator=gyro-only", "--set", "duration=0.2", "--out", "out")
         metrics = json.load(open("out/metrics.json"))
         found["ran"] = [code, metrics["options"]["estimator"], metrics["rms_error_deg"]]
-        import scenarios, studies.lab_matrix, studies.metge
-        from scenarios.flightlog import replay
-        found["choices"] = list(scenarios.get("tp").options["estimator"].choices)
-        found["compared"] = [list(studies.lab_matrix.COMPARED), list(studies.metge.STUDY_ESTIMATORS)]
+        import quadcosim.scenarios, quadcosim.studies.lab_matrix, quadcosim.studies.metge
+        from quadcosim.scenarios.flightlog import replay
+        found["choices"] = list(quadcosim.scenarios.get("tp").options["estimator"].choices)
+        found["compared"] = [list(quadcosim.studies.lab_matrix.COMPARED),
+                             list(quadcosim.studies.metge.STUDY_ESTIMATORS)]
         found["replayed"] = list(replay.ESTIMATORS)
-        from scenarios.registries import estimator_rows
+        from quadcosim.scenarios.registries import estimator_rows
         found["documented"] = [row for row in estimator_rows() if row[0] == "`gyro-only`"]
     ''', tmp_path)
     assert "|gyro-only)" in found["listed"]  # quadcosim list: tp's estimator choices
@@ -70,7 +89,7 @@ def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
     log = tmp_path / "flight.bin"
     write_log(log, duration=40.0)
     found = _with_line('''
-        from calibration.flight import catalogue
+        from quadcosim.calibration.flight import catalogue
         from dummy_model import Nothing
         catalogue.MODELS["nothing"] = catalogue.Model("nothing", lambda fitted: Nothing(), preference=5)
     ''', '''
@@ -80,9 +99,9 @@ def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
         code, _ = cli("calibrate", "flight.bin", "--models", "nothing", "current", "--out", "chosen")
         metrics = json.load(open("chosen/metrics.json"))
         found["chosen"] = [code, sorted(metrics["models"]), metrics["models"]["nothing"]["explained_test"]]
-        from calibration.flight import catalogue
+        from quadcosim.calibration.flight import catalogue
         found["orders"] = [list(catalogue.preferred("in_file")), list(catalogue.preferred("autopilot"))]
-        from scenarios.registries import model_rows
+        from quadcosim.scenarios.registries import model_rows
         found["documented"] = [row[0] for row in model_rows()]
     ''', tmp_path)
     assert found["default"][0] == 0 and "nothing" in found["default"][1]  # --models' default: every model
@@ -92,17 +111,14 @@ def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
 
 
 def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
-    found = _with_line('''
-        from scenarios.catalogue import register
-        register("dummy", "dummy_scenario", "studies")
-    ''', '''
+    found = _with_member("quadcosim.scenarios", "dummy = dummy_scenario", '''
         code, listing = cli("list")
         found["listed"] = [line for line in listing.splitlines() if line.startswith("dummy:")]
         code, _ = cli("run", "dummy", "--set", "duration=0.3", "--out", "out")
         found["ran"] = [code, json.load(open("out/metrics.json"))["final_time_s"]]
-        import scenarios
+        from quadcosim import scenarios
         found["names"] = list(scenarios.names())
-        from scenarios.registries import scenario_rows
+        from quadcosim.scenarios.registries import scenario_rows
         found["documented"] = [row for row in scenario_rows() if row[0] == "`dummy`"]
     ''', tmp_path)
     assert found["listed"] == ["dummy: a clock alone"]
@@ -132,7 +148,7 @@ def _paths(section: str) -> list[str]:
 
 def test_every_file_a_checklist_names_exists():
     """``<Model>`` stands for each plant model; a path of the new member's own name is skipped."""
-    from fmus import MODELS
+    from quadcosim.fmus import MODELS
 
     missing = []
     for path in _paths(CHECKLISTS.read_text()):
@@ -146,7 +162,7 @@ def test_every_file_a_checklist_names_exists():
 
 
 def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
-    from fmus import MODELS
+    from quadcosim.fmus import MODELS
 
     section = _paths(_section("Adding a sensor FMU"))
     for required in ("fmus/<Model>/model.c", "fmus/<Model>/variables.py", "fmus/<Model>/__init__.py",
@@ -155,7 +171,7 @@ def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
         assert required in section, required
     build = (ROOT / "fmus" / "build.py").read_text()
     assert 'HERE / model / "model.c"' in build  # what the build compiles of a model
-    assert 'f"fmus.{model}.variables"' in (ROOT / "fmus" / "models.py").read_text()  # its table
+    assert 'f"quadcosim.fmus.{model}.variables"' in (ROOT / "fmus" / "models.py").read_text()  # its table
     from tests.test_variable_tables import INPUTS
 
     order = (ROOT / "fmus" / "QuadCoSim" / "package.order").read_text().split()
@@ -166,15 +182,15 @@ def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
 
 def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_extend():
     """The registry line of each dummy test is the one its checklist names."""
-    from calibration.flight import catalogue
-    from estimators import kinds
+    from quadcosim.calibration.flight import catalogue
+    from quadcosim.estimators import kinds
 
     estimator = _section("Adding an estimator")
     assert Path(kinds.__file__).relative_to(ROOT).as_posix() in _paths(estimator)
     assert "estimators/contract.py" in _paths(estimator) and "`KINDS`" in estimator
     model = _section("Adding a flight-log model or autopilot")
     assert Path(catalogue.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`MODELS`" in model
-    from calibration.flight import autopilot
+    from quadcosim.calibration.flight import autopilot
 
     assert Path(autopilot.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`AUTOPILOTS`" in model
     scenario = _section("Adding a scenario")

@@ -14,9 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from quadcosim.fmus import MODELS
 from raw_fmu import RawFMU
-
-from fmus import MODELS
 
 OK, ERROR = 0, 3
 HERE = Path(__file__).resolve().parent

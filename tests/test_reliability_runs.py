@@ -20,13 +20,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers import documentation
+from quadcosim.orchestrator import Block, Fault, FMUBlock, Result, SimulationError, System, Table
 from scipy.io import loadmat
 
-import orchestrator.files
-import scenarios
-from orchestrator import Block, Fault, FMUBlock, Result, SimulationError, System, Table
-from orchestrator.files import atomic_path
-from orchestrator.interrupts import Terminated, first_only
+import quadcosim.infra.files
+from quadcosim import scenarios
+from quadcosim.infra.files import atomic_path
+from quadcosim.infra.interrupts import Terminated, first_only
 from quadcosim.main import main as cli
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -161,18 +161,18 @@ def test_an_interrupt_while_saving_keeps_the_earlier_file(tmp_path, monkeypatch)
 def test_atomic_files_take_the_usual_permissions(tmp_path):
     with atomic_path(tmp_path / "metrics.json") as temporary:
         temporary.write_text("{}")
-    assert (tmp_path / "metrics.json").stat().st_mode & 0o777 == 0o666 & ~orchestrator.files._UMASK
+    assert (tmp_path / "metrics.json").stat().st_mode & 0o777 == 0o666 & ~quadcosim.infra.files._UMASK
 
 
 def test_a_signal_as_the_temporary_file_is_made_leaves_no_temporary(tmp_path, monkeypatch):
-    made = orchestrator.files.tempfile.mkstemp
+    made = quadcosim.infra.files.tempfile.mkstemp
 
     def interrupted_right_after_creation(*args, **kwargs):
         handle, name = made(*args, **kwargs)
         signal.raise_signal(signal.SIGINT)  # the file exists, its name not yet returned
         return handle, name
 
-    monkeypatch.setattr(orchestrator.files.tempfile, "mkstemp", interrupted_right_after_creation)
+    monkeypatch.setattr(quadcosim.infra.files.tempfile, "mkstemp", interrupted_right_after_creation)
     with pytest.raises(KeyboardInterrupt):
         with atomic_path(tmp_path / "yaw.png") as temporary:
             temporary.write_bytes(b"never reached")
@@ -415,7 +415,7 @@ def test_the_help_fault_example_runs(tmp_path, capsys):
 
 def test_the_tp_report_adds_little_to_the_memory_of_its_record(tmp_path):
     """The report's own allocations grow by under 5 % of what a longer run records (the full
-    benchmark, peak RSS of whole runs, is ``python -m benchmarks.memory``)."""
+    benchmark, peak RSS of whole runs, is ``python -m quadcosim.benchmarks.memory``)."""
     scenario = scenarios.get("tp")
     peaks, recorded = [], []
     for duration in (5.0, 5.0, 40.0):

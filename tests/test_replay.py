@@ -4,11 +4,11 @@ import json
 
 import numpy as np
 import pytest
+from quadcosim.estimators import DEFAULT_GAINS, recording, score
+from quadcosim.orchestrator.result import Result
+from quadcosim.scenarios import replay
 
-import scenarios
-from estimators import DEFAULT_GAINS, recording, score
-from orchestrator.result import Result
-from scenarios import replay
+from quadcosim import scenarios
 
 
 @pytest.mark.parametrize("kind, options", [("explicit", {"kI": 0.05, "corrections": "on"}),
@@ -93,7 +93,7 @@ def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch
     """``quadcosim replay --figure``: inclination and heading errors sample by sample, whose RMS over the scored
     samples is the reported one; a recording without a reference, or a figure suffix matplotlib
     does not write, is refused naming the fix."""
-    import orchestrator.files
+    from quadcosim.infra import files
     from quadcosim.main import main as quadcosim
 
     drawn = []
@@ -102,8 +102,8 @@ def test_replay_figure_draws_the_errors_it_reports(tmp_path, capsys, monkeypatch
         drawn.append([(ax.lines[0].get_ydata(), ax.get_title(loc="left")) for ax in fig.axes])
         return saved(fig, path, **options)
 
-    saved = orchestrator.files.save_figure
-    monkeypatch.setattr(orchestrator.files, "save_figure", keep)
+    saved = files.save_figure
+    monkeypatch.setattr(files, "save_figure", keep)
     run, metrics = scenarios.run("tp", {"estimator": "explicit", "flight": "nonstationary", "noise": True,
                                         "duration": 3.0}, tmp_path / "run")
     drawn.clear()  # the run's own report figures

@@ -9,9 +9,8 @@ nothing of how its time constants carry across rates.
 
 import numpy as np
 import pytest
+from quadcosim.estimators import estimate
 from scipy.spatial.transform import Rotation
-
-from estimators import estimate
 
 FINE_RATE = 4000.0  # Hz, the motion's own grid; every rate below divides it
 RATES = (50.0, 100.0, 400.0)  # Hz

@@ -6,12 +6,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from quadcosim.scenarios.plant import angle_between
+from quadcosim.scenarios.rig import phases
 from scipy.stats import spearmanr
 
-import scenarios
+from quadcosim import scenarios
 from quadcosim.main import main as cli
-from scenarios.plant import angle_between
-from scenarios.rig import phases
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 
@@ -77,7 +77,7 @@ def test_a_set_block_parameter_is_resolved_once_and_the_parsed_options_stay_as_p
     import json
     import pickle
 
-    from orchestrator import parameters
+    from quadcosim.orchestrator import parameters
 
     resolved = []
     original = parameters.resolve

@@ -6,8 +6,8 @@ Each is now read right or refused naming the line and the fix."""
 import json
 
 import pytest
+from quadcosim.calibration.flight.autopilot import read_parameters
 
-from calibration.flight.autopilot import read_parameters
 from quadcosim.main import main
 from tests.flightlog_synthetic import write_log
 

@@ -5,9 +5,9 @@ import subprocess
 import sys
 
 import pytest
+from quadcosim.benchmarks.startup import imported_modules
 
-import scenarios
-from benchmarks.startup import imported_modules
+from quadcosim import scenarios
 
 NOT_FOR_LISTING = ("control", "dask", "distributed", "matplotlib", "pyarrow", "scipy.optimize", "scipy.signal")
 
@@ -16,7 +16,7 @@ NOT_FOR_LISTING = ("control", "dask", "distributed", "matplotlib", "pyarrow", "s
 def test_listing_and_help_import_no_heavy_package(command):
     imported = imported_modules(command)
     if command == ["list"]:
-        assert "studies.gain_study" in imported  # the hook saw the options of every scenario
+        assert "quadcosim.studies.gain_study" in imported  # the hook saw the options of every scenario
     assert [m for m in NOT_FOR_LISTING if m in imported] == []
     if command == ["--help"]:  # the parser names the verbs; their estimators load when one is run
         assert "numba" not in imported and "estimators" not in imported
@@ -41,11 +41,11 @@ def test_the_command_starts_one_blas_thread_unless_told(given, seen):
 
 
 def test_a_scenario_look_up_imports_that_scenario_alone():
-    code = ("import sys, scenarios; scenarios.get('open-loop'); "
-            "print(sorted(m for m in sys.modules if m.startswith('scenarios.')))")
+    code = ("import sys, quadcosim.scenarios; quadcosim.scenarios.get('open-loop'); "
+            "print(sorted(m for m in sys.modules if m.startswith('quadcosim.scenarios.')))")
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout
     imported = ast.literal_eval(out)
-    assert "scenarios.open_loop" in imported
+    assert "quadcosim.scenarios.open_loop" in imported
     others = [module for name, (module, _) in scenarios.catalogue.registrations().items() if name != "open-loop"]
     assert [m for m in others if m in imported] == []
     assert scenarios.names() == tuple(scenarios.registry())

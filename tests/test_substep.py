@@ -5,13 +5,12 @@ default sub-step changes no output by more than 1e-6 of its peak, and doubling i
 least one of them. The MotorMagnetics manoeuvres drive the motor currents onto both bounds of the
 ESC (zero, where free-wheeling stops them, and the current limit), so the located mode switches
 are part of what converges. The IMU has no continuous state and no integrator: its sub-step
-question does not arise. The manoeuvres are fmus/agreement.py's; `python -m fmus.agreement
+question does not arise. The manoeuvres are fmus/agreement.py's; `python -m quadcosim.fmus.agreement
 --substeps` prints the changes.
 """
 
 import pytest
-
-from fmus.agreement import SUBSTEP_CASES, change_when_halved, default_sub_step
+from quadcosim.fmus.agreement import SUBSTEP_CASES, change_when_halved, default_sub_step
 
 BOUND = 1e-6  # of each output's peak
 

@@ -18,11 +18,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from fmus import MODELS
-from studies import sweep
-from studies.sweep import command, table
-from studies.sweep.engine import worker_state
+from quadcosim.fmus import MODELS
+from quadcosim.studies import sweep
+from quadcosim.studies.sweep import command, table
+from quadcosim.studies.sweep.engine import worker_state
 
 ROOT = Path(__file__).resolve().parent.parent
 GRID = ["--grid", "k=0.05,0.2,1e5", "--set", "duration=0.5", "--set", "noise=on", "--seeds", "4"]
@@ -76,7 +75,7 @@ def test_one_and_two_workers_give_the_same_table(reference, tmp_path):
 def test_killed_sweep_resumes_to_the_same_table(reference, tmp_path):
     _, _, uninterrupted = reference
     out = tmp_path / "killed"
-    process = subprocess.Popen([sys.executable, "-m", "studies.sweep", "tp", *GRID, "--workers", "1",
+    process = subprocess.Popen([sys.executable, "-m", "quadcosim.studies.sweep", "tp", *GRID, "--workers", "1",
                                 "--out", str(out), "--quiet"], cwd=tmp_path, start_new_session=True,
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120
@@ -222,7 +221,7 @@ def test_bad_grids_are_refused_before_any_run(grids, settings, seeds, message):
 
 
 def test_seeds_need_a_seed_option(monkeypatch):
-    import scenarios
+    from quadcosim import scenarios
 
     tp = scenarios.get("tp")
     unseeded = scenarios.Scenario("unseeded", "", {k: o for k, o in tp.options.items() if k != "seed"}, tp.build,
@@ -285,7 +284,7 @@ def test_rows_kept_on_disk_write_the_table_of_the_rows_in_member_order(tmp_path)
 
 def test_the_rows_of_a_large_sweep_take_bytes_per_member_in_memory(tmp_path):
     """The table's rows go to disk: memory keeps where each is, 17 bytes a member, and per
-    column its kinds (``python -m benchmarks.sweep_memory`` measures a whole sweep's client)."""
+    column its kinds (``python -m quadcosim.benchmarks.sweep_memory`` measures a whole sweep's client)."""
     import tracemalloc
 
     members = 20_000
@@ -337,8 +336,9 @@ def test_figure_orders_curves_and_categories_as_numbers():
     ({"k_min": 2.0, "k_max": 1.0}, "k_max = 1.0 must exceed k_min = 2.0"),
 ])
 def test_gain_study_options_are_checked_before_any_run(settings, message, monkeypatch):
-    import scenarios
-    from orchestrator import System
+    from quadcosim.orchestrator import System
+
+    from quadcosim import scenarios
 
     def no_run(*args, **kwargs):
         raise AssertionError("a run started with invalid options")
@@ -349,8 +349,8 @@ def test_gain_study_options_are_checked_before_any_run(settings, message, monkey
 
 
 def test_lab_matrix_is_a_named_sweep_of_every_case():
-    from studies import lab_matrix
-    from studies.sweep import named
+    from quadcosim.studies import lab_matrix
+    from quadcosim.studies.sweep import named
 
     plan = named.get("lab-matrix").plan(["noise=on"])
     labels = [m.label for m in plan.members]
@@ -367,13 +367,14 @@ def test_lab_matrix_is_a_named_sweep_of_every_case():
 def test_the_lab_matrix_marks_its_diverged_member():
     """The passive filter on TRIAD, estimate-fed in non-stationary flight, crashes (roll 60 deg off
     its setpoint at t = 15.7 s): summary.md prints its numbers as a crash, and lists it."""
-    import scenarios
-    from studies import lab_matrix
-    from studies.sweep.engine import run_member
+    from quadcosim.studies import lab_matrix
+    from quadcosim.studies.sweep.engine import run_member
+
+    from quadcosim import scenarios
 
     name = "compare-passive-nonstationary"
     record = run_member("tp", scenarios.get("tp").parse(lab_matrix.COMPARISON[name]),
-                        extra_metrics="studies.lab_matrix:late_mean_error")
+                        extra_metrics="quadcosim.studies.lab_matrix:late_mean_error")
     assert record["status"] == "diverged" and "roll 60 deg from its setpoint" in record["error"]
     metrics = record["metrics"]
     summary = {"diverged": {name: record["error"]}, "cases": {}, "explicit_steady_bias_error_deg": [],

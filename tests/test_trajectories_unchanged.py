@@ -5,9 +5,8 @@ numerics fails. Bit-exact digests on one machine are `make digests`."""
 
 import numpy as np
 import pytest
+from quadcosim.orchestrator import pool
 from trajectory_runs import FILTERS, RUNS, compare, floor, kept, key, load_references, record
-
-from orchestrator import pool
 
 REFERENCES, TOLERANCES = load_references()
 
@@ -32,7 +31,7 @@ def test_a_gain_changed_by_one_part_in_a_million_fails_the_references():
     """The tolerances are tight enough to see a genuine change: the lab's linear filter gain k
     times 1 + 1e-6 moves the estimate beyond them."""
     name, options = RUNS["tp-linear"]
-    import scenarios
+    from quadcosim import scenarios
 
     result, _ = scenarios.run(name, dict(options) | {"k": 0.05 * (1 + 1e-6)})
     signals = {s: np.asarray(result[s]) for s in result.names} | {"time": np.asarray(result.time)}

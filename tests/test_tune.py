@@ -4,9 +4,9 @@ tune.json holds the history, --resume runs nothing already run, bad arguments ar
 import json
 
 import pytest
+from quadcosim.studies import tune
 
 from quadcosim.main import main as cli
-from studies import tune
 
 
 @pytest.mark.slow

@@ -2,7 +2,7 @@
 
 Each twin is simulated by the PyPI package ``modelica`` (pinned) with its inputs bound to
 functions of time in a wrapper model; the FMU is stepped with the same functions (see
-fmus/twins.py); the cases are fmus/agreement.py's, whose `python -m fmus.agreement`
+fmus/twins.py); the cases are fmus/agreement.py's, whose `python -m quadcosim.fmus.agreement`
 prints the differences. Noise is off. Tolerance, of each signal's peak over 2 s: 1e-6 for the
 IMU; 3e-7 for the Quadrotor; 1e-12 for the clamped Quadrotor, whose outputs are algebraic in its
 inputs, so the two agree to rounding; 2e-5 for MotorMagnetics: the FMU holds each input over a
@@ -20,11 +20,11 @@ import pytest
 
 pytest.importorskip("modelica")
 
-from fmus.agreement import TWIN_CASES, twin_difference  # noqa: E402
-from fmus.build import table  # noqa: E402
-from fmus.twins import simulate_twin  # noqa: E402
+from quadcosim.fmus.agreement import TWIN_CASES, twin_difference  # noqa: E402
+from quadcosim.fmus.build import table  # noqa: E402
+from quadcosim.fmus.twins import simulate_twin  # noqa: E402
 
-# of the peak of each signal, near what each case measures (python -m fmus.agreement --twins)
+# of the peak of each signal, near what each case measures (python -m quadcosim.fmus.agreement --twins)
 TOLERANCE = {"IMU": 1e-6,  # measured 4.0e-7
              "Quadrotor": 3e-7,  # measured 9.2e-8
              "Quadrotor clamped": 1e-12,  # measured 1.4e-15: algebraic outputs, equal to rounding
@@ -32,7 +32,7 @@ TOLERANCE = {"IMU": 1e-6,  # measured 4.0e-7
 
 
 def check(label, report=print):
-    """The case ``label`` of fmus.agreement.TWIN_CASES within its tolerance."""
+    """The case ``label`` of quadcosim.fmus.agreement.TWIN_CASES within its tolerance."""
     difference, name = twin_difference(label)
     report(f"\n{label} twin against FMU: largest difference {difference:.2g} of the peak ({name})")
     assert difference <= TOLERANCE.get(label, TOLERANCE[TWIN_CASES[label][0]]), name

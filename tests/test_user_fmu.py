@@ -7,8 +7,8 @@ import zipfile
 
 import numpy as np
 import pytest
+from quadcosim.orchestrator import Constant, FMUBlock, System
 
-from orchestrator import Constant, FMUBlock, System
 from quadcosim.main import main
 
 MOTOR = "FirstOrderMotor"
@@ -62,7 +62,7 @@ def test_fmu_on_the_command_line_replaces_a_plant_block(motor_fmu, tmp_path, cap
     assert "MotorMagnetics.omega_r1: the FMU declares no unit; taken as rad/s" in err  # pythonfmu writes none
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["replaced_blocks"]["MotorMagnetics"]["fmu"] == str(motor_fmu)
-    from orchestrator import Result
+    from quadcosim.orchestrator import Result
 
     result = Result.load(out)
     command, speed = result["Setpoint.c1"], result["MotorMagnetics.omega_r1"]
@@ -111,7 +111,7 @@ def test_a_vector_whose_components_are_apart_in_the_record_is_saved_as_recorded(
     """Another exporter may interleave a vector's components with other outputs (omega_r1, domega_r1,
     i1, omega_r2, ...): the .npz gathers them into one array, in C order, and reads them back
     unchanged (it wrote Fortran-ordered copies under a C-order header, scrambling every sample)."""
-    from orchestrator import Result
+    from quadcosim.orchestrator import Result
 
     t = np.arange(50) * 1e-3
     names = [f"M.{kind}{n}" for n in (1, 2, 3) for kind in ("omega_r", "i")]

@@ -11,12 +11,11 @@ import dataclasses
 import numpy as np
 import pytest
 from fmpy import read_model_description
+from quadcosim.fmus import MODELS, fmu_path
+from quadcosim.fmus.build import BuildError, build_fmu, table
+from quadcosim.fmus.variables import base_unit
+from quadcosim.orchestrator.fmu import FMUInstance
 from raw_fmu import RawFMU
-
-from fmus import MODELS, fmu_path
-from fmus.build import BuildError, build_fmu, table
-from fmus.variables import base_unit
-from orchestrator.fmu import FMUInstance
 
 # Inputs held over the check, by model: a rotating, tilted body with the motors unequal.
 INPUTS = {

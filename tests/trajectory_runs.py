@@ -10,7 +10,7 @@ library's FMA and non-FMA variants (:data:`VARIANTS`): ten times that spread.
   may move what moved nowhere here. Their tolerance is never less than ten times four ulp of the
   signal's largest value. A gain changed by one part in a million goes far beyond it.
 - The filters alone (:data:`FILTERS`), at the lab's gains, on inputs computed with
-  :mod:`orchestrator.portable` (the same bits on every CPU): what moved nowhere must match to the
+  :mod:`quadcosim.orchestrator.portable` (the same bits on every CPU): what moved nowhere must match to the
   bit. A sum reordered inside a filter fails them.
 
 ``tests/test_trajectories_unchanged.py`` compares a fresh run with them.
@@ -53,7 +53,7 @@ RUNS = {
     "rig": ("rig", {"reference": 0.2, "sweep": 0.2, "noise": True}),
     "ir-calibration": ("ir-calibration", {"duration": 20.0}),
 }
-#: The filters on :func:`synthetic_imu`: (kind, gains, options of :func:`estimators.estimate`).
+#: The filters on :func:`synthetic_imu`: (kind, gains, options of :func:`quadcosim.estimators.estimate`).
 #: The lab's (its gains, corrections off, as ``tp`` runs them), and the one recommended for real
 #: recordings at its defaults.
 _LAB = {"corrections": False}
@@ -88,8 +88,8 @@ VARIANTS = {
 def synthetic_imu(seconds: float = 4.0, dt: float = 1e-3) -> dict[str, np.ndarray]:
     """Gyro (rad/s), accelerometer (m/s^2) and magnetometer (T) of a body swinging in roll, pitch
     and yaw, with a gyro bias and uniform noise: the same bits on every CPU."""
-    from estimators.filters import references
-    from orchestrator import portable
+    from quadcosim.estimators.filters import references
+    from quadcosim.orchestrator import portable
 
     t = np.arange(int(round(seconds / dt))) * dt
     roll, pitch, yaw = 0.4 * portable.sin(1.3 * t), 0.3 * portable.sin(0.9 * t + 0.5), 1.2 * portable.sin(0.4 * t)
@@ -115,7 +115,7 @@ def record(label: str) -> dict[str, np.ndarray]:
     """Every recorded signal of run ``label`` of :data:`RUNS` and ``time``, or every output of
     filter ``label`` of :data:`FILTERS`, whole."""
     if label in FILTERS:
-        from estimators import LAB_GAINS, RECOMMENDED, estimate
+        from quadcosim.estimators import LAB_GAINS, RECOMMENDED, estimate
 
         kind, gains, options = FILTERS[label]
         if kind == "recommended":
@@ -125,7 +125,7 @@ def record(label: str) -> dict[str, np.ndarray]:
         out = estimate(kind, **synthetic_imu(), gains=gains, outputs=("q", "b"), **options)
         return {f"{name}{i}": np.asarray(out[name])[..., i].ravel() for name in ("q", "b")
                 for i in range(np.asarray(out[name]).shape[-1])}
-    import scenarios
+    from quadcosim import scenarios
 
     name, options = RUNS[label]
     result, _ = scenarios.run(name, dict(options))

@@ -5,21 +5,21 @@ Earth field rotated into the body frame, an offset, and the field of the motor c
 
     m_raw(t) = R(t)^T m_E + b + b_d(t)
 
-- :mod:`calibration.flight.data`: the compass aligned with the attitude that removes the Earth
+- :mod:`quadcosim.calibration.flight.data`: the compass aligned with the attitude that removes the Earth
   field, the log's own or one whose heading is integrated from the gyro (the default: the log's
   heading is steered by the compass being calibrated, so its interference leaks into it);
-- :mod:`calibration.flight.linear`: the Earth field and offset of each flight with the shared
+- :mod:`quadcosim.calibration.flight.linear`: the Earth field and offset of each flight with the shared
   coefficients, by least squares;
-- :mod:`calibration.flight.models`: the ``current``, ``throttle``, ``motors`` and ``metge``
-  models and :mod:`calibration.flight.dynamic`, each refused with its reason when the flight
+- :mod:`quadcosim.calibration.flight.models`: the ``current``, ``throttle``, ``motors`` and ``metge``
+  models and :mod:`quadcosim.calibration.flight.dynamic`, each refused with its reason when the flight
   cannot identify it;
-- :mod:`calibration.flight.evaluate`: out-of-sample scores;
-- :mod:`calibration.flight.calibrate`: all of it, and the :class:`calibration.Calibration`;
-- :mod:`calibration.flight.autopilot`: ArduPilot and PX4 parameters, and the corrections those
+- :mod:`quadcosim.calibration.flight.evaluate`: out-of-sample scores;
+- :mod:`quadcosim.calibration.flight.calibrate`: all of it, and the :class:`quadcosim.calibration.Calibration`;
+- :mod:`quadcosim.calibration.flight.autopilot`: ArduPilot and PX4 parameters, and the corrections those
   autopilots apply with them.
 """
 
-from calibration.flight.calibrate import MODELS, calibrate
-from calibration.flight.data import ATTITUDES, FlightData, flight_data
+from quadcosim.calibration.flight.calibrate import MODELS, calibrate
+from quadcosim.calibration.flight.data import ATTITUDES, FlightData, flight_data
 
 __all__ = ["ATTITUDES", "MODELS", "FlightData", "calibrate", "flight_data"]

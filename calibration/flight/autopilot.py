@@ -2,7 +2,7 @@
 each firmware does with the parameters (applies them to the raw field, names them, which motor
 compensations it has) and its parameter file, ArduPilot's (``NAME,VALUE`` lines, as Mission
 Planner loads them) or PX4's (QGroundControl's tab-separated format). The firmware arithmetic
-itself is in :mod:`flightlogs.ardupilot` and :mod:`flightlogs.px4`.
+itself is in :mod:`quadcosim.flightlogs.ardupilot` and :mod:`quadcosim.flightlogs.px4`.
 """
 
 from __future__ import annotations
@@ -11,21 +11,21 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from flightlogs import ardupilot, px4
+from quadcosim.flightlogs import ardupilot, px4
 
 
 def write_ardupilot(params: dict, path) -> None:
     """``params`` as an ArduPilot parameter file (``NAME,VALUE`` lines, as Mission Planner loads) at
-    ``path``, written atomically (:func:`orchestrator.files.atomic_path`)."""
-    from orchestrator.files import write_text
+    ``path``, written atomically (:func:`quadcosim.infra.files.atomic_path`)."""
+    from quadcosim.infra.files import write_text
 
     write_text(path, "".join(f"{name},{value:.9g}\n" for name, value in params.items()))
 
 
 def write_px4(params: dict, path) -> None:
     """``params`` as a QGroundControl parameter file for PX4 (tab-separated, vehicle 1) at ``path``,
-    written atomically (:func:`orchestrator.files.atomic_path`)."""
-    from orchestrator.files import write_text
+    written atomically (:func:`quadcosim.infra.files.atomic_path`)."""
+    from quadcosim.infra.files import write_text
 
     lines = ["# Vehicle-Id Component-Id Name Value Type\n"]
     for name, value in params.items():
@@ -36,7 +36,8 @@ def write_px4(params: dict, path) -> None:
 
 def rules_of(part, override=None) -> ardupilot.Rules:
     """The ArduPilot rules of the firmware named by the banner of ``part``'s log (``part``: a
-    :class:`calibration.flight.data.FlightData`), or ``override`` (a :class:`flightlogs.ardupilot.Rules`)."""
+    :class:`quadcosim.calibration.flight.data.FlightData`), or ``override`` (a
+    :class:`quadcosim.flightlogs.ardupilot.Rules`)."""
     return override or ardupilot.log_rules(part.log.firmware)
 
 
@@ -70,7 +71,7 @@ def _ardupilot_enabling(part):
 
 
 def _ardupilot_models(part, rule):
-    from calibration.flight import catalogue
+    from quadcosim.calibration.flight import catalogue
 
     if rules_of(part, rule).per_motor and _compass(part).slot == 0:  # COMPASS_PMOT: 4.0 and later, first compass
         return catalogue.preferred("autopilot")
@@ -114,14 +115,14 @@ class Autopilot:
     """An autopilot the export writes parameters for, and how its firmware uses them.
 
     The callables ``apply`` to ``firmware`` take ``part`` (a
-    :class:`calibration.flight.data.FlightData` of one compass of one of this autopilot's logs)
-    and, last, ``rule``: a :class:`flightlogs.ardupilot.Rules` overriding the firmware version
+    :class:`quadcosim.calibration.flight.data.FlightData` of one compass of one of this autopilot's logs)
+    and, last, ``rule``: a :class:`quadcosim.flightlogs.ardupilot.Rules` overriding the firmware version
     the log names (None: the log's); it is ArduPilot's, and the PX4 functions ignore it.
 
     Attributes
     ----------
     name : str
-        As a flight log names it (:attr:`flightlogs.FlightLog.autopilot`).
+        As a flight log names it (:attr:`quadcosim.flightlogs.FlightLog.autopilot`).
     file : str
         The parameter file the export writes in the results folder.
     write : callable
@@ -131,13 +132,13 @@ class Autopilot:
         from the part's raw field with ``params`` (all of them, the log's included) and
         ``inputs`` (``current`` (A), ``throttle`` (0..1), ``commands`` (0..1), ``voltage`` (V)).
     parameters : callable
-        ``(part, candidate, rule)``: a :class:`calibration.flight.export.Candidate` (hard iron
+        ``(part, candidate, rule)``: a :class:`quadcosim.calibration.flight.export.Candidate` (hard iron
         ``offset`` (T), soft-iron inverse ``correction`` (1), motor ``model`` and its field ``K``
         (T per unit of the model's input: A, throttle or motor command)) as the firmware's
         parameters of the part's compass, name: value in the firmware's units.
     motor_models : callable
         ``(part, rule)``: the motor compensations the firmware has for the part's compass, names
-        of :data:`calibration.flight.catalogue.MODELS`.
+        of :data:`quadcosim.calibration.flight.catalogue.MODELS`.
     scale_reset : callable
         ``(part, rule)``: parameters to reset when a fitted soft iron is exported (it carries the
         scale).
@@ -155,7 +156,7 @@ class Autopilot:
         leaves out (ArduPilot's ``AHRS_TRIM``); None: the logged attitude is the sensors' frame's.
     enabling : callable or None
         ``(part)``: the parameters a compass the log's firmware does not use needs to be used
-        (ArduPilot's ``COMPASS_USEn`` and ``COMPASS_DEV_IDn``, :func:`flightlogs.ardupilot.enabling`);
+        (ArduPilot's ``COMPASS_USEn`` and ``COMPASS_DEV_IDn``, :func:`quadcosim.flightlogs.ardupilot.enabling`);
         empty for a compass in use; None: the firmware has no such switch. The export carries them
         and its notes say so.
     """
@@ -210,7 +211,7 @@ def read_parameters(path) -> dict:
         The file is missing, not a regular file (a FIFO would block), too large, not text, or a
         line holds no ``NAME VALUE``; the message names the file, the line and the fix.
     """
-    from orchestrator.inputs import regular_file
+    from quadcosim.infra.inputs import regular_file
 
     path = Path(path)
     status = regular_file(path, "the parameter file", "give a parameter file (.parm or .params)")

@@ -1,20 +1,19 @@
 """A magnetometer calibration from flights: hard and soft iron when the rotations allow, each
 interference model fitted on training flights and scored on held-out ones, and the result as a
-:class:`calibration.Calibration`."""
+:class:`quadcosim.calibration.Calibration`."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
 import numpy as np
-
-from calibration.dynamic import MotorFieldModel
-from calibration.file import Calibration
-from calibration.flight import catalogue
-from calibration.flight.evaluate import score
-from calibration.flight.linear import earth_and_offset
-from calibration.flight.models import Refused
-from calibration.static import CalibrationError, StaticCalibration, fit_static, sphere_coverage
+from quadcosim.calibration.dynamic import MotorFieldModel
+from quadcosim.calibration.file import Calibration
+from quadcosim.calibration.flight import catalogue
+from quadcosim.calibration.flight.evaluate import score
+from quadcosim.calibration.flight.linear import earth_and_offset
+from quadcosim.calibration.flight.models import Refused
+from quadcosim.calibration.static import CalibrationError, StaticCalibration, fit_static, sphere_coverage
 
 MODELS = catalogue.MODELS  # by name, in the order they are fitted (read when a calibration runs)
 MIN_COVERAGE = 0.5  # share of the 80 sphere cells the Earth field must visit in the body frame
@@ -76,7 +75,7 @@ def model_offsets(fitted) -> np.ndarray:
 
     Parameters
     ----------
-    fitted : calibration.flight.models.Fitted
+    fitted : quadcosim.calibration.flight.models.Fitted
         A fitted model whose ``extra["nuisance"]`` holds each flight's Earth field and offsets (P, 6), T.
 
     Returns
@@ -98,7 +97,7 @@ def paired_static(static: StaticCalibration, notes: dict, chosen: str | None, fi
 
     Parameters
     ----------
-    static : calibration.static.StaticCalibration
+    static : quadcosim.calibration.static.StaticCalibration
         Hard iron ``b_s`` (3,), T, and soft iron ``A`` (3, 3) from :func:`_static`.
     notes : dict
         :func:`_static`'s notes (``source``: ``"log"`` or ``"flight"``).
@@ -109,7 +108,7 @@ def paired_static(static: StaticCalibration, notes: dict, chosen: str | None, fi
 
     Returns
     -------
-    calibration.static.StaticCalibration
+    quadcosim.calibration.static.StaticCalibration
         ``static``, its offsets (T) those fitted with ``chosen`` when the log's were kept.
     """
     if chosen is None or notes["source"] != "log":
@@ -133,7 +132,7 @@ def _field_model(fitted: dict, motors: int, explained: dict | None = None) -> tu
 
     Returns
     -------
-    name, model : str and calibration.dynamic.MotorFieldModel, or None and None
+    name, model : str and quadcosim.calibration.dynamic.MotorFieldModel, or None and None
     """
     # the first the flights identify of those the file can carry (an a-priori order, richest
     # first, not a choice on the scores), provided it beats no model on the held-out part
@@ -148,8 +147,8 @@ def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Ca
     ``names`` the models tried (default every model of :data:`MODELS`), ``attitude`` the
     attitude the parts were built with (recorded).
 
-    Returns the metrics (JSON-ready), the :class:`calibration.Calibration` for the file and the
-    fitted models by name (:class:`calibration.flight.models.Fitted`).
+    Returns the metrics (JSON-ready), the :class:`quadcosim.calibration.Calibration` for the file and the
+    fitted models by name (:class:`quadcosim.calibration.flight.models.Fitted`).
     """
     names = tuple(MODELS) if names is None else names
     fitted, refused = _fit_models(train, names)

@@ -1,10 +1,10 @@
 """The interference models a flight calibration fits, one line each in :data:`MODELS`, in the
 order they are fitted (a model may start from one fitted before it), with what each can be
-carried by: the calibration file (:class:`calibration.Calibration`) and the autopilots'
-parameters (:mod:`calibration.flight.export`).
+carried by: the calibration file (:class:`quadcosim.calibration.Calibration`) and the autopilots'
+parameters (:mod:`quadcosim.calibration.flight.export`).
 
 Adding a model is one file (its class: ``refusal(parts)`` and ``fit(parts)``, as
-:mod:`calibration.flight.models`) and one line here; the command line's ``--models``, the
+:mod:`quadcosim.calibration.flight.models`) and one line here; the command line's ``--models``, the
 calibration's metrics and the file's choice follow.
 """
 
@@ -14,10 +14,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-
-from calibration.dynamic import MotorFieldModel
-from calibration.flight.dynamic import DynamicModel
-from calibration.flight.models import LinearModel, MetgeModel
+from quadcosim.calibration.dynamic import MotorFieldModel
+from quadcosim.calibration.flight.dynamic import DynamicModel
+from quadcosim.calibration.flight.models import LinearModel, MetgeModel
 
 
 def _vectors_field(vectors) -> MotorFieldModel:
@@ -50,16 +49,16 @@ class Model:
     name : str
         As ``--models``, ``metrics.json`` and the calibration file name it.
     build : callable
-        The models fitted before it, by name (dict of :class:`calibration.flight.models.Fitted`),
+        The models fitted before it, by name (dict of :class:`quadcosim.calibration.flight.models.Fitted`),
         to the model to fit: an object with ``refusal(parts)`` (the reason the flights cannot
         identify it, or None) and ``fit(parts)`` (a ``Fitted``).
     preference : int
         Rank, richest first, shared by the file and the export: each carries the first model
         it can that the flights identify.
     to_file : callable or None
-        ``(fitted, motors)``: the fitted model (a :class:`calibration.flight.models.Fitted`) on
+        ``(fitted, motors)``: the fitted model (a :class:`quadcosim.calibration.flight.models.Fitted`) on
         a vehicle of ``motors`` motors as the calibration file carries it, a
-        :class:`calibration.MotorFieldModel`; None: the file cannot carry it.
+        :class:`quadcosim.calibration.MotorFieldModel`; None: the file cannot carry it.
     autopilot : bool
         The autopilots' motor compensation can carry it (ArduPilot ``COMPASS_MOTCT`` or
         ``COMPASS_PMOT``, PX4 ``CAL_MAG_COMP_TYP``).

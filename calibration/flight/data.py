@@ -8,8 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-
-from calibration.static import CalibrationError
+from quadcosim.calibration.static import CalibrationError
 
 ATTITUDES = ("auto", "gyro", "log")
 #: Compass rate (Hz) a flight calibration needs. Measured by decimating the example flights a, b, c
@@ -40,11 +39,10 @@ def rotation_of(euler: np.ndarray) -> np.ndarray:
 def board_quaternions(log, trim: bool = True) -> np.ndarray:
     """The attitude (T, 4) of the frame the autopilot's sensors are rotated into, at the log's
     attitude instants: ArduPilot's ``ATT`` is the vehicle's, the board's turned by ``AHRS_TRIM``,
-    which is added back (:func:`flightlogs.ardupilot.trim_rotation`); PX4 rotates its
+    which is added back (:func:`quadcosim.flightlogs.ardupilot.trim_rotation`); PX4 rotates its
     sensors into the vehicle's frame itself. ``trim=False`` ignores the trim (an ablation)."""
+    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
     from scipy.spatial.transform import Rotation
-
-    from calibration.flight.autopilot import AUTOPILOTS
 
     q = log.attitude.q
     board_trim = AUTOPILOTS[log.autopilot].board_trim
@@ -89,13 +87,13 @@ class FlightData:
     euler : (T, 3) array
         The log's roll, pitch and yaw (rad) at ``time``: tilt compensation and the reference heading.
     motors, battery :
-        The log's :class:`flightlogs.Motors` and :class:`flightlogs.Battery` (or None).
+        The log's :class:`quadcosim.flightlogs.Motors` and :class:`quadcosim.flightlogs.Battery` (or None).
     log : FlightLog
         The log itself.
     compass : int
         The compass's index in the log.
     earth : (3,) array or None
-        The Earth field model at the log's position (NED, T; :mod:`calibration.flight.earth`), or
+        The Earth field model at the log's position (NED, T; :mod:`quadcosim.calibration.flight.earth`), or
         None: then it is fitted, free, per flight.
     """
 
@@ -153,9 +151,9 @@ class FlightData:
 
 
 def rate_refusal(log, compass: int) -> str | None:
-    """Why compass ``compass`` of the :class:`flightlogs.FlightLog` ``log`` is logged too slowly for a
+    """Why compass ``compass`` of the :class:`quadcosim.flightlogs.FlightLog` ``log`` is logged too slowly for a
     flight calibration (its rate, the rate needed and the logging setting that gives it), or None."""
-    from flightlogs.model import FASTER_COMPASS, rate
+    from quadcosim.flightlogs.model import FASTER_COMPASS, rate
 
     chosen = log.compasses[compass] if 0 <= compass < len(log.compasses) else None
     if chosen is None:
@@ -173,14 +171,14 @@ def rate_refusal(log, compass: int) -> str | None:
 
 def fused(log, compass: int) -> bool:
     """Whether the log's heading fuses compass ``compass``: ArduPilot's ``COMPASS_PRIMARY``, PX4's first
-    (:class:`calibration.flight.autopilot.Autopilot`'s ``fused_compass``)."""
-    from calibration.flight.autopilot import AUTOPILOTS
+    (:class:`quadcosim.calibration.flight.autopilot.Autopilot`'s ``fused_compass``)."""
+    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
 
     return compass == AUTOPILOTS[log.autopilot].fused_compass(log.params)
 
 
 def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: bool = True) -> FlightData:
-    """Align compass ``compass`` of the :class:`flightlogs.FlightLog` ``log`` for calibration.
+    """Align compass ``compass`` of the :class:`quadcosim.flightlogs.FlightLog` ``log`` for calibration.
 
     ``attitude`` chooses the rotation that removes the Earth field: ``"gyro"`` takes roll and pitch
     from the log and integrates the heading from the gyro (see :func:`gyro_heading`), so the heading
@@ -196,7 +194,7 @@ def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: boo
         No such compass, no motors, attitude or IMU in the log (named), sensors that share no span
         of time, too few compass samples in the span they share, or an unknown ``attitude``.
     """
-    from flightlogs import LogError
+    from quadcosim.flightlogs import LogError
 
     if attitude not in ATTITUDES:
         raise CalibrationError(f"attitude {attitude!r} must be one of {', '.join(ATTITUDES)}")

@@ -1,20 +1,19 @@
 """The ``dynamic`` model on a flight: the commands through identified motor dynamics.
 
-:func:`calibration.fit_motor_dynamics` fits the back-EMF dynamics and one field gain per motor
+:func:`quadcosim.calibration.fit_motor_dynamics` fits the back-EMF dynamics and one field gain per motor
 along the directions of the ``metge`` fit, to the field left once the Earth field and the offset
-are removed; :func:`calibration.compensate` evaluates it. Motor time constants are tens of
+are removed; :func:`quadcosim.calibration.compensate` evaluates it. Motor time constants are tens of
 milliseconds, so both the magnetometer and the motor outputs must be logged faster than
-:data:`calibration.flight.models.DYNAMIC_MIN_RATE_HZ`; slower logs refuse the model.
+:data:`quadcosim.calibration.flight.models.DYNAMIC_MIN_RATE_HZ`; slower logs refuse the model.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from calibration.compensator import compensate
-from calibration.file import Calibration
-from calibration.flight.models import DYNAMIC_MIN_RATE_HZ, Fitted
-from calibration.identify import fit_motor_dynamics
+from quadcosim.calibration.compensator import compensate
+from quadcosim.calibration.file import Calibration
+from quadcosim.calibration.flight.models import DYNAMIC_MIN_RATE_HZ, Fitted
+from quadcosim.calibration.identify import fit_motor_dynamics
 
 GRID_HZ = 200.0  # the dynamics are integrated on this uniform grid
 

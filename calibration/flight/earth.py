@@ -35,7 +35,7 @@ class EarthField:
 
 
 def model_field(position) -> tuple[EarthField | None, str]:
-    """The World Magnetic Model's field at ``position`` (a :class:`flightlogs.Position`, or
+    """The World Magnetic Model's field at ``position`` (a :class:`quadcosim.flightlogs.Position`, or
     None), and a line saying what was used or why not."""
     if position is None:
         return None, ("no GPS fix in the log: the Earth field is left free per flight, so the z offset and the "
@@ -93,8 +93,8 @@ def align(train, test, fields: dict) -> tuple[list, list, dict]:
     """
     from dataclasses import replace
 
-    from calibration.flight.linear import fit_linear
-    from calibration.flight.models import LinearModel
+    from quadcosim.calibration.flight.linear import fit_linear
+    from quadcosim.calibration.flight.models import LinearModel
 
     if any(fields.get(p.log.path) is None for p in [*train, *test]):
         return train, test, {}

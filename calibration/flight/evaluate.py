@@ -8,8 +8,7 @@ are fitted again; ``explained`` is the share of the baseline's squared residual 
 from __future__ import annotations
 
 import numpy as np
-
-from calibration.flight.linear import earth_and_offset
+from quadcosim.calibration.flight.linear import earth_and_offset
 
 AIRBORNE_THROTTLE = 0.2  # collective throttle above which the vehicle is taken to fly
 
@@ -47,7 +46,7 @@ def heading_error(heading: np.ndarray, reference: np.ndarray, offset: float | No
 
 def score(fitted, parts) -> dict:
     """``explained`` share, costs (T^2), heading figures (deg) of the model ``fitted`` (a
-    :class:`calibration.flight.models.Fitted`, or None for the baseline alone) on ``parts`` (FlightData)."""
+    :class:`quadcosim.calibration.flight.models.Fitted`, or None for the baseline alone) on ``parts`` (FlightData)."""
     base_cost = model_cost = 0.0
     change, before, after, perturbation = [], [], [], []
     for p in parts:

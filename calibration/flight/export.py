@@ -3,7 +3,7 @@
 :func:`score_parameters` is the one judge of a parameter set: any ArduPilot or PX4 parameters
 (this project's export, the log's own, a file another tool wrote), loaded on top of the log's
 parameters and applied to the raw field exactly as the log's firmware applies them
-(:mod:`flightlogs.ardupilot`, :mod:`flightlogs.px4`), on the held-out parts. It
+(:mod:`quadcosim.flightlogs.ardupilot`, :mod:`quadcosim.flightlogs.px4`), on the held-out parts. It
 returns the heading error against the log's attitude and the share of the field residual the
 parameters' motor compensation explains. The heading's constant offset (declination, mounting) is
 estimated for each parameter set on parts it does not score and removed frozen: a hard iron that
@@ -23,12 +23,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from calibration.flight.autopilot import autopilot_of
-from calibration.flight.evaluate import heading_offset, tilt_compensated_heading, wrap
-from calibration.flight.linear import earth_and_offset, fit_linear
-from calibration.static import CalibrationError
-from flightlogs import ardupilot
+from quadcosim.calibration.flight.autopilot import autopilot_of
+from quadcosim.calibration.flight.evaluate import heading_offset, tilt_compensated_heading, wrap
+from quadcosim.calibration.flight.linear import earth_and_offset, fit_linear
+from quadcosim.calibration.static import CalibrationError
+from quadcosim.flightlogs import ardupilot
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
 
@@ -99,7 +98,7 @@ def score_file(path, parts, rule=None, *, offset_from) -> dict:
     """:func:`score_parameters` of the parameter file at ``path`` (ArduPilot ``.parm`` or a PX4
     ``.params`` of QGroundControl) on ``parts``, its heading offset estimated on ``offset_from``,
     applied under ``rule`` (None: the log's), with its name and parameter count."""
-    from calibration.flight.autopilot import read_parameters
+    from quadcosim.calibration.flight.autopilot import read_parameters
 
     params = read_parameters(path)
     _check_scored(path, parts, params, rule)
@@ -287,7 +286,7 @@ def _setup_notes(part) -> dict:
     """The notes of how the compass is set up: ``orientation``, the rotation the export's frame depends
     on (the offsets and motor vectors are in the frame the firmware rotates the compass into before
     correcting it, ``AP_Compass_Backend::rotate_field``), and ``use``, what the export carries to
-    enable a compass the log's firmware does not use (:class:`calibration.flight.autopilot.Autopilot`'s
+    enable a compass the log's firmware does not use (:class:`quadcosim.calibration.flight.autopilot.Autopilot`'s
     ``enabling``); each left out when it does not apply (an orientation ``NONE``: nothing rotated)."""
     notes = {}
     orientation = part.log.compasses[part.compass].setup.get("orientation", "")
@@ -310,7 +309,7 @@ def choose(train, choice, rule=None, models=None) -> tuple[dict, dict]:
     estimated on ``train``) (the motor compensation
     also needs a positive explained share there). The export's score belongs on parts neither has
     seen. ``rule`` overrides ArduPilot's version rules; ``models`` (names of the models an
-    autopilot can carry, :mod:`calibration.flight.catalogue`) restricts the motor compensations
+    autopilot can carry, :mod:`quadcosim.calibration.flight.catalogue`) restricts the motor compensations
     tried (default: all the firmware has).
 
     Raises

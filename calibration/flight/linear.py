@@ -8,7 +8,7 @@ For the samples ``k`` of flight ``p``::
 ``R_k`` the body-to-NED rotation, ``m_E,p`` the Earth field (NED, T) and ``b_p`` the offset (body,
 T) of that flight, ``x_kj`` the interference regressors (current, throttle, commands) and
 ``K_j`` their field vectors (T per unit), shared by all flights. When the Earth field is known
-(the World Magnetic Model at the log's position, :mod:`calibration.flight.earth`), ``m_E,p`` is
+(the World Magnetic Model at the log's position, :mod:`quadcosim.calibration.flight.earth`), ``m_E,p`` is
 that field and only the offset is fitted with the coefficients.
 """
 

@@ -7,9 +7,9 @@ and each refused, with the reason, when the flight cannot identify it.
   when the log has none;
 - ``motors``: ``b_d = sum_n K_n c_n``, one vector per motor command;
 - ``metge``: Metge et al.'s ``b_d = sum_n f(c_n, u; theta_n) v_n`` (eqs. 3, 4), the bi-polynomial
-  of command and battery voltage evaluated by :class:`calibration.MotorFieldModel`;
-- ``dynamic``: the commands through identified motor dynamics (:func:`calibration.fit_motor_dynamics`,
-  evaluated by :func:`calibration.compensate`).
+  of command and battery voltage evaluated by :class:`quadcosim.calibration.MotorFieldModel`;
+- ``dynamic``: the commands through identified motor dynamics (:func:`quadcosim.calibration.fit_motor_dynamics`,
+  evaluated by :func:`quadcosim.calibration.compensate`).
 
 Each linear model is fitted for every delay of :data:`DELAYS` (its regressors read at ``t - d``)
 and keeps the delay of least training residual, as PX4's offline compensation scripts search a
@@ -21,9 +21,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
-from calibration.dynamic import MotorFieldModel
-from calibration.flight.linear import NUISANCE, fit_linear
+from quadcosim.calibration.dynamic import MotorFieldModel
+from quadcosim.calibration.flight.linear import NUISANCE, fit_linear
 
 DELAYS = np.round(np.arange(0.0, 0.301, 0.02), 3)  # s
 MIN_CURRENT_SPREAD_A = 1.0  # standard deviation of the current needed to identify the current model

@@ -12,7 +12,7 @@ turn rate. Three estimators of ``(a, b)`` and of the present turn rate ``(IR - b
   Beyond the slides: innovation gating as in PX4's EKF2 (test ratio
   ``nu^2 / (gamma^2 S)``, a rejected measurement is not fused), and CUSUM detectors on the
   normalised innovations that declare a fault, attribute it to the IR or the GPS and end it
-  when that sensor is consistent again (:mod:`calibration.infrared.detection`). A fourth CUSUM
+  when that sensor is consistent again (:mod:`quadcosim.calibration.infrared.detection`). A fourth CUSUM
   watches the GPS-IR consistency residual against the calibration of a few samples before, which
   has not yet absorbed a small offset into ``b``, and a generalised likelihood ratio on the
   residual's shape (a GPS offset: a step; an IR offset: a ramp over the GPS window) names the
@@ -35,20 +35,20 @@ stretch of flight, as the slides pair IR and GPS "without offset".
 
 Each estimator's arithmetic is one compiled step function, called by the batch path (a
 compiled loop over recorded arrays, :meth:`Estimator.run`) and by the streaming block
-(:class:`InfraredCalibration`, an :class:`orchestrator.Block`). :func:`cost` counts the
+(:class:`InfraredCalibration`, an :class:`quadcosim.orchestrator.Block`). :func:`cost` counts the
 operations of each step by running the same Python source on counting numbers, and times it.
 
-Modules, one concern each: :mod:`~calibration.infrared.layout` (the state vectors),
-:mod:`~calibration.infrared.filters` (the step functions), :mod:`~calibration.infrared.detection`
-(faults), :mod:`~calibration.infrared.estimator` (settings, the estimator and its block),
-:mod:`~calibration.infrared.cost` (operations and time per iteration).
+Modules, one concern each: :mod:`~quadcosim.calibration.infrared.layout` (the state vectors),
+:mod:`~quadcosim.calibration.infrared.filters` (the step functions), :mod:`~quadcosim.calibration.infrared.detection`
+(faults), :mod:`~quadcosim.calibration.infrared.estimator` (settings, the estimator and its block),
+:mod:`~quadcosim.calibration.infrared.cost` (operations and time per iteration).
 
 Units: turn rate rad/s, IR in counts, ``a`` in counts per rad/s.
 """
 
-from calibration.infrared.cost import SLIDES_OPERATIONS, SLIDES_PROCESSOR, SLIDES_RATE, cost
-from calibration.infrared.estimator import METHODS, CalibrationError, Estimator, InfraredCalibration
-from calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
+from quadcosim.calibration.infrared.cost import SLIDES_OPERATIONS, SLIDES_PROCESSOR, SLIDES_RATE, cost
+from quadcosim.calibration.infrared.estimator import METHODS, CalibrationError, Estimator, InfraredCalibration
+from quadcosim.calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
 
 __all__ = ["METHODS", "SLIDES_OPERATIONS", "SLIDES_PROCESSOR", "SLIDES_RATE", "CalibrationError", "EKFSettings",
            "Estimator", "InfraredCalibration", "RLSSettings", "RegressionSettings", "cost"]

@@ -2,12 +2,12 @@
 a change of the consistency residual, with its onset and size.
 
 The ring of the last ``RING_SIZE`` samples (the paired IR, the GPS turn rate and the residual's
-variance, kept by :mod:`calibration.infrared.detection`) is seen against the calibration from
+variance, kept by :mod:`quadcosim.calibration.infrared.detection`) is seen against the calibration from
 before its oldest sample (:func:`_ring`). Each shape is fitted there, onset and size free, beside
 an error of that calibration, ``delta_b + delta_a u`` with a Gaussian prior on ``delta_a``
 (:func:`_best`); :func:`evidence` gives both fits' log-likelihoods and :func:`attribute` declares
 the better one once it is significant and clearly the better (the algorithm as a whole is
-described in :mod:`calibration.infrared.detection`).
+described in :mod:`quadcosim.calibration.infrared.detection`).
 """
 
 from __future__ import annotations
@@ -16,8 +16,7 @@ import math
 
 import numpy as np
 from numba import njit
-
-from calibration.infrared.layout import (
+from quadcosim.calibration.infrared.layout import (
     COMPLETE,
     CUSUM_CONS,
     DECISIVE,

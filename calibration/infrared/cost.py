@@ -12,10 +12,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from calibration.infrared.estimator import CalibrationError, Estimator, _finite
-from calibration.infrared.filters import buffer_size
-from calibration.infrared.settings import EKFSettings
+from quadcosim.calibration.infrared.estimator import CalibrationError, Estimator, _finite
+from quadcosim.calibration.infrared.filters import buffer_size
+from quadcosim.calibration.infrared.settings import EKFSettings
 
 SLIDES_OPERATIONS = 300  # per iteration, counted by the slides
 SLIDES_RATE = 20.0  # Hz
@@ -112,7 +111,7 @@ class _CountedMath:
 
 
 def _modules():
-    from calibration.infrared import attribution, detection, estimator, filters
+    from quadcosim.calibration.infrared import attribution, detection, estimator, filters
 
     return (filters, detection, attribution, estimator)
 

@@ -80,9 +80,8 @@ from __future__ import annotations
 import math
 
 from numba import njit
-
-from calibration.infrared.attribution import attribute, evidence, n_ring
-from calibration.infrared.layout import (
+from quadcosim.calibration.infrared.attribution import attribute, evidence, n_ring
+from quadcosim.calibration.infrared.layout import (
     A_SAFE,
     ALT_A,
     ALT_B,

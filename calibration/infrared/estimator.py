@@ -1,6 +1,6 @@
 """The :class:`Estimator` on arrays or sample by sample, and its streaming block.
 
-Its settings are in :mod:`calibration.infrared.settings`. Units: turn rate rad/s, IR in counts,
+Its settings are in :mod:`quadcosim.calibration.infrared.settings`. Units: turn rate rad/s, IR in counts,
 ``a`` in counts per rad/s.
 """
 
@@ -10,8 +10,7 @@ import math
 
 import numpy as np
 from numba import njit
-
-from calibration.infrared.filters import (
+from quadcosim.calibration.infrared.filters import (
     buffer_size,
     ekf_joint_step,
     ekf_step,
@@ -21,7 +20,7 @@ from calibration.infrared.filters import (
     regression_step,
     rls_step,
 )
-from calibration.infrared.layout import (
+from quadcosim.calibration.infrared.layout import (
     CUSUM_CONS,
     END_LLR,
     FAULT_SIZE,
@@ -63,8 +62,8 @@ from calibration.infrared.layout import (
     B,
     R,
 )
-from calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
-from orchestrator.blocks import Block
+from quadcosim.calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
+from quadcosim.orchestrator.blocks import Block
 
 METHODS = ("kalman", "regression", "rls")
 _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_gps": GATE_GPS, "nu_ir": NU_IR,

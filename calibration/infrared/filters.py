@@ -1,8 +1,8 @@
 """The estimators' step functions: the Kalman filter (sequential and joint), the regression, the RLS.
 
-Each takes the state ``s`` and configuration ``c`` vectors of :mod:`calibration.infrared.layout`,
+Each takes the state ``s`` and configuration ``c`` vectors of :mod:`quadcosim.calibration.infrared.layout`,
 the paired IR, the GPS turn rate, whether the GPS is to be used and the present IR, and
-updates ``s`` in place. Compiled with numba; :mod:`calibration.infrared.cost` runs the same
+updates ``s`` in place. Compiled with numba; :mod:`quadcosim.calibration.infrared.cost` runs the same
 Python source on counting numbers.
 """
 
@@ -11,9 +11,8 @@ from __future__ import annotations
 import math
 
 from numba import njit
-
-from calibration.infrared.detection import check_present, consistency, detect, remember_calibration
-from calibration.infrared.layout import (
+from quadcosim.calibration.infrared.detection import check_present, consistency, detect, remember_calibration
+from quadcosim.calibration.infrared.layout import (
     AIRSPEED,
     BANK_MAX,
     BANK_MIN,
@@ -150,12 +149,12 @@ def _fuse_gps(s, nu, S):
 @njit(cache=True)
 def ekf_step(s, c, ir_pair, gps, gps_available, ir_now):
     """One sample of the EKF on (a, b, r), sequential scalar updates, gated, with fault
-    detection (:mod:`calibration.infrared.detection`).
+    detection (:mod:`quadcosim.calibration.infrared.detection`).
 
     Parameters
     ----------
     s : (EKF_SIZE,) float array
-        State, updated in place (layout: :mod:`calibration.infrared.layout`).
+        State, updated in place (layout: :mod:`quadcosim.calibration.infrared.layout`).
     c : (EKF_CONFIG_SIZE,) float array
         Configuration; ``c[GAMMA2] = 0`` turns gating and fault detection off.
     ir_pair : float

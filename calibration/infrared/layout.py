@@ -1,6 +1,6 @@
 """Layouts of the estimators' state and configuration vectors: one index per quantity.
 
-The step functions (:mod:`calibration.infrared.filters`, :mod:`calibration.infrared.detection`)
+The step functions (:mod:`quadcosim.calibration.infrared.filters`, :mod:`quadcosim.calibration.infrared.detection`)
 work on flat float arrays so that numba compiles them and the batch path and the streaming
 block share them; these constants name the entries.
 """

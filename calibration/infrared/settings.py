@@ -12,8 +12,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-from calibration.infrared.layout import (
+from quadcosim.calibration.infrared.layout import (
     A_SAFE,
     ALT_ENDED,
     ALT_FRACTION,
@@ -126,7 +125,7 @@ class EKFSettings:
         Innovation gate gamma in standard deviations; 0 turns gating and fault detection off.
     cusum_k, cusum_h : float
         Allowance and threshold (standard deviations) of the CUSUMs on the GPS and the paired
-        IR innovations (:mod:`calibration.infrared.detection`); ``cusum_h = inf`` (the default)
+        IR innovations (:mod:`quadcosim.calibration.infrared.detection`); ``cusum_h = inf`` (the default)
         turns them off: the consistency residual sees the same offsets without the lag of the
         filter's turn rate, which made them declare faults in hard turn reversals (fault-free
         flights of seeds 1 to 2000: three; the earlier design's ``cusum_h = 10``).
@@ -138,10 +137,10 @@ class EKFSettings:
     held_k, held_h : float
         Allowance and threshold (standard deviations) of the two-sided CUSUM on the GPS-IR
         consistency residual against the held calibration
-        (:func:`calibration.infrared.detection.consistency`), which finds the offsets the filter
+        (:func:`quadcosim.calibration.infrared.detection.consistency`), which finds the offsets the filter
         absorbs into ``b`` and ``a`` before its own innovations show them. The allowance is
         half the smallest offset it is meant for (a GPS +0.1 rad/s, 40 counts, 2.3 standard
-        deviations); its alarm is only examined (:func:`~calibration.infrared.attribution.attribute`).
+        deviations); its alarm is only examined (:func:`~quadcosim.calibration.infrared.attribution.attribute`).
     held_lag : int
         How old the held calibration is (samples) while the CUSUM is at zero.
     freeze : bool
@@ -158,7 +157,7 @@ class EKFSettings:
         (``delta_b + delta_a u + beta t``) before a fault is declared. Set on the tuning seeds:
         on the fault-free flights of seeds 1 to 9000 the largest was 10.3; in the first 5 s of
         a GPS +0.1 rad/s offset on seeds 1 to 300 the smallest 25.0
-        (``python -m studies.ir_detectability --calibrate``).
+        (``python -m quadcosim.studies.ir_detectability --calibrate``).
     sd_a_held : float
         Prior standard deviation of the held calibration's error of ``a`` (count per rad/s)
         in that test: the largest error of the filter's ``a`` 10 samples old on the fault-free
@@ -179,7 +178,7 @@ class EKFSettings:
         would otherwise leave it blind).
     end : {"consistency", "innovation"}
         How a fault ends: the consistency residual stepping back by half the offset or more
-        (:func:`~calibration.infrared.detection._end_held`), or the faulty sensor's innovation
+        (:func:`~quadcosim.calibration.infrared.detection._end_held`), or the faulty sensor's innovation
         consistent again (the earlier design; a turn exposing the held calibration's error of
         ``a`` ended GPS faults early).
     decisive : float
@@ -220,7 +219,7 @@ class EKFSettings:
         last 160 s (one a second) show, at the present turn rate, a plateau at the present one
         for at least ``plateau`` samples (0: never), the newest ``plateau_skip`` samples left
         out (the change itself), and, within ``plateau_move`` samples before it, the
-        calibration the change brings the sensors back to (:func:`~calibration.infrared.
+        calibration the change brings the sensors back to (:func:`~quadcosim.calibration.infrared.
         detection._plateau_return`). The cloud and the filter's catching up after it leave no
         plateau that long before the GPS fault that follows.
     plateau_flat, plateau_flat_max : float

@@ -94,7 +94,7 @@ def _run(command: str, then: str | None = None, name: str | None = None, setup: 
 
 
 def _shown(value, digits: int | None = None) -> str:
-    from scenarios.shown import MEASURED_DIGITS, shown
+    from quadcosim.scenarios.shown import MEASURED_DIGITS, shown
 
     return shown(value, digits or MEASURED_DIGITS)
 
@@ -142,8 +142,8 @@ class QuadcosimRun(Directive):
 
 def _variable_tables(app):
     """``_generated/fmu_variables.md``: every FMU's variable table (from its ``variables.py``)."""
-    from fmus import MODELS
-    from fmus.build import table
+    from quadcosim.fmus import MODELS
+    from quadcosim.fmus.build import table
 
     lines = ["# The FMUs' variables", "",
              "Generated from each model's `fmus/<Model>/variables.py` (the source of its "
@@ -152,7 +152,7 @@ def _variable_tables(app):
     for model in MODELS:
         lines += [f"## {model}", "", "| name | causality | unit | start | description |", "|---|---|---|---|---|"]
         for variable in table(model).variables:
-            from scenarios.shown import PARAMETER_DIGITS
+            from quadcosim.scenarios.shown import PARAMETER_DIGITS
 
             start = "" if variable.start is None else _shown(variable.start, PARAMETER_DIGITS)
             description = str(variable.description).replace("|", "\\|")
@@ -169,9 +169,8 @@ def _variable_tables(app):
 
 def _registry_tables(app):
     """``_generated/registries.md``: the estimators, interference models, autopilots and scenarios,
-    read from their registries (:mod:`scenarios.registries`)."""
-    import studies  # noqa: F401  (registers its scenarios, as the command line does)
-    from scenarios.registries import tables
+    read from their registries (:mod:`quadcosim.scenarios.registries`)."""
+    from quadcosim.scenarios.registries import tables
 
     GENERATED.mkdir(exist_ok=True)
     target = GENERATED / "registries.md"

@@ -1,11 +1,11 @@
 """Variable table of the IMU FMU: accelerometer, gyrometer, magnetometer, and R_reel.
 
 The defaults (noise densities, rates, the lab's gyro bias) and their sources are in
-:mod:`fmus.vehicle`.
+:mod:`quadcosim.fmus.vehicle`.
 """
 
-from fmus import vehicle as V
-from fmus.variables import Boolean, Integer, Real, Table
+from quadcosim.fmus import vehicle as V
+from quadcosim.fmus.variables import Boolean, Integer, Real, Table
 
 _Q = ("q0", "q1", "q2", "q3")
 _W = ("omega_x", "omega_y", "omega_z")

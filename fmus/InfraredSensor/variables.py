@@ -11,7 +11,7 @@ scenario prints them). The slides' three numbers are not consistent with one lea
 line: 990 - 400 x 0.037 = 975, not 965.
 """
 
-from fmus.variables import Boolean, Integer, Real, Table
+from quadcosim.fmus.variables import Boolean, Integer, Real, Table
 
 GRAVITY = 9.81  # m/s^2
 AIRSPEED = 12.0  # m/s: cruise of a 1.4 kg, 1.4 m span fixed-wing

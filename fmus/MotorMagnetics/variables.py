@@ -1,7 +1,7 @@
 """Variable table of the MotorMagnetics FMU (motors, ESCs, battery, field of the supply currents)."""
 
-from fmus import vehicle as V
-from fmus.variables import Boolean, Real, Table
+from quadcosim.fmus import vehicle as V
+from quadcosim.fmus.variables import Boolean, Real, Table
 
 _N = range(1, 5)
 

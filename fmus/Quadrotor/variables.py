@@ -1,7 +1,7 @@
 """Variable table of the Quadrotor FMU: rigid body of a quad-X with rotor drag, wind and rotor inertia."""
 
-from fmus import vehicle as V
-from fmus.variables import Boolean, Real, Table
+from quadcosim.fmus import vehicle as V
+from quadcosim.fmus.variables import Boolean, Real, Table
 
 _W = ("omega_r1", "omega_r2", "omega_r3", "omega_r4")
 _DW = ("domega_r1", "domega_r2", "domega_r3", "domega_r4")

@@ -1,7 +1,7 @@
 /* An FMU in a worker process, seen by the master as the three C signatures of the call runner.
  *
  * The worker hosts the FMU's instance (FMI 2.0 or 3.0, of any variable type) and asks it, once
- * per run, for the C calls (orchestrator.fmi_types.CEntry) that set its inputs from, and write
+ * per run, for the C calls (quadcosim.orchestrator.fmi_types.CEntry) that set its inputs from, and write
  * its outputs to, float64 slots in a shared mapping, and for the call of its step. Each such
  * list of calls is a program, named by a number. The master's side (proxy_set, proxy_get,
  * proxy_step) has the signatures of fmi2SetReal, fmi2GetReal and fmi2DoStep; its first argument
@@ -265,7 +265,7 @@ __attribute__((visibility("default"))) int proxy_step(Entry *e, double t, double
 }
 
 /* ------------------------------------------------------------------ the worker's side */
-/* One C call of the hosted instance (an orchestrator.fmi_types.CEntry) in program `program`. */
+/* One C call of the hosted instance (an quadcosim.orchestrator.fmi_types.CEntry) in program `program`. */
 typedef struct {
     void *function;
     void *component;

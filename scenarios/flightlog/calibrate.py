@@ -28,7 +28,7 @@ FIGURES = ("residual.png", "heading.png")
 
 def _logs(files, verb: str, span=None) -> list:
     """The logs at ``files``, each cut to ``span`` (start, end; s on its clock) when given."""
-    from scenarios.flightlog.reading import load
+    from quadcosim.scenarios.flightlog.reading import load
 
     logs = [load(f, verb) for f in files]
     return logs if span is None else [_spanned(log, span) for log in logs]
@@ -36,7 +36,7 @@ def _logs(files, verb: str, span=None) -> list:
 
 def _spanned(log, span):
     """``log`` cut to ``span`` (``--span START END``, s on the log's clock); a span outside it is refused."""
-    from flightlogs import LogError, trim
+    from quadcosim.flightlogs import LogError, trim
 
     start, end = (float(x) for x in span)
     first, last = log.start, log.start + log.duration
@@ -72,8 +72,8 @@ def split_parts(train_logs, test_logs, compass: int, attitude: str = "auto", tri
     """:class:`Split` of compass ``compass`` of ``train_logs`` (FlightLogs; one alone is split in time
     with its last ``test_fraction``, default 0.5, held out) and ``test_logs`` (held-out flights, or
     empty), with the ``attitude``, ``trim`` and ``earth`` field (``model`` or ``free``) the command uses."""
-    from calibration.flight import flight_data
-    from calibration.flight.earth import align, model_field
+    from quadcosim.calibration.flight import flight_data
+    from quadcosim.calibration.flight.earth import align, model_field
 
     fields, notes = {}, {}
     for log in [*train_logs, *test_logs]:
@@ -119,8 +119,8 @@ def _split(args) -> Split:
         logs = _logs(args.files, "calibrate", args.span)
         train_logs, test_logs = (logs, []) if len(logs) == 1 or args.test_fraction is not None else \
             (logs[:-1], logs[-1:])
-    from calibration.flight.data import rate_refusal
-    from calibration.static import CalibrationError
+    from quadcosim.calibration.flight.data import rate_refusal
+    from quadcosim.calibration.static import CalibrationError
 
     for log in [*train_logs, *test_logs]:  # the command's floor; split_parts itself fits any rate (a measurement)
         refusal = rate_refusal(log, args.compass)
@@ -134,7 +134,7 @@ def _rule(args, part):
     """ArduPilot's rules for the export: the log's firmware, or --firmware's."""
     if args.firmware is None:
         return None
-    from flightlogs import ardupilot
+    from quadcosim.flightlogs import ardupilot
 
     version = ardupilot.parse_version(f"ArduCopter V{args.firmware}")
     if version is None:
@@ -147,8 +147,9 @@ def _write(out: Path, split: Split, metrics: dict, calibration, fitted: dict, ex
     """Every output file, ``metrics.json`` last (in the room kept for it: a disk that fills on the
     way still takes it, listing what was not written); the files written. ``export``: the
     autopilot, the parameter file's name and its parameters."""
-    from calibration.flight.autopilot import write_parameters
-    from orchestrator.files import DiskFull, Reserve, write_json
+    from quadcosim.calibration.flight.autopilot import write_parameters
+
+    from quadcosim.infra.files import DiskFull, Reserve, write_json
 
     reserve = Reserve(out)  # DiskFull when not even metrics.json fits: nothing is written
     files, not_written = ["metrics.json"], {}
@@ -186,7 +187,7 @@ def _write(out: Path, split: Split, metrics: dict, calibration, fitted: dict, ex
 def _figures(train, test, fitted, model, attitude) -> tuple:
     """The drawers (path -> None) of :data:`FIGURES`: the residual on the held-out part and the
     heading over a whole flight, before and after ``model``."""
-    from scenarios.flightlog.calibration_figures import heading_figure, residual_figure
+    from quadcosim.scenarios.flightlog.calibration_figures import heading_figure, residual_figure
 
     name = Path(train[0].source).name
 
@@ -200,7 +201,7 @@ def _figures(train, test, fitted, model, attitude) -> tuple:
         if whole is train[0]:
             from dataclasses import replace
 
-            from calibration.flight import flight_data
+            from quadcosim.calibration.flight import flight_data
 
             whole = replace(flight_data(train[0].log, train[0].compass, attitude), earth=train[0].earth)
         heading_figure(whole, fitted[model], model, cut, path,
@@ -211,10 +212,10 @@ def _figures(train, test, fitted, model, attitude) -> tuple:
 
 
 def _export(args, split: Split, metrics: dict) -> tuple:
-    """The parameters of the log's autopilot chosen and scored (:mod:`calibration.flight.export`),
+    """The parameters of the log's autopilot chosen and scored (:mod:`quadcosim.calibration.flight.export`),
     described in ``metrics["export"]``; (autopilot, file name, parameters)."""
-    from calibration.flight.autopilot import AUTOPILOTS
-    from calibration.flight.export import choose, judge, log_parameters, score_parameters
+    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
+    from quadcosim.calibration.flight.export import choose, judge, log_parameters, score_parameters
 
     train, score = split.train, split.score
     rule = _rule(args, split.test[0])
@@ -293,8 +294,15 @@ def _export_lines(export: dict) -> list[str]:
 
 
 def _score(args, split: Split) -> int:
-    from calibration.flight.export import Candidate, log_parameters, parameters_of, score_file, score_parameters
-    from orchestrator.files import write_json
+    from quadcosim.calibration.flight.export import (
+        Candidate,
+        log_parameters,
+        parameters_of,
+        score_file,
+        score_parameters,
+    )
+
+    from quadcosim.infra.files import write_json
 
     score = split.score
     rule = _rule(args, score[0])
@@ -321,12 +329,12 @@ def _score(args, split: Split) -> int:
 def run(args) -> int:
     """``quadcosim calibrate`` (``args`` from :func:`add_arguments`): 0, 2 on bad input (nothing
     written), 1 when the disk filled while the files were written (``metrics.json`` says which
-    were not). The folder is held (:func:`orchestrator.files.folder_lock`) from before its
+    were not). The folder is held (:func:`quadcosim.infra.files.folder_lock`) from before its
     earlier results are replaced until ``metrics.json`` is written; signals wait while the files
     are written, so that an interrupt leaves them all with their ``metrics.json``, or nothing."""
-    from calibration.flight import calibrate
-    from calibration.static import CalibrationError
-    from scenarios.output_options import default_folder
+    from quadcosim.calibration.flight import calibrate
+    from quadcosim.calibration.static import CalibrationError
+    from quadcosim.scenarios.output_options import default_folder
 
     if not args.out:
         first = (args.files or args.train or [None])[0]
@@ -372,9 +380,10 @@ def _saved(out: Path, overwrite: bool, write):
     a folder this command created is removed again when nothing could be written into it."""
     import contextlib
 
-    from orchestrator.files import prepare_out_dir
-    from orchestrator.interrupts import held
-    from scenarios.outputs import remove_if_empty
+    from quadcosim.scenarios.outputs import remove_if_empty
+
+    from quadcosim.infra.files import prepare_out_dir
+    from quadcosim.infra.interrupts import held
 
     made = not out.exists()
     with contextlib.ExitStack() as lock, held():
@@ -388,7 +397,7 @@ def _saved(out: Path, overwrite: bool, write):
 
 def _check_out(out: Path, overwrite: bool):
     """Refuse at once an output folder that will be refused after the flights are read and fitted."""
-    from orchestrator.files import FolderBusy, busy_message, held_by, holds_results
+    from quadcosim.infra.files import FolderBusy, busy_message, held_by, holds_results
 
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {out}: a file of that name exists; give a folder name")
@@ -404,11 +413,12 @@ def _check_out(out: Path, overwrite: bool):
 def _numeric(call, sources, also=(ValueError,)):
     """``call()``, a numerical library's failure (``LinAlgError``, ``FloatingPointError``,
     ``IndexError`` and the classes ``also``) named with the flights ``sources``, its cause and the
-    fix; the project's own refusals (:class:`~calibration.static.CalibrationError`,
-    :class:`~flightlogs.LogError`, ...) pass unchanged."""
-    from calibration.static import CalibrationError
-    from flightlogs import LogError
-    from orchestrator.files import OutputRefused
+    fix; the project's own refusals (:class:`~quadcosim.calibration.static.CalibrationError`,
+    :class:`~quadcosim.flightlogs.LogError`, ...) pass unchanged."""
+    from quadcosim.calibration.static import CalibrationError
+    from quadcosim.flightlogs import LogError
+
+    from quadcosim.infra.files import OutputRefused
 
     try:
         return call()
@@ -439,7 +449,7 @@ def _ours(error: BaseException) -> bool:
 def _check_choices(args):
     """--attitude and --models against the calibration's own names (checked here rather than by
     argparse, so that the command line's help does not import the calibration package)."""
-    from calibration.flight import ATTITUDES, MODELS
+    from quadcosim.calibration.flight import ATTITUDES, MODELS
 
     if args.attitude not in ATTITUDES:
         raise ValueError(f"--attitude {args.attitude!r} must be one of {', '.join(ATTITUDES)}")

@@ -4,16 +4,16 @@ throttle before and after the exported model, and the heading before and after o
 from __future__ import annotations
 
 import numpy as np
+from quadcosim.calibration.flight.evaluate import tilt_compensated_heading, wrap
+from quadcosim.calibration.flight.linear import earth_and_offset
 
-from calibration.flight.evaluate import tilt_compensated_heading, wrap
-from calibration.flight.linear import earth_and_offset
-from orchestrator.files import printable, save_figure
+from quadcosim.infra.files import printable, save_figure
 
 TESLA_TO_UT = 1e6
 
 
 def _pyplot():
-    from orchestrator.files import headless_backend
+    from quadcosim.infra.files import headless_backend
 
     headless_backend()
     import matplotlib.pyplot as plt

@@ -1,5 +1,5 @@
 """``quadcosim log info FILE``, ``quadcosim log plot FILE``: what a flight log holds, in text and in
-one figure; ``quadcosim log replay FILE``: the estimators on it (:mod:`scenarios.flightlog.replay`);
+one figure; ``quadcosim log replay FILE``: the estimators on it (:mod:`quadcosim.scenarios.flightlog.replay`);
 ``quadcosim log example FOLDER``: three synthetic logs to try them on."""
 
 from __future__ import annotations
@@ -8,13 +8,13 @@ import json
 import sys
 from pathlib import Path
 
-from scenarios.flightlog.reading import load
+from quadcosim.scenarios.flightlog.reading import load
 
 
 def info(args) -> int:
     """``quadcosim log info FILE [--json]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
-    from flightlogs import LogError
-    from flightlogs.info import summary, text
+    from quadcosim.flightlogs import LogError
+    from quadcosim.flightlogs.info import summary, text
 
     try:
         found = summary(load(args.file, "log info"))
@@ -28,14 +28,15 @@ def info(args) -> int:
 def plot(args) -> int:
     """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); 2 on a bad
     log or output path, 1 when the figure could not be written (a full disk)."""
-    from flightlogs import LogError
-    from orchestrator.files import OutputRefused, figure_file
-    from scenarios.flightlog.overview import plot_overview
+    from quadcosim.flightlogs import LogError
+    from quadcosim.scenarios.flightlog.overview import plot_overview
+
+    from quadcosim.infra.files import OutputRefused, figure_file
 
     try:
         out = figure_file(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
         if not args.out and not args.overwrite:
-            from scenarios.output_options import free_file
+            from quadcosim.scenarios.output_options import free_file
 
             out = free_file(out, "log plot")
         log = load(args.file, "log plot")
@@ -51,9 +52,9 @@ def plot(args) -> int:
 
 def replay(args) -> int:
     """``quadcosim log replay FILE`` (``args`` from :func:`add_arguments`, handed to
-    :func:`scenarios.flightlog.replay.run`), imported when called: the estimators (and numba)
+    :func:`quadcosim.scenarios.flightlog.replay.run`), imported when called: the estimators (and numba)
     load for a replay, not for every command's parser."""
-    from scenarios.flightlog import replay as replayed
+    from quadcosim.scenarios.flightlog import replay as replayed
 
     return replayed.run(args)
 
@@ -79,12 +80,12 @@ def add_arguments(parser):
                               "compensation, against the autopilot's attitude (a reference, not the truth)")
     replayed.add_argument("file", help="PX4 .ulg, ArduPilot .bin or .log")
     replayed.add_argument("--compass", type=int, default=0, help="compass to use, from 0 in the log's order")
-    from scenarios.output_options import add_json_flag
+    from quadcosim.scenarios.output_options import add_json_flag
 
     add_json_flag(replayed, "print the result as JSON on standard output, in place of the table")
     replayed.add_argument("--out", metavar="FILE", help="also write the result to this JSON file")
     replayed.set_defaults(func=replay)
-    from scenarios.flightlog import example
+    from quadcosim.scenarios.flightlog import example
 
     made = sub.add_parser("example", help="write three small synthetic flight logs to try these commands on "
                           "(ArduPilot text logs: example-a.log, example-b.log, example-c.log)")

@@ -21,8 +21,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
-from flightlogs.model import SYNTHETIC_MARK
+from quadcosim.flightlogs.model import SYNTHETIC_MARK
 
 #: Earth position of the flights: latitude, longitude (deg), altitude (m), and the date (year).
 SITE = (45.19, 5.72, 210.0)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.files import printable, save_figure
+from quadcosim.infra.files import printable, save_figure
 
 TESLA_TO_UT = 1e6
 #: Legends stand right of their axes, where they cover no trace.
@@ -29,11 +29,11 @@ def _broken_at_wraps(time: np.ndarray, angle_deg: np.ndarray) -> tuple[np.ndarra
 
 
 def plot_overview(log, out) -> Path:
-    """Draw the overview of ``log`` (:class:`flightlogs.FlightLog`) into the figure file ``out``
-    (its format from its suffix, written atomically: :func:`orchestrator.files.save_figure`): each
+    """Draw the overview of ``log`` (:class:`quadcosim.flightlogs.FlightLog`) into the figure file ``out``
+    (its format from its suffix, written atomically: :func:`quadcosim.infra.files.save_figure`): each
     compass's raw field (uT), battery current (A) and voltage (V), motor commands and throttle
     (1), and the autopilot's roll, pitch and yaw (deg), on the log's clock (s)."""
-    from orchestrator.files import headless_backend
+    from quadcosim.infra.files import headless_backend
 
     headless_backend()
     import matplotlib.pyplot as plt

@@ -7,9 +7,9 @@ import sys
 
 
 def load(path, verb: str):
-    """The :class:`flightlogs.FlightLog` at ``path``, with a simulator log and corruption read
+    """The :class:`quadcosim.flightlogs.FlightLog` at ``path``, with a simulator log and corruption read
     past announced on standard error, prefixed by ``verb``; raises ``LogError``."""
-    from flightlogs import read_log
+    from quadcosim.flightlogs import read_log
 
     log = read_log(path)
     if log.simulator:

@@ -9,8 +9,8 @@ How a log is replayed:
 
 - the first IMU, resampled to a uniform period (its median sample spacing), gives gyro and
   specific force; the compass (``--compass``) is interpolated to the same instants;
-- the compensation is calibrated on the first half of the flight (:func:`calibration.flight.calibrate`)
-  and applied by :func:`calibration.compensate` (eq. 9 of Metge et al.) with the offsets fitted
+- the compensation is calibrated on the first half of the flight (:func:`quadcosim.calibration.flight.calibrate`)
+  and applied by :func:`quadcosim.calibration.compensate` (eq. 9 of Metge et al.) with the offsets fitted
   with its model (the log's offsets already hold the motors' mean field); without it, only the
   log's offsets are removed;
 - the Earth field in NED is the compass's field rotated by the log's attitude, averaged over the
@@ -23,8 +23,7 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-
-from estimators import kinds
+from quadcosim.estimators import kinds
 
 MIN_SAMPLES = 100  # IMU samples a replay needs: half of them, the second, are scored
 ESTIMATORS = kinds.compared(batch=True)  # estimator -> its settings (estimators/kinds.py)
@@ -33,9 +32,8 @@ REFERENCE_NOTE = ("differences from the autopilot's own attitude estimate, a ref
 
 
 def _uniform(log, compass: int):
+    from quadcosim.flightlogs import LogError
     from scipy.spatial.transform import Rotation, Slerp
-
-    from flightlogs import LogError
 
     imu = log.imus[0]
     chosen = log.compass(compass)
@@ -59,13 +57,13 @@ def _fields(log, compass: int, time, model_offsets: bool = True):
     log's, which count the motors' mean field twice; an ablation)."""
     from dataclasses import replace
 
-    from calibration import compensate
-    from calibration.flight import calibrate, flight_data
+    from quadcosim.calibration import compensate
+    from quadcosim.calibration.flight import calibrate, flight_data
 
     data = flight_data(log, compass)
     train, test = data.split(0.5)
     # the calibration pairs its model with the offsets fitted with it when the log's are kept
-    # (calibration.flight.calibrate.paired_static); without the model, the log's offsets
+    # (quadcosim.calibration.flight.calibrate.paired_static); without the model, the log's offsets
     metrics, calibration, _ = calibrate([train], [test], ("current", "throttle", "motors", "metge"))
     raw = np.column_stack([np.interp(time, data.time, data.raw[:, k]) for k in range(3)])
     motors = log.motors
@@ -87,18 +85,18 @@ def _fields(log, compass: int, time, model_offsets: bool = True):
 
 def replay_log(path, compass: int = 0, settle_s: float = 5.0, kinds=tuple(ESTIMATORS)) -> dict:
     """Run every estimator of :data:`ESTIMATORS` on the log at ``path`` (or an already read
-    :class:`flightlogs.FlightLog`) with compass ``compass``, without and with the
+    :class:`quadcosim.flightlogs.FlightLog`) with compass ``compass``, without and with the
     compensation; heading and inclination RMS differences (deg) from the log's attitude over the
     second half of the flight (at least ``settle_s`` (s) after the start); ``kinds``: the
     estimators run (names of :data:`ESTIMATORS`)."""
-    from estimators import estimate
-    from flightlogs import FlightLog, read_log
+    from quadcosim.estimators import estimate
+    from quadcosim.flightlogs import FlightLog, read_log
 
     log = path if isinstance(path, FlightLog) else read_log(path)
     log.require("a replay", "imu", "attitude", "compass", "motors")
     time, dt, gyro, acc, reference = _uniform(log, compass)
     without, with_model, model = _fields(log, compass, time)
-    from calibration.flight.data import rate_refusal
+    from quadcosim.calibration.flight.data import rate_refusal
 
     refused = rate_refusal(log, compass)
     if refused:  # a compass logged too slowly for a calibration: replayed without a compensation fitted on it
@@ -140,9 +138,10 @@ def text(result: dict) -> str:
 def _replayed(log, compass: int) -> dict:
     """:func:`replay_log` of the read ``log``, a numerical library's failure named with the file,
     its likely cause and the fix."""
-    from calibration.static import CalibrationError
-    from flightlogs import LogError
-    from orchestrator.files import OutputRefused
+    from quadcosim.calibration.static import CalibrationError
+    from quadcosim.flightlogs import LogError
+
+    from quadcosim.infra.files import OutputRefused
 
     try:
         return replay_log(log, compass)
@@ -160,9 +159,10 @@ def run(args) -> int:
     result written as JSON there; 2 on bad
     input (a log, an option or an output path refused), 1 when the JSON could not be written (a
     full disk: nothing is left under its name)."""
-    from calibration.static import CalibrationError
-    from orchestrator.files import output_file, write_json
-    from scenarios.flightlog.reading import load
+    from quadcosim.calibration.static import CalibrationError
+    from quadcosim.scenarios.flightlog.reading import load
+
+    from quadcosim.infra.files import output_file, write_json
 
     out = getattr(args, "out", None)
     try:

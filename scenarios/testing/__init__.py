@@ -4,22 +4,22 @@ Installed with the package (entry point ``pytest11``), so that its fixtures are 
 test without an import:
 
 ``run_scenario(name, duration=..., **options)``
-    Runs a scenario (:func:`scenarios.run`) for a short horizon, without result files, figures
-    or wiring diagram (unless ``out`` is given), and returns its :class:`orchestrator.Result`
+    Runs a scenario (:func:`quadcosim.scenarios.run`) for a short horizon, without result files, figures
+    or wiring diagram (unless ``out`` is given), and returns its :class:`quadcosim.orchestrator.Result`
     with the scenario's metrics as ``result.metrics``.
 ``make_system(dt=...)``
-    An empty :class:`orchestrator.System`, to wire blocks of one's own.
+    An empty :class:`quadcosim.orchestrator.System`, to wire blocks of one's own.
 ``quadcosim_seed``
     The test's seed: fixed by the test's node id, the same on every run and every worker,
     printed in the report of a failing test. ``run_scenario`` gives it to a scenario's
     ``seed`` option unless the test sets it.
 
 FMU instances are pooled for the session (one pool per process, so one per pytest-xdist
-worker) and reset between runs (:mod:`orchestrator.pool`): the second test does not pay for
+worker) and reset between runs (:mod:`quadcosim.orchestrator.pool`): the second test does not pay for
 instantiating the plant. An FMU of one's own is pooled only when its reset is verified (one
 step after a reset equals one step of a fresh instance); otherwise each test takes a fresh
 instance, which a warning says once: results never depend on the order of the tests. The
-checks on a result are in :mod:`scenarios.testing.assertions`.
+checks on a result are in :mod:`quadcosim.scenarios.testing.assertions`.
 """
 
 from __future__ import annotations
@@ -27,8 +27,7 @@ from __future__ import annotations
 import zlib
 
 import pytest
-
-from scenarios.testing.assertions import (
+from quadcosim.scenarios.testing.assertions import (
     assert_attitude_error,
     assert_bias_converges,
     assert_bounds,
@@ -96,7 +95,7 @@ def pytest_runtest_makereport(item, call):
 def pytest_runtest_call(item):
     """End the session on an interrupted run, as pytest's own KeyboardInterrupt does (exit 2).
 
-    A run stopped by Ctrl-C or SIGTERM raises :class:`orchestrator.RunInterrupted`, an error
+    A run stopped by Ctrl-C or SIGTERM raises :class:`quadcosim.orchestrator.RunInterrupted`, an error
     of the simulation: left as it is, pytest would count the test as failed and run the next
     one. It is raised again as a KeyboardInterrupt, naming what the run kept.
 
@@ -105,7 +104,7 @@ def pytest_runtest_call(item):
     item : pytest.Item
         The test.
     """
-    from orchestrator.errors import RunInterrupted
+    from quadcosim.orchestrator.errors import RunInterrupted
 
     try:
         return (yield)
@@ -124,7 +123,7 @@ def quadcosim_seed(request) -> int:
 @pytest.fixture(scope="session")
 def _quadcosim_pool():
     """The session's FMU instances: kept idle between the plugin's tests, freed at the end."""
-    from orchestrator import pool
+    from quadcosim.orchestrator import pool
 
     yield pool
     pool.reuse(False)
@@ -141,17 +140,17 @@ def run_scenario(request, quadcosim_seed, _quadcosim_pool):
     - ``duration``: simulated time (s), the scenario's option ``duration``;
     - ``options``: the scenario's options (``estimator="passive"``, ``bias=True``); an
       estimator of one's own as ``estimator="my_filter.py:MyFilter"`` or ``estimator=MyFilter``
-      (a class or an instance, :mod:`estimators.contract`); ``seed`` defaults to the test's;
+      (a class or an instance, :mod:`quadcosim.estimators.contract`); ``seed`` defaults to the test's;
     - ``blocks``: blocks of one's own in the place of the scenario's, ``{"Controller": block}``;
     - ``parameters``: block parameters, ``{"Controller.kp": 100.0, "IMU.gyro_noise_density": 1e-3}``;
-    - ``faults``: :class:`orchestrator.Fault` injected; ``record``: signals kept (default: the
+    - ``faults``: :class:`quadcosim.orchestrator.Fault` injected; ``record``: signals kept (default: the
       scenario's);
     - ``out``: a folder: results, metrics and figures written there, as ``quadcosim run`` does.
 
-    Returns the :class:`orchestrator.Result`, its metrics in ``result.metrics`` and the test's
+    Returns the :class:`quadcosim.orchestrator.Result`, its metrics in ``result.metrics`` and the test's
     seed and node id in ``result.meta["test"]``.
     """
-    import scenarios
+    from quadcosim import scenarios
 
     runs = request.node.stash.setdefault(_RUNS, [])
     previous = _quadcosim_pool.reuse(True)
@@ -159,7 +158,7 @@ def run_scenario(request, quadcosim_seed, _quadcosim_pool):
     def run(name, duration=None, *, estimator=None, blocks=None, parameters=None, faults=(), record=None, out=None,
             **options):
         if name not in scenarios.names():
-            from orchestrator.fmu import nearest
+            from quadcosim.orchestrator.fmu import nearest
 
             raise ValueError(f"run_scenario: no scenario {name!r}.{nearest(str(name), scenarios.names())} "
                              f"Scenarios: {', '.join(scenarios.names())}")
@@ -193,9 +192,9 @@ def run_scenario(request, quadcosim_seed, _quadcosim_pool):
 
 @pytest.fixture
 def make_system():
-    """A function making an empty :class:`orchestrator.System`: ``make_system(dt=1e-3)``, the
+    """A function making an empty :class:`quadcosim.orchestrator.System`: ``make_system(dt=1e-3)``, the
     macro step ``dt`` in seconds."""
-    from orchestrator import System
+    from quadcosim.orchestrator import System
 
     def make(dt: float = 1e-3):
         return System(dt=dt)

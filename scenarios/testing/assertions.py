@@ -1,6 +1,6 @@
 """Physical assertions on a recorded run, for tests: each checks one property in physical units.
 
-Every helper takes an :class:`orchestrator.Result` (a run of :func:`scenarios.run` or of the
+Every helper takes an :class:`quadcosim.orchestrator.Result` (a run of :func:`quadcosim.scenarios.run` or of the
 ``run_scenario`` fixture), returns the figure it checked, and on failure raises
 :class:`AssertionError` saying what failed, where and by how much: the worst sample's time (s),
 its value and the bound, and the seed of the run, so that the failure can be run again.
@@ -12,8 +12,8 @@ its value and the bound, and the seed of the run, so that the failure can be run
 - :func:`assert_bounds`: a signal within its bounds;
 - :func:`assert_runs_close`: two runs agreeing signal by signal within a tolerance.
 
-The errors they compute are those of the scenarios' metrics (:func:`scenarios.tp.euler_error`,
-:func:`scenarios.tp.bias_convergence_time`), so that a test and a ``metrics.json`` measure the
+The errors they compute are those of the scenarios' metrics (:func:`quadcosim.scenarios.tp.euler_error`,
+:func:`quadcosim.scenarios.tp.bias_convergence_time`), so that a test and a ``metrics.json`` measure the
 same thing.
 """
 
@@ -35,7 +35,7 @@ def seed_text(result) -> str:
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
 
     Returns
     -------
@@ -121,18 +121,18 @@ def _worst(excess: np.ndarray, mask: np.ndarray) -> int:
 def attitude_errors_deg(result) -> np.ndarray:
     """Estimation error of every sample (deg; columns roll, pitch, yaw, wrapped to +-180): the
     estimate ``Quaternion_estim.theta_est`` minus the truth ``Quadrotor.theta``, as tp's metrics
-    compute it (:func:`scenarios.tp.euler_error`).
+    compute it (:func:`quadcosim.scenarios.tp.euler_error`).
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A run of the lab's closed loop (or any run recording those two signals).
 
     Returns
     -------
     numpy.ndarray, shape (len(result), 3)
     """
-    from scenarios.tp import euler_error
+    from quadcosim.scenarios.tp import euler_error
 
     return np.degrees(np.column_stack([euler_error(result, "Quaternion_estim.theta_est", k) for k in range(3)]))
 
@@ -142,7 +142,7 @@ def assert_attitude_error(result, below_deg: float, after_s: float = 0.0, axes=A
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A run recording ``Quaternion_estim.theta_est`` and ``Quadrotor.theta`` (rad).
     below_deg : float
         Bound on the absolute Euler angle error of every sample (deg).
@@ -181,7 +181,7 @@ def assert_tracking(result, signal, setpoint, within: float, after_s: float = 0.
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
     signal : str or (str, array_like)
         A recorded signal (``"Quadrotor.theta2"``), or a name and one value per sample.
     setpoint : str, float or (str, array_like)
@@ -213,7 +213,7 @@ def assert_tracking(result, signal, setpoint, within: float, after_s: float = 0.
         target_name, target = _values(result, setpoint)
     difference = values - target
     if angle:
-        from scenarios.tp import wrapped
+        from quadcosim.scenarios.tp import wrapped
 
         difference = wrapped(difference)
     mask = _after(result, after_s)
@@ -265,7 +265,7 @@ def step_response(result, signal, step_s: float, final: float | None = None, ban
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
     signal : str or (str, array_like)
         A recorded signal, or a name and one value per sample.
     step_s : float
@@ -279,7 +279,7 @@ def step_response(result, signal, step_s: float, final: float | None = None, ban
     -------
     StepResponse
     """
-    from flight.measured import step_figures
+    from quadcosim.flight.measured import step_figures
 
     name, values = _values(result, signal)
     start = int(np.searchsorted(result.time, step_s))
@@ -307,7 +307,7 @@ def assert_step(result, signal, step_s: float, final: float | None = None, settl
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
     signal : str or (str, array_like)
         A recorded signal, or a name and one value per sample.
     step_s : float
@@ -359,7 +359,7 @@ def assert_bias_converges(result, within_s: float | None = None, tolerance: floa
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
         A run recording the bias estimate and the true bias (rad/s, body frame).
     within_s : float, optional
         Bound on the convergence time (s); None checks only that it converges before the end.
@@ -371,7 +371,7 @@ def assert_bias_converges(result, within_s: float | None = None, tolerance: floa
     Returns
     -------
     float
-        The convergence time (s, :func:`scenarios.tp.bias_convergence_time`).
+        The convergence time (s, :func:`quadcosim.scenarios.tp.bias_convergence_time`).
 
     Raises
     ------
@@ -379,7 +379,7 @@ def assert_bias_converges(result, within_s: float | None = None, tolerance: floa
         No convergence, or too late; the message gives the last sample outside the tolerance
         (time, axis, error), the bound and the seed.
     """
-    from scenarios.tp import bias_convergence_time
+    from quadcosim.scenarios.tp import bias_convergence_time
 
     tolerance = _number("tolerance", tolerance)
     within_s = None if within_s is None else _number("within_s", within_s)
@@ -407,7 +407,7 @@ def assert_bounds(result, signal, lower: float | None = None, upper: float | Non
 
     Parameters
     ----------
-    result : orchestrator.Result
+    result : quadcosim.orchestrator.Result
     signal : str or (str, array_like)
         A recorded signal or vector (``"Quadrotor.p"``), or a name and values (one row per sample).
     lower, upper : float, optional
@@ -456,7 +456,7 @@ def assert_runs_close(result, other, signals=None, atol: float = 0.0, rtol: floa
 
     Parameters
     ----------
-    result, other : orchestrator.Result
+    result, other : quadcosim.orchestrator.Result
         The runs, on the same time samples.
     signals : sequence of str, optional
         Signals or vectors compared; default: every signal both recorded.

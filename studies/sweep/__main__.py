@@ -1,10 +1,10 @@
 import sys
 
-from orchestrator.interrupts import exit_code, leave  # the standard library alone: no window before the try
+from quadcosim.infra.interrupts import exit_code, leave  # the standard library alone: no window before the try
 
 if __name__ == "__main__":
     try:
-        from studies.sweep.command import main
+        from quadcosim.studies.sweep.command import main
 
         code = main()
     except KeyboardInterrupt as interrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep

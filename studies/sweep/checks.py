@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from studies.sweep.grid import ChainedMembers, GridMembers, Plan
+from quadcosim.studies.sweep.grid import ChainedMembers, GridMembers, Plan
 
 #: Dimensions with up to this many values are probed value by value.
 PROBED_VALUES = 32
@@ -70,10 +70,11 @@ def check(plan: Plan) -> int:
         A member's system cannot be built or an FMU refused its parameters: the message names
         the member, the reason, and that the sweep did not start.
     """
-    import scenarios
-    from fmus import FMUNotFoundError
-    from orchestrator.blocks import FMUBlock
-    from orchestrator.fmu import FMUError
+    from quadcosim.fmus import FMUNotFoundError
+    from quadcosim.orchestrator.blocks import FMUBlock
+    from quadcosim.orchestrator.fmu import FMUError
+
+    from quadcosim import scenarios
 
     scenario = scenarios.get(plan.scenario)
     indices = probes(plan)

@@ -1,4 +1,4 @@
-"""``quadcosim sweep`` and ``quadcosim sweep-plot`` (also ``python -m studies.sweep``).
+"""``quadcosim sweep`` and ``quadcosim sweep-plot`` (also ``python -m quadcosim.studies.sweep``).
 
     quadcosim sweep tp --grid k=0.01:10:log12 --grid estimator=linear,explicit \\
         --set duration=5 --seeds 4 --workers 2 --out results/k-sweep
@@ -37,7 +37,7 @@ def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
                    help="also retry members that raised or gave a NaN (members are deterministic)")
     p.add_argument("--results", action="store_true", help="keep each member's results and figures (large)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
-    from studies.sweep.grid import MAX_MEMBERS
+    from quadcosim.studies.sweep.grid import MAX_MEMBERS
 
     p.add_argument("--max-members", type=int, default=MAX_MEMBERS, metavar="N",
                    help=f"refuse a plan of more members (default {MAX_MEMBERS:,}); counted before any is made")
@@ -56,7 +56,7 @@ def add_plot_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
 
 
 def _stored_plan(out: Path):
-    from studies.sweep.grid import Plan, stored_members
+    from quadcosim.studies.sweep.grid import Plan, stored_members
 
     path = out / "sweep.json"
     try:
@@ -90,7 +90,7 @@ def default_out(base: Path, resume: bool, label: str, marker: str = "sweep.json"
     """
     if resume:
         return base
-    from orchestrator.files import first_free
+    from quadcosim.infra.files import first_free
 
     candidate = first_free(base, lambda folder: (folder / marker).exists()
                            or (folder.exists() and not folder.is_dir()))
@@ -103,7 +103,7 @@ def default_out(base: Path, resume: bool, label: str, marker: str = "sweep.json"
 def make_plan(args):
     """The plan the parsed arguments ``args`` describe (a named sweep, a grid, or the stored one
     on --resume)."""
-    from studies.sweep import grid, named
+    from quadcosim.studies.sweep import grid, named
 
     out = Path(args.out) if args.out else default_out(Path("results") / f"sweep-{args.scenario}", args.resume,
                                                       f"quadcosim sweep {args.scenario}")
@@ -130,11 +130,11 @@ def sweep(args) -> int:
     Returns
     -------
     int
-        Exit code (:data:`studies.sweep.engine.EXIT_CODES`): 0 when every member is ``ok``, 1
+        Exit code (:data:`quadcosim.studies.sweep.engine.EXIT_CODES`): 0 when every member is ``ok``, 1
         when any failed or was not run, 2 for bad arguments or a refused folder, 3 when every
         member ran and some diverged, 128 + the signal when interrupted.
     """
-    from studies.sweep import engine, named
+    from quadcosim.studies.sweep import engine, named
 
     try:
         if args.workers is not None and args.workers < 1:
@@ -145,7 +145,7 @@ def sweep(args) -> int:
             raise ValueError(f"--max-members {args.max_members}: give at least 1 (the most members a plan may have)")
         if not args.connect_timeout > 0:
             raise ValueError(f"--connect-timeout {args.connect_timeout:g}: give a number of seconds above 0")
-        from studies.sweep.folder import check_out, check_scheduler
+        from quadcosim.studies.sweep.folder import check_out, check_scheduler
 
         check_scheduler(args.scheduler)  # before the plan is made or anything written
         if args.out:
@@ -174,8 +174,9 @@ def _plot_context(folder: Path) -> tuple[dict, str, dict]:
     """Units of the swept scenario's options and block parameters (as declared), a line naming the scenario and
     the options held fixed, and what its metrics' components are (``rms_error_deg[0]``: roll),
     from the sweep's ``sweep.json`` (nothing without one)."""
-    import scenarios
-    from studies.sweep import units as units_of
+    from quadcosim.studies.sweep import units as units_of
+
+    from quadcosim import scenarios
 
     try:
         stored = json.loads((folder / "sweep.json").read_text())
@@ -199,7 +200,7 @@ def sweep_plot(args) -> int:
     int
         Exit code: 0, 2 for a missing table or column or a figure path refused, 1 for a full disk.
     """
-    from studies.sweep import figure, table
+    from quadcosim.studies.sweep import figure, table
 
     try:
         columns = table.read(args.table)
@@ -225,9 +226,9 @@ def sweep_plot(args) -> int:
 
 
 def main(argv=None) -> int:
-    """``python -m studies.sweep``: the same as ``quadcosim sweep``; returns its exit code.
+    """``python -m quadcosim.studies.sweep``: the same as ``quadcosim sweep``; returns its exit code.
     ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    from orchestrator.interrupts import exit_code, terminate_as_interrupt
+    from quadcosim.infra.interrupts import exit_code, terminate_as_interrupt
 
     def one_line(message, category, filename, lineno, file=None, line=None):  # as quadcosim prints warnings
         print(f"quadcosim sweep: warning: {' '.join(str(message).split())}", file=sys.stderr)
@@ -236,7 +237,7 @@ def main(argv=None) -> int:
         with terminate_as_interrupt(), warnings.catch_warnings():
             warnings.simplefilter("default")
             warnings.showwarning = one_line
-            p = add_arguments(argparse.ArgumentParser(prog="python -m studies.sweep", description=__doc__,
+            p = add_arguments(argparse.ArgumentParser(prog="python -m quadcosim.studies.sweep", description=__doc__,
                                                       formatter_class=argparse.RawDescriptionHelpFormatter))
             return sweep(p.parse_args(argv))
     except KeyboardInterrupt as interrupt:  # while loading or planning: nothing to keep yet

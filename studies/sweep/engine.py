@@ -38,10 +38,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from distributed import WorkerPlugin
+from quadcosim.studies.sweep import table
+from quadcosim.studies.sweep.grid import Member, Plan, stored_members
 
-from orchestrator.files import atomic_path, write_text
-from studies.sweep import table
-from studies.sweep.grid import Member, Plan, stored_members
+from quadcosim.infra.files import atomic_path, write_text
 
 #: Keys of a scenario's metrics that are not metrics of a member.
 NOT_METRICS = ("scenario", "options", "figures", "units", "injected_faults", "status", "diverged",
@@ -72,10 +72,11 @@ class Preload(WorkerPlugin):
         import matplotlib
 
         matplotlib.use("Agg")
-        import scenarios
-        from fmus import MODELS, FMUNotFoundError
-        from orchestrator import pool
-        from orchestrator.fmu import FMUInstance
+        from quadcosim.fmus import MODELS, FMUNotFoundError
+        from quadcosim.orchestrator import pool
+        from quadcosim.orchestrator.fmu import FMUInstance
+
+        from quadcosim import scenarios
 
         scenarios.get(self.scenario)
         pool.reuse(True)  # members reset the worker's FMU instances rather than make new ones
@@ -90,7 +91,7 @@ class Preload(WorkerPlugin):
 def worker_state(dask_worker=None) -> dict:
     """What this worker process has done: members run, FMU extractions, preparation time (s).
     Called through ``Client.run``, which passes the worker as ``dask_worker``."""
-    from orchestrator import fmu
+    from quadcosim.orchestrator import fmu
 
     return {"members": _members_run, "extractions": len(fmu._extracted),
             "preload_s": getattr(dask_worker, "quadcosim_preload_s", None)}
@@ -147,7 +148,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
         stepping loop alone), ``worker``, ``files``.
     """
     global _members_run
-    import scenarios
+    from quadcosim import scenarios
 
     try:
         from distributed import get_worker
@@ -178,7 +179,7 @@ def run_member(scenario: str, options: dict, keep_results: bool = False, extra_m
         record["metrics"] = _plain({k: v for k, v in metrics.items() if k not in NOT_METRICS})
         bad = first_non_finite(record["metrics"])
         if diverged is not None:  # a crash: its numbers are kept, and never counted as a result
-            from scenarios.divergence import message
+            from quadcosim.scenarios.divergence import message
 
             record |= {"status": "diverged", "diverged": _plain(diverged),
                        "error": message(scenario, diverged, diverged.get("settings") or [])}
@@ -200,7 +201,7 @@ class Summary:
     """How a sweep went: counts over the whole table, and what this call ran.
 
     ``out`` is the sweep's folder; ``total``, ``ok``, ``failed`` and ``diverged`` count the
-    members of the table by outcome (:data:`studies.sweep.table.OUTCOMES`), ``ran`` and
+    members of the table by outcome (:data:`quadcosim.studies.sweep.table.OUTCOMES`), ``ran`` and
     ``skipped`` (already done, on --resume) those of this call; ``seconds`` its wall time (s) on
     ``workers`` workers, of which ``startup_s`` and ``shutdown_s`` (s) went to the cluster;
     ``interrupted`` the signal that stopped it (0 if none); ``failures`` and ``divergences`` the
@@ -353,7 +354,7 @@ def _prepare_folder(plan: Plan, out: Path, resume: bool) -> table.Rows:
 def _write_plan(plan: Plan, out: Path) -> None:
     """``sweep.json`` and ``members/``: written once the cluster is up, so that a sweep refused
     before leaves nothing."""
-    from studies.sweep import units
+    from quadcosim.studies.sweep import units
 
     (out / "members").mkdir(exist_ok=True)
     names = list(plan.varied) + (list(plan.members[0].options) if len(plan.members) else [])
@@ -430,7 +431,7 @@ def cluster(workers: int | None = None, scheduler: str | None = None, connect_ti
     workers : int, optional
         Local worker processes (default: the CPUs). Ignored with ``scheduler``.
     scheduler : str, optional
-        A running scheduler's address (checked by :func:`studies.sweep.folder.check_scheduler`).
+        A running scheduler's address (checked by :func:`quadcosim.studies.sweep.folder.check_scheduler`).
     connect_timeout : float
         Seconds to reach the scheduler (s).
     timeout : float
@@ -484,7 +485,7 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     Parameters
     ----------
     plan : Plan
-        The scenario and its members (:func:`studies.sweep.plan`).
+        The scenario and its members (:func:`quadcosim.studies.sweep.plan`).
     out : path
         Sweep folder (see the module documentation).
     workers : int, optional
@@ -522,16 +523,16 @@ def run(plan: Plan, out, workers: int | None = None, scheduler: str | None = Non
     SweepError
         The folder does not match the plan, holds no sweep to resume, or the scheduler cannot be
         reached.
-    studies.sweep.folder.FolderRefused
+    quadcosim.studies.sweep.folder.FolderRefused
         The folder cannot be made or written, or the scheduler's address is not one.
-    orchestrator.files.FolderBusy
+    quadcosim.infra.files.FolderBusy
         Another process is writing the folder.
-    studies.sweep.checks.MemberRefused
-        A member's values would fail (:func:`studies.sweep.checks.check`); nothing was run.
+    quadcosim.studies.sweep.checks.MemberRefused
+        A member's values would fail (:func:`quadcosim.studies.sweep.checks.check`); nothing was run.
     """
     if retries < 0:
         raise SweepError(f"retries = {retries} must be zero or more")
-    from studies.sweep import checks, folder
+    from quadcosim.studies.sweep import checks, folder
 
     folder.check_scheduler(scheduler)
     out = folder.check_out(Path(out))
@@ -563,7 +564,7 @@ class _Sweep:
     def __init__(self, plan: Plan, out: Path, resume: bool):
         self.plan, self.out = plan, out
         self.rows = _prepare_folder(plan, out, resume)  # on disk, member by member: the client stays flat
-        from studies.sweep import units
+        from quadcosim.studies.sweep import units
 
         names = list(plan.varied) + (list(plan.members[0].options) if len(plan.members) else [])
         self.rows.units = units.of_options(plan.scenario, names)  # the Parquet columns' metadata
@@ -621,7 +622,7 @@ class _Sweep:
                 bar.update(record["status"])
                 self.flush()
         except KeyboardInterrupt as interrupt:  # Ctrl-C, or SIGTERM under the command line
-            from orchestrator.interrupts import signal_number
+            from quadcosim.infra.interrupts import signal_number
 
             self.interrupted = signal_number(interrupt)
             client.cancel(list(pending.futures))

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.files import save_figure
+from quadcosim.infra.files import save_figure
 
 
 def _number(value) -> float | None:
@@ -41,7 +41,7 @@ def metric_unit(name: str) -> str:
     str
         The unit, or ``""``.
     """
-    from scenarios.metrics import unit_of_name
+    from quadcosim.scenarios.metrics import unit_of_name
 
     return unit_of_name(name.split("[", 1)[0]) or ""
 
@@ -76,7 +76,7 @@ def plot(columns: dict[str, list], metric: str, x: str, by: str | None = None, o
     Parameters
     ----------
     columns : dict
-        A sweep table as columns (:func:`studies.sweep.read_table`).
+        A sweep table as columns (:func:`quadcosim.studies.sweep.read_table`).
     metric, x, by : str
         Column names: a metric, the option along the horizontal axis, the option that splits
         the members into curves (optional).
@@ -161,7 +161,7 @@ def _groups(columns, metric, x, by):
     whether x is numeric, how many members failed, and the x positions of those that diverged."""
     for name in (metric, x, by):
         if name is not None and name not in columns:
-            from orchestrator.fmu import nearest
+            from quadcosim.orchestrator.fmu import nearest
 
             raise KeyError(f"the sweep table has no column {name!r}.{nearest(name, columns)}")
     count = len(columns[x])

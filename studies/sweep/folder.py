@@ -5,7 +5,7 @@
 - :func:`check_scheduler`: a scheduler's address is one a client in another process can reach
   (``tcp://HOST:PORT``), said before anything is written or a connection tried;
 - :func:`held`: the folder made if need be and held by this process (the output folder lock of
-  ``quadcosim run``, :func:`orchestrator.files.folder_lock`) while the sweep writes it; a sweep
+  ``quadcosim run``, :func:`quadcosim.infra.files.folder_lock`) while the sweep writes it; a sweep
   refused before it wrote anything leaves no folder behind.
 """
 
@@ -138,10 +138,10 @@ def held(out: Path, command: str | None = None):
     ------
     FolderRefused
         The folder cannot be made.
-    orchestrator.files.FolderBusy
+    quadcosim.infra.files.FolderBusy
         Another live process holds the folder (a ValueError naming its pid and command).
     """
-    from orchestrator.files import FolderBusy, folder_lock
+    from quadcosim.infra.files import FolderBusy, folder_lock
 
     made = []  # the folders this call creates, the outermost first
     missing = out

@@ -201,7 +201,7 @@ def stored_members(stored: dict) -> Sequence:
 
 
 def _typed(scenario, name: str, values: list) -> list:
-    """``values`` of option ``name`` typed and checked as :meth:`scenarios.Scenario.parse` does it
+    """``values`` of option ``name`` typed and checked as :meth:`quadcosim.scenarios.Scenario.parse` does it
     (a block parameter, ``Block.name``, is kept as text and checked when a system is built)."""
     if "." in name:
         return [_text(v) for v in values]
@@ -238,7 +238,7 @@ def plan(scenario_name: str, grids=(), settings=(), seeds: str | None = None,
     ValueError
         A bad specification or value (the message names it), or too many members.
     """
-    import scenarios
+    from quadcosim import scenarios
 
     scenario = scenarios.get(scenario_name)
     fixed = dict(split_assignment(s, "--set") for s in settings)
@@ -292,7 +292,7 @@ def distinct_members(scenario, base: dict, typed: dict, seeds_given: bool = Fals
 
     Parameters
     ----------
-    scenario : scenarios.Scenario
+    scenario : quadcosim.scenarios.Scenario
     base : dict
         The options every member shares, typed.
     typed : dict of str to list
@@ -338,7 +338,7 @@ def distinct_members(scenario, base: dict, typed: dict, seeds_given: bool = Fals
 def plan_of_cases(scenario_name: str, cases: dict[str, dict], name: str | None = None) -> Plan:
     """A plan of the scenario ``scenario_name`` from named ``cases`` (label -> options), as a named
     sweep (its ``name``) declares them."""
-    import scenarios
+    from quadcosim import scenarios
 
     scenario = scenarios.get(scenario_name)
     members = [Member(i, scenario.parse(options), label) for i, (label, options) in enumerate(cases.items())]

@@ -10,7 +10,7 @@ import importlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from orchestrator.fmu import nearest
+from quadcosim.orchestrator.fmu import nearest
 
 MODULES = ("lab_matrix",)
 
@@ -49,7 +49,7 @@ class NamedSweep:
 
     def plan(self, settings=()):
         """The sweep's plan, with ``settings`` (``["duration=5", ...]``) applied to every case."""
-        from studies.sweep.grid import plan_of_cases, split_assignment
+        from quadcosim.studies.sweep.grid import plan_of_cases, split_assignment
 
         fixed = dict(split_assignment(s, "--set") for s in settings)
         cases = {label: options | fixed for label, options in self.cases().items()}
@@ -61,9 +61,9 @@ def registry() -> dict[str, NamedSweep]:
     sweeps = {}
     for module in MODULES:
         try:
-            found = getattr(importlib.import_module(f"studies.{module}"), "SWEEP", None)
+            found = getattr(importlib.import_module(f"quadcosim.studies.{module}"), "SWEEP", None)
         except ModuleNotFoundError as error:
-            if error.name != f"studies.{module}":
+            if error.name != f"quadcosim.studies.{module}":
                 raise
             continue
         if found is not None:
@@ -94,7 +94,7 @@ def records(plan, out) -> list[dict]:
     member order."""
     import json
 
-    from studies.sweep.engine import member_folder
+    from quadcosim.studies.sweep.engine import member_folder
 
     return [json.loads((member_folder(Path(out), m.index) / "metrics.json").read_text()) for m in plan.members]
 

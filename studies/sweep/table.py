@@ -14,7 +14,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from orchestrator.files import atomic_path
+from quadcosim.infra.files import atomic_path
 
 #: Columns that come first, in this order; the options and then the metrics follow.
 LEADING = ("member", "label", "status", "error", "attempts", "wall_s", "cpu_s", "stepping_cpu_s", "worker")
@@ -197,7 +197,7 @@ class Rows:
 
         def parquet_file(path):
             types = {n: self._arrow_type(n) for n in names}
-            from studies.sweep.units import of_columns
+            from quadcosim.studies.sweep.units import of_columns
 
             unit = of_columns(names, self.units)
             schema = pa.schema([pa.field(n, pa.string() if t is None else t,

@@ -19,14 +19,14 @@ def of_options(scenario_name: str, names) -> dict[str, str]:
     dict
         Name to unit (``{"k": "1/s", "Controller.kp": "1/s^2"}``); names without a unit are left out.
     """
-    import scenarios
+    from quadcosim import scenarios
 
     scenario = scenarios.get(scenario_name)
     units = {name: option.unit for name, option in scenario.options.items() if option.unit}
     wanted = [name for name in names if "." in name]
     if wanted:
-        from orchestrator.blocks import FMUBlock
-        from orchestrator.parameters import fmu_parameters
+        from quadcosim.orchestrator.blocks import FMUBlock
+        from quadcosim.orchestrator.parameters import fmu_parameters
 
         try:
             blocks = scenario.system(scenario.parse({})).blocks
@@ -48,8 +48,8 @@ def of_options(scenario_name: str, names) -> dict[str, str]:
 
 def of_columns(names, option_units: dict) -> dict[str, str]:
     """The unit of each column of ``names``: an option's from ``option_units``, a metric's from
-    the end of its name (:func:`studies.sweep.figure.metric_unit`)."""
-    from studies.sweep.figure import metric_unit
+    the end of its name (:func:`quadcosim.studies.sweep.figure.metric_unit`)."""
+    from quadcosim.studies.sweep.figure import metric_unit
 
     found = {}
     for name in names:

@@ -10,8 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from orchestrator import Result
+from quadcosim.orchestrator import Result
 
 ROOT = Path(__file__).resolve().parents[2]
 

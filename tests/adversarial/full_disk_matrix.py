@@ -98,7 +98,7 @@ def _whole(path: Path) -> str:
         except ValueError as error:
             return f"JSON that does not parse ({error})"
     if path.suffix in (".parm", ".params"):
-        from calibration.flight.autopilot import read_parameters
+        from quadcosim.calibration.flight.autopilot import read_parameters
 
         try:
             read_parameters(path)
@@ -143,7 +143,7 @@ def check(name: str, out: Path, disk: Path) -> tuple[str, list[str]]:
         problems.append(f"present but not listed: {unlisted}")
     if name.startswith("run") and {"results.npz", "results.stream"} & set(listed):
         try:  # a record metrics.json lists must load (one it says was not written is absent)
-            from orchestrator import Result
+            from quadcosim.orchestrator import Result
 
             Result.load(out)
         except Exception as error:  # noqa: BLE001 - a record that does not load is the finding
@@ -220,7 +220,7 @@ def main(argv=None) -> int:
     broken = sum(bool(o["problems"]) for o in outcomes)
     print(f"\n{len(outcomes)} runs, {broken} broke the rule")
     if args.json:
-        from orchestrator.files import write_json
+        from quadcosim.infra.files import write_json
 
         write_json(args.json, outcomes)
     return 1 if broken else 0

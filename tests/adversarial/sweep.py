@@ -492,7 +492,7 @@ def sweep_full_disk(s: Sweep, logs: list[tuple[str, Path]]):
 
 
 ESTIMATORS = """
-from estimators.contract import AttitudeEstimator
+from quadcosim.estimators.contract import AttitudeEstimator
 
 
 class Growing(AttitudeEstimator):
@@ -604,7 +604,7 @@ def main(argv=None) -> int:
     for o in broken:
         print(f"  [{o['surface']}] {o['what']}: {o['problem']}")
     if args.json:
-        from orchestrator.files import write_json
+        from quadcosim.infra.files import write_json
 
         write_json(args.json, outcomes)
     return 1 if broken else 0

@@ -1,5 +1,5 @@
 """Hangs and memory: every file the project reads goes through one check
-(:func:`orchestrator.files.regular_file`) before it is opened. ``/dev/zero`` as a calibration
+(:func:`quadcosim.infra.files.regular_file`) before it is opened. ``/dev/zero`` as a calibration
 file once filled 16 GB of memory and ignored SIGTERM; a FIFO blocked its reader until killed.
 Each is now refused at once, exit 2, naming what the path is."""
 
@@ -10,10 +10,10 @@ import time
 
 import pytest
 from conftest import ROOT
+from quadcosim.calibration import Calibration
+from quadcosim.calibration.static import CalibrationError
 
-from calibration import Calibration
-from calibration.static import CalibrationError
-from orchestrator.inputs import regular_file
+from quadcosim.infra.inputs import regular_file
 
 #: Seconds a refusal may take: the process starts, imports and reads the options; never a hang.
 LIMIT_S = 120

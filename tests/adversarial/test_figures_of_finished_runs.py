@@ -8,9 +8,9 @@ import re
 import shutil
 
 import pytest
+import quadcosim.scenarios.outputs
 from conftest import SHORT_TP
 
-import scenarios.outputs
 from quadcosim.main import main as cli
 from quadcosim.main import parser
 from tests.flightlog_synthetic import write_log
@@ -79,8 +79,9 @@ def test_log_plot_and_replay_outputs(tmp_path, capsys):
 
 
 def test_sizes_that_differ_are_printed_differently(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(scenarios.outputs.RunFiles, "disk_need", lambda self, rows, signals, members: 2_031_200)
-    monkeypatch.setattr(scenarios.outputs, "free_bytes", lambda folder: 2_030_500)
+    monkeypatch.setattr(quadcosim.scenarios.outputs.RunFiles, "disk_need",
+                        lambda self, rows, signals, members: 2_031_200)
+    monkeypatch.setattr(quadcosim.scenarios.outputs, "free_bytes", lambda folder: 2_030_500)
     assert cli([*SHORT_TP, "--out", str(tmp_path / "run")]) == 2
     assert "need about 2.031 MB in " in capsys.readouterr().err  # where 2.03 MB are free: not 2.03 twice
 

@@ -56,4 +56,4 @@ def test_an_output_the_writer_refuses_is_refused_before_any_group_runs(tmp_path,
         os.mkfifo(out)
     assert findings_main(["excerpt", "--quick", "--no-readme", "--out", str(out)]) == 2  # a traceback before
     err = capsys.readouterr().err
-    assert err.startswith(f"quadcosim findings: {'--out ' if kind == 'folder' else ''}{out}") and not ran
+    assert err.startswith(f"python -m findings: {'--out ' if kind == 'folder' else ''}{out}") and not ran

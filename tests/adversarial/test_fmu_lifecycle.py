@@ -10,9 +10,8 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from quadcosim.fmus import MODELS  # noqa: E402
 from raw_fmu import RawFMU  # noqa: E402
-
-from fmus import MODELS  # noqa: E402
 
 OK, ERROR = 0, 3
 
@@ -113,7 +112,8 @@ def test_the_long_fuzz_reports_calls_on_freed_instances_and_double_frees():
     import json
     import subprocess
 
-    done = subprocess.run([sys.executable, "-m", "benchmarks.fuzz", "--calls", "600", "--models", "Quadrotor", "IMU",
+    done = subprocess.run([sys.executable, "-m", "quadcosim.benchmarks.fuzz", "--calls", "600",
+                           "--models", "Quadrotor", "IMU",
                            "--json"], capture_output=True, text=True, timeout=300,
                           cwd=Path(__file__).resolve().parents[2])
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]

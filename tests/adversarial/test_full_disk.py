@@ -8,16 +8,16 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
+import quadcosim.orchestrator.result  # noqa: E402
+import quadcosim.scenarios.outputs  # noqa: E402
 from conftest import SHORT_TP, metrics_of  # noqa: E402
+from quadcosim.orchestrator import Result  # noqa: E402
+from quadcosim.orchestrator.diagram import draw  # noqa: E402
+from quadcosim.scenarios import get  # noqa: E402
+from quadcosim.scenarios.plant import save_figure  # noqa: E402
 
-import orchestrator.result  # noqa: E402
-import scenarios.outputs  # noqa: E402
-from orchestrator import Result  # noqa: E402
-from orchestrator.diagram import draw  # noqa: E402
-from orchestrator.files import DiskFull  # noqa: E402
+from quadcosim.infra.files import DiskFull  # noqa: E402
 from quadcosim.main import main as cli  # noqa: E402
-from scenarios import get  # noqa: E402
-from scenarios.plant import save_figure  # noqa: E402
 
 
 def _filling(written: int):
@@ -46,14 +46,14 @@ def test_figures_are_never_left_truncated_when_the_disk_fills(tmp_path, monkeypa
 
 
 def test_a_full_disk_while_the_record_is_written_names_the_folder_and_keeps_metrics(tmp_path, monkeypatch, capsys):
-    write = orchestrator.result._write_array
+    write = quadcosim.orchestrator.result._write_array
 
     def filling(archive, name, values):
         if name == "IMU.acc":  # some arrays written, then the disk is full
             raise OSError(errno.ENOSPC, "No space left on device")
         write(archive, name, values)
 
-    monkeypatch.setattr(orchestrator.result, "_write_array", filling)
+    monkeypatch.setattr(quadcosim.orchestrator.result, "_write_array", filling)
     out = tmp_path / "run"
     assert cli([*SHORT_TP, "--out", str(out), "--format", "npz,csv"]) == 1
     err = capsys.readouterr().err
@@ -67,7 +67,7 @@ def test_a_full_disk_while_the_record_is_written_names_the_folder_and_keeps_metr
 
 
 def test_a_record_too_large_for_the_disk_is_refused_before_the_run(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(scenarios.outputs, "free_bytes", lambda folder: 300_000)
+    monkeypatch.setattr(quadcosim.scenarios.outputs, "free_bytes", lambda folder: 300_000)
     out = tmp_path / "run"
     assert cli([*SHORT_TP, "--out", str(out)]) == 2
     err = capsys.readouterr().err
@@ -80,7 +80,7 @@ def test_a_full_disk_for_metrics_json_itself_is_a_clear_failure(tmp_path, monkey
     def no_room(path, data):
         raise DiskFull(path, 3000, 0)
 
-    monkeypatch.setattr(scenarios.outputs, "write_json", no_room)
+    monkeypatch.setattr(quadcosim.scenarios.outputs, "write_json", no_room)
     out = tmp_path / "run"
     assert cli([*SHORT_TP, "--out", str(out)]) == 1
     assert f"no space left in {out}/ to write metrics.json: it needs about 0.003 MB" in capsys.readouterr().err

@@ -7,10 +7,10 @@ import json
 import signal
 
 import pytest
+import quadcosim.scenarios.flightlog.reading
 from conftest import send_self
+from quadcosim.calibration.flight import autopilot
 
-import scenarios.flightlog.reading
-from calibration.flight import autopilot
 from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
@@ -44,14 +44,14 @@ def test_a_signal_while_the_files_are_written_keeps_them_all_with_metrics_json(f
 
 
 def test_a_signal_while_the_flights_are_read_leaves_no_folder(flight, tmp_path, monkeypatch, capsys):
-    load = scenarios.flightlog.reading.load
+    load = quadcosim.scenarios.flightlog.reading.load
 
     def signalled(path, verb):
         log = load(path, verb)
         send_self(signal.SIGINT)
         return log
 
-    monkeypatch.setattr(scenarios.flightlog.reading, "load", signalled)
+    monkeypatch.setattr(quadcosim.scenarios.flightlog.reading, "load", signalled)
     # Python's own Ctrl-C handler, whatever an earlier test of the session left installed: once in a
     # loaded full run this signal was lost (exit 0); a handler leaking between tests is suspected, unproven
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)

@@ -6,16 +6,16 @@ import signal
 
 import numpy as np
 import pytest
+import quadcosim.orchestrator.result
 from conftest import SHORT_TP, assert_whole, metrics_of, send_self
+from quadcosim.orchestrator import Result
 
-import orchestrator.result
-from orchestrator import Result
 from quadcosim.main import main as cli
 
 
 @pytest.mark.parametrize("sent, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_a_signal_while_the_record_is_written_lets_the_save_finish(tmp_path, monkeypatch, sent, code, capsys):
-    write = orchestrator.result._write_array
+    write = quadcosim.orchestrator.result._write_array
     calls = []
 
     def interrupted(archive, name, values):  # two signals in the middle of the archive: both held
@@ -24,7 +24,7 @@ def test_a_signal_while_the_record_is_written_lets_the_save_finish(tmp_path, mon
             send_self(sent)
         write(archive, name, values)
 
-    monkeypatch.setattr(orchestrator.result, "_write_array", interrupted)
+    monkeypatch.setattr(quadcosim.orchestrator.result, "_write_array", interrupted)
     out = tmp_path / "run"
     assert cli([*SHORT_TP, "--out", str(out)]) == code
     metrics = assert_whole(out)
@@ -76,9 +76,9 @@ def test_overwrite_removes_every_file_of_the_earlier_run(tmp_path):
 def test_a_second_signal_while_a_partial_record_is_saved_is_held(tmp_path, monkeypatch):
     """Item 3 in one process: the run is interrupted in its loop; a second signal arrives while
     its partial record is written, and a third while metrics.json is."""
-    import scenarios.outputs
+    import quadcosim.scenarios.outputs
 
-    save, write_json = Result.save, scenarios.outputs.write_json
+    save, write_json = Result.save, quadcosim.scenarios.outputs.write_json
 
     def save_interrupted(self, *args, **kwargs):
         send_self()
@@ -88,7 +88,7 @@ def test_a_second_signal_while_a_partial_record_is_saved_is_held(tmp_path, monke
         send_self(signal.SIGTERM)
         return write_json(path, data)
 
-    from orchestrator.chunks import CHUNK_STEPS, ChunkRunner
+    from quadcosim.orchestrator.chunks import CHUNK_STEPS, ChunkRunner
 
     chunk_end, ends = ChunkRunner._chunk_end, []
 
@@ -100,7 +100,7 @@ def test_a_second_signal_while_a_partial_record_is_saved_is_held(tmp_path, monke
 
     monkeypatch.setattr(ChunkRunner, "_chunk_end", chunk_end_interrupted)
     monkeypatch.setattr(Result, "save", save_interrupted)
-    monkeypatch.setattr(scenarios.outputs, "write_json", metrics_interrupted)
+    monkeypatch.setattr(quadcosim.scenarios.outputs, "write_json", metrics_interrupted)
     out = tmp_path / "run"
     assert cli(["run", "tp", "--set", "duration=10", "--out", str(out)]) == 130
     metrics = assert_whole(out)

@@ -5,9 +5,9 @@ the flights it failed on."""
 
 import numpy as np
 import pytest
+import quadcosim.scenarios.flightlog.replay
 import scipy.optimize
 
-import scenarios.flightlog.replay
 from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 
@@ -76,7 +76,7 @@ def test_a_replay_that_fails_in_the_library_names_the_log_and_the_fix(tmp_path, 
     def failing(*args, **kwargs):
         raise error
 
-    monkeypatch.setattr(scenarios.flightlog.replay, "_fields", failing)
+    monkeypatch.setattr(quadcosim.scenarios.flightlog.replay, "_fields", failing)
     assert cli(["log", "replay", str(log)]) == 2
     said = capsys.readouterr().err.strip().splitlines()[-1]
     assert said.startswith(f"quadcosim log replay: {log}: the replay failed ({type(error).__name__}: {error}):")

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-import flightlogs
+from quadcosim import flightlogs
 from quadcosim.main import main as cli
 
 

@@ -11,10 +11,10 @@ from collections import Counter
 import numpy as np
 import pytest
 from conftest import ROOT
+from quadcosim.orchestrator import Result
+from quadcosim.orchestrator.signals import vector_groups
 
-from orchestrator import Result
-from orchestrator.memory import cgroup_left, writers_peak
-from orchestrator.signals import vector_groups
+from quadcosim.infra.memory import cgroup_left, writers_peak
 
 GIB = 2 ** 30
 

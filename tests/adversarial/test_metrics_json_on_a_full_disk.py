@@ -11,7 +11,7 @@ import matplotlib.figure
 import pytest
 from conftest import SHORT_TP, metrics_of, mounted
 
-import scenarios
+from quadcosim import scenarios
 from quadcosim.main import main as cli
 from tests.flightlog_synthetic import write_log
 

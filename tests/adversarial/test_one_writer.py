@@ -12,10 +12,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
+from quadcosim.calibration.flight import autopilot  # noqa: E402
 
-import orchestrator.files  # noqa: E402
-from calibration.flight import autopilot  # noqa: E402
-from orchestrator.files import DiskFull, save_figure, write_json, write_text  # noqa: E402
+import quadcosim.infra.files  # noqa: E402
+from quadcosim.infra.files import DiskFull, save_figure, write_json, write_text  # noqa: E402
 
 PARAMETERS = {"COMPASS_OFS_X": 12.5, "COMPASS_MOTCT": 2}
 
@@ -29,10 +29,10 @@ def test_parameter_files_are_never_left_empty_by_a_full_disk(tmp_path, monkeypat
     def full(source, target):  # the data written, then no room for the rename's metadata
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(orchestrator.files.os, "replace", full)
+    monkeypatch.setattr(quadcosim.infra.files.os, "replace", full)
     with pytest.raises(DiskFull, match=f"no space left in {tmp_path}/ to write compass.params"):
         writer(PARAMETERS, path)
-    monkeypatch.setattr(orchestrator.files.os, "replace", real_replace)
+    monkeypatch.setattr(quadcosim.infra.files.os, "replace", real_replace)
     assert path.read_text() == "earlier\n"  # the earlier file, whole
     assert sorted(p.name for p in tmp_path.iterdir()) == ["compass.params"]  # no temporary left
     writer(PARAMETERS, path)
@@ -55,7 +55,7 @@ def test_a_symbolic_link_is_followed_and_kept(tmp_path):
 
 
 def test_a_fifo_is_refused_and_its_reader_is_not_fed_a_replacement(tmp_path):
-    from orchestrator.files import OutputRefused
+    from quadcosim.infra.files import OutputRefused
 
     fifo = tmp_path / "pipe.json"
     os.mkfifo(fifo)
@@ -66,7 +66,7 @@ def test_a_fifo_is_refused_and_its_reader_is_not_fed_a_replacement(tmp_path):
 
 
 def test_a_device_a_folder_and_a_missing_folder_are_refused(tmp_path):
-    from orchestrator.files import OutputRefused
+    from quadcosim.infra.files import OutputRefused
 
     if os.geteuid() == 0:  # a device node of its own (the null device's numbers), never /dev/null itself
         device = tmp_path / "null"

@@ -10,12 +10,12 @@ import textwrap
 import pytest
 from conftest import ROOT, SHORT_TP, assert_whole
 
-from orchestrator.files import LOCK_NAME, FolderBusy, folder_lock, free_folder, held_by
+from quadcosim.infra.files import LOCK_NAME, FolderBusy, folder_lock, free_folder, held_by
 from quadcosim.main import main as cli
 
 HOLDER = textwrap.dedent("""
     import sys, time
-    from orchestrator.files import folder_lock
+    from quadcosim.infra.files import folder_lock
     with folder_lock(sys.argv[1], command="quadcosim run tp --out " + sys.argv[1]):
         print("held", flush=True)
         time.sleep(60)

@@ -6,8 +6,8 @@ overflow warning; ``--firmware`` is refused before the flights are read."""
 import os
 
 import pytest
+from quadcosim.calibration.flight.autopilot import read_parameters
 
-from calibration.flight.autopilot import read_parameters
 from quadcosim.main import main as cli
 
 

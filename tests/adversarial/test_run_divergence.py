@@ -45,9 +45,8 @@ class _Record:
 
 def test_a_crossing_must_be_held_and_is_dated_where_it_starts():
     import numpy as np
-
-    from scenarios.divergence import Bounds, first_crossing
-    from scenarios.tp import DIVERGENCE
+    from quadcosim.scenarios.divergence import Bounds, first_crossing
+    from quadcosim.scenarios.tp import DIVERGENCE
 
     t = np.arange(0.0, 5.0, 0.01)
     zero = np.zeros_like(t)

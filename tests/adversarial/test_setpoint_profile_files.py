@@ -30,8 +30,8 @@ def test_a_latin_1_profile_is_named_as_not_utf_8(tmp_path, capsys):
 
 
 def test_a_spreadsheets_byte_order_mark_is_not_part_of_the_header(tmp_path):
-    from flight import SETPOINT
-    from flight.profile_file import read_profile
+    from quadcosim.flight import SETPOINT
+    from quadcosim.flight.profile_file import read_profile
 
     marked = tmp_path / "marked.csv"
     marked.write_text("t,z_d\n0,0\n2,-1.5\n", encoding="utf-8-sig")  # "CSV UTF-8" of a spreadsheet

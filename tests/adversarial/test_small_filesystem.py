@@ -7,9 +7,9 @@ import os
 
 import pytest
 from conftest import mounted
+from quadcosim.orchestrator import Result
 from scipy.io import loadmat
 
-from orchestrator import Result
 from quadcosim.main import main as cli
 
 

@@ -3,18 +3,18 @@ bit, the record kept in memory, with either master; a run cut short keeps its wh
 
 import numpy as np
 import pytest
+import quadcosim.orchestrator.stream
 from conftest import assert_whole
+from quadcosim.orchestrator import Result
+from quadcosim.orchestrator.stream import StreamWriter
+from quadcosim.scenarios import get
 
-import orchestrator.stream
-from orchestrator import Result
-from orchestrator.stream import StreamWriter
 from quadcosim.main import main as cli
-from scenarios import get
 
 
 @pytest.mark.parametrize("master", ["chunk", "step"])
 def test_a_streamed_record_equals_the_record_in_memory_bit_for_bit(tmp_path, monkeypatch, master):
-    monkeypatch.setattr(orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 700)  # 700 rows: several chunks
+    monkeypatch.setattr(quadcosim.orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 700)  # 700 rows: several chunks
     monkeypatch.setenv("QUADCOSIM_MASTER", master)
     scenario = get("tp")
     options = ["duration=2", "noise=on", "bias=on", "estimator=explicit"]
@@ -42,7 +42,7 @@ def test_stream_on_the_command_line_writes_the_folder_and_result_load_reads_eith
 
 
 def test_a_streamed_run_cut_short_keeps_its_whole_chunks(tmp_path, monkeypatch):
-    monkeypatch.setattr(orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 1000)
+    monkeypatch.setattr(quadcosim.orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 1000)
     writer = StreamWriter(tmp_path / "s")
     chunks = []
     write = writer.write
@@ -65,10 +65,11 @@ def test_a_streamed_run_cut_short_keeps_its_whole_chunks(tmp_path, monkeypatch):
 def test_the_report_of_a_streamed_record_taken_chunk_by_chunk_equals_the_whole_records(tmp_path, monkeypatch):
     """tp's statistics and envelopes read a streamed record one chunk at a time: the same
     bias convergence time and figure samples, the same errors to rounding."""
-    import scenarios
-    from orchestrator.result import envelope
+    from quadcosim.orchestrator.result import envelope
 
-    monkeypatch.setattr(orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 1500)  # 1500 rows a chunk
+    from quadcosim import scenarios
+
+    monkeypatch.setattr(quadcosim.orchestrator.stream, "WINDOW_BYTES", 8 * 126 * 1500)  # 1500 rows a chunk
     settings = {"duration": 6, "estimator": "passive", "bias": True, "flight": "hover", "kP": 10, "kI": 10}
     streamed, by_chunk = scenarios.run("tp", settings, tmp_path / "s", stream=True)
     kept, whole = scenarios.run("tp", settings, tmp_path / "m")
@@ -83,8 +84,8 @@ def test_the_report_of_a_streamed_record_taken_chunk_by_chunk_equals_the_whole_r
         expected = envelope(kept.time, kept[name], points=700)
         assert np.array_equal(drawn[0], expected[0]) and np.array_equal(drawn[1], expected[1])
     assert by_chunk["figures"] == whole["figures"] == ["roll_pitch.png", "yaw.png", "bias.png"]
-    from scenarios.figures import angle_curve
-    from scenarios.tp import _angle_curve
+    from quadcosim.scenarios.figures import angle_curve
+    from quadcosim.scenarios.tp import _angle_curve
 
     drawn = _angle_curve(streamed, "Quadrotor.theta3")
     expected = angle_curve(kept.time, np.degrees(kept["Quadrotor.theta3"]))

@@ -11,8 +11,7 @@ import time
 import tracemalloc
 
 import pytest
-
-from studies.sweep import command, grid, table
+from quadcosim.studies.sweep import command, grid, table
 
 
 def test_a_plan_over_the_limit_is_refused_by_its_count_before_any_value_is_made(capsys, tmp_path):
@@ -53,7 +52,7 @@ def test_a_100000_member_plan_is_made_member_by_member_in_little_memory():
 def test_planning_gives_way_to_ctrl_c(cpu_s, tmp_path):
     import psutil
 
-    process = subprocess.Popen([sys.executable, "-m", "studies.sweep", "tp", "--grid", "k=0.1:1:log990000",
+    process = subprocess.Popen([sys.executable, "-m", "quadcosim.studies.sweep", "tp", "--grid", "k=0.1:1:log990000",
                                 "--seeds", "1", "--out", str(tmp_path / "long"), "--quiet"],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
@@ -122,7 +121,7 @@ def test_two_sweeps_into_one_folder_at_once_the_second_is_refused(tmp_path):
     import socket
 
     out = tmp_path / "shared"
-    command_line = [sys.executable, "-m", "studies.sweep", *SHORT, "--workers", "1", "--out", str(out)]
+    command_line = [sys.executable, "-m", "quadcosim.studies.sweep", *SHORT, "--workers", "1", "--out", str(out)]
     dashboard = socket.socket()  # Dask's default dashboard port taken, as by another cluster
     try:
         dashboard.bind(("", 8787))

@@ -1,8 +1,7 @@
 """A dummy estimator for the registry test: the gyro integrated alone, no correction."""
 
 import numpy as np
-
-from estimators.contract import AttitudeEstimator
+from quadcosim.estimators.contract import AttitudeEstimator
 
 
 class GyroOnly(AttitudeEstimator):

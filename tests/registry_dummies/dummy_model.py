@@ -1,8 +1,7 @@
 """A dummy interference model for the registry test: no interference at all."""
 
 import numpy as np
-
-from calibration.flight.models import Fitted
+from quadcosim.calibration.flight.models import Fitted
 
 
 class Nothing:

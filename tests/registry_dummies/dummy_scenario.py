@@ -1,7 +1,7 @@
 """``dummy``: a clock alone, for the registry test."""
 
-from orchestrator import Block, System
-from scenarios import Option, Scenario
+from quadcosim.orchestrator import Block, System
+from quadcosim.scenarios import Option, Scenario
 
 
 class Clock(Block):

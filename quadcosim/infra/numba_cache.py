@@ -28,7 +28,10 @@ FLOORS = ("fmus", "orchestrator", "flightlogs", "estimators", "calibration", "fl
 #: Folders of earlier sources kept per package (the most recently used).
 KEEP = 4
 
-ROOT = Path(__file__).resolve().parent.parent  # the folder holding the packages (checkout or site-packages)
+_PACKAGE = Path(__file__).resolve().parents[1]
+#: The folder holding the floors' folders: the source checkout (``fmus/`` beside ``pyproject.toml``),
+#: or the installed ``quadcosim`` package.
+ROOT = _PACKAGE.parent if (_PACKAGE.parent / "fmus" / "__init__.py").is_file() else _PACKAGE
 
 _digests: dict[tuple[str, Path], tuple[tuple, bytes]] = {}  # (package, root) -> (stat signature, digest)
 _current: dict[str, Path] = {}  # package -> its folder, until numba comes back to a module (a reload)
@@ -85,8 +88,8 @@ def source_digest(package: str, root: Path = ROOT) -> str:
 
 def cache_root() -> Path:
     """The folder holding the digest-named cache folders: ``numba/`` under the build root
-    (:func:`fmus.build_root`)."""
-    from fmus import build_root
+    (:func:`quadcosim.infra.folders.build_root`)."""
+    from quadcosim.infra.folders import build_root
 
     return build_root() / "numba"
 
@@ -111,7 +114,7 @@ def _folder(package: str, root: Path) -> Path:
         if folder.is_dir():
             os.utime(folder)  # most recently used: kept by the pruning
         else:
-            from fmus import make_folder
+            from quadcosim.infra.folders import make_folder
 
             make_folder(folder, "numba's cache")
             _prune(folder, package)

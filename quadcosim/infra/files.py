@@ -12,7 +12,7 @@ saving leaves the earlier file (or none), never a truncated one.
   (the file it points to is replaced, the link is kept, as ``open(path, "w")`` would do); a
   folder, a FIFO, a device or a socket, a read-only file and a folder that does not exist are
   refused with :class:`OutputRefused`, before anything is written.
-- Every file the project *reads* is checked by :func:`orchestrator.inputs.regular_file` first.
+- Every file the project *reads* is checked by :func:`quadcosim.infra.inputs.regular_file` first.
 - :func:`tracking` lists the files written into a folder while it is active, so that a run's
   ``metrics.json`` names exactly the files it wrote (figures included).
 - :func:`prepare_out_dir` checks an output folder before a run and, with ``overwrite``,
@@ -189,7 +189,7 @@ def atomic_path(path, size: int | None = None):
     size : int, optional
         Bytes the file is expected to take, named in the message of a full disk.
     """
-    from orchestrator.interrupts import held
+    from quadcosim.infra.interrupts import held
 
     asked = Path(path)
     path = output_file(asked)

@@ -3,6 +3,7 @@ environment setting that chose a folder, and ``$CC`` split as a shell splits it.
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -47,3 +48,45 @@ def make_folder(folder, what: str) -> Path:
     fix = (f"it comes from ${chosen}={os.environ[chosen]}: set ${chosen} to a writable folder, or unset it"
            if chosen else "make it writable, or set $QUADCOSIM_BUILD_DIR to a writable folder")
     raise BuildFolderRefused(f"{folder}/: cannot write {what} there ({problem}); {fix}")
+
+
+def _checkout() -> Path | None:
+    """The source checkout this package is imported from (the folder holding quadcosim's
+    ``pyproject.toml`` beside the packages), or None for an installed package."""
+    root = Path(__file__).resolve().parents[2]
+    project = root / "pyproject.toml"
+    if project.is_file() and 'name = "quadcosim"' in project.read_text():
+        return root
+    return None
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("quadcosim")
+    except PackageNotFoundError:
+        return "unversioned"
+
+
+def build_root() -> Path:
+    """Where compiled artefacts (FMUs, the master's C runner, benchmark references) live.
+
+    Returns
+    -------
+    pathlib.Path
+        ``$QUADCOSIM_BUILD_DIR`` if set; else ``build/`` in the source checkout the package is
+        imported from; else, for an installed package, the per-user cache
+        ``$XDG_CACHE_HOME/quadcosim/<version>`` (``~/.cache/quadcosim/<version>``).
+    """
+    return _build_root(os.environ.get("QUADCOSIM_BUILD_DIR"), os.environ.get("XDG_CACHE_HOME"))
+
+
+@functools.lru_cache(maxsize=8)  # resolved once per setting: runs look FMUs up often
+def _build_root(env: str | None, cache: str | None) -> Path:
+    if env:
+        return Path(env)
+    checkout = _checkout()
+    if checkout is not None:
+        return checkout / "build"
+    return Path(cache or Path.home() / ".cache") / "quadcosim" / _version()
