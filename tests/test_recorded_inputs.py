@@ -132,7 +132,7 @@ def test_replay_refuses_a_folder_that_is_not_a_tp_run(tmp_path, capsys):
 def test_the_readme_estimate_example_runs_as_written_on_the_shipped_recording(capsys):
 
     readme = documentation()
-    start = readme.index("```python\nfrom quadcosim.estimators import estimate, gain_grid, recording")
+    start = readme.index("```python\nfrom quadcosim import estimate, gain_grid, recording")
     code = readme[start + len("```python\n"):readme.index("```", start + 10)]
     namespace = {}
     exec(compile(code, "README.md", "exec"), namespace)

@@ -194,4 +194,5 @@ def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_exte
 
     assert Path(autopilot.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`AUTOPILOTS`" in model
     scenario = _section("Adding a scenario")
-    assert "scenarios/catalogue.py" in _paths(scenario) and "`MODULES`" in scenario
+    assert "scenarios/catalogue.py" in _paths(scenario) and '"quadcosim.scenarios"' in scenario
+    assert "pyproject.toml" in scenario

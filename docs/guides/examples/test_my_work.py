@@ -1,12 +1,13 @@
 """A user's estimator and controller, tested on the lab's closed loop (``tp``) with the quadcosim
 pytest plugin: the fixtures ``run_scenario`` and ``make_system`` need no import, the checks come
-from ``quadcosim.scenarios.testing``. Run it with ``pytest test_my_work.py`` (``-n 2`` on two cores)."""
+from ``quadcosim``. Run it with ``pytest test_my_work.py`` (``-n 2`` on two cores)."""
 
 import numpy as np
 import pytest
-from quadcosim.estimators.contract import AttitudeEstimator
-from quadcosim.flight import Controller
-from quadcosim.scenarios.testing import (
+
+from quadcosim import (
+    AttitudeEstimator,
+    Controller,
     assert_attitude_error,
     assert_bias_converges,
     assert_bounds,
