@@ -150,9 +150,12 @@ def message(scenario: str, crossing: dict, settings: list[str]) -> str:
     torque = max((v for n, v in peaks.items() if n.startswith("Controller.tau")), default=None)
     asked = f"; the controller asked for up to {torque:.3g} N.m" if torque is not None else ""
     given = ", ".join(settings) if settings else "the default settings"
+    # no controller signal recorded: an open loop (or a rig) left its bounds; there is no loop to call unstable
+    cause = (f"The loop is unstable with {given}" if peaks else
+             f"The vehicle left the scenario's bounds with {given}, with no controller flying it")
     return (f"{scenario} diverged at t = {crossing['at_s']:.2f} s: {crossing['what']} (bound {crossing['bound']:g} "
-            f"{crossing['unit']}){asked}. The loop is unstable with {given}; its numbers describe a crash, not the "
-            "controller or the estimator")
+            f"{crossing['unit']}){asked}. {cause}; its numbers describe a crash, not the controller or the "
+            "estimator")
 
 
 #: The bounds of a vehicle clamped to its rig (``rig``, ``metge``): it does not move. A rig whose

@@ -25,7 +25,10 @@ def test_open_loop_rolled_over_by_its_pulses_ends_diverged(tmp_path, capsys):
     crossing = _metrics(tmp_path / "o")["diverged"]
     assert crossing["what"].startswith("roll ") and crossing["what"].endswith("deg from level")
     assert crossing["bound"] == 60.0 and 1.0 < crossing["at_s"] < 2.0
-    assert "open-loop diverged at t = " in capsys.readouterr().err
+    said = capsys.readouterr().err
+    assert "open-loop diverged at t = " in said
+    # no controller flies it: the message says the vehicle left its bounds, not that a loop is unstable
+    assert "with no controller flying it" in said and "loop is unstable" not in said
 
 
 def test_open_loop_flown_past_its_pulses_ends_diverged(tmp_path):
