@@ -214,7 +214,7 @@ def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
     from quadcosim.estimators import reference
     from quadcosim.estimators.filters import check_gains
 
-    if kind in reference.KINDS:
+    if kind in reference.PUBLISHED:
         merged = reference.check_gains(kind, gains)
     else:
         merged = check_gains(kind, gains, False if kind == "linear" else corrections)
@@ -224,7 +224,7 @@ def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
 def tp_recording(results_dir) -> dict:
     """The recording of the ``tp`` run in the results folder ``results_dir``, as
     :func:`quadcosim.estimators.recording.load` returns one (see the module docstring)."""
-    from quadcosim.estimators.core import euler_to_quaternion
+    from quadcosim.estimators.quaternions import euler_to_quaternion
     from quadcosim.orchestrator.result import Result
     from quadcosim.scenarios.tp import estimator_gains, initial_state
 

@@ -12,7 +12,7 @@ from functools import partial
 
 import numpy as np
 from quadcosim.estimators import LAB_GAINS, QuaternionEstim, kinds, parse_corrections
-from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.estimators.quaternions import euler_to_quaternion
 from quadcosim.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from quadcosim.flight.controller import SETPOINT_UNITS
 from quadcosim.flight.profile_file import FileProfile, is_profile_file
