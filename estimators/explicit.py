@@ -85,7 +85,14 @@ KIND = Kind("explicit", "explicit", lab=True, bias=True, rank=1, code=CODE, corr
 
 @njit(cache=True, error_model="numpy", inline="always")
 def correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field):
-    """sum k_i v_i x vhat_i, weighted, as a 3-tuple; the magnetometer's part kept vertical when heading only."""
+    """The explicit filter's correction ``omega_mes = sum k_i v_i x vhat_i`` as a 3-tuple (``kP omega_mes`` in rad/s).
+
+    ``acc`` and ``mag`` are the (low-passed) measurements, body frame; ``gains`` the gain vector
+    (:mod:`quadcosim.estimators.layout`); ``acc_weight`` and ``mag_weight`` (0..1) weigh each
+    direction; ``v_up`` and ``v_field`` are the unit directions of the specific force at rest and
+    of the Earth field the estimate predicts, body frame. The magnetometer's part is kept
+    vertical when heading only.
+    """
     w0, w1, w2 = 0.0, 0.0, 0.0
     if acc_weight > 0.0:
         c = _cross(acc, _norm3(acc), v_up, gains[K1] * acc_weight)

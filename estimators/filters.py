@@ -102,11 +102,12 @@ def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
         raise ValueError(f"the {kind} filter has no disturbance-aware corrections; use corrections=False")
     gains = dict(gains or {})
     taus = {name: gains.pop(name) for name in tuple(gains) if name.startswith("tau_")}
-    unknown = [name for name in taus if name not in member.time_constants]
-    if unknown:
-        raise ValueError(f"the {kind} filter has no time constant {unknown[0]!r}; "
-                         + (f"its time constants are {', '.join(member.time_constants)}" if member.time_constants
-                            else "give it its gains by name"))
+    if any(name not in member.time_constants for name in taus):
+        owners = [name for name, other in core.COMPILED.items() if set(taus) <= set(other.time_constants)]
+        raise ValueError(f"the time constants {', '.join(taus)} set the {' or '.join(owners) or 'no'} filter's gains; "
+                         f"give the {kind} filter its gains by name" + (
+                             f" or its time constants {', '.join(member.time_constants)}" if member.time_constants
+                             else ""))
     if taus:
         merged |= member.from_time_constants(**(member.time_constants | taus))
     for name, value in gains.items():

@@ -30,7 +30,8 @@ KIND = Kind("linear", "linear", lab=True, rank=0, code=CODE, ned_only=True, gain
 @njit(cache=True, error_model="numpy")
 def step(x, u, gains, config, dt):
     """One step of the linear filter: the Euler angles of the state ``x`` advanced over ``dt`` (s) by the
-    sample ``u`` (layouts of :mod:`quadcosim.estimators.layout`), and its quaternion."""
+    sample ``u`` with the gain vector ``gains`` and the configuration ``config`` (its gravity), and
+    its quaternion (the layouts of :mod:`quadcosim.estimators.layout`)."""
     g = math.sqrt(config[GRAVITY] ** 2 + config[GRAVITY + 1] ** 2 + config[GRAVITY + 2] ** 2)
     acc, gyro, mag = u[ACC:ACC + 3], u[GYRO:GYRO + 3], u[MAG:MAG + 3]
     theta = x[THETA:THETA + 3]

@@ -93,7 +93,14 @@ def _correction(acc, mag, u, config, gains, acc_weight, mag_weight, r, work, w):
 
 @njit(cache=True, error_model="numpy")
 def correction(acc, mag, u, config, gains, acc_weight, mag_weight, r, v_up, work):
-    """The passive filter's correction (3-tuple), through the arrays of ``work``."""
+    """The passive filter's correction (3-tuple), through the scratch arrays of ``work``.
+
+    ``acc`` and ``mag`` are the (low-passed) measurements, body frame; ``u`` the sample (its
+    ``R_reel``); ``config`` the configuration and ``gains`` the gain vector
+    (:mod:`quadcosim.estimators.layout`); ``acc_weight`` and ``mag_weight`` (0..1) weigh the tilt
+    and heading parts; ``r`` is the estimate's rotation (9-tuple, row-major) and ``v_up`` its
+    vertical, body frame.
+    """
     rm, w = work[W_R:W_R + 9].reshape((3, 3)), work[W_OMEGA:W_OMEGA + 3]
     for i in range(9):
         rm[i // 3, i % 3] = r[i]

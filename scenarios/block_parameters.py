@@ -49,7 +49,8 @@ def parameter_lines(model: str) -> list[str]:
                      "documentation)")
         lab, recordings = kind.lab_gains(), kind.defaults()
         for name, (unit, meaning) in kind.meanings().items():
-            lines.append(f"    {name:4s} tp {shown(lab[name], PARAMETER_DIGITS):8} recordings "
+            in_tp = shown(lab[name], PARAMETER_DIGITS) if kind.streaming else "-"  # not a closed-loop choice
+            lines.append(f"    {name:4s} tp {in_tp:8} recordings "
                          f"{shown(recordings[name], PARAMETER_DIGITS):12}{'[' + unit + ']':9s} {meaning}")
     return lines
 

@@ -297,7 +297,7 @@ def _vector(text: str, size: int, label: str) -> list:
 def _parser(prog: str = "python -m quadcosim.scenarios.replay") -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording, or a tp run's results folder")
-    parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")
+    parser.add_argument("--estimator", help=", ".join(name for name, kind in kinds.registry().items() if kind.batch))
     parser.add_argument("--set", action="append", default=[], metavar="GAIN=VALUE",
                         help="a gain or correction setting by name")
     parser.add_argument("--corrections", nargs="?", const="on", metavar="on|off|NAMES",
