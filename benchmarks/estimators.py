@@ -41,12 +41,13 @@ def _batch_case(gain_sets: int, samples: int, discretisation: str) -> dict:
     """The arrays of one batch run: the explicit filter's defaults with the corrections the C reference
     transcribes on (the low-passes and the magnetic reference tracking off), kI = 0.1 (1/s^2) and k1
     from 0.01 to 10 over the gain sets."""
-    from quadcosim.estimators import core
-    from quadcosim.estimators.filters import CORRECTIONS, check_measurements, config_vector, gain_table
+    from quadcosim.estimators import layout
+    from quadcosim.estimators.corrections import CORRECTIONS
+    from quadcosim.estimators.filters import check_measurements, config_vector, gain_table
 
     acc, gyro, mag = _data(samples)
     config = config_vector(discretisation)
-    inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[core.GRAVITY:core.GRAVITY + 3])), True)
+    inputs = check_measurements(gyro, acc, mag, float(np.linalg.norm(config[layout.GRAVITY:layout.GRAVITY + 3])), True)
     inputs = np.ascontiguousarray(np.column_stack([inputs, np.zeros((samples, 9))]))
     gains = {"k1": np.geomspace(0.01, 10, gain_sets), "kI": 0.1}
     corrections = {name: (0.0 if name in _NOT_IN_C else True) for name in CORRECTIONS}
@@ -65,19 +66,19 @@ def _numba_batch(case: dict) -> np.ndarray:
 
 def _c_batch(case: dict) -> np.ndarray:
     """The attitude (G, N, 4) of the C reference, after checking its slot numbers against
-    :mod:`quadcosim.estimators.core`'s layouts."""
+    :mod:`quadcosim.estimators.layout`'s layouts."""
     import ctypes
 
     from quadcosim.benchmarks import reference_library
-    from quadcosim.estimators import core
+    from quadcosim.estimators import layout
 
     library = reference_library("batch_explicit")
     slots = np.zeros(len(_C_SLOTS), dtype=np.int64)
     library.batch_explicit_slots(slots.ctypes.data_as(ctypes.c_void_p))
-    expected = [getattr(core, name) for name in _C_SLOTS]
+    expected = [getattr(layout, name) for name in _C_SLOTS]
     if slots.tolist() != expected:
         raise RuntimeError(f"benchmarks/c/batch_explicit.c numbers its slots {slots.tolist()}, "
-                           "quadcosim.estimators.core "
+                           "quadcosim.estimators.layout "
                            f"{expected} ({', '.join(_C_SLOTS)}): update the C reference")
     table, inputs = case["table"], case["inputs"]
     q = np.empty((len(table), len(inputs), 4))

@@ -21,7 +21,8 @@ import numpy as np
 from quadcosim.benchmarks import datasets
 from quadcosim.benchmarks.real_recordings import ABLATIONS, _options, errors
 from quadcosim.estimators import estimate
-from quadcosim.estimators.filters import DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
+from quadcosim.estimators.explicit import DEFAULT_TIME_CONSTANTS
+from quadcosim.estimators.filters import DEFAULT_CORRECTIONS
 from quadcosim.scenarios.replay import field_from_data
 
 # an iPhone whose magnetometer the phone re-calibrates at the start, and a BROAD trial with a magnet

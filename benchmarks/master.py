@@ -171,13 +171,14 @@ def _control(block) -> _Control:
 
 
 def _explicit(block) -> _Explicit:
-    from quadcosim.estimators import core
+    from quadcosim.estimators import layout
 
     gains, config, vector = block.gains, block.config, _double * 3
     if block.kind != "explicit" or any(gains[name] for name in gains if name not in ("k1", "k2", "kP", "kI")):
         raise ValueError("the C reference is the explicit filter without corrections")
-    return _Explicit(gains["k1"], gains["k2"], gains["kP"], gains["kI"], vector(*config[core.GRAVITY:core.GRAVITY + 3]),
-                     vector(*config[core.FIELD:core.FIELD + 3]), (_double * 4)(*block.q0), vector(*block.b0))
+    return _Explicit(gains["k1"], gains["k2"], gains["kP"], gains["kI"],
+                     vector(*config[layout.GRAVITY:layout.GRAVITY + 3]),
+                     vector(*config[layout.FIELD:layout.FIELD + 3]), (_double * 4)(*block.q0), vector(*block.b0))
 
 
 def compare(scenario: str, settings: dict, seconds: float, repeats: int) -> dict:

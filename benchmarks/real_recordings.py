@@ -34,7 +34,8 @@ from pathlib import Path
 import numpy as np
 from quadcosim.benchmarks import datasets
 from quadcosim.estimators import DEFAULT_GAINS, estimate
-from quadcosim.estimators.filters import DEFAULT_CORRECTIONS, DEFAULT_TIME_CONSTANTS
+from quadcosim.estimators.explicit import DEFAULT_TIME_CONSTANTS
+from quadcosim.estimators.filters import DEFAULT_CORRECTIONS
 from quadcosim.scenarios.replay import field_from_data, references
 
 from quadcosim.infra.files import write_text

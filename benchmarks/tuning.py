@@ -30,7 +30,7 @@ dataset it held out, against VQF at its defaults and VQF tuned by the same fold
 (:func:`score_folds`): the held-out table.
 
 Parameters, all physical (:data:`SEARCH`): for ``explicit`` (the recommended filter, corrections
-on), the time constants of inclination, heading and bias (s, :func:`quadcosim.estimators.filters.explicit_gains`),
+on), the time constants of inclination, heading and bias (s, :func:`quadcosim.estimators.explicit.explicit_gains`),
 the magnetic disturbance thresholds on the field's norm (µT at the lab's 47 µT field; the filter
 applies it relative to the reference norm, so any magnetometer unit works) and on its dip (deg),
 the magnetic reference's time (s: its tracking time constant, and how long a new field must last

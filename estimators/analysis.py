@@ -130,7 +130,7 @@ def explicit_bias_steady_error(k1: float, k2: float, kP: float, bias, attitude=(
     estimation, for a constant gyro ``bias`` (rad/s, body axes), at a fixed ``attitude`` (rad;
     roll, pitch, yaw), with the weights ``k1`` (gravity), ``k2`` (field), the gain ``kP`` (1/s)
     and the reference field ``earth_field`` (T, NED; only its direction counts)."""
-    from quadcosim.estimators.core import quaternion_from_euler, rotation
+    from quadcosim.estimators.quaternions import quaternion_from_euler, rotation
 
     q, r = np.empty(4), np.empty((3, 3))
     quaternion_from_euler(np.asarray(attitude, dtype=float), q)

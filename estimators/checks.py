@@ -14,7 +14,7 @@ import math
 import warnings
 
 import numpy as np
-from quadcosim.estimators import core
+from quadcosim.estimators import layout
 
 UNIT_WINDOW_S = 2.0  # s, windows over which the specific force is averaged for the unit check (several steps)
 QUIET_FRACTION = 0.2  # the windows with the least gyro activity that judge the unit
@@ -113,10 +113,10 @@ def loop_coefficients(kind: str, table: np.ndarray, dt: float) -> dict:
     ``table`` (G, GAIN_SIZE) at the period ``dt`` (s): (G,) arrays named after the gain that sets
     them (the fraction of the error removed per sample; for ``kI`` the bias loop's)."""
     if kind == "linear":
-        return {name: table[:, core.GAIN_SLOTS[name]] * dt for name in ("k1", "k2", "k3")}
-    strongest = np.maximum(table[:, core.K1], table[:, core.K2])
-    return {"kP": table[:, core.KP] * strongest * dt, "kI": table[:, core.KI] * strongest * dt * dt,
-            "rest_gain": table[:, core.REST_GAIN] * dt}
+        return {name: table[:, layout.GAIN_SLOTS[name]] * dt for name in ("k1", "k2", "k3")}
+    strongest = np.maximum(table[:, layout.K1], table[:, layout.K2])
+    return {"kP": table[:, layout.KP] * strongest * dt, "kI": table[:, layout.KI] * strongest * dt * dt,
+            "rest_gain": table[:, layout.REST_GAIN] * dt}
 
 
 def check_stability(kind: str, table: np.ndarray, dt: float, names=None):
@@ -141,7 +141,7 @@ def check_stability(kind: str, table: np.ndarray, dt: float, names=None):
         if np.any(mask):
             g = int(np.argmax(mask))
             label = f" (gain set {g})" if len(table) > 1 else ""
-            value = table[g, core.GAIN_SLOTS[name]]
+            value = table[g, layout.GAIN_SLOTS[name]]
             raise ValueError(f"gain {name} = {value:g}{label} makes the {kind} filter diverge at dt = {dt:g} s: "
                              f"keep {limits[name]}, or sample faster")
 
@@ -156,5 +156,5 @@ def check_finite(kind: str, table: np.ndarray, stored: np.ndarray, sums: np.ndar
     if per_set.all():
         return
     g = int(np.argmin(per_set))
-    gains = ", ".join(f"{name} = {table[g, slot]:g}" for name, slot in core.GAIN_SLOTS.items() if table[g, slot])
+    gains = ", ".join(f"{name} = {table[g, slot]:g}" for name, slot in layout.GAIN_SLOTS.items() if table[g, slot])
     raise ValueError(f"the {kind} filter diverged (non-finite estimate) with gain set {g}: {gains}; lower kP or kI")

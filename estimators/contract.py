@@ -54,7 +54,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
-from quadcosim.estimators.core import euler_from_quaternion
+from quadcosim.estimators.quaternions import euler_from_quaternion
 from quadcosim.orchestrator.blocks import Block
 
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")

@@ -6,7 +6,7 @@
     ``vqf`` package: rest and motion bias estimation, magnetic disturbance rejection. Gains:
     any parameter of ``vqf.VQF`` by name (``tauAcc``, ``tauMag`` in s, ...), package defaults
     otherwise. VQF initialises itself from the first samples: ``q0`` and ``initial`` are not
-    used.
+    used. The vqf package's own parameters (``tauAcc``, ``tauMag``, ...; see its documentation).
 ``madgwick``
     Madgwick's gradient-descent filter (Madgwick, Harrison, Vaidyanathan, "Estimation of
     IMU and MARG orientation using a gradient descent algorithm", 2011), from the ``ahrs``
@@ -27,10 +27,18 @@ rotation between the two frames built from those references.
 from __future__ import annotations
 
 import numpy as np
-from quadcosim.estimators import core
+from quadcosim.estimators import layout, quaternions
+from quadcosim.estimators.kinds import Gain, Kind
 
-KINDS = ("vqf", "madgwick", "mahony")
-DEFAULT_GAINS = {"vqf": {}, "madgwick": {"beta": 0.041}, "mahony": {"k_P": 1.0, "k_I": 0.3}}
+VQF_KIND = Kind("vqf", "VQF", rank=3)
+MADGWICK_KIND = Kind("madgwick", "Madgwick", rank=4,
+                     gains={"beta": Gain(0.041, "rad/s", "gradient step (the ahrs package's default)")})
+MAHONY_KIND = Kind("mahony", "Mahony", streaming=False, compared=None, rank=5, gains={
+    "k_P": Gain(1.0, "1/s", "proportional gain (the ahrs package's default)"),
+    "k_I": Gain(0.3, "1/s^2", "bias gain (the ahrs package's default)")})
+#: The published filters this module runs, by name (each registered by its line in pyproject.toml).
+PUBLISHED = {kind.name: kind for kind in (VQF_KIND, MADGWICK_KIND, MAHONY_KIND)}
+DEFAULT_GAINS = {name: kind.defaults() for name, kind in PUBLISHED.items()}
 
 
 def _vqf_parameters() -> dict:
@@ -64,8 +72,8 @@ def _gain_sets(kind, gains) -> list[dict]:
 def frame_rotation(kind: str, config) -> np.ndarray:
     """Quaternion of the rotation from the inertial frame of the package of ``kind`` to the one of
     the configuration vector ``config``."""
-    g = config[core.GRAVITY:core.GRAVITY + 3]
-    m = config[core.FIELD:core.FIELD + 3]
+    g = config[layout.GRAVITY:layout.GRAVITY + 3]
+    m = config[layout.FIELD:layout.FIELD + 3]
     up = -g / np.linalg.norm(g)
     north = m - (m @ up) * up
     north /= np.linalg.norm(north)
@@ -74,7 +82,7 @@ def frame_rotation(kind: str, config) -> np.ndarray:
     else:
         columns = (north, np.cross(up, north), up)
     q = np.empty(4)
-    core.quaternion_from_rotation(np.column_stack(columns), q)
+    quaternions.quaternion_from_rotation(np.column_stack(columns), q)
     return q
 
 
@@ -104,7 +112,7 @@ class _Runner:
             else:
                 self.filter = Madgwick(gain=gains["beta"], frequency=1.0 / dt)
             self.state = np.empty(4)
-            core.quaternion_multiply(self.from_ours, q0, self.state)
+            quaternions.quaternion_multiply(self.from_ours, q0, self.state)
         self.pending = from_triad
         self.sample = np.empty((3, 3))
 
@@ -121,26 +129,26 @@ class _Runner:
             if self.pending:
                 self.pending = False
                 r = np.empty((3, 3))
-                if core.triad(np.asarray(acc, float), np.asarray(mag, float), self.config, r):
+                if quaternions.triad(np.asarray(acc, float), np.asarray(mag, float), self.config, r):
                     start = np.empty(4)
-                    core.quaternion_from_rotation(r, start)
-                    core.quaternion_multiply(self.from_ours, start, self.state)
+                    quaternions.quaternion_from_rotation(r, start)
+                    quaternions.quaternion_multiply(self.from_ours, start, self.state)
             self.state = self.filter.updateMARG(self.state, gyr=np.asarray(gyro, float), acc=np.asarray(acc, float),
                                                 mag=np.asarray(mag, float), dt=self.dt)
             quaternion = self.state
             if self.kind == "mahony":
                 self.bias[:] = self.filter.b
-        core.quaternion_multiply(self.to_ours, quaternion, self.q)
+        quaternions.quaternion_multiply(self.to_ours, quaternion, self.q)
         if self.q[0] < 0:
             self.q *= -1.0
 
 
 def _write(runner, gyro, y):
-    y[core.OUT_Q:core.OUT_Q + 4] = runner.q
-    core.euler_from_quaternion(runner.q, y[core.OUT_THETA:core.OUT_THETA + 3])
-    y[core.OUT_B:core.OUT_B + 3] = runner.bias
-    y[core.OUT_OMEGA:core.OUT_OMEGA + 3] = gyro - runner.bias
-    y[core.OUT_WEIGHTS:core.OUT_WEIGHTS + 3] = runner.flags
+    y[layout.OUT_Q:layout.OUT_Q + 4] = runner.q
+    quaternions.euler_from_quaternion(runner.q, y[layout.OUT_THETA:layout.OUT_THETA + 3])
+    y[layout.OUT_B:layout.OUT_B + 3] = runner.bias
+    y[layout.OUT_OMEGA:layout.OUT_OMEGA + 3] = gyro - runner.bias
+    y[layout.OUT_WEIGHTS:layout.OUT_WEIGHTS + 3] = runner.flags
 
 
 def streaming_step(kind, gains, config, dt, q0, b0, from_triad):
@@ -149,7 +157,7 @@ def streaming_step(kind, gains, config, dt, q0, b0, from_triad):
     inertial, scalar first; or TRIAD, ``from_triad``); ``b0`` is taken for the common signature
     and not used."""
     runner = _Runner(kind, check_gains(kind, gains), config, dt, q0, from_triad)
-    acc, gyro, mag = slice(core.ACC, core.ACC + 3), slice(core.GYRO, core.GYRO + 3), slice(core.MAG, core.MAG + 3)
+    acc, gyro, mag = (slice(start, start + 3) for start in (layout.ACC, layout.GYRO, layout.MAG))
 
     def step(t, u, y):
         runner.step(u[acc], u[gyro], u[mag])
@@ -163,12 +171,13 @@ def _vqf_batch(gains, config, dt, inputs) -> np.ndarray:
     ``config``."""
     from vqf import VQF
 
-    acc, gyro, mag = (np.ascontiguousarray(inputs[:, start:start + 3]) for start in (core.ACC, core.GYRO, core.MAG))
+    acc, gyro, mag = (np.ascontiguousarray(inputs[:, start:start + 3])
+                      for start in (layout.ACC, layout.GYRO, layout.MAG))
     quat = VQF(dt, **gains).updateBatch(gyro, acc, mag)["quat9D"]
     to_ours = frame_rotation("vqf", config)
     out = np.empty_like(quat)
     for n in range(len(quat)):
-        core.quaternion_multiply(to_ours, quat[n], out[n])
+        quaternions.quaternion_multiply(to_ours, quat[n], out[n])
     out *= np.where(out[:, :1] < 0, -1.0, 1.0)
     return out
 
@@ -185,9 +194,9 @@ def estimate(kind, inputs, dt, gains, config, q0, b0, from_triad, outputs) -> di
     sets = _gain_sets(kind, gains)
     count = len(inputs)
     q_all = np.empty((len(sets), count, 4))
-    kept = {name: np.empty((len(sets), count, core.OUTPUT_SLOTS[name][1] - core.OUTPUT_SLOTS[name][0]))
+    kept = {name: np.empty((len(sets), count, layout.OUTPUT_SLOTS[name][1] - layout.OUTPUT_SLOTS[name][0]))
             for name in outputs}
-    y = np.empty(core.OUTPUT_SIZE)
+    y = np.empty(layout.OUTPUT_SIZE)
     for g, gain_set in enumerate(sets):
         if kind == "vqf" and set(outputs) <= {"q"}:
             q_all[g] = _vqf_batch(gain_set, config, dt, inputs)  # the same updates, in one call into the package
@@ -197,9 +206,9 @@ def estimate(kind, inputs, dt, gains, config, q0, b0, from_triad, outputs) -> di
         runner = _Runner(kind, gain_set, config, dt, q0, from_triad)
         for n in range(count):
             u = inputs[n]
-            runner.step(u[core.ACC:core.ACC + 3], u[core.GYRO:core.GYRO + 3], u[core.MAG:core.MAG + 3])
-            _write(runner, u[core.GYRO:core.GYRO + 3], y)
+            runner.step(u[layout.ACC:layout.ACC + 3], u[layout.GYRO:layout.GYRO + 3], u[layout.MAG:layout.MAG + 3])
+            _write(runner, u[layout.GYRO:layout.GYRO + 3], y)
             q_all[g, n] = runner.q
             for name, array in kept.items():
-                array[g, n] = y[slice(*core.OUTPUT_SLOTS[name])]
+                array[g, n] = y[slice(*layout.OUTPUT_SLOTS[name])]
     return kept | {"q_all": q_all}

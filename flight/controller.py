@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 from numba import njit
-from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.estimators.quaternions import euler_to_quaternion
 from quadcosim.flight.mixer import allocation_matrix, esc_command
 from quadcosim.fmus import vehicle
 from quadcosim.orchestrator import portable
@@ -277,11 +277,11 @@ def _compiled_step():
     global _COMPILED
     if _COMPILED is None:
         from numba import carray, cfunc
-        from quadcosim.estimators import core
+        from quadcosim.estimators import quaternions
         from quadcosim.flight import mixer
         from quadcosim.orchestrator.blocks import COMPILED_SIGNATURE, source_fingerprint
 
-        sources = source_fingerprint(core, mixer, vehicle)  # the files the law calls into: in the cache key
+        sources = source_fingerprint(quaternions, mixer, vehicle)  # the files the law calls into: in the cache key
 
         @cfunc(COMPILED_SIGNATURE, cache=True, error_model="numpy")
         def step(t, u, y, data):

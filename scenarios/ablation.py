@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 from quadcosim.estimators import estimate, parse_corrections
-from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.estimators.quaternions import euler_to_quaternion
 from quadcosim.fmus import vehicle
 from quadcosim.orchestrator.blocks import Block
 

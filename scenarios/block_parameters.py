@@ -1,9 +1,9 @@
 """The parameters of the Python blocks, as ``quadcosim list --parameters MODEL`` shows them.
 
 An FMU's parameters come from its variable table; a Python block's from the tables its module
-declares: the controller's gains (:data:`quadcosim.flight.GAINS`) and each attitude filter's
-gains (:data:`quadcosim.estimators.GAIN_MEANINGS`, defaults :data:`quadcosim.estimators.LAB_GAINS` as ``tp`` runs
-them and :data:`quadcosim.estimators.DEFAULT_GAINS` as :func:`quadcosim.estimators.estimate` runs them).
+declares: the controller's gains (:data:`quadcosim.flight.GAINS`) and each registered estimator's
+gains (:attr:`quadcosim.estimators.kinds.Kind.gains`: unit, meaning, the lab's value as ``tp`` runs
+it and the default of :func:`quadcosim.estimators.estimate`).
 """
 
 from __future__ import annotations
@@ -36,23 +36,22 @@ def parameter_lines(model: str) -> list[str]:
         for name, (default, unit, meaning) in GAINS.items():
             lines.append(f"  {name:10s} = {shown(default, PARAMETER_DIGITS):10}{'[' + unit + ']':10s} {meaning}")
         return lines
-    from quadcosim.estimators import DEFAULT_GAINS, GAIN_MEANINGS, LAB_GAINS
-    from quadcosim.estimators.reference import DEFAULT_GAINS as REFERENCE_GAINS
+    from quadcosim.estimators import kinds
 
     lines = ["Quaternion_estim gains, by estimator: tp's default (the lab's values; tp sets them with its options "
              "k, k1, k2, kP, kI) and the default of quadcosim.estimators.estimate (recordings); in Python, "
              "QuaternionEstim(KIND, gains={NAME: VALUE}):"]
-    for kind, meanings in GAIN_MEANINGS.items():
-        lines.append(f"  {kind}:")
-        for name, (unit, meaning) in meanings.items():
-            lab, recordings = shown(LAB_GAINS[kind][name], PARAMETER_DIGITS), shown(DEFAULT_GAINS[kind][name],
-                                                                                    PARAMETER_DIGITS)
-            lines.append(f"    {name:4s} tp {lab:8} recordings {recordings:12}{'[' + unit + ']':9s} {meaning}")
-    lines.append("  madgwick:")
-    lines.append(f"    beta tp {shown(REFERENCE_GAINS['madgwick']['beta'], PARAMETER_DIGITS):8} "
-                 f"recordings {shown(REFERENCE_GAINS['madgwick']['beta'], PARAMETER_DIGITS):12}{'[rad/s]':9s} "
-                 "gradient step (the ahrs package's default)")
-    lines.append("  vqf: the vqf package's own parameters (tauAcc, tauMag, ...; see its documentation)")
+    for kind in kinds.registry().values():
+        if kind.block:
+            lines.append(f"  {kind.name}: its own block ({kind.block}), its parameters its own")
+            continue
+        lines.append(f"  {kind.name}:" if kind.gains else f"  {kind.name}: its package's own parameters (see its "
+                     "documentation)")
+        lab, recordings = kind.lab_gains(), kind.defaults()
+        for name, (unit, meaning) in kind.meanings().items():
+            in_tp = shown(lab[name], PARAMETER_DIGITS) if kind.streaming else "-"  # not a closed-loop choice
+            lines.append(f"    {name:4s} tp {in_tp:8} recordings "
+                         f"{shown(recordings[name], PARAMETER_DIGITS):12}{'[' + unit + ']':9s} {meaning}")
     return lines
 
 

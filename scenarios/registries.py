@@ -1,6 +1,6 @@
 """The package's closed sets of names as Markdown tables, read from their registries.
 
-- the estimators, :data:`quadcosim.estimators.kinds.KINDS`;
+- the estimators, the entry-point group ``quadcosim.estimators`` (:func:`quadcosim.estimators.kinds.registry`);
 - the interference models a flight calibration fits, :data:`quadcosim.calibration.flight.catalogue.MODELS`;
 - the autopilots the export writes parameters for, :data:`quadcosim.calibration.flight.autopilot.AUTOPILOTS`;
 - the scenarios, :mod:`quadcosim.scenarios.catalogue` (those a higher floor registers too, once imported).
@@ -28,12 +28,12 @@ def _table(header, rows) -> list[str]:
 def estimator_rows() -> list[tuple]:
     """One row per estimator: name, label, lab filter, gyro bias, closed loop, recorded arrays,
     compared, its own block (none: :class:`quadcosim.estimators.QuaternionEstim` builds it by name)."""
-    from quadcosim.estimators.kinds import KINDS
+    from quadcosim.estimators.kinds import registry
 
     return [(f"`{kind.name}`", kind.label, _yes(kind.lab), _yes(kind.bias), _yes(kind.streaming), _yes(kind.batch),
              "" if kind.compared is None else ", ".join(f"{k}={v}" for k, v in kind.compared.items()) or "yes",
              f"`{kind.block}`" if kind.block else "")
-            for kind in KINDS.values()]
+            for kind in registry().values()]
 
 
 def model_rows() -> list[tuple]:
@@ -64,7 +64,8 @@ def tables() -> str:
     lines = ["# What the package names", "",
              "Generated from the registries when the site is built; each set is extended by one line in the "
              "module named (see {doc}`../guides/maintainers`).", "",
-             "## Estimators", "", "`estimators/kinds.py`, read by a scenario's `estimator` choices, the comparisons "
+             "## Estimators", "", "The entry-point group `quadcosim.estimators` (`pyproject.toml`, one line per "
+             "estimator naming its module's `Kind`), read by a scenario's `estimator` choices, the comparisons "
              "and the replays. Columns: one of the lab's filters (gains `k1`, `k2`, `kP`, `kI`); a gyro bias "
              "estimated; runs in a closed loop; runs on recorded arrays (the batch path); in the comparisons (with "
              "these settings); its own block (without one, `quadcosim.estimators.QuaternionEstim` builds the "

@@ -131,10 +131,11 @@ def replay(data: dict, estimator: str | None = None, gains: dict | None = None, 
         field = field_from_data(data["acc"], data["mag"], max(1, int(field_from_data_s * data["rate"])))
         dip, norm = (field["dip"] if dip is None else dip), field["norm"]
     refs = references(frame, dip, norm, declination)
-    filtered = kind in kinds.KINDS and kinds.KINDS[kind].lab
-    corrections_used = settings["corrections"] if kind != "linear" and filtered else None
+    member = kinds.get(kind)
+    corrected = member is not None and member.lab and member.corrections is not None  # runs the corrections
+    corrections_used = settings["corrections"] if corrected else None
     out = estimate(kind, gyro=data["gyro"], acc=data["acc"], mag=data["mag"], dt=1.0 / data["rate"],
-                   gains=settings["gains"], corrections=False if kind == "linear" else corrections_used,
+                   gains=settings["gains"], corrections=corrections_used if corrected else False,
                    ry=settings["ry"], discretisation=settings["discretisation"], initial=settings["initial"],
                    q0=settings["q0"], b0=settings["b0"], outputs=("q",) if keep_estimate else (),
                    reference=data["quat"], scored=data["scored"], align_heading=align_heading, **refs)
@@ -214,17 +215,18 @@ def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
     from quadcosim.estimators import reference
     from quadcosim.estimators.filters import check_gains
 
-    if kind in reference.KINDS:
+    if kind in reference.PUBLISHED:
         merged = reference.check_gains(kind, gains)
     else:
-        merged = check_gains(kind, gains, False if kind == "linear" else corrections)
+        member = kinds.get(kind)
+        merged = check_gains(kind, gains, False if member is not None and member.corrections is None else corrections)
     return {name: float(np.asarray(value).reshape(-1)[0]) for name, value in merged.items()}
 
 
 def tp_recording(results_dir) -> dict:
     """The recording of the ``tp`` run in the results folder ``results_dir``, as
     :func:`quadcosim.estimators.recording.load` returns one (see the module docstring)."""
-    from quadcosim.estimators.core import euler_to_quaternion
+    from quadcosim.estimators.quaternions import euler_to_quaternion
     from quadcosim.orchestrator.result import Result
     from quadcosim.scenarios.tp import estimator_gains, initial_state
 
@@ -295,7 +297,7 @@ def _vector(text: str, size: int, label: str) -> list:
 def _parser(prog: str = "python -m quadcosim.scenarios.replay") -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
     parser.add_argument("recording", nargs="?", help=".npz, .mat or .csv recording, or a tp run's results folder")
-    parser.add_argument("--estimator", help="linear, explicit, passive, vqf or madgwick")
+    parser.add_argument("--estimator", help=", ".join(name for name, kind in kinds.registry().items() if kind.batch))
     parser.add_argument("--set", action="append", default=[], metavar="GAIN=VALUE",
                         help="a gain or correction setting by name")
     parser.add_argument("--corrections", nargs="?", const="on", metavar="on|off|NAMES",
@@ -433,9 +435,9 @@ def summary(result: dict, recording: str) -> str:
     def shown(values: dict) -> str:
         return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v}" for k, v in values.items())
 
-    kind = kinds.KINDS.get(result["estimator"])
+    kind = kinds.get(result["estimator"])
     named = ("frame",) if kind is None or not kind.lab else ("discretisation", "frame")
-    named = ("ry", *named) if result["estimator"] == "passive" else named
+    named = ("ry", *named) if kind is not None and kind.reads_reel else named
     settings = [f"{k} {result[k]}" for k in named if result.get(k) is not None]
     in_force = result["gains_in_force"]
     gains = {k: v for k, v in in_force.items() if k not in CORRECTIONS}

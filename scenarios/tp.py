@@ -11,8 +11,8 @@ import math
 from functools import partial
 
 import numpy as np
-from quadcosim.estimators import LAB_GAINS, QuaternionEstim, kinds, parse_corrections
-from quadcosim.estimators.core import euler_to_quaternion
+from quadcosim.estimators import QuaternionEstim, kinds, parse_corrections
+from quadcosim.estimators.quaternions import euler_to_quaternion
 from quadcosim.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
 from quadcosim.flight.controller import SETPOINT_UNITS
 from quadcosim.flight.profile_file import FileProfile, is_profile_file
@@ -100,12 +100,14 @@ def estimator_gains(o: dict) -> dict:
     kind = o["estimator"]
     if kind == "linear":
         return {"k1": o["k"], "k2": o["k"], "k3": o["k"]}
-    if kind not in kinds.KINDS or not kinds.KINDS[kind].lab:
+    member = kinds.get(kind)
+    if member is None or not member.lab:
         return {}  # the packages' defaults; a user's block holds its own
-    ki = LAB_GAINS[kind]["kI"] if o["kI"] == "lab" else o["kI"]
+    lab = member.lab_gains()
+    ki = lab["kI"] if o["kI"] == "lab" else o["kI"]
     if kind == "explicit":
         return {"k1": o["k1"], "k2": o["k2"], "kP": o["kP"], "kI": ki}
-    return {"k1": LAB_GAINS[kind]["k1"], "k2": LAB_GAINS[kind]["k2"], "kP": o["kP"], "kI": ki}
+    return {"k1": lab["k1"], "k2": lab["k2"], "kP": o["kP"], "kI": ki}
 
 
 def resolve(o: dict) -> dict:
@@ -179,7 +181,7 @@ def build(o: dict, estimator=None) -> System:
     if o["accelerometer"] == "gravity":
         system.connect("Quadrotor.q", "GravityOnly.q")
     q0 = euler_to_quaternion(0.0, start.get("theta2_0", 0.0), 0.0)
-    registered = kinds.KINDS.get(o["estimator"])
+    registered = kinds.get(o["estimator"])
     if estimator is not None or registered is None or registered.block:  # a block of its own
         from quadcosim.estimators import contract
 
@@ -436,7 +438,7 @@ def estimator_text(o: dict, name: str | None = None) -> str:
     str
         ``"explicit filter (k1 = 0.2, k2 = 0.2, kP = 1 1/s, kI = 0.1 1/s^2)"``.
     """
-    if name or o["estimator"] not in kinds.KINDS or kinds.KINDS[o["estimator"]].block:  # a block of its own
+    if name or kinds.get(o["estimator"]) is None or kinds.get(o["estimator"]).block:  # a block of its own
         return f"estimator {name or o['estimator']}"
     kind = o["estimator"]
     gains = estimator_gains(o)

@@ -151,14 +151,14 @@ def test_an_unknown_master_is_refused():
 
 def test_the_cached_compiled_steps_follow_the_files_they_call_into():
     """numba reuses a cached function while its own file is unchanged; the compiled steps hold a
-    fingerprint of the files they call into (estimators/core.py, ...) in their cache key."""
-    from quadcosim.estimators import core, filters
+    fingerprint of the files they call into (estimators/core.py and those it compiles from, ...) in their cache key."""
+    from quadcosim.estimators import core, filters, quaternions
     from quadcosim.flight import controller, mixer
     from quadcosim.fmus import vehicle
     from quadcosim.orchestrator.blocks import source_fingerprint
 
-    for function, modules in ((filters._compiled_step(), (core,)),
-                              (controller._compiled_step(), (core, mixer, vehicle))):
+    for function, modules in ((filters._compiled_step(), (core, *core.SOURCES)),
+                              (controller._compiled_step(), (quaternions, mixer, vehicle))):
         closure = [cell.cell_contents for cell in function._pyfunc.__closure__]
         assert source_fingerprint(*modules) in closure
     assert source_fingerprint(core) != source_fingerprint(core, mixer)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from quadcosim.estimators import CORRECTIONS, score
-from quadcosim.estimators.filters import NEW_FOR_EXPLICIT
+from quadcosim.estimators.corrections import NEW_FOR_EXPLICIT
 from quadcosim.fmus.IMU.variables import LAB_GYRO_BIAS
 from quadcosim.orchestrator import Fault
 
@@ -80,7 +80,7 @@ def test_bias_is_estimated_at_rest():
 def _spinning_and_shaken(n=20000, dt=1e-3, shake=3.0):
     """A body turning at 1 rad/s about a tilted axis while shaken along the inertial x axis at
     2 Hz (``shake`` m/s^2): true attitude and perfect gyro, accelerometer and magnetometer."""
-    from quadcosim.estimators import core
+    from quadcosim.estimators import layout, quaternions
     from quadcosim.fmus import vehicle
 
     t = np.arange(n) * dt
@@ -88,9 +88,9 @@ def _spinning_and_shaken(n=20000, dt=1e-3, shake=3.0):
     q, r = np.array([1.0, 0.0, 0.0, 0.0]), np.empty((3, 3))
     truth, acc, mag = np.empty((n, 4)), np.empty((n, 3)), np.empty((n, 3))
     for k in range(n):
-        core._integrate(q, *rate, dt, core.EXP)
+        quaternions._integrate(q, *rate, dt, layout.EXP)
         truth[k] = q
-        core.rotation(q, r)
+        quaternions.rotation(q, r)
         linear = np.array([shake * np.sin(2 * np.pi * 2.0 * t[k]), 0.0, 0.0])
         acc[k] = r.T @ (linear - np.array([0.0, 0.0, vehicle.GRAVITY]))
         mag[k] = r.T @ np.array(vehicle.EARTH_FIELD)

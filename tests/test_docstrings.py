@@ -106,5 +106,5 @@ def test_the_pending_lists_name_existing_callables():
 
 @pytest.mark.parametrize("package", PACKAGES)
 def test_every_public_callable_has_a_docstring(package):
-    problems = [p for p in _problems() if p.startswith(package + ".") and p.split(":")[0] not in PENDING]
+    problems = [p for p in _problems() if p.startswith(f"quadcosim.{package}.") and p.split(":")[0] not in PENDING]
     assert not problems, f"{len(problems)} public callables of {package} lack documentation:\n" + "\n".join(problems)

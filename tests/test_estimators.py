@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from quadcosim.estimators import analysis, core, estimate, filters, gain_grid, parse_corrections, score
+from quadcosim.estimators import analysis, estimate, filters, gain_grid, layout, parse_corrections, quaternions, score
 from quadcosim.fmus import vehicle
 
 from quadcosim import scenarios
@@ -16,9 +16,9 @@ def synthetic(n=3000, dt=1e-3, seed=0):
     q, r = np.array([0.9, 0.1, -0.2, 0.3]) / np.linalg.norm([0.9, 0.1, -0.2, 0.3]), np.empty((3, 3))
     truth, acc, mag = np.empty((n, 4)), np.empty((n, 3)), np.empty((n, 3))
     for k in range(n):
-        core._integrate(q, *rates[k], dt, core.EXP)
+        quaternions._integrate(q, *rates[k], dt, layout.EXP)
         truth[k] = q
-        core.rotation(q, r)
+        quaternions.rotation(q, r)
         acc[k] = r.T @ [0.0, 0.0, -vehicle.GRAVITY]
         mag[k] = r.T @ np.array(vehicle.EARTH_FIELD)
     gyro = rates + [0.02, -0.01, 0.015] + 0.01 * rng.standard_normal((n, 3))
@@ -124,7 +124,8 @@ def test_gains_are_placed_by_name_whatever_the_dict_order():
     assert np.array_equal(forward["q"], backward["q"])
     assert not np.allclose(forward["q"], swapped["q"])
     table = filters.gain_table("explicit", {"kI": 0.1, "kP": 2.0})[0]
-    assert table[core.KP] == 2.0 and table[core.KI] == 0.1 and table[core.K1] == filters.DEFAULT_GAINS["explicit"]["k1"]
+    assert table[layout.KP] == 2.0 and table[layout.KI] == 0.1
+    assert table[layout.K1] == filters.DEFAULT_GAINS["explicit"]["k1"]
 
 
 def test_gain_grid_is_a_cartesian_product_and_reshapes_in_order():
@@ -161,7 +162,7 @@ def test_heading_alignment_removes_a_constant_frame_offset():
     offset = np.radians(30.0)
     rotation = np.array([np.cos(offset / 2), 0, 0, np.sin(offset / 2)])  # about NED's vertical
     for n in range(len(truth)):
-        core.quaternion_multiply(rotation, truth[n], turned[n])
+        quaternions.quaternion_multiply(rotation, truth[n], turned[n])
     plain = score(turned, truth)
     aligned = score(turned, truth, align_heading=True)
     assert plain["total_rmse_deg"] == pytest.approx(30.0, abs=1e-9)
@@ -174,7 +175,7 @@ def test_triad_start_and_initial_function():
     truth, acc, gyro, mag = synthetic(5)
     clean_acc = acc.copy()
     r = np.empty((3, 3))
-    core.rotation(truth[0], r)
+    quaternions.rotation(truth[0], r)
     clean_acc[0] = r.T @ [0.0, 0.0, -vehicle.GRAVITY]
     mag[0] = r.T @ np.array(vehicle.EARTH_FIELD)
     out = estimate("explicit", acc=clean_acc, gyro=gyro, mag=mag, dt=1e-3, initial="triad", gains={"kP": 0.0})
@@ -208,7 +209,7 @@ def test_references_set_the_inertial_frame():
     to_enu = np.array([0.0, np.sqrt(0.5), np.sqrt(0.5), 0.0])  # NED -> ENU: 180 deg about (1, 1, 0)
     truth_enu = np.empty_like(truth)
     for n in range(len(truth)):
-        core.quaternion_multiply(to_enu, truth[n], truth_enu[n])
+        quaternions.quaternion_multiply(to_enu, truth[n], truth_enu[n])
     field = np.array(vehicle.EARTH_FIELD)
     enu = estimate("explicit", acc=acc, gyro=gyro, mag=mag, dt=1e-3, reference=truth_enu, initial="triad",
                    gravity=(0.0, 0.0, -vehicle.GRAVITY), earth_field=(field[1], field[0], -field[2]),

@@ -44,7 +44,7 @@ def test_the_explicit_filters_inclination_on_a_flight_is_set_by_its_correction_t
     heading pays (flight b, internal compass: 3.61 -> 2.44 deg inclination, 9.46 -> 9.81 deg
     heading, measured)."""
     import quadcosim.scenarios.flightlog.replay as replay
-    from quadcosim.estimators.filters import DEFAULT_TIME_CONSTANTS, explicit_gains
+    from quadcosim.estimators.explicit import DEFAULT_TIME_CONSTANTS, explicit_gains
 
     found = {}
     for tau in (DEFAULT_TIME_CONSTANTS["tau_inclination"], 5.0):

@@ -35,7 +35,7 @@ EXCEPTIONS = {
         "11": "64 - 53: the top 53 bits of a hash make a double in [0, 1)",
         "0x1.0p-53": "2^-53, the spacing of doubles in [0.5, 1)",
     },
-    "estimators/core.py": {"0.25": "Shepperd's quaternion from a rotation matrix (q_i = s / 4)"},
+    "estimators/quaternions.py": {"0.25": "Shepperd's quaternion from a rotation matrix (q_i = s / 4)"},
 }
 
 _C_NUMBER = re.compile(r"(?<![\w.])(0[xX][0-9a-fA-F]*(?:\.[0-9a-fA-F]*)?(?:[pP][-+]?\d+)?[uUlL]*"

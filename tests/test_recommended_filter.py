@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 from quadcosim.estimators import DEFAULT_GAINS, estimate
-from quadcosim.estimators.filters import DEFAULT_TIME_CONSTANTS, RECOMMENDED, RECORDED, explicit_gains, time_constants
+from quadcosim.estimators.explicit import DEFAULT_TIME_CONSTANTS, explicit_gains, time_constants
+from quadcosim.estimators.filters import RECOMMENDED, RECORDED
 
 G = 9.81
 FIELD = 4.7e-5  # T

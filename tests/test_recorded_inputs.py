@@ -17,12 +17,12 @@ G = 9.81  # m/s^2
 
 def _static(seconds=20.0, tilt_deg=(20.0, -10.0)):
     """A sensor at rest, tilted (roll, pitch), in NED with the lab's field: gyro, acc, mag, reference."""
-    from quadcosim.estimators.core import euler_to_quaternion
     from quadcosim.estimators.filters import references
+    from quadcosim.estimators.quaternions import euler_to_quaternion
 
     q = np.array(euler_to_quaternion(math.radians(tilt_deg[0]), math.radians(tilt_deg[1]), 0.3))
     r = np.empty((3, 3))
-    from quadcosim.estimators.core import rotation
+    from quadcosim.estimators.quaternions import rotation
 
     rotation(q, r)
     g, m = references()

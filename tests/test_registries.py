@@ -56,10 +56,7 @@ def _with_line(registry_line: str, body: str, tmp_path: Path) -> dict:
 
 
 def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
-    found = _with_line('''
-        from quadcosim.estimators import kinds
-        kinds.KINDS["gyro-only"] = kinds.Kind("gyro-only", "gyro only", batch=False, block="dummy_estimator:GyroOnly")
-    ''', '''
+    found = _with_member("quadcosim.estimators", "gyro-only = dummy_estimator:KIND", '''
         code, listing = cli("list")
         found["listed"] = [line for line in listing.splitlines() if line.strip().startswith("estimator ")][0]
         code, _ = cli("run", "tp", "--set", "estimator=gyro-only", "--set", "duration=0.2", "--out", "out")
@@ -73,6 +70,10 @@ def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
         found["replayed"] = list(replay.ESTIMATORS)
         from quadcosim.scenarios.registries import estimator_rows
         found["documented"] = [row for row in estimator_rows() if row[0] == "`gyro-only`"]
+        code, parameters = cli("list", "--parameters", "Quaternion_estim")
+        found["parameters"] = [line.strip() for line in parameters.splitlines() if "gyro-only" in line]
+        from quadcosim.estimators import kinds
+        found["bias"] = list(kinds.with_bias())
     ''', tmp_path)
     assert "|gyro-only)" in found["listed"]  # quadcosim list: tp's estimator choices
     assert found["ran"][:2] == [0, "gyro-only"] and found["ran"][2]  # run and scored
@@ -81,6 +82,8 @@ def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
     assert "gyro-only" not in found["replayed"]  # a block alone: no batch path for recorded arrays
     # the docs' table (docs/_generated/registries.md): closed loop, no batch path, its own block
     assert found["documented"] == [["`gyro-only`", "gyro only", "", "", "yes", "", "yes", "`dummy_estimator:GyroOnly`"]]
+    assert found["parameters"] == ["gyro-only: its own block (dummy_estimator:GyroOnly), its parameters its own"]
+    assert found["bias"] == ["explicit", "passive"]  # no gyro-bias estimate: not scored as one
 
 
 def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
@@ -180,6 +183,25 @@ def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
         assert model in order and model in INPUTS and f"| `{model}` |" in table, model
 
 
+def _the_estimator_checklist_is_how_every_estimator_stands(checklist: str):
+    """Each registered estimator is a module's ``KIND`` named by one line of ``pyproject.toml``, as
+    the checklist's line shows; each filter of the compiled core is in ``COMPILED``, with its code."""
+    import tomllib
+
+    from quadcosim.estimators import core, kinds
+
+    assert '`<name> = "quadcosim.estimators.<name>:KIND"`' in checklist and "`COMPILED`" in checklist
+    lines = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"][kinds.GROUP]
+    assert list(lines) == list(kinds.registry())  # the lines are the registry, in its order
+    for value in lines.values():
+        module, _, attribute = value.partition(":")
+        assert attribute.endswith("KIND") and module.startswith("quadcosim.estimators."), value
+    compiled = {name for name, kind in kinds.registry().items() if kind.code is not None}
+    assert compiled == set(core.COMPILED) and len({kind.code for kind in core.COMPILED.values()}) == len(compiled)
+    for name in compiled:  # a compiled filter's module is named after it, as the checklist says
+        assert (ROOT / "estimators" / f"{name}.py").is_file(), name
+
+
 def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_extend():
     """The registry line of each dummy test is the one its checklist names."""
     from quadcosim.calibration.flight import catalogue
@@ -187,7 +209,8 @@ def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_exte
 
     estimator = _section("Adding an estimator")
     assert Path(kinds.__file__).relative_to(ROOT).as_posix() in _paths(estimator)
-    assert "estimators/contract.py" in _paths(estimator) and "`KINDS`" in estimator
+    assert "estimators/contract.py" in _paths(estimator) and f'`[project.entry-points."{kinds.GROUP}"]`' in estimator
+    _the_estimator_checklist_is_how_every_estimator_stands(estimator)
     model = _section("Adding a flight-log model or autopilot")
     assert Path(catalogue.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`MODELS`" in model
     from quadcosim.calibration.flight import autopilot

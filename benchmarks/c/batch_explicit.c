@@ -7,7 +7,7 @@
  * compiled without floating-point contraction (-ffp-contract=off; numba contracts nothing
  * without fastmath). The attitude starts from q0 (no TRIAD start).
  *
- * The slots of the layouts are numbered as in estimators/core.py; the benchmark checks
+ * The slots of the layouts are numbered as in estimators/layout.py; the benchmark checks
  * `batch_explicit_slots` against those layouts before any run.
  */
 #include <math.h>
@@ -22,7 +22,7 @@ enum { GRAVITY = 0, FIELD = 3, DISCRETE = 6 };
 enum { K1 = 0, K2 = 1, KP = 3, KI = 4, HEADING_ONLY = 5, ACC_TOL = 6, MAG_NORM_TOL = 7, MAG_DIP_TOL = 8,
        REST_GYRO = 9, REST_ACC = 10, REST_MIN_TIME = 11, REST_GAIN = 12, GAIN_SIZE = 22 };
 enum { EULER = 1 };
-#define REST_LOWPASS_TAU 0.5 /* s, as estimators/core.py */
+#define REST_LOWPASS_TAU 0.5 /* s, as estimators/layout.py */
 
 /* Writes the slot numbers this file uses, in the order the benchmark lists them. */
 void batch_explicit_slots(long *slots) {
