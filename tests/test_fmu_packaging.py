@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 from quadcosim.fmus import MODELS, fmu_path
+from quadcosim.fmus.models import sensors
 from quadcosim.orchestrator.fmu import FMUError, FMUInstance
 
 
@@ -39,21 +40,9 @@ def test_nan_input_is_an_error_with_a_message():
     assert "omega_r1" in str(error.value) and "not a finite number" in str(error.value)
 
 
-@pytest.mark.parametrize("model, parameter, value, words", [
-    ("Quadrotor", "m", -1.0, "m = -1 must be positive"),
-    ("Quadrotor", "Jxx", 0.0, "Jxx = 0 must be positive"),
-    ("MotorMagnetics", "L_m", 0.0, "L_m = 0 must be positive"),
-    ("IMU", "sample_rate", -5.0, "sample_rate = -5 Hz must be positive"),
-    ("Quadrotor", "k_d", -1e-4, "k_d = -0.0001 must be non-negative"),
-    ("Quadrotor", "c_Dx", -0.01, "c_Dx = -0.01 must be non-negative"),
-    ("Quadrotor", "drag", -0.2, "drag = -0.2 must be non-negative"),
-    ("Quadrotor", "J_r", -3e-5, "J_r = -3e-05 must be non-negative"),
-    ("MotorMagnetics", "i_max", 0.0, "i_max = 0 must be positive"),
-    ("IMU", "mag_sample_rate", 0.0, "mag_sample_rate = 0 Hz must be positive"),
-    ("IMU", "vibration_amplitude", -0.1, "vibration_amplitude = -0.1 m/s2 must be non-negative"),
-    ("MotorMagnetics", "i_max", -5.0, "i_max = -5 must be positive"),
-    ("MotorMagnetics", "omega0", 2000.0, "omega0 = 2000 rad/s needs a motor current of 61.7 A, beyond i_max = 18 A"),
-])
+@pytest.mark.parametrize("model, parameter, value, words",
+                         [(name, *refused) for name, member in sensors().items()
+                          for refused in member.check("REFUSED_PARAMETERS")])
 def test_invalid_parameter_is_an_error_with_a_message(model, parameter, value, words):
     with pytest.raises(FMUError) as error:
         FMUInstance(model, {parameter: value})

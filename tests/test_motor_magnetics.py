@@ -147,11 +147,12 @@ def test_current_limit_holds_the_motor_current_on_a_start_from_rest(capsys):
 
 @pytest.mark.parametrize("case", [0, 1])
 def test_substep_manoeuvres_reach_both_current_bounds(case):
-    """The sub-step convergence manoeuvres (fmus/agreement.py, tests/test_substep.py) exercise the mode switches."""
-    from quadcosim.fmus.agreement import SUBSTEP_CASES as CASES
+    """The sub-step convergence manoeuvres (fmus/MotorMagnetics/__init__.py, tests/test_substep.py) exercise the
+    mode switches."""
+    from quadcosim.fmus.MotorMagnetics import SUBSTEP_CASES
     from quadcosim.fmus.twins import simulate_fmu
 
-    inputs, params, _ = CASES["MotorMagnetics"][case]
+    inputs, params, _ = SUBSTEP_CASES[case]
     _, out = simulate_fmu("MotorMagnetics", inputs, params, 2.0, 0.02, MOTOR_CURRENTS)
     currents = np.column_stack([out[k] for k in MOTOR_CURRENTS])
     assert currents.min() == 0.0 and currents.max() == vehicle.ESC_CURRENT_LIMIT

@@ -13,19 +13,18 @@ import pytest
 from fmpy import read_model_description
 from quadcosim.fmus import MODELS, fmu_path
 from quadcosim.fmus.build import BuildError, build_fmu, table
+from quadcosim.fmus.models import sensor, sensors
 from quadcosim.fmus.variables import base_unit
 from quadcosim.orchestrator.fmu import FMUInstance
 from raw_fmu import RawFMU
 
-# Inputs held over the check, by model: a rotating, tilted body with the motors unequal.
-INPUTS = {
-    "Quadrotor": {"omega_r1": 480.0, "omega_r2": 500.0, "omega_r3": 490.0, "omega_r4": 505.0},
-    "MotorMagnetics": {"c1": 0.35, "c2": 0.5, "c3": 0.62, "c4": 0.8},
-    "IMU": {"q0": 0.9, "q1": 0.3, "q2": -0.2, "q3": np.sqrt(0.06), "omega_x": 0.3, "omega_y": -0.2,
-            "omega_z": 0.1, "f_x": 1.0, "f_y": -0.5, "f_z": -9.7, "b_d_x": 1e-6, "b_d_y": -2e-6, "b_d_z": 3e-6},
-    "InfraredSensor": {"phi": 0.3},
-}
-PARAMETERS = {"IMU": {"noise_enabled": True, "bias_enabled": True}}
+
+def held(model: str) -> tuple[dict, dict]:
+    """The inputs held over the check and the parameters of the run: the model's ``HELD_INPUTS``
+    and ``HELD_PARAMETERS`` (its folder's ``__init__.py``; for the plant, a rotating, tilted body
+    with the motors unequal)."""
+    member = sensor(model)
+    return member.check("HELD_INPUTS"), member.check("HELD_PARAMETERS")
 
 
 def _units(tab):
@@ -49,9 +48,10 @@ def _reordered(tab, units):
 
 
 def _run(path, model, steps=300, h=1e-3):
-    fmu = FMUInstance(str(path), PARAMETERS.get(model), name=model)
+    inputs, parameters = held(model)
+    fmu = FMUInstance(str(path), parameters, name=model)
     try:
-        names, values = list(INPUTS[model]), list(INPUTS[model].values())
+        names, values = list(inputs), list(inputs.values())
         rows = []
         for k in range(steps):
             fmu.set(names, values)
@@ -66,7 +66,7 @@ def _run(path, model, steps=300, h=1e-3):
 def test_a_table_reordered_without_splitting_a_vector_gives_identical_results(model, tmp_path):
     tab = table(model)
     reordered = _reordered(tab, _units(tab)[::-1])
-    assert [tab.vr[n] for n in INPUTS[model]] != [reordered.vr[n] for n in INPUTS[model]]  # it did move
+    assert [tab.vr[v.name] for v in tab.variables] != [reordered.vr[v.name] for v in tab.variables]  # it did move
     expected = _run(fmu_path(model), model)
     got = _run(build_fmu(model, tmp_path, variables=reordered), model)
     assert got.keys() == expected.keys()
@@ -74,9 +74,10 @@ def test_a_table_reordered_without_splitting_a_vector_gives_identical_results(mo
         assert np.array_equal(got[name], expected[name]), name
 
 
-@pytest.mark.parametrize(("model", "vector"), [("Quadrotor", "q"), ("MotorMagnetics", "omega_r"),
-                                               ("IMU", "magneto")])
+@pytest.mark.parametrize(("model", "vector"), [(name, member.check("SPLIT_VECTOR"))
+                                               for name, member in sensors().items() if member.check("SPLIT_VECTOR")])
 def test_a_table_that_splits_a_vector_is_refused_by_the_build(model, vector, tmp_path):
+    """Each model's ``SPLIT_VECTOR`` (a vector of three rows or more), split."""
     tab = table(model)
     units = _units(tab)
     index = next(k for k, unit in enumerate(units) if len(unit) > 1 and unit[0].name.startswith(vector))
