@@ -174,3 +174,14 @@ def test_rig_one_motor_error_is_of_the_order_of_table_1(capsys):
     assert 9.5 < single < 11.5
     assert supply.min() >= 0.0 and result["MotorMagnetics.i"].min() >= 0.0
     assert errors["free"] > single  # fast, simultaneous changes of all four disturb more
+
+
+def test_out_of_range_command_is_saturated_and_logged():
+    fmu = FMUInstance("MotorMagnetics")
+    fmu.set(["c1", "c2"], [1.7, 1.0])
+    for k in range(300):
+        fmu.step(k * 1e-3, 1e-3)
+    w1, w2 = fmu.get(["omega_r1", "omega_r2"])
+    assert w1 == pytest.approx(w2, rel=1e-12)  # 1.7 acts as 1.0
+    assert any("c1 = 1.7" in line and "saturated" in line for line in fmu.log)
+    fmu.close()
