@@ -187,6 +187,23 @@ def test_a_dummy_sensor_fmu_is_one_folder_and_one_line(tmp_path):
     assert sorted(set(passed)) == sorted(checks) and len(passed) >= 10, done.stdout[-3000:]
 
 
+def test_a_sensor_registration_that_is_no_sensor_fmu_is_refused_with_the_fix(tmp_path):
+    """A registered name other than its table's, and a package without model.c: each refused
+    when the model is asked for, the message naming what is wrong and what to do."""
+    site = installed_member(tmp_path / "site", "quadcosim.sensors", "Altimeter = dummy_sensor")
+    found = _with_member("quadcosim.sensors", "Empty = json", '''
+        from quadcosim.fmus.models import SensorError, fmu_sources, model_variables
+        for name, ask in (("Altimeter", model_variables), ("Empty", fmu_sources)):
+            try:
+                ask(name)
+            except SensorError as error:
+                found[name] = str(error)
+    ''', tmp_path)
+    assert site == tmp_path / "site"
+    assert "TABLE is named 'Barometer'; name it 'Altimeter'" in found["Altimeter"]
+    assert "has no model.c nor variables.py" in found["Empty"] and "a sensor FMU is a folder" in found["Empty"]
+
+
 # --- the maintainers' checklists (docs/guides/maintainers.md) -------------------------------
 
 CHECKLISTS = ROOT / "docs" / "guides" / "maintainers.md"
