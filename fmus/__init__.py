@@ -2,9 +2,12 @@
 
 - :mod:`quadcosim.fmus.vehicle`: the physical constants of the default vehicle, with units;
 - :mod:`quadcosim.fmus.airframe`: motor numbering and spin directions;
-- ``fmus/<Model>/variables.py``: each model's variable table; ``fmus/<Model>/model.c``: its
-  equations; ``fmus/c/``: the FMI shell they share;
-- ``fmus/QuadCoSim/``: the Modelica twins;
+- :mod:`quadcosim.fmus.models`: the registered models (:data:`MODELS`, the entry-point group
+  ``quadcosim.sensors``), each a folder ``fmus/<Model>/``: its equations ``model.c``, its variable
+  table ``variables.py``, its Modelica twin ``<Model>.mo`` and the data its checks use;
+  ``fmus/c/``: the FMI shell they share;
+- :mod:`quadcosim.fmus.twins`: the twins gathered into the Modelica package ``QuadCoSim``
+  (``fmus/QuadCoSim/package.mo`` and each model's class), simulated against the FMUs;
 - :mod:`quadcosim.fmus.build`: builds ``<build root>/fmus/<Model>.fmu`` (FMI 2.0, what a run loads) and
   ``<build root>/fmus/fmi3/<Model>.fmu`` (FMI 3.0), each for Linux and, with mingw-w64, Windows
   (``quadcosim build``, or on first use).
@@ -18,7 +21,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from quadcosim.fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
+from quadcosim.fmus import models as _models
+from quadcosim.fmus.models import fmu_sources, model_variables  # noqa: F401  (the package's names)
 
 from quadcosim.infra.folders import (  # noqa: F401  (the package's names)
     BuildFolderRefused,
@@ -26,6 +30,12 @@ from quadcosim.infra.folders import (  # noqa: F401  (the package's names)
     compiler_command,
     make_folder,
 )
+
+
+def __getattr__(name: str):
+    if name == "MODELS":  # the registered models' names, read at each look-up (quadcosim.fmus.models)
+        return _models.MODELS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class FMUNotFoundError(FileNotFoundError):
@@ -100,13 +110,14 @@ def fmu_path(name: str, fmi_version: int = 2) -> Path:
     if fmi_version not in (2, 3):
         raise ValueError(f"FMI version {fmi_version!r}: the plant's FMUs are built in FMI 2 and 3")
     path = default_fmu_dir() / ("" if fmi_version == 2 else "fmi3") / f"{name}.fmu"
-    if name in MODELS and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
+    models = _models.MODELS
+    if name in models and "QUADCOSIM_FMU_DIR" not in os.environ and path not in _checked:
         if stale(path, name):
             _build_on_first_use(name, path, fmi_version)
         _checked.add(path)
     if not path.is_file():
-        known = ", ".join(MODELS)
-        hint = "" if name in MODELS else f" ({name!r} is not one of the plant models: {known})"
+        known = ", ".join(models)
+        hint = "" if name in models else f" ({name!r} is not one of the plant models: {known})"
         raise FMUNotFoundError(
             f"FMU {name!r} not found at {path}{hint}. Build the FMUs with `quadcosim build` "
             "(or `make fmus`)."

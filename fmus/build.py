@@ -23,8 +23,9 @@ import sys
 import zipfile
 from pathlib import Path
 
+from quadcosim.fmus import models as registry
 from quadcosim.fmus.airframe import c_header as airframe_header
-from quadcosim.fmus.models import MODELS, fmu_sources, model_variables
+from quadcosim.fmus.models import fmu_sources, model_folder, model_variables
 
 from quadcosim.infra.folders import compiler_command, make_folder
 
@@ -58,12 +59,12 @@ def table(model: str):
     Parameters
     ----------
     model : str
-        Model folder under ``fmus/``.
+        A registered model (:data:`quadcosim.fmus.MODELS`).
 
     Returns
     -------
     quadcosim.fmus.variables.Table
-        ``fmus.<model>.variables.TABLE``.
+        The ``TABLE`` of its folder's ``variables.py``.
     """
     return model_variables(model).TABLE
 
@@ -150,7 +151,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
     Parameters
     ----------
     model : str
-        Model folder under ``fmus/`` (its ``model.c``; its ``variables.py`` unless ``variables``).
+        A registered model (its folder's ``model.c``; its ``variables.py`` unless ``variables``).
     out_dir : pathlib.Path
         Output folder; the staged sources stay beside the FMU, in ``<model>/``.
     compiler : str, optional
@@ -191,7 +192,7 @@ def build_fmu(model: str, out_dir: Path, compiler: str | None = None, variables=
         shutil.copy(_fmi_header_dir() / name, sources / name)
     for name in (*SHELL_HEADERS, source_files[0]):
         shutil.copy(HERE / "c" / name, sources / name)
-    shutil.copy(HERE / model / "model.c", sources / "model.c")
+    shutil.copy(model_folder(model) / "model.c", sources / "model.c")
     (sources / "variables.h").write_text(header)
     (sources / "airframe.h").write_text(airframe_header())
     if fmi_version == 3:
@@ -242,16 +243,17 @@ def up_to_date(model: str, out_dir: Path, fmi_version: int = 2) -> bool:
     return all(f"binaries/{PLATFORMS[fmi_version][p]}/{model}{suffix[p]}" in names for p in platforms)
 
 
-def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=FMI_VERSIONS,
+def build_all(out_dir: Path, models=None, verbose: bool = True, fmi_versions=FMI_VERSIONS,
               force: bool = False) -> list[Path]:
-    """Build every plant FMU, in each FMI version, that is not up to date.
+    """Build every plant FMU, in each FMI version, that is not up to date, and write the Modelica
+    package of their twins beside them (:func:`quadcosim.fmus.modelica.write_package`).
 
     Parameters
     ----------
     out_dir : pathlib.Path
         Output folder (:func:`quadcosim.fmus.default_fmu_dir`, where a run looks for the FMUs).
-    models : sequence of str
-        Model names (folders under ``fmus/``); all of :data:`quadcosim.fmus.MODELS` by default.
+    models : sequence of str, optional
+        Model names; every registered one (:data:`quadcosim.fmus.MODELS`) by default.
     verbose : bool
         Print each FMU's path as it is built (or found up to date).
     fmi_versions : sequence of int
@@ -265,7 +267,10 @@ def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=F
     list of pathlib.Path
         The ``.fmu`` files, built or up to date.
     """
+    from quadcosim.fmus.modelica import write_package
+
     out_dir = make_folder(out_dir, "the FMUs")
+    models = registry.MODELS if models is None else tuple(models)
     built = []
     for fmi_version in fmi_versions:
         fmu_file(models[0], out_dir, fmi_version).parent.mkdir(parents=True, exist_ok=True)
@@ -278,4 +283,7 @@ def build_all(out_dir: Path, models=MODELS, verbose: bool = True, fmi_versions=F
             built.append(build_fmu(model, out_dir, fmi_version=fmi_version))
             if verbose:
                 print(f"built {built[-1]}")
+    package = write_package(out_dir / "QuadCoSim")
+    if verbose:
+        print(f"wrote {package}")
     return built

@@ -3,7 +3,7 @@
 The twins are simulated with the pure-Python Modelica toolchain published on PyPI as
 ``modelica`` (pinned in pyproject.toml). Two of its limits shape this module:
 - it reads one program, not a package directory, and ignores ``within``: the package is
-  assembled here from ``package.mo`` and the class files named in ``package.order``;
+  assembled from ``package.mo`` and each registered model's twin (:mod:`quadcosim.fmus.modelica`);
 - it leaves top-level inputs unset: each check wraps the model in a small model that binds
   every input to an expression of ``time``.
 Input expressions use only ``time``, numbers, ``+ - * /`` and ``sin``, ``cos``, ``exp``, so
@@ -13,34 +13,13 @@ the same text is valid Modelica and valid Python.
 from __future__ import annotations
 
 import math
-import re
 import shutil
-from pathlib import Path
 
 import numpy as np
 from quadcosim.fmus import fmu_path
+from quadcosim.fmus.modelica import package_source
 
-PACKAGE_DIR = Path(__file__).resolve().parent / "QuadCoSim"
 _FUNCTIONS = {"sin": np.sin, "cos": np.cos, "exp": np.exp, "pi": math.pi}
-
-
-def package_source() -> str:
-    """The QuadCoSim package as one Modelica text, class files nested in ``package.mo``.
-
-    Returns
-    -------
-    str
-        The package, as the ``modelica`` toolchain reads a single program.
-    """
-    package = (PACKAGE_DIR / "package.mo").read_text()
-    order = (PACKAGE_DIR / "package.order").read_text().split()
-    body = []
-    for name in order:
-        text = (PACKAGE_DIR / f"{name}.mo").read_text()
-        body.append(re.sub(r"^\s*within\s+[\w.]*\s*;", "", text, count=1))
-    package = re.sub(r"^\s*within\s*;", "", package, count=1)
-    end = package.rindex("end QuadCoSim;")
-    return package[:end] + "\n".join(body) + "\n" + package[end:]
 
 
 def _modelica_value(value) -> str:

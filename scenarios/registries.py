@@ -3,7 +3,8 @@
 - the estimators, the entry-point group ``quadcosim.estimators`` (:func:`quadcosim.estimators.kinds.registry`);
 - the interference models a flight calibration fits, :data:`quadcosim.calibration.flight.catalogue.MODELS`;
 - the autopilots the export writes parameters for, :data:`quadcosim.calibration.flight.autopilot.AUTOPILOTS`;
-- the scenarios, :mod:`quadcosim.scenarios.catalogue` (those a higher floor registers too, once imported).
+- the scenarios, :mod:`quadcosim.scenarios.catalogue` (those a higher floor registers too, once imported);
+- the sensor FMUs, :data:`quadcosim.fmus.MODELS` (the entry-point group ``quadcosim.sensors``).
 
 The documentation's page of these sets is :func:`tables`, written when the site is built: a
 member added by its registry line is listed there as in ``quadcosim list`` and the command
@@ -59,6 +60,26 @@ def scenario_rows() -> list[tuple]:
     return [(f"`{name}`", scenario.description, f"`{modules[name][0]}`") for name, scenario in registry().items()]
 
 
+def sensor_rows() -> list[tuple]:
+    """One row per sensor FMU: name, states, integrator, default sub-step, the package of its folder
+    (each model's ``SUMMARY`` and table, :mod:`quadcosim.fmus.models`)."""
+    from quadcosim.fmus.build import table
+    from quadcosim.fmus.models import sensors
+
+    rows = []
+    for name, member in sensors().items():
+        summary = member.check("SUMMARY")
+        sub_step = next((v.start for v in table(name).of("parameter") if v.name == "sub_step"), None)
+        rows.append((f"`{name}`", summary["states"], summary["integrator"],
+                     "—" if sub_step is None else f"{sub_step * 1e3:g} ms", f"`{member.module}`"))
+    return rows
+
+
+def sensor_table() -> str:
+    """The sensor FMUs as one Markdown table (the documentation's guide to the FMUs includes it)."""
+    return "\n".join(_table(("FMU", "states", "integrator", "default sub-step", "folder (package)"), sensor_rows()))
+
+
 def tables() -> str:
     """The four sets as one Markdown page (a heading, then a table per set)."""
     lines = ["# What the package names", "",
@@ -84,4 +105,7 @@ def tables() -> str:
     lines += ["## Scenarios", "", "`scenarios/catalogue.py` (and `register` from a higher floor): `quadcosim run`, "
               "`quadcosim list`, sweeps.", ""]
     lines += _table(("name", "description", "module"), scenario_rows())
+    lines += ["## Sensor FMUs", "", "The entry-point group `quadcosim.sensors` (`pyproject.toml`), a folder each: "
+              "`quadcosim build`, `quadcosim list --parameters`, the orchestrator's `--set`, the twins and the FMU "
+              "checks.", "", sensor_table()]
     return "\n".join(lines)

@@ -371,7 +371,8 @@ def _c_includes(path: Path) -> list[tuple[str, str]]:
 def test_the_fmus_c_sources_include_only_what_their_part_may():
     bad = []
     shared = {p.name for p in (ROOT / "fmus" / "c").glob("*.h")}
-    for path in sorted((ROOT / "fmus").rglob("*.[ch]")):
+    # the package's FMUs and the registry's dummy sensor FMU (tests/registry_dummies/), held to the same rules
+    for path in sorted([*(ROOT / "fmus").rglob("*.[ch]"), *(ROOT / "tests" / "registry_dummies").rglob("*.[ch]")]):
         part, where = _c_part(path), path.relative_to(ROOT)
         for bracket, name in _c_includes(path):
             if bracket == "<" and name not in C_STANDARD:

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 from quadcosim.fmus import MODELS
+from quadcosim.fmus.models import sensor
 from quadcosim.orchestrator import pool
 from quadcosim.orchestrator.fmu import FMUError, FMUInstance
 from quadcosim.scenarios.testing.assertions import assert_runs_close
@@ -13,12 +14,12 @@ from quadcosim.scenarios.testing.assertions import assert_runs_close
 from quadcosim import scenarios
 
 DT = 1e-3
-PARAMETERS = {  # off their defaults, so that a reset that kept the earlier run's values would show
-    "Quadrotor": ({"m": 1.3, "omega_x0": 0.2}, {"m": 0.9}),
-    "MotorMagnetics": ({"soc0": 0.8}, {"soc0": 0.6, "sub_step": 1e-4}),
-    "IMU": ({"noise_enabled": True, "bias_enabled": True, "seed": 7}, {"noise_enabled": True, "seed": 3}),
-    "InfraredSensor": ({"noise_enabled": True, "seed": 5}, {"seed": 9, "gps_delay": 0.5}),
-}
+
+
+def reset_parameters(model: str) -> tuple[dict, dict]:
+    """The model's ``RESET_PARAMETERS`` (its folder's ``__init__.py``): those of a fresh run and of an
+    earlier one, off their defaults, so that a reset that kept the earlier run's values would show."""
+    return sensor(model).check("RESET_PARAMETERS")
 
 
 def inputs_at(fmu: FMUInstance, k: int, phase: float) -> np.ndarray:
@@ -42,7 +43,7 @@ def trajectory(fmu: FMUInstance, steps: int, phase: float = 0.0) -> np.ndarray:
 
 @pytest.mark.parametrize("model", MODELS)
 def test_a_reset_instance_steps_exactly_as_a_fresh_one(model):
-    wanted, other = PARAMETERS[model]
+    wanted, other = reset_parameters(model)
     fresh = FMUInstance(model, wanted)
     expected = trajectory(fresh, 300)
     fresh.close()
@@ -58,7 +59,7 @@ def test_a_reset_instance_steps_exactly_as_a_fresh_one(model):
 
 @pytest.mark.parametrize("model", MODELS)
 def test_a_reset_after_an_error_state_gives_a_fresh_instance(model):
-    wanted, _ = PARAMETERS[model]
+    wanted, _ = reset_parameters(model)
     fresh = FMUInstance(model, wanted)
     expected = trajectory(fresh, 50)
     fresh.close()

@@ -146,15 +146,3 @@ def test_twin_agrees_with_the_fmu():
     assert fmu["gps_valid"][-1] == 1.0 and np.ptp(fmu["gps_turn_rate"]) > 0.1
     bad = {k: float(v) for k, v in worst.items() if not v <= 1e-6}
     assert not bad, bad
-
-
-def test_twin_parameters_equal_fmu_start_values():
-    pytest.importorskip("modelica")
-    from quadcosim.fmus.twins import simulate_twin
-
-    tab = table("InfraredSensor")
-    twin = simulate_twin("InfraredSensor", {"phi": "0.0"}, {}, 0.01, np.array([0.0, 0.01]))
-    for v in tab.of("parameter"):
-        if v.name in ("seed", "ir_noise", "gps_heading_noise"):
-            continue
-        assert twin[v.name][0] == pytest.approx(float(v.start), rel=1e-12, abs=0), v.name

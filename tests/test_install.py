@@ -76,7 +76,8 @@ def test_the_wheel_holds_the_project_packages_and_their_c_sources(installed):
     top = {name.split("/")[0] for name in files if not name.startswith("..")} - {record.name}
     assert top == TOP_LEVEL, top  # no `build`, no `tests`, nothing else at the top level
     for source in ("benchmarks/c/loops.c", "benchmarks/c/rotation.h", "orchestrator/c/calls.c",
-                   "fmus/c/shell.c", "fmus/Quadrotor/model.c", "fmus/QuadCoSim/package.order"):
+                   "fmus/c/shell.c", "fmus/Quadrotor/model.c", "fmus/Quadrotor/Quadrotor.mo",
+                   "fmus/QuadCoSim/package.mo"):
         assert (site / "quadcosim" / source).is_file(), source
     # every package of the checkout is shipped (pyproject.toml lists them one by one)
     inits = [init.parent.relative_to(ROOT).as_posix() for folder in (*FOLDERS, "quadcosim")

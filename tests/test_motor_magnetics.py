@@ -147,11 +147,12 @@ def test_current_limit_holds_the_motor_current_on_a_start_from_rest(capsys):
 
 @pytest.mark.parametrize("case", [0, 1])
 def test_substep_manoeuvres_reach_both_current_bounds(case):
-    """The sub-step convergence manoeuvres (fmus/agreement.py, tests/test_substep.py) exercise the mode switches."""
-    from quadcosim.fmus.agreement import SUBSTEP_CASES as CASES
+    """The sub-step convergence manoeuvres (fmus/MotorMagnetics/__init__.py, tests/test_substep.py) exercise the
+    mode switches."""
+    from quadcosim.fmus.MotorMagnetics import SUBSTEP_CASES
     from quadcosim.fmus.twins import simulate_fmu
 
-    inputs, params, _ = CASES["MotorMagnetics"][case]
+    inputs, params, _ = SUBSTEP_CASES[case]
     _, out = simulate_fmu("MotorMagnetics", inputs, params, 2.0, 0.02, MOTOR_CURRENTS)
     currents = np.column_stack([out[k] for k in MOTOR_CURRENTS])
     assert currents.min() == 0.0 and currents.max() == vehicle.ESC_CURRENT_LIMIT
@@ -173,3 +174,14 @@ def test_rig_one_motor_error_is_of_the_order_of_table_1(capsys):
     assert 9.5 < single < 11.5
     assert supply.min() >= 0.0 and result["MotorMagnetics.i"].min() >= 0.0
     assert errors["free"] > single  # fast, simultaneous changes of all four disturb more
+
+
+def test_out_of_range_command_is_saturated_and_logged():
+    fmu = FMUInstance("MotorMagnetics")
+    fmu.set(["c1", "c2"], [1.7, 1.0])
+    for k in range(300):
+        fmu.step(k * 1e-3, 1e-3)
+    w1, w2 = fmu.get(["omega_r1", "omega_r2"])
+    assert w1 == pytest.approx(w2, rel=1e-12)  # 1.7 acts as 1.0
+    assert any("c1 = 1.7" in line and "saturated" in line for line in fmu.log)
+    fmu.close()

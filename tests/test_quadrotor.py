@@ -5,6 +5,7 @@ import pytest
 from quadcosim.fmus import vehicle
 from quadcosim.fmus.airframe import MOTORS
 from quadcosim.orchestrator.fmu import FMUInstance
+from raw_fmu import RawFMU
 
 from tests.helpers import rotation, run_fmu
 
@@ -187,3 +188,15 @@ def test_rotor_pair_step_with_drag_torque_adds_the_reaction():
     assert np.abs(measured[window] - predicted[window]).max() < 0.015 * np.abs(predicted[window]).max()  # 0.79 %
     reaction = vehicle.ROTOR_INERTIA * (result["MotorMagnetics.domega_r"] @ spin)[window]
     assert reaction.max() > 0.5 * (predicted[window] * vehicle.INERTIA[2]).max()
+
+
+def test_a_failed_step_leaves_the_model_time_at_the_last_good_point():
+    fmu = RawFMU("Quadrotor")
+    assert fmu.instantiate()
+    assert fmu.initialize() == 0, fmu.messages()
+    assert fmu.do_step(0.0, 1e-3) == 0
+    refs = [fmu.refs[f"omega_r{n}"] for n in range(1, 5)]
+    assert fmu.set_real(refs, [1e200] * 4) == 0
+    assert fmu.do_step(1e-3, 1e-3) == 3  # the state overflows: Error
+    assert fmu.time() == 1e-3  # fmi2LastSuccessfulTime: the step that failed did not count
+    fmu.free()

@@ -130,6 +130,83 @@ def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
     assert found["documented"] == [["`dummy`", "a clock alone", "`dummy_scenario`"]]  # the docs' table
 
 
+def test_a_dummy_sensor_fmu_is_one_folder_and_one_line(tmp_path):
+    """tests/registry_dummies/dummy_sensor/ (a barometer: model.c, variables.py, its twin, its
+    checks' data) registered by one entry point: built, listed, in the docs' table, a real FMU that
+    validates and runs in a System, and in the FMU checks' tables, which it passes."""
+    import os
+    import shutil
+
+    from quadcosim.fmus import default_fmu_dir
+
+    fmus = tmp_path / "fmus"  # the FMUs built already, as they are (up to date): the build makes the dummy's
+    shutil.copytree(default_fmu_dir(), fmus, ignore=shutil.ignore_patterns("QuadCoSim", ".*"))
+    found = _with_member("quadcosim.sensors", "Barometer = dummy_sensor", f"""
+        import os
+        os.environ["QUADCOSIM_FMU_DIR"] = {str(fmus)!r}
+        code, out = cli("build", "--out", {str(fmus)!r})
+        found["built"] = [code, [line.split()[0] for line in out.splitlines() if "Barometer" in line]]
+        found["twins"] = open({str(fmus / "QuadCoSim" / "package.order")!r}).read().split()
+        code, listing = cli("list", "--parameters", "Barometer")
+        found["listed"] = [code, listing.splitlines()]
+        from fmpy.validation import validate_fmu
+        found["problems"] = validate_fmu({str(fmus / "Barometer.fmu")!r})
+        from quadcosim import Constant, FMUBlock, System
+        system = System(dt=1e-3)
+        speeds = dict((f"{{name}}{{n}}", 540.0 * (name == "omega_r")) for name in ("omega_r", "domega_r")
+                      for n in range(1, 5))
+        system.add(Constant("Rotors", speeds | dict(wind_x=0.0, wind_y=0.0, wind_z=0.0)))
+        system.add(FMUBlock("Quadrotor", model="Quadrotor"))
+        system.add(FMUBlock("Barometer", model="Barometer", parameters=dict(tau=0.005)))
+        for name in [*speeds, "wind_x", "wind_y", "wind_z"]:
+            system.connect(f"Rotors.{{name}}", f"Quadrotor.{{name}}")
+        system.connect("Quadrotor.p_z", "Barometer.p_z")
+        result = system.run(1.0)
+        found["climb"] = [float(-result["Quadrotor.p_z"][-1]), float(result["Barometer.altitude"][-1]),
+                          float(result["Barometer.pressure"][0] - result["Barometer.pressure"][-1])]
+        from quadcosim.scenarios.registries import sensor_rows, tables
+        found["documented"] = [list(row) for row in sensor_rows() if row[0] == "`Barometer`"]
+        found["page"] = "`dummy_sensor`" in tables()
+    """, tmp_path)
+    assert found["built"] == [0, ["built", "built"]]  # its FMI 2.0 and 3.0 FMUs, the others up to date
+    assert found["twins"][-1] == "Barometer"  # its twin in the Modelica package the build writes
+    assert found["listed"][0] == 0 and any(line.split()[:3] == ["tau", "=", "0.02"] for line in found["listed"][1])
+    assert found["problems"] == []  # fmpy's validation
+    climb, altitude, drop = found["climb"]
+    assert climb > 0.5 and altitude == climb  # the Quadrotor climbs (rotors above hover); h0 = 0
+    # the standard atmosphere near sea level: dp/dh = -rho g = -1.225 kg/m3 * 9.80665 m/s2 = -12.01 Pa/m
+    assert abs(drop / climb - 12.01) < 0.03 * 12.01, drop / climb
+    assert found["documented"] == [["`Barometer`", "the measured pressure (1)", "exact (altitude held over a step)",
+                                    "—", "`dummy_sensor`"]] and found["page"]
+    # the FMU checks iterate the registry, and the dummy passes each with its own data
+    env = dict(os.environ, QUADCOSIM_FMU_DIR=str(fmus),
+               PYTHONPATH=os.pathsep.join([str(tmp_path / "site"), str(DUMMIES), str(ROOT)]))
+    checks = ["tests/test_fmu_reset.py", "tests/test_fmu_packaging.py", "tests/test_variable_tables.py",
+              "tests/test_twins.py"]
+    done = subprocess.run([sys.executable, "-m", "pytest", "-v", "-p", "no:cacheprovider", "-k", "Barometer", *checks],
+                          cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout[-3000:]
+    passed = [line.split("::")[0] for line in done.stdout.splitlines() if "[Barometer" in line and " PASSED" in line]
+    assert sorted(set(passed)) == sorted(checks) and len(passed) >= 10, done.stdout[-3000:]
+
+
+def test_a_sensor_registration_that_is_no_sensor_fmu_is_refused_with_the_fix(tmp_path):
+    """A registered name other than its table's, and a package without model.c: each refused
+    when the model is asked for, the message naming what is wrong and what to do."""
+    site = installed_member(tmp_path / "site", "quadcosim.sensors", "Altimeter = dummy_sensor")
+    found = _with_member("quadcosim.sensors", "Empty = json", '''
+        from quadcosim.fmus.models import SensorError, fmu_sources, model_variables
+        for name, ask in (("Altimeter", model_variables), ("Empty", fmu_sources)):
+            try:
+                ask(name)
+            except SensorError as error:
+                found[name] = str(error)
+    ''', tmp_path)
+    assert site == tmp_path / "site"
+    assert "TABLE is named 'Barometer'; name it 'Altimeter'" in found["Altimeter"]
+    assert "has no model.c nor variables.py" in found["Empty"] and "a sensor FMU is a folder" in found["Empty"]
+
+
 # --- the maintainers' checklists (docs/guides/maintainers.md) -------------------------------
 
 CHECKLISTS = ROOT / "docs" / "guides" / "maintainers.md"
@@ -165,22 +242,33 @@ def test_every_file_a_checklist_names_exists():
 
 
 def test_the_fmu_checklist_names_what_the_build_and_the_tests_require():
-    from quadcosim.fmus import MODELS
+    """The sensor checklist names a model's folder files and its registry line; each model has
+    them; each check it names is read by the test file it names, which names no model."""
+    import re
+    import tomllib
 
-    section = _paths(_section("Adding a sensor FMU"))
-    for required in ("fmus/<Model>/model.c", "fmus/<Model>/variables.py", "fmus/<Model>/__init__.py",
-                     "fmus/models.py", "fmus/QuadCoSim/<Model>.mo", "fmus/QuadCoSim/package.order",
-                     "tests/test_variable_tables.py", "docs/guides/fmus.md"):
-        assert required in section, required
-    build = (ROOT / "fmus" / "build.py").read_text()
-    assert 'HERE / model / "model.c"' in build  # what the build compiles of a model
-    assert 'f"quadcosim.fmus.{model}.variables"' in (ROOT / "fmus" / "models.py").read_text()  # its table
-    from tests.test_variable_tables import INPUTS
+    from quadcosim.fmus.models import CHECKS, GROUP, sensors
 
-    order = (ROOT / "fmus" / "QuadCoSim" / "package.order").read_text().split()
-    table = (ROOT / "docs" / "guides" / "fmus.md").read_text()
-    for model in MODELS:  # each step, done for every model there is
-        assert model in order and model in INPUTS and f"| `{model}` |" in table, model
+    text = _section("Adding a sensor FMU")
+    section = _paths(text)
+    own = [p for p in section if p.startswith("fmus/<Model>/")]
+    assert own == ["fmus/<Model>/model.c", "fmus/<Model>/variables.py", "fmus/<Model>/<Model>.mo",
+                   "fmus/<Model>/__init__.py"]  # the folder: everything of the model
+    assert f"`{GROUP}`" in text and '`<Model> = "quadcosim.fmus.<Model>"`' in text  # the one registry line
+    registered = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"][GROUP]
+    for name, member in sensors().items():
+        if member.distribution != "quadcosim":
+            continue
+        assert registered[name] == f"quadcosim.fmus.{name}" and member.folder == ROOT / "fmus" / name
+        assert all((member.folder / p.rsplit("/", 1)[1].replace("<Model>", name)).is_file() for p in own), name
+    # each check the checklist names is a declared one, read by the test it is named with, and
+    # those tests read the registry: no model's name in them
+    for check, test in re.findall(r"`([A-Z_]+)`[^`]*?(?:and `[A-Z_]+`[^`]*?)?for `(tests/test_\w+\.py)`", text):
+        assert check in CHECKS, check
+        source = (ROOT / test).read_text()
+        assert f'"{check}"' in source, (check, test)
+        assert not [name for name in sensors() if f'"{name}"' in source], test
+    assert set(CHECKS) <= set(re.findall(r"`([A-Z_]+)`", text))  # every check is in the checklist
 
 
 def _the_estimator_checklist_is_how_every_estimator_stands(checklist: str):

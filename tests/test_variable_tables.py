@@ -13,19 +13,17 @@ import pytest
 from fmpy import read_model_description
 from quadcosim.fmus import MODELS, fmu_path
 from quadcosim.fmus.build import BuildError, build_fmu, table
+from quadcosim.fmus.models import sensor, sensors
 from quadcosim.fmus.variables import base_unit
 from quadcosim.orchestrator.fmu import FMUInstance
-from raw_fmu import RawFMU
 
-# Inputs held over the check, by model: a rotating, tilted body with the motors unequal.
-INPUTS = {
-    "Quadrotor": {"omega_r1": 480.0, "omega_r2": 500.0, "omega_r3": 490.0, "omega_r4": 505.0},
-    "MotorMagnetics": {"c1": 0.35, "c2": 0.5, "c3": 0.62, "c4": 0.8},
-    "IMU": {"q0": 0.9, "q1": 0.3, "q2": -0.2, "q3": np.sqrt(0.06), "omega_x": 0.3, "omega_y": -0.2,
-            "omega_z": 0.1, "f_x": 1.0, "f_y": -0.5, "f_z": -9.7, "b_d_x": 1e-6, "b_d_y": -2e-6, "b_d_z": 3e-6},
-    "InfraredSensor": {"phi": 0.3},
-}
-PARAMETERS = {"IMU": {"noise_enabled": True, "bias_enabled": True}}
+
+def held(model: str) -> tuple[dict, dict]:
+    """The inputs held over the check and the parameters of the run: the model's ``HELD_INPUTS``
+    and ``HELD_PARAMETERS`` (its folder's ``__init__.py``; for the plant, a rotating, tilted body
+    with the motors unequal)."""
+    member = sensor(model)
+    return member.check("HELD_INPUTS"), member.check("HELD_PARAMETERS")
 
 
 def _units(tab):
@@ -49,9 +47,10 @@ def _reordered(tab, units):
 
 
 def _run(path, model, steps=300, h=1e-3):
-    fmu = FMUInstance(str(path), PARAMETERS.get(model), name=model)
+    inputs, parameters = held(model)
+    fmu = FMUInstance(str(path), parameters, name=model)
     try:
-        names, values = list(INPUTS[model]), list(INPUTS[model].values())
+        names, values = list(inputs), list(inputs.values())
         rows = []
         for k in range(steps):
             fmu.set(names, values)
@@ -66,7 +65,7 @@ def _run(path, model, steps=300, h=1e-3):
 def test_a_table_reordered_without_splitting_a_vector_gives_identical_results(model, tmp_path):
     tab = table(model)
     reordered = _reordered(tab, _units(tab)[::-1])
-    assert [tab.vr[n] for n in INPUTS[model]] != [reordered.vr[n] for n in INPUTS[model]]  # it did move
+    assert [tab.vr[v.name] for v in tab.variables] != [reordered.vr[v.name] for v in tab.variables]  # it did move
     expected = _run(fmu_path(model), model)
     got = _run(build_fmu(model, tmp_path, variables=reordered), model)
     assert got.keys() == expected.keys()
@@ -74,9 +73,10 @@ def test_a_table_reordered_without_splitting_a_vector_gives_identical_results(mo
         assert np.array_equal(got[name], expected[name]), name
 
 
-@pytest.mark.parametrize(("model", "vector"), [("Quadrotor", "q"), ("MotorMagnetics", "omega_r"),
-                                               ("IMU", "magneto")])
+@pytest.mark.parametrize(("model", "vector"), [(name, member.check("SPLIT_VECTOR"))
+                                               for name, member in sensors().items() if member.check("SPLIT_VECTOR")])
 def test_a_table_that_splits_a_vector_is_refused_by_the_build(model, vector, tmp_path):
+    """Each model's ``SPLIT_VECTOR`` (a vector of three rows or more), split."""
     tab = table(model)
     units = _units(tab)
     index = next(k for k, unit in enumerate(units) if len(unit) > 1 and unit[0].name.startswith(vector))
@@ -87,14 +87,19 @@ def test_a_table_that_splits_a_vector_is_refused_by_the_build(model, vector, tmp
         build_fmu(model, tmp_path, variables=_reordered(tab, units))
 
 
-def test_a_vector_out_of_component_order_is_refused(tmp_path):
-    tab = table("Quadrotor")
-    names = [v.name for v in tab.variables]
+@pytest.mark.parametrize(("model", "vector"), [(name, member.check("SPLIT_VECTOR"))
+                                               for name, member in sensors().items() if member.check("SPLIT_VECTOR")])
+def test_a_vector_out_of_component_order_is_refused(model, vector, tmp_path):
+    tab = table(model)
+    members = [v.name for v in tab.vectors()[vector]]
     variables = list(tab.variables)
-    i, j = names.index("q1"), names.index("q2")
+    names = [v.name for v in variables]
+    i, j = names.index(members[1]), names.index(members[2])
     variables[i], variables[j] = variables[j], variables[i]
-    with pytest.raises(BuildError, match="members of vector q are out of order in the table: q0, q2, q1, q3"):
-        build_fmu("Quadrotor", tmp_path, variables=dataclasses.replace(tab, variables=variables))
+    swapped = [members[0], members[2], members[1], *members[3:]]
+    with pytest.raises(BuildError, match=f"members of vector {vector} are out of order in the table: "
+                                         f"{', '.join(swapped)}"):
+        build_fmu(model, tmp_path, variables=dataclasses.replace(tab, variables=variables))
 
 
 @pytest.mark.parametrize(("unit", "expected"), [
@@ -123,15 +128,3 @@ def test_every_unit_definition_declares_its_si_base_unit(model):
         declared = {k: getattr(base, k) for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad") if getattr(base, k)}
         assert declared == base_unit(name), name
         assert base.factor == 1.0 and base.offset == 0.0
-
-
-def test_a_failed_step_leaves_the_model_time_at_the_last_good_point():
-    fmu = RawFMU("Quadrotor")
-    assert fmu.instantiate()
-    assert fmu.initialize() == 0, fmu.messages()
-    assert fmu.do_step(0.0, 1e-3) == 0
-    refs = [fmu.refs[f"omega_r{n}"] for n in range(1, 5)]
-    assert fmu.set_real(refs, [1e200] * 4) == 0
-    assert fmu.do_step(1e-3, 1e-3) == 3  # the state overflows: Error
-    assert fmu.time() == 1e-3  # fmi2LastSuccessfulTime: the step that failed did not count
-    fmu.free()

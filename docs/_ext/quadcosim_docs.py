@@ -170,13 +170,14 @@ def _variable_tables(app):
 def _registry_tables(app):
     """``_generated/registries.md``: the estimators, interference models, autopilots and scenarios,
     read from their registries (:mod:`quadcosim.scenarios.registries`)."""
-    from quadcosim.scenarios.registries import tables
+    from quadcosim.scenarios.registries import sensor_table, tables
 
-    GENERATED.mkdir(exist_ok=True)
-    target = GENERATED / "registries.md"
-    text = tables()
-    if not target.is_file() or target.read_text() != text:
-        target.write_text(text)
+    (GENERATED / "tables").mkdir(parents=True, exist_ok=True)
+    # the page of the sets, and the table of FMUs that docs/guides/fmus.md includes
+    pages = {GENERATED / "registries.md": tables(), GENERATED / "tables" / "sensors.md": sensor_table()}
+    for target, text in pages.items():
+        if not target.is_file() or target.read_text() != text:
+            target.write_text(text)
 
 
 NOTEBOOKS = HERE.parent / "notebooks"
