@@ -7,8 +7,7 @@ instance with its own time stamps, motor outputs normalised to 0..1 from the log
 limits, the battery, the autopilot's attitude, the parameters, firmware, vehicle type and
 whether it is a simulator log. Each compass carries the field as logged and the raw field
 before the autopilot's offsets and motor compensation, which is what a calibration starts
-from (each autopilot's reader says how it logs it, as
-:mod:`quadcosim.flightlogs.autopilots.ardupilot.dataflash` and :mod:`quadcosim.flightlogs.autopilots.px4.ulog`).
+from (each autopilot's reader says how it logs it, :mod:`quadcosim.flightlogs.autopilots`).
 The format is told by the file's first bytes, by the detection of each registered autopilot's
 formats. This is the one reading layer: the command line, the estimators' replay and the
 calibration all read logs through it.
