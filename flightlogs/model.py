@@ -142,16 +142,19 @@ class Attitude:
 
 @dataclass
 class FlightLog:
-    """Everything quadcosim reads from one PX4 ULog or ArduPilot DataFlash log.
+    """Everything quadcosim reads from one flight log (PX4 ULog, ArduPilot DataFlash or another
+    installed autopilot's).
 
     Attributes
     ----------
     path : str
         The file.
     format : str
-        ``ulog``, ``dataflash-binary`` or ``dataflash-text``.
+        The name of the log's format (``ulog``, ``dataflash-binary``, ``dataflash-text``: a
+        :class:`quadcosim.flightlogs.autopilots.LogFormat` of its autopilot).
     autopilot : str
-        ``PX4`` or ``ArduPilot``.
+        The name of the installed autopilot that wrote it (``PX4``, ``ArduPilot``:
+        :func:`quadcosim.flightlogs.autopilots.registry`).
     firmware : str
         Firmware name and version as the log states it.
     vehicle : str

@@ -142,6 +142,8 @@ def test_a_dummy_autopilot_is_one_file_and_one_line(tmp_path):
         found["calibrated"] = [code, metrics["files"], metrics["export"]["file"], metrics["export"]["firmware"]]
         found["written"] = open("out/dummy.cfg").read().splitlines()
         found["export"] = metrics["export"]
+        code, _ = cli("calibrate", "flight.dummy", "--score", "out/dummy.cfg", "--out", "scored")
+        found["scored"] = [code, json.load(open("scored/metrics.json"))["score"]]
         from quadcosim.scenarios.registries import autopilot_rows
         found["documented"] = [list(row) for row in autopilot_rows() if row[0] == "Dummy"]
     ''', tmp_path)
@@ -162,6 +164,9 @@ def test_a_dummy_autopilot_is_one_file_and_one_line(tmp_path):
     assert export["model"] == "current" and written["DUMMY_MOT_ON"] == "1", export["notes"]
     assert [float(written[f"DUMMY_MOT_{a}"]) for a in "XYZ"] == pytest.approx([0.3, -0.5, 0.8], abs=0.05)
     assert export["heading_rms_deg"] < export["as_flown"]["heading_rms_deg"], export
+    # the file written, read back by --score as the dummy's own lines, scores as the export did
+    assert found["scored"][0] == 0 and found["scored"][1]["parameters"] == 7
+    assert found["scored"][1]["heading_rms_deg"] == pytest.approx(export["heading_rms_deg"], abs=1e-3)
     assert found["documented"] == [["Dummy", "`dummy-text` (dummy autopilot text (.dummy))", "`dummy.cfg`", "",
                                     "`dummy_autopilot`"]]
 

@@ -29,10 +29,20 @@ FLOAT32_MAX = 3.4028234663852886e38  # the largest value of the autopilots' 32-b
 MAX_PARAMETER_BYTES = 16 * 1024 * 1024  # an autopilot's whole parameter list takes a few hundred kB
 
 
-def read_parameters(path) -> dict:
+def _shared_line(line: str) -> tuple[str, str]:
+    """The name and value of an ArduPilot (``NAME,VALUE``, ``NAME VALUE``) or QGroundControl
+    (``1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE``) line; ValueError or IndexError for a line holding none."""
+    parts = line.split("\t") if "\t" in line else line.split(",") if "," in line else line.split()
+    name, value = (parts[2], parts[3]) if len(parts) > 3 else parts[:2]
+    return name, value
+
+
+def read_parameters(path, autopilot=None) -> dict:
     """Parameters from an ArduPilot ``.parm`` (``NAME,VALUE`` or ``NAME VALUE`` lines) or a
     QGroundControl ``.params`` file (tab-separated) at ``path``, as the ArduPilot and PX4
-    autopilots write them (:mod:`quadcosim.flightlogs.autopilots`).
+    autopilots write them (:mod:`quadcosim.flightlogs.autopilots`), or, for an ``autopilot``
+    (:class:`quadcosim.flightlogs.autopilots.Autopilot`) with a ``parameter_line`` of its own, its
+    own file's lines.
 
     Raises
     ------
@@ -53,18 +63,20 @@ def read_parameters(path) -> dict:
                          ".params the ground station saved") from None
     except OSError as error:
         raise ValueError(f"{path}: cannot read the parameter file ({error.strerror})") from None
+    own = getattr(autopilot, "parameter_line", None)
+    parse = own or _shared_line
+    form = (f"a line of {autopilot.name}'s parameter file ({autopilot.file})" if own else
+            "NAME,VALUE (ArduPilot) nor 1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE (QGroundControl)")
     params = {}
     for number, line in enumerate(text.splitlines(), 1):
         line = line.strip()
         if not line or line.startswith("#"):
             continue
-        parts = line.split("\t") if "\t" in line else line.split(",") if "," in line else line.split()
         try:
-            name, value = (parts[2], parts[3]) if len(parts) > 3 else parts[:2]
+            name, value = parse(line)
             given = int(value) if value.strip().lstrip("-").isdigit() else float(value)
         except (ValueError, IndexError):
-            raise ValueError(f"{path}, line {number}: {line[:60]!r} is not NAME,VALUE (ArduPilot) nor "
-                             "1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE (QGroundControl); fix or remove the line") from None
+            raise ValueError(f"{path}, line {number}: {line[:60]!r} is not {form}; fix or remove the line") from None
         if name.strip() in params:
             raise ValueError(f"{path}, line {number}: {name.strip()} is given a second time; an autopilot keeps one "
                              "value per name: remove one of the lines")

@@ -99,7 +99,7 @@ def score_file(path, parts, rule=None, *, offset_from) -> dict:
     applied under ``rule`` (None: the log's), with its name and parameter count."""
     from quadcosim.calibration.flight.autopilot import read_parameters
 
-    params = read_parameters(path)
+    params = read_parameters(path, autopilot_of(parts[0]))
     _check_scored(path, parts, params, rule)
     scored = score_parameters(parts, params, rule, offset_from=offset_from)
     return {"file": str(path), "parameters": len(params)} | scored

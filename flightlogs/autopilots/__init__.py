@@ -107,6 +107,11 @@ class Autopilot:
     versions : callable or None
         ``(text)``: the rules of the firmware version ``text`` (``--firmware``), raising ValueError
         naming what a version looks like; None: the autopilot has one set of rules, the log's.
+    parameter_line : callable or None
+        ``(line)``: the name and value (str, str) of one line of its parameter file (neither blank
+        nor a ``#`` comment), raising ValueError or IndexError for a line that holds none, as
+        ``quadcosim calibrate --score`` reads the file; None: ArduPilot's ``NAME,VALUE`` and
+        QGroundControl's tab-separated lines (:func:`quadcosim.calibration.flight.autopilot.read_parameters`).
     """
 
     name: str
@@ -128,6 +133,7 @@ class Autopilot:
     board_trim: Callable | None = None
     enabling: Callable | None = None
     versions: Callable[[str], object] | None = None
+    parameter_line: Callable[[str], tuple[str, str]] | None = None
 
 
 class UnknownAutopilot(KeyError):

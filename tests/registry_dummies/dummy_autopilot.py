@@ -8,7 +8,8 @@ gyro (rad/s), specific force (m/s^2)), ``att`` (time, quaternion body to NED, sc
 (time, motor commands 0..1) and ``bat`` (time, voltage (V), current (A)). Its firmware corrects the
 compass as ``field = raw - OFS - ON MOT i`` (``DUMMY_OFS_*`` and ``DUMMY_MOT_*`` in uT and uT/A,
 ``DUMMY_MOT_ON`` 0 or 1, ``i`` the battery current): no soft iron, one motor compensation. Its
-parameter file ``dummy.cfg`` holds ``NAME = VALUE`` lines.
+parameter file ``dummy.cfg`` holds ``NAME = VALUE`` lines, which ``quadcosim calibrate --score`` reads
+by its ``parameter_line``.
 """
 
 from __future__ import annotations
@@ -128,4 +129,4 @@ AUTOPILOT = Autopilot(
     file="dummy.cfg", write=write, apply=_apply, parameters=_parameters, motor_models=lambda part, rule: ("current",),
     motor_inputs=_motor_inputs, scale_reset=lambda part, rule: {}, firmware=lambda part, rule: part.log.firmware,
     motor_off={"DUMMY_MOT_ON": 0}, is_motor_key=lambda name: name.startswith("DUMMY_MOT"),
-    fused_compass=lambda params: 0)
+    fused_compass=lambda params: 0, parameter_line=lambda line: tuple(part.strip() for part in line.split("=")))
