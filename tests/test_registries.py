@@ -163,7 +163,9 @@ def test_a_dummy_autopilot_is_one_file_and_one_line(tmp_path):
     # firmware, and scored under it: the heading error drops from the log's values
     assert export["model"] == "current" and written["DUMMY_MOT_ON"] == "1", export["notes"]
     assert [float(written[f"DUMMY_MOT_{a}"]) for a in "XYZ"] == pytest.approx([0.3, -0.5, 0.8], abs=0.05)
-    assert export["heading_rms_deg"] < export["as_flown"]["heading_rms_deg"], export
+    # and the hard iron of the synthetic flight (10, -20, 5 uT); measured 0.58 deg against 27.0 deg as flown
+    assert [float(written[f"DUMMY_OFS_{a}"]) for a in "XYZ"] == pytest.approx([10.0, -20.0, 5.0], abs=1.0)
+    assert export["heading_rms_deg"] < 1.0 < 20.0 < export["as_flown"]["heading_rms_deg"], export
     # the file written, read back by --score as the dummy's own lines, scores as the export did
     assert found["scored"][0] == 0 and found["scored"][1]["parameters"] == 7
     assert found["scored"][1]["heading_rms_deg"] == pytest.approx(export["heading_rms_deg"], abs=1e-3)
