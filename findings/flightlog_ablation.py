@@ -30,7 +30,7 @@ def costs(log, compass: int) -> dict:
     compensation alone) and under each of :data:`WRONG_RULES`, every one applied with the log's
     own firmware rules."""
     from quadcosim.calibration.flight.export import choose
-    from quadcosim.flightlogs import ardupilot
+    from quadcosim.flightlogs.autopilots.ardupilot import firmware as ardupilot
     from quadcosim.scenarios.flightlog.calibrate import split_parts
 
     right = split_parts([log], [], compass)

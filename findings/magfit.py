@@ -227,9 +227,9 @@ def peer(key: str, compass: int, settings=tuple(SETTINGS)) -> dict:
     """
     require_mavproxy()  # skips before any work when MAVProxy is absent
     from pymavlink import mavutil
-    from quadcosim.calibration.flight.autopilot import write_ardupilot
     from quadcosim.calibration.flight.export import score_parameters
     from quadcosim.flightlogs import read_log
+    from quadcosim.flightlogs.autopilots.ardupilot import write as write_ardupilot
     from quadcosim.scenarios.flightlog.calibrate import main as calibrate
     from quadcosim.scenarios.flightlog.calibrate import split_parts
 

@@ -1,4 +1,5 @@
-"""Real flight logs: PX4 ULog (pyulog) and ArduPilot DataFlash, binary and text (pymavlink).
+"""Real flight logs, of every installed autopilot (:mod:`quadcosim.flightlogs.autopilots`): PX4 ULog
+(pyulog) and ArduPilot DataFlash, binary and text (pymavlink), and any other registered.
 
 :func:`read_log` turns a log into a :class:`FlightLog` in the project's conventions: NED
 inertial frame, FRD body frame, SI units (T, rad/s, m/s^2, A, V, s), every compass and IMU
@@ -6,9 +7,10 @@ instance with its own time stamps, motor outputs normalised to 0..1 from the log
 limits, the battery, the autopilot's attitude, the parameters, firmware, vehicle type and
 whether it is a simulator log. Each compass carries the field as logged and the raw field
 before the autopilot's offsets and motor compensation, which is what a calibration starts
-from (:mod:`quadcosim.flightlogs.dataflash` and :mod:`quadcosim.flightlogs.ulog` say how each
-autopilot logs it). This is the one reading layer: the command line, the estimators' replay and
-the calibration all read logs through it.
+from (each autopilot's reader says how it logs it, :mod:`quadcosim.flightlogs.autopilots`).
+The format is told by the file's first bytes, by the detection of each registered autopilot's
+formats. This is the one reading layer: the command line, the estimators' replay and the
+calibration all read logs through it.
 """
 
 from __future__ import annotations
@@ -27,11 +29,6 @@ from quadcosim.flightlogs.model import (
     Throttle,
     rate,
 )
-
-ULOG_MAGIC = b"ULog\x01\x12\x35"
-DATAFLASH_HEAD = b"\xa3\x95"
-FORMATS = "PX4 ULog (.ulg), ArduPilot DataFlash binary (.bin) or text (.log)"
-
 
 #: The largest log read (bytes). The readers take about a second per megabyte of DataFlash (a
 #: gigabyte is hours); the longest flights log a few hundred megabytes.
@@ -63,11 +60,13 @@ def check_file(path) -> int:
     LogError
         Naming the file, what it is and the fix.
     """
+    from quadcosim.flightlogs.autopilots import known_formats
+
     from quadcosim.infra.inputs import regular_file
 
     path = Path(path)
-    status = regular_file(path, "the log", f"give a log file ({FORMATS}); copy a log streamed elsewhere to a file "
-                          "first", LogError)
+    status = regular_file(path, "the log", f"give a log file ({known_formats()}); copy a log streamed elsewhere "
+                          "to a file first", LogError)
     size = status.st_size
     if size > MAX_LOG_BYTES:
         raise LogError(f"{path}: {size / 1e9:.1f} GB, more than the {MAX_LOG_BYTES / 1e9:.0f} GB quadcosim reads "
@@ -81,25 +80,31 @@ def check_file(path) -> int:
 
 
 def detect_format(path) -> str:
-    """``ulog``, ``dataflash-binary`` or ``dataflash-text`` from the first bytes of the file at
-    ``path`` (not its name), checked first by :func:`check_file`; a :class:`LogError` naming
-    the file otherwise."""
+    """The name of the log format of the file at ``path`` (``ulog``, ``dataflash-binary``,
+    ``dataflash-text`` or another installed autopilot's) from its first bytes (not its name), checked
+    first by :func:`check_file`; a :class:`LogError` naming the file and the formats known otherwise."""
+    return _detected(path)[1].name
+
+
+def _detected(path):
+    """The autopilot and log format (:class:`quadcosim.flightlogs.autopilots.LogFormat`) whose detection
+    claims the file at ``path``."""
+    from quadcosim.flightlogs.autopilots import HEAD_BYTES, known_formats, recognised
+
     path = Path(path)
     check_file(path)
     try:
         with open(path, "rb") as file:
-            head = file.read(64)
+            head = file.read(HEAD_BYTES)
     except OSError as error:
         raise LogError(f"{path}: cannot read the log ({error.strerror})") from None
     if not head:
         raise LogError(f"{path}: the file is empty; copy the log again from the vehicle")
-    if head.startswith(ULOG_MAGIC):
-        return "ulog"
-    if head.startswith(DATAFLASH_HEAD):
-        return "dataflash-binary"
-    if head.lstrip().startswith(b"FMT,"):
-        return "dataflash-text"
-    raise LogError(f"{path}: unknown log format (it starts with {head[:8]!r}); quadcosim reads {FORMATS}")
+    found = recognised(head)
+    if found is None:
+        raise LogError(f"{path}: unknown log format (it starts with {head[:8]!r}): no installed autopilot recognises "
+                       f"it; quadcosim reads {known_formats()}")
+    return found
 
 
 def read_log(path) -> FlightLog:
@@ -123,14 +128,8 @@ def read_log(path) -> FlightLog:
     from quadcosim.flightlogs.checks import validated
 
     path = Path(path)
-    kind = detect_format(path)
-    if kind == "ulog":
-        from quadcosim.flightlogs.ulog import read_ulog
-
-        return validated(read_ulog(path))
-    from quadcosim.flightlogs.dataflash import read_dataflash
-
-    return validated(read_dataflash(path, text=kind == "dataflash-text"))
+    _, found = _detected(path)
+    return validated(found.read(path))
 
 
 __all__ = ["Attitude", "Battery", "Compass", "FlightLog", "Imu", "LogError", "Motors", "Position", "Throttle",

@@ -142,16 +142,19 @@ class Attitude:
 
 @dataclass
 class FlightLog:
-    """Everything quadcosim reads from one PX4 ULog or ArduPilot DataFlash log.
+    """Everything quadcosim reads from one flight log (PX4 ULog, ArduPilot DataFlash or another
+    installed autopilot's).
 
     Attributes
     ----------
     path : str
         The file.
     format : str
-        ``ulog``, ``dataflash-binary`` or ``dataflash-text``.
+        The name of the log's format (``ulog``, ``dataflash-binary``, ``dataflash-text``: a
+        :class:`quadcosim.flightlogs.autopilots.LogFormat` of its autopilot).
     autopilot : str
-        ``PX4`` or ``ArduPilot``.
+        The name of the installed autopilot that wrote it (``PX4``, ``ArduPilot``:
+        :func:`quadcosim.flightlogs.autopilots.registry`).
     firmware : str
         Firmware name and version as the log states it.
     vehicle : str
@@ -214,8 +217,9 @@ class FlightLog:
     def compass(self, index: int) -> Compass:
         """Compass ``index``, counted from 0 in the log's order; a clear error if absent."""
         if not self.compasses:
-            raise LogError(f"{self.path}: the log holds no magnetometer; log one (ArduPilot: LOG_BITMASK with IMU "
-                           "and compass; PX4: the sensor_mag topic) to calibrate it")
+            carrier = self._autopilot()
+            raise LogError(f"{self.path}: the log holds no magnetometer; log one ({carrier.messages['compass']}, "
+                           f"chosen by {carrier.logging}) to calibrate it")
         if not 0 <= index < len(self.compasses):
             names = ", ".join(f"{k}: {c.name}" for k, c in enumerate(self.compasses))
             raise LogError(f"{self.path}: no compass {index}; the log holds {names}")
@@ -227,8 +231,8 @@ class FlightLog:
         return chosen
 
     def require(self, purpose: str, *parts: str):
-        """Refuse a log that lacks a part ``purpose`` needs, naming the messages (ArduPilot) or
-        topics (PX4) that carry it.
+        """Refuse a log that lacks a part ``purpose`` needs, naming the messages (or topics) of its
+        autopilot that carry it.
 
         Parameters
         ----------
@@ -246,11 +250,16 @@ class FlightLog:
                    "motors": self.motors is not None, "battery": self.battery is not None}
         missing = [part for part in parts if not present[part]]
         if missing:
-            carriers = MESSAGES["PX4" if self.autopilot == "PX4" else "ArduPilot"]
-            named = "; ".join(f"{PARTS[part]} ({carriers[part]})" for part in missing)
+            carrier = self._autopilot()
+            named = "; ".join(f"{PARTS[part]} ({carrier.messages[part]})" for part in missing)
             raise LogError(f"{self.path}: {purpose} needs what the log does not hold: {named}. Log them "
-                           f"({LOGGING[self.autopilot if self.autopilot in LOGGING else 'ArduPilot']}) or give "
-                           "another log")
+                           f"({carrier.logging}) or give another log")
+
+    def _autopilot(self):
+        """The installed autopilot that wrote the log (:mod:`quadcosim.flightlogs.autopilots`)."""
+        from quadcosim.flightlogs.autopilots import of
+
+        return of(self.autopilot)
 
     def overlap(self, *series) -> tuple[float, float]:
         """The span of time (s) that every one of ``series`` covers (objects with a ``time``).
@@ -279,22 +288,8 @@ def synthetic_statement(messages) -> str:
     return next((m for m in messages if str(m).startswith(SYNTHETIC_MARK)), "")
 
 
-#: The messages (ArduPilot) and topics (PX4) that carry each part of a log, named when one is missing.
-MESSAGES = {"ArduPilot": {"compass": "MAG", "imu": "IMU", "attitude": "ATT", "motors": "RCOU",
-                          "battery": "BAT or CURR"},
-            "PX4": {"compass": "sensor_mag or vehicle_magnetometer", "imu": "sensor_accel and sensor_gyro, or "
-                    "sensor_combined", "attitude": "vehicle_attitude", "motors": "actuator_motors or "
-                    "actuator_outputs", "battery": "battery_status"}}
-LOGGING = {"ArduPilot": "LOG_BITMASK", "PX4": "SDLOG_PROFILE"}
-#: How to log a compass faster, by autopilot. PX4's logger (``LoggedTopics::add_default_topics``) logs
-#: ``sensor_mag`` every 1000 ms and ``vehicle_magnetometer`` every 500 ms; the sensor comparison
-#: profile (``SDLogProfileMask::SENSOR_COMPARISON``, bit 6, value 64: ``add_sensor_comparison_topics``)
-#: logs ``sensor_mag`` every 100 ms.
-FASTER_COMPASS = {
-    "PX4": "set SDLOG_PROFILE's sensor comparison bit (64: SDLOG_PROFILE = 65 beside the default profile's 1), "
-           "which logs sensor_mag at 10 Hz, and fly again",
-    "ArduPilot": "log the compass at its full rate (LOG_BITMASK with IMU and compass; ArduPilot logs MAG at 10 Hz "
-                 "or faster) and fly again"}
+#: The parts of a log :meth:`FlightLog.require` names, each carried by the messages its autopilot's
+#: ``messages`` name (:class:`quadcosim.flightlogs.autopilots.Autopilot`).
 PARTS = {"compass": "a magnetometer", "imu": "an IMU", "attitude": "the attitude", "motors": "the motor outputs",
          "battery": "the battery"}
 

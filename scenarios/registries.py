@@ -1,9 +1,11 @@
 """The package's closed sets of names as Markdown tables, read from their registries.
 
 - the estimators, the entry-point group ``quadcosim.estimators`` (:func:`quadcosim.estimators.kinds.registry`);
-- the interference models a flight calibration fits, :data:`quadcosim.calibration.flight.catalogue.MODELS`;
-- the autopilots the export writes parameters for, :data:`quadcosim.calibration.flight.autopilot.AUTOPILOTS`;
-- the scenarios, :mod:`quadcosim.scenarios.catalogue` (those a higher floor registers too, once imported);
+- the interference models a flight calibration fits, :func:`quadcosim.calibration.flight.catalogue.models`
+  (entry-point group ``quadcosim.interference``);
+- the autopilots whose logs are read and whose parameters the export writes,
+  :func:`quadcosim.flightlogs.autopilots.registry` (entry-point group ``quadcosim.autopilots``);
+- the scenarios, :mod:`quadcosim.scenarios.catalogue` (entry-point group ``quadcosim.scenarios``);
 - the sensor FMUs, :data:`quadcosim.fmus.MODELS` (the entry-point group ``quadcosim.sensors``).
 
 The documentation's page of these sets is :func:`tables`, written when the site is built: a
@@ -39,17 +41,23 @@ def estimator_rows() -> list[tuple]:
 
 def model_rows() -> list[tuple]:
     """One row per interference model, richest first: name, rank, calibration file, an autopilot."""
-    from quadcosim.calibration.flight.catalogue import MODELS
+    from quadcosim.calibration.flight.catalogue import models
 
-    ordered = sorted(MODELS.values(), key=lambda model: model.preference)
+    ordered = sorted(models().values(), key=lambda model: model.preference)
     return [(f"`{model.name}`", model.preference, _yes(model.in_file), _yes(model.autopilot)) for model in ordered]
 
 
 def autopilot_rows() -> list[tuple]:
-    """One row per autopilot: name, the parameter file written."""
-    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
+    """One row per autopilot: name, the log formats it reads (by name and description), the parameter
+    file written, whether ``--firmware`` chooses among its versions, its module."""
+    from quadcosim.flightlogs.autopilots import registry
 
-    return [(autopilot.name, f"`{autopilot.file}`") for autopilot in AUTOPILOTS.values()]
+    from quadcosim.infra.members import registered
+
+    lines = registered("quadcosim.autopilots")
+    return [(autopilot.name, ", ".join(f"`{f.name}` ({f.description})" for f in autopilot.formats),
+             f"`{autopilot.file}`", _yes(autopilot.versions is not None), f"`{lines[name][0].split(':')[0]}`")
+            for name, autopilot in registry().items()]
 
 
 def scenario_rows() -> list[tuple]:
@@ -94,14 +102,16 @@ def tables() -> str:
              "name).", ""]
     lines += _table(("name", "label", "lab", "bias", "loop", "batch", "compared", "block"),
                     estimator_rows())
-    lines += ["## Interference models", "", "`calibration/flight/catalogue.py`, richest first: `quadcosim calibrate "
+    lines += ["## Interference models", "", "Entry-point group `quadcosim.interference` (protocol: "
+              "`calibration/flight/catalogue.py`), richest first: `quadcosim calibrate "
               "--models`, the calibration file and the autopilots' parameters carry the first they can that the "
               "flights identify. An autopilot carries a model when its firmware has that compensation for the "
               "compass (`motors`: ArduPilot `4.0` and later, first compass).", ""]
     lines += _table(("name", "rank", "calibration file", "an autopilot"), model_rows())
-    lines += ["## Autopilots", "", "`calibration/flight/autopilot.py`: a flight log of one is exported in its own "
-              "parameter file.", ""]
-    lines += _table(("name", "parameter file"), autopilot_rows())
+    lines += ["## Autopilots", "", "Entry-point group `quadcosim.autopilots` (protocol: "
+              "`flightlogs/autopilots/__init__.py`): a log is read by the autopilot whose format claims its first "
+              "bytes, and a flight log of one is exported in its own parameter file.", ""]
+    lines += _table(("name", "log formats", "parameter file", "firmware versions", "module"), autopilot_rows())
     lines += ["## Scenarios", "", "`scenarios/catalogue.py` (and `register` from a higher floor): `quadcosim run`, "
               "`quadcosim list`, sweeps.", ""]
     lines += _table(("name", "description", "module"), scenario_rows())

@@ -9,7 +9,8 @@ from helpers import documentation
 from quadcosim.calibration import Calibration, StaticCalibration, compensate
 from quadcosim.calibration.flight import autopilot, calibrate, flight_data
 from quadcosim.calibration.flight.calibrate import _field_model
-from quadcosim.flightlogs import ardupilot, px4
+from quadcosim.flightlogs.autopilots.ardupilot import firmware as ardupilot
+from quadcosim.flightlogs.autopilots.px4 import firmware as px4
 
 from quadcosim.main import main
 from tests.flightlog_data import ERLE, PX4, QUAD, log, path
@@ -135,7 +136,7 @@ def test_the_readmes_calibration_example_prints_what_the_readme_shows(tmp_path, 
 
 
 def test_the_command_lines_defaults_are_the_calibrations_names():
-    from quadcosim.calibration.flight import MODELS
+    from quadcosim.calibration.flight.catalogue import models
     from quadcosim.scenarios.flightlog.calibrate import _check_choices
 
     from quadcosim.main import parser
@@ -143,7 +144,7 @@ def test_the_command_lines_defaults_are_the_calibrations_names():
     args = parser().parse_args(["calibrate", "flight.log", "--out", "out"])
     assert args.models is None and args.attitude == "auto"
     _check_choices(args)  # the default read from the catalogue when the command runs
-    assert tuple(args.models) == tuple(MODELS)
+    assert tuple(args.models) == tuple(models()) == ("current", "throttle", "motors", "metge", "dynamic")
 
 
 def test_rotations_covering_the_sphere_give_hard_and_soft_iron_and_flights_cross_validate(synthetic, capsys):

@@ -187,10 +187,10 @@ def test_score_judges_any_parameter_file_with_the_exports_own_scorer(tmp_path, c
 
 
 def test_the_log_motor_compensation_carried_into_a_trial_leaves_its_offsets_and_soft_iron_alone():
-    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
+    from quadcosim.flightlogs.autopilots import of
 
     def _motor_keys(params, autopilot):  # what the export carries of the log's motor compensation
-        return {k for k in params if AUTOPILOTS[autopilot].is_motor_key(k)}
+        return {k for k in params if of(autopilot).is_motor_key(k)}
 
     ardupilot = {"COMPASS_OFS2_X": -27.0, "COMPASS_DIA2_X": 1.0, "COMPASS_ODI2_X": 0.0, "COMPASS_SCALE": 1.0,
                  "COMPASS_MOTCT": 2, "COMPASS_MOT2_X": 0.5, "COMPASS_PMOT1_X": 0.1, "COMPASS_PMOT_EN": 1}

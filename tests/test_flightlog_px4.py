@@ -8,7 +8,8 @@ import json
 import numpy as np
 import pytest
 from quadcosim.calibration.flight.data import MIN_COMPASS_RATE_HZ
-from quadcosim.flightlogs import px4, read_log
+from quadcosim.flightlogs import read_log
+from quadcosim.flightlogs.autopilots.px4 import firmware as px4
 from quadcosim.flightlogs.info import summary
 
 from quadcosim.main import main

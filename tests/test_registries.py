@@ -11,6 +11,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 DUMMIES = Path(__file__).resolve().parent / "registry_dummies"
 
@@ -91,11 +93,7 @@ def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
 
     log = tmp_path / "flight.bin"
     write_log(log, duration=40.0)
-    found = _with_line('''
-        from quadcosim.calibration.flight import catalogue
-        from dummy_model import Nothing
-        catalogue.MODELS["nothing"] = catalogue.Model("nothing", lambda fitted: Nothing(), preference=5)
-    ''', '''
+    found = _with_member("quadcosim.interference", "nothing = dummy_model:NOTHING", '''
         code, _ = cli("calibrate", "flight.bin", "--out", "out")
         metrics = json.load(open("out/metrics.json"))
         found["default"] = [code, sorted(metrics["models"])]
@@ -103,14 +101,79 @@ def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
         metrics = json.load(open("chosen/metrics.json"))
         found["chosen"] = [code, sorted(metrics["models"]), metrics["models"]["nothing"]["explained_test"]]
         from quadcosim.calibration.flight import catalogue
+        found["names"] = list(catalogue.models())
         found["orders"] = [list(catalogue.preferred("in_file")), list(catalogue.preferred("autopilot"))]
         from quadcosim.scenarios.registries import model_rows
         found["documented"] = [row[0] for row in model_rows()]
     ''', tmp_path)
     assert found["default"][0] == 0 and "nothing" in found["default"][1]  # --models' default: every model
     assert found["chosen"][:2] == [0, ["current", "nothing"]] and abs(found["chosen"][2]) < 1e-9
+    assert found["names"] == ["current", "throttle", "motors", "metge", "dynamic", "nothing"]  # fitted after ours
     assert "nothing" not in found["orders"][0] + found["orders"][1]  # neither the file nor an autopilot carries it
     assert found["documented"][-2:] == ["`dynamic`", "`nothing`"]  # the docs' table, by its rank
+
+
+def test_a_dummy_autopilot_is_one_file_and_one_line(tmp_path):
+    """The dummy's own log (tests/registry_dummies/dummy_autopilot.py: its text format, the same
+    synthetic flight as an ArduPilot log) is detected, read, shown by ``log info`` and calibrated,
+    the export written as the dummy's own parameter file under its own firmware's arithmetic."""
+    from tests.flightlog_synthetic import write_log
+
+    write_log(tmp_path / "flight.log", duration=40.0, gps=True)
+    found = _with_member("quadcosim.autopilots", "Dummy = dummy_autopilot:AUTOPILOT", '''
+        from quadcosim.flightlogs import LogError, detect_format, read_log
+        import dummy_autopilot
+        source = read_log("flight.log")
+        dummy_autopilot.write_log(source, "flight.dummy")
+        dummy_autopilot.write_log(source, "nobattery.dummy", parts=("mag", "imu", "att", "mot"))
+        found["format"] = detect_format("flight.dummy")
+        log = read_log("flight.dummy")
+        found["read"] = [log.autopilot, log.format, len(log.compasses[0].time), len(source.compasses[0].time)]
+        try:
+            read_log("nobattery.dummy").require("a test", "battery")
+        except LogError as error:
+            found["missing"] = str(error)
+        open("notes.txt", "w").write("not a log\\n")
+        try:
+            read_log("notes.txt")
+        except LogError as error:
+            found["unknown"] = str(error)
+        code, shown = cli("log", "info", "flight.dummy")
+        found["info"] = [code, shown.splitlines()[0]]
+        code, _ = cli("calibrate", "flight.dummy", "--models", "current", "--out", "out")
+        metrics = json.load(open("out/metrics.json"))
+        found["calibrated"] = [code, metrics["files"], metrics["export"]["file"], metrics["export"]["firmware"]]
+        found["written"] = open("out/dummy.cfg").read().splitlines()
+        found["export"] = metrics["export"]
+        code, _ = cli("calibrate", "flight.dummy", "--score", "out/dummy.cfg", "--out", "scored")
+        found["scored"] = [code, json.load(open("scored/metrics.json"))["score"]]
+        from quadcosim.scenarios.registries import autopilot_rows
+        found["documented"] = [list(row) for row in autopilot_rows() if row[0] == "Dummy"]
+    ''', tmp_path)
+    assert found["format"] == "dummy-text"  # its detection claims its own log
+    assert found["read"][:2] == ["Dummy", "dummy-text"] and found["read"][2] == found["read"][3] > 100
+    # a missing part is named in the dummy's own words, not ArduPilot's
+    assert "the battery (bat records). Log them (DUMMY_LOG_RECORDS)" in found["missing"]
+    assert "unknown log format" in found["unknown"] and "dummy autopilot text (.dummy)" in found["unknown"]
+    assert found["info"] == [0, "flight.dummy: dummy-text, Dummy Dummy 1.0"]
+    assert found["calibrated"][0] == 0 and "dummy.cfg" in found["calibrated"][1]
+    assert found["calibrated"][2:] == ["dummy.cfg", "Dummy 1.0"]
+    written = dict(line.split(" = ") for line in found["written"])
+    assert set(written) == {"DUMMY_OFS_X", "DUMMY_OFS_Y", "DUMMY_OFS_Z", "DUMMY_MOT_X", "DUMMY_MOT_Y", "DUMMY_MOT_Z",
+                            "DUMMY_MOT_ON"}
+    export = found["export"]
+    # the flight's current field (0.3, -0.5, 0.8 uT/A, tests/flightlog_synthetic.py) exported by the dummy's
+    # firmware, and scored under it: the heading error drops from the log's values
+    assert export["model"] == "current" and written["DUMMY_MOT_ON"] == "1", export["notes"]
+    assert [float(written[f"DUMMY_MOT_{a}"]) for a in "XYZ"] == pytest.approx([0.3, -0.5, 0.8], abs=0.05)
+    # and the hard iron of the synthetic flight (10, -20, 5 uT); measured 0.58 deg against 27.0 deg as flown
+    assert [float(written[f"DUMMY_OFS_{a}"]) for a in "XYZ"] == pytest.approx([10.0, -20.0, 5.0], abs=1.0)
+    assert export["heading_rms_deg"] < 1.0 < 20.0 < export["as_flown"]["heading_rms_deg"], export
+    # the file written, read back by --score as the dummy's own lines, scores as the export did
+    assert found["scored"][0] == 0 and found["scored"][1]["parameters"] == 7
+    assert found["scored"][1]["heading_rms_deg"] == pytest.approx(export["heading_rms_deg"], abs=1e-3)
+    assert found["documented"] == [["Dummy", "`dummy-text` (dummy autopilot text (.dummy))", "`dummy.cfg`", "",
+                                    "`dummy_autopilot`"]]
 
 
 def test_a_dummy_scenario_is_one_file_and_one_line(tmp_path):
@@ -300,10 +363,54 @@ def test_the_estimator_and_model_checklists_name_the_registries_the_dummies_exte
     assert "estimators/contract.py" in _paths(estimator) and f'`[project.entry-points."{kinds.GROUP}"]`' in estimator
     _the_estimator_checklist_is_how_every_estimator_stands(estimator)
     model = _section("Adding a flight-log model or autopilot")
-    assert Path(catalogue.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`MODELS`" in model
-    from quadcosim.calibration.flight import autopilot
+    assert Path(catalogue.__file__).relative_to(ROOT).as_posix() in _paths(model)
+    assert "`quadcosim.interference`" in model and "`quadcosim.autopilots`" in model
+    assert "tests/registry_dummies/dummy_model.py" in _paths(model)
+    assert "tests/registry_dummies/dummy_autopilot.py" in _paths(model)
+    from quadcosim.flightlogs import autopilots
 
-    assert Path(autopilot.__file__).relative_to(ROOT).as_posix() in _paths(model) and "`AUTOPILOTS`" in model
+    assert Path(autopilots.__file__).relative_to(ROOT).as_posix() in _paths(model)
     scenario = _section("Adding a scenario")
     assert "scenarios/catalogue.py" in _paths(scenario) and '"quadcosim.scenarios"' in scenario
     assert "pyproject.toml" in scenario
+
+
+def test_the_autopilot_and_model_checklists_are_how_the_package_registers_its_own():
+    """Each step of the checklists, as the package's own members take it: every autopilot a folder of
+    ``flightlogs/autopilots/`` named in the checklist, registered by one line in ``quadcosim.autopilots``
+    that names its ``AUTOPILOT`` under the name its logs give; every interference model a ``Model``
+    registered by one line in ``quadcosim.interference``, in one of the files the checklist names; and
+    no consumer naming a member's module: the command line, the calibration and the export read the
+    registries."""
+    import tomllib
+
+    from quadcosim.calibration.flight.catalogue import Model
+    from quadcosim.flightlogs.autopilots import Autopilot
+
+    from quadcosim.infra.members import load
+
+    section = _section("Adding a flight-log model or autopilot")
+    points = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["entry-points"]
+    autopilots = points["quadcosim.autopilots"]
+    assert set(autopilots) >= {"ArduPilot", "PX4"}
+    for name, value in autopilots.items():
+        module, _, attribute = value.partition(":")
+        folder = module.removeprefix("quadcosim.").replace(".", "/")
+        assert attribute == "AUTOPILOT" and (ROOT / folder / "__init__.py").is_file(), value
+        assert f"`{folder}/`" in section, folder  # the checklist shows each folder as the example
+        member = load(value)
+        assert isinstance(member, Autopilot) and member.name == name and member.formats
+    models = points["quadcosim.interference"]
+    assert set(models) >= {"current", "throttle", "motors", "metge", "dynamic"}
+    for name, value in models.items():
+        module = value.partition(":")[0].removeprefix("quadcosim.").replace(".", "/") + ".py"
+        assert module in _paths(section), module
+        member = load(value)
+        assert isinstance(member, Model) and member.name == name
+    consumers = ["calibration/flight/export.py", "calibration/flight/data.py", "calibration/flight/calibrate.py",
+                 "calibration/flight/autopilot.py", "scenarios/flightlog/calibrate.py", "flightlogs/__init__.py",
+                 "flightlogs/model.py", "flightlogs/info.py", "scenarios/registries.py"]
+    members = ("autopilots.ardupilot", "autopilots.px4", '"ArduPilot"', '"PX4"', "LinearModel", "MetgeModel",
+               "DynamicModel")
+    named = {path: [m for m in members if m in (ROOT / path).read_text()] for path in consumers}
+    assert {path: found for path, found in named.items() if found} == {}

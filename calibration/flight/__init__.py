@@ -10,16 +10,18 @@ Earth field rotated into the body frame, an offset, and the field of the motor c
   heading is steered by the compass being calibrated, so its interference leaks into it);
 - :mod:`quadcosim.calibration.flight.linear`: the Earth field and offset of each flight with the shared
   coefficients, by least squares;
-- :mod:`quadcosim.calibration.flight.models`: the ``current``, ``throttle``, ``motors`` and ``metge``
-  models and :mod:`quadcosim.calibration.flight.dynamic`, each refused with its reason when the flight
-  cannot identify it;
+- :mod:`quadcosim.calibration.flight.catalogue`: the interference models, registered in the
+  entry-point group ``quadcosim.interference``: :mod:`quadcosim.calibration.flight.models`' ``current``,
+  ``throttle``, ``motors`` and ``metge`` and :mod:`quadcosim.calibration.flight.dynamic`'s, each refused
+  with its reason when the flight cannot identify it;
 - :mod:`quadcosim.calibration.flight.evaluate`: out-of-sample scores;
 - :mod:`quadcosim.calibration.flight.calibrate`: all of it, and the :class:`quadcosim.calibration.Calibration`;
-- :mod:`quadcosim.calibration.flight.autopilot`: ArduPilot and PX4 parameters, and the corrections those
-  autopilots apply with them.
+- :mod:`quadcosim.calibration.flight.export`: the parameters of the log's autopilot, scored as its
+  firmware applies them (each autopilot's arithmetic and parameter writer are its own, in
+  :mod:`quadcosim.flightlogs.autopilots`).
 """
 
-from quadcosim.calibration.flight.calibrate import MODELS, calibrate
+from quadcosim.calibration.flight.calibrate import calibrate
 from quadcosim.calibration.flight.data import ATTITUDES, FlightData, flight_data
 
-__all__ = ["ATTITUDES", "MODELS", "FlightData", "calibrate", "flight_data"]
+__all__ = ["ATTITUDES", "FlightData", "calibrate", "flight_data"]

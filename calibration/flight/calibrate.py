@@ -15,14 +15,14 @@ from quadcosim.calibration.flight.linear import earth_and_offset
 from quadcosim.calibration.flight.models import Refused
 from quadcosim.calibration.static import CalibrationError, StaticCalibration, fit_static, sphere_coverage
 
-MODELS = catalogue.MODELS  # by name, in the order they are fitted (read when a calibration runs)
 MIN_COVERAGE = 0.5  # share of the 80 sphere cells the Earth field must visit in the body frame
 
 
 def _fit_models(train, names) -> tuple[dict, dict]:
     fitted, refused = {}, {}
+    known = catalogue.models()
     for name in names:
-        model = catalogue.MODELS[name].build(fitted)
+        model = known[name].build(fitted)
         reason = model.refusal(train)
         if reason is None:
             try:
@@ -138,19 +138,20 @@ def _field_model(fitted: dict, motors: int, explained: dict | None = None) -> tu
     # first, not a choice on the scores), provided it beats no model on the held-out part
     for name in catalogue.preferred("in_file"):
         if name in fitted and (explained is None or explained.get(name, 0.0) > 0.0):
-            return name, catalogue.MODELS[name].to_file(fitted[name], motors)
+            return name, catalogue.models()[name].to_file(fitted[name], motors)
     return None, None
 
 
 def calibrate(train, test, names=None, attitude: str = "auto") -> tuple[dict, Calibration, dict]:
     """Fit on the ``train`` parts, score on the ``test`` parts (lists of FlightData of one compass);
-    ``names`` the models tried (default every model of :data:`MODELS`), ``attitude`` the
-    attitude the parts were built with (recorded).
+    ``names`` the models tried (default every installed model,
+    :func:`quadcosim.calibration.flight.catalogue.models`), ``attitude`` the attitude the parts were
+    built with (recorded).
 
     Returns the metrics (JSON-ready), the :class:`quadcosim.calibration.Calibration` for the file and the
     fitted models by name (:class:`quadcosim.calibration.flight.models.Fitted`).
     """
-    names = tuple(MODELS) if names is None else names
+    names = tuple(catalogue.models()) if names is None else names
     fitted, refused = _fit_models(train, names)
     for name, reason in _unscorable(fitted, test).items():  # fitted on the training flights, not testable
         refused[name] = reason

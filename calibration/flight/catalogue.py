@@ -1,11 +1,18 @@
-"""The interference models a flight calibration fits, one line each in :data:`MODELS`, in the
-order they are fitted (a model may start from one fitted before it), with what each can be
-carried by: the calibration file (:class:`quadcosim.calibration.Calibration`) and the autopilots'
-parameters (:mod:`quadcosim.calibration.flight.export`).
+"""The interference models a flight calibration fits, registered one line each in the entry-point
+group ``quadcosim.interference`` (:mod:`quadcosim.infra.members`)::
+
+    [project.entry-points."quadcosim.interference"]
+    current = "quadcosim.calibration.flight.models:CURRENT"
+
+The line's value is a :class:`Model`: how the model is built, its rank and what can carry it, the
+calibration file (:class:`quadcosim.calibration.Calibration`) and the autopilots' parameters
+(:mod:`quadcosim.calibration.flight.export`). :func:`models` gives them in the order they are fitted
+(a model may start from one fitted before it).
 
 Adding a model is one file (its class: ``refusal(parts)`` and ``fit(parts)``, as
-:mod:`quadcosim.calibration.flight.models`) and one line here; the command line's ``--models``, the
-calibration's metrics and the file's choice follow.
+:mod:`quadcosim.calibration.flight.models`, and its :class:`Model`) and one registry line; the
+command line's ``--models``, the calibration's metrics, the file's choice and the documentation's
+table follow.
 """
 
 from __future__ import annotations
@@ -13,31 +20,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
 from quadcosim.calibration.dynamic import MotorFieldModel
-from quadcosim.calibration.flight.dynamic import DynamicModel
-from quadcosim.calibration.flight.models import LinearModel, MetgeModel
 
-
-def _vectors_field(vectors) -> MotorFieldModel:
-    """Field vectors per motor (motors, 3) (T per unit command) as the file's model (eqs. 3, 4 of
-    Metge et al.): unit directions and magnitudes, the field linear in each command."""
-    norms = np.linalg.norm(vectors, axis=1)
-    safe = np.where(norms > 0, norms, 1.0)
-    directions = np.where(norms[:, None] > 0, vectors / safe[:, None], np.array([1.0, 0.0, 0.0]))
-    return MotorFieldModel(directions, norms[:, None], (1, 0))
-
-
-def _motors_field(fitted, motors: int) -> MotorFieldModel:
-    return _vectors_field(fitted.extra["K"])
-
-
-def _throttle_field(fitted, motors: int) -> MotorFieldModel:
-    return _vectors_field(np.repeat(fitted.extra["K"] / motors, motors, axis=0))  # throttle = mean command
-
-
-def _metge_field(fitted, motors: int) -> MotorFieldModel:
-    return fitted.extra["field"]
+#: The entry-point group of the interference models.
+GROUP = "quadcosim.interference"
 
 
 @dataclass(frozen=True)
@@ -61,7 +47,11 @@ class Model:
         :class:`quadcosim.calibration.MotorFieldModel`; None: the file cannot carry it.
     autopilot : bool
         The autopilots' motor compensation can carry it (ArduPilot ``COMPASS_MOTCT`` or
-        ``COMPASS_PMOT``, PX4 ``CAL_MAG_COMP_TYP``).
+        ``COMPASS_PMOT``, PX4 ``CAL_MAG_COMP_TYP``: the names an autopilot's ``motor_models`` gives,
+        :class:`quadcosim.flightlogs.autopilots.Autopilot`).
+    order : int
+        Its place in the fitting order: the models are fitted by increasing ``order`` (ties by name),
+        so ``build`` may start from the models of a lower order (by default after the package's own).
     """
 
     name: str
@@ -69,6 +59,7 @@ class Model:
     preference: int
     to_file: Callable[[object, int], MotorFieldModel] | None = None
     autopilot: bool = False
+    order: int = 10
 
     @property
     def in_file(self) -> bool:
@@ -76,16 +67,28 @@ class Model:
         return self.to_file is not None
 
 
-MODELS = {model.name: model for model in (
-    Model("current", lambda fitted: LinearModel("current"), preference=1, autopilot=True),
-    Model("throttle", lambda fitted: LinearModel("throttle"), preference=3, to_file=_throttle_field, autopilot=True),
-    Model("motors", lambda fitted: LinearModel("motors"), preference=2, to_file=_motors_field, autopilot=True),
-    Model("metge", lambda fitted: MetgeModel(fitted.get("motors")), preference=0, to_file=_metge_field),
-    Model("dynamic", lambda fitted: DynamicModel(fitted.get("metge")), preference=4),
-)}
+def models() -> dict[str, Model]:
+    """The installed interference models, name: :class:`Model`, in the order they are fitted.
+
+    Raises
+    ------
+    TypeError
+        A registry line names something that is not a :class:`Model` of the line's own name.
+    """
+    from quadcosim.infra.members import load, registered
+
+    found = {}
+    for name, (value, owner) in registered(GROUP).items():
+        model = load(value)
+        if not isinstance(model, Model) or model.name != name:
+            raise TypeError(f"{owner} registers {name} = {value!r} in {GROUP}: not a Model named {name!r} "
+                            "(quadcosim.calibration.flight.catalogue.Model); fix the line or the model")
+        found[name] = model
+    return dict(sorted(found.items(), key=lambda pair: (pair[1].order, pair[0])))
 
 
 def preferred(capable: str) -> tuple[str, ...]:
     """The models ``capable`` (``"in_file"`` or ``"autopilot"``) can carry, richest first."""
-    return tuple(sorted((name for name, model in MODELS.items() if getattr(model, capable)),
-                        key=lambda name: MODELS[name].preference))
+    known = models()
+    return tuple(sorted((name for name, model in known.items() if getattr(model, capable)),
+                        key=lambda name: known[name].preference))

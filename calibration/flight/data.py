@@ -39,13 +39,13 @@ def rotation_of(euler: np.ndarray) -> np.ndarray:
 def board_quaternions(log, trim: bool = True) -> np.ndarray:
     """The attitude (T, 4) of the frame the autopilot's sensors are rotated into, at the log's
     attitude instants: ArduPilot's ``ATT`` is the vehicle's, the board's turned by ``AHRS_TRIM``,
-    which is added back (:func:`quadcosim.flightlogs.ardupilot.trim_rotation`); PX4 rotates its
+    which is added back (the autopilot's ``board_trim``, :mod:`quadcosim.flightlogs.autopilots`); PX4 rotates its
     sensors into the vehicle's frame itself. ``trim=False`` ignores the trim (an ablation)."""
-    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
+    from quadcosim.flightlogs.autopilots import of
     from scipy.spatial.transform import Rotation
 
     q = log.attitude.q
-    board_trim = AUTOPILOTS[log.autopilot].board_trim
+    board_trim = of(log.autopilot).board_trim
     if not trim or board_trim is None:
         return q
     board = Rotation.from_quat(q, scalar_first=True) * Rotation.from_matrix(board_trim(log.params))
@@ -153,7 +153,8 @@ class FlightData:
 def rate_refusal(log, compass: int) -> str | None:
     """Why compass ``compass`` of the :class:`quadcosim.flightlogs.FlightLog` ``log`` is logged too slowly for a
     flight calibration (its rate, the rate needed and the logging setting that gives it), or None."""
-    from quadcosim.flightlogs.model import FASTER_COMPASS, rate
+    from quadcosim.flightlogs.autopilots import of
+    from quadcosim.flightlogs.model import rate
 
     chosen = log.compasses[compass] if 0 <= compass < len(log.compasses) else None
     if chosen is None:
@@ -166,15 +167,15 @@ def rate_refusal(log, compass: int) -> str | None:
     other = f"; this log has {', '.join(faster)} (--compass)" if faster else ""
     return (f"{log.path}: {chosen.name} is logged at {found:.1f} Hz; a flight calibration needs the compass at "
             f"{MIN_COMPASS_RATE_HZ:g} Hz or faster (below it the motors' field and its delay cannot be told apart): "
-            f"{FASTER_COMPASS.get(log.autopilot, FASTER_COMPASS['ArduPilot'])}{other}")
+            f"{of(log.autopilot).faster_compass}{other}")
 
 
 def fused(log, compass: int) -> bool:
     """Whether the log's heading fuses compass ``compass``: ArduPilot's ``COMPASS_PRIMARY``, PX4's first
-    (:class:`quadcosim.calibration.flight.autopilot.Autopilot`'s ``fused_compass``)."""
-    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
+    (:class:`quadcosim.flightlogs.autopilots.Autopilot`'s ``fused_compass``)."""
+    from quadcosim.flightlogs.autopilots import of
 
-    return compass == AUTOPILOTS[log.autopilot].fused_compass(log.params)
+    return compass == of(log.autopilot).fused_compass(log.params)
 
 
 def flight_data(log, compass: int, attitude: str = "auto", earth=None, trim: bool = True) -> FlightData:

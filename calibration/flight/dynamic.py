@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from quadcosim.calibration.compensator import compensate
 from quadcosim.calibration.file import Calibration
+from quadcosim.calibration.flight.catalogue import Model
 from quadcosim.calibration.flight.models import DYNAMIC_MIN_RATE_HZ, Fitted
 from quadcosim.calibration.identify import fit_motor_dynamics
 
@@ -73,3 +74,7 @@ class DynamicModel:
                                        "exponent": dynamics.exponent, "freewheel": dynamics.freewheel,
                                        "gain_T_per_V": np.asarray(dynamics.gain).tolist()},
                       predict, extra={"dynamics": dynamics})
+
+
+#: The dynamic model, registered by its line in quadcosim.interference (pyproject.toml); it starts from metge.
+DYNAMIC = Model("dynamic", lambda fitted: DynamicModel(fitted.get("metge")), preference=4, order=5)

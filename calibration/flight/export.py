@@ -3,7 +3,7 @@
 :func:`score_parameters` is the one judge of a parameter set: any ArduPilot or PX4 parameters
 (this project's export, the log's own, a file another tool wrote), loaded on top of the log's
 parameters and applied to the raw field exactly as the log's firmware applies them
-(:mod:`quadcosim.flightlogs.ardupilot`, :mod:`quadcosim.flightlogs.px4`), on the held-out parts. It
+(each autopilot's ``apply``, :mod:`quadcosim.flightlogs.autopilots`), on the held-out parts. It
 returns the heading error against the log's attitude and the share of the field residual the
 parameters' motor compensation explains. The heading's constant offset (declination, mounting) is
 estimated for each parameter set on parts it does not score and removed frozen: a hard iron that
@@ -27,7 +27,6 @@ from quadcosim.calibration.flight.autopilot import autopilot_of
 from quadcosim.calibration.flight.evaluate import heading_offset, tilt_compensated_heading, wrap
 from quadcosim.calibration.flight.linear import earth_and_offset, fit_linear
 from quadcosim.calibration.static import CalibrationError
-from quadcosim.flightlogs import ardupilot
 
 MAX_CONDITION = 1e3  # column-normalised design: above it the parameters cannot be told apart
 
@@ -100,7 +99,7 @@ def score_file(path, parts, rule=None, *, offset_from) -> dict:
     applied under ``rule`` (None: the log's), with its name and parameter count."""
     from quadcosim.calibration.flight.autopilot import read_parameters
 
-    params = read_parameters(path)
+    params = read_parameters(path, autopilot_of(parts[0]))
     _check_scored(path, parts, params, rule)
     scored = score_parameters(parts, params, rule, offset_from=offset_from)
     return {"file": str(path), "parameters": len(params)} | scored
@@ -143,21 +142,16 @@ class Candidate:
 
 
 def _motor_regressors(part, model: str) -> np.ndarray | None:
-    """(T, J) regressors of the firmware's motor compensation ``model``, without delay."""
-    x = _inputs(part)
-    if model == "current":
-        return None if x["current"] is None else x["current"][:, None]
-    if model == "throttle":
-        return x["throttle"][:, None]
-    if np.isnan(x["voltage"]).any():
-        return None
-    return ardupilot.per_motor_outputs(x["commands"], x["voltage"])[:, :ardupilot.PMOT_MOTORS]
+    """(T, J) regressors of the firmware's motor compensation ``model``, without delay (the
+    autopilot's ``motor_inputs``)."""
+    return autopilot_of(part).motor_inputs(model, _inputs(part))
 
 
 def motor_models(part, rule=None) -> tuple[str, ...]:
-    """The motor compensations ``part``'s firmware has for its compass (:class:`Autopilot`'s
-    ``motor_models``): ``current`` and ``throttle``, and ``motors`` (``COMPASS_PMOT``) on ArduPilot
-    4.0 and later's first compass (``rule`` overriding the log's version)."""
+    """The motor compensations ``part``'s firmware has for its compass (the autopilot's
+    ``motor_models``, :class:`quadcosim.flightlogs.autopilots.Autopilot`): ``current`` and ``throttle``,
+    and ``motors`` (``COMPASS_PMOT``) on ArduPilot 4.0 and later's first compass (``rule`` overriding
+    the log's version)."""
     return autopilot_of(part).motor_models(part, rule)
 
 
@@ -236,7 +230,7 @@ def log_parameters(part, names) -> dict:
 
 
 def _motor_keys(part, params: dict) -> dict:
-    """The motor-compensation entries of ``params`` for ``part``'s firmware (:class:`Autopilot`'s
+    """The motor-compensation entries of ``params`` for ``part``'s firmware (the autopilot's
     ``is_motor_key``: ArduPilot's ``COMPASS_*MOT*``, PX4's ``CAL_MAG*COMP*``)."""
     is_motor_key = autopilot_of(part).is_motor_key
     return {k: v for k, v in params.items() if is_motor_key(k)}
@@ -286,7 +280,7 @@ def _setup_notes(part) -> dict:
     """The notes of how the compass is set up: ``orientation``, the rotation the export's frame depends
     on (the offsets and motor vectors are in the frame the firmware rotates the compass into before
     correcting it, ``AP_Compass_Backend::rotate_field``), and ``use``, what the export carries to
-    enable a compass the log's firmware does not use (:class:`quadcosim.calibration.flight.autopilot.Autopilot`'s
+    enable a compass the log's firmware does not use (:class:`quadcosim.flightlogs.autopilots.Autopilot`'s
     ``enabling``); each left out when it does not apply (an orientation ``NONE``: nothing rotated)."""
     notes = {}
     orientation = part.log.compasses[part.compass].setup.get("orientation", "")

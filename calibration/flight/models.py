@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from quadcosim.calibration.dynamic import MotorFieldModel
+from quadcosim.calibration.flight.catalogue import Model
 from quadcosim.calibration.flight.linear import NUISANCE, fit_linear
 
 DELAYS = np.round(np.arange(0.0, 0.301, 0.02), 3)  # s
@@ -186,3 +187,33 @@ class MetgeModel:
                                        "theta": found.theta.tolist()},
                       lambda data: found.field(data.commands(delay), data.voltage(delay)), condition,
                       {"field": found, "nuisance": fit.x[:NUISANCE * P].reshape(P, NUISANCE)})
+
+
+def _vectors_field(vectors) -> MotorFieldModel:
+    """Field vectors per motor (motors, 3) (T per unit command) as the file's model (eqs. 3, 4 of
+    Metge et al.): unit directions and magnitudes, the field linear in each command."""
+    norms = np.linalg.norm(vectors, axis=1)
+    safe = np.where(norms > 0, norms, 1.0)
+    directions = np.where(norms[:, None] > 0, vectors / safe[:, None], np.array([1.0, 0.0, 0.0]))
+    return MotorFieldModel(directions, norms[:, None], (1, 0))
+
+
+def _motors_field(fitted, motors: int) -> MotorFieldModel:
+    return _vectors_field(fitted.extra["K"])
+
+
+def _throttle_field(fitted, motors: int) -> MotorFieldModel:
+    return _vectors_field(np.repeat(fitted.extra["K"] / motors, motors, axis=0))  # throttle = mean command
+
+
+def _metge_field(fitted, motors: int) -> MotorFieldModel:
+    return fitted.extra["field"]
+
+
+# The models of this file, each registered by its line in quadcosim.interference (pyproject.toml).
+CURRENT = Model("current", lambda fitted: LinearModel("current"), preference=1, autopilot=True, order=1)
+THROTTLE = Model("throttle", lambda fitted: LinearModel("throttle"), preference=3, to_file=_throttle_field,
+                 autopilot=True, order=2)
+MOTORS = Model("motors", lambda fitted: LinearModel("motors"), preference=2, to_file=_motors_field, autopilot=True,
+               order=3)
+METGE = Model("metge", lambda fitted: MetgeModel(fitted.get("motors")), preference=0, to_file=_metge_field, order=4)

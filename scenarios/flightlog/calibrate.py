@@ -11,7 +11,7 @@ neither has seen (the held-out part's second half, or the held-out flights); see
 ``--score PARAMS`` scores a parameter file (any tool's) on that score part instead, with the
 same code that scores the export.
 Outputs in DIR: ``metrics.json``, ``calibration.json`` (the project's format, for ``tp``'s
-``calibration=`` option), ``ardupilot.parm`` or ``px4.params`` (the log's autopilot's),
+``calibration=`` option), the parameter file of the log's autopilot (``ardupilot.parm``, ``px4.params``: its ``file``),
 ``residual.png`` and ``heading.png``.
 """
 
@@ -131,15 +131,25 @@ def _split(args) -> Split:
 
 
 def _rule(args, part):
-    """ArduPilot's rules for the export: the log's firmware, or --firmware's."""
+    """The firmware rules the export follows: None (the log's own firmware), or ``--firmware``'s, read by
+    the autopilot of ``part``'s log (its ``versions``; an autopilot with one set of rules ignores it).
+    ``part`` None: checked against every installed autopilot that has versions, before a log is read."""
     if args.firmware is None:
         return None
-    from quadcosim.flightlogs import ardupilot
+    from quadcosim.flightlogs.autopilots import of, registry
 
-    version = ardupilot.parse_version(f"ArduCopter V{args.firmware}")
-    if version is None:
-        raise ValueError(f"--firmware {args.firmware!r} is not a Copter version such as 3.4 or 4.5")
-    return ardupilot.rules(version)
+    if part is not None:
+        versions = of(part.log.autopilot).versions
+        return None if versions is None else versions(args.firmware)
+    refusals = []
+    for autopilot in registry().values():
+        if autopilot.versions is not None:
+            try:
+                return autopilot.versions(args.firmware)
+            except ValueError as error:
+                refusals.append(str(error))
+    raise ValueError("; ".join(refusals) or f"--firmware {args.firmware!r}: no installed autopilot has firmware "
+                     "versions to choose from")
 
 
 def _write(out: Path, split: Split, metrics: dict, calibration, fitted: dict, export: tuple,
@@ -214,14 +224,14 @@ def _figures(train, test, fitted, model, attitude) -> tuple:
 def _export(args, split: Split, metrics: dict) -> tuple:
     """The parameters of the log's autopilot chosen and scored (:mod:`quadcosim.calibration.flight.export`),
     described in ``metrics["export"]``; (autopilot, file name, parameters)."""
-    from quadcosim.calibration.flight.autopilot import AUTOPILOTS
+    from quadcosim.calibration.flight.autopilot import autopilot_of
     from quadcosim.calibration.flight.export import choose, judge, log_parameters, score_parameters
 
     train, score = split.train, split.score
     rule = _rule(args, split.test[0])
     params, chosen = choose(split.fit, split.choice, rule)
-    autopilot = train[0].log.autopilot
-    name = AUTOPILOTS[autopilot].file
+    autopilot = autopilot_of(train[0])
+    name = autopilot.file
     flown_params = log_parameters(score[0], params)
     unscored = [*split.fit, *split.choice]  # where each candidate's heading offset is estimated
     flown = score_parameters(score, flown_params, rule, offset_from=unscored)
@@ -232,7 +242,7 @@ def _export(args, split: Split, metrics: dict) -> tuple:
         if exported is flown:  # the log's values written back
             chosen = {**chosen, "kept": {group: "log" for group in chosen["kept"]}, "model": None}
             chosen["notes"].pop("use", None)  # nothing that enables the compass is written
-    firmware = AUTOPILOTS[autopilot].firmware(train[0], rule)
+    firmware = autopilot.firmware(train[0], rule)
     metrics["export"] = {"file": name, "firmware": firmware, "model": chosen["model"],
                          "heading_rms_deg": exported["heading_rms_deg"], "explained_test": exported["explained"],
                          "heading_offset_deg": exported["heading_offset_deg"],
@@ -243,7 +253,7 @@ def _export(args, split: Split, metrics: dict) -> tuple:
                                    "score_from_s": [float(p.time[0]) for p in score],
                                    "choice_from_s": [float(p.time[0]) for p in split.choice],
                                    "rule": split.notes["validation"]}}
-    return autopilot, name, params
+    return autopilot.name, name, params
 
 def _report(metrics: dict) -> list[str]:
     lines = [f"trained on {', '.join(metrics['train'])}; tested on {', '.join(metrics['test'])} "
@@ -449,14 +459,16 @@ def _ours(error: BaseException) -> bool:
 def _check_choices(args):
     """--attitude and --models against the calibration's own names (checked here rather than by
     argparse, so that the command line's help does not import the calibration package)."""
-    from quadcosim.calibration.flight import ATTITUDES, MODELS
+    from quadcosim.calibration.flight import ATTITUDES
+    from quadcosim.calibration.flight.catalogue import models
 
     if args.attitude not in ATTITUDES:
         raise ValueError(f"--attitude {args.attitude!r} must be one of {', '.join(ATTITUDES)}")
-    args.models = list(MODELS) if args.models is None else args.models
-    unknown = [m for m in args.models if m not in MODELS]
+    known = models()
+    args.models = list(known) if args.models is None else args.models
+    unknown = [m for m in args.models if m not in known]
     if unknown:
-        raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(MODELS)}")
+        raise ValueError(f"--models: unknown {', '.join(unknown)}; the models are {', '.join(known)}")
     if args.earth not in ("model", "free"):
         raise ValueError(f"--earth {args.earth!r} must be model or free")
     _rule(args, None)  # --firmware refused before the flights are read
@@ -464,7 +476,8 @@ def _check_choices(args):
 
 def add_arguments(parser):
     """The ``calibrate`` verb's options on ``parser`` (an argparse parser); returns it."""
-    parser.add_argument("files", nargs="*", metavar="FILE", help="PX4 .ulg, ArduPilot .bin or .log flights")
+    parser.add_argument("files", nargs="*", metavar="FILE", help="flight logs, in a format an installed autopilot "
+                        "writes (PX4 .ulg, ArduPilot .bin or .log)")
     parser.add_argument("--compass", type=int, default=0, help="compass to calibrate, from 0 in the log's order")
     parser.add_argument("--out", help="folder for the results (default results/calibrate-FLIGHT, FLIGHT the first "
                                       "flight's name, or results/calibrate-FLIGHT-N when that holds results)")
@@ -478,12 +491,13 @@ def add_arguments(parser):
                              "fuses, log for the others), gyro (roll and pitch from the log, heading integrated from "
                              "the gyro) or log")
     parser.add_argument("--models", nargs="+", default=None,
-                        help="models to fit (default: every model of calibration/flight/catalogue.py; an unknown "
+                        help="models to fit (default: every installed interference model; an unknown "
                              "name lists them)")
     parser.add_argument("--earth", default="model",
                         help="Earth field: model (default: the World Magnetic Model at the log's GPS position and "
                              "date; free without a GPS fix) or free (fitted per flight)")
-    parser.add_argument("--firmware", help="ArduPilot Copter version whose rules the export follows (default: the "
+    parser.add_argument("--firmware", help="firmware version whose rules the export follows, for an autopilot "
+                                           "with versions (ArduPilot: a Copter version such as 3.4; default: the "
                                            "log's)")
     parser.add_argument("--no-trim", action="store_true", help="ignore AHRS_TRIM (an ablation)")
     parser.add_argument("--span", nargs=2, type=float, metavar=("START", "END"),

@@ -27,13 +27,15 @@ def flight(tmp_path):
 @pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_while_the_files_are_written_keeps_them_all_with_metrics_json(flight, tmp_path, monkeypatch,
                                                                                number, capsys):
-    ardupilot = autopilot.AUTOPILOTS["ArduPilot"]
+    from quadcosim.flightlogs.autopilots import ardupilot, of
+
+    member = of("ArduPilot")
 
     def signalled(params, path):
         send_self(number)  # as the first parameter file is written
-        ardupilot.write(params, path)
+        member.write(params, path)
 
-    monkeypatch.setitem(autopilot.AUTOPILOTS, "ArduPilot", dataclasses.replace(ardupilot, write=signalled))
+    monkeypatch.setattr(ardupilot, "AUTOPILOT", dataclasses.replace(member, write=signalled))
     out = tmp_path / "cal"
     assert cli(["calibrate", str(flight), "--out", str(out), *MODELS]) == 128 + number
     capsys.readouterr()

@@ -13,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 from quadcosim.calibration.flight import autopilot  # noqa: E402
+from quadcosim.flightlogs.autopilots import registry  # noqa: E402
 
 import quadcosim.infra.files  # noqa: E402
 from quadcosim.infra.files import DiskFull, save_figure, write_json, write_text  # noqa: E402
@@ -20,7 +21,7 @@ from quadcosim.infra.files import DiskFull, save_figure, write_json, write_text 
 PARAMETERS = {"COMPASS_OFS_X": 12.5, "COMPASS_MOTCT": 2}
 
 
-@pytest.mark.parametrize("writer", [autopilot.write_ardupilot, autopilot.write_px4])
+@pytest.mark.parametrize("writer", [member.write for member in registry().values()])
 def test_parameter_files_are_never_left_empty_by_a_full_disk(tmp_path, monkeypatch, writer):
     path = tmp_path / "compass.params"
     path.write_text("earlier\n")

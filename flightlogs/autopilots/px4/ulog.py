@@ -10,8 +10,8 @@ How PX4's logged topics differ from ArduPilot's messages:
 - No motor-compensation offsets are logged: PX4 adds ``CAL_MAGn_*COMP`` times the throttle or
   the current inside the calibration step, so the raw topic is the field before it.
 - The calibration slot ``CAL_MAGn`` of a sensor is the one whose ``CAL_MAGn_ID`` is its
-  ``device_id`` (:func:`quadcosim.flightlogs.px4.slot`); the raw field stays in the sensor's frame and
-  :attr:`Compass.rotation` carries ``CAL_MAGn_ROT`` or the board's rotation into the body frame.
+  ``device_id`` (:func:`quadcosim.flightlogs.autopilots.px4.firmware.slot`); the raw field stays in the
+  sensor's frame and :attr:`Compass.rotation` carries ``CAL_MAGn_ROT`` or the board's rotation into the body frame.
 - ``vehicle_gps_position``: the position and date of the Earth field model; the thrust setpoint's
   norm (``vehicle_thrust_setpoint``, or ``actuator_controls_0.control[3]`` in older logs) is the
   throttle ``CAL_MAG_COMP_TYP = 1`` multiplies.
@@ -19,7 +19,7 @@ How PX4's logged topics differ from ArduPilot's messages:
 - Motors: ``actuator_motors`` (already 0..1, newer) or ``actuator_outputs`` in us, normalised
   output by output with ``PWM_MAIN_MINn``/``PWM_MAIN_MAXn`` (1.13 and later), ``PWM_MAIN_MIN``/``MAX``
   (1.11, 1.12) or ``PWM_MIN``/``PWM_MAX`` (1.9, 1.10), or PX4's defaults when none is logged
-  (:func:`quadcosim.flightlogs.px4.pwm_limits`).
+  (:func:`quadcosim.flightlogs.autopilots.px4.firmware.pwm_limits`).
 - Battery: ``battery_status.voltage_v`` and ``current_a`` (negative when not measured).
 - Attitude: ``vehicle_attitude.q``, scalar first, body FRD to NED: the project's convention.
 - Time stamps are microseconds since boot.
@@ -30,7 +30,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from quadcosim.flightlogs import px4
+from quadcosim.flightlogs.autopilots.px4 import firmware as px4
 from quadcosim.flightlogs.model import Attitude, Battery, Compass, FlightLog, Imu, LogError, Motors, Position, Throttle
 
 GAUSS = 1e-4  # T

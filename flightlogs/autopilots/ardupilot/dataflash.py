@@ -7,10 +7,10 @@ What ArduPilot logs, and how it is turned into the project's conventions:
   (4.0 and later): the field in the body frame, in milligauss, *after* the compass's corrections,
   with the offsets ``Ofs`` (``COMPASS_OFS*``) and the motor compensation ``MOfs`` (``MOX..MOZ`` from
   4.0) logged beside it. The raw field is recovered sample by sample in the order of the log's
-  firmware version (:func:`quadcosim.flightlogs.ardupilot.recover_raw`: ``M^-1 Mag - MOfs - Ofs`` up to Copter
-  3.5, ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later). A 4.x instance ``I`` is the compass's
-  priority; its parameters are those of the slot whose ``COMPASS_DEV_IDn`` is
-  ``COMPASS_PRIO{I+1}_ID`` (:func:`quadcosim.flightlogs.ardupilot.slot_of`).
+  firmware version (:func:`quadcosim.flightlogs.autopilots.ardupilot.firmware.recover_raw`:
+  ``M^-1 Mag - MOfs - Ofs`` up to Copter 3.5, ``M^-1 (Mag - MOfs) / COMPASS_SCALE - Ofs`` later). A
+  4.x instance ``I`` is the compass's priority; its parameters are those of the slot whose ``COMPASS_DEV_IDn`` is
+  ``COMPASS_PRIO{I+1}_ID`` (:func:`quadcosim.flightlogs.autopilots.ardupilot.firmware.slot_of`).
 - ``PARM``: the parameters (pymavlink's), and from 4.x the firmware's default of each (``Default``).
 - ``GPS`` (the first receiver, ``I = 0`` in 4.x logs): the position and date the Earth field model is
   evaluated at (3D fixes only).
@@ -35,7 +35,8 @@ import re
 from pathlib import Path
 
 import numpy as np
-from quadcosim.flightlogs import ardupilot, trim
+from quadcosim.flightlogs import trim
+from quadcosim.flightlogs.autopilots.ardupilot import firmware as ardupilot
 from quadcosim.flightlogs.model import (
     Attitude,
     Battery,
