@@ -14,20 +14,18 @@ import pytest
 from fmpy.validation import validate_fmu
 from quadcosim.fmus import MODELS, fmu_path
 from quadcosim.fmus.build import PLATFORMS, SOURCE_FILES, table, windows_compiler
+from quadcosim.fmus.models import sensor
 
 HERE = Path(__file__).resolve().parent
 VERSIONS = (2, 3)
-#: Constant inputs that move every output: rotors near hover, a wind, a tilted and turning body.
-_Q = np.array([0.9, 0.1, -0.2, 0.3]) / np.linalg.norm([0.9, 0.1, -0.2, 0.3])
-ROTORS = {"omega_r1": 495.0, "omega_r2": 500.0, "omega_r3": 490.0, "omega_r4": 505.0}
-INPUTS = {
-    "Quadrotor": ROTORS | {"domega_r1": 3.0, "domega_r3": -2.0, "wind_x": 2.0, "wind_y": -1.0},
-    "MotorMagnetics": {"c1": 0.45, "c2": 0.5, "c3": 0.55, "c4": 0.6},
-    "IMU": ROTORS | {f"q{k}": float(_Q[k]) for k in range(4)} | {
-        "omega_x": 0.1, "omega_y": -0.2, "omega_z": 0.3, "f_x": 0.5, "f_y": -0.3, "f_z": -9.6,
-        "b_d_x": 1e-6, "b_d_y": -2e-6, "b_d_z": 3e-6},
-    "InfraredSensor": {"phi": 0.2},
-}
+
+
+def inputs_of(model: str) -> dict:
+    """Constant inputs that move the model's outputs: its ``HELD_INPUTS`` (its folder's
+    ``__init__.py``; for the plant, a tilted, turning body with the rotors unequal)."""
+    return sensor(model).check("HELD_INPUTS")
+
+
 STEP = 1e-3
 STEPS = 200  # 0.2 s: the IMU's 200 samples (and 20 of the magnetometer), MotorMagnetics' spin-up
 
@@ -68,7 +66,8 @@ def test_validates_with_both_platforms_and_its_sources(model, version):
     if version == 3:
         assert "sources/buildDescription.xml" in names
         arrays = {v.name: v.shape for v in description.modelVariables if v.shape}
-        assert arrays == ({"acc": (3,), "gyro": (3,), "magneto": (3,)} if model == "IMU" else {})
+        # the arrays its table declares (the IMU's acc, gyro, magneto), each of its members' count
+        assert arrays == {name: (len(members),) for name, members in table(model).array_members().items()}
         assert [s.sourceFiles for c in description.buildConfigurations for s in c.sourceFileSets] == [
             list(SOURCE_FILES[3])]
 
@@ -91,7 +90,7 @@ def test_the_fmi3_binaries_export_every_function_of_the_standard(tmp_path):
 @pytest.mark.parametrize("model", MODELS)
 def test_fmi3_runs_in_fmpy_equal_to_fmi2(model):
     runs = [fmpy.simulate_fmu(str(fmu_path(model, fmi_version=v)), stop_time=0.05, step_size=STEP,
-                              start_values=INPUTS[model]) for v in VERSIONS]
+                              start_values=inputs_of(model)) for v in VERSIONS]
     names = [v.name for v in _outputs(fmpy.read_model_description(str(fmu_path(model))))]
     moved = 0
     for name in names:
@@ -206,11 +205,11 @@ def _plan(folder: Path, platform: str, windows_paths: bool) -> tuple[Path, dict]
             suffix = ".dll" if platform == "windows" else ".so"
             library = unzipped / "binaries" / PLATFORMS[version][platform] / f"{model}{suffix}"
             output = folder / f"{platform}-fmi{version}-{model}.bin"
-            inputs = " ".join(f"{by_name[n]} {value!r}" for n, value in INPUTS[model].items())
+            inputs = " ".join(f"{by_name[n]} {value!r}" for n, value in inputs_of(model).items())
             variables = _outputs(description)
             refs = " ".join(str(v.valueReference) for v in variables)
             lines += [f"{version} {native(library)} {model} {description.guid} {STEPS} {STEP!r}",
-                      f"{len(INPUTS[model])} {inputs}", f"{len(variables)} {_values(variables)} {refs}",
+                      f"{len(inputs_of(model))} {inputs}", f"{len(variables)} {_values(variables)} {refs}",
                       native(output)]
             outputs[version, model] = (output, _values(variables))
     plan = folder / f"{platform}.plan"

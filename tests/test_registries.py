@@ -244,8 +244,8 @@ def test_a_dummy_sensor_fmu_is_one_folder_and_one_line(tmp_path):
     # the FMU checks iterate the registry, and the dummy passes each with its own data
     env = dict(os.environ, QUADCOSIM_FMU_DIR=str(fmus),
                PYTHONPATH=os.pathsep.join([str(tmp_path / "site"), str(DUMMIES), str(ROOT)]))
-    checks = ["tests/test_fmu_reset.py", "tests/test_fmu_packaging.py", "tests/test_variable_tables.py",
-              "tests/test_twins.py"]
+    checks = ["tests/test_fmu_reset.py", "tests/test_fmu_packaging.py", "tests/test_fmu_platforms.py",
+              "tests/test_variable_tables.py", "tests/test_twins.py"]
     done = subprocess.run([sys.executable, "-m", "pytest", "-v", "-p", "no:cacheprovider", "-k", "Barometer", *checks],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout[-3000:]
