@@ -400,6 +400,17 @@ def test_the_autopilot_and_model_checklists_are_how_the_package_registers_its_ow
         assert f"`{folder}/`" in section, folder  # the checklist shows each folder as the example
         member = load(value)
         assert isinstance(member, Autopilot) and member.name == name and member.formats
+    # the models an autopilot can carry (Model.autopilot) are those the autopilots' firmware has, on a
+    # compass of each (a 4.5 firmware's first compass: ArduPilot's per-motor compensation included)
+    from types import SimpleNamespace
+
+    from quadcosim.calibration.flight.catalogue import preferred
+    from quadcosim.flightlogs.autopilots import registry
+
+    part = SimpleNamespace(log=SimpleNamespace(firmware="ArduCopter V4.5.0", compasses=[SimpleNamespace(slot=0)]),
+                           compass=0)
+    carried = {name: set(member.motor_models(part, None)) for name, member in registry().items()}
+    assert set().union(*carried.values()) == set(preferred("autopilot")), carried
     models = points["quadcosim.interference"]
     assert set(models) >= {"current", "throttle", "motors", "metge", "dynamic"}
     for name, value in models.items():
