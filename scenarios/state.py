@@ -1,10 +1,12 @@
-"""A run's state, typed: the options as parsed (read-only), what the caller asks beside them, and
-the system as built with the options as it uses them.
+"""A run's state, typed: the options as parsed (read-only), what the caller asks beside them, what
+its ``metrics.json`` states whatever its end, and the system as built with the options as it uses them.
 
-``--set Controller.kp_yaw=50`` is read once (:meth:`quadcosim.scenarios.Scenario.parse`, into
-:class:`Options`), resolved once against the built system and set on its block
-(:meth:`quadcosim.scenarios.Scenario.prepare`, into :class:`Prepared`), and written to ``metrics.json``
-from :attr:`Prepared.used`; nothing on the way changes the options in place.
+``--set Controller.kp_yaw=50`` is read once and checked against the scenario's declared blocks
+before anything is built (:meth:`quadcosim.scenarios.Scenario.parse`, into :class:`Options`: the
+gain as a number), set on the built block through the block contract
+(:meth:`quadcosim.scenarios.Scenario.prepare`, into :class:`Prepared`), and written to
+``metrics.json`` from :attr:`Prepared.used` (:class:`RunStated`); nothing on the way changes the
+options in place.
 """
 
 from __future__ import annotations
