@@ -154,7 +154,10 @@ def _unit_quaternion(q) -> np.ndarray:
 def load(spec: str) -> type:
     """The class named by ``spec``: ``"package.module:Class"``, or ``"path/to/file.py:Class"``.
 
-    A module is looked for in the working directory first, then on the Python path.
+    A module is looked for in the working directory first, then on the Python path. Loading
+    it executes its top-level code, as ``import`` does. The working directory is on the path only
+    while the module is imported (for its own imports of its neighbours): a file there named as a
+    standard module (``fractions.py``) does not replace that module for the rest of the run.
 
     Raises
     ------
@@ -181,9 +184,7 @@ def load(spec: str) -> type:
                 sys.modules[module_name] = module
                 loader.loader.exec_module(module)
         else:
-            if str(Path.cwd()) not in sys.path and "" not in sys.path:
-                sys.path.insert(0, str(Path.cwd()))
-            module = importlib.import_module(where)
+            module = _import_from(where, Path.cwd())
     except ValueError:
         raise
     except Exception as error:  # the user's module failed to import: say so, with its own error
@@ -195,6 +196,26 @@ def load(spec: str) -> type:
         raise ValueError(f"estimator {spec!r}: {where} has no {name!r}"
                          + (f"; its blocks: {', '.join(classes)}" if classes else ""))
     return cls
+
+
+def _import_from(where: str, folder: Path):
+    """Module ``where`` (dotted), from ``folder`` if it holds it, else from the Python path; ``folder``
+    is first on ``sys.path`` while the import runs and taken off after it, whatever happens."""
+    top = where.partition(".")[0]
+    if not ((folder / f"{top}.py").is_file() or (folder / top / "__init__.py").is_file()):
+        return importlib.import_module(where)
+    stale = sys.modules.get(top)
+    if stale is not None and not str(getattr(stale, "__file__", "") or "").startswith(str(folder)):
+        raise ValueError(f"estimator module {where!r}: the name {top!r} is already taken by {stale.__name__} "
+                         f"({getattr(stale, '__file__', None) or 'built in'}); rename your file, or give it as "
+                         f"{top}.py:Class")
+    entry = str(folder)
+    sys.path.insert(0, entry)
+    try:
+        importlib.invalidate_caches()
+        return importlib.import_module(where)
+    finally:
+        sys.path.remove(entry)
 
 
 def label(estimator) -> str:

@@ -223,9 +223,9 @@ class Controller(Block):
         self.parameters = parameters(gains)
         self.mixer_inverse = portable.inverse(allocation_matrix())  # LAPACK's bits differ by CPU
 
-    def named_parameters(self) -> dict:
+    def parameter_values(self) -> dict:
         """The gains (:data:`GAINS`) by name, their present values; ``--set Controller.kp_yaw=50``
-        sets one.
+        sets one (:meth:`set_parameter`).
 
         Returns
         -------
@@ -234,7 +234,14 @@ class Controller(Block):
         """
         return {name: float(self.parameters[PARAMETERS.index(name)]) for name in GAINS}
 
-    def set_named_parameter(self, name: str, value: float):
+    @classmethod
+    def check_parameter(cls, name: str, value: float) -> float:
+        """Gain ``name`` at ``value`` (its unit in :data:`GAINS`), checked with the other gains at
+        their defaults, as :func:`parameters` checks it; refused with a ValueError."""
+        parameters({name: float(value)})
+        return float(value)
+
+    def set_parameter(self, name: str, value: float):
         """Set gain ``name`` to ``value`` before the run, checked as :func:`parameters` checks.
 
         Parameters
@@ -244,7 +251,7 @@ class Controller(Block):
         value : float
             The gain, in its unit (:data:`GAINS`).
         """
-        self.parameters = parameters(self.named_parameters() | {name: float(value)})
+        self.parameters = parameters(self.parameter_values() | {name: float(value)})
 
     def start(self, t0, dt):
         """Reset the integral; compile the law before the run. ``t0``: the start time (s);

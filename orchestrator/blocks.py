@@ -10,6 +10,12 @@ present inputs (direct feedthrough) runs after the blocks that feed it. A Python
 declares no feedthrough sees, from blocks ordered after it, the values of the previous macro
 step: a unit delay.
 
+A Python block's parameters, the values a setting may change before a run (``--set
+Controller.kp_yaw=50``, :meth:`quadcosim.orchestrator.System.set_parameter`), reach it through
+:meth:`Block.parameter_values` and :meth:`Block.set_parameter`. A class that declares them
+(:attr:`Block.parameter_units`) has its settings checked before any block is built; one that
+does not offers its public numeric attributes, checked once it is built.
+
 A block may also expose its step as compiled code (:meth:`Block.compiled`): a C-callable
 function that the chunk runner calls for whole chunks of steps without returning to Python.
 Such a block keeps its Python ``step`` too, and both must compute the same numbers from the
@@ -18,7 +24,8 @@ same memory (the per-step master and the chunk runner give bit-identical results
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import numbers
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
@@ -74,12 +81,17 @@ class CompiledStep(NamedTuple):
     keep: object = None
 
 
+#: Attributes of every block that are not parameters, though some are numbers.
+NOT_PARAMETERS = ("name", "period", "feedthrough", "inputs", "outputs")
+
+
 class Block:
     """Base class of Python blocks.
 
     Subclasses set ``inputs`` and ``outputs`` (tuples of names), may set ``feedthrough``
     (``True``: every output depends on the present inputs; ``False``: none does) and
-    implement :meth:`step`. ``parameters`` documents the tunable values with their units.
+    implement :meth:`step`. Its parameters are declared by :attr:`parameter_units`, read by
+    :meth:`parameter_values` and set by :meth:`set_parameter`.
 
     Parameters
     ----------
@@ -92,6 +104,10 @@ class Block:
     inputs: tuple[str, ...] = ()
     outputs: tuple[str, ...] = ()
     feedthrough: bool = True
+    #: The parameters the class declares, name to unit (``"1/s^2"``; ``"1"`` for a pure number):
+    #: a setting of one is checked before any block is built. Empty (the default): the block's
+    #: parameters are its public numeric attributes, known once it is built.
+    parameter_units: ClassVar[dict[str, str]] = {}
 
     def __init__(self, name: str, period: int = 1):
         if int(period) != period or period < 1:
@@ -118,6 +134,41 @@ class Block:
     def step(self, t: float, u: np.ndarray, y: np.ndarray) -> None:
         """Compute the outputs at time ``t`` (s) from the inputs ``u``, writing ``y`` in place."""
         raise NotImplementedError(f"{type(self).__name__} must implement step(t, u, y)")
+
+    def parameter_values(self) -> dict:
+        """The parameters a setting may change, by name, and their present values.
+
+        Returns
+        -------
+        dict
+            Name to value (a number, or a bool), sorted by name: the declared parameters
+            (:attr:`parameter_units`, read as attributes), else the public numeric attributes.
+        """
+        if self.parameter_units:
+            return {name: getattr(self, name) for name in sorted(self.parameter_units)}
+        return dict(sorted((k, v) for k, v in vars(self).items()
+                           if not k.startswith("_") and k not in NOT_PARAMETERS and isinstance(v, numbers.Real)))
+
+    @classmethod
+    def check_parameter(cls, name: str, value):
+        """A value of declared parameter ``name`` checked before any block is built: returned as
+        it will be set, or refused (ValueError, saying what is expected). The default takes any
+        finite number in the declared unit (the caller checks that much)."""
+        return value
+
+    def set_parameter(self, name: str, value) -> None:
+        """Set parameter ``name`` (one of :meth:`parameter_values`) to ``value`` before the run.
+
+        Parameters
+        ----------
+        name : str
+            The parameter's name.
+        value : float, int or bool
+            Its value, in its unit, of the type of its present value (checked by the caller,
+            :func:`quadcosim.orchestrator.parameters.resolve`); a block that keeps the value
+            elsewhere, or checks more, overrides this method and raises ValueError on a bad one.
+        """
+        setattr(self, name, value)
 
     def compiled(self) -> CompiledStep | None:
         """The step as compiled code, after :meth:`start`; ``None`` (the default): Python only.

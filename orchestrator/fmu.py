@@ -177,8 +177,13 @@ def _cleanup():
 
 
 def nearest(name: str, candidates, n: int = 3) -> str:
-    """``"did you mean a, b?"`` for the candidates closest to ``name``."""
-    close = difflib.get_close_matches(name, list(candidates), n=n, cutoff=0.5)
+    """``"did you mean a, b?"`` for the candidates closest to ``name`` (in any case, when none is close as
+    written: ``Imu`` finds ``IMU``)."""
+    candidates = list(candidates)
+    close = difflib.get_close_matches(name, candidates, n=n, cutoff=0.5)
+    if not close:
+        folded = {str(c).lower(): c for c in candidates}
+        close = [folded[c] for c in difflib.get_close_matches(name.lower(), list(folded), n=n, cutoff=0.5)]
     return f" Did you mean {', '.join(close)}?" if close else ""
 
 

@@ -7,11 +7,15 @@ variable module may declare ``ALIASES`` (another name for a parameter vector, su
 while it is true: setting a noise density while the noise is off is refused rather than ignored).
 
 A value given as text may carry the variable's unit after it (``"0.002 rad/s/Hz0.5"``); another
-unit is refused with the expected one named. A Python block's parameters are its public numeric
-attributes (``Quaternion_estim.beta``), set before the run starts it, and the named parameters it
-declares: a block with ``named_parameters()`` (name to present value) and
-``set_named_parameter(name, value)`` (which checks the value) exposes values it keeps elsewhere,
-such as the controller's gains (``Controller.kp_yaw``).
+unit is refused with the expected one named. A Python block's parameters reach it through the
+block contract (:meth:`quadcosim.orchestrator.Block.parameter_values` and
+:meth:`~quadcosim.orchestrator.Block.set_parameter`): the ones its class declares
+(:attr:`~quadcosim.orchestrator.Block.parameter_units`, such as the controller's gains,
+``Controller.kp_yaw``), else its public numeric attributes (``Quaternion_estim.beta``).
+
+:func:`check_declared` checks settings before any block is built, against what a system will hold
+(block name to an FMU model or a block class); :func:`resolve_all` and :func:`set_all` then set
+them on the built system.
 """
 
 from __future__ import annotations
@@ -20,13 +24,12 @@ import math
 import numbers
 import re
 
-from quadcosim.orchestrator.blocks import FMUBlock
+from quadcosim.orchestrator.blocks import Block, FMUBlock
 from quadcosim.orchestrator.fmi_types import INTEGER_TYPES, is_parameter
 from quadcosim.orchestrator.fmu import nearest
 from quadcosim.orchestrator.signals import expand
 
 _NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(.*)", re.IGNORECASE)
-_NOT_PARAMETERS = ("name", "period", "feedthrough", "inputs", "outputs")
 
 
 def fmu_parameters(model: str) -> dict:
@@ -173,12 +176,8 @@ def set_all(system, resolved: dict[str, dict], options: dict | None = None) -> d
         if isinstance(block, FMUBlock):
             block.parameters.update(values)
         else:
-            named = block.named_parameters() if hasattr(block, "named_parameters") else {}
             for name, v in values.items():
-                if name in named:
-                    block.set_named_parameter(name, v)
-                else:
-                    setattr(block, name, v)
+                block.set_parameter(name, v)
         used[target] = list(values.values()) if len(values) > 1 else next(iter(values.values()))
     for target in resolved:
         _check_switch(system, target, options or {})
@@ -266,14 +265,9 @@ def python_parameters(block) -> dict:
     Returns
     -------
     dict
-        Name to value, sorted by name: its public numeric attributes, and the named parameters it
-        declares (``named_parameters()``).
+        Name to value, sorted by name (:meth:`quadcosim.orchestrator.Block.parameter_values`).
     """
-    values = {k: v for k, v in vars(block).items()
-              if not k.startswith("_") and k not in _NOT_PARAMETERS and isinstance(v, numbers.Real)}
-    if hasattr(block, "named_parameters"):
-        values.update(block.named_parameters())
-    return dict(sorted(values.items()))
+    return dict(sorted(block.parameter_values().items()))
 
 
 def _python_value(block, name: str, value):
@@ -281,8 +275,8 @@ def _python_value(block, name: str, value):
     if name not in values:
         raise KeyError(f"{block.name} has no parameter {name!r}.{nearest(name, values)} "
                        f"{'Its parameters: ' + ', '.join(values) if values else 'It has no numeric parameter'}"
-                       " (a Python block's parameters are its public numeric attributes and the named ones it "
-                       "declares).")
+                       " (a Python block's parameters are the ones its class declares, else its public numeric "
+                       "attributes).")
     present = values[name]
     label = f"{block.name}.{name}"
     if isinstance(present, bool):
@@ -301,3 +295,77 @@ def _python_value(block, name: str, value):
             raise ValueError(f"{label} = {value!r} must be an integer")
         return int(number)
     return number
+
+
+def check_declared(blocks: dict, settings: dict) -> tuple[dict[str, dict], list[str]]:
+    """Settings checked before any block is built, against the blocks a system will hold.
+
+    Parameters
+    ----------
+    blocks : dict
+        Block name to what the block will be: an FMU model's name or an FMU file's path (its
+        variable table is read), or a :class:`quadcosim.orchestrator.Block` class (its declared
+        :attr:`~quadcosim.orchestrator.Block.parameter_units`).
+    settings : dict
+        ``{"Block.parameter": value}``, each as :func:`resolve` takes it.
+
+    Returns
+    -------
+    resolved : dict
+        ``{"Block.parameter": {name: value}}`` for each setting checked (as :func:`resolve_all`).
+    deferred : list of str
+        The settings of blocks whose class declares no parameters (its public numeric
+        attributes are known once it is built): checked by :func:`resolve` on the built system.
+
+    Raises
+    ------
+    KeyError
+        An unknown block or parameter; the message names the nearest names and where the
+        parameters are listed.
+    ValueError
+        A value of the wrong type, count or unit.
+    """
+    resolved, deferred = {}, []
+    for target, value in settings.items():
+        block_name, dot, name = target.partition(".")
+        if not dot or not name:
+            raise ValueError(f"{target!r}: write Block.parameter=value, e.g. IMU.gyro_noise_density=0.001")
+        if block_name not in blocks:
+            raise KeyError(f"unknown block {block_name!r} in {target!r}.{nearest(block_name, blocks)} "
+                           f"Blocks: {', '.join(blocks)}.")
+        model = blocks[block_name]
+        if isinstance(model, type) and issubclass(model, Block):
+            if not model.parameter_units:
+                deferred.append(target)
+                continue
+            resolved[target] = {name: _declared_value(block_name, model, name, value)}
+            continue
+        variables = fmu_parameters(str(model))
+        aliases, _ = model_notes(str(model))
+        members = expand(aliases.get(name, name), variables)
+        if not members:
+            raise KeyError(f"{block_name} has no parameter {name!r}.{nearest(name, list(variables) + list(aliases))} "
+                           "Its parameters are listed, with their units, by `quadcosim list --parameters "
+                           f"{model}`.")
+        texts = _components(target, value, len(members))
+        resolved[target] = {m: _parse(f"{block_name}.{m}", variables[m], t)
+                            for m, t in zip(members, texts, strict=True)}
+    return resolved, deferred
+
+
+class _Declared:
+    """A declared parameter of a Python block, read as :func:`_parse` reads an FMU variable."""
+
+    type = "Real"
+
+    def __init__(self, unit: str):
+        self.unit = "" if unit == "1" else unit
+
+
+def _declared_value(block_name: str, cls: type, name: str, value) -> float:
+    """The value of a parameter ``cls`` declares, a finite number in its declared unit."""
+    units = cls.parameter_units
+    if name not in units:
+        raise KeyError(f"{block_name} has no parameter {name!r}.{nearest(name, units)} Its parameters: "
+                       f"{', '.join(units)} (`quadcosim list --parameters {block_name}` gives their units).")
+    return cls.check_parameter(name, _parse(f"{block_name}.{name}", _Declared(units[name]), value))

@@ -9,94 +9,13 @@ figures and returns its metrics. :func:`run` does the rest: results (``results.n
 from __future__ import annotations
 
 import contextlib
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from quadcosim.scenarios.catalogue import get, names, registry
-from quadcosim.scenarios.state import Build, Duration, Extra, Options, Prepared, Report, Resolve, RunRequest
-
-
-@dataclass
-class Option:
-    default: object
-    help: str
-    choices: tuple | None = None
-    minimum: float | None = None
-    classes: bool = False  # beside the choices, a block class of the user's, "module:Class"
-    files: str | None = None  # beside the choices, a file of this suffix (".csv"), read by the scenario
-    applies: str | None = None  # "other=a,b": the option acts only when option `other` is a or b
-    #: A word that stands for a value the scenario chooses (``kI = "lab"``: the chosen estimator's lab
-    #: value); the option then takes that word or a number (float). The default is the word, shown
-    #: as it is everywhere (``quadcosim list``, ``metrics.json``, the result files, ``sweep.csv``)
-    #: until the scenario resolves it (:attr:`Scenario.resolve`).
-    marker: str | None = None
-
-    @property
-    def unit(self) -> str | None:
-        """The option's unit, the first parenthesised unit of its help (``"(s)"``), or None."""
-        from quadcosim.scenarios.metrics import option_unit
-
-        return option_unit(self.help)
-
-    def parse(self, name: str, text):
-        """The option's value from text, checked against its type, choices and minimum.
-
-        Parameters
-        ----------
-        name : str
-            Option name, for messages.
-        text : str or value
-            ``"0.5"``, ``"true"``, ...
-
-        Returns
-        -------
-        object
-            The value, of the default's type.
-
-        Raises
-        ------
-        ValueError
-            Not a valid value; the message says what is expected.
-        """
-        default = self.default
-        if self.marker is not None:
-            if str(text).strip().lower() == self.marker:
-                return self.marker
-            default = 0.0  # otherwise a number
-        if isinstance(text, (list, tuple, dict, set)) or text is None or \
-                (isinstance(text, bool) and not isinstance(default, bool)):
-            also = f" (or {self.marker})" if self.marker is not None else ""
-            raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}{also}: give one "
-                             f"value, such as {self.default!r}")
-        try:
-            if isinstance(default, bool):
-                if str(text).lower() in ("1", "true", "on", "yes"):
-                    value = True
-                elif str(text).lower() in ("0", "false", "off", "no"):
-                    value = False
-                else:
-                    raise ValueError(text)
-            elif isinstance(default, int):
-                value = int(text)
-            elif isinstance(default, float):
-                value = float(text)
-                if not math.isfinite(value):
-                    raise ValueError(text)
-            else:
-                value = str(text)
-        except ValueError:
-            also = f" (or {self.marker})" if self.marker is not None else ""
-            raise ValueError(f"option {name}={text!r} is not a valid {type(default).__name__}{also}") from None
-        file = self.files is not None and str(value).lower().endswith(self.files)
-        if self.choices and value not in self.choices and not (self.classes and ":" in value) and not file:
-            other = " or module:Class (a block of your own)" if self.classes else ""
-            other += f" or a {self.files} file" if self.files else ""
-            raise ValueError(f"option {name}={text!r} must be one of {', '.join(map(str, self.choices))}{other}")
-        if self.minimum is not None and value < self.minimum:
-            raise ValueError(f"option {name}={value} must be at least {self.minimum}")
-        return value
+from quadcosim.scenarios.option import Option, settings_pairs
+from quadcosim.scenarios.state import Build, Duration, Extra, Options, Prepared, Report, Resolve, RunRequest, RunStated
 
 
 @dataclass
@@ -157,18 +76,39 @@ class Scenario:
                    if key not in self.options or value != self.options[key].default]  # or Block.parameter
         return f"{self.name}: " + (", ".join(changed) if changed else "default options")
 
-    def parse(self, settings: dict | list | None) -> Options:
+    def parse(self, settings: dict | list | None, fmus: dict | None = None) -> Options:
         """Options with defaults, from ``settings`` ``{"k": v}`` or ``["k=v", ...]`` (None: all
-        defaults); refuses unknown keys. The options returned are read-only (:class:`Options`).
+        defaults), each read once and checked before anything is built. The options returned
+        are read-only (:class:`Options`).
 
-        A key ``Block.parameter`` sets a block parameter (``IMU.gyro_noise_density``); it is
-        kept as given and checked against the block when :meth:`prepare` builds the system.
+        A key ``Block.parameter`` sets a block parameter (``IMU.gyro_noise_density``). Where the
+        scenario declares its blocks (``extra["blocks"]``), it is checked against the block's
+        declared parameters (an FMU's variable table, a block class's
+        :attr:`~quadcosim.orchestrator.Block.parameter_units`) and kept as the value it stands
+        for (a number, a bool, or a list for a vector); a parameter the scenario sets from one of
+        its options is refused, naming the option. A block whose parameters are known once it is
+        built keeps its text, checked when :meth:`prepare` builds the system.
+
+        Parameters
+        ----------
+        settings : dict, list of str or None
+            Option values and block parameters.
+        fmus : dict, optional
+            Block name to an FMU file of the user's that will take that block's place: its
+            parameters are that file's.
+
+        Raises
+        ------
+        KeyError
+            An unknown block or block parameter (the nearest names given).
+        ValueError
+            An unknown option (the nearest names given), or a value it does not take.
         """
         values = {k: o.default for k, o in self.options.items()}
-        pairs = settings.items() if isinstance(settings, dict) else [_split(s) for s in settings or []]
-        for key, text in pairs:
+        parameters = {}
+        for key, text in settings_pairs(settings):
             if "." in key:
-                values[key] = text
+                values[key] = parameters[key] = text
                 continue
             if key not in self.options:
                 from quadcosim.orchestrator.fmu import nearest
@@ -176,7 +116,37 @@ class Scenario:
                 raise ValueError(f"unknown option {key!r} for scenario {self.name}.{nearest(key, self.options)} "
                                  f"Options: {', '.join(self.options)} (see `quadcosim list`).")
             values[key] = self.options[key].parse(key, text)
+        values |= self._checked_parameters(parameters, fmus)
         return Options(values)
+
+    def _checked_parameters(self, settings: dict, fmus: dict | None) -> dict:
+        """``Block.parameter`` settings checked against the declared blocks (:meth:`parse`)."""
+        declared = self.extra.get("blocks")
+        if not settings or declared is None:
+            return settings
+        from quadcosim.orchestrator.parameters import check_declared
+
+        resolved, deferred = check_declared(dict(declared) | dict(fmus or {}), settings)
+        for target, values in resolved.items():
+            self._refuse_derived(target, values)
+        for target in deferred:
+            self._refuse_derived(target, [target.partition(".")[2]])
+        return {target: list(values.values()) if len(values) > 1 else next(iter(values.values()))
+                for target, values in resolved.items()}
+
+    def _refuse_derived(self, target: str, names):
+        """Refuse ``target`` if any parameter it sets (``names``, within its block) is one the
+        scenario sets from an option (``extra["derived"]``), naming that option."""
+        derived = self.extra.get("derived", {})
+        block = target.partition(".")[0]
+        for name in names:
+            option = derived.get(f"{block}.{name}")
+            if option is not None and option.startswith("("):  # fixed by the scenario, no option
+                raise ValueError(f"{block}.{name} is fixed by scenario {self.name} {option}: leave {target} "
+                                 "out of --set")
+            if option is not None:
+                raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
+                                 f"use --set {option}=... instead of {target}")
 
 
     def system(self, options: Mapping, estimator=None, fmus: dict | None = None):
@@ -251,15 +221,7 @@ class Scenario:
         derived = self.extra.get("derived", {})
         resolved = resolve_all(system, {k: v for k, v in options.items() if "." in k})
         for key, values in resolved.items():
-            block = key.partition(".")[0]
-            for name in values:
-                option = derived.get(f"{block}.{name}")
-                if option is not None and option.startswith("("):  # fixed by the scenario, no option
-                    raise ValueError(f"{block}.{name} is fixed by scenario {self.name} {option}: leave {key} "
-                                     "out of --set")
-                if option is not None:
-                    raise ValueError(f"{block}.{name} is set by scenario {self.name}'s option {option}: "
-                                     f"use --set {option}=... instead of {key}")
+            self._refuse_derived(key, values)
         options = Options(options | set_all(system, resolved, derived))
         return Prepared(system, options, self.used(options))
 
@@ -267,13 +229,6 @@ class Scenario:
 def _with_estimator() -> str:
     names = [s.name for s in registry().values() if "estimator" in s.options]
     return f"the scenarios with one: {', '.join(names)}"
-
-
-def _split(text: str) -> tuple[str, str]:
-    key, eq, value = text.partition("=")
-    if not eq:
-        raise ValueError(f"--set {text!r}: write key=value")
-    return key.strip(), value.strip()
 
 
 def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(), decimation: int = 1,
@@ -356,21 +311,19 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
                 _check_formats(formats, stream, out_dir)
                 if name not in names():
                     get(name)  # refused (the nearest names given) before any folder is made
+                given = dict(settings_pairs(settings))  # read once; a text with no "=" refused here
                 made = out_dir is not None and not Path(out_dir).exists()
                 out = prepare_out_dir(out_dir, overwrite, lock) if out_dir else None
-                given = dict(settings) if isinstance(settings, dict) else dict(
-                    _split(s) for s in settings or [] if "=" in s)
-                base = {"scenario": name, "options": given,
-                        "injected_faults": [fault_record(f) for f in faults], "decimation": decimation}
+                stated = RunStated(name, dict(given), [fault_record(f) for f in faults], decimation)
                 try:
-                    files = RunFiles(out, formats, base, {}, compress) if out is not None else None
+                    files = RunFiles(out, formats, stated, {}, compress) if out is not None else None
                 except ValueError:  # no room for even metrics.json: refused, the folder left as it was
                     if made:
                         remove_if_empty(out)
                     raise
             with (files.tracking() if files else contextlib.nullcontext()):
                 request = RunRequest(tuple(faults), estimator, record, stream, blocks, fmus, decimation)
-                return _run_tracked(name, settings, files, base, made, request, progress)
+                return _run_tracked(name, given, files, stated, made, request, progress)
         except KeyboardInterrupt as interrupt:  # as the folder was being made
             if files is None:
                 raise
@@ -378,17 +331,18 @@ def run(name: str, settings=None, out_dir=None, progress: bool = False, faults=(
                 raise files.interrupted(interrupt) from None
 
 
-def _run_tracked(name: str, settings, files, base: dict, made: bool, request: RunRequest, progress: bool):
-    """The run of :func:`run` once its folder is made: load, then :func:`_run_phases`; an
-    interrupt in any phase becomes :class:`quadcosim.orchestrator.RunInterrupted`, a refusal leaves the
-    folder as it was."""
+def _run_tracked(name: str, given: dict, files, stated: RunStated, made: bool, request: RunRequest,
+                 progress: bool):
+    """The run of :func:`run` once its folder is made: load, parse ``given`` (the settings, as
+    pairs) and check it before anything is built, then :func:`_run_phases`; an interrupt in any
+    phase becomes :class:`quadcosim.orchestrator.RunInterrupted`, a refusal leaves the folder as it was."""
     try:
         scenario = get(name)
-        options = scenario.parse(settings)
-        base["options"] = dict(options)
+        options = scenario.parse(given, fmus=request.fmus)
+        stated.options = dict(options)
         if files:
             files.units = {f"options.{k}": o.unit for k, o in scenario.options.items() if o.unit}
-        return _run_phases(scenario, options, base, files, request, progress)
+        return _run_phases(scenario, options, stated, files, request, progress)
     except KeyboardInterrupt as interrupt:  # outside the loop: loading, building, drawing, saving, reporting
         if files is None:
             raise
@@ -416,7 +370,8 @@ def _check_formats(formats, stream: bool, out_dir):
                          "--format (other formats can be written afterwards: Result.load(folder).save(...))")
 
 
-def _run_phases(scenario: Scenario, options: Options, base: dict, files, request: RunRequest, progress: bool):
+def _run_phases(scenario: Scenario, options: Options, stated: RunStated, files, request: RunRequest,
+                progress: bool):
     """Build, draw, run, save and report, each phase named in ``files`` for ``metrics.json``;
     ``request`` holds the faults, the user's estimator, blocks and FMUs, the signals to record
     and ``stream``."""
@@ -426,7 +381,7 @@ def _run_phases(scenario: Scenario, options: Options, base: dict, files, request
     from quadcosim.infra.progress import status
 
     name = scenario.name
-    prepared, duration, kept, saved = _build(scenario, options, base, files, request)
+    prepared, duration, kept, saved = _build(scenario, options, stated, files, request)
     system, options = prepared.system, prepared.options
     if files:
         files.phase, files.stream = "running", _open_stream(files, request.stream)
@@ -444,10 +399,10 @@ def _run_phases(scenario: Scenario, options: Options, base: dict, files, request
         if files is not None:
             files.refused()
         raise
-    result.meta |= {"scenario": {"name": name, "options": base["options"]}, "faults": base["injected_faults"]}
-    if base.get("signals_not_saved"):  # named in the files, so that asking for one says how to keep it
-        result.meta["left_out"] = base["signals_not_saved"]
-    metrics = base | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
+    result.meta |= {"scenario": {"name": name, "options": stated.options}, "faults": stated.injected_faults}
+    if stated.signals_not_saved:  # named in the files, so that asking for one says how to keep it
+        result.meta["left_out"] = stated.signals_not_saved
+    metrics = stated.metrics() | {"status": "completed", "samples": len(result), "signals_recorded": len(result.names),
                       "fmu_warnings": _warning_counts(result)}
     metrics |= _divergence(scenario, result, options)
     if files is not None:
@@ -528,10 +483,10 @@ def _open_stream(files, stream: bool):
     return StreamWriter(files.out / FOLDER)
 
 
-def _build(scenario: Scenario, options: Options, base: dict, files, request: RunRequest):
+def _build(scenario: Scenario, options: Options, stated: RunStated, files, request: RunRequest):
     """The prepared system (:meth:`Scenario.prepare`), its duration (s), the signals recorded and
-    those written (``base`` takes the options as used, the duration and the FMUs replaced). A
-    refusal removes what this run wrote."""
+    those written (``stated`` takes the options as used, the duration, the FMUs replaced and the
+    signals left out of the files). A refusal removes what this run wrote."""
     from quadcosim.infra.progress import status
 
     if files:
@@ -540,16 +495,15 @@ def _build(scenario: Scenario, options: Options, base: dict, files, request: Run
     try:
         prepared = scenario.prepare(options, estimator=request.estimator, fmus=request.fmus)
         system = prepared.system
-        if system.replaced:
-            base["replaced_blocks"] = system.replaced
+        stated.replaced_blocks = system.replaced or None
         for block_name, block in (request.blocks or {}).items():
             system.replace(block_name, block)
         for fault in request.faults:
             system.inject(fault)
         duration = scenario.duration(prepared.options) if scenario.duration else prepared.options["duration"]
         _check_decimation(request.decimation, duration, system.dt)
-        base |= {"options": prepared.used, "duration_s": duration}
-        kept, saved = _signals_kept(scenario, system, request.record, base)
+        stated.options, stated.duration_s = prepared.used, duration
+        kept, saved, stated.signals_not_saved = _signals_kept(scenario, system, request.record)
         if files:
             files.saved = saved
             recorded = _recorded_names(system, kept)
@@ -637,26 +591,25 @@ def fault_record(fault) -> dict:
             "value": fault.value, "seed": fault.seed}
 
 
-def _signals_kept(scenario, system, record, base: dict) -> tuple[list[str] | None, list[str] | None]:
-    """The signals to record and those to write into the result files (None: all).
+def _signals_kept(scenario, system, record) -> tuple[list[str] | None, list[str] | None, list[str] | None]:
+    """The signals to record, those to write into the result files (None: all), and those
+    recorded but left out of the files (None: none is).
 
     ``record`` chooses (``["all"]``: every output, recorded and written); else the scenario:
     ``extra["record"]`` lists what it records, ``extra["unrecorded"]`` what its files leave out
-    (recorded all the same, for the report and for Python callers), listed in
-    ``base["signals_not_saved"]``.
+    (recorded all the same, for the report and for Python callers), the third list.
     """
     from quadcosim.scenarios.metrics import recorded_outputs
 
     if record == ["all"]:
-        return None, None
+        return None, None, None
     if record:
-        return record, None
+        return record, None, None
     if "unrecorded" in scenario.extra:
         every = recorded_outputs(system)
         saved = recorded_outputs(system, scenario.extra["unrecorded"])
-        base["signals_not_saved"] = [n for n in every if n not in set(saved)]
-        return None, saved
-    return scenario.extra.get("record"), None
+        return None, saved, [n for n in every if n not in set(saved)]
+    return scenario.extra.get("record"), None, None
 
 
 def _warning_counts(result) -> dict:

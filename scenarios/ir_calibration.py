@@ -430,5 +430,7 @@ SCENARIO = Scenario(
     options=OPTIONS,
     build=build,
     report=report,
-    extra={"divergence": DIVERGENCE},
+    extra={"divergence": DIVERGENCE,
+           "blocks": {"Bank": Table, "InfraredSensor": "InfraredSensor", "Faults": SensorFaults,
+                      **{m.capitalize(): InfraredCalibration for m in METHODS}}},
 )

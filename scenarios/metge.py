@@ -40,7 +40,7 @@ from quadcosim.orchestrator.parameters import apply
 from quadcosim.scenarios import Option, Scenario
 from quadcosim.scenarios.divergence import CLAMPED
 from quadcosim.scenarios.figures import title_lines
-from quadcosim.scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
+from quadcosim.scenarios.plant import PLANT_BLOCKS, add_plant, angle_between, imu_parameters, save_figure
 
 from quadcosim.infra.files import write_json
 from quadcosim.infra.progress import status
@@ -595,7 +595,8 @@ def duration(o: dict) -> float:
 
 
 SCENARIO = Scenario("metge", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD, "derived": DERIVED, "divergence": CLAMPED})
+                    duration=duration, extra={"record": RECORD, "derived": DERIVED, "divergence": CLAMPED,
+                                              "blocks": {"Setpoint": Table, **PLANT_BLOCKS}})
 
 
 # --- the rig calibration a closed loop's compensation uses (quadcosim.scenarios.compensation) -----

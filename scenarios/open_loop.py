@@ -15,7 +15,7 @@ from quadcosim.orchestrator import System, Table
 from quadcosim.scenarios import Option, Scenario
 from quadcosim.scenarios.divergence import Bounds
 from quadcosim.scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
-from quadcosim.scenarios.plant import add_plant, imu_parameters, save_figure
+from quadcosim.scenarios.plant import PLANT_BLOCKS, add_plant, imu_parameters, save_figure
 
 OPTIONS = {
     "duration": Option(2.0, "simulated time (s)", minimum=1e-3),
@@ -161,4 +161,4 @@ def _figures(result, o, out) -> list[str]:
 DIVERGENCE = Bounds(tilt_error_deg=None, altitude_error_m=None, speed_m_s=10.0, held_s=0.1, tilt_deg=60.0)
 SCENARIO = Scenario("open-loop", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
                     extra={"derived": {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed"},
-                           "divergence": DIVERGENCE})
+                           "divergence": DIVERGENCE, "blocks": {"Setpoint": Table, **PLANT_BLOCKS}})

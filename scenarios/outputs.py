@@ -58,7 +58,7 @@ class RunFiles:
         The output folder, checked (:func:`quadcosim.infra.files.prepare_out_dir`).
     formats : sequence of str
         Record formats (``npz``, ``mat``, ``csv``).
-    base : dict
+    stated : quadcosim.scenarios.state.RunStated
         What ``metrics.json`` states in every case: scenario, options, faults, duration (s).
     units : dict
         Units of the options, merged into ``metrics.json``'s ``units``.
@@ -66,8 +66,8 @@ class RunFiles:
         Compress the ``.npz`` and ``.mat`` files.
     """
 
-    def __init__(self, out: Path, formats, base: dict, units: dict, compress: bool = False):
-        self.out, self.formats, self.base, self.units, self.compress = out, list(formats), base, units, compress
+    def __init__(self, out: Path, formats, stated, units: dict, compress: bool = False):
+        self.out, self.formats, self.stated, self.units, self.compress = out, list(formats), stated, units, compress
         self.phase = "loading the scenario"
         self.names: list[str] = []  # files written, in order (tracked)
         self.not_written: dict[str, str] = {}  # file -> why it is missing
@@ -189,8 +189,8 @@ class RunFiles:
         partial = error.result if error.result is not None else empty_result()
         signals = self.saved if partial.names else None  # stopped before the loop: an empty record, every format
         if not self.record_saved:
-            partial.meta |= {"scenario": {"name": self.base["scenario"], "options": self.base["options"]},
-                             "faults": self.base["injected_faults"]}
+            partial.meta |= {"scenario": {"name": self.stated.scenario, "options": self.stated.options},
+                             "faults": self.stated.injected_faults}
             self._keep(partial, signals, self.stream)
         interrupted = isinstance(error, RunInterrupted)
         record = self.result if self.result is not None else partial
@@ -203,7 +203,7 @@ class RunFiles:
             done["interrupted_by"] = signal_name(error.signal_number)
         if getattr(error, "traceback", None):  # a block of the user's raised: where, for its author
             done["traceback"] = error.traceback
-        self._write(self.base | done | self._files())
+        self._write(self.stated.metrics() | done | self._files())
 
     def interrupted(self, interrupt: BaseException) -> RunInterrupted:
         """Keep what was recorded when a signal stopped the run outside its loop (building,
@@ -286,9 +286,9 @@ class RunFiles:
             shutil.rmtree(self.stream.path)
         if fmu_refusal is not None:
             self.names.clear()
-            self._write(self.base | {"status": "refused", "error": str(fmu_refusal), "stopped_during": self.phase,
-                                     "recorded_until_s": None, "samples": 0, "record_complete": False,
-                                     "files": []})
+            self._write(self.stated.metrics() | {"status": "refused", "error": str(fmu_refusal),
+                                                 "stopped_during": self.phase, "recorded_until_s": None,
+                                                 "samples": 0, "record_complete": False, "files": []})
             return
         self.reserve.release()
         if remove_folder:

@@ -14,6 +14,9 @@ import contextvars
 import numpy as np
 from quadcosim.orchestrator import FMUBlock, System
 
+#: The blocks :func:`add_plant` adds, by name: each an FMU of that model.
+PLANT_BLOCKS = {"MotorMagnetics": "MotorMagnetics", "Quadrotor": "Quadrotor", "IMU": "IMU"}
+
 
 def add_plant(system: System, quadrotor=None, motors=None, imu=None, magnetic: bool = True,
               imu_period: int = 1, wind=(0.0, 0.0, 0.0), specific_force: str = "Quadrotor.f") -> System:

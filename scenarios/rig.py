@@ -15,7 +15,7 @@ from quadcosim.orchestrator import System, Table, portable
 from quadcosim.scenarios import Option, Scenario
 from quadcosim.scenarios.divergence import CLAMPED
 from quadcosim.scenarios.figures import fault_text, faults_of, label_axes, shade_faults, title_lines
-from quadcosim.scenarios.plant import add_plant, angle_between, imu_parameters, save_figure
+from quadcosim.scenarios.plant import PLANT_BLOCKS, add_plant, angle_between, imu_parameters, save_figure
 
 OPTIONS = {
     "reference": Option(1.0, "motors-off time at the start (s)", minimum=0.1),
@@ -193,4 +193,5 @@ def report(result, o, out) -> dict:
 
 
 SCENARIO = Scenario("rig", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report, duration=duration,
-                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.seed": "seed"}, "divergence": CLAMPED})
+                    extra={"derived": {"IMU.noise_enabled": "noise", "IMU.seed": "seed"}, "divergence": CLAMPED,
+                           "blocks": {"Setpoint": Table, **PLANT_BLOCKS}})

@@ -1,10 +1,12 @@
-"""A run's state, typed: the options as parsed (read-only), what the caller asks beside them, and
-the system as built with the options as it uses them.
+"""A run's state, typed: the options as parsed (read-only), what the caller asks beside them, what
+its ``metrics.json`` states whatever its end, and the system as built with the options as it uses them.
 
-``--set Controller.kp_yaw=50`` is read once (:meth:`quadcosim.scenarios.Scenario.parse`, into
-:class:`Options`), resolved once against the built system and set on its block
-(:meth:`quadcosim.scenarios.Scenario.prepare`, into :class:`Prepared`), and written to ``metrics.json``
-from :attr:`Prepared.used`; nothing on the way changes the options in place.
+``--set Controller.kp_yaw=50`` is read once and checked against the scenario's declared blocks
+before anything is built (:meth:`quadcosim.scenarios.Scenario.parse`, into :class:`Options`: the
+gain as a number), set on the built block through the block contract
+(:meth:`quadcosim.scenarios.Scenario.prepare`, into :class:`Prepared`), and written to
+``metrics.json`` from :attr:`Prepared.used` (:class:`RunStated`); nothing on the way changes the
+options in place.
 """
 
 from __future__ import annotations
@@ -69,6 +71,46 @@ class RunRequest:
     decimation: int = 1
 
 
+@dataclass
+class RunStated:
+    """What a run of :func:`quadcosim.scenarios.run` states in ``metrics.json`` (and its result
+    files' meta) whatever its end, filled in as the run learns it.
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name.
+    options : dict
+        The settings as given, then the options as parsed, then as used (no default markers).
+    injected_faults : list of dict
+        The faults (:func:`quadcosim.scenarios.fault_record`).
+    decimation : int
+        Every N-th macro step kept.
+    replaced_blocks : dict, optional
+        Block name to the FMU of the user's that took its place and what it did not take over.
+    duration_s : float, optional
+        The simulated time (s), once the system is built.
+    signals_not_saved : list of str, optional
+        The signals recorded for the report but left out of the result files.
+    """
+
+    scenario: str
+    options: dict
+    injected_faults: list
+    decimation: int
+    replaced_blocks: dict | None = None
+    duration_s: float | None = None
+    signals_not_saved: list | None = None
+
+    def metrics(self) -> dict:
+        """The entries of ``metrics.json`` it stands for, in this order, each optional one once known."""
+        stated = {"scenario": self.scenario, "options": self.options, "injected_faults": self.injected_faults,
+                  "decimation": self.decimation}
+        optional = {"replaced_blocks": self.replaced_blocks, "duration_s": self.duration_s,
+                    "signals_not_saved": self.signals_not_saved}
+        return stated | {key: value for key, value in optional.items() if value is not None}
+
+
 @dataclass(frozen=True)
 class Prepared:
     """A scenario's system built from its options, block parameters set.
@@ -106,6 +148,9 @@ class Extra(TypedDict, total=False):
     diagram: bool  # its wiring diagram drawn with each run's results
     title: Callable[[Mapping], str]  # the diagram's title from the options
     derived: dict[str, str]  # "Block.parameter" -> the option that sets it (--set refuses the parameter)
+    # every block the system may hold, by name: an FMU model's name or a Block class; --set Block.parameter
+    # is checked against them before anything is built (tests/test_scenarios.py checks them against builds)
+    blocks: dict[str, Any]
     record: list[str]  # the signals recorded (default: every output)
     unrecorded: list[str]  # recorded for the report, left out of the result files
     components: dict[str, tuple[str, ...]]  # a list metric's components, named (roll, pitch, yaw)

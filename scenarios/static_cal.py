@@ -190,4 +190,4 @@ def report(result, o, out) -> dict:
 SCENARIO = Scenario("static-cal", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
                     duration=duration, extra={"record": ["IMU.magneto"], "derived": {
                         "IMU.noise_enabled": "noise", "IMU.seed": "seed", "IMU.sample_rate": "mag_rate",
-                        "IMU.mag_sample_rate": "mag_rate"}})
+                        "IMU.mag_sample_rate": "mag_rate"}, "blocks": {"Hand": Table, "IMU": "IMU"}})

@@ -11,6 +11,7 @@ import math
 from functools import partial
 
 import numpy as np
+from quadcosim.calibration import MagCompensator
 from quadcosim.estimators import QuaternionEstim, kinds, parse_corrections
 from quadcosim.estimators.quaternions import euler_to_quaternion
 from quadcosim.flight import FLIGHTS, SETPOINT, Controller, initial_state, profile_at
@@ -33,7 +34,7 @@ from quadcosim.scenarios.figures import (
     title_lines,
     wrapped_curve,
 )
-from quadcosim.scenarios.plant import add_plant, imu_parameters, save_figure
+from quadcosim.scenarios.plant import PLANT_BLOCKS, add_plant, imu_parameters, save_figure
 
 BENCH_SUPPLY = 1000.0  # 1, capacity multiplier of option bench_supply
 
@@ -656,7 +657,12 @@ DIVERGENCE = Bounds(tilt_error_deg=60.0, altitude_error_m=10.0, speed_m_s=60.0, 
 
 # IMU parameters the options set: --set IMU.seed=... would contradict the option seed
 DERIVED = {"IMU.noise_enabled": "noise", "IMU.bias_enabled": "bias", "IMU.seed": "seed", "IMU.sample_rate": "imu_rate"}
+# every block tp may hold (GravityOnly, MagCompensator: by their options; Quaternion_estim: another block
+# class when the estimator is one, whose parameters are checked once it is built)
+BLOCKS = {"Setpoint": Table, "GravityOnly": GravityOnly, **PLANT_BLOCKS, "Quaternion_estim": QuaternionEstim,
+          "Controller": Controller, "MagCompensator": MagCompensator}
 SCENARIO = Scenario("tp", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
                     extra={"diagram": True, "title": diagram_title, "derived": DERIVED, "unrecorded": UNRECORDED,
+                           "blocks": BLOCKS,
                            "components": COMPONENTS, "divergence": DIVERGENCE},
                     resolve=resolve)

@@ -30,6 +30,7 @@ from quadcosim.scenarios import Option, Scenario
 from quadcosim.scenarios.divergence import Bounds
 from quadcosim.scenarios.figures import fault_text, faults_of, title_lines
 from quadcosim.scenarios.plant import save_figure
+from quadcosim.scenarios.tp import BLOCKS as TP_BLOCKS
 
 from quadcosim.infra.progress import active, status
 
@@ -355,5 +356,6 @@ def resolve(o: dict) -> dict:
 # the stream records no velocity nor setpoint, so the tilt from level is the bound
 DIVERGENCE = Bounds(tilt_error_deg=None, altitude_error_m=None, speed_m_s=None, held_s=0.2, tilt_deg=30.0)
 SCENARIO = Scenario("gain-study", __doc__.split(": ", 1)[1].splitlines()[0], OPTIONS, build, report,
-                    duration=duration, extra={"record": RECORD, "units": METRIC_UNITS, "divergence": DIVERGENCE},
+                    duration=duration, extra={"record": RECORD, "units": METRIC_UNITS, "divergence": DIVERGENCE,
+                                              "blocks": TP_BLOCKS},
                     resolve=resolve)

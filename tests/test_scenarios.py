@@ -90,9 +90,9 @@ def test_a_set_block_parameter_is_resolved_once_and_the_parsed_options_stay_as_p
     assert pickle.loads(pickle.dumps(options)) == options and type(options | {"k": 1.0}) is dict
     prepared = tp.prepare(options)
     assert resolved == ["Controller.kp_yaw"]
-    assert options["Controller.kp_yaw"] == "50"  # as given
+    assert options["Controller.kp_yaw"] == 50.0  # read once, checked against the declared gains
     assert prepared.options["Controller.kp_yaw"] == prepared.used["Controller.kp_yaw"] == 50.0
-    assert prepared.system.blocks["Controller"].named_parameters()["kp_yaw"] == 50.0
+    assert prepared.system.blocks["Controller"].parameter_values()["kp_yaw"] == 50.0
     assert prepared.used["kI"] == "lab" and prepared.options["k"] == 0.05
     resolved.clear()
     assert cli(["run", "tp", "--set", "duration=0.05", "Controller.kp_yaw=50", "--out", str(tmp_path / "run")]) == 0
