@@ -88,6 +88,21 @@ def test_a_dummy_estimator_is_one_file_and_one_line(tmp_path):
     assert found["bias"] == ["explicit", "passive"]  # no gyro-bias estimate: not scored as one
 
 
+def test_an_estimator_line_that_names_no_kind_is_refused_with_its_fix(tmp_path):
+    """A registry line naming the block class instead of its Kind, or a Kind of another name."""
+    lines = "gyro-only = dummy_estimator:GyroOnly\nother = dummy_estimator:KIND"
+    found = _with_member("quadcosim.estimators", lines, '''
+        from quadcosim.estimators import kinds
+        try:
+            kinds.registry()
+        except kinds.EstimatorRegistrationError as error:
+            found["error"] = [str(error), isinstance(error, ValueError)]
+    ''', tmp_path)
+    message, is_value_error = found["error"]
+    assert is_value_error and "quadcosim.estimators gyro-only = 'dummy_estimator:GyroOnly'" in message
+    assert "registered by dummy-members" in message and "point the line at the module's Kind(\"gyro-only\"" in message
+
+
 def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):
     from tests.flightlog_synthetic import write_log
 
