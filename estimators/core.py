@@ -46,7 +46,7 @@ def _offsets(layout):
 
 
 LINEAR, EXPLICIT, PASSIVE = 0, 1, 2
-KINDS = {"linear": LINEAR, "explicit": EXPLICIT, "passive": PASSIVE}
+OBSERVER_CODES = {"linear": LINEAR, "explicit": EXPLICIT, "passive": PASSIVE}
 EXP, EULER = 0, 1
 REEL, TRIAD = 0, 1
 

@@ -117,7 +117,7 @@ from quadcosim.estimators.checks import check_finite, check_measurements, check_
 from quadcosim.fmus import vehicle
 from quadcosim.orchestrator.blocks import Block
 
-FILTERS = tuple(core.KINDS)
+FILTERS = tuple(core.OBSERVER_CODES)
 RECOMMENDED = "explicit"  # the lab's filter recommended for real recordings, at DEFAULT_GAINS
 RECORDED = "vqf"  # estimate()'s default: RECOMMENDED loses to it out of sample
 # (quadcosim.benchmarks.tuning --score-folds)
@@ -227,7 +227,7 @@ WARM_UP_STEP = 1e-3  # s, step of the throw-away update that compiles the kernel
 def _reference_kinds():
     from quadcosim.estimators import reference
 
-    return reference.KINDS
+    return reference.REFERENCE_FILTERS
 
 
 def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
@@ -253,7 +253,7 @@ def check_gains(kind: str, gains: dict | None = None, corrections=None) -> dict:
         Every name the filter reads, with its value. Unknown names and negative or
         non-finite values are refused with a ``ValueError``.
     """
-    if kind not in core.KINDS:
+    if kind not in core.OBSERVER_CODES:
         raise ValueError(f"unknown estimator {kind!r}; use one of {', '.join(FILTERS + _reference_kinds())}")
     merged = dict(DEFAULT_GAINS[kind])
     if kind != "linear":
@@ -462,7 +462,7 @@ class QuaternionEstim(Block):
         _check_frame(kind, self.config)
         self.inputs = MEASUREMENTS + (R_REEL if kind == "passive" and ry == "reel" else ())
         self._gains = gain_table(kind, self.gains)[0]
-        self._code = core.KINDS[kind]
+        self._code = core.OBSERVER_CODES[kind]
 
     def start(self, t0, dt):
         self.dt = dt
@@ -645,7 +645,7 @@ def estimate(kind: str = RECORDED, *, gyro, acc, mag, dt: float, gains: dict | N
     stored = np.empty((len(table), len(inputs) if len(columns) else 0, len(columns)))
     sums = np.zeros((len(table), core.ERROR_SIZE))
     offsets = np.zeros(len(table))
-    args = (core.KINDS[kind], inputs, table, config, dt, q_start, np.asarray(b0, dtype=float), from_triad,
+    args = (core.OBSERVER_CODES[kind], inputs, table, config, dt, q_start, np.asarray(b0, dtype=float), from_triad,
             columns.astype(np.int64))
     core.run_batch(*args, stored, reference, scored, offsets, sums)
     check_finite(kind, table, stored, sums)

@@ -29,7 +29,8 @@ from __future__ import annotations
 import numpy as np
 from quadcosim.estimators import core
 
-KINDS = ("vqf", "madgwick", "mahony")
+#: The third-party reference filters this module runs, by name.
+REFERENCE_FILTERS = ("vqf", "madgwick", "mahony")
 DEFAULT_GAINS = {"vqf": {}, "madgwick": {"beta": 0.041}, "mahony": {"k_P": 1.0, "k_I": 0.3}}
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from quadcosim.fmus.models import MODELS, fmu_sources, model_variables  # noqa: F401  (the package's names)
 
+from quadcosim.infra.errors import UsageError
 from quadcosim.infra.folders import (  # noqa: F401  (the package's names)
     BuildFolderRefused,
     build_root,
@@ -28,7 +29,7 @@ from quadcosim.infra.folders import (  # noqa: F401  (the package's names)
 )
 
 
-class FMUNotFoundError(FileNotFoundError):
+class FMUNotFoundError(UsageError, FileNotFoundError):
     """A built FMU is missing."""
 
 

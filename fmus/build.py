@@ -26,6 +26,7 @@ from pathlib import Path
 from quadcosim.fmus.airframe import c_header as airframe_header
 from quadcosim.fmus.models import MODELS, fmu_sources, model_variables
 
+from quadcosim.infra.errors import RunError
 from quadcosim.infra.folders import compiler_command, make_folder
 
 HERE = Path(__file__).resolve().parent
@@ -48,7 +49,7 @@ WINDOWS_COMPILER = "x86_64-w64-mingw32-gcc"
 LINK_FLAGS = {"linux": [], "windows": ["-static-libgcc", "-s"]}
 
 
-class BuildError(RuntimeError):
+class BuildError(RunError, RuntimeError):
     """The C compiler refused a model."""
 
 

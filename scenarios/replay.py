@@ -214,7 +214,7 @@ def gains_in_force(kind: str, gains: dict | None, corrections=None) -> dict:
     from quadcosim.estimators import reference
     from quadcosim.estimators.filters import check_gains
 
-    if kind in reference.KINDS:
+    if kind in reference.REFERENCE_FILTERS:
         merged = reference.check_gains(kind, gains)
     else:
         merged = check_gains(kind, gains, False if kind == "linear" else corrections)
@@ -337,17 +337,26 @@ def _options(args) -> dict:
     return options
 
 
-def main(argv=None, prog: str = "python -m quadcosim.scenarios.replay") -> int:
-    """Command line (see the module docstring); returns the exit status (2 on bad input).
-    ``argv``: the arguments (default ``sys.argv[1:]``); ``prog``: the command as its messages
-    name it (``quadcosim replay``)."""
+def main(argv=None, prog: str = "quadcosim replay") -> int:
+    """``quadcosim replay`` (see the module docstring); returns 0, raises a
+    :class:`~quadcosim.infra.errors.UsageError` on bad input (exit 2).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    prog : str
+        The command as its help names it.
+    """
+    from quadcosim.infra.errors import refusals
+
     parser = _parser(prog)
     args = parser.parse_args(argv)
     if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
         from quadcosim.scenarios.flightlog import replay as flight
 
         return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json, out=args.out))
-    try:
+    with refusals(usage=(ValueError, OSError), failures=()):  # a file missing or unreadable, a value refused
         if args.from_tp:
             if not args.write:
                 parser.error("--from-tp needs --write RECORDING")
@@ -381,9 +390,6 @@ def main(argv=None, prog: str = "python -m quadcosim.scenarios.replay") -> int:
         if args.figure:
             print(f"figure: {draw_errors(data, result | estimate, args.figure, Path(args.recording).name)}",
                   file=sys.stderr)
-    except (ValueError, FileNotFoundError, OSError) as error:
-        print(f"{prog}: {error}", file=sys.stderr)
-        return 2
     return 0
 
 
@@ -456,5 +462,7 @@ def summary(result: dict, recording: str) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim replay
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim replay").run, main)
