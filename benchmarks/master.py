@@ -349,5 +349,7 @@ def draw(figures: dict, path) -> Path:
         plt.close(fig)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench master
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench master").run, main)

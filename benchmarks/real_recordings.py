@@ -260,5 +260,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench real-recordings
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench real-recordings").run, main)

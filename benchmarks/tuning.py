@@ -488,5 +488,7 @@ def fold_table(scores: dict) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench tuning
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench tuning").run, main)

@@ -15,7 +15,6 @@ its peak, in parts per million (ppm):
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 from quadcosim.fmus.build import table
@@ -150,5 +149,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim study agreement
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study agreement").run, main)

@@ -20,6 +20,8 @@
   quadcosim replay RECORDING [--estimator KIND] [--figure FILE]   an estimator on a recorded file, scored
   quadcosim log info|plot FILE             a PX4 or ArduPilot flight log: what it holds, an overview figure
   quadcosim calibrate FILE... --compass N --out DIR   the magnetometer and its motor interference from flights
+  quadcosim study NAME [...]              a study the documentation's figures come from (quadcosim study NAME -h)
+  quadcosim bench NAME [...]              a measurement of the documentation (real-recordings, tuning, ...)
 """
 
 from __future__ import annotations
@@ -30,7 +32,8 @@ import sys
 
 #: The verbs' modules (:mod:`quadcosim.cli.run`, ...), in the order ``quadcosim --help`` lists them.
 #: Each has ``add(sub)``, which adds its verbs to the sub-parsers ``sub`` with their ``func``.
-VERBS = ("build", "listing", "run", "diagram", "bench", "replay", "plot", "sweep", "tune", "log", "calibrate")
+VERBS = ("build", "listing", "run", "diagram", "bench", "replay", "plot", "sweep", "tune", "log", "calibrate",
+         "study")
 
 #: The verbs whose work may compile the numba steps: said before, not in silence.
 COMPILING = ("run", "sweep", "tune", "bench", "build")
@@ -100,6 +103,16 @@ def _verb(command, argv) -> int | None:
 
         command.prog = "quadcosim replay"
         return replay.main(argv[1:])
+    if argv[:1] == ["study"]:  # each study's own parser
+        from quadcosim.cli import study
+
+        command.prog = " ".join(["quadcosim", *argv[:2]])
+        return study.main(argv[1:])
+    from quadcosim.cli import bench
+
+    if argv[:1] == ["bench"] and argv[1:2] and argv[1] in bench.MEASUREMENTS:  # each measurement's own parser
+        command.prog = f"quadcosim bench {argv[1]}"
+        return bench.measurement(argv[1], argv[2:])
     args = parser().parse_args(argv)
     args.final = final
     command.prog = _prog(args)

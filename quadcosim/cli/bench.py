@@ -11,6 +11,12 @@ from quadcosim.infra.errors import UsageError
 SUITES = {"master": "master", "infrared": "infrared", "sweep": "sweep", "pytest": "pytest_cost",
           "isolation": "isolation"}
 
+#: The measurements the documentation's figures come from, by name, and the module of each: their
+#: options are their own (``quadcosim bench NAME --help``), also ``python -m quadcosim.benchmarks.MODULE``.
+MEASUREMENTS = {name.replace("_", "-"): name for name in (
+    "estimators", "fuzz", "gaps", "magnetic", "memory", "real_recordings", "run_cost", "save", "startup", "study",
+    "sweep_memory", "tuning")}
+
 
 def add(sub) -> None:
     """Add the ``bench`` verb to the sub-parsers ``sub``.
@@ -25,7 +31,8 @@ def add(sub) -> None:
     bench.add_argument("suite", nargs="?", default="master", choices=tuple(SUITES),
                        help="what to time: master (the co-simulation loop, the default), infrared (the IR "
                             "calibration's cost per update), sweep (40 closed-loop runs on Dask), pytest (the "
-                            "pytest plugin's fixtures) or isolation (an FMU in a worker process against in process)")
+                            "pytest plugin's fixtures) or isolation (an FMU in a worker process against in process); "
+                            f"also, each with its own options, {', '.join(MEASUREMENTS)}")
     bench.add_argument("--json", action="store_true",
                        help="print the measurements as one JSON object on standard output instead of a table")
     bench.add_argument("--seconds", type=float, default=5.0, metavar="S",
@@ -51,3 +58,17 @@ def command(args) -> int:
     if args.suite == "master":
         argv += ["--seconds", str(args.seconds)] + (["--out", args.out] if args.out else [])
     return suite.main(argv)
+
+
+def measurement(name: str, argv: list) -> int:
+    """``quadcosim bench NAME ARGS...`` for a measurement of :data:`MEASUREMENTS`: its own
+    ``main(ARGS)``.
+
+    Parameters
+    ----------
+    name : str
+        The measurement.
+    argv : list of str
+        Its arguments.
+    """
+    return importlib.import_module(f"quadcosim.benchmarks.{MEASUREMENTS[name]}").main(argv)
