@@ -247,9 +247,10 @@ def main(argv=None) -> int:
     names = tuple(n.strip() for n in args.datasets.split(","))
     unknown = [n for n in names if n not in datasets.LOADERS]
     if unknown or not Path(args.folder).is_dir():
-        print(f"real_recordings: {args.folder} is not a folder, or unknown dataset {unknown}; datasets are "
-              f"{', '.join(datasets.LOADERS)}", file=sys.stderr)
-        return 2
+        from quadcosim.infra.errors import UsageError
+
+        raise UsageError(f"{args.folder} is not a folder, or unknown dataset {unknown}; datasets are "
+                         f"{', '.join(datasets.LOADERS)}")
     results = evaluate(args.folder, names, args.cache, tuple(k.strip() for k in args.published.split(",") if k))
     print(table(results))
     print(notes(results))

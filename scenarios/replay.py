@@ -337,7 +337,21 @@ def _options(args) -> dict:
     return options
 
 
-def main(argv=None, prog: str = "quadcosim replay") -> int:
+def main(argv=None) -> int:
+    """``python -m quadcosim.scenarios.replay``, the same as ``quadcosim replay``: :func:`command`'s
+    exit code, its errors printed (2 on bad input).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    """
+    from quadcosim.infra.command import Command
+
+    return Command("quadcosim replay").run(command, argv)
+
+
+def command(argv=None, prog: str = "quadcosim replay") -> int:
     """``quadcosim replay`` (see the module docstring); returns 0, raises a
     :class:`~quadcosim.infra.errors.UsageError` on bad input (exit 2).
 
@@ -463,6 +477,6 @@ def summary(result: dict, recording: str) -> str:
 
 
 if __name__ == "__main__":  # the same as quadcosim replay
-    from quadcosim.infra.command import Command, program
+    from quadcosim.infra.command import program
 
-    program(Command("quadcosim replay").run, main)
+    program(main)

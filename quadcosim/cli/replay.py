@@ -29,6 +29,6 @@ def main(argv) -> int:
     argv : list of str
         The arguments after ``replay``.
     """
-    from quadcosim.scenarios.replay import main as replay
+    from quadcosim.scenarios.replay import command
 
-    return replay(argv, prog="quadcosim replay")
+    return command(argv, prog="quadcosim replay")

@@ -10,4 +10,4 @@ def _sweep() -> int:
 
 
 if __name__ == "__main__":
-    program(Command("quadcosim sweep").run, _sweep)
+    program(Command("quadcosim sweep").run, _sweep)  # Ctrl-C while the packages load: said, 130

@@ -219,13 +219,18 @@ def sweep_plot(args) -> int:
 
 def main(argv=None) -> int:
     """``python -m quadcosim.studies.sweep``: the same parser and work as ``quadcosim sweep``;
-    returns its exit code, or raises.
+    returns its exit code, its errors printed (2 when refused).
 
     Parameters
     ----------
     argv : list of str, optional
         The arguments (default ``sys.argv[1:]``).
     """
-    p = add_arguments(argparse.ArgumentParser(prog="python -m quadcosim.studies.sweep", description=__doc__,
-                                              formatter_class=argparse.RawDescriptionHelpFormatter))
-    return sweep(p.parse_args(argv))
+    from quadcosim.infra.command import Command
+
+    def parsed_and_run(argv):
+        p = add_arguments(argparse.ArgumentParser(prog="python -m quadcosim.studies.sweep", description=__doc__,
+                                                  formatter_class=argparse.RawDescriptionHelpFormatter))
+        return sweep(p.parse_args(argv))
+
+    return Command("quadcosim sweep").run(parsed_and_run, argv)
