@@ -207,7 +207,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    import sys
+if __name__ == "__main__":  # the same as quadcosim bench estimators
+    from quadcosim.infra.command import Command, program
 
-    sys.exit(main())
+    program(Command("quadcosim bench estimators").run, main)

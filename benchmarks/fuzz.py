@@ -85,5 +85,7 @@ def main(argv=None) -> int:
     return 1 if report["failed"] else 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench fuzz
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench fuzz").run, main)

@@ -14,7 +14,6 @@ import argparse
 import os
 import selectors
 import subprocess
-import sys
 import time
 
 
@@ -91,5 +90,7 @@ def main(argv=None) -> int:
     return code
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench gaps
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench gaps").run, main)

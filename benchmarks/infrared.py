@@ -12,7 +12,6 @@ Timings on a shared machine are noisy: compare ratios from one run.
 from __future__ import annotations
 
 import json
-import sys
 
 
 def measure(samples: int = 8000, start_s: float = 0.0, repeats: int = 3, faults: str = "none") -> dict:
@@ -59,5 +58,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench infrared
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench infrared").run, main)

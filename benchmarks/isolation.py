@@ -78,5 +78,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":  # the same as quadcosim bench isolation
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench isolation").run, main)

@@ -14,7 +14,6 @@ rejection (s) and the heading RMSE (deg) of both rules and of VQF.
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -144,9 +143,10 @@ def main(argv=None) -> int:
         dataset, _, name = item.partition("/")
         recordings = dict(datasets.load(args.folder, dataset)) if dataset in datasets.LOADERS else {}
         if name not in recordings:
-            print(f"magnetic: no usable recording {item} under {args.folder}; give DATASET/NAME, DATASET one of "
-                  f"{', '.join(datasets.LOADERS)}", file=sys.stderr)
-            return 2
+            from quadcosim.infra.errors import UsageError
+
+            raise UsageError(f"no usable recording {item} under {args.folder}; give DATASET/NAME, DATASET one of "
+                             f"{', '.join(datasets.LOADERS)}")
         found[item] = analyse(recordings[name])
         rules = found[item]["rules"]
         print(f"{item}: " + "; ".join(f"{rule}: rejected {r['rejected_share']:.0%} of the time, longest "
@@ -158,5 +158,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench magnetic
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench magnetic").run, main)

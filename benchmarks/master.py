@@ -247,8 +247,12 @@ def measure(seconds: float = 5.0, repeats: int = 3) -> dict:
 
 
 def main(argv=None) -> int:
-    """``quadcosim bench`` with the arguments ``argv``; prints the figures and returns 0."""
+    """``quadcosim bench`` with the arguments ``argv``; prints the figures and returns 0; raises a
+    :class:`~quadcosim.infra.errors.UsageError` for a refused option (exit 2), a
+    :class:`~quadcosim.infra.errors.RunError` when the figure could not be written (exit 1)."""
     import argparse
+
+    from quadcosim.infra.errors import RunError, UsageError
 
     parser = argparse.ArgumentParser(prog="quadcosim bench", description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object")
@@ -257,22 +261,15 @@ def main(argv=None) -> int:
     parser.add_argument("--out", help="also draw the figures: a PNG, SVG or PDF file, or a folder (bench.png)")
     args = parser.parse_args(argv)
     if not MIN_SECONDS <= args.seconds <= MAX_SECONDS:  # NaN too
-        print(f"quadcosim bench: --seconds {args.seconds:g}: give the simulated time of each timed run, from "
-              f"{MIN_SECONDS:g} s ({MIN_SECONDS / 1e-3:g} macro steps) to {MAX_SECONDS:g} s (default 5)",
-              file=sys.stderr)
-        return 2
+        raise UsageError(f"--seconds {args.seconds:g}: give the simulated time of each timed run, from "
+                         f"{MIN_SECONDS:g} s ({MIN_SECONDS / 1e-3:g} macro steps) to {MAX_SECONDS:g} s (default 5)")
     if args.repeats < 1:
-        print(f"quadcosim bench: --repeats {args.repeats}: give 1 or more", file=sys.stderr)
-        return 2
+        raise UsageError(f"--repeats {args.repeats}: give 1 or more")
     path = None
     if args.out:
-        from quadcosim.infra.files import OutputRefused, figure_file
+        from quadcosim.infra.files import figure_file
 
-        try:
-            path = figure_file(args.out, "bench.png", None)  # refused before minutes of timing
-        except OutputRefused as error:
-            print(f"quadcosim bench: {error}", file=sys.stderr)
-            return 2
+        path = figure_file(args.out, "bench.png", None)  # refused (OutputRefused) before minutes of timing
     figures = measure(args.seconds, args.repeats)
     if args.json:
         print(json.dumps(figures))
@@ -283,8 +280,7 @@ def main(argv=None) -> int:
         try:
             print(f"figure: {draw(figures, path)}", file=sys.stderr if args.json else sys.stdout)
         except (OSError, ValueError) as error:  # a disk that filled: the figures above are the measurement
-            print(f"quadcosim bench: the figure was not written: {error}", file=sys.stderr)
-            return 1
+            raise RunError(f"the figure was not written: {error}") from error
     return 0
 
 
@@ -350,5 +346,7 @@ def draw(figures: dict, path) -> Path:
         plt.close(fig)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench master
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench master").run, main)

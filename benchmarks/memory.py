@@ -76,5 +76,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench memory
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench memory").run, main)

@@ -248,9 +248,10 @@ def main(argv=None) -> int:
     names = tuple(n.strip() for n in args.datasets.split(","))
     unknown = [n for n in names if n not in datasets.LOADERS]
     if unknown or not Path(args.folder).is_dir():
-        print(f"real_recordings: {args.folder} is not a folder, or unknown dataset {unknown}; datasets are "
-              f"{', '.join(datasets.LOADERS)}", file=sys.stderr)
-        return 2
+        from quadcosim.infra.errors import UsageError
+
+        raise UsageError(f"{args.folder} is not a folder, or unknown dataset {unknown}; datasets are "
+                         f"{', '.join(datasets.LOADERS)}")
     results = evaluate(args.folder, names, args.cache, tuple(k.strip() for k in args.published.split(",") if k))
     print(table(results))
     print(notes(results))
@@ -261,5 +262,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench real-recordings
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench real-recordings").run, main)

@@ -121,5 +121,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench save
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench save").run, main)

@@ -152,5 +152,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench startup
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench startup").run, main)

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import json
 import statistics
-import sys
 import tempfile
 import threading
 import time
@@ -117,5 +116,7 @@ def main(argv=None) -> int:
     return 1 if f["failed"] else 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench study
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench study").run, main)

@@ -19,7 +19,6 @@ from __future__ import annotations
 import json
 import os
 import statistics
-import sys
 import tempfile
 from pathlib import Path
 
@@ -155,5 +154,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench sweep
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench sweep").run, main)

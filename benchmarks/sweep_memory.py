@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 import tempfile
 from pathlib import Path
 
@@ -136,5 +135,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench sweep-memory
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench sweep-memory").run, main)

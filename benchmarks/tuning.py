@@ -443,8 +443,9 @@ def main(argv=None) -> int:
     parser.add_argument("--json", help="with --score-folds: write the held-out scores here")
     args = parser.parse_args(argv)
     if not Path(args.folder).is_dir():
-        print(f"tuning: {args.folder} is not a folder", file=sys.stderr)
-        return 2
+        from quadcosim.infra.errors import UsageError
+
+        raise UsageError(f"{args.folder} is not a folder: give the folder of the datasets")
     started = time.perf_counter()
     if args.score_folds:
         scores = score_folds(args.folder)
@@ -488,5 +489,7 @@ def fold_table(scores: dict) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim bench tuning
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim bench tuning").run, main)

@@ -31,8 +31,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from quadcosim.infra.errors import UsageError
 
-class CalibrationError(ValueError):
+
+class CalibrationError(UsageError, ValueError):
     """Data or a file that cannot give a calibration; the message names the defect and the fix."""
 
 

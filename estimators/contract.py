@@ -57,6 +57,8 @@ import numpy as np
 from quadcosim.estimators.quaternions import euler_from_quaternion
 from quadcosim.orchestrator.blocks import Block
 
+from quadcosim.infra.errors import UsageError
+
 MEASUREMENTS = ("acc_x", "acc_y", "acc_z", "gyro_x", "gyro_y", "gyro_z", "magneto_x", "magneto_y", "magneto_z")
 R_REEL = tuple(f"R_reel_{i}{j}" for i in range(1, 4) for j in range(1, 4))
 INPUTS = MEASUREMENTS + R_REEL
@@ -281,7 +283,7 @@ def adopt(estimator, period: int, q0=None, available=INPUTS) -> Block:
 NORM_TOLERANCE = 1e-3
 
 
-class ContractBroken(ValueError):
+class ContractBroken(UsageError, ValueError):
     """An estimator's output broke the contract while the run went (a NaN, a quaternion off
     unit norm); the message names the output, the time and the value."""
 

@@ -7,8 +7,10 @@ from dataclasses import field as _default
 
 import numpy as np
 
+from quadcosim.infra.errors import UsageError
 
-class LogError(ValueError):
+
+class LogError(UsageError, ValueError):
     """A log that cannot be read or used; the message names the file, the defect and the fix."""
 
 

@@ -24,6 +24,7 @@ from pathlib import Path
 from quadcosim.fmus import models as _models
 from quadcosim.fmus.models import fmu_sources, model_variables  # noqa: F401  (the package's names)
 
+from quadcosim.infra.errors import UsageError
 from quadcosim.infra.folders import (  # noqa: F401  (the package's names)
     BuildFolderRefused,
     build_root,
@@ -38,7 +39,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-class FMUNotFoundError(FileNotFoundError):
+class FMUNotFoundError(UsageError, FileNotFoundError):
     """A built FMU is missing."""
 
 

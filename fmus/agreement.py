@@ -17,7 +17,6 @@ Each model declares its cases in its folder's ``__init__.py`` (``TWIN_CASES``, `
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 from quadcosim.fmus.build import table
@@ -118,5 +117,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim study agreement
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study agreement").run, main)

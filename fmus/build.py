@@ -27,6 +27,7 @@ from quadcosim.fmus import models as registry
 from quadcosim.fmus.airframe import c_header as airframe_header
 from quadcosim.fmus.models import fmu_sources, model_folder, model_variables
 
+from quadcosim.infra.errors import RunError
 from quadcosim.infra.folders import compiler_command, make_folder
 
 HERE = Path(__file__).resolve().parent
@@ -49,7 +50,7 @@ WINDOWS_COMPILER = "x86_64-w64-mingw32-gcc"
 LINK_FLAGS = {"linux": [], "windows": ["-static-libgcc", "-s"]}
 
 
-class BuildError(RuntimeError):
+class BuildError(RunError, RuntimeError):
     """The C compiler refused a model."""
 
 

@@ -18,12 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
+from quadcosim.infra.errors import RunError
+
 SOURCE = Path(__file__).resolve().parent / "c" / "calls.c"
 LIBRARY_NAME = "libquadcosim_calls.so"
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-Wall", "-Wextra", "-Werror", "-shared")
 
 
-class RunnerBuildError(RuntimeError):
+class RunnerBuildError(RunError, RuntimeError):
     """The C compiler refused the call runner, or no C compiler was found."""
 
 

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from quadcosim.orchestrator.result import Result
 
+from quadcosim.infra.errors import RunError, UsageError
 
-class SimulationError(RuntimeError):
+
+class SimulationError(RunError, RuntimeError):
     """A run failed.
 
     Parameters
@@ -39,8 +41,13 @@ class RunInterrupted(SimulationError):
         super().__init__(message, result)
         self.signal_number = signal_number
 
+    @property
+    def exit_code(self) -> int:
+        """The command line's exit code: 128 + the signal, as a process that signal ended."""
+        return 128 + self.signal_number
 
-class AlgebraicLoopError(ValueError):
+
+class AlgebraicLoopError(UsageError, ValueError):
     """Blocks with direct feedthrough form a cycle."""
 
     def __init__(self, cycle: list[str]):

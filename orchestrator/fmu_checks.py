@@ -16,6 +16,8 @@ import re
 import zipfile
 from pathlib import Path, PurePosixPath
 
+from quadcosim.infra.errors import UsageError
+
 #: Extraction limits: the size of everything an FMU holds once extracted, and the ratio of that
 #: size to the file's (a zip bomb expands a few MB into GB).
 EXTRACT_LIMIT_BYTES = 1 << 30
@@ -30,7 +32,7 @@ _HOST = {"x86_64": 62, "amd64": 62, "aarch64": 183, "arm64": 183}.get(platform.m
 _passed: set[tuple] = set()  # FMU files (path, modification time, size) that passed check_file
 
 
-class FMURefused(ValueError):
+class FMURefused(UsageError, ValueError):
     """An FMU the master will not run, for the reason (and the fix) its message gives."""
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections import deque
 
+from quadcosim.infra.errors import RunError, UsageError
+
 STATUS = ("OK", "Warning", "Discard", "Error", "Fatal", "Pending")
 #: A status above any FMI status: an FMI 3.0 FMU asked to end the simulation in ``fmi3DoStep``
 #: (``terminateSimulation``), or returned early, which the master does not allow.
@@ -56,7 +58,7 @@ def keep(log, status: int, message: bytes | None):
             log.first_warnings.append(text)
 
 
-class FMUError(RuntimeError):
+class FMUError(RunError, RuntimeError):
     """An FMU refused a call: the block, the time, the status and what the FMU logged.
 
     Parameters
@@ -82,7 +84,7 @@ class FMUError(RuntimeError):
         super().__init__(f"{block}: {function} {what}{when}.\n  FMU log:\n  {logged}")
 
 
-class ParameterRefused(FMUError, ValueError):
+class ParameterRefused(UsageError, FMUError, ValueError):
     """An FMU refused the parameter values it was given, at instantiation or initialisation.
 
     A ``ValueError`` too: it is refused input, which the command line answers with exit 2.

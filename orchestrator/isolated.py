@@ -48,7 +48,8 @@ SOURCE = Path(__file__).resolve().parent / "c" / "isolated.c"
 LIBRARY_NAME = "libquadcosim_isolated.so"
 OP_PYTHON = 4
 FAILURE_NONE, FAILURE_ENDED, FAILURE_WATCHDOG, FAILURE_INTERRUPTED = range(4)
-KINDS = {"Set": 0, "Get": 1, "Step": 2}
+#: The code of each kind of call a program holds, as isolated.c numbers them.
+CALL_CODES = {"Set": 0, "Get": 1, "Step": 2}
 MAX_PROGRAMS = 256  # as in isolated.c
 START_SECONDS = 60.0  # the worker's own start (Python, numpy, fmpy), before any FMU code runs
 CLOSE_SECONDS = 5.0  # fmi2Terminate and fmi2FreeInstance at the end: a worker slower than this is killed

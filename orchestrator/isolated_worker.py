@@ -17,7 +17,7 @@ from pathlib import Path
 
 from quadcosim.orchestrator.fmi_types import CEntry
 from quadcosim.orchestrator.fmu import FMUError, FMUInstance, FMULog
-from quadcosim.orchestrator.isolated import KINDS, MAX_PROGRAMS, OP_PYTHON, library
+from quadcosim.orchestrator.isolated import CALL_CODES, MAX_PROGRAMS, OP_PYTHON, library
 
 
 class _Call(ctypes.Structure):
@@ -57,7 +57,7 @@ class _Hosted:
             entries = (instance.setter if direction == "Set" else instance.getter)(names, addresses)
         program = self.programs
         self.programs += 1
-        self.calls += [(program, KINDS[direction], e) for e in entries]
+        self.calls += [(program, CALL_CODES[direction], e) for e in entries]
         self.table = (_Call * len(self.calls))(*[_Call(e.function, e.component, e.vr or None, e.n, e.values or None,
                                                        kind, p) for p, kind, e in self.calls])
         return program, ", ".join(dict.fromkeys(e.label for e in entries))

@@ -2,9 +2,8 @@
 
 The ``.npz`` and ``.mat`` files are compressed and carry the signals' units and the run's
 options; vector signals (``IMU.acc``, ``Quadrotor.q``) are stored as N x k arrays and the
-rotation matrix ``IMU.R_reel`` as N x 3 x 3. A record streamed to disk as the run went
-(:mod:`quadcosim.orchestrator.stream` writes it) is read back by :class:`StreamedResult`, one signal at a
-time; :meth:`Result.load` reads either.
+rotation matrix ``IMU.R_reel`` as N x 3 x 3. A record streamed to disk as the run went (by
+:mod:`quadcosim.orchestrator.stream`) is read back by :class:`StreamedResult`; :meth:`Result.load` reads either.
 """
 
 from __future__ import annotations
@@ -19,6 +18,7 @@ from quadcosim.orchestrator.fmu import nearest
 from quadcosim.orchestrator.signals import expand, matrix_shape, vector_groups
 from quadcosim.orchestrator.values import float_text, integer_text, matlab_values
 
+from quadcosim.infra.errors import UsageError
 from quadcosim.infra.files import atomic_path, json_text
 from quadcosim.infra.inputs import read_small_text, regular_file
 
@@ -79,7 +79,7 @@ def check_record_fits(rows: int, signals: int, decimation: int = 1, writers: int
     return record
 
 
-class RecordTooLarge(MemoryError, ValueError):
+class RecordTooLarge(UsageError, MemoryError, ValueError):
     """A run's record would not fit in memory (a ``ValueError`` too: it is refused input)."""
 
 
@@ -555,7 +555,7 @@ WRITE_ROWS = 2 ** 16
 FOLDER = "results.stream"
 
 
-class DamagedRecord(ValueError):
+class DamagedRecord(UsageError, ValueError):
     """A streamed record whose chunks are missing or whose description is unreadable."""
 
 

@@ -22,7 +22,6 @@ bias-estimate error with the recorded accelerometer and with gravity alone in it
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 from quadcosim.estimators import estimate, parse_corrections
@@ -185,5 +184,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim study ablation
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study ablation").run, main)

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 from quadcosim.orchestrator import Result, RunInterrupted, SimulationError
 
+from quadcosim.infra.errors import UsageError
 from quadcosim.infra.files import (
     LOCK_NAME,
     DiskFull,
@@ -366,5 +367,5 @@ def remove_if_empty(folder: Path):
         folder.rmdir()
 
 
-class NoRoom(ValueError):
+class NoRoom(UsageError, ValueError):
     """The record's files would not fit on the disk of the output folder (refused input)."""

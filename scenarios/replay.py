@@ -339,17 +339,40 @@ def _options(args) -> dict:
     return options
 
 
-def main(argv=None, prog: str = "python -m quadcosim.scenarios.replay") -> int:
-    """Command line (see the module docstring); returns the exit status (2 on bad input).
-    ``argv``: the arguments (default ``sys.argv[1:]``); ``prog``: the command as its messages
-    name it (``quadcosim replay``)."""
+def main(argv=None) -> int:
+    """``python -m quadcosim.scenarios.replay``, the same as ``quadcosim replay``: :func:`command`'s
+    exit code, its errors printed (2 on bad input).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    """
+    from quadcosim.infra.command import Command
+
+    return Command("quadcosim replay").run(command, argv)
+
+
+def command(argv=None, prog: str = "quadcosim replay") -> int:
+    """``quadcosim replay`` (see the module docstring); returns 0, raises a
+    :class:`~quadcosim.infra.errors.UsageError` on bad input (exit 2).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    prog : str
+        The command as its help names it.
+    """
+    from quadcosim.infra.errors import refusals
+
     parser = _parser(prog)
     args = parser.parse_args(argv)
     if args.recording and Path(args.recording).suffix.lower() in FLIGHT_LOGS:
         from quadcosim.scenarios.flightlog import replay as flight
 
         return flight.run(argparse.Namespace(file=args.recording, compass=args.compass, json=args.json, out=args.out))
-    try:
+    with refusals(usage=(ValueError, OSError), failures=()):  # a file missing or unreadable, a value refused
         if args.from_tp:
             if not args.write:
                 parser.error("--from-tp needs --write RECORDING")
@@ -383,9 +406,6 @@ def main(argv=None, prog: str = "python -m quadcosim.scenarios.replay") -> int:
         if args.figure:
             print(f"figure: {draw_errors(data, result | estimate, args.figure, Path(args.recording).name)}",
                   file=sys.stderr)
-    except (ValueError, FileNotFoundError, OSError) as error:
-        print(f"{prog}: {error}", file=sys.stderr)
-        return 2
     return 0
 
 
@@ -458,5 +478,7 @@ def summary(result: dict, recording: str) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim replay
+    from quadcosim.infra.command import program
+
+    program(main)

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from quadcosim.scenarios.output_options import free_file
 
+from quadcosim.infra.errors import UsageError, refusals
 from quadcosim.infra.files import figure_file, printable, save_figure
 from quadcosim.infra.inputs import read_small_text
 
@@ -333,32 +334,28 @@ def compare(runs, signal: str, out=None, deg: bool = False, figure_format: str |
 
 
 def plot_command(args) -> int:
-    """``quadcosim plot``: exit code 0, or 2 for a run or signal that is not there.
+    """``quadcosim plot``: exit code 0; raises :class:`~quadcosim.infra.errors.UsageError` for a
+    run or signal that is not there (exit 2), :class:`~quadcosim.infra.errors.RunError` for a full
+    disk (exit 1).
 
     Parameters
     ----------
     args : argparse.Namespace
         ``run``, ``signals`` and ``out``, as :func:`add_arguments` declares them.
     """
-    import sys
-
-    try:
+    with refusals(usage=(ValueError,)):  # OutputRefused among them; a full disk: nothing left under its name
         if not args.signals:
             print("\n".join(signal_lines(args.run)))
             return 0
         print(plot(args.run, args.signals, args.out, deg=args.deg, figure_format=args.format,
                    tracking=args.tracking, overwrite=args.overwrite))
-    except ValueError as error:  # OutputRefused among them
-        print(f"quadcosim plot: {error}", file=sys.stderr)
-        return 2
-    except OSError as error:  # a full disk (named; nothing left under the figure's name)
-        print(f"quadcosim plot: failed: {error}", file=sys.stderr)
-        return 1
     return 0
 
 
 def compare_command(args) -> int:
-    """``quadcosim compare``: exit code 0, or 2 for a run or signal that is not there.
+    """``quadcosim compare``: exit code 0; raises :class:`~quadcosim.infra.errors.UsageError` for
+    a run or signal that is not there (exit 2), :class:`~quadcosim.infra.errors.RunError` for a
+    full disk (exit 1).
 
     Parameters
     ----------
@@ -366,21 +363,12 @@ def compare_command(args) -> int:
         ``items`` (the runs, then the signal unless ``signal`` is given), ``signal`` and ``out``,
         as :func:`add_arguments` declares them.
     """
-    import sys
-
     runs, signal = (args.items, args.signal) if args.signal else (args.items[:-1], args.items[-1])
     if len(runs) < 2:
-        print("quadcosim compare: give two runs or more, then the signal: compare RUN RUN SIGNAL", file=sys.stderr)
-        return 2
-    try:
+        raise UsageError("give two runs or more, then the signal: compare RUN RUN SIGNAL")
+    with refusals(usage=(ValueError,)):  # OutputRefused among them; a full disk: nothing left under its name
         print(compare(runs, signal, args.out, deg=args.deg, figure_format=args.format,
                       overwrite=args.overwrite))
-    except ValueError as error:  # OutputRefused among them
-        print(f"quadcosim compare: {error}", file=sys.stderr)
-        return 2
-    except OSError as error:  # a full disk (named; nothing left under the figure's name)
-        print(f"quadcosim compare: failed: {error}", file=sys.stderr)
-        return 1
     return 0
 
 

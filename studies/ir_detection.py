@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -397,5 +396,7 @@ def one_fault(sensor: str, size: float, seed: int = 1, settings: EKFSettings | N
 __all__ = ["ABLATIONS", "CASES", "FRESH", "FRESH_CLEAN", "QUICK", "TUNING", "ablation", "fleet", "one_fault",
            "missed_figure", "outcome", "per_hour", "plateau_ablation", "proportion", "quick", "study", "summary"]
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim study ir-detection
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study ir-detection").run, main)

@@ -25,7 +25,6 @@ after 60 s, the regression's start without the slides' line, and a drift of ``a`
 from __future__ import annotations
 
 import argparse
-import sys
 
 import numpy as np
 from quadcosim.calibration.infrared import EKFSettings, Estimator, RegressionSettings
@@ -137,5 +136,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim study ir-slides
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study ir-slides").run, main)

@@ -24,7 +24,6 @@ A named sweep: its members run on Dask like any sweep (``--workers``, ``--schedu
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -267,5 +266,7 @@ def _sweep():
 SWEEP = _sweep()
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # the same as quadcosim study lab-matrix
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study lab-matrix").run, main)

@@ -80,5 +80,7 @@ def main(argv=None) -> int:
     return 0
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":  # the same as quadcosim study mag-rate
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study mag-rate").run, main)

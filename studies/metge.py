@@ -88,5 +88,7 @@ def main(argv=None):
     yaw_study(args.out, args.calibration, estimators=tuple(args.estimators.split(",")), duration=args.duration)
 
 
-if __name__ == "__main__":
-    main()
+if __name__ == "__main__":  # the same as quadcosim study metge
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study metge").run, main)

@@ -35,6 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+from quadcosim.infra.errors import RunError, UsageError, refusals
+
 #: What the optimiser sees for an evaluation without a value (a member diverged or failed).
 PENALTY = 1e9
 #: Share of the budget spent on the first scan (and its most points).
@@ -43,7 +45,7 @@ _OVER = re.compile(r"^\s*([^=\s]+)\s*=\s*([^:]+):([^:]+)(?::(log|lin))?\s*$")
 _METRIC = re.compile(r"^[A-Za-z_][\w.]*(\[\d+\])?$")
 
 
-class TuneError(ValueError):
+class TuneError(UsageError, ValueError):
     """A tune refused or stopped: the message names the problem and the fix."""
 
 
@@ -492,7 +494,7 @@ def command(args) -> int:
     from quadcosim.studies.sweep.command import default_out
 
     label = f"quadcosim tune {args.scenario}"
-    try:
+    with refusals(failures=()):  # TuneError is a ValueError: exit 2
         if args.workers is not None and args.workers < 1:
             raise TuneError(f"--workers {args.workers}: give at least 1")
         if args.workers and args.scheduler:
@@ -501,13 +503,9 @@ def command(args) -> int:
         out = Path(args.out) if args.out else default_out(Path("results") / f"tune-{args.scenario}", args.resume,
                                                           label, marker="tune.json")
         data = run(tune_plan, out, args.workers, args.scheduler, args.resume, not args.quiet, args.connect_timeout)
-    except (KeyError, ValueError) as error:
-        print(f"{label}: {error.args[0] if error.args else error}", file=sys.stderr)
-        return 2
     if data["best"] is None:
-        print(f"tune {args.scenario}: no evaluation of {data['evaluations']} has a value (every one diverged or "
-              f"failed); see {out / 'tune.json'}", file=sys.stderr)
-        return 1
+        raise RunError(f"no evaluation of {data['evaluations']} has a value (every one diverged or failed); see "
+                       f"{out / 'tune.json'}")
     print(f"tune {args.scenario}: {args.minimize} = {data['value']:.6g} at {_text(data['best'])} "
           f"({data['evaluations']} evaluations, {data['diverged_or_failed']} without a value)")
     if data.get("prediction"):

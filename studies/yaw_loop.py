@@ -125,5 +125,23 @@ def study() -> dict:
     return {"cases": cases, "largest_quiet_100hz": quiet, "first_at_bound_100hz": bound}
 
 
-if __name__ == "__main__":
+def main(argv=None) -> int:
+    """``quadcosim study yaw-loop`` (``python -m quadcosim.studies.yaw_loop``): :func:`study`,
+    printed as it goes; it takes no options.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``): none but ``--help``.
+    """
+    import argparse
+
+    argparse.ArgumentParser(prog="quadcosim study yaw-loop", description=__doc__.splitlines()[0]).parse_args(argv)
     study()
+    return 0
+
+
+if __name__ == "__main__":  # the same as quadcosim study yaw-loop
+    from quadcosim.infra.command import Command, program
+
+    program(Command("quadcosim study yaw-loop").run, main)

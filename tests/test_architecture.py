@@ -280,7 +280,7 @@ def test_the_command_line_and_the_benchmarks_live_in_the_top_layer():
     import tomllib
 
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    assert project["project"]["scripts"]["quadcosim"] == "quadcosim.main:entry"
+    assert project["project"]["scripts"]["quadcosim"] == "quadcosim.cli:entry"
     assert "quadcosim.benchmarks" in project["tool"]["setuptools"]["packages"]
     assert not (ROOT / "orchestrator" / "cli.py").exists()
     assert not list((ROOT / "orchestrator").glob("bench*.py"))

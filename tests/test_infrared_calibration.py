@@ -4,7 +4,7 @@ batch equals streaming, and refusals of bad data."""
 
 import numpy as np
 import pytest
-from quadcosim.calibration.infrared import SLIDES_OPERATIONS, CalibrationError, EKFSettings, Estimator, cost
+from quadcosim.calibration.infrared import SLIDES_OPERATIONS, EKFSettings, Estimator, InfraredCalibrationError, cost
 from quadcosim.scenarios.ir_calibration import estimate, fault_windows, simulate_flight
 
 from quadcosim import scenarios
@@ -95,9 +95,9 @@ def test_joint_and_sequential_forms_agree_without_gating():
 
 
 def test_non_finite_input_and_bad_covariance_are_refused():
-    with pytest.raises(CalibrationError, match="non-finite value .* at sample 3"):
+    with pytest.raises(InfraredCalibrationError, match="non-finite value .* at sample 3"):
         Estimator("kalman").run([900.0, 901, 902, np.nan], [0.0, 0, 0, 0])
-    with pytest.raises(CalibrationError, match="finite readings only"):
+    with pytest.raises(InfraredCalibrationError, match="finite readings only"):
         Estimator("rls").update(np.inf, 0.1)
     with pytest.raises(ValueError, match="not positive definite"):
         Estimator("kalman", covariance=np.diag([1.0, -1.0, 1.0]))

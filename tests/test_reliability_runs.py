@@ -404,7 +404,7 @@ def test_every_command_in_the_readme_runs(command, tmp_path, monkeypatch, capsys
 
 
 def test_the_help_fault_example_runs(tmp_path, capsys):
-    from quadcosim.main import _parse_fault
+    from quadcosim.cli.run import _parse_fault
 
     with pytest.raises(ValueError) as error:
         _parse_fault("IMU.omega_x")

@@ -31,9 +31,9 @@ def test_the_command_starts_one_blas_thread_unless_told(given, seen):
     environment = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
     if given:
         environment["OPENBLAS_NUM_THREADS"] = given
-    code = ("import os, sys, quadcosim.main as command; assert 'numpy' not in sys.modules, 'numpy before the setting'; "
+    code = ("import os, sys, quadcosim.cli as command; assert 'numpy' not in sys.modules, 'numpy before the setting'; "
             "print(os.environ.get('OPENBLAS_NUM_THREADS', 'unset')); "
-            "command.main = lambda: print(os.environ['OPENBLAS_NUM_THREADS'], 'numpy' in sys.modules) or 0; "
+            "command.main = lambda *argv: print(os.environ['OPENBLAS_NUM_THREADS'], 'numpy' in sys.modules) or 0; "
             "command.entry()")
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, env=environment)
     # importing the module changes nothing (a program that imports it keeps its environment); the command sets it

@@ -12,7 +12,7 @@ from quadcosim.calibration.file import Calibration
 from quadcosim.calibration.flight import catalogue
 from quadcosim.calibration.flight.evaluate import score
 from quadcosim.calibration.flight.linear import earth_and_offset
-from quadcosim.calibration.flight.models import Refused
+from quadcosim.calibration.flight.models import NotIdentifiable
 from quadcosim.calibration.static import CalibrationError, StaticCalibration, fit_static, sphere_coverage
 
 MIN_COVERAGE = 0.5  # share of the 80 sphere cells the Earth field must visit in the body frame
@@ -27,7 +27,7 @@ def _fit_models(train, names) -> tuple[dict, dict]:
         if reason is None:
             try:
                 fitted[name] = model.fit(train)
-            except (Refused, CalibrationError) as error:
+            except (NotIdentifiable, CalibrationError) as error:
                 reason = str(error)
         if reason is not None:
             refused[name] = reason

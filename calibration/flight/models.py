@@ -25,6 +25,8 @@ from quadcosim.calibration.dynamic import MotorFieldModel
 from quadcosim.calibration.flight.catalogue import Model
 from quadcosim.calibration.flight.linear import NUISANCE, fit_linear
 
+from quadcosim.infra.errors import RunError
+
 DELAYS = np.round(np.arange(0.0, 0.301, 0.02), 3)  # s
 MIN_CURRENT_SPREAD_A = 1.0  # standard deviation of the current needed to identify the current model
 MIN_COMMAND_SPREAD = 0.02  # standard deviation of a command (or the throttle) needed to identify a model
@@ -35,7 +37,7 @@ METGE_EVALUATIONS = 2000  # residual evaluations, finite differences included
 DYNAMIC_MIN_RATE_HZ = 50.0  # motor time constants of tens of ms need both records faster than this
 
 
-class Refused(Exception):
+class NotIdentifiable(RunError):
     """A model the flight cannot identify; the message is the reason."""
 
 
@@ -99,7 +101,7 @@ class LinearModel:
                 best = (float(delay), fit)
         delay, fit = best
         if fit.condition > MAX_CONDITION:
-            raise Refused(f"its regressors cannot be told from one another or from the Earth field and offset "
+            raise NotIdentifiable(f"its regressors cannot be told from one another or from the Earth field and offset "
                           f"(condition number {fit.condition:.3g} > {MAX_CONDITION:g})")
         K = fit.K.copy()
         names = {"current": "K_T_per_A", "throttle": "K_T_per_throttle", "motors": "K_T_per_command"}
@@ -137,19 +139,19 @@ class MetgeModel:
         for orders in METGE_ORDERS:
             try:
                 fitted = self._fit(parts, orders)
-            except Refused as error:
+            except NotIdentifiable as error:
                 reasons.append(f"orders (I, J) = {orders}: {error}")
                 continue
             if reasons:
                 fitted.coefficients["richer_orders_refused"] = reasons
             return fitted
-        raise Refused("; ".join(reasons))
+        raise NotIdentifiable("; ".join(reasons))
 
     def _fit(self, parts, orders) -> Fitted:
         from scipy.optimize import least_squares
 
         if orders[1] > 0 and any(p.battery is None for p in parts):
-            raise Refused("no battery voltage in the log for the voltage terms")
+            raise NotIdentifiable("no battery voltage in the log for the voltage terms")
         delay = self.motors.delay
         K = self.motors.extra["K"]
         N, (I, J) = len(K), orders
@@ -180,7 +182,7 @@ class MetgeModel:
         singular = np.linalg.svd(columns, compute_uv=False)
         condition = float(singular[0] / max(singular[-1], 1e-300))
         if condition > MAX_CONDITION:
-            raise Refused(f"its per-motor directions and polynomial coefficients cannot be told apart on these "
+            raise NotIdentifiable(f"its per-motor directions and polynomial coefficients cannot be told apart on these "
                           f"flights (condition number {condition:.3g} > {MAX_CONDITION:g})")
         found = model(fit.x)
         return Fitted("metge", delay, {"orders": {"I": I, "J": J}, "v": found.v.tolist(),

@@ -47,8 +47,8 @@ Units: turn rate rad/s, IR in counts, ``a`` in counts per rad/s.
 """
 
 from quadcosim.calibration.infrared.cost import SLIDES_OPERATIONS, SLIDES_PROCESSOR, SLIDES_RATE, cost
-from quadcosim.calibration.infrared.estimator import METHODS, CalibrationError, Estimator, InfraredCalibration
+from quadcosim.calibration.infrared.estimator import METHODS, Estimator, InfraredCalibration, InfraredCalibrationError
 from quadcosim.calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
 
-__all__ = ["METHODS", "SLIDES_OPERATIONS", "SLIDES_PROCESSOR", "SLIDES_RATE", "CalibrationError", "EKFSettings",
+__all__ = ["METHODS", "SLIDES_OPERATIONS", "SLIDES_PROCESSOR", "SLIDES_RATE", "InfraredCalibrationError", "EKFSettings",
            "Estimator", "InfraredCalibration", "RLSSettings", "RegressionSettings", "cost"]

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from quadcosim.calibration.infrared.estimator import CalibrationError, Estimator, _finite
+from quadcosim.calibration.infrared.estimator import Estimator, InfraredCalibrationError, _finite
 from quadcosim.calibration.infrared.filters import buffer_size
 from quadcosim.calibration.infrared.settings import EKFSettings
 
@@ -179,7 +179,7 @@ def cost(ir, gps, gps_use=None, repeats: int = 3, methods=None) -> dict[str, dic
                 "regression": ("regression", None), "rls": ("rls", None)}
     unknown = set(methods or ()) - set(variants)
     if unknown:
-        raise CalibrationError(f"unknown estimators {sorted(unknown)}; choose among {', '.join(variants)}")
+        raise InfraredCalibrationError(f"unknown estimators {sorted(unknown)}; choose among {', '.join(variants)}")
     out = {}
     for label, (method, settings) in variants.items():
         if methods is not None and label not in methods:

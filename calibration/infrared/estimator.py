@@ -65,6 +65,8 @@ from quadcosim.calibration.infrared.layout import (
 from quadcosim.calibration.infrared.settings import EKFSettings, RegressionSettings, RLSSettings
 from quadcosim.orchestrator.blocks import Block
 
+from quadcosim.infra.errors import UsageError
+
 METHODS = ("kalman", "regression", "rls")
 _EKF_FIELDS = {"a": A, "b": B, "r": R, "turn_rate": RATE, "nu_gps": NU_GPS, "S_gps": GATE_GPS, "nu_ir": NU_IR,
                "S_ir": GATE_IR, "gps_fault": GPS_FAULT, "ir_fault": IR_FAULT, "gps_used": GPS_USED,
@@ -81,8 +83,8 @@ _STATUS_TEXT = {LOST_PD: "the covariance lost positive definiteness (a variance 
                            "check the initial a0 and the IR data"}
 
 
-class CalibrationError(ValueError):
-    """An estimator was given data or settings it cannot use."""
+class InfraredCalibrationError(UsageError, ValueError):
+    """An infrared calibration estimator was given data or settings it cannot use."""
 
 
 # the step each estimator takes; by number, so that the compiled loops are cached (numba's cache
@@ -132,8 +134,8 @@ def _finite(name: str, values) -> np.ndarray:
     bad = ~np.isfinite(values)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise CalibrationError(f"{name} holds a non-finite value ({values[k]!r}) at sample {k}; "
-                               "the estimators take finite readings only: drop or repair that sample")
+        raise InfraredCalibrationError(f"{name} holds a non-finite value ({values[k]!r}) at sample {k}; "
+                                       "the estimators take finite readings only: drop or repair that sample")
     return values
 
 
@@ -155,10 +157,10 @@ class Estimator:
     def __init__(self, method: str = "kalman", settings=None, delay: int = 20, window: int = 20,
                  covariance=None):
         if method not in METHODS:
-            raise CalibrationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+            raise InfraredCalibrationError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
         if int(delay) != delay or delay < 0 or int(window) != window or window < 1:
-            raise CalibrationError(f"delay = {delay!r} and window = {window!r} must be whole numbers of samples, "
-                                   "delay >= 0 and window >= 1")
+            raise InfraredCalibrationError(f"delay = {delay!r} and window = {window!r} must be whole numbers of "
+                                           "samples, delay >= 0 and window >= 1")
         self.method, self.delay, self.window = method, int(delay), int(window)
         if method == "kalman":
             self.settings = settings or EKFSettings()
@@ -196,13 +198,14 @@ class Estimator:
         ``a``, ``b`` and the present turn rate.
         """
         if not (math.isfinite(ir) and math.isfinite(gps)):
-            raise CalibrationError(f"sample {self.k}: IR = {ir!r}, GPS turn rate = {gps!r}; the estimators take "
-                                   "finite readings only: drop or repair that sample")
+            raise InfraredCalibrationError(f"sample {self.k}: IR = {ir!r}, GPS turn rate = {gps!r}; the estimators "
+                                           "take finite readings only: drop or repair that sample")
         _sample(self._kind, self.state, self.config, self.buffer, self.k, float(ir), float(gps), bool(gps_use),
                 self.delay, self.window, self._suspect)
         self.k += 1
         if self._status >= 0 and self.state[self._status] != 0.0:
-            raise CalibrationError(f"{self.method} at sample {self.k - 1}: {_STATUS_TEXT[self.state[self._status]]}")
+            raise InfraredCalibrationError(f"{self.method} at sample {self.k - 1}: "
+                                           f"{_STATUS_TEXT[self.state[self._status]]}")
         return self.state
 
     def run(self, ir, gps, gps_use=None) -> dict[str, np.ndarray]:
@@ -228,17 +231,18 @@ class Estimator:
         ir = _finite("IR", ir)
         gps = _finite("GPS turn rate", gps)
         if gps.shape != ir.shape or ir.ndim != 1:
-            raise CalibrationError(f"IR {ir.shape} and GPS {gps.shape} must be 1-D arrays of the same length")
+            raise InfraredCalibrationError(f"IR {ir.shape} and GPS {gps.shape} must be 1-D arrays of the same length")
         use = np.ones(ir.shape, dtype=np.bool_) if gps_use is None else np.asarray(gps_use, dtype=np.bool_)
         if use.shape != ir.shape:
-            raise CalibrationError(f"gps_use {use.shape} must have the shape of IR {ir.shape}")
+            raise InfraredCalibrationError(f"gps_use {use.shape} must have the shape of IR {ir.shape}")
         self.reset()
         out = np.full((ir.shape[0], self._index.shape[0]), np.nan)
         done = _run(self._kind, self.state, self.config, self.buffer, self.delay, self.window, ir, gps, use,
                     self._index, self._status, self._suspect, out)
         self.k = done
         if done < ir.shape[0]:
-            raise CalibrationError(f"{self.method} at sample {done - 1}: {_STATUS_TEXT[self.state[self._status]]}")
+            raise InfraredCalibrationError(f"{self.method} at sample {done - 1}: "
+                                           f"{_STATUS_TEXT[self.state[self._status]]}")
         return {name: out[:, j] for j, name in enumerate(self.names)}
 
 

@@ -13,8 +13,7 @@ saving leaves the earlier file (or none), never a truncated one.
   folder, a FIFO, a device or a socket, a read-only file and a folder that does not exist are
   refused with :class:`OutputRefused`, before anything is written.
 - Every file the project *reads* is checked by :func:`quadcosim.infra.inputs.regular_file` first.
-- :func:`tracking` lists the files written into a folder while it is active, so that a run's
-  ``metrics.json`` names exactly the files it wrote (figures included).
+- :func:`tracking` lists the files written into a folder while active: a run's ``metrics.json`` names them.
 - :func:`prepare_out_dir` checks an output folder before a run and, with ``overwrite``,
   removes every file an earlier run left there; :func:`folder_lock` holds it for one process
   (a second one is refused with :class:`FolderBusy`, naming the first).
@@ -35,6 +34,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from quadcosim.infra.errors import RunError, UsageError
+
 #: Files a run leaves in its output folder (figures aside): an existing folder holding any of
 #: them holds earlier results.
 RESULT_FILES = ("results.npz", "results.mat", "results.csv", "metrics.json", "results.stream")
@@ -51,7 +52,7 @@ os.umask(_UMASK)
 _written: contextvars.ContextVar[tuple[Path, list[str]] | None] = contextvars.ContextVar("written", default=None)
 
 
-class DiskFull(OSError):
+class DiskFull(RunError, OSError):
     """A file did not fit on its disk; nothing was left under its final name.
 
     Parameters
@@ -111,7 +112,7 @@ def free_bytes(folder) -> int | None:
         return None
 
 
-class OutputRefused(ValueError):
+class OutputRefused(UsageError, ValueError):
     """A path that cannot take a file: a folder, a FIFO or device, a read-only file, or a file in
     a folder that does not exist. Nothing was written; the message names the path and the fix."""
 
@@ -417,7 +418,7 @@ def _plain(value):
 LOCK_NAME = ".quadcosim.lock"
 
 
-class FolderBusy(ValueError):
+class FolderBusy(UsageError, ValueError):
     """Another process is writing into the output folder; the message names it (pid, command)."""
 
 

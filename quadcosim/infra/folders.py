@@ -7,8 +7,10 @@ import functools
 import os
 from pathlib import Path
 
+from quadcosim.infra.errors import RunError
 
-class BuildFolderRefused(ValueError):
+
+class BuildFolderRefused(RunError, ValueError):
     """A folder compiled artefacts go to cannot be made or written; the message names the
     environment setting that chose it, when one did."""
 

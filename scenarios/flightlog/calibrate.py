@@ -343,15 +343,16 @@ def run(args) -> int:
     earlier results are replaced until ``metrics.json`` is written; signals wait while the files
     are written, so that an interrupt leaves them all with their ``metrics.json``, or nothing."""
     from quadcosim.calibration.flight import calibrate
-    from quadcosim.calibration.static import CalibrationError
     from quadcosim.scenarios.output_options import default_folder
+
+    from quadcosim.infra.errors import RunError, UsageError, refusals
 
     if not args.out:
         first = (args.files or args.train or [None])[0]
         if first is not None:
             args.out = str(default_folder("calibrate", f"calibrate-{Path(first).stem}", args.overwrite))
     out = Path(args.out or "results/calibrate")
-    try:
+    with refusals(usage=(ValueError,)):  # CalibrationError, LogError, FolderBusy and OutputRefused among them
         _check_choices(args)
         _check_out(out, args.overwrite)  # before the flights are read; again, held, before writing
         split = _numeric(lambda: _split(args), args.files or [*(args.train or []), *(args.test or [])], also=())
@@ -364,24 +365,15 @@ def run(args) -> int:
         export = _numeric(lambda: _export(args, split, metrics), sources)
         files = _saved(out, args.overwrite,
                        lambda: _write(out, split, metrics, calibration, fitted, export, args.attitude))
-    except (CalibrationError, ValueError) as error:  # LogError, FolderBusy and OutputRefused among them
-        print(f"quadcosim calibrate: {error}", file=sys.stderr)
-        return 2
-    except OSError as error:  # not even metrics.json fitted: nothing written
-        print(f"quadcosim calibrate: failed: {error}", file=sys.stderr)
-        return 1
     print("\n".join(_report(metrics)))
     if metrics["status"] == "failed":
         for name, why in metrics["files_not_written"].items():
             print(f"quadcosim calibrate: {name} not written: {why}", file=sys.stderr)
-        print(f"quadcosim calibrate: failed; metrics.json in {out}/ lists what was written", file=sys.stderr)
-        return 1
+        raise RunError(f"metrics.json in {out}/ lists what was written")
     print(f"{', '.join(files)} in {out}/")
     if not fitted:
         sources = ", ".join(sorted({p.source.rsplit(":", 1)[0] for p in split.train}))
-        print(f"quadcosim calibrate: no interference model could be identified from {sources} (reasons above)",
-              file=sys.stderr)
-        return 2
+        raise UsageError(f"no interference model could be identified from {sources} (reasons above)")
     return 0
 
 

@@ -5,35 +5,32 @@ one figure; ``quadcosim log replay FILE``: the estimators on it (:mod:`quadcosim
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 from quadcosim.scenarios.flightlog.reading import load
 
+from quadcosim.infra.errors import refusals
+
 
 def info(args) -> int:
-    """``quadcosim log info FILE [--json]`` (``args`` from :func:`add_arguments`); 2 on a bad log."""
-    from quadcosim.flightlogs import LogError
+    """``quadcosim log info FILE [--json]`` (``args`` from :func:`add_arguments`); a bad log raises
+    :class:`~quadcosim.flightlogs.LogError` (exit 2)."""
     from quadcosim.flightlogs.info import summary, text
 
-    try:
-        found = summary(load(args.file, "log info"))
-    except LogError as error:
-        print(f"quadcosim log info: {error}", file=sys.stderr)
-        return 2
+    found = summary(load(args.file, "log info"))
     print(json.dumps(found, indent=2) if args.json else text(found))
     return 0
 
 
 def plot(args) -> int:
-    """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); 2 on a bad
-    log or output path, 1 when the figure could not be written (a full disk)."""
-    from quadcosim.flightlogs import LogError
+    """``quadcosim log plot FILE [--out FIGURE]`` (``args`` from :func:`add_arguments`); a bad log
+    or output path raises a :class:`~quadcosim.infra.errors.UsageError` (exit 2), a figure that
+    could not be written (a full disk) a :class:`~quadcosim.infra.errors.RunError` (exit 1)."""
     from quadcosim.scenarios.flightlog.overview import plot_overview
 
-    from quadcosim.infra.files import OutputRefused, figure_file
+    from quadcosim.infra.files import figure_file
 
-    try:
+    with refusals(usage=()):  # a full disk (named, nothing left), a folder removed under it
         out = figure_file(args.out, f"{Path(args.file).stem}-overview.png", Path("results") / "logs")
         if not args.out and not args.overwrite:
             from quadcosim.scenarios.output_options import free_file
@@ -41,12 +38,6 @@ def plot(args) -> int:
             out = free_file(out, "log plot")
         log = load(args.file, "log plot")
         print(plot_overview(log, out))
-    except (LogError, OutputRefused) as error:
-        print(f"quadcosim log plot: {error}", file=sys.stderr)
-        return 2
-    except OSError as error:  # a full disk (named, nothing left), a folder removed under it
-        print(f"quadcosim log plot: failed: {error}", file=sys.stderr)
-        return 1
     return 0
 
 

@@ -20,8 +20,6 @@ How a log is replayed:
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 from quadcosim.estimators import kinds
 
@@ -156,22 +154,19 @@ def _replayed(log, compass: int) -> dict:
 def run(args) -> int:
     """``quadcosim log replay FILE [--compass N] [--json] [--out FILE]`` (``args`` from argparse):
     the table, or with ``--json`` the result as JSON, on standard output, and with ``--out`` the
-    result written as JSON there; 2 on bad
-    input (a log, an option or an output path refused), 1 when the JSON could not be written (a
-    full disk: nothing is left under its name)."""
-    from quadcosim.calibration.static import CalibrationError
+    result written as JSON there. Bad input (a log, an option or an output path refused) raises a
+    :class:`~quadcosim.infra.errors.UsageError` (exit 2), a JSON that could not be written (a full
+    disk: nothing is left under its name) a :class:`~quadcosim.infra.errors.RunError` (exit 1)."""
     from quadcosim.scenarios.flightlog.reading import load
 
+    from quadcosim.infra.errors import refusals
     from quadcosim.infra.files import output_file, write_json
 
     out = getattr(args, "out", None)
-    try:
+    with refusals(usage=(ValueError,), failures=()):  # LogError, CalibrationError and OutputRefused among them
         if out:
             output_file(out)  # refused before the replay, not after it
         result = _replayed(load(args.file, "log replay"), args.compass)
-    except (CalibrationError, ValueError) as error:  # LogError and OutputRefused among them
-        print(f"quadcosim log replay: {error}", file=sys.stderr)
-        return 2
     if getattr(args, "json", False) is True:
         import json
 
@@ -179,9 +174,6 @@ def run(args) -> int:
     else:
         print(text(result))
     if out:
-        try:
+        with refusals(usage=()):
             write_json(out, result)
-        except OSError as error:
-            print(f"quadcosim log replay: failed: {error}", file=sys.stderr)
-            return 1
     return 0

@@ -1,13 +1,13 @@
-import sys
+"""``python -m quadcosim.studies.sweep``: the same as ``quadcosim sweep``."""
 
-from quadcosim.infra.interrupts import exit_code, leave  # the standard library alone: no window before the try
+from quadcosim.infra.command import Command, program  # the standard library alone: no window before the try
+
+
+def _sweep() -> int:
+    from quadcosim.studies.sweep.command import main  # Ctrl-C while the packages load: nothing started
+
+    return main()
+
 
 if __name__ == "__main__":
-    try:
-        from quadcosim.studies.sweep.command import main
-
-        code = main()
-    except KeyboardInterrupt as interrupt:  # Ctrl-C while the packages load: nothing started, nothing to keep
-        print("quadcosim sweep: interrupted", file=sys.stderr)
-        code = exit_code(interrupt)
-    leave(code)
+    program(Command("quadcosim sweep").run, _sweep)  # Ctrl-C while the packages load: said, 130

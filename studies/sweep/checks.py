@@ -16,11 +16,13 @@ import math
 
 from quadcosim.studies.sweep.grid import ChainedMembers, GridMembers, Plan
 
+from quadcosim.infra.errors import UsageError
+
 #: Dimensions with up to this many values are probed value by value.
 PROBED_VALUES = 32
 
 
-class MemberRefused(ValueError):
+class MemberRefused(UsageError, ValueError):
     """A member of a plan would fail: its label and the reason."""
 
 

@@ -12,8 +12,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import warnings
 from pathlib import Path
+
+from quadcosim.infra.errors import UsageError, refusals
 
 
 def add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -136,7 +137,7 @@ def sweep(args) -> int:
     """
     from quadcosim.studies.sweep import engine, named
 
-    try:
+    with refusals(failures=()):  # SweepError is a ValueError: exit 2
         if args.workers is not None and args.workers < 1:
             raise ValueError(f"--workers {args.workers}: give at least 1")
         if args.workers and args.scheduler:
@@ -160,9 +161,6 @@ def sweep(args) -> int:
                              keep_results=args.results or named.keep_results(plan),
                              progress=False if args.quiet else None,
                              extra_metrics=named.extra_metrics(plan), connect_timeout=args.connect_timeout)
-    except (KeyError, ValueError) as error:  # SweepError is a ValueError
-        print(f"quadcosim sweep {args.scenario}: {error.args[0] if error.args else error}", file=sys.stderr)
-        return 2
     written = named.summarise(plan, args.out, summary)
     print(summary.text())
     if written is not None:  # a named sweep's own tables and checks (lab-matrix's summary.md)
@@ -202,8 +200,12 @@ def sweep_plot(args) -> int:
     """
     from quadcosim.studies.sweep import figure, table
 
-    try:
-        columns = table.read(args.table)
+    with refusals():  # a missing column or a figure path refused: exit 2; a full disk: exit 1, nothing left
+        try:
+            columns = table.read(args.table)
+        except FileNotFoundError as error:
+            raise UsageError(f"no sweep table at {error.filename}: give a sweep folder (--out of quadcosim sweep) "
+                             "or its sweep.parquet / sweep.csv") from None
         source = Path(args.table)
         folder = source if source.is_dir() else source.parent
         safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in f"{args.metric}-vs-{args.x}")
@@ -211,35 +213,24 @@ def sweep_plot(args) -> int:
         path = figure.plot(columns, args.metric, args.x, by=args.by, logy=args.logy,
                            out=args.out or folder / f"{safe}.png", units=units, subtitle=subtitle,
                            components=components)
-    except FileNotFoundError as error:
-        print(f"quadcosim sweep-plot: no sweep table at {error.filename}: give a sweep folder (--out of "
-              "quadcosim sweep) or its sweep.parquet / sweep.csv", file=sys.stderr)
-        return 2
-    except (KeyError, ValueError) as error:
-        print(f"quadcosim sweep-plot: {error.args[0] if error.args else error}", file=sys.stderr)
-        return 2
-    except OSError as error:  # a full disk: named, nothing left under the figure's name
-        print(f"quadcosim sweep-plot: failed: {error}", file=sys.stderr)
-        return 1
     print(path)
     return 0
 
 
 def main(argv=None) -> int:
-    """``python -m quadcosim.studies.sweep``: the same as ``quadcosim sweep``; returns its exit code.
-    ``argv``: the arguments (default ``sys.argv[1:]``)."""
-    from quadcosim.infra.interrupts import exit_code, terminate_as_interrupt
+    """``python -m quadcosim.studies.sweep``: the same parser and work as ``quadcosim sweep``;
+    returns its exit code, its errors printed (2 when refused).
 
-    def one_line(message, category, filename, lineno, file=None, line=None):  # as quadcosim prints warnings
-        print(f"quadcosim sweep: warning: {' '.join(str(message).split())}", file=sys.stderr)
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    """
+    from quadcosim.infra.command import Command
 
-    try:
-        with terminate_as_interrupt(), warnings.catch_warnings():
-            warnings.simplefilter("default")
-            warnings.showwarning = one_line
-            p = add_arguments(argparse.ArgumentParser(prog="python -m quadcosim.studies.sweep", description=__doc__,
-                                                      formatter_class=argparse.RawDescriptionHelpFormatter))
-            return sweep(p.parse_args(argv))
-    except KeyboardInterrupt as interrupt:  # while loading or planning: nothing to keep yet
-        print("quadcosim sweep: interrupted", file=sys.stderr)
-        return exit_code(interrupt)
+    def parsed_and_run(argv):
+        p = add_arguments(argparse.ArgumentParser(prog="python -m quadcosim.studies.sweep", description=__doc__,
+                                                  formatter_class=argparse.RawDescriptionHelpFormatter))
+        return sweep(p.parse_args(argv))
+
+    return Command("quadcosim sweep").run(parsed_and_run, argv)

@@ -41,6 +41,7 @@ from distributed import WorkerPlugin
 from quadcosim.studies.sweep import table
 from quadcosim.studies.sweep.grid import Member, Plan, stored_members
 
+from quadcosim.infra.errors import UsageError
 from quadcosim.infra.files import atomic_path, write_text
 
 #: Keys of a scenario's metrics that are not metrics of a member.
@@ -52,7 +53,7 @@ _members_run = 0  # members run by this process (reported by worker_state)
 IN_FLIGHT_PER_WORKER, IN_FLIGHT_LEAST = 16, 32
 
 
-class SweepError(ValueError):
+class SweepError(UsageError, ValueError):
     """A sweep cannot start: its folder, its plan or its cluster is not what it should be."""
 
 

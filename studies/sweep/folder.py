@@ -16,8 +16,10 @@ import errno
 import os
 from pathlib import Path
 
+from quadcosim.infra.errors import UsageError
 
-class FolderRefused(ValueError):
+
+class FolderRefused(UsageError, ValueError):
     """The sweep's folder or scheduler address is refused; nothing was written. The message names
     the path or address and the fix."""
 

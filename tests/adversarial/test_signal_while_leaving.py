@@ -10,9 +10,9 @@ from conftest import ROOT
 
 LEAVING = """
 import atexit, os, signal
-import quadcosim.main as program
+import quadcosim.cli as program
 
-def finished():  # the command's work done; the signal arrives while the process exits
+def finished(argv=None):  # the command's work done; the signal arrives while the process exits
     atexit.register(lambda: os.kill(os.getpid(), signal.{name}))
     return 0
 
