@@ -126,7 +126,18 @@ def test_seeds_come_from_the_node_id():
     assert seed_of("tests/test_mine.py::test_hover[0]") == seed_of("tests/test_mine.py::test_hover[0]")
 
 
-def test_the_guide_example_runs_as_written(pytester):
+@pytest.fixture
+def numba_loaded():
+    """numba's lazily loaded registries (its polynomial types), loaded before pytester's snapshot of
+    the modules: the guide's run is in this process, pytester drops the modules it imported when it
+    ends, and the next test that compiles would register them a second time ("duplicate
+    registration")."""
+    from numba.core.registry import cpu_target
+
+    cpu_target.target_context.refresh()
+
+
+def test_the_guide_example_runs_as_written(numba_loaded, pytester):
     """docs/guides/examples/test_my_work.py, the slow test deselected as the guide shows."""
     pytester.makepyfile(test_my_work=EXAMPLE.read_text())
     result = pytester.runpytest("-p", "no:cacheprovider", "-m", "not slow")
