@@ -23,6 +23,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from quadcosim.infra.errors import UsageError
+
 #: The entry-point group of the autopilots.
 GROUP = "quadcosim.autopilots"
 #: How many of a file's first bytes a format's detection is given.
@@ -136,7 +138,7 @@ class Autopilot:
     parameter_line: Callable[[str], tuple[str, str]] | None = None
 
 
-class UnknownAutopilot(KeyError):
+class UnknownAutopilot(UsageError, KeyError):
     """A name no installed package registers as an autopilot."""
 
     def __str__(self) -> str:
