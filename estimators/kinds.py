@@ -140,18 +140,7 @@ def registry() -> dict[str, Kind]:
     """
     lines = members.registered(GROUP)
     if _loaded.get("lines") is not lines:
-        found = {}
-        for name, (value, owner) in lines.items():
-            try:
-                kind = members.load(value)
-            except (ImportError, AttributeError) as error:
-                raise EstimatorRegistrationError(f"{GROUP} {name} = {value!r} (registered by {owner}) cannot be "
-                                                 f"loaded: {error}") from error
-            if not isinstance(kind, Kind) or kind.name != name:
-                raise EstimatorRegistrationError(
-                    f"{GROUP} {name} = {value!r} (registered by {owner}) names {kind!r}, not the Kind of {name!r}: "
-                    f"point the line at the module's Kind(\"{name}\", ...)")
-            found[name] = kind
+        found = members.loaded(GROUP, Kind, EstimatorRegistrationError)
         _loaded["kinds"] = dict(sorted(found.items(), key=lambda item: (item[1].rank, item[0])))
         _loaded["lines"] = lines
     return _loaded["kinds"]

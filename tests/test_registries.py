@@ -100,7 +100,8 @@ def test_an_estimator_line_that_names_no_kind_is_refused_with_its_fix(tmp_path):
     ''', tmp_path)
     message, is_value_error = found["error"]
     assert is_value_error and "quadcosim.estimators gyro-only = 'dummy_estimator:GyroOnly'" in message
-    assert "registered by dummy-members" in message and "point the line at the module's Kind(\"gyro-only\"" in message
+    assert "registered by dummy-members" in message and "fix the line or the member" in message
+    assert "not a quadcosim.estimators.kinds.Kind named 'gyro-only'" in message
 
 
 def test_a_dummy_calibration_model_is_one_file_and_one_line(tmp_path):

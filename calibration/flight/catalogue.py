@@ -72,19 +72,12 @@ def models() -> dict[str, Model]:
 
     Raises
     ------
-    TypeError
+    quadcosim.infra.members.RegistrationRefused
         A registry line names something that is not a :class:`Model` of the line's own name.
     """
-    from quadcosim.infra.members import load, registered
+    from quadcosim.infra.members import loaded
 
-    found = {}
-    for name, (value, owner) in registered(GROUP).items():
-        model = load(value)
-        if not isinstance(model, Model) or model.name != name:
-            raise TypeError(f"{owner} registers {name} = {value!r} in {GROUP}: not a Model named {name!r} "
-                            "(quadcosim.calibration.flight.catalogue.Model); fix the line or the model")
-        found[name] = model
-    return dict(sorted(found.items(), key=lambda pair: (pair[1].order, pair[0])))
+    return dict(sorted(loaded(GROUP, Model).items(), key=lambda pair: (pair[1].order, pair[0])))
 
 
 def preferred(capable: str) -> tuple[str, ...]:

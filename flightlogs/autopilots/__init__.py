@@ -150,19 +150,12 @@ def registry() -> dict[str, Autopilot]:
 
     Raises
     ------
-    TypeError
+    quadcosim.infra.members.RegistrationRefused
         A registry line names something that is not an :class:`Autopilot` of the line's own name.
     """
-    from quadcosim.infra.members import load, registered
+    from quadcosim.infra.members import loaded
 
-    found = {}
-    for name, (value, owner) in registered(GROUP).items():
-        member = load(value)
-        if not isinstance(member, Autopilot) or member.name != name:
-            raise TypeError(f"{owner} registers {name} = {value!r} in {GROUP}: not an Autopilot named {name!r} "
-                            "(quadcosim.flightlogs.autopilots.Autopilot); fix the line or the member")
-        found[name] = member
-    return found
+    return loaded(GROUP, Autopilot)
 
 
 def of(name: str) -> Autopilot:

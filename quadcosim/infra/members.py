@@ -94,6 +94,47 @@ def load(value: str):
     return loaded
 
 
+class RegistrationRefused(UsageError, TypeError):
+    """A registry line that names no member of its set, or a member of another name."""
+
+
+def loaded(group: str, kind: type, error: type = RegistrationRefused) -> dict:
+    """Every member of ``group``, imported and checked: name -> the object its line names.
+
+    Parameters
+    ----------
+    group : str
+        An entry-point group, one of :data:`GROUPS`' values.
+    kind : type
+        The class every member of the set is an instance of (it has a ``name``).
+    error : type
+        The exception raised for a line that names no ``kind`` of its own name, or that cannot be
+        imported (default :class:`RegistrationRefused`).
+
+    Returns
+    -------
+    dict
+        In the order of :func:`registered`.
+
+    Raises
+    ------
+    RegistrationRefused
+        (or ``error``) A line's module cannot be imported, or names no ``kind`` called as the line.
+    """
+    found = {}
+    for name, (value, owner) in registered(group).items():
+        try:
+            member = load(value)
+        except (ImportError, AttributeError) as failure:
+            raise error(f"{group} {name} = {value!r} (registered by {owner}) cannot be loaded: {failure}") \
+                from failure
+        if not isinstance(member, kind) or getattr(member, "name", None) != name:
+            raise error(f"{group} {name} = {value!r} (registered by {owner}) names {member!r}, not a "
+                        f"{kind.__module__}.{kind.__qualname__} named {name!r}: fix the line or the member")
+        found[name] = member
+    return found
+
+
 def forget() -> None:
     """Read the installed members afresh on the next look-up (after installing a package)."""
     registered.cache_clear()
