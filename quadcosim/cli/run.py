@@ -164,8 +164,9 @@ def _run_reporting(args) -> int:
     from quadcosim import scenarios
     from quadcosim.orchestrator import RunInterrupted, SimulationError
     from quadcosim.orchestrator.fmu_checks import FMURefused
+    from quadcosim.scenarios.output_options import default_folder
 
-    out = Path(args.out) if args.out else _default_out(args.scenario, args.overwrite)
+    out = Path(args.out) if args.out else default_folder(f"run {args.scenario}", args.scenario, args.overwrite)
     formats = [f.strip() for f in args.format.split(",") if f.strip()]
     from quadcosim.scenarios.plant import figure_format
 
@@ -204,21 +205,6 @@ def _run_reporting(args) -> int:
     if metrics.get("status") == "diverged":  # warned above, naming the settings
         raise RunError(f"the run diverged (metrics.json: status diverged); its record and figures are in {out}/")
     return 0
-
-
-def _default_out(scenario: str, overwrite: bool) -> Path:
-    """``results/SCENARIO``, or with earlier results there (and no --overwrite) the next free
-    ``results/SCENARIO-N``, said on standard error: a run never replaces results unasked."""
-    from quadcosim.infra.files import free_folder, holds_results
-
-    base = Path("results") / scenario
-    if overwrite:
-        return base
-    out = free_folder(base)
-    if out != base:
-        print(f"quadcosim run {scenario}: {base}/ holds earlier results ({', '.join(holds_results(base))}); "
-              f"writing to {out}/ (--out DIR chooses the folder, --overwrite replaces {base}/)", file=sys.stderr)
-    return out
 
 
 def _print_warnings(warnings: dict, shown: int = 3):
