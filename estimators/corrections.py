@@ -67,6 +67,19 @@ or tunes each:
     A magnetometer rejected (weight under 0.5) for longer than this corrects the heading again at
     half its weight, so that a lasting disturbance bounds the gyro's heading drift; the time
     spent rejected runs back twice as fast while the field is accepted (VQF's choice).
+``mag_new_time`` (s)
+    With ``mag_reference_time``: how long a candidate field must hold to replace a rejected
+    reference (VQF's ``magNewTime``); 0: ``mag_reference_time``.
+``mag_first_time`` (s)
+    With ``mag_reference_time``: the configured field is not the reference; the first field that
+    keeps its own norm and dip for this long is (VQF's ``magNewFirstTime``), and until then the
+    magnetometer corrects the heading at half its weight. A magnetometer whose first seconds are
+    not yet calibrated (a phone's) or read while the attitude is still converging gives no
+    reference.
+``heading_angle`` (0 or 1), explicit filter with ``heading_level``
+    The heading correction is ``k2 psi``, the angle itself, not ``k2 sin(psi)``: an error near
+    180 deg (a first heading taken from a magnetometer not yet calibrated) is corrected at full
+    rate instead of lingering where the sine vanishes (VQF corrects by the angle too).
 
 """
 
@@ -84,7 +97,9 @@ from quadcosim.estimators.layout import (
     FIELD_REF,
     GYRO_LP,
     MAG_DIP_TOL,
+    MAG_FIRST_TIME,
     MAG_NEW_MIN_GYRO,
+    MAG_NEW_TIME,
     MAG_NORM_TOL,
     MAG_REF_TIME,
     MAG_REJECTION_TIME,
@@ -120,12 +135,15 @@ CORRECTIONS = {
     "mag_new_min_gyro": math.radians(20.0),  # rad/s
     "mag_rejection_time": 60.0,  # s
     "correct_at_sample": 1.0,
+    "mag_new_time": 20.0,  # s
+    "mag_first_time": 5.0,  # s
+    "heading_angle": 1.0,
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 #: The corrections added for the explicit filter after the passive filter was tuned (off in the passive filter's
 #: defaults).
 NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time",
-                    "correct_at_sample")
+                    "correct_at_sample", "mag_new_time", "mag_first_time", "heading_angle")
 
 
 def chosen(corrections, defaults: dict | None) -> dict:
@@ -255,17 +273,21 @@ def _field_weight(norm, dip, reference_norm, reference_dip, gains):
 def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
     """Magnetic reference tracking, after VQF (Laidig and Seel, 2023): the reference (norm, dip)
     follows the field slowly while the field agrees with it (weight over 0.5); a candidate
-    field that has held its own norm and dip (within the tolerances) for ``mag_reference_time``
-    while the reference is rejected becomes the reference. A short disturbance stays rejected,
-    a lasting new field (an uncompensated motor field, a room's iron) is accepted instead of
-    being rejected for ever. With ``mag_new_min_gyro`` (rad/s) the candidate's time runs only while the
-    low-passed gyro norm reaches it (VQF's test)."""
+    field that has held its own norm and dip (within the tolerances) for ``mag_new_time`` (or
+    ``mag_reference_time``) while the reference is rejected becomes the reference. A short
+    disturbance stays rejected, a lasting new field (an uncompensated motor field, a room's iron)
+    is accepted instead of being rejected for ever. With ``mag_new_min_gyro`` (rad/s) the
+    candidate's time runs only while the low-passed gyro norm reaches it (VQF's test). With
+    ``mag_first_time`` the reference starts unset (norm 0) and is the first candidate that held
+    that long."""
     if first:
-        x[FIELD_REF], x[FIELD_REF + 1] = field, field_dip
+        unset = gains[MAG_FIRST_TIME] > 0.0
+        x[FIELD_REF], x[FIELD_REF + 1] = (0.0, 0.0) if unset else (field, field_dip)
         x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
     span = gains[MAG_REF_TIME]
     k = min(1.0, dt / span)
-    accepted = _field_weight(norm, dip, x[FIELD_REF], x[FIELD_REF + 1], gains) > 0.5
+    unset = x[FIELD_REF] <= 0.0
+    accepted = not unset and _field_weight(norm, dip, x[FIELD_REF], x[FIELD_REF + 1], gains) > 0.5
     if accepted:
         x[FIELD_REF] += k * (norm - x[FIELD_REF])
         x[FIELD_REF + 1] += k * (dip - x[FIELD_REF + 1])
@@ -279,7 +301,11 @@ def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
             x[CANDIDATE_TIME] += dt
     else:
         x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
-    if not accepted and x[CANDIDATE_TIME] >= span:
+    if unset:
+        needed = gains[MAG_FIRST_TIME]
+    else:
+        needed = gains[MAG_NEW_TIME] if gains[MAG_NEW_TIME] > 0.0 else span
+    if not accepted and x[CANDIDATE_TIME] >= needed:
         x[FIELD_REF], x[FIELD_REF + 1] = x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1]
 
 
@@ -311,6 +337,8 @@ def _weights(acc, mag, gains, v_up, v_field, g, field, x, dt, first):
     if gains[MAG_REF_TIME] > 0.0:
         field_dip = _asin(-(v_field[0] * v_up[0] + v_field[1] * v_up[1] + v_field[2] * v_up[2]))
         _track_field(x, nm, _asin(sin_dip), gains, dt, first, field, field_dip)
+        if x[FIELD_REF] <= 0.0:  # no reference yet (mag_first_time): half weight, as after a bounded rejection
+            return acc_weight, REJECTION_SLOWDOWN
         mag_weight = _field_weight(nm, _asin(sin_dip), x[FIELD_REF], x[FIELD_REF + 1], gains)
     else:
         mag_weight = _ramp(nm / field - 1.0, gains[MAG_NORM_TOL])
