@@ -59,6 +59,9 @@ ABLATIONS = {
     "fixed_reference": {"mag_reference_time": 0.0},  # the field of the first second the reference for ever
     "no_separation": {"heading_level": 0.0, "heading_only": 0.0},  # the magnetometer's correction tilts too
     "previous_attitude": {"correct_at_sample": 0.0},  # corrections against the previous sample's attitude
+    "first_second_reference": {"mag_first_time": 0.0},  # the first reference the first second's field
+    "new_field_at_reference_time": {"mag_new_time": 0.0},  # a new field adopted after mag_reference_time
+    "sine_heading": {"heading_angle": 0.0},  # the heading corrected by the sine of its error
 }
 TUNING_RECORDS = Path(__file__).parent / "data"  # the search records of quadcosim.benchmarks.tuning
 
