@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 from quadcosim.estimators.corrections import CORRECTIONS as SETTINGS
 from quadcosim.estimators.kinds import Gain, Kind
-from quadcosim.estimators.layout import HEADING_ANGLE, HEADING_LEVEL, HEADING_ONLY, K1, K2
+from quadcosim.estimators.layout import HEADING_ANGLE, HEADING_LEVEL, HEADING_ONLY, K1, K2, SMALL_ANGLE
 from quadcosim.estimators.quaternions import _cross, _norm, _norm3, _parts
 from quadcosim.fmus import vehicle
 
@@ -113,7 +113,7 @@ def correction(acc, mag, gains, acc_weight, mag_weight, v_up, v_field):
                 u = _cross(h, norms, f, 1.0)
                 sine = _norm(u[0], u[1], u[2])
                 cosine = (h[0] * f[0] + h[1] * f[1] + h[2] * f[2]) / norms
-                if sine > 1e-9:
+                if sine > SMALL_ANGLE:  # below, the angle is its sine
                     scale = math.atan2(sine, cosine) / sine
             c = _cross(h, norms, f, gains[K2] * mag_weight * scale)
             w0, w1, w2 = w0 + c[0], w1 + c[1], w2 + c[2]

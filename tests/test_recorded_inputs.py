@@ -118,7 +118,7 @@ def test_gains_that_make_a_filter_diverge_are_named():
     table = gain_table("explicit", {"kP": [1.0, 2.0]})
     stored = np.zeros((2, 3, 4))
     stored[1, 2, 0] = np.nan
-    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.2, kP = 2"):
+    with pytest.raises(ValueError, match=r"diverged .* gain set 1: k1 = 1, k2 = 0.1, kP = 2"):
         checks.check_finite("explicit", table, stored, np.zeros((2, 6)))
 
 
