@@ -27,7 +27,8 @@ drawn per dataset with the score (``--figures``). The record (``--out``,
 ``benchmarks/data/tuning_KIND.json``) holds the defaults, every fold's values and the sweeps.
 ``--score-folds`` reads the committed records only and scores each fold, on every recording of the
 dataset it held out, against VQF at its defaults and VQF tuned by the same fold
-(:func:`score_folds`): the held-out table.
+(:func:`score_folds`): the held-out table; then, for the fold that loses most, each parameter on
+which it and the defaults differ swapped between them (:func:`swaps`).
 
 Parameters, all physical (:data:`SEARCH`): for ``explicit`` (the recommended filter, corrections
 on), the time constants of inclination, heading and bias (s, :func:`quadcosim.estimators.explicit.explicit_gains`),
@@ -428,6 +429,38 @@ def score_folds(folder, log=print) -> dict:
     return out
 
 
+def swaps(folder, held: str) -> dict:
+    """What makes the fold that held out ``held`` lose there: each parameter on which that fold's values
+    (the committed record's) and the defaults differ, put at the defaults' value in the fold's values,
+    and at the fold's value in the defaults; every recording of ``held``, mean total RMSE over VQF's.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder of the datasets.
+    held : str
+        The held-out dataset.
+
+    Returns
+    -------
+    dict
+        ``{"fold": ratio, "defaults": ratio, "swapped": {parameter: {"into_fold": ratio,
+        "into_defaults": ratio}}}``.
+    """
+    record = json.loads(record_path("explicit").read_text())
+    fold, chosen = record["folds"][held]["values"], record["chosen"]
+    differ = [name for name in fold if fold[name] != chosen[name]]
+    sets = [fold, chosen] + [fold | {n: chosen[n]} for n in differ] + [chosen | {n: fold[n]} for n in differ]
+    recordings = datasets.load(folder, held)
+    gains = filter_gains("explicit", {n: np.array([s[n] for s in sets]) for n in fold})
+    total = np.mean([errors("explicit", data, gains)["total_rmse_deg"] for _, data in recordings], axis=0)
+    ratio = total / _mean_errors("vqf", recordings, None)["total_rmse_deg"]
+    count = len(differ)
+    return {"fold": float(ratio[0]), "defaults": float(ratio[1]),
+            "swapped": {n: {"into_fold": float(ratio[2 + k]), "into_defaults": float(ratio[2 + count + k])}
+                        for k, n in enumerate(differ)}}
+
+
 def main(argv=None) -> int:
     """Command line (see the module docstring); prints the chosen values, returns 0 (2 for a bad
     folder). ``argv``: the arguments (default ``sys.argv[1:]``)."""
@@ -450,6 +483,12 @@ def main(argv=None) -> int:
     if args.score_folds:
         scores = score_folds(args.folder)
         print(fold_table(scores))
+        worst = max(scores, key=lambda held: scores[held]["explicit_over_vqf"])
+        found = swaps(args.folder, worst)
+        print(f"\n{worst}: the fold's values {found['fold']:.2f}, the defaults {found['defaults']:.2f} x VQF; each "
+              "differing parameter at the defaults' value in the fold, at the fold's value in the defaults:")
+        for name, ratios in found["swapped"].items():
+            print(f"  {name}: {ratios['into_fold']:.2f}, {ratios['into_defaults']:.2f}")
         if args.json:
             write_text(args.json, json.dumps(scores, indent=1) + "\n")
         return 0

@@ -89,6 +89,18 @@ def folds(scores: dict) -> list[dict]:
     return out
 
 
+SWAPPED = "iphones"  # the held-out dataset whose fold's loss is taken apart (the worst held-out ratio)
+
+
+def swaps(found: dict) -> list[dict]:
+    """The findings of :func:`quadcosim.benchmarks.tuning.swaps` on :data:`SWAPPED`: the fold's and the defaults'
+    ratio to VQF there, and each differing parameter swapped in either direction."""
+    out = [_entry(f"swaps.{SWAPPED}.{k}", found[k], "1", command=FOLDS) for k in ("fold", "defaults")]
+    for name, ratios in found["swapped"].items():
+        out += [_entry(f"swaps.{SWAPPED}.{name}.{k}", v, "1", command=FOLDS) for k, v in ratios.items()]
+    return out
+
+
 def unreachable() -> list[dict]:
     """The rows of the datasets that cannot be reached now
     (:data:`quadcosim.benchmarks.real_recordings.UNREACHABLE`), as measured in an earlier round and kept in
@@ -152,7 +164,7 @@ def compute(quick: bool = False) -> list[dict]:
                for path in sorted(real_recordings.TUNING_RECORDS.glob("tuning_*.json"))}
     results = real_recordings.evaluate(folder, names=real_recordings.DEVELOPMENT, cache=cache, published=published)
     return (findings(results) + tuning(records) + folds(search.score_folds(folder, log=lambda text: None))
-            + unreachable())
+            + swaps(search.swaps(folder, SWAPPED)) + unreachable())
 
 
 def _deg(value) -> str:

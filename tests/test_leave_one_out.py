@@ -49,3 +49,26 @@ def test_the_search_takes_recordings_spread_over_a_dataset():
     picked = [label for label, _ in tuning.spread(recordings, 4)]
     assert picked == ["r00", "r10", "r19", "r29"]
     assert tuning.spread(recordings, None) == recordings and tuning.spread(recordings[:3], 12) == recordings[:3]
+
+
+def test_swaps_put_each_differing_parameter_of_a_fold_at_the_defaults_value_and_back(tmp_path, monkeypatch):
+    import json
+
+    fold = {"tau_heading": 10.0, "tau_bias": 800.0, "mag_reference_time": 320.0}
+    chosen = {"tau_heading": 10.0, "tau_bias": 100.0, "mag_reference_time": 20.0}
+    record = tmp_path / "tuning_explicit.json"
+    record.write_text(json.dumps({"chosen": chosen, "folds": {"held": {"values": fold}}}))
+    monkeypatch.setattr(tuning, "record_path", lambda kind: record)
+    monkeypatch.setattr(tuning.datasets, "load", lambda folder, name: [("r1", 1.0), ("r2", 3.0)])
+
+    def errors(kind, data, gains):  # a total RMSE that adds each parameter's share: 2 deg for VQF
+        if gains is None:
+            return {"total_rmse_deg": np.array([2.0 * data])}
+        return {"total_rmse_deg": data * (1.0 + gains["tau_bias"] / 100.0 + gains["mag_reference_time"] / 10.0)}
+
+    monkeypatch.setattr(tuning, "errors", errors)
+    found = tuning.swaps(tmp_path, "held")
+    assert set(found["swapped"]) == {"tau_bias", "mag_reference_time"}  # tau_heading does not differ
+    assert found["fold"] == (1 + 8 + 32) / 2 and found["defaults"] == (1 + 1 + 2) / 2
+    assert found["swapped"]["tau_bias"] == {"into_fold": (1 + 1 + 32) / 2, "into_defaults": (1 + 8 + 2) / 2}
+    assert found["swapped"]["mag_reference_time"] == {"into_fold": (1 + 8 + 2) / 2, "into_defaults": (1 + 1 + 32) / 2}
