@@ -429,6 +429,11 @@ def score_folds(folder, log=print) -> dict:
     return out
 
 
+def worst_fold(scores: dict) -> str:
+    """The held-out dataset of :func:`score_folds`' ``scores`` on which the explicit filter loses most to VQF."""
+    return max(scores, key=lambda held: scores[held]["explicit_over_vqf"])
+
+
 def swaps(folder, held: str) -> dict:
     """What makes the fold that held out ``held`` lose there: each parameter on which that fold's values
     (the committed record's) and the defaults differ, put at the defaults' value in the fold's values,
@@ -483,7 +488,7 @@ def main(argv=None) -> int:
     if args.score_folds:
         scores = score_folds(args.folder)
         print(fold_table(scores))
-        worst = max(scores, key=lambda held: scores[held]["explicit_over_vqf"])
+        worst = worst_fold(scores)
         found = swaps(args.folder, worst)
         print(f"\n{worst}: the fold's values {found['fold']:.2f}, the defaults {found['defaults']:.2f} x VQF; each "
               "differing parameter at the defaults' value in the fold, at the fold's value in the defaults:")

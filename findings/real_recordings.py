@@ -89,15 +89,12 @@ def folds(scores: dict) -> list[dict]:
     return out
 
 
-SWAPPED = "iphones"  # the held-out dataset whose fold's loss is taken apart (the worst held-out ratio)
-
-
-def swaps(found: dict) -> list[dict]:
-    """The findings of :func:`quadcosim.benchmarks.tuning.swaps` on :data:`SWAPPED`: the fold's and the defaults'
-    ratio to VQF there, and each differing parameter swapped in either direction."""
-    out = [_entry(f"swaps.{SWAPPED}.{k}", found[k], "1", command=FOLDS) for k in ("fold", "defaults")]
+def swaps(found: dict, held: str) -> list[dict]:
+    """The findings of :func:`quadcosim.benchmarks.tuning.swaps` on the held-out dataset ``held``: the fold's and
+    the defaults' ratio to VQF there, and each differing parameter swapped in either direction."""
+    out = [_entry(f"swaps.{held}.{k}", found[k], "1", command=FOLDS) for k in ("fold", "defaults")]
     for name, ratios in found["swapped"].items():
-        out += [_entry(f"swaps.{SWAPPED}.{name}.{k}", v, "1", command=FOLDS) for k, v in ratios.items()]
+        out += [_entry(f"swaps.{held}.{name}.{k}", v, "1", command=FOLDS) for k, v in ratios.items()]
     return out
 
 
@@ -163,8 +160,10 @@ def compute(quick: bool = False) -> list[dict]:
     records = {path.stem.removeprefix("tuning_"): json.loads(path.read_text())
                for path in sorted(real_recordings.TUNING_RECORDS.glob("tuning_*.json"))}
     results = real_recordings.evaluate(folder, names=real_recordings.DEVELOPMENT, cache=cache, published=published)
-    return (findings(results) + tuning(records) + folds(search.score_folds(folder, log=lambda text: None))
-            + swaps(search.swaps(folder, SWAPPED)) + unreachable())
+    scores = search.score_folds(folder, log=lambda text: None)
+    worst = search.worst_fold(scores)  # the fold whose loss is taken apart
+    return (findings(results) + tuning(records) + folds(scores) + swaps(search.swaps(folder, worst), worst)
+            + unreachable())
 
 
 def _deg(value) -> str:
