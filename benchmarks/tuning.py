@@ -1,6 +1,7 @@
 """Choose the recommended filter's defaults, each dataset in turn held out, and tune VQF the same way.
 
-    python -m quadcosim.benchmarks.tuning DATA [--filter explicit|vqf] [--limit N] [--out FILE] [--figures DIR]
+    python -m quadcosim.benchmarks.tuning DATA [--filter explicit|vqf] [--limit N] [--gyro-bias DEG]
+                                               [--out FILE] [--figures DIR]
     python -m quadcosim.benchmarks.tuning DATA --score-folds [--json FILE]
 
 DATA holds one sub-folder per dataset, as :mod:`quadcosim.benchmarks.datasets` describes; the datasets are
@@ -12,6 +13,12 @@ the mean of the worst dataset's ratio and of the mean ratio. The worst alone wou
 that loses least where it loses most but leaves the parameters that dataset does not care about
 to drift; the mean lets every dataset speak.
 
+Each dataset is scored twice: as recorded, and with a constant gyro bias of :data:`GYRO_BIAS_DEG`
+(1 deg/s, a consumer MEMS gyro's zero-rate offset) added to every recording in a direction drawn
+per recording (:func:`with_gyro_bias`), VQF too; the two count as two datasets in the score. The
+development datasets come from gyros calibrated or nearly bias-free: a search on them alone learns
+the bias slowly, which fails where the gyro is raw (a phone's, as the iPhones').
+
 The search is a compass search on a logarithmic grid: around the current point, each parameter
 alone at ``1/STEP`` and ``STEP`` times its value (2n + 1 gain sets, in one batch call per
 recording) is scored; the search moves to the best when it gains more than :data:`MIN_GAIN` and
@@ -20,8 +27,8 @@ chosen on (the grid is widened, by recentring, until none does).
 
 Leave one dataset out (:func:`leave_one_out`): the search is run once per dataset with that
 dataset held out (:class:`Fold`: it is not read), then once on all of them: the defaults. The
-search reads at most ``--limit`` recordings of each dataset (:data:`LIMIT`, spread over it,
-:func:`spread`), which keeps a search within minutes on two cores. Then each parameter is swept
+search reads every recording of each dataset, or at most ``--limit`` of them (spread over it,
+:func:`spread`). Then each parameter is swept
 alone over ``STEP^-3 .. STEP^3`` times its chosen value, the others held: the sensitivity curves,
 drawn per dataset with the score (``--figures``). The record (``--out``,
 ``benchmarks/data/tuning_KIND.json``) holds the defaults, every fold's values and the sweeps.
@@ -46,6 +53,7 @@ import argparse
 import json
 import sys
 import time
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -57,9 +65,11 @@ from quadcosim.infra.files import save_figure, write_text
 
 STEP = 2.0  # ratio between neighbouring grid values
 SWEEP = 3  # the sensitivity sweeps reach STEP**SWEEP either side of the chosen value
-LIMIT = 12  # recordings of a dataset in the search at most (spread); the held-out folds are scored on all
+LIMIT = None  # recordings of a dataset in the search at most (spread); None: all, as the held-out folds are scored
 MIN_GAIN = 1e-3  # a move must lower the score by more than this; the scores of means over tens of recordings
 # differ by less than this in directions no dataset cares about
+GYRO_BIAS_DEG = 1.0  # deg/s: a consumer MEMS gyro's zero-rate offset; each recording is also scored with one
+BIASED = "+bias"  # the suffix of a dataset's variant scored with the gyro bias
 LAB_FIELD_UT = vehicle.EARTH_FIELD_NORM * 1e6  # µT, the field the norm threshold is stated at
 # parameter: (start, unit, description)
 SEARCH = {
@@ -114,6 +124,30 @@ def spread(recordings: list, limit: int | None) -> list:
     return [recordings[k] for k in np.linspace(0, len(recordings) - 1, limit).round().astype(int)]
 
 
+def with_gyro_bias(dataset: str, label: str, data: dict, bias_deg: float) -> dict:
+    """The recording ``data`` with a constant gyro bias of ``bias_deg`` (deg/s) added, in a direction of the
+    body frame drawn from a generator seeded by ``dataset`` and ``label``: the same for a recording in
+    every search, whatever else is read.
+
+    Parameters
+    ----------
+    dataset, label : str
+        The dataset and the recording's name in it.
+    data : dict
+        The recording, as :mod:`quadcosim.benchmarks.datasets` loads it (``gyro`` in rad/s, body frame).
+    bias_deg : float
+        The bias's norm, deg/s.
+
+    Returns
+    -------
+    dict
+        A copy of ``data`` whose ``gyro`` is offset; the other arrays are shared.
+    """
+    direction = np.random.default_rng(zlib.crc32(f"{dataset}/{label}".encode())).normal(size=3)
+    bias = np.radians(bias_deg) * direction / np.linalg.norm(direction)
+    return data | {"gyro": np.asarray(data["gyro"]) + bias}
+
+
 class Scorer:
     """Mean total, heading and inclination RMSE (deg) of gain sets on datasets, and their total over
     VQF's at its defaults; every gain set is scored once per dataset (kept in ``memo``).
@@ -126,9 +160,12 @@ class Scorer:
         The datasets scored; the development ones by default.
     limit : int, optional
         At most this many recordings of each dataset (:func:`spread`); all by default.
+    gyro_bias_deg : float
+        Each dataset is also scored with this gyro bias added to every recording (deg/s,
+        :func:`with_gyro_bias`; variant ``NAME+bias``); 0: as recorded only.
     """
 
-    def __init__(self, folder, names=DEVELOPMENT, limit: int | None = None):
+    def __init__(self, folder, names=DEVELOPMENT, limit: int | None = None, gyro_bias_deg: float = GYRO_BIAS_DEG):
         self.recordings = {}
         for name in names:
             found = spread(datasets.load(folder, name), limit)
@@ -136,21 +173,34 @@ class Scorer:
                 self.recordings[name] = found
         if not self.recordings:
             raise FileNotFoundError(f"none of the datasets {', '.join(names)} is under {folder}")
+        self.gyro_bias_deg = float(gyro_bias_deg)
+        self.scored = {}  # variant -> recordings: each dataset as recorded and, with a gyro bias, biased
+        for name, found in self.recordings.items():
+            self.scored[name] = found
+            if self.gyro_bias_deg > 0.0:
+                self.scored[name + BIASED] = [(label, with_gyro_bias(name, label, data, self.gyro_bias_deg))
+                                              for label, data in found]
         self.memo = {}
-        self.vqf = {name: self.means("vqf", name, {}) for name in self.recordings}
+        self.vqf = {variant: self.means("vqf", variant, {}) for variant in self.scored}
         self.evaluated = 0
 
-    def means(self, kind: str, name: str, gains: dict) -> dict:
-        """Per metric, the (G,) mean over the recordings of ``name`` of the filter ``kind`` with ``gains``."""
+    def variants(self, name: str) -> list[str]:
+        """The variants of the dataset ``name`` that are scored: as recorded, and with the gyro bias."""
+        return [name] + ([name + BIASED] if name + BIASED in self.scored else [])
+
+    def means(self, kind: str, variant: str, gains: dict) -> dict:
+        """Per metric, the (G,) mean over the recordings of ``variant`` (:meth:`variants`) of the filter ``kind``
+        with ``gains``."""
         if kind == "vqf":
             sets = _sets(gains)
-            rows = [[errors("vqf", data, s) for s in sets] for _, data in self.recordings[name]]
+            rows = [[errors("vqf", data, s) for s in sets] for _, data in self.scored[variant]]
             return {m: np.mean([[r[m][0] for r in row] for row in rows], axis=0) for m in rows[0][0]}
-        rows = [errors(kind, data, filter_gains(kind, gains)) for _, data in self.recordings[name]]
+        rows = [errors(kind, data, filter_gains(kind, gains)) for _, data in self.scored[variant]]
         return {m: np.mean([r[m] for r in rows], axis=0) for m in rows[0]}
 
     def ratios(self, kind: str, gains: dict, names=None) -> dict:
-        """Dataset -> (G,) mean total RMSE over VQF's (defaults); also keeps the means in ``self.last``.
+        """Variant (:meth:`variants`: ``NAME`` and ``NAME+bias``) -> (G,) mean total RMSE over VQF's (defaults,
+        on the same variant); also keeps the means in ``self.last``.
 
         Parameters
         ----------
@@ -159,12 +209,14 @@ class Scorer:
         gains : dict
             Gain name -> (G,) array: G gain sets scored at once; those scored before come from ``memo``.
         names : sequence of str, optional
-            The datasets scored (all of :attr:`recordings` by default); no other is read.
+            The datasets scored, each in all its variants (all of :attr:`recordings` by default); no other is
+            read.
         """
         names = list(self.recordings) if names is None else list(names)
+        variants = [variant for name in names for variant in self.variants(name)]
         sets = _sets(gains)
         self.last = {}
-        for name in names:
+        for name in variants:
             keys = [(kind, name, tuple(sorted(s.items()))) for s in sets]
             todo = [k for k, key in enumerate(keys) if key not in self.memo]
             if todo:
@@ -173,7 +225,7 @@ class Scorer:
                     self.memo[keys[k]] = {m: float(v[j]) for m, v in found.items()}
                 self.evaluated += len(todo)
             self.last[name] = {m: np.array([self.memo[key][m] for key in keys]) for m in self.memo[keys[0]]}
-        return {name: self.last[name]["total_rmse_deg"] / self.vqf[name]["total_rmse_deg"] for name in names}
+        return {name: self.last[name]["total_rmse_deg"] / self.vqf[name]["total_rmse_deg"] for name in variants}
 
 
 class Fold:
@@ -327,8 +379,12 @@ def figures(kind: str, swept: dict, chosen: dict, folder) -> list[Path]:
         _, unit, label = SEARCH[kind][name]
         fig, ax = plt.subplots(figsize=(5.5, 3.6))
         try:
-            for dataset, ratios in found["ratios"].items():
-                ax.plot(found["values"], ratios, marker="o", ms=3, lw=1, label=dataset)
+            colours = {}
+            for variant, ratios in found["ratios"].items():
+                dataset = variant.removesuffix(BIASED)
+                style = {"ls": "--", "marker": "x"} if variant.endswith(BIASED) else {"marker": "o"}
+                line, = ax.plot(found["values"], ratios, ms=3, lw=1, label=variant, color=colours.get(dataset), **style)
+                colours[dataset] = line.get_color()
             ax.plot(found["values"], found["score"], color="k", lw=2.2, label="score")
             ax.axvline(chosen[name], color="0.4", ls="--", lw=1, label=f"chosen {chosen[name]:g} {unit}")
             ax.axhline(1.0, color="0.6", lw=0.8)
@@ -473,7 +529,10 @@ def main(argv=None) -> int:
     parser.add_argument("folder")
     parser.add_argument("--filter", default="explicit", choices=sorted(SEARCH))
     parser.add_argument("--limit", type=int, default=LIMIT,
-                        help=f"at most this many recordings of each dataset in the search (default {LIMIT})")
+                        help="at most this many recordings of each dataset in the search (default: all)")
+    parser.add_argument("--gyro-bias", type=float, default=GYRO_BIAS_DEG,
+                        help=f"each dataset is also scored with a gyro bias of this norm, deg/s "
+                             f"(default {GYRO_BIAS_DEG:g}; 0: as recorded only)")
     parser.add_argument("--out", help="write the search record (JSON) here")
     parser.add_argument("--figures", help="write the sensitivity figures (PNG) into this folder")
     parser.add_argument("--score-folds", action="store_true",
@@ -498,11 +557,12 @@ def main(argv=None) -> int:
             write_text(args.json, json.dumps(scores, indent=1) + "\n")
         return 0
     log = lambda text: print(text, file=sys.stderr, flush=True)  # noqa: E731
-    scorer = Scorer(args.folder, limit=args.limit)
+    scorer = Scorer(args.folder, limit=args.limit, gyro_bias_deg=args.gyro_bias)
     folds = leave_one_out(scorer, args.filter, log=log)
     chosen = search(scorer, args.filter, log=log)
     swept = sweeps(scorer, args.filter, chosen["values"])
     record = {"filter": args.filter, "development": list(scorer.recordings), "step": STEP, "limit": args.limit,
+              "gyro_bias_deg": scorer.gyro_bias_deg,
               "recordings": {n: [label for label, _ in found] for n, found in scorer.recordings.items()},
               "chosen": chosen["values"], "score": chosen["score"], "ratios": chosen["ratios"],
               "means": chosen["means"],

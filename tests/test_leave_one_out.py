@@ -2,6 +2,7 @@
 their scores alone choose; the recordings a search uses are spread over a dataset."""
 
 import numpy as np
+import pytest
 from quadcosim.benchmarks import tuning
 
 # three 'datasets' whose ratio to VQF is a bowl in log2 of the inclination time constant, least at 2, 8 and 32 s
@@ -72,3 +73,32 @@ def test_swaps_put_each_differing_parameter_of_a_fold_at_the_defaults_value_and_
     assert found["fold"] == (1 + 8 + 32) / 2 and found["defaults"] == (1 + 1 + 2) / 2
     assert found["swapped"]["tau_bias"] == {"into_fold": (1 + 1 + 32) / 2, "into_defaults": (1 + 8 + 2) / 2}
     assert found["swapped"]["mag_reference_time"] == {"into_fold": (1 + 8 + 2) / 2, "into_defaults": (1 + 1 + 32) / 2}
+
+
+def test_a_recording_gets_the_same_gyro_bias_of_the_given_norm_in_every_search():
+    data = {"gyro": np.zeros((50, 3)), "acc": np.ones((50, 3))}
+    first = tuning.with_gyro_bias("iphones", "r1", data, 1.0)
+    bias = first["gyro"][0]
+    assert np.degrees(np.linalg.norm(bias)) == pytest.approx(1.0, rel=1e-12)
+    assert np.all(first["gyro"] == bias) and first["acc"] is data["acc"] and not data["gyro"].any()
+    assert np.array_equal(tuning.with_gyro_bias("iphones", "r1", data, 1.0)["gyro"], first["gyro"])
+    others = [tuning.with_gyro_bias(d, r, data, 1.0)["gyro"][0] for d, r in (("iphones", "r2"), ("broad", "r1"))]
+    assert all(np.linalg.norm(o - bias) > 1e-3 for o in others)  # drawn per recording
+
+
+def test_a_fold_scores_its_datasets_as_recorded_and_biased_and_never_the_held_out_one(monkeypatch):
+    monkeypatch.setattr(tuning.datasets, "load", lambda folder, name: [(f"{name}-r", {"gyro": np.zeros((10, 3))})])
+
+    def errors(kind, data, gains):  # an error (deg) of 1 plus the gyro's bias in deg/s, VQF's half of it
+        bias = np.degrees(np.linalg.norm(data["gyro"][0]))
+        count = len(gains["tau_inclination"]) if kind == "explicit" else 1
+        return {"total_rmse_deg": np.full(count, 1.0 + (bias if kind == "explicit" else bias / 2))}
+
+    monkeypatch.setattr(tuning, "errors", errors)
+    scorer = tuning.Scorer("data", names=("one", "two", "three"), gyro_bias_deg=2.0)
+    assert list(scorer.scored) == ["one", "one+bias", "two", "two+bias", "three", "three+bias"]
+    found = tuning.Fold(scorer, ["one", "two"]).ratios("explicit", {"tau_inclination": np.array([1.0, 2.0])})
+    assert set(found) == {"one", "one+bias", "two", "two+bias"}
+    assert np.allclose(found["one"], 1.0) and np.allclose(found["two+bias"], 3.0 / 2.0)
+    plain = tuning.Scorer("data", names=("one",), gyro_bias_deg=0.0)
+    assert list(plain.scored) == ["one"]
