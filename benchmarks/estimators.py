@@ -35,7 +35,7 @@ _C_SLOTS = ("ACC", "GYRO", "MAG", "INPUT_SIZE", "GRAVITY", "FIELD", "DISCRETE", 
 # corrections benchmarks/c/batch_explicit.c does not transcribe: off in its case
 _NOT_IN_C = ("acc_lowpass", "mag_lowpass", "mag_reference_time", "bias_clip", "heading_level", "rest_deviation",
              "mag_new_min_gyro", "mag_rejection_time", "correct_at_sample", "mag_new_time", "mag_first_time",
-             "heading_angle")
+             "heading_angle", "mag_scale_time")
 
 
 def _batch_case(gain_sets: int, samples: int, discretisation: str) -> dict:

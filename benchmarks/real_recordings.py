@@ -62,6 +62,7 @@ ABLATIONS = {
     "first_second_reference": {"mag_first_time": 0.0},  # the first reference the first second's field
     "new_field_at_reference_time": {"mag_new_time": 0.0},  # a new field adopted after mag_reference_time
     "sine_heading": {"heading_angle": 0.0},  # the heading corrected by the sine of its error
+    "no_scale_change": {"mag_scale_time": 0.0},  # a field that only changed its norm waits mag_new_time too
 }
 TUNING_RECORDS = Path(__file__).parent / "data"  # the search records of quadcosim.benchmarks.tuning
 

@@ -76,6 +76,11 @@ or tunes each:
     magnetometer corrects the heading at half its weight. A magnetometer whose first seconds are
     not yet calibrated (a phone's) or read while the attitude is still converging gives no
     reference.
+``mag_scale_time`` (s)
+    With ``mag_reference_time``: a candidate field whose dip agrees with the rejected reference's
+    (within half ``mag_dip_tolerance``: only its norm moved, as when a phone recalibrates its
+    magnetometer's scale while recording) replaces the reference after this long instead of
+    ``mag_new_time``.
 ``heading_angle`` (0 or 1), explicit filter with ``heading_level``
     The heading correction is ``k2 psi``, the angle itself, not ``k2 sin(psi)``: an error near
     180 deg (a first heading taken from a magnetometer not yet calibrated) is corrected at full
@@ -103,6 +108,7 @@ from quadcosim.estimators.layout import (
     MAG_NORM_TOL,
     MAG_REF_TIME,
     MAG_REJECTION_TIME,
+    MAG_SCALE_TIME,
     REJECTION_RECOVERY,
     REJECTION_SLOWDOWN,
     REJECTION_TIME,
@@ -138,12 +144,13 @@ CORRECTIONS = {
     "mag_new_time": 20.0,  # s
     "mag_first_time": 5.0,  # s
     "heading_angle": 1.0,
+    "mag_scale_time": 5.0,  # s
 }
 CORRECTIONS_OFF = dict.fromkeys(CORRECTIONS, 0.0)
 #: The corrections added for the explicit filter after the passive filter was tuned (off in the passive filter's
 #: defaults).
 NEW_FOR_EXPLICIT = ("heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time",
-                    "correct_at_sample", "mag_new_time", "mag_first_time", "heading_angle")
+                    "correct_at_sample", "mag_new_time", "mag_first_time", "heading_angle", "mag_scale_time")
 
 
 def chosen(corrections, defaults: dict | None) -> dict:
@@ -305,6 +312,9 @@ def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
         needed = gains[MAG_FIRST_TIME]
     else:
         needed = gains[MAG_NEW_TIME] if gains[MAG_NEW_TIME] > 0.0 else span
+        if gains[MAG_SCALE_TIME] > 0.0 and _ramp(x[FIELD_CANDIDATE + 1] - x[FIELD_REF + 1], gains[MAG_DIP_TOL]) > 0.5:
+            # the candidate keeps the reference's dip: only the norm moved, a magnetometer's scale recalibrated
+            needed = min(needed, gains[MAG_SCALE_TIME])
     if not accepted and x[CANDIDATE_TIME] >= needed:
         x[FIELD_REF], x[FIELD_REF + 1] = x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1]
 

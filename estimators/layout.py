@@ -56,7 +56,7 @@ GAIN_NAMES = ("k1", "k2", "k3", "kP", "kI", "heading_only", "acc_tolerance", "ma
               "mag_dip_tolerance", "rest_gyro", "rest_acc", "rest_time", "rest_gain",
               "acc_lowpass", "mag_lowpass", "mag_reference_time", "bias_clip", "heading_level", "rest_deviation",
               "mag_new_min_gyro", "mag_rejection_time", "correct_at_sample",
-              "mag_new_time", "mag_first_time", "heading_angle")
+              "mag_new_time", "mag_first_time", "heading_angle", "mag_scale_time")
 GAIN_SLOTS = {name: i for i, name in enumerate(GAIN_NAMES)}
 GAIN_SIZE = len(GAIN_NAMES)
 K1, K2, K3, KP, KI = (GAIN_SLOTS[n] for n in ("k1", "k2", "k3", "kP", "kI"))
@@ -68,8 +68,8 @@ ACC_LOWPASS, MAG_LOWPASS, MAG_REF_TIME, BIAS_CLIP = (GAIN_SLOTS[n] for n in ("ac
                                                                              "mag_reference_time", "bias_clip"))
 HEADING_LEVEL, REST_DEVIATION, MAG_NEW_MIN_GYRO, MAG_REJECTION_TIME, CORRECT_AT_SAMPLE = (GAIN_SLOTS[n] for n in (
     "heading_level", "rest_deviation", "mag_new_min_gyro", "mag_rejection_time", "correct_at_sample"))
-MAG_NEW_TIME, MAG_FIRST_TIME, HEADING_ANGLE = (GAIN_SLOTS[n] for n in ("mag_new_time", "mag_first_time",
-                                                                       "heading_angle"))
+MAG_NEW_TIME, MAG_FIRST_TIME, HEADING_ANGLE, MAG_SCALE_TIME = (GAIN_SLOTS[n] for n in (
+    "mag_new_time", "mag_first_time", "heading_angle", "mag_scale_time"))
 
 REST_LOWPASS_TAU = 0.5  # s, time constant of the low-pass filters of the rest detector
 REJECTION_SLOWDOWN = 0.5  # magnetometer weight once rejected for longer than mag_rejection_time (VQF's factor 2)

@@ -20,7 +20,7 @@ enum { ACC = 0, GYRO = 3, MAG = 6, INPUT_SIZE = 18 };
 enum { GRAVITY = 0, FIELD = 3, DISCRETE = 6 };
 /* gain vector */
 enum { K1 = 0, K2 = 1, KP = 3, KI = 4, HEADING_ONLY = 5, ACC_TOL = 6, MAG_NORM_TOL = 7, MAG_DIP_TOL = 8,
-       REST_GYRO = 9, REST_ACC = 10, REST_MIN_TIME = 11, REST_GAIN = 12, GAIN_SIZE = 25 };
+       REST_GYRO = 9, REST_ACC = 10, REST_MIN_TIME = 11, REST_GAIN = 12, GAIN_SIZE = 26 };
 enum { EULER = 1 };
 #define REST_LOWPASS_TAU 0.5 /* s, as estimators/layout.py */
 
