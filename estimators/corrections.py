@@ -308,6 +308,8 @@ def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
             x[CANDIDATE_TIME] += dt
     else:
         x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1], x[CANDIDATE_TIME] = norm, dip, 0.0
+    if accepted:  # the candidate replaces a rejected (or unset) reference only
+        return
     if unset:
         needed = gains[MAG_FIRST_TIME]
     else:
@@ -315,7 +317,7 @@ def _track_field(x, norm, dip, gains, dt, first, field, field_dip):
         if gains[MAG_SCALE_TIME] > 0.0 and _ramp(x[FIELD_CANDIDATE + 1] - x[FIELD_REF + 1], gains[MAG_DIP_TOL]) > 0.5:
             # the candidate keeps the reference's dip: only the norm moved, a magnetometer's scale recalibrated
             needed = min(needed, gains[MAG_SCALE_TIME])
-    if not accepted and x[CANDIDATE_TIME] >= needed:
+    if x[CANDIDATE_TIME] >= needed:
         x[FIELD_REF], x[FIELD_REF + 1] = x[FIELD_CANDIDATE], x[FIELD_CANDIDATE + 1]
 
 

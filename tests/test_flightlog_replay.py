@@ -33,7 +33,7 @@ def test_the_estimators_run_on_shared_logs_of_every_format(name, compass):
 
 
 INCLINATION_BOUND_DEG = {"explicit": 4.0, "vqf": 3.4}
-# measured up to 6.4, 19.3 and 0.2 deg: the Erle-Brain's reference fused its one compass uncompensated
+# measured up to 6.4, 19.3 and 0.3 deg: the Erle-Brain's reference fused its one compass uncompensated
 HEADING_BOUND_DEG = {QUAD[1]: 7.0, ERLE: 21.0, PX4: 0.5}
 
 
