@@ -156,6 +156,23 @@ def test_a_new_field_is_adopted_only_once_it_has_held_while_turning(turning):
         assert adopted == math.inf and weight.max() == 0.0
 
 
+@pytest.mark.parametrize(("dip_deg", "scale", "expected_s"), [(65.0, True, 5.0), (65.0, 0.0, 7.0), (45.0, True, 7.0)],
+                         ids=["norm moved", "norm moved, rule off", "dip moved too"])
+def test_a_field_whose_norm_alone_moved_is_adopted_after_mag_scale_time(dip_deg, scale, expected_s):
+    # a field 40 % stronger than the reference, rejected: with the reference's dip (a magnetometer rescaled) it is
+    # adopted after mag_scale_time (5 s), with another dip (or the rule off) after mag_new_time (7 s here)
+    data = _still(10.0, field=1.4 * _field(dip_deg))
+    weight = estimate(RECOMMENDED, **data, corrections={"mag_norm_tolerance": True, "mag_dip_tolerance": True,
+                                                        "mag_reference_time": True, "mag_new_time": 7.0,
+                                                        "mag_scale_time": scale},
+                      outputs=("weights",))["weights"][0][:, 1]
+    t = np.arange(1, len(weight) + 1) / RATE
+    adopted = t[np.argmax(weight > 0.5)]
+    print(f"dip {dip_deg} deg, rule {scale}: adopted at {adopted:.2f} s, weight {weight[0]:.2f} then {weight[-1]:.3f}")
+    # after adoption the field is the reference: 1.000, and 0.970 with the other dip (its correction tilts the estimate)
+    assert weight[0] == 0.0 and expected_s - 0.05 < adopted < expected_s + 0.05 and weight[-1] > 0.95
+
+
 def test_a_rejection_longer_than_mag_rejection_time_corrects_at_half_weight():
     data = _still(8.0, field=1.4 * _field(65.0))
     weight = estimate(RECOMMENDED, **data, gains={"mag_rejection_time": 5.0},
